@@ -1,0 +1,39 @@
+# The two commands of the README: `make demo` and `make test`. Both build .venv from scratch
+# with only Python 3.11 on the machine.
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed
+
+.PHONY: demo test tex lint bench clean
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet -e '.[test]'
+	touch $(STAMP)
+
+# pdflatex for the tests that compile every generated .tex (Debian's texlive).
+tex:
+	@command -v pdflatex >/dev/null 2>&1 || { \
+	  SUDO=$$( [ "$$(id -u)" -eq 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends \
+	    texlive-latex-base texlive-latex-recommended texlive-latex-extra >/dev/null; }
+
+demo: $(STAMP) tex
+	$(BIN)/lindstedt demo
+
+test: $(STAMP) tex
+	$(BIN)/ruff check generator tests benchmarks
+	$(BIN)/python -m pytest
+
+lint: $(STAMP)
+	$(BIN)/ruff check generator tests benchmarks
+
+bench: $(STAMP)
+	$(BIN)/python benchmarks/derive.py
+	$(BIN)/python benchmarks/evaluate.py
+
+clean:
+	rm -rf $(VENV) out .pytest_cache

@@ -1,0 +1,117 @@
+"""The ``lindstedt`` command line.  Bad input: one line on stderr, exit status 2."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+
+from . import __version__
+from .errors import InputError
+from .lindstedt import SeriesSolution, derive
+from .models import MODELS, check_order, model_by_name
+
+COST_LIMIT_SECONDS = 60.0
+# NOTE: above this estimate the CLI asks for --force instead of running for minutes or hours.
+
+
+def estimated_seconds(model: str, order: int) -> float:
+    """Wall time of ``derive`` on this 2-core machine, fitted to docs/benchmarks.md.
+
+    Duffing grows like K^3.5 (13.6 s at K = 300); the pendulum, which needs every power
+    u^(2k+1) up to k = K, like K^4.6 (22 s at K = 100).
+    """
+    if model == "pendulum":
+        return 22.0 * (order / 100) ** 4.6
+    return 13.6 * (order / 300) ** 3.5
+
+
+def _rational(c: object) -> str:
+    """Exact ``"p/q"`` (always with a denominator, so scripts can split on '/')."""
+    return f"{int(c.p)}/{int(c.q)}"
+
+
+def series_json(sol: SeriesSolution) -> dict:
+    """The contract of ``lindstedt series MODEL --order K --json`` (keys are stable)."""
+    return {
+        "model": sol.model.name,
+        "order": sol.order,
+        "variable": sol.model.variable,
+        "omega": [_rational(c) for c in sol.omega],
+        "period": [_rational(c) for c in sol.period],
+        "q": [{str(n): _rational(c) for n, c in sorted(qj.items())} for qj in sol.q],
+        "convention": sol.convention,
+        "radius": str(sol.model.radius),
+    }
+
+
+def series_table(sol: SeriesSolution) -> str:
+    """Readable table: ω_j, T_j/2π and the harmonics of q_j per order."""
+    m = sol.model
+    lines = [
+        f"{m.name}: {m.title}, expansion variable {m.variable}, order {sol.order}",
+        f"convention: {sol.convention}",
+        f"{'j':>3}  {'omega_j':>24}  {'(T/2pi)_j':>24}  q_j: harmonic n -> coefficient",
+    ]
+    for j in range(sol.order + 1):
+        harmonics = ", ".join(f"{n}: {_rational(c)}" for n, c in sorted(sol.q[j].items()))
+        lines.append(
+            f"{j:>3}  {_rational(sol.omega[j]):>24}  {_rational(sol.period[j]):>24}  {harmonics}"
+        )
+    return "\n".join(lines)
+
+
+def _cmd_series(args: argparse.Namespace) -> int:
+    order = check_order(args.order)
+    cost = estimated_seconds(args.model, order)
+    if cost > COST_LIMIT_SECONDS and not args.force:
+        raise InputError(
+            f"order {order}: about {cost:,.0f} s of derivation for {args.model} on this machine; "
+            "pass --force to run it"
+        )
+    sol = derive(model_by_name(args.model, order), order)
+    print(json.dumps(series_json(sol)) if args.json else series_table(sol))
+    return 0
+
+
+def _order(text: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"order {text!r}: not an integer") from None
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with the project's one-line errors (no usage dump), exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="lindstedt",
+        description="Exact Lindstedt–Poincaré series for nonlinear oscillators, "
+        "emitted as numba evaluators and LaTeX.",
+    )
+    parser.add_argument("--version", action="version", version=f"lindstedt {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("series", help="derive the L–P series of a free oscillator")
+    p.add_argument("model", choices=MODELS)
+    p.add_argument("--order", type=_order, default=4, help="highest order K (default 4)")
+    p.add_argument("--json", action="store_true", help="print the JSON contract")
+    p.add_argument("--force", action="store_true", help="run even when it would take minutes")
+    p.set_defaults(func=_cmd_series)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except InputError as exc:
+        print(f"lindstedt: error: {exc}", file=sys.stderr)
+        return 2

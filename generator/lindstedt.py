@@ -1,0 +1,274 @@
+"""Lindstedt–Poincaré series of a free oscillator, and the naive expansion it replaces.
+
+With ``s = ωt``, ``ω = Σ ω_j y^j``, ``u = Σ y^j u_j(s)`` (notes §10.3), the ``y^j`` equation is::
+
+    u_j'' + u_j = F_j(s) = -Σ_{a=1..j} W_a u_{j-a}'' - [y^j] Σ_k y^k Σ_n c_kn u^n,
+
+where ``ω² = Σ W_a y^a``, ``W_j = 2ω_j + S_j`` and ``S_j = Σ_{a=1..j-1} ω_a ω_{j-a}``.  ``ω_j``
+enters ``F_j`` only as ``W_j cos s`` (from ``-W_j u_0''``), so the secular condition (no
+``cos s`` in ``F_j``) fixes it.  Amplitude convention of the notes: ``q(0) = A``,
+``q̇(0) = 0``, hence ``u_j(0) = 0`` for ``j ≥ 1`` (the free ``cos s`` of each ``u_j`` is set by
+it; the first-harmonic convention would give other coefficients).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from math import factorial
+from typing import Any
+
+import sympy as sp
+
+from .models import Model, check_order, t
+from .series import Basis, Ground, coefficient, solve_oscillator, to_fourier
+
+CONVENTION = "q(0) = A, q'(0) = 0, so q_j(0) = 0 for j >= 1"
+s = sp.Symbol("s")
+
+
+@dataclass(frozen=True)
+class SeriesSolution:
+    """The L–P series to order K, exact, in the scaled variable ``y`` of the model.
+
+    ``omega[j]`` and ``period[j]`` are the coefficients of ``y^j`` in ``ω`` and ``T/2π``;
+    ``q[j]`` maps harmonic ``n`` to the coefficient of ``y^j · amplitude · cos(n s)``.
+    """
+
+    model: Model
+    order: int
+    ground: Ground
+    omega: tuple
+    period: tuple
+    q: tuple[dict[int, Any], ...]
+    forcing: tuple  # F_j without its W_j cos s term, in the kernel's basis (display only)
+    convention: str = CONVENTION
+
+
+def derive(model: Model, order: int) -> SeriesSolution:
+    """ω₀…ω_K, u₀…u_K and T/2π of ``model`` to order K (notes §10.3, carried to order K)."""
+    order = check_order(order)
+    basis = Basis(model.odd)
+    ground = Ground.for_coefficients(model.coefficients())
+    zero, one = ground.scalar(0), ground.scalar(1)
+    forcing = [[(n, ground.scalar(c)) for n, c in terms] for terms in model.forcing]
+    # u_0 = cos s: one monomial at the resonant index.
+    r = basis.resonant
+    P = [ground.poly([zero] * r + [one])]
+    DP = [P[0] * ground.scalar(-1)]  # u_0'' = -u_0
+    powers = _Powers(P, basis, sorted({n for terms in forcing for n, _ in terms}))
+    omega, W, rests = [one], [one], []
+    for j in range(1, order + 1):
+        powers.extend(j - 1)
+        G = ground.poly([])
+        for k, terms in enumerate(forcing[:j], start=1):
+            for n, c in terms:
+                G = G - powers.term(n, j - k) * c
+        for a in range(1, j):
+            G = G - DP[j - a] * W[a]
+        g = G.coeffs()
+        g = g + [zero] * (r + 1 - len(g))
+        solved = solve_oscillator(g, basis, ground)
+        S = sum((omega[a] * omega[j - a] for a in range(1, j)), zero)
+        Wj = -solved.secular  # the secular condition: [cos s] F_j = secular + W_j = 0
+        W.append(Wj)
+        omega.append((Wj - S) * ground.scalar(Fraction(1, 2)))
+        p = solved.particular
+        p[r] = -sum((c for k, c in enumerate(p) if k != r), zero)  # u_j(0) = 0
+        Pj = ground.poly(p)
+        P.append(Pj)
+        g[r] = g[r] + Wj
+        DP.append(ground.poly(g) - Pj)  # u_j'' = F_j - u_j
+        rests.append(G)
+    period = [one]
+    for j in range(1, order + 1):
+        period.append(-sum((omega[a] * period[j - a] for a in range(1, j + 1)), zero))
+    return SeriesSolution(
+        model=model,
+        order=order,
+        ground=ground,
+        omega=tuple(omega),
+        period=tuple(period),
+        q=tuple(to_fourier(Pj, basis, ground) for Pj in P),
+        forcing=tuple(rests),
+    )
+
+
+class _Powers:
+    """``[y^m] P^n`` for the forcing powers, built order by order from ``P^(n-s)·P^s``."""
+
+    def __init__(self, P: list, basis: Basis, needed: list[int]) -> None:
+        self.P, self.basis = P, basis
+        step = basis.stride  # odd models: only odd powers (and P² as the step)
+        chain = set()
+        for n in needed:
+            while n > 1:
+                chain.add(n)
+                n -= step
+        chain.add(step)
+        self.tables = {n: [] for n in sorted(chain) if n > 1}
+        self.step = step
+
+    def series(self, n: int) -> list:
+        return self.P if n == 1 else self.tables[n]
+
+    def extend(self, m: int) -> None:
+        """Make ``[y^m] P^n`` available for every tracked ``n`` (needs ``P_0..P_m``)."""
+        for n, table in self.tables.items():
+            if len(table) > m:
+                continue
+            if n == 2:
+                acc = _square_coefficient(self.P, m)
+            else:
+                a_series, b_series = self.series(n - self.step), self.series(self.step)
+                acc = a_series[0] * b_series[m]
+                for a in range(1, m + 1):
+                    acc = acc + a_series[a] * b_series[m - a]
+            table.append(acc)
+
+    def term(self, n: int, m: int) -> Any:
+        """``[y^m] u^n / C^parity`` in the kernel's basis."""
+        shift = self.basis.power_shift(n)
+        value = self.series(n)[m]
+        return value.left_shift(shift) if shift else value
+
+
+def _square_coefficient(P: list, m: int) -> Any:
+    """``[y^m] P²`` with half the products (symmetry of the convolution)."""
+    acc = None
+    for a in range((m + 1) // 2):
+        term = P[a] * P[m - a]
+        acc = term if acc is None else acc + term
+    acc = acc * 2 if acc is not None else None
+    if m % 2 == 0:
+        sq = P[m // 2] * P[m // 2]
+        acc = sq if acc is None else acc + sq
+    return acc
+
+
+def omega_coefficients(solution: SeriesSolution) -> list[sp.Expr]:
+    """Physical ``ω_j`` (coefficient of ``coupling^j``): ``ω_j^scaled · order_factor^j``."""
+    m = solution.model
+    return [solution.ground.to_sympy(w) * m.order_factor**j for j, w in enumerate(solution.omega)]
+
+
+def period_series(solution: SeriesSolution) -> sp.Expr:
+    """``T(A) = 2π Σ τ_j y^j`` (notes: ``T ≅ 2π(1 - 3εA²/8 + 57(εA²)²/256)``)."""
+    y = solution.model.y
+    return 2 * sp.pi * sum(
+        solution.ground.to_sympy(c) * y**j for j, c in enumerate(solution.period)
+    )
+
+
+def q_expression(solution: SeriesSolution, j: int, var: sp.Symbol = s) -> sp.Expr:
+    """Physical ``q_j(s)``, the coefficient of ``coupling^j`` in ``q``."""
+    m = solution.model
+    scale = m.amplitude * m.order_factor**j
+    return scale * sum(
+        solution.ground.to_sympy(c) * sp.cos(n * var) for n, c in sorted(solution.q[j].items())
+    )
+
+
+def solution_expression(solution: SeriesSolution, var: sp.Symbol = t) -> sp.Expr:
+    """``q(t)`` to order K with ``s = ω t`` and ω truncated at the same order."""
+    m = solution.model
+    omega = sum(c * m.coupling**j for j, c in enumerate(omega_coefficients(solution)))
+    return sum(
+        m.coupling**j * q_expression(solution, j, var).subs(var, omega * var)
+        for j in range(solution.order + 1)
+    )
+
+
+@dataclass(frozen=True)
+class OrderEquation:
+    """The ``coupling^j`` equation of §10.3 with its secular condition, as SymPy objects."""
+
+    order: int
+    equation: sp.Eq  # q_j'' + q_j = F_j(s), ω_j left as a symbol
+    secular_condition: sp.Eq  # [cos s] F_j = 0
+    omega: sp.Eq  # ω_j = … (the secular condition solved)
+    solution: sp.Eq  # q_j(s) = …
+
+
+def order_equation(solution: SeriesSolution, j: int) -> OrderEquation:
+    """Order ``j ≥ 1`` as the notes write it: ``q̈_j + q_j = F_j(s)``, secular term, ω_j, q_j."""
+    if not 1 <= j <= solution.order:
+        raise ValueError(f"order {j}: equations exist for 1..{solution.order}")
+    m, g = solution.model, solution.ground
+    basis = Basis(m.odd)
+    scale = m.amplitude * m.order_factor**j
+    omegas = omega_coefficients(solution)
+    omega_j = sp.Symbol(f"omega_{j}")
+    S = sum(omegas[a] * omegas[j - a] for a in range(1, j))
+    rest = {n: g.to_sympy(c) for n, c in to_fourier(solution.forcing[j - 1], basis, g).items()}
+    resonant = sp.expand(rest.pop(1, 0) * scale + m.amplitude * (2 * omega_j + S))
+    F = resonant * sp.cos(s) + sum(scale * c * sp.cos(n * s) for n, c in sorted(rest.items()))
+    qj = sp.Function(f"q_{j}")(s)
+    return OrderEquation(
+        order=j,
+        equation=sp.Eq(qj.diff(s, 2) + qj, F),
+        secular_condition=sp.Eq(resonant, 0),
+        omega=sp.Eq(omega_j, sp.factor(omegas[j])),
+        solution=sp.Eq(qj, q_expression(solution, j)),
+    )
+
+
+@dataclass(frozen=True)
+class NaiveSolution:
+    """Successive approximation ``q = Σ coupling^j q_j(t)`` without frequency strain.
+
+    ``terms[j]`` maps ``(m, n, "cos" | "sin")`` to the coefficient of
+    ``y^j · amplitude · t^m · cos|sin(n t)``; terms with ``m > 0`` are the secular terms.
+    """
+
+    model: Model
+    order: int
+    terms: tuple[dict[tuple[int, int, str], sp.Rational], ...]
+
+
+def naive_expansion(model: Model, order: int) -> NaiveSolution:
+    """The naive series of §10.3 (``q₁ = -A³(3t sin t/8 + (cos t - cos 3t)/32)``).
+
+    Successive approximation with ``q(0) = A``, ``q̇(0) = 0`` has a unique solution at each
+    order, which is the Taylor expansion in ``y`` at fixed ``t`` of the exact solution; the
+    L–P series is that solution with ``s = ωt``.  Expanding ``cos(n(1 + δ)t)`` with
+    ``δ = Σ_{j≥1} ω_j y^j`` in powers of ``y`` therefore gives every ``q_j(t)`` exactly, its
+    secular terms ``t^m cos|sin(nt)`` included.
+    """
+    order = check_order(order)
+    lp = derive(model, order)
+    g = lp.ground
+    delta = [sp.Integer(0)] + [g.to_sympy(w) for w in lp.omega[1:]]
+    # delta_pow[m][i] = [y^i] δ^m
+    delta_pow = [[sp.Integer(1)] + [sp.Integer(0)] * order]
+    for _ in range(order):
+        prev = delta_pow[-1]
+        delta_pow.append(
+            [sum(prev[a] * delta[i - a] for a in range(i + 1)) for i in range(order + 1)]
+        )
+    # d^m/dθ^m cos θ = sign · (cos|sin) θ
+    derivs = [(1, "cos"), (-1, "sin"), (-1, "cos"), (1, "sin")]
+    terms: list[dict] = [{} for _ in range(order + 1)]
+    for i, harmonics in enumerate(lp.q):
+        for n, a in harmonics.items():
+            a = g.to_sympy(a)
+            for mpow in range(order - i + 1):
+                sign, trig = derivs[mpow % 4]
+                weight = sign * a * sp.Integer(n) ** mpow / factorial(mpow)
+                for jj in range(mpow, order - i + 1):
+                    c = weight * delta_pow[mpow][jj]
+                    if c:
+                        key = (mpow, n, trig)
+                        bucket = terms[i + jj]
+                        bucket[key] = bucket.get(key, 0) + c
+    cleaned = tuple({k: v for k, v in sorted(b.items()) if v != 0} for b in terms)
+    return NaiveSolution(model=model, order=order, terms=cleaned)
+
+
+def naive_expression(naive: NaiveSolution, j: int) -> sp.Expr:
+    """Physical naive ``q_j(t)``, coefficient of ``coupling^j``."""
+    m = naive.model
+    trig = {"cos": sp.cos, "sin": sp.sin}
+    return (m.amplitude * m.order_factor**j) * sum(
+        c * t**mp * trig[f](n * t) for (mp, n, f), c in naive.terms[j].items()
+    )

@@ -1,0 +1,255 @@
+"""Exact Fourier-series algebra: the fast kernel of every derivation.
+
+An even (cosine) Fourier sum ``Σ a_n cos(n s)`` is a polynomial in ``C = cos s``
+(``cos n s = T_n(C)``).  The kernel stores it in the monomial basis of ``C``, which
+turns every product of Fourier sums into a plain polynomial product, done by FLINT
+(python-flint ``fmpq_poly``) in C on exact rationals.  For forces made of odd powers the
+sums hold odd harmonics only, ``u = C · P(C²)``, and the kernel works with ``P`` in
+``v = C²``: a quarter of the length of the Laurent polynomial in ``z = e^{is}``.
+``docs/benchmarks.md`` records the representations that were measured against it.
+
+Coefficients stay exact: rationals (FLINT), or, when a parameter is left symbolic,
+elements of a SymPy polynomial domain such as ``QQ[A]`` (:class:`DensePoly`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any
+
+import sympy as sp
+from flint import fmpq, fmpq_poly
+from sympy.polys.densearith import dup_add, dup_mul, dup_mul_ground, dup_neg, dup_sub
+from sympy.polys.domains import QQ
+
+
+@dataclass(frozen=True)
+class Basis:
+    """Monomials ``C^n`` of ``C = cos s`` kept by a series: ``n = parity + stride·k``.
+
+    ``odd=True`` keeps only odd harmonics (``u = C·P(C²)``, index ``k`` ↔ ``n = 2k + 1``);
+    ``odd=False`` keeps all of them (index ``k`` ↔ ``n = k``).
+    """
+
+    odd: bool
+
+    @property
+    def parity(self) -> int:
+        return 1 if self.odd else 0
+
+    @property
+    def stride(self) -> int:
+        return 2 if self.odd else 1
+
+    def harmonic(self, k: int) -> int:
+        """Power of ``C`` (and highest harmonic) carried by index ``k``."""
+        return self.parity + self.stride * k
+
+    @property
+    def resonant(self) -> int:
+        """Index of ``C¹ = cos s``, the harmonic in resonance with ``q'' + q``."""
+        return 0 if self.odd else 1
+
+    @property
+    def step(self) -> int:
+        """Index distance from ``C^n`` to ``C^(n-2)``."""
+        return 2 // self.stride
+
+    def power_shift(self, n: int) -> int:
+        """``u^n = C^parity · v^shift · P^n`` for ``u = C^parity · P(v)``."""
+        return (n - 1) // 2 if self.odd else 0
+
+
+class DensePoly:
+    """Dense univariate polynomial over a SymPy domain (e.g. ``QQ[A]``).
+
+    The same interface as FLINT's ``fmpq_poly`` as far as the kernel uses it: ``+ - *``,
+    ``coeffs()`` (low to high), ``left_shift``, multiplication by a domain element.
+    """
+
+    __slots__ = ("dom", "rep")
+
+    def __init__(self, coeffs: Sequence[Any], dom: Any) -> None:
+        rep = [dom.convert(c) for c in reversed(list(coeffs))]
+        while rep and not rep[0]:
+            rep.pop(0)
+        self.dom, self.rep = dom, rep
+
+    @classmethod
+    def _wrap(cls, rep: list, dom: Any) -> DensePoly:
+        out = cls.__new__(cls)
+        out.dom, out.rep = dom, rep
+        return out
+
+    def coeffs(self) -> list:
+        return self.rep[::-1]
+
+    def left_shift(self, k: int) -> DensePoly:
+        return self._wrap(self.rep + [self.dom.zero] * k if self.rep else [], self.dom)
+
+    def __add__(self, other: DensePoly) -> DensePoly:
+        return self._wrap(dup_add(self.rep, other.rep, self.dom), self.dom)
+
+    def __sub__(self, other: DensePoly) -> DensePoly:
+        return self._wrap(dup_sub(self.rep, other.rep, self.dom), self.dom)
+
+    def __neg__(self) -> DensePoly:
+        return self._wrap(dup_neg(self.rep, self.dom), self.dom)
+
+    def __mul__(self, other: Any) -> DensePoly:
+        if isinstance(other, DensePoly):
+            return self._wrap(dup_mul(self.rep, other.rep, self.dom), self.dom)
+        return self._wrap(dup_mul_ground(self.rep, self.dom.convert(other), self.dom), self.dom)
+
+    __rmul__ = __mul__
+
+
+@dataclass(frozen=True)
+class Ground:
+    """The exact coefficient ring of a derivation and its polynomial type."""
+
+    domain: Any  # a SymPy domain: QQ, or QQ[params] for symbolic coefficients
+
+    @property
+    def is_rational(self) -> bool:
+        return self.domain == QQ
+
+    def scalar(self, value: Any) -> Any:
+        """An exact ring element from an int, Fraction, SymPy number or expression."""
+        if self.is_rational:
+            r = sp.Rational(value)
+            return fmpq(int(r.p), int(r.q))
+        return self.domain.from_sympy(sp.sympify(value))
+
+    def poly(self, coeffs: Sequence[Any]) -> Any:
+        """Polynomial from coefficients listed low to high."""
+        return fmpq_poly(list(coeffs)) if self.is_rational else DensePoly(coeffs, self.domain)
+
+    def to_sympy(self, c: Any) -> sp.Expr:
+        if self.is_rational:
+            return sp.Rational(int(c.p), int(c.q))
+        return self.domain.to_sympy(c)
+
+    def to_fraction(self, c: Any) -> Fraction:
+        if not self.is_rational:
+            raise TypeError("coefficients with symbolic parameters have no Fraction value")
+        return Fraction(int(c.p), int(c.q))
+
+    @staticmethod
+    def for_coefficients(values: Sequence[sp.Expr]) -> Ground:
+        """QQ when every value is rational, else ``QQ[free symbols]`` (sorted by name)."""
+        symbols = sorted(set().union(*(sp.sympify(v).free_symbols for v in values)), key=str)
+        return Ground(QQ.poly_ring(*symbols)) if symbols else Ground(QQ)
+
+
+def coefficient(poly: Any, k: int, ground: Ground) -> Any:
+    """Coefficient of ``v^k`` (zero beyond the degree)."""
+    cs = poly.coeffs()
+    return cs[k] if k < len(cs) else ground.scalar(0)
+
+
+@dataclass(frozen=True)
+class Solved:
+    """Result of solving ``u'' + u = G`` in the kernel's basis (see :func:`solve_oscillator`)."""
+
+    particular: list  # coefficients of the particular solution, resonant index left at zero
+    secular: Any  # Fourier coefficient of cos s in G: must vanish for a periodic solution
+
+
+def solve_oscillator(g: Sequence[Any], basis: Basis, ground: Ground) -> Solved:
+    """Particular periodic solution of ``u'' + u = G(s)`` and the secular part of ``G``.
+
+    In the monomial basis ``(d²/ds² + 1) C^n = (1 - n²) C^n + n(n-1) C^(n-2)`` is triangular,
+    so back-substitution from the top degree solves it: the Fourier route's
+    ``c cos ns / (1 - n²)`` without leaving the basis.  The row of ``C¹`` has a zero pivot;
+    what remains in it is the Fourier coefficient of ``cos s`` in ``G`` (the resonant,
+    secular forcing), returned separately.
+    """
+    top = len(g) - 1
+    p = [ground.scalar(0)] * (top + 1)
+    zero = ground.scalar(0)
+    step = basis.step
+    r = basis.resonant
+    secular = zero
+    for k in range(top, -1, -1):
+        above = k + step
+        rhs = g[k]
+        if above <= top:
+            n_above = basis.harmonic(above)
+            rhs = rhs - p[above] * (n_above * (n_above - 1))
+        if k == r:
+            secular = rhs
+            continue
+        n = basis.harmonic(k)
+        p[k] = rhs * ground.scalar(Fraction(1, 1 - n * n))
+    return Solved(p, secular)
+
+
+def second_derivative(poly: Any, basis: Basis, ground: Ground) -> Any:
+    """``d²/ds²`` of ``C^parity · P(v)`` divided by ``C^parity`` (same basis)."""
+    cs = poly.coeffs()
+    out = [ground.scalar(0)] * len(cs)
+    for k, c in enumerate(cs):
+        n = basis.harmonic(k)
+        out[k] = out[k] + c * (-n * n)
+        if n >= 2:
+            out[k - basis.step] = out[k - basis.step] + c * (n * (n - 1))
+    return ground.poly(out)
+
+
+def to_fourier(poly: Any, basis: Basis, ground: Ground) -> dict[int, Any]:
+    """Fourier cosine coefficients ``{n: a_n}`` of ``C^parity · P(v)``.
+
+    Horner's rule in ``z = e^{is}`` with ``z·C = (z² + 1)/2``: ``z^D · u`` is a polynomial in
+    ``z`` whose coefficient of ``z^(D+n)`` is ``a_n / 2`` (``a_0`` itself for ``n = 0``).
+    """
+    cs = poly.coeffs()
+    if not cs:
+        return {}
+    half = ground.scalar(Fraction(1, 2))
+    zc = ground.poly([half, ground.scalar(0), half])
+    w = zc if basis.stride == 1 else zc * zc
+    top = len(cs) - 1
+    acc = ground.poly([cs[top]])
+    for k in range(top - 1, -1, -1):
+        acc = acc * w + ground.poly([cs[k]]).left_shift(basis.stride * (top - k))
+    if basis.parity:
+        acc = acc * zc
+    degree = basis.harmonic(top)
+    z = acc.coeffs()
+    out = {}
+    for n in range(degree, -1, -1):
+        c = z[degree + n] if degree + n < len(z) else ground.scalar(0)
+        if n:
+            c = c * 2
+        if c:
+            out[n] = c
+    return out
+
+
+def from_fourier(coeffs: dict[int, Any], basis: Basis, ground: Ground) -> Any:
+    """Inverse of :func:`to_fourier`: ``Σ a_n cos(ns)`` in the monomial basis.
+
+    Raises ``ValueError`` for a harmonic the basis cannot hold (an even one in the odd basis).
+    """
+    if not coeffs:
+        return ground.poly([])
+    top = max(coeffs)
+    if any(basis.odd and n % 2 == 0 for n in coeffs):
+        raise ValueError(f"harmonics {sorted(coeffs)}: the odd basis holds odd harmonics only")
+    # Chebyshev recurrence on monomial coefficient lists: T_{n+1} = 2 C T_n - T_{n-1}.
+    cheb = [[1], [0, 1]]
+    for _ in range(2, top + 1):
+        a, b = cheb[-1], cheb[-2]
+        nxt = [0] + [2 * x for x in a]
+        for i, x in enumerate(b):
+            nxt[i] -= x
+        cheb.append(nxt)
+    mono = [ground.scalar(0)] * (top + 1)
+    for n, a in coeffs.items():
+        for i, t in enumerate(cheb[n]):
+            if t:
+                mono[i] = mono[i] + a * t
+    return ground.poly(mono[basis.parity :: basis.stride])
