@@ -21,7 +21,7 @@ from typing import Any
 import sympy as sp
 
 from .models import Model, check_order, t
-from .series import Basis, Ground, coefficient, solve_oscillator, to_fourier
+from .series import Basis, Ground, solve_oscillator, to_fourier
 
 CONVENTION = "q(0) = A, q'(0) = 0, so q_j(0) = 0 for j >= 1"
 s = sp.Symbol("s")
