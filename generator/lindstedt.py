@@ -180,6 +180,38 @@ def solution_expression(solution: SeriesSolution, var: sp.Symbol = t) -> sp.Expr
 
 
 @dataclass(frozen=True)
+class OrderTerms:
+    """Order ``j`` of §10.3 in exact scaled numbers (factor ``amplitude · order_factor^j``).
+
+    ``F_j(s) = (resonant + 2ω_j) cos s + Σ_{n≠1} forcing[n] cos ns`` (``ω_j`` scaled), the secular
+    condition ``resonant + 2ω_j = 0``, and the solution ``q_j = Σ q[n] cos ns``.
+    """
+
+    order: int
+    forcing: dict[int, sp.Rational]
+    resonant: sp.Expr
+    omega: sp.Expr
+    q: dict[int, sp.Expr]
+
+
+def order_terms(solution: SeriesSolution, j: int) -> OrderTerms:
+    """The pieces of the ``y^j`` equation, from the kernel's ``F_j`` (Fourier, exact)."""
+    if not 1 <= j <= solution.order:
+        raise ValueError(f"order {j}: equations exist for 1..{solution.order}")
+    g = solution.ground
+    basis = Basis(solution.model.odd)
+    rest = {n: g.to_sympy(c) for n, c in to_fourier(solution.forcing[j - 1], basis, g).items()}
+    S = sum(g.to_sympy(solution.omega[a] * solution.omega[j - a]) for a in range(1, j))
+    return OrderTerms(
+        order=j,
+        forcing={n: c for n, c in sorted(rest.items()) if n != 1},
+        resonant=sp.expand(rest.get(1, 0) + S),
+        omega=g.to_sympy(solution.omega[j]),
+        q={n: g.to_sympy(c) for n, c in sorted(solution.q[j].items())},
+    )
+
+
+@dataclass(frozen=True)
 class OrderEquation:
     """The ``coupling^j`` equation of §10.3 with its secular condition, as SymPy objects."""
 
@@ -192,23 +224,18 @@ class OrderEquation:
 
 def order_equation(solution: SeriesSolution, j: int) -> OrderEquation:
     """Order ``j ≥ 1`` as the notes write it: ``q̈_j + q_j = F_j(s)``, secular term, ω_j, q_j."""
-    if not 1 <= j <= solution.order:
-        raise ValueError(f"order {j}: equations exist for 1..{solution.order}")
-    m, g = solution.model, solution.ground
-    basis = Basis(m.odd)
+    terms = order_terms(solution, j)
+    m = solution.model
     scale = m.amplitude * m.order_factor**j
-    omegas = omega_coefficients(solution)
-    omega_j = sp.Symbol(f"omega_{j}")
-    S = sum(omegas[a] * omegas[j - a] for a in range(1, j))
-    rest = {n: g.to_sympy(c) for n, c in to_fourier(solution.forcing[j - 1], basis, g).items()}
-    resonant = sp.expand(rest.pop(1, 0) * scale + m.amplitude * (2 * omega_j + S))
-    F = resonant * sp.cos(s) + sum(scale * c * sp.cos(n * s) for n, c in sorted(rest.items()))
+    omega_j = sp.Symbol(f"omega_{j}")  # physical ω_j = order_factor^j · scaled ω_j
+    resonant = sp.expand(scale * terms.resonant + 2 * m.amplitude * omega_j)
+    F = resonant * sp.cos(s) + sum(scale * c * sp.cos(n * s) for n, c in terms.forcing.items())
     qj = sp.Function(f"q_{j}")(s)
     return OrderEquation(
         order=j,
         equation=sp.Eq(qj.diff(s, 2) + qj, F),
         secular_condition=sp.Eq(resonant, 0),
-        omega=sp.Eq(omega_j, sp.factor(omegas[j])),
+        omega=sp.Eq(omega_j, sp.factor(terms.omega * m.order_factor**j)),
         solution=sp.Eq(qj, q_expression(solution, j)),
     )
 

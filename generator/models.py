@@ -19,6 +19,7 @@ import sympy as sp
 from .errors import InputError
 
 t, eps, A, theta0 = sp.symbols("t epsilon A theta_0")
+Y = sp.Symbol("Y")  # stands for the expansion variable y in conditions
 
 
 @dataclass(frozen=True)
@@ -27,6 +28,7 @@ class Model:
 
     name: str
     title: str  # the equation of motion in plain text
+    latex: str  # the equation of motion in LaTeX
     equation: sp.Eq  # the physical equation of motion, for display
     coordinate: sp.Symbol  # q or θ
     amplitude: sp.Symbol  # A or θ₀ (q(0) = amplitude, q̇(0) = 0)
@@ -35,6 +37,8 @@ class Model:
     variable: str  # the expansion variable as the JSON contract names it
     forcing: tuple[tuple[tuple[int, sp.Expr], ...], ...]
     radius: sp.Expr | None  # radius of convergence of ω(y), T(y) in |y| (None: unknown)
+    parameters: tuple[tuple[str, sp.Symbol], ...] = ()  # argument name -> symbol, in order
+    orbit_condition: sp.Basic = sp.true  # in the symbol Y = y: a periodic orbit exists
 
     @property
     def odd(self) -> bool:
@@ -55,6 +59,7 @@ def duffing() -> Model:
     return Model(
         name="duffing",
         title="q'' + q + eps*q**3 = 0",
+        latex=r"\ddot q + q + \varepsilon q^3 = 0",
         equation=sp.Eq(sp.Derivative(q, t, 2) + q + eps * q**3, 0),
         coordinate=q,
         amplitude=A,
@@ -63,6 +68,8 @@ def duffing() -> Model:
         variable="x = eps*A**2",
         forcing=(((3, sp.Integer(1)),),),
         radius=sp.Integer(1),
+        parameters=(("A", A), ("eps", eps)),
+        orbit_condition=sp.Gt(Y, -1),  # εA² ≤ -1: the orbit reaches the separatrix
     )
 
 
@@ -82,6 +89,7 @@ def pendulum(order: int) -> Model:
     return Model(
         name="pendulum",
         title="theta'' + sin(theta) = 0",
+        latex=r"\ddot\theta + \sin\theta = 0",
         equation=sp.Eq(sp.Derivative(th, t, 2) + sp.sin(th), 0),
         coordinate=th,
         amplitude=theta0,
@@ -90,6 +98,8 @@ def pendulum(order: int) -> Model:
         variable="theta0**2",
         forcing=forcing,
         radius=sp.pi**2,
+        parameters=(("theta0", theta0),),
+        orbit_condition=sp.Lt(Y, sp.pi**2),  # |θ₀| ≥ π: over the top, no libration
     )
 
 
@@ -123,6 +133,7 @@ def polynomial(coefficients: dict[int, object]) -> Model:
     return Model(
         name="polynomial",
         title=f"q'' + q + eps*({sp.sstr(force)}) = 0",
+        latex=rf"\ddot q + q + \varepsilon\left({sp.latex(force)}\right) = 0",
         equation=sp.Eq(sp.Derivative(q, t, 2) + q + eps * force, 0),
         coordinate=q,
         amplitude=A,
@@ -131,6 +142,8 @@ def polynomial(coefficients: dict[int, object]) -> Model:
         variable=variable,
         forcing=forcing,
         radius=None,
+        parameters=(("A", A), ("eps", eps), *((str(s), s) for s in sorted(
+            set().union(*(sp.sympify(c).free_symbols for _, c in terms)), key=str))),
     )
 
 
