@@ -2,10 +2,14 @@
 
 The pipeline, one module per stage (input -> output)::
 
-    models     oscillator definitions                      -> Model
-    series     exact Fourier-series algebra over QQ / QQ[params] (the fast kernel)
-    lindstedt  L–P series and the naive expansion          Model, order -> SeriesSolution
-    cli        the command line                            arguments -> tables, JSON
+    models     oscillator definitions (frozen dataclasses)           -> Model
+    series     exact Fourier algebra in the monomial basis of cos s  (the fast kernel)
+    lindstedt  L–P series, order-by-order equations, naive expansion Model, order -> SeriesSolution
+    numerics   exact references: elliptic-integral periods, Jacobi cn
+    lower      solutions -> IR records (Evaluator, Module)           Horner, Chebyshev recurrence
+    printers   NumbaPrinter(PythonCodePrinter), LaTeX rationals      Expr -> str
+    emit       strict Jinja2 environments, provenance, atomic writes IR -> files in generated/
+    cli        the command line
 """
 
 __version__ = "0.1.0"

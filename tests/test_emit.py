@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import os
 import shutil
 import subprocess
@@ -17,6 +16,7 @@ import sympy as sp
 from scipy.special import ellipj, ellipk
 
 from generator.emit import TEMPLATES, environment, generate, latex_context, render_module
+from generator.emit import load_generated as load
 from generator.errors import InputError
 from generator.lindstedt import derive, omega_coefficients, period_series, solution_expression
 from generator.lower import lower_free
@@ -26,14 +26,6 @@ from generator.printers import identifier, latex_rational, pycode
 ROOT = Path(__file__).resolve().parent.parent
 GENERATED = ROOT / "generated"
 DEFAULTS = [("duffing", 12), ("pendulum", 12)]
-
-
-def load(path: Path):
-    spec = importlib.util.spec_from_file_location(path.stem + "_under_test", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # numba's cache locates functions by module
-    spec.loader.exec_module(module)
-    return module
 
 
 @pytest.fixture(scope="module")
@@ -71,7 +63,7 @@ def test_templates_get_exactly_the_variables_they_use():
     sol = derive(duffing(), 5)
     module = lower_free(sol, "cmd")
     latex_ctx = set(latex_context(sol, 3)) | {"banner"}
-    module_ctx = {"banner", "doc", "constants", "evaluators"}
+    module_ctx = {"banner", "doc", "constants", "evaluators", "fastmath"}
     for name, env, ctx in [
         ("module.py.j2", environment(False), module_ctx),
         ("tables.tex.j2", environment(True), latex_ctx),
