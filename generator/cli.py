@@ -4,13 +4,17 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import shutil
 import subprocess
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
+
 from . import __version__
+from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
 from .emit import generate, load_generated
 from .errors import InputError
 from .lindstedt import SeriesSolution, derive
@@ -137,6 +141,83 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def driven_json(d: Drive, order: int, harmonics: int) -> dict:
+    """The contract of ``lindstedt driven … --json``: every 1:1 branch, three ways."""
+    from .numerics import shoot
+
+    damped = d.damping > 0
+    top = max(2 * harmonics - 1, 2 * order + 1)
+    branches = []
+    for br in first_order_branches(d):
+        mu = mu_expansion(d, br, order)
+        orders = []
+        for j in range(len(mu.coefficients)):
+            c, phase = mu.partial(j)
+            A, B = amplitudes(c, phase, 2 * j + 1)
+            entry = {"order": j, "A": _keyed(A), "delta": phase}
+            if damped:
+                entry["B"] = _keyed(B)
+            orders.append(entry)
+        hb = harmonic_balance(d, br, harmonics)
+        A, B = amplitudes(hb.coefficients, 0.0, 2 * harmonics - 1)
+        hb_json = {"harmonics": harmonics, "A": _keyed(A), "residual": hb.residual,
+                   "converged": hb.converged}
+        if damped:
+            hb_json["B"] = _keyed(B)
+        guess = np.array([sum(A.values()), d.omega * sum(n * b for n, b in B.items())])
+        orbit = shoot(d.eps, d.force, d.omega, d.damping, guess, harmonics=top)
+        numerical = None
+        if orbit is not None:
+            numerical = {"A": _keyed(orbit.A), "floquet_moduli": sorted(
+                float(abs(m)) for m in orbit.multipliers), "stable": orbit.stable}
+            if damped:
+                numerical["B"] = _keyed(orbit.B)
+        branches.append({
+            "A1": br.A1, "delta0": br.delta0, "mu_expansion": orders,
+            "mu_converged": mu.converged, "mu_note": mu.reason,
+            "harmonic_balance": hb_json, "numerical": numerical,
+        })
+    return {
+        "parameters": {"eps": d.eps, "force": d.force, "omega": d.omega,
+                       "Q": None if math.isinf(d.Q) else d.Q, "order": order,
+                       "harmonics": harmonics},
+        "branches": branches,
+    }
+
+
+def _keyed(values: dict) -> dict:
+    return {str(n): float(v) for n, v in sorted(values.items())}
+
+
+def driven_table(data: dict) -> str:
+    p = data["parameters"]
+    lines = [f"q'' + q'/Q + q + eps q^3 = f cos(w t): eps = {p['eps']}, f = {p['force']}, "
+             f"w = {p['omega']}, Q = {p['Q'] if p['Q'] is not None else 'inf (undamped)'}"]
+    for i, br in enumerate(data["branches"], 1):
+        num = br["numerical"]
+        verdict = "no orbit found" if num is None else ("stable" if num["stable"] else "unstable")
+        lines.append(f"\nbranch {i}: first-order A1 = {br['A1']:.6f} ({verdict})")
+        lines.append(f"{'':>22} {'A1':>12} {'A3':>12} {'A5':>12}")
+        rows = [(f"mu-expansion order {e['order']}", e["A"]) for e in br["mu_expansion"]]
+        rows.append((f"harmonic balance N={br['harmonic_balance']['harmonics']}",
+                     br["harmonic_balance"]["A"]))
+        if num is not None:
+            rows.append(("numerical (shooting)", num["A"]))
+        for label, A in rows:
+            cells = " ".join(f"{A[k]:>12.6f}" if k in A else f"{'':>12}" for k in "135")
+            lines.append(f"{label:>22} {cells}")
+        if not br["mu_converged"]:
+            lines.append(f"  warning: {br['mu_note']}")
+    return "\n".join(lines)
+
+
+def _cmd_driven(args: argparse.Namespace) -> int:
+    d = Drive(args.eps, args.force, args.omega, args.Q)
+    data = driven_json(d, args.order, args.harmonics)
+    print(json.dumps(data) if args.json else driven_table(data))
+    return 0
+
+
 def _order(text: str) -> int:
     try:
         return int(text)
@@ -180,6 +261,17 @@ def build_parser() -> argparse.ArgumentParser:
                    help="evaluate beyond the radius of convergence instead of returning NaN")
     p.add_argument("--force", action="store_true", help="run even when it would take minutes")
     p.set_defaults(func=_cmd_generate)
+
+    p = sub.add_parser("driven", help="steady 1:1 response of the driven Duffing oscillator")
+    p.add_argument("--eps", type=float, required=True)
+    p.add_argument("--force", type=float, required=True)
+    p.add_argument("--omega", type=float, required=True)
+    p.add_argument("--Q", type=float, default=math.inf, help="quality factor (default: undamped)")
+    p.add_argument("--order", type=_order, default=4, help="μ-expansion order K (default 4)")
+    p.add_argument("--harmonics", type=_order, default=4,
+                   help="odd harmonics N of harmonic balance (default 4)")
+    p.add_argument("--json", action="store_true", help="print the JSON contract")
+    p.set_defaults(func=_cmd_driven)
 
     p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults")
     p.add_argument("--out", default="generated", help="output folder (default generated/)")

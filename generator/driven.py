@@ -1,0 +1,302 @@
+"""The driven Duffing oscillator ``q̈ + q̇/Q + q + εq³ = f cos ωt`` (notes §10.4, eq. 10.60).
+
+Two perturbative routes to its steady 1:1 response:
+
+* the μ-expansion with phase (eq. 10.66–10.72): with ``τ = ωt − δ(μ)``,
+  ``q'' + q = μ[(1 − 1/ω²) q − q'/(ωQ) − (ε/ω²) q³ + (f/ω²) cos(τ + δ)]``,
+  ``q = Σ μʲ q_j``, ``δ = Σ μʲ δ_j``.  Order 1's secular conditions give the cubic
+  ``(ω² − 1)A₁ − ¾εA₁³ + f cos δ₀ = 0`` and ``f sin δ₀ = A₁ω/Q``; each later order's fix the
+  constant ``b_j`` of ``q_j = b_j cos τ + …`` and the phase ``δ_j`` (a 2×2 linear system
+  whose determinant vanishes at a fold of the response curve).
+* harmonic balance with N odd harmonics, solved by Newton's method from every root of the
+  one-harmonic equation.
+
+Both work on Fourier sums stored as complex coefficients ``c_n`` of ``e^{inτ}``
+(``q = Σ c_n e^{inτ}``, ``c_{−n} = c̄_n``), where products are exact convolutions.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from .errors import InputError
+
+
+@dataclass(frozen=True)
+class Drive:
+    """Parameters of eq. 10.60; ``Q = inf`` is the undamped oscillator."""
+
+    eps: float
+    force: float
+    omega: float
+    Q: float = math.inf
+
+    def __post_init__(self) -> None:
+        for name in ("eps", "force", "omega", "Q"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise InputError(f"{name} {value!r}: not a number")
+            if math.isnan(value) or (math.isinf(value) and name != "Q"):
+                raise InputError(f"{name} {value!r}: not finite")
+        if self.Q <= 0:
+            raise InputError(f"Q {self.Q}: must be > 0 (Q = inf for no damping)")
+        if self.omega <= 0:
+            raise InputError(f"omega {self.omega}: must be > 0")
+
+    @property
+    def damping(self) -> float:
+        """``1/Q`` (zero when undamped)."""
+        return 0.0 if math.isinf(self.Q) else 1.0 / self.Q
+
+
+# --- Fourier sums as complex coefficient arrays, index n + M --------------------------------
+
+def _product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Coefficients of the product, truncated to the same harmonics ``|n| ≤ M``."""
+    M = (len(a) - 1) // 2
+    return np.convolve(a, b)[M : 3 * M + 1]
+
+
+def _harmonics(M: int) -> np.ndarray:
+    return np.arange(-M, M + 1)
+
+
+def _cos_tau(M: int, amplitude: complex = 1.0) -> np.ndarray:
+    """``amplitude · e^{iτ}/2 + c.c.``: ``A cos τ`` for real A."""
+    out = np.zeros(2 * M + 1, dtype=complex)
+    out[M + 1] = amplitude / 2
+    out[M - 1] = np.conj(amplitude) / 2
+    return out
+
+
+def _secular(F: np.ndarray) -> np.ndarray:
+    """``(cos τ, sin τ)`` coefficients of ``F``: ``2 Re c₁``, ``−2 Im c₁``."""
+    M = (len(F) - 1) // 2
+    return np.array([2 * F[M + 1].real, -2 * F[M + 1].imag])
+
+
+def amplitudes(c: np.ndarray, phase: float, harmonics: int) -> tuple[dict, dict]:
+    """``A_n``, ``B_n`` of ``q(t) = Σ A_n cos nωt + B_n sin nωt`` from ``c_n`` of ``e^{inτ}``,
+    ``τ = ωt − phase``, for odd ``n ≤ harmonics``."""
+    M = (len(c) - 1) // 2
+    A, B = {}, {}
+    for n in range(1, min(harmonics, M) + 1, 2):
+        z = c[M + n] * np.exp(-1j * n * phase)
+        A[n], B[n] = 2 * z.real, -2 * z.imag
+    return A, B
+
+
+# --- first order: the branches --------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Branch:
+    """One root of the first-order secular conditions: ``q₀ = A₁ cos τ``, phase ``δ₀``."""
+
+    A1: float
+    delta0: float
+
+
+def first_order_branches(d: Drive) -> list[Branch]:
+    """All real roots of the secular conditions at order 1, largest ``A₁`` first.
+
+    Undamped: ``(ω² − 1)A₁ − ¾εA₁³ + f = 0`` with ``δ₀ = 0`` (``A₁ < 0`` is the branch in
+    antiphase).  Damped: ``r²[(1 − ω² + ¾εr²)² + ω²/Q²] = f²`` (cubic in ``r²``) with
+    ``f sin δ₀ = rω/Q`` and ``f cos δ₀ = ¾εr³ − (ω² − 1)r``.
+    """
+    w2 = d.omega**2
+    if d.damping == 0:
+        roots = np.roots([-0.75 * d.eps, 0.0, w2 - 1, d.force])
+        real = sorted({float(r.real) for r in roots if abs(r.imag) <= 1e-9 * (1 + abs(r))},
+                      reverse=True)
+        return [Branch(_polish_cubic(d, r), 0.0) for r in real]
+    # u = r²: (9/16)ε² u³ + (3/2)ε(1 − ω²) u² + ((1 − ω²)² + ω²/Q²) u − f² = 0
+    a = 1 - w2
+    roots = np.roots([9 / 16 * d.eps**2, 1.5 * d.eps * a, a * a + w2 * d.damping**2,
+                      -d.force**2])
+    out = []
+    for u in roots:
+        if abs(u.imag) <= 1e-9 * (1 + abs(u)) and u.real > 0:
+            r = math.sqrt(u.real)
+            delta = math.atan2(r * d.omega * d.damping, 0.75 * d.eps * r**3 - (w2 - 1) * r)
+            out.append(Branch(r, delta))
+    return sorted(out, key=lambda b: -b.A1)
+
+
+def _polish_cubic(d: Drive, A: float) -> float:
+    """Two Newton steps on the undamped cubic: roots to full double precision."""
+    for _ in range(3):
+        g = (d.omega**2 - 1) * A - 0.75 * d.eps * A**3 + d.force
+        dg = (d.omega**2 - 1) - 2.25 * d.eps * A**2
+        if dg == 0:
+            break
+        A -= g / dg
+    return A
+
+
+# --- the μ-expansion -------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class MuExpansion:
+    """Orders 0..K of the μ-expansion on one branch (notes' convention: order j is
+    ``q₀ + … + q_j`` with ``b_j`` fixed by the secular conditions at order ``j + 1``)."""
+
+    branch: Branch
+    coefficients: tuple[np.ndarray, ...]  # c_n of q_j, index n + M
+    deltas: tuple[float, ...]
+    determinants: tuple[float, ...]  # of the 2×2 secular system at each order (0 at a fold)
+    converged: bool
+    reason: str
+
+    def partial(self, j: int) -> tuple[np.ndarray, float]:
+        """Coefficients of ``q₀ + … + q_j`` and the phase ``δ₀ + … + δ_j``."""
+        return sum(self.coefficients[: j + 1]), sum(self.deltas[: j + 1])
+
+
+def _forcing(d: Drive, q: list, cubes: list, E: list, delta0: float, j: int) -> np.ndarray:
+    """``F_j`` of eq. 10.68: needs ``q_{j−1}``, ``[μ^{j−1}] q³`` and ``E_{j−1}``."""
+    M = (len(q[0]) - 1) // 2
+    n = _harmonics(M)
+    w2 = d.omega**2
+    prev = q[j - 1]
+    F = (1 - 1 / w2) * prev - d.damping / d.omega * (1j * n * prev) - d.eps / w2 * cubes[j - 1]
+    # [μ^{j−1}] cos(τ + δ) = Re(e^{i(τ+δ₀)} E_{j−1}),  E = exp(i Σ_{k≥1} δ_k μ^k)
+    return F + d.force / w2 * _cos_tau(M, np.exp(1j * delta0) * E[j - 1])
+
+
+def _extend(q: list, squares: list, cubes: list, E: list, deltas: list, m: int) -> None:
+    """Append ``[μ^m]`` of ``q²``, ``q³`` and ``E`` (``m E_m = i Σ k δ_k E_{m−k}``)."""
+    squares.append(sum(_product(q[a], q[m - a]) for a in range(m + 1)))
+    cubes.append(sum(_product(q[a], squares[m - a]) for a in range(m + 1)))
+    E.append(1j * sum(k * deltas[k] * E[m - k] for k in range(1, m + 1)) / m)
+
+
+def mu_expansion(d: Drive, branch: Branch, order: int) -> MuExpansion:
+    """The μ-expansion (eq. 10.66–10.72) to ``order`` on ``branch``, numerically (float64)."""
+    if isinstance(order, bool) or not isinstance(order, int) or not 0 <= order <= 200:
+        raise InputError(f"order {order!r}: must be an integer in 0..200")
+    M = 2 * order + 5
+    n = _harmonics(M)
+    q = [_cos_tau(M, branch.A1)]
+    deltas = [branch.delta0]
+    squares = [_product(q[0], q[0])]
+    cubes = [_product(q[0], squares[0])]
+    E = [1.0 + 0j]
+    dets: list[float] = []
+    resonant = np.abs(n) == 1
+    for j in range(1, order + 1):
+        F = _forcing(d, q, cubes, E, branch.delta0, j)
+        p = np.where(resonant, 0, F / np.where(resonant, 1, 1 - n * n))
+
+        def secular_next(b: float, delta: float, p: np.ndarray = p, j: int = j) -> np.ndarray:
+            """Secular part of F_{j+1} for trial b_j, δ_j (it is affine in both)."""
+            qs, ds = [*q, p + _cos_tau(M, b)], [*deltas, delta]
+            sq, cb, Es = list(squares), list(cubes), list(E)
+            _extend(qs, sq, cb, Es, ds, j)
+            return _secular(_forcing(d, qs, cb, Es, branch.delta0, j + 1))
+
+        s0 = secular_next(0.0, 0.0)
+        J = np.column_stack([secular_next(1.0, 0.0) - s0, secular_next(0.0, 1.0) - s0])
+        det = float(np.linalg.det(J))
+        dets.append(det)
+        if abs(det) < 1e-12 * (1 + d.force + abs(d.eps) * branch.A1**2):
+            return MuExpansion(branch, tuple(q), tuple(deltas), tuple(dets), False,
+                               f"order {j}: singular secular system (a fold: branches merge)")
+        b, delta = np.linalg.solve(J, -s0)
+        q.append(p + _cos_tau(M, b))
+        deltas.append(float(delta))
+        _extend(q, squares, cubes, E, deltas, j)
+    converged, reason = _convergence(q)
+    return MuExpansion(branch, tuple(q), tuple(deltas), tuple(dets), converged, reason)
+
+
+def _convergence(q: list[np.ndarray]) -> tuple[bool, str]:
+    """Judge the series by the size of its last terms (a growing tail is no answer)."""
+    sizes = [float(np.abs(c).sum()) for c in q]
+    if len(sizes) < 4:
+        return True, "too few orders to judge; terms: " + ", ".join(f"{s:.1e}" for s in sizes)
+    tail = sizes[-3:]
+    if tail[-1] > tail[0] and tail[-1] > 1e-14 * sizes[0]:
+        return False, f"terms grow ({tail[0]:.1e} -> {tail[-1]:.1e}): the μ-series diverges here"
+    return True, f"last term {tail[-1]:.1e}"
+
+
+# --- harmonic balance ------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class HarmonicBalance:
+    """Harmonic balance with odd harmonics ``1, 3, …, 2N − 1`` (cos and sin when damped)."""
+
+    harmonics: int
+    coefficients: np.ndarray  # c_n of e^{inωt}, index n + M
+    residual: float
+    converged: bool
+
+
+def harmonic_balance(d: Drive, start: Branch, harmonics: int, tol: float = 1e-13,
+                     max_iter: int = 50) -> HarmonicBalance:
+    """Newton's method on the Galerkin residual of eq. 10.60 (exact: products are
+    convolutions, no aliasing), started from a one-harmonic root."""
+    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 100:
+        raise InputError(f"harmonics {harmonics!r}: must be an integer in 1..100")
+    odd = np.arange(1, 2 * harmonics, 2)
+    M = 3 * (2 * harmonics - 1)
+    n = _harmonics(M)
+    # unknowns: a_k, b_k of q = Σ a_k cos kωt + b_k sin kωt
+    x = np.zeros(2 * len(odd))
+    x[0] = start.A1 * math.cos(start.delta0)
+    x[len(odd)] = start.A1 * math.sin(start.delta0)
+    drive = _cos_tau(M, d.force)
+    lin = -(n * d.omega) ** 2 + 1j * n * d.omega * d.damping + 1
+
+    def coeffs(x: np.ndarray) -> np.ndarray:
+        c = np.zeros(2 * M + 1, dtype=complex)
+        z = (x[: len(odd)] - 1j * x[len(odd):]) / 2
+        c[M + odd] = z
+        c[M - odd] = np.conj(z)
+        return c
+
+    def project(R: np.ndarray) -> np.ndarray:
+        return np.concatenate([2 * R[M + odd].real, -2 * R[M + odd].imag])
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        c = coeffs(x)
+        return project(lin * c + d.eps * _product(c, _product(c, c)) - drive)
+
+    converged = False
+    for _ in range(max_iter):
+        r = residual(x)
+        c = coeffs(x)
+        q2 = _product(c, c)
+        J = np.empty((len(x), len(x)))
+        for k in range(len(x)):
+            e = np.zeros_like(x)
+            e[k] = 1.0
+            dc = coeffs(e)
+            J[:, k] = project(lin * dc + 3 * d.eps * _product(q2, dc))
+        step = np.linalg.solve(J, -r)
+        x = x + step
+        if np.max(np.abs(step)) <= tol * (1 + np.max(np.abs(x))):
+            converged = True
+            break
+    return HarmonicBalance(harmonics, coeffs(x), float(np.max(np.abs(residual(x)))), converged)
+
+
+# --- the first-order secular conditions, symbolically (display, tests) -----------------------
+
+def first_order_secular() -> tuple[sp.Expr, sp.Expr]:
+    """The cos τ and sin τ coefficients of ``ω²F₁(τ)`` (eq. 10.72 with damping), by SymPy.
+
+    ``F₁ = (1 − 1/ω²)q₀ − q₀'/(ωQ) − (ε/ω²)q₀³ + (f/ω²)cos(τ + δ₀)``, ``q₀ = A₁ cos τ``.
+    """
+    tau, A1, w, eps, f, Q, d0 = sp.symbols("tau A_1 omega epsilon f Q delta_0", real=True)
+    q0 = A1 * sp.cos(tau)
+    F1 = (1 - 1 / w**2) * q0 - sp.diff(q0, tau) / (w * Q) - eps / w**2 * q0**3 \
+        + f / w**2 * sp.cos(tau + d0)
+    F1 = sp.expand(w**2 * F1)
+    cos_c = sp.simplify(sp.integrate(F1 * sp.cos(tau), (tau, 0, 2 * sp.pi)) / sp.pi)
+    sin_c = sp.simplify(sp.integrate(F1 * sp.sin(tau), (tau, 0, 2 * sp.pi)) / sp.pi)
+    return sp.expand(cos_c), sp.expand(sin_c)

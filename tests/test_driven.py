@@ -1,0 +1,152 @@
+"""Driven Duffing: the notes' table, harmonic balance against shooting, Floquet closed forms."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from generator.driven import (
+    Drive,
+    amplitudes,
+    first_order_branches,
+    first_order_secular,
+    harmonic_balance,
+    mu_expansion,
+)
+from generator.errors import InputError
+from generator.numerics import shoot
+
+NOTES = Drive(eps=0.1, force=1.0, omega=1.0)
+
+
+def mu_amplitudes(d, order):
+    (br,) = [b for b in first_order_branches(d) if b.A1 > 0][:1]
+    mu = mu_expansion(d, br, order)
+    return [amplitudes(*mu.partial(j), 5)[0] for j in range(order + 1)], mu
+
+
+def test_notes_table_to_its_printed_digits():
+    """Notes §10.4: μ-orders 0, 1, 2 give A₁ ≅ 2.371, 2.357, 2.355; A₃ ≅ 0.0417, 0.0453;
+    A₅ ≅ 0.0007; numerically A₁ = 2.356, A₃ = 0.0456, A₅ = 0.0008."""
+    A, _ = mu_amplitudes(NOTES, 2)
+    assert round(A[0][1], 3) == 2.371
+    assert round(A[1][1], 3) == 2.357 and round(A[1][3], 4) == 0.0417
+    # the notes print 2.355 for 2.35575 (truncated, not rounded): within one unit of the digit
+    assert abs(A[2][1] - 2.355) < 1e-3 and round(A[2][3], 4) == 0.0453
+    assert round(A[2][5], 4) == 0.0007
+    orbit = shoot(0.1, 1.0, 1.0, 0.0, np.array([2.4, 0.0]))
+    assert round(orbit.A[1], 3) == 2.356 and round(orbit.A[3], 4) == 0.0456
+    assert round(orbit.A[5], 4) == 0.0008
+
+
+def test_mu_expansion_error_decreases_with_order():
+    A, mu = mu_amplitudes(NOTES, 8)
+    orbit = shoot(0.1, 1.0, 1.0, 0.0, np.array([2.4, 0.0]))
+    errors = [abs(a[1] - orbit.A[1]) for a in A]
+    assert all(e2 < e1 for e1, e2 in zip(errors[:6], errors[1:7], strict=True))
+    assert errors[8] < 1e-9 and mu.converged
+
+
+@pytest.mark.parametrize("d", [NOTES, Drive(0.1, 0.3, 1.3, Q=20.0), Drive(0.05, 0.5, 0.8, Q=5)])
+def test_harmonic_balance_against_shooting(d):
+    for br in first_order_branches(d):
+        hb = harmonic_balance(d, br, 10)
+        A, B = amplitudes(hb.coefficients, 0.0, 19)
+        guess = np.array([sum(A.values()), d.omega * sum(n * b for n, b in B.items())])
+        orbit = shoot(d.eps, d.force, d.omega, d.damping, guess, harmonics=9)
+        assert orbit is not None and hb.converged
+        for n in (1, 3, 5, 7, 9):
+            assert abs(A[n] - orbit.A[n]) <= 1e-10 and abs(B[n] - orbit.B[n]) <= 1e-10
+
+
+def test_three_branches_and_their_stability():
+    """Inside the hysteresis loop: large and small branches stable, the middle one not."""
+    d = Drive(0.1, 0.3, 1.3, Q=20.0)
+    branches = first_order_branches(d)
+    assert len(branches) == 3
+    verdicts = []
+    for br in branches:
+        hb = harmonic_balance(d, br, 6)
+        A, B = amplitudes(hb.coefficients, 0.0, 11)
+        orbit = shoot(d.eps, d.force, d.omega, d.damping,
+                      np.array([sum(A.values()), d.omega * sum(n * b for n, b in B.items())]))
+        verdicts.append(orbit.stable)
+    assert verdicts == [True, False, True]
+
+
+def test_first_order_cubic_and_damped_amplitude_equation_symbolically():
+    cos_c, sin_c = first_order_secular()
+    A1, w, eps, f, Q, d0 = sp.symbols("A_1 omega epsilon f Q delta_0", real=True)
+    # undamped, δ₀ = 0: the notes' cubic (ω² − 1)A₁ − ¾εA₁³ + f = 0
+    cubic = (w**2 - 1) * A1 - sp.Rational(3, 4) * eps * A1**3 + f
+    assert sp.simplify(cos_c.subs(d0, 0) - cubic) == 0
+    assert sp.simplify(sin_c.subs({Q: sp.oo, d0: 0})) == 0
+    # damped: eliminate δ₀ — each condition gives f cos δ₀, f sin δ₀; square and add (= f²)
+    fcos = sp.expand(f * sp.cos(d0) - cos_c)
+    fsin = sp.expand(sin_c + f * sp.sin(d0))
+    assert not fcos.has(d0) and not fsin.has(d0)
+    r = sp.Symbol("r", positive=True)
+    amp = sp.expand((fcos**2 + fsin**2).subs(A1, r))
+    expected = sp.expand(r**2 * ((1 - w**2 + sp.Rational(3, 4) * eps * r**2) ** 2 + w**2 / Q**2))
+    assert sp.simplify(amp - expected) == 0
+
+
+def test_floquet_multipliers_of_linear_damped_oscillator():
+    """q̈ + q̇/Q + q = f cos ωt: multipliers exp(λ±T), λ± = −1/(2Q) ± i√(1 − 1/(4Q²))."""
+    Q, w = 7.0, 1.3
+    T = 2 * np.pi / w
+    orbit = shoot(0.0, 1.0, w, 1 / Q, np.array([1.0, 0.0]))
+    lam = -1 / (2 * Q) + 1j * math.sqrt(1 - 1 / (4 * Q**2))
+    expected = np.exp(np.array([lam, np.conj(lam)]) * T)
+    got = sorted(orbit.multipliers, key=lambda z: z.imag)
+    np.testing.assert_allclose(got, sorted(expected, key=lambda z: z.imag), atol=1e-12)
+
+
+def test_fold_is_reported_not_summed():
+    """At a fold of the undamped cubic the secular system is singular: say so."""
+    eps, f = 0.1, 1.0
+    # double root of (ω² − 1)A − ¾εA³ + f: (ω² − 1) = (9/4)εA², f = −(3/2)εA³ → A < 0
+    A = -((2 * f) / (3 * eps)) ** (1 / 3)
+    w = math.sqrt(1 + 2.25 * eps * A**2)
+    d = Drive(eps, f, w)
+    br = min(first_order_branches(d), key=lambda b: abs(b.A1 - A))
+    mu = mu_expansion(d, br, 4)
+    assert not mu.converged
+
+
+@pytest.mark.parametrize("kwargs", [dict(eps=float("nan"), force=1, omega=1),
+                                    dict(eps=0.1, force=1, omega=0),
+                                    dict(eps=0.1, force=1, omega=1, Q=-1),
+                                    dict(eps=0.1, force=float("inf"), omega=1)])
+def test_bad_drive(kwargs):
+    with pytest.raises(InputError):
+        Drive(**kwargs)
+
+
+def test_driven_contract():
+    out = subprocess.run(
+        [sys.executable, "-m", "generator", "driven", "--eps", "0.1", "--force", "0.3",
+         "--omega", "1.3", "--Q", "20", "--order", "3", "--harmonics", "5", "--json"],
+        capture_output=True, text=True, check=False)
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert {"parameters", "branches"} <= data.keys()
+    a1 = [b["A1"] for b in data["branches"]]
+    assert a1 == sorted(a1, reverse=True) and len(a1) == 3
+    for br in data["branches"]:
+        assert [e["order"] for e in br["mu_expansion"]] == [0, 1, 2, 3]
+        assert "B" in br["mu_expansion"][0] and "1" in br["mu_expansion"][3]["A"]
+        assert br["harmonic_balance"]["harmonics"] == 5
+        num = br["numerical"]
+        assert set(num) >= {"A", "floquet_moduli", "stable"}
+        assert abs(num["A"]["1"] - br["harmonic_balance"]["A"]["1"]) < 1e-9
+    bad = subprocess.run([sys.executable, "-m", "generator", "driven", "--eps", "0.1",
+                          "--force", "1", "--omega", "1", "--Q", "0"],
+                         capture_output=True, text=True, check=False)
+    assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
