@@ -269,14 +269,12 @@ def harmonic_balance(d: Drive, start: Branch, harmonics: int, tol: float = 1e-13
     converged = False
     for _ in range(max_iter):
         r = residual(x)
-        c = coeffs(x)
-        q2 = _product(c, c)
-        J = np.empty((len(x), len(x)))
-        for k in range(len(x)):
-            e = np.zeros_like(x)
-            e[k] = 1.0
-            dc = coeffs(e)
-            J[:, k] = project(lin * dc + 3 * d.eps * _product(q2, dc))
+        q2 = _product(coeffs(x), coeffs(x))
+        # dR_n/dc_m = lin_n δ_nm + 3ε (q²)_{n−m}; c_{±m} = (a_m ∓ i b_m)/2
+        K_plus = np.diag(lin[M + odd]) + 3 * d.eps * q2[M + odd[:, None] - odd[None, :]]
+        K_minus = 3 * d.eps * q2[M + odd[:, None] + odd[None, :]]
+        dR_da, dR_db = (K_plus + K_minus) / 2, -1j * (K_plus - K_minus) / 2
+        J = np.block([[2 * dR_da.real, 2 * dR_db.real], [-2 * dR_da.imag, -2 * dR_db.imag]])
         step = np.linalg.solve(J, -r)
         x = x + step
         if np.max(np.abs(step)) <= tol * (1 + np.max(np.abs(x))):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import subprocess
@@ -49,7 +50,7 @@ def test_mu_expansion_error_decreases_with_order():
     A, mu = mu_amplitudes(NOTES, 8)
     orbit = shoot(0.1, 1.0, 1.0, 0.0, np.array([2.4, 0.0]))
     errors = [abs(a[1] - orbit.A[1]) for a in A]
-    assert all(e2 < e1 for e1, e2 in zip(errors[:6], errors[1:7], strict=True))
+    assert all(e2 < e1 for e1, e2 in itertools.pairwise(errors[:7]))
     assert errors[8] < 1e-9 and mu.converged
 
 

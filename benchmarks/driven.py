@@ -1,0 +1,43 @@
+"""Driven Duffing timings: μ-expansion, harmonic balance, shooting + Floquet (after compiling).
+
+    .venv/bin/python benchmarks/driven.py
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from generator.driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
+from generator.numerics import shoot
+
+
+def best(fn, repeat: int = 5) -> float:
+    out = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - t0)
+    return min(out)
+
+
+def main() -> None:
+    d = Drive(0.1, 1.0, 1.0)
+    (br,) = first_order_branches(d)
+    shoot(0.1, 1.0, 1.0, 0.0, np.array([2.4, 0.0]))  # compile (cached on disk afterwards)
+    hb = harmonic_balance(d, br, 8)
+    A, _ = amplitudes(hb.coefficients, 0.0, 15)
+    rows = [
+        ("mu-expansion, order 6 (eps=0.1, f=1, w=1)", best(lambda: mu_expansion(d, br, 6)), 1.0),
+        ("harmonic balance, N = 8, one frequency", best(lambda: harmonic_balance(d, br, 8)), 1e-3),
+        ("shooting + Floquet, one orbit",
+         best(lambda: shoot(0.1, 1.0, 1.0, 0.0, np.array([sum(A.values()), 0.0]))), 10e-3),
+    ]
+    print(f"{'task':<44} {'seconds':>10} {'target':>9}")
+    for label, sec, target in rows:
+        print(f"{label:<44} {sec:>10.2e} {target:>9.0e}  {'met' if sec <= target else 'MISSED'}")
+
+
+if __name__ == "__main__":
+    main()
