@@ -298,3 +298,82 @@ def first_order_secular() -> tuple[sp.Expr, sp.Expr]:
     cos_c = sp.simplify(sp.integrate(F1 * sp.cos(tau), (tau, 0, 2 * sp.pi)) / sp.pi)
     sin_c = sp.simplify(sp.integrate(F1 * sp.sin(tau), (tau, 0, 2 * sp.pi)) / sp.pi)
     return sp.expand(cos_c), sp.expand(sin_c)
+
+
+# --- the undamped μ-expansion, exactly (for display, LaTeX and emitted evaluators) -----------
+
+A1_, omega_, eps_, force_ = sp.symbols("A_1 omega epsilon f")
+
+
+@dataclass(frozen=True)
+class MuOrder:
+    """Order ``j`` of the undamped μ-expansion in ``A₁, ω, ε`` (``A₁`` a root of the cubic)."""
+
+    order: int
+    forcing: dict[int, sp.Expr]  # F_j: coefficients of cos nτ, n ≠ 1
+    secular: sp.Expr  # cos τ coefficient of F_j (= 0), with b_{j−1} as a symbol
+    unknown: sp.Symbol  # what it fixes: A₁ (order 1) or b_{j−1}
+    value: sp.Expr | None  # b_{j−1} (None at order 1: the cubic is solved per branch)
+    q: dict[int, sp.Expr]  # q_j: coefficients of cos nτ, b_j (fixed at order j+1) included
+
+
+def mu_expansion_exact(order: int) -> tuple[MuOrder, ...]:
+    """Orders 1..K of eq. 10.68 (``Q → ∞``, so ``δ = 0``) with exact rational functions.
+
+    The kernel of :mod:`series` does the algebra in the monomial basis of ``C = cos τ`` over
+    ``QQ(A₁, ω, ε)``.  ``F₁`` holds ``f/ω² cos τ``; its secular condition is the cubic
+    ``(ω² − 1)A₁ − ¾εA₁³ + f = 0``, which removes ``f`` from every later order.  At order
+    ``j + 1`` the secular condition is affine in ``b_j``: ``s₀ + D b_j = 0`` with
+    ``D = 1 − 1/ω² − 9εA₁²/(4ω²)``, which vanishes at a fold.
+    """
+    from .series import Basis, Ground, solve_oscillator, to_fourier
+
+    if isinstance(order, bool) or not isinstance(order, int) or not 1 <= order <= 12:
+        raise InputError(f"order {order!r}: the exact μ-expansion takes 1..12")
+    from sympy.polys.domains import QQ
+
+    ground = Ground(QQ.frac_field(A1_, omega_, eps_))
+    basis = Basis(odd=True)
+    lin = ground.scalar(1 - 1 / omega_**2)
+    cub = ground.scalar(-eps_ / omega_**2)
+    D = lin + cub * ground.scalar(sp.Rational(9, 4) * A1_**2)
+    P = [ground.poly([A1_])]  # q₀ = A₁ cos τ = C·P₀
+
+    def cube(m: int) -> object:
+        """``[μ^m] P³`` by direct convolution (low orders only)."""
+        acc = ground.poly([])
+        for a in range(m + 1):
+            for b in range(m + 1 - a):
+                acc = acc + P[a] * P[b] * P[m - a - b]
+        return acc
+
+    def forcing(j: int) -> object:
+        return P[j - 1] * lin + cube(j - 1).left_shift(1) * cub
+
+    def fourier(poly: object) -> dict[int, sp.Expr]:
+        return {n: sp.factor(ground.to_sympy(c)) for n, c in to_fourier(poly, basis, ground).items()}
+
+    forcings, seculars, values, b_symbols = [], [], [], []
+    for j in range(1, order + 2):
+        s0 = solve_oscillator(forcing(j).coeffs() or [ground.scalar(0)], basis, ground).secular
+        if j == 1:  # the cubic (its f/ω² cos τ term stands outside the kernel's QQ(A₁, ω, ε))
+            seculars.append(sp.expand(ground.to_sympy(s0) + force_ / omega_**2))
+            values.append(None)
+            b_symbols.append(A1_)
+        else:  # s₀ + D b_{j−1} = 0 fixes the constant of q_{j−1}
+            b = -s0 * (ground.scalar(1) / D)
+            b_sym = sp.Symbol(f"b_{j - 1}")
+            seculars.append(sp.factor(ground.to_sympy(s0)) + sp.factor(ground.to_sympy(D)) * b_sym)
+            values.append(sp.factor(ground.to_sympy(b)))
+            b_symbols.append(b_sym)
+            P[j - 1] = P[j - 1] + ground.poly([b])
+        if j == order + 1:
+            break
+        F = forcing(j)
+        forcings.append({n: c for n, c in fourier(F).items() if n != 1})
+        P.append(ground.poly(solve_oscillator(F.coeffs(), basis, ground).particular))
+    return tuple(
+        MuOrder(order=j, forcing=forcings[j - 1], secular=seculars[j - 1],
+                unknown=b_symbols[j - 1], value=values[j - 1], q=fourier(P[j]))
+        for j in range(1, order + 1)
+    )
