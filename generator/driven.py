@@ -351,7 +351,8 @@ def mu_expansion_exact(order: int) -> tuple[MuOrder, ...]:
         return P[j - 1] * lin + cube(j - 1).left_shift(1) * cub
 
     def fourier(poly: object) -> dict[int, sp.Expr]:
-        return {n: sp.factor(ground.to_sympy(c)) for n, c in to_fourier(poly, basis, ground).items()}
+        return {n: sp.factor(ground.to_sympy(c))
+                for n, c in to_fourier(poly, basis, ground).items()}
 
     forcings, seculars, values, b_symbols = [], [], [], []
     for j in range(1, order + 2):

@@ -22,7 +22,7 @@ import sympy as sp
 
 from .errors import InputError
 from .lindstedt import SeriesSolution, derive, order_terms
-from .lower import Evaluator, Module, Provenance, lower_free
+from .lower import Evaluator, Module, Provenance, lower_driven, lower_free
 from .models import check_order, model_by_name
 from .printers import latex_expr, latex_rational, pycode
 
@@ -245,3 +245,61 @@ def load_generated(path: Path) -> ModuleType:
     sys.modules[name] = module
     spec.loader.exec_module(module)
     return module
+
+
+NOTES_DRIVE = (0.1, 1.0, 1.0)
+# NOTE: ε, f, ω of the notes' table (§10.4, undamped), reproduced in every driven derivation.
+NOTES_TABLE_ORDERS = 6
+
+
+def notes_table() -> dict:
+    """The notes' table (A₁, A₃, A₅ by μ-order, harmonic balance, shooting) as strings."""
+    import numpy as np
+
+    from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
+    from .numerics import shoot
+
+    eps, force, omega = NOTES_DRIVE
+    d = Drive(eps, force, omega)
+    (branch,) = first_order_branches(d)
+    mu = mu_expansion(d, branch, NOTES_TABLE_ORDERS)
+    rows = []
+
+    def row(label: str, A: dict) -> dict:
+        cells = {f"a{n}": f"{A[n]:.6f}" if A.get(n) else "" for n in (1, 3, 5)}
+        return {"label": label, **cells}
+
+    for j in range(NOTES_TABLE_ORDERS + 1):
+        rows.append(row(f"$\\mu$-expansion, order {j}", amplitudes(*mu.partial(j), 2 * j + 1)[0]))
+    hb = harmonic_balance(d, branch, 8)
+    A, _ = amplitudes(hb.coefficients, 0.0, 15)
+    rows.append(row("harmonic balance, $N = 8$", A))
+    orbit = shoot(eps, force, omega, 0.0, np.array([sum(A.values()), 0.0]))
+    rows.append(row("numerical (shooting)", orbit.A))
+    rows.append({"label": "notes: numerical", "a1": "2.356", "a3": "0.0456", "a5": "0.0008"})
+    return {"eps": eps, "force": force, "omega": omega, "rows": rows}
+
+
+def _dmath(expr: sp.Expr) -> str:
+    return sp.latex(expr).replace("A_{1}", "A_1")
+
+
+def generate_driven(order: int, out: Path) -> list[Path]:
+    """``lindstedt generate driven``: A_n(ω) evaluators and the μ-expansion's derivation."""
+    from .driven import mu_expansion_exact
+
+    command = f"lindstedt generate driven --order {order}"
+    orders = mu_expansion_exact(order)
+    module = lower_driven(orders, command)
+    ctx_orders = [{
+        "j": o.order,
+        "forcing": [(n, _dmath(c)) for n, c in sorted(o.forcing.items())],
+        "secular": _dmath(o.secular),
+        "unknown": _dmath(o.unknown),
+        "value": _dmath(o.value) if o.value is not None else "",
+        "solution": [(n, _dmath(c)) for n, c in sorted(o.q.items())],
+    } for o in orders]
+    tex = environment(latex=True).get_template("mu_derivation.tex.j2").render(
+        banner=banner(module.provenance, "%"), order=order, orders=ctx_orders,
+        table=notes_table())
+    return write_files(out, {"driven.py": render_module(module), "driven_derivation.tex": tex})

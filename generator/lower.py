@@ -195,3 +195,70 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
             forcing=[[(n, str(c)) for n, c in terms] for terms in m.forcing[: order + 2]],
         ),
     )
+
+
+def cubic_branches(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol) -> tuple[sp.Expr, ...]:
+    """Real roots of ``(ω² − 1)A − ¾εA³ + f = 0``, largest first, as SymPy expressions.
+
+    ``A³ + pA + q = 0`` with ``p = −4(ω² − 1)/(3ε)``, ``q = −4f/(3ε)``: three real roots by the
+    trigonometric formula when ``4p³ + 27q² < 0`` (NaN for the missing ones otherwise), else
+    Cardano's single root.
+    """
+    p = -4 * (omega**2 - 1) / (3 * eps)
+    q = -4 * force / (3 * eps)
+    three = 4 * p**3 + 27 * q**2 < 0
+    arg = sp.Min(sp.Max(3 * q / (2 * p) * sp.sqrt(-3 / p), -1), 1)
+    trig = [2 * sp.sqrt(-p / 3) * sp.cos(sp.acos(arg) / 3 - 2 * sp.pi * k / 3) for k in range(3)]
+    delta = q**2 / 4 + p**3 / 27
+
+    def cbrt(z: sp.Expr) -> sp.Expr:
+        return sp.sign(z) * sp.Abs(z) ** sp.Rational(1, 3)
+
+    cardano = cbrt(-q / 2 + sp.sqrt(delta)) + cbrt(-q / 2 - sp.sqrt(delta))
+    return (
+        sp.Piecewise((trig[0], three), (cardano, True)),
+        sp.Piecewise((trig[1], three), (sp.nan, True)),
+        sp.Piecewise((trig[2], three), (sp.nan, True)),
+    )
+
+
+def lower_driven(orders: tuple, command: str) -> Module:
+    """Evaluators ``A_n(omega, eps, force, branch)`` of the undamped μ-expansion at order K.
+
+    ``branch`` 0, 1, 2 picks a real root of the first-order cubic, largest first (NaN where that
+    branch does not exist).  The sum is NaN at a fold (``D = 0``) and where its last constant
+    ``b_K`` exceeds ``b_{K−1}`` (``A₁`` for K = 1): a growing series is no answer.
+    """
+    from .driven import A1_, eps_, omega_
+
+    K = len(orders)
+    omega, eps, force, branch = sp.symbols("omega eps force branch")
+    A1, D = sp.symbols("A1 D")
+    to_args = {A1_: A1, omega_: omega, eps_: eps}
+    roots = cubic_branches(omega, eps, force)
+    pick = sp.Piecewise((roots[0], sp.Eq(branch, 0)), (roots[1], sp.Eq(branch, 1)),
+                        (roots[2], sp.Eq(branch, 2)), (sp.nan, True))
+    b = [orders[j].q.get(1, 0) for j in range(K)]  # b_j is q_j's cos τ coefficient
+    last = sp.Abs(b[-1].xreplace(to_args))
+    before = sp.Abs(A1) if K == 1 else sp.Abs(b[-2].xreplace(to_args))
+    guard = sp.And(sp.Ne(eps, 0), sp.Ne(D, 0), last <= before)
+    prelude = ((A1, pick), (D, 1 - 1 / omega**2 - sp.Rational(9, 4) * eps * A1**2 / omega**2))
+    evaluators = []
+    for n in range(1, 2 * K + 2, 2):
+        total = (A1 if n == 1 else 0) + sum(o.q.get(n, 0) for o in orders)
+        subexprs, (out,) = sp.cse(sp.together(total.xreplace(to_args)),
+                                  symbols=sp.numbered_symbols("x_"))
+        evaluators.append(Evaluator(
+            f"A_{n}",
+            f"Coefficient of cos {n}ωt, μ-expansion order {K}, undamped (eq. 10.66–10.72).",
+            (omega, eps, force, branch), prelude, guard, tuple(subexprs), out))
+    evaluators.append(Evaluator(
+        "first_order", "A₁ of the branch: a real root of (ω² − 1)A₁ − ¾εA₁³ + f = 0.",
+        (omega, eps, force, branch), ((A1, pick),), sp.Ne(eps, 0), (), A1))
+    return Module(
+        name="driven",
+        doc=f"Driven Duffing q'' + q + eps*q**3 = f cos(omega t): μ-expansion to order {K}.",
+        constants=(("ORDER", K), ("MODEL", "driven (undamped)")),
+        evaluators=tuple(evaluators),
+        provenance=provenance("driven", K, command),
+    )

@@ -15,7 +15,16 @@ import pytest
 import sympy as sp
 from scipy.special import ellipj, ellipk
 
-from generator.emit import TEMPLATES, environment, generate, latex_context, render_module
+from generator.cli import DRIVEN_ORDER
+from generator.driven import Drive, amplitudes, first_order_branches, mu_expansion
+from generator.emit import (
+    TEMPLATES,
+    environment,
+    generate,
+    generate_driven,
+    latex_context,
+    render_module,
+)
 from generator.emit import load_generated as load
 from generator.errors import InputError
 from generator.lindstedt import derive, omega_coefficients, period_series, solution_expression
@@ -84,6 +93,7 @@ def test_generated_is_fresh(tmp_path):
     """Regenerating the defaults gives byte-identical files (pinned versions, no timestamp)."""
     for model, order in DEFAULTS:
         generate(model, order, tmp_path)
+    generate_driven(DRIVEN_ORDER, tmp_path)
     fresh = sorted(p.name for p in tmp_path.iterdir())
     committed = sorted(p.name for p in GENERATED.iterdir() if p.is_file())
     assert fresh == committed
@@ -199,6 +209,35 @@ def test_cached_module_imports_without_recompiling(tmp_path):
     assert first.returncode == 0 and second.returncode == 0, second.stderr
     assert "data saved" in first.stdout
     assert "data loaded" in second.stdout and "data saved" not in second.stdout
+
+
+def test_driven_module_equals_numeric_mu_expansion():
+    drv = load(GENERATED / "driven.py")
+    for eps_, f, w in [(0.1, 1.0, 1.0), (0.1, 0.3, 1.3), (-0.05, 0.2, 0.9)]:
+        d = Drive(eps_, f, w)
+        for k, br in enumerate(first_order_branches(d)):
+            assert drv.first_order(w, eps_, f, k) == pytest.approx(br.A1, rel=1e-12, abs=1e-12)
+            mu = mu_expansion(d, br, drv.ORDER)
+            A, _ = amplitudes(*mu.partial(drv.ORDER), 2 * drv.ORDER + 1)
+            for n in (1, 3, 5, 7):
+                got = getattr(drv, f"A_{n}")(w, eps_, f, k)
+                assert got == pytest.approx(A[n], rel=1e-10, abs=1e-13), (eps_, f, w, k, n)
+        missing = len(first_order_branches(d))
+        if missing < 3:
+            assert np.isnan(drv.A_1(w, eps_, f, missing))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        assert np.isnan(drv.A_1(1.0, 0.0, 1.0, 0))  # ε = 0: not a Duffing oscillator
+
+
+def test_driven_module_refuses_near_a_fold():
+    drv = load(GENERATED / "driven.py")
+    eps_, f = 0.1, 1.0
+    A = -((2 * f) / (3 * eps_)) ** (1 / 3)
+    w = np.sqrt(1 + 2.25 * eps_ * A**2)
+    w = w * (1 + 1e-9)  # three branches exist, two of them about to merge
+    assert all(np.isfinite(drv.first_order(w, eps_, f, k)) for k in range(3))
+    values = [drv.A_1(w, eps_, f, k) for k in range(3)]
+    assert np.isfinite(values[0]) and np.isnan(values[1:]).any()
 
 
 # --- files: atomic, no clobbering, bad input -------------------------------------------------
