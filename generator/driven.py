@@ -378,3 +378,61 @@ def mu_expansion_exact(order: int) -> tuple[MuOrder, ...]:
                 unknown=b_symbols[j - 1], value=values[j - 1], q=fourier(P[j]))
         for j in range(1, order + 1)
     )
+
+
+# --- harmonic balance, symbolically (emitted as compiled residual and Jacobian) --------------
+
+def _trig_product(x: dict, y: dict) -> dict:
+    """Product of real Fourier sums ``{(n, "c"|"s"): coeff}`` by product-to-sum."""
+    out: dict = {}
+
+    def add(n: int, kind: str, value: sp.Expr) -> None:
+        if n < 0:
+            n, value = -n, (value if kind == "c" else -value)
+        if n == 0 and kind == "s":
+            return
+        out[(n, kind)] = out.get((n, kind), 0) + value
+
+    for (m, p), u in x.items():
+        for (n, r), v in y.items():
+            h = u * v / 2
+            if p == "c" and r == "c":
+                add(m - n, "c", h), add(m + n, "c", h)
+            elif p == "s" and r == "s":
+                add(m - n, "c", h), add(m + n, "c", -h)
+            elif p == "s":  # sin m cos n
+                add(m + n, "s", h), add(m - n, "s", h)
+            else:  # cos m sin n
+                add(m + n, "s", h), add(n - m, "s", h)
+    return out
+
+
+@dataclass(frozen=True)
+class BalanceEquations:
+    """Galerkin residual of eq. 10.60 for ``q = Σ a_k cos kωt + b_k sin kωt``, k odd ≤ 2N − 1."""
+
+    harmonics: int
+    unknowns: tuple[sp.Symbol, ...]  # a_1, a_3, …, b_1, b_3, …
+    parameters: tuple[sp.Symbol, ...]  # omega, eps, force, damping (= 1/Q)
+    residuals: tuple[sp.Expr, ...]  # cos kωt and sin kωt components, same order as unknowns
+
+
+def balance_equations(harmonics: int) -> BalanceEquations:
+    """``−(kω)² q_k + kω/Q q̃_k + q_k + ε[q³]_k − f δ_k1`` for every odd ``k ≤ 2N − 1``."""
+    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 12:
+        raise InputError(f"harmonics {harmonics!r}: the symbolic balance takes 1..12")
+    odd = range(1, 2 * harmonics, 2)
+    a = [sp.Symbol(f"a_{k}") for k in odd]
+    b = [sp.Symbol(f"b_{k}") for k in odd]
+    w, eps, f, g = sp.symbols("omega eps force damping")
+    q = {**{(k, "c"): ak for k, ak in zip(odd, a, strict=True)},
+         **{(k, "s"): bk for k, bk in zip(odd, b, strict=True)}}
+    cube = _trig_product(_trig_product(q, q), q)
+    cos_res, sin_res = [], []
+    for k, ak, bk in zip(odd, a, b, strict=True):
+        # q̇ contributes kω(b_k cos − a_k sin), q̈ contributes −(kω)² q
+        cos_res.append(sp.expand((1 - (k * w) ** 2) * ak + g * k * w * bk
+                                 + eps * cube.get((k, "c"), 0) - (f if k == 1 else 0)))
+        sin_res.append(sp.expand((1 - (k * w) ** 2) * bk - g * k * w * ak
+                                 + eps * cube.get((k, "s"), 0)))
+    return BalanceEquations(harmonics, (*a, *b), (w, eps, f, g), (*cos_res, *sin_res))

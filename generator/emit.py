@@ -22,7 +22,15 @@ import sympy as sp
 
 from .errors import InputError
 from .lindstedt import SeriesSolution, derive, order_terms
-from .lower import Evaluator, Module, Provenance, lower_driven, lower_free
+from .lower import (
+    ArrayKernel,
+    Evaluator,
+    Module,
+    Provenance,
+    lower_balance,
+    lower_driven,
+    lower_free,
+)
 from .models import check_order, model_by_name
 from .printers import latex_expr, latex_rational, pycode
 
@@ -89,6 +97,18 @@ def _evaluator_context(ev: Evaluator) -> dict:
     }
 
 
+def _kernel_context(k: ArrayKernel) -> dict:
+    return {
+        "name": k.name,
+        "doc": k.doc,
+        "args": ", ".join(["x", *(str(a) for a in k.args)]),
+        "unpack": [(str(u), i) for i, u in enumerate(k.unpack)],
+        "shape": repr(k.shape),
+        "subexprs": [(str(lhs), pycode(rhs)) for lhs, rhs in k.subexprs],
+        "entries": [(", ".join(map(str, idx)), pycode(v)) for idx, v in k.entries],
+    }
+
+
 def render_module(module: Module) -> str:
     """The numba module of ``module`` (template ``module.py.j2``)."""
     return environment(latex=False).get_template("module.py.j2").render(
@@ -97,6 +117,8 @@ def render_module(module: Module) -> str:
         fastmath=FASTMATH,
         constants=[(name, pyliteral(value)) for name, value in module.constants],
         evaluators=[_evaluator_context(ev) for ev in module.evaluators],
+        kernels=[_kernel_context(k) for k in module.kernels],
+        newton=module.newton,
     )
 
 
@@ -303,3 +325,12 @@ def generate_driven(order: int, out: Path) -> list[Path]:
         banner=banner(module.provenance, "%"), order=order, orders=ctx_orders,
         table=notes_table())
     return write_files(out, {"driven.py": render_module(module), "driven_derivation.tex": tex})
+
+
+def generate_balance(harmonics: int, out: Path) -> list[Path]:
+    """``lindstedt generate balance``: compiled harmonic-balance residual, Jacobian, Newton."""
+    from .driven import balance_equations
+
+    module = lower_balance(balance_equations(harmonics),
+                           f"lindstedt generate balance --harmonics {harmonics}")
+    return write_files(out, {"balance.py": render_module(module)})

@@ -36,6 +36,20 @@ class Evaluator:
 
 
 @dataclass(frozen=True)
+class ArrayKernel:
+    """One numba ``@njit`` function returning an array: ``x`` unpacked into named symbols,
+    shared subexpressions, then ``out[index] = value`` entries."""
+
+    name: str
+    doc: str
+    unpack: tuple[sp.Symbol, ...]  # x[0], x[1], … bound to these names
+    args: tuple[sp.Symbol, ...]  # scalar arguments after x
+    shape: tuple[int, ...]
+    subexprs: tuple[Assign, ...]
+    entries: tuple[tuple[tuple[int, ...], sp.Expr], ...]
+
+
+@dataclass(frozen=True)
 class Provenance:
     """What a generated file says about where it came from (no timestamp: reproducible)."""
 
@@ -58,6 +72,8 @@ class Module:
     constants: tuple[tuple[str, object], ...]  # name -> int, float, str or tuple of them
     evaluators: tuple[Evaluator, ...]
     provenance: Provenance
+    kernels: tuple[ArrayKernel, ...] = ()
+    newton: bool = False  # emit newton(x0, …) driving the kernels "residual" and "jacobian"
 
 
 def provenance(model: str, order: int, command: str, **inputs: object) -> Provenance:
@@ -261,4 +277,40 @@ def lower_driven(orders: tuple, command: str) -> Module:
         constants=(("ORDER", K), ("MODEL", "driven (undamped)")),
         evaluators=tuple(evaluators),
         provenance=provenance("driven", K, command),
+    )
+
+
+def lower_balance(eqs, command: str) -> Module:
+    """Compiled residual and Jacobian of N-harmonic balance, and a Newton solver over them."""
+    n = len(eqs.unknowns)
+    jac = [[sp.diff(r, u) for u in eqs.unknowns] for r in eqs.residuals]
+    flat = [*eqs.residuals, *(e for row in jac for e in row)]
+    subexprs, reduced = sp.cse(flat, symbols=sp.numbered_symbols("x_"), order="canonical")
+    res, jac_flat = reduced[:n], reduced[n:]
+    # NOTE: one CSE over residual and Jacobian together; each kernel keeps what it uses.
+    kernels = []
+    for name, doc, shape, entries in (
+        ("residual", "Galerkin residual: cos and sin components for k = 1, 3, …", (n,),
+         tuple(((i,), e) for i, e in enumerate(res))),
+        ("jacobian", "d residual / d (a_1, a_3, …, b_1, b_3, …)", (n, n),
+         tuple(((i // n, i % n), e) for i, e in enumerate(jac_flat))),
+    ):
+        used = set().union(*(e.free_symbols for _, e in entries))
+        needed: list[Assign] = []
+        for lhs, rhs in reversed(subexprs):
+            if lhs in used:
+                needed.append((lhs, rhs))
+                used |= rhs.free_symbols
+        kernels.append(ArrayKernel(name, doc, eqs.unknowns, eqs.parameters, shape,
+                                   tuple(reversed(needed)), entries))
+    return Module(
+        name="balance",
+        doc=f"Driven Duffing q'' + damping*q' + q + eps*q**3 = force*cos(omega t): harmonic "
+            f"balance with {eqs.harmonics} odd harmonics.",
+        constants=(("HARMONICS", eqs.harmonics),
+                   ("UNKNOWNS", tuple(str(u) for u in eqs.unknowns))),
+        evaluators=(),
+        provenance=provenance("balance", eqs.harmonics, command),
+        kernels=tuple(kernels),
+        newton=True,
     )

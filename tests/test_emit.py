@@ -15,12 +15,19 @@ import pytest
 import sympy as sp
 from scipy.special import ellipj, ellipk
 
-from generator.cli import DRIVEN_ORDER
-from generator.driven import Drive, amplitudes, first_order_branches, mu_expansion
+from generator.cli import BALANCE_HARMONICS, DRIVEN_ORDER
+from generator.driven import (
+    Drive,
+    amplitudes,
+    first_order_branches,
+    harmonic_balance,
+    mu_expansion,
+)
 from generator.emit import (
     TEMPLATES,
     environment,
     generate,
+    generate_balance,
     generate_driven,
     latex_context,
     render_module,
@@ -72,11 +79,12 @@ def test_templates_get_exactly_the_variables_they_use():
     sol = derive(duffing(), 5)
     module = lower_free(sol, "cmd")
     latex_ctx = set(latex_context(sol, 3)) | {"banner"}
-    module_ctx = {"banner", "doc", "constants", "evaluators", "fastmath"}
+    module_ctx = {"banner", "doc", "constants", "evaluators", "fastmath", "kernels", "newton"}
     for name, env, ctx in [
         ("module.py.j2", environment(False), module_ctx),
         ("tables.tex.j2", environment(True), latex_ctx),
         ("derivation.tex.j2", environment(True), latex_ctx),
+        ("mu_derivation.tex.j2", environment(True), {"banner", "order", "orders", "table"}),
     ]:
         used = jinja2.meta.find_undeclared_variables(env.parse((TEMPLATES / name).read_text()))
         assert used <= ctx, (name, used - ctx)
@@ -94,6 +102,7 @@ def test_generated_is_fresh(tmp_path):
     for model, order in DEFAULTS:
         generate(model, order, tmp_path)
     generate_driven(DRIVEN_ORDER, tmp_path)
+    generate_balance(BALANCE_HARMONICS, tmp_path)
     fresh = sorted(p.name for p in tmp_path.iterdir())
     committed = sorted(p.name for p in GENERATED.iterdir() if p.is_file())
     assert fresh == committed
@@ -227,6 +236,28 @@ def test_driven_module_equals_numeric_mu_expansion():
             assert np.isnan(drv.A_1(w, eps_, f, missing))
     with np.errstate(divide="ignore", invalid="ignore"):
         assert np.isnan(drv.A_1(1.0, 0.0, 1.0, 0))  # ε = 0: not a Duffing oscillator
+
+
+def test_balance_module_newton_equals_convolution_balance():
+    """The emitted residual/Jacobian (SymPy product-to-sum) against the convolution route."""
+    bal = load(GENERATED / "balance.py")
+    n = bal.HARMONICS
+    d = Drive(0.1, 0.3, 1.3, Q=20.0)
+    for br in first_order_branches(d):
+        x0 = np.zeros(2 * n)
+        x0[0], x0[n] = br.A1 * np.cos(br.delta0), br.A1 * np.sin(br.delta0)
+        x, ok = bal.newton(x0, d.omega, d.eps, d.force, d.damping)
+        hb = harmonic_balance(d, br, n)
+        A, B = amplitudes(hb.coefficients, 0.0, 2 * n - 1)
+        assert ok
+        np.testing.assert_allclose(x, [*A.values(), *B.values()], atol=1e-12)
+        # Jacobian against central differences of the residual
+        h = 1e-6
+        num = np.column_stack([
+            (bal.residual(x + h * e, 1.3, 0.1, 0.3, 0.05) - bal.residual(x - h * e, 1.3, 0.1, 0.3,
+                                                                        0.05)) / (2 * h)
+            for e in np.eye(2 * n)])
+        np.testing.assert_allclose(bal.jacobian(x, 1.3, 0.1, 0.3, 0.05), num, atol=1e-7)
 
 
 def test_driven_module_refuses_near_a_fold():
