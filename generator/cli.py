@@ -19,6 +19,7 @@ from .emit import generate, generate_balance, generate_driven, load_generated
 from .errors import InputError
 from .lindstedt import SeriesSolution, derive
 from .models import MODELS, check_order, model_by_name
+from .numerics import duffing_period_exact, pendulum_period_exact, shoot
 
 DEFAULT_ORDER = 12
 # NOTE: order 12 keeps T(A) within 1e-6 for |εA²| ≤ 0.3 and the LaTeX a few pages long.
@@ -117,10 +118,6 @@ BALANCE_HARMONICS = 4
 
 def _cmd_demo(args: argparse.Namespace) -> int:
     """The main job on the built-in defaults: derive, emit, evaluate against exact, typeset."""
-    import numpy as np
-
-    from .numerics import duffing_period_exact, pendulum_period_exact
-
     print(series_table(derive(model_by_name("duffing", 6), 6)))
     out = Path(args.out)
     print(f"\nwriting the default evaluators and LaTeX into {out}/")
@@ -167,8 +164,6 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 def driven_json(d: Drive, order: int, harmonics: int) -> dict:
     """The contract of ``lindstedt driven … --json``: every 1:1 branch, three ways."""
-    from .numerics import shoot
-
     damped = d.damping > 0
     top = max(2 * harmonics - 1, 2 * order + 1)
     branches = []

@@ -22,8 +22,10 @@ from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
+from sympy.polys.domains import QQ
 
 from .errors import InputError
+from .series import Basis, Ground, solve_oscillator, to_fourier
 
 
 @dataclass(frozen=True)
@@ -326,12 +328,8 @@ def mu_expansion_exact(order: int) -> tuple[MuOrder, ...]:
     ``j + 1`` the secular condition is affine in ``b_j``: ``s₀ + D b_j = 0`` with
     ``D = 1 − 1/ω² − 9εA₁²/(4ω²)``, which vanishes at a fold.
     """
-    from .series import Basis, Ground, solve_oscillator, to_fourier
-
     if isinstance(order, bool) or not isinstance(order, int) or not 1 <= order <= 12:
         raise InputError(f"order {order!r}: the exact μ-expansion takes 1..12")
-    from sympy.polys.domains import QQ
-
     ground = Ground(QQ.frac_field(A1_, omega_, eps_))
     basis = Basis(odd=True)
     lin = ground.scalar(1 - 1 / omega_**2)

@@ -18,8 +18,18 @@ from pathlib import Path
 from types import ModuleType
 
 import jinja2
+import numpy as np
 import sympy as sp
 
+from .driven import (
+    Drive,
+    amplitudes,
+    balance_equations,
+    first_order_branches,
+    harmonic_balance,
+    mu_expansion,
+    mu_expansion_exact,
+)
 from .errors import InputError
 from .lindstedt import SeriesSolution, derive, order_terms
 from .lower import (
@@ -32,6 +42,7 @@ from .lower import (
     lower_free,
 )
 from .models import check_order, model_by_name
+from .numerics import shoot
 from .printers import latex_expr, latex_rational, pycode
 
 TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
@@ -276,11 +287,6 @@ NOTES_TABLE_ORDERS = 6
 
 def notes_table() -> dict:
     """The notes' table (A₁, A₃, A₅ by μ-order, harmonic balance, shooting) as strings."""
-    import numpy as np
-
-    from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
-    from .numerics import shoot
-
     eps, force, omega = NOTES_DRIVE
     d = Drive(eps, force, omega)
     (branch,) = first_order_branches(d)
@@ -308,8 +314,6 @@ def _dmath(expr: sp.Expr) -> str:
 
 def generate_driven(order: int, out: Path) -> list[Path]:
     """``lindstedt generate driven``: A_n(ω) evaluators and the μ-expansion's derivation."""
-    from .driven import mu_expansion_exact
-
     command = f"lindstedt generate driven --order {order}"
     orders = mu_expansion_exact(order)
     module = lower_driven(orders, command)
@@ -329,8 +333,6 @@ def generate_driven(order: int, out: Path) -> list[Path]:
 
 def generate_balance(harmonics: int, out: Path) -> list[Path]:
     """``lindstedt generate balance``: compiled harmonic-balance residual, Jacobian, Newton."""
-    from .driven import balance_equations
-
     module = lower_balance(balance_equations(harmonics),
                            f"lindstedt generate balance --harmonics {harmonics}")
     return write_files(out, {"balance.py": render_module(module)})

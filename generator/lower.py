@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from . import __version__
+from .driven import A1_, BalanceEquations, MuOrder, eps_, omega_
 from .lindstedt import SeriesSolution
 from .printers import identifier
 
@@ -238,15 +239,13 @@ def cubic_branches(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol) -> tuple[
     )
 
 
-def lower_driven(orders: tuple, command: str) -> Module:
+def lower_driven(orders: tuple[MuOrder, ...], command: str) -> Module:
     """Evaluators ``A_n(omega, eps, force, branch)`` of the undamped μ-expansion at order K.
 
     ``branch`` 0, 1, 2 picks a real root of the first-order cubic, largest first (NaN where that
     branch does not exist).  The sum is NaN at a fold (``D = 0``) and where its last constant
     ``b_K`` exceeds ``b_{K−1}`` (``A₁`` for K = 1): a growing series is no answer.
     """
-    from .driven import A1_, eps_, omega_
-
     K = len(orders)
     omega, eps, force, branch = sp.symbols("omega eps force branch")
     A1, D = sp.symbols("A1 D")
@@ -280,7 +279,7 @@ def lower_driven(orders: tuple, command: str) -> Module:
     )
 
 
-def lower_balance(eqs, command: str) -> Module:
+def lower_balance(eqs: BalanceEquations, command: str) -> Module:
     """Compiled residual and Jacobian of N-harmonic balance, and a Newton solver over them."""
     n = len(eqs.unknowns)
     jac = [[sp.diff(r, u) for u in eqs.unknowns] for r in eqs.residuals]

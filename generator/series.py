@@ -144,12 +144,6 @@ class Ground:
         return Ground(QQ.poly_ring(*symbols)) if symbols else Ground(QQ)
 
 
-def coefficient(poly: Any, k: int, ground: Ground) -> Any:
-    """Coefficient of ``v^k`` (zero beyond the degree)."""
-    cs = poly.coeffs()
-    return cs[k] if k < len(cs) else ground.scalar(0)
-
-
 @dataclass(frozen=True)
 class Solved:
     """Result of solving ``u'' + u = G`` in the kernel's basis (see :func:`solve_oscillator`)."""
@@ -185,18 +179,6 @@ def solve_oscillator(g: Sequence[Any], basis: Basis, ground: Ground) -> Solved:
         n = basis.harmonic(k)
         p[k] = rhs * ground.scalar(Fraction(1, 1 - n * n))
     return Solved(p, secular)
-
-
-def second_derivative(poly: Any, basis: Basis, ground: Ground) -> Any:
-    """``d²/ds²`` of ``C^parity · P(v)`` divided by ``C^parity`` (same basis)."""
-    cs = poly.coeffs()
-    out = [ground.scalar(0)] * len(cs)
-    for k, c in enumerate(cs):
-        n = basis.harmonic(k)
-        out[k] = out[k] + c * (-n * n)
-        if n >= 2:
-            out[k - basis.step] = out[k - basis.step] + c * (n * (n - 1))
-    return ground.poly(out)
 
 
 def to_fourier(poly: Any, basis: Basis, ground: Ground) -> dict[int, Any]:

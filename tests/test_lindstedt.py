@@ -58,17 +58,27 @@ def test_notes_first_and_second_order(duffing40):
 
 
 def _residual_polynomial(model, order):
-    """ω² u'' + u + Σ y^k P_k(u) as a polynomial in (y, C = cos s), built by SymPy alone."""
+    """ω² u'' + u + Σ y^k P_k(u) as a polynomial in (y, C = cos s), by SymPy's Poly alone.
+
+    ``cos ns`` is Chebyshev's ``T_n(C)`` and ``(cos ns)'' = -n² cos ns``.
+    """
     sol = derive(model, order)
-    s, y, C = sp.symbols("s y C")
+    y, C = sp.symbols("y C")
     g = sol.ground.to_sympy
-    u = sum(y**j * sum(g(c) * sp.cos(n * s) for n, c in qj.items()) for j, qj in enumerate(sol.q))
-    omega = sum(g(w) * y**j for j, w in enumerate(sol.omega))
-    force = sum(y**k * sum(c * u**n for n, c in terms) for k, terms in enumerate(model.forcing, 1))
-    expr = omega**2 * sp.diff(u, s, 2) + u + force
-    top = max(n for qj in sol.q for n in qj)
-    expr = expr.subs({sp.cos(n * s): sp.chebyshevt(n, C) for n in range(top, 0, -1)})
-    return sp.Poly(sp.expand(expr), y, C), y
+
+    def poly(expr):
+        return sp.Poly(expr, y, C, domain="QQ")
+
+    cheb = {n: poly(sp.chebyshevt(n, C)) for qj in sol.q for n in qj}
+    zero = poly(0)
+    u = sum((poly(y**j) * cheb[n] * g(c) for j, qj in enumerate(sol.q)
+             for n, c in qj.items()), zero)
+    upp = sum((poly(y**j) * cheb[n] * (-n * n * g(c)) for j, qj in enumerate(sol.q)
+               for n, c in qj.items()), zero)
+    omega = sum((poly(y**j) * g(w) for j, w in enumerate(sol.omega)), zero)
+    force = sum((poly(y**k) * (u**n) * c for k, terms in enumerate(model.forcing, 1)
+                 for n, c in terms), zero)
+    return omega**2 * upp + u + force, y
 
 
 @pytest.mark.parametrize("model,order", [(duffing(), 6), (pendulum(5), 5)])
