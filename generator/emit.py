@@ -308,8 +308,21 @@ def notes_table() -> dict:
     return {"eps": eps, "force": force, "omega": omega, "rows": rows}
 
 
+DMATH_INLINE = 90
+# NOTE: longer rational functions are typeset as 1/D·(N), N expanded: breqn can break a sum
+# inside \Bigl(…\Bigr) but never inside a \frac.
+
+
 def _dmath(expr: sp.Expr) -> str:
-    return sp.latex(expr).replace("A_{1}", "A_1")
+    r"""LaTeX for a breqn ``dmath*``: short expressions as SymPy prints them, long ones
+    as ``\frac{1}{D}\Bigl(N\Bigr)``."""
+    text = sp.latex(expr)
+    if len(text) > DMATH_INLINE:
+        num, den = sp.fraction(sp.together(expr))
+        num = sp.expand(num)
+        if den != 1 and isinstance(num, sp.Add):
+            text = rf"\frac{{1}}{{{sp.latex(den)}}}\Bigl({sp.latex(num)}\Bigr)"
+    return text.replace("A_{1}", "A_1")
 
 
 def generate_driven(order: int, out: Path) -> list[Path]:
