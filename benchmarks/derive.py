@@ -11,10 +11,10 @@ to agree before any time is printed.
 from __future__ import annotations
 
 import argparse
-import time
 
 import sympy as sp
 from sympy.simplify.fu import TR8
+from timing import best
 
 from generator.lindstedt import derive
 from generator.models import duffing, pendulum
@@ -44,15 +44,6 @@ def textbook(order: int) -> list[sp.Rational]:
     return omegas
 
 
-def best_of(fn, repeat: int) -> float:
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--textbook-max", type=int, default=8)
@@ -62,16 +53,16 @@ def main() -> None:
     print("Duffing L–P, all q_j exact: engine vs textbook SymPy (same process)")
     print(f"{'order':>5} {'engine [s]':>12} {'textbook [s]':>13} {'ratio':>9}")
     for k in range(2, args.textbook_max + 1, 2):
-        t_text = best_of(lambda k=k: textbook(k), 1)
-        t_eng = best_of(lambda k=k: derive(duffing(), k), 20)
+        t_text = best(lambda k=k: textbook(k), 1)
+        t_eng = best(lambda k=k: derive(duffing(), k), 20)
         sol = derive(duffing(), k)
         assert [sp.Rational(int(w.p), int(w.q)) for w in sol.omega] == textbook(k)
         print(f"{k:>5} {t_eng:>12.2e} {t_text:>13.3f} {t_text / t_eng:>8.0f}x")
     print()
     print(f"{'order':>5} {'duffing [s]':>12} {'pendulum [s]':>13}")
     for k in args.orders:
-        t_d = best_of(lambda k=k: derive(duffing(), k), 3 if k <= 100 else 1)
-        t_p = best_of(lambda k=k: derive(pendulum(k), k), 1) if k <= 100 else float("nan")
+        t_d = best(lambda k=k: derive(duffing(), k), 3 if k <= 100 else 1)
+        t_p = best(lambda k=k: derive(pendulum(k), k), 1) if k <= 100 else float("nan")
         print(f"{k:>5} {t_d:>12.3f} {t_p:>13.3f}")
 
 

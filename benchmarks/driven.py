@@ -10,19 +10,11 @@ import time
 from pathlib import Path
 
 import numpy as np
+from timing import best
 
 from generator.driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
 from generator.emit import generate_balance, load_generated
 from generator.numerics import shoot
-
-
-def best(fn, repeat: int = 5) -> float:
-    out = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t0)
-    return min(out)
 
 
 def main() -> None:

@@ -24,6 +24,7 @@ import numpy as np
 import sympy as sp
 from sympy.codegen.rewriting import create_expand_pow_optimization, optimize
 from sympy.printing.c import C99CodePrinter
+from timing import best
 
 from generator.emit import generate, load_generated
 from generator.lindstedt import derive, period_series, solution_expression
@@ -81,15 +82,6 @@ LAMBDIFY_POINTS = 100_000
 
 def p(a: np.ndarray):
     return a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
-
-
-def best(fn, repeat: int = 3) -> float:
-    out = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t0)
-    return min(out)
 
 
 def measure(n, rng, mod, libs, f_period, f_q) -> None:
