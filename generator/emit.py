@@ -233,11 +233,17 @@ def check_writable(out: Path, names: list[str]) -> None:
 def write_files(out: Path, files: Mapping[str, str]) -> list[Path]:
     """Write ``files`` into ``out`` atomically (temporary file in the folder, then rename)."""
     check_writable(out, list(files))
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"--out {out}: {exc.strerror or exc}") from None
     written = []
     for name, text in sorted(files.items()):
         target = out / name
-        fd, tmp = tempfile.mkstemp(dir=out, prefix=f".{name}.", suffix=".tmp")
+        try:
+            fd, tmp = tempfile.mkstemp(dir=out, prefix=f".{name}.", suffix=".tmp")
+        except OSError as exc:
+            raise InputError(f"--out {out}: {exc.strerror or exc}") from None
         try:
             with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
                 fh.write(text)

@@ -303,6 +303,12 @@ def test_out_is_a_file(tmp_path):
     assert f.read_text() == "x"
 
 
+def test_out_cannot_be_created():
+    out = run_cli("generate", "duffing", "--order", "3", "--out", "/proc/lindstedt-nope")
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert len(out.stderr.strip().splitlines()) == 1
+
+
 def test_generate_bad_order_and_model(tmp_path):
     for args in (["duffing", "--order", "-2"], ["nosuch"]):
         out = run_cli("generate", *args, "--out", str(tmp_path / "o"))
