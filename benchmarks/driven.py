@@ -14,13 +14,15 @@ from timing import best
 
 from generator.driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
 from generator.emit import generate_balance, load_generated
-from generator.numerics import shoot
+from generator.numerics import shoot, sweep
+from generator.response import continue_balance, one_harmonic_curve
 
 
 def main() -> None:
     d = Drive(0.1, 1.0, 1.0)
     (br,) = first_order_branches(d)
     shoot(0.1, 1.0, 1.0, 0.0, np.array([2.4, 0.0]))  # compile (cached on disk afterwards)
+    sweep(0.1, 0.3, 0.05, 0.6, 1.9, periods=100)
     hb = harmonic_balance(d, br, 8)
     A, _ = amplitudes(hb.coefficients, 0.0, 15)
     tmp = Path(tempfile.mkdtemp(prefix="lindstedt-balance-"))
@@ -38,6 +40,12 @@ def main() -> None:
         ("harmonic balance, N = 8, one frequency", best(lambda: harmonic_balance(d, br, 8)), 1e-3),
         ("emitted balance (N = 8) Newton, one frequency",
          best(lambda: bal.newton(x0, 1.0, 0.1, 1.0, 0.0)), 1e-3),
+        ("one-harmonic curve, all branches + stability, 1e5 w",
+         best(lambda: one_harmonic_curve(0.1, 0.3, 20.0, np.linspace(0.5, 2, 100_000))), 0.1),
+        ("harmonic balance continuation N = 8, both folds",
+         best(lambda: continue_balance(0.1, 0.3, 20.0, 8, 0.6, 1.9), 1), 1.0),
+        ("sweep simulation, 1e4 periods (compiled)",
+         best(lambda: sweep(0.1, 0.3, 0.05, 0.6, 1.9)), 2.0),
         ("shooting + Floquet, one orbit",
          best(lambda: shoot(0.1, 1.0, 1.0, 0.0, np.array([sum(A.values()), 0.0]))), 10e-3),
     ]

@@ -6,7 +6,8 @@ The pipeline, one module per stage (input -> output)::
     series     exact Fourier algebra in the monomial basis of cos s  (the fast kernel)
     lindstedt  L–P series, order-by-order equations, naive expansion Model, order -> SeriesSolution
     driven     μ-expansion with phase, harmonic balance          Drive, order -> branches
-    numerics   references: elliptic periods, Jacobi cn, shooting + Floquet multipliers
+    response   one-harmonic curves and folds, balance continuation  Drive, ω range -> folds
+    numerics   references: elliptic periods, Jacobi cn, shooting + Floquet, sweeps, true folds
     lower      solutions -> IR records (Evaluator, Module)           Horner, Chebyshev recurrence
     printers   NumbaPrinter(PythonCodePrinter), LaTeX rationals      Expr -> str
     emit       strict Jinja2 environments, provenance, atomic writes IR -> files in generated/

@@ -14,12 +14,20 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
+from .driven import (
+    BalanceSystem,
+    Drive,
+    amplitudes,
+    first_order_branches,
+    harmonic_balance,
+    mu_expansion,
+)
 from .emit import generate, generate_balance, generate_driven, load_generated
 from .errors import InputError
 from .lindstedt import SeriesSolution, derive
 from .models import MODELS, check_order, model_by_name
-from .numerics import duffing_period_exact, pendulum_period_exact, shoot
+from .numerics import duffing_period_exact, orbit_fold, pendulum_period_exact, shoot, sweep
+from .response import continue_balance, one_harmonic_folds
 
 DEFAULT_ORDER = 12
 # NOTE: order 12 keeps T(A) within 1e-6 for |εA²| ≤ 0.3 and the LaTeX a few pages long.
@@ -237,6 +245,57 @@ def _cmd_driven(args: argparse.Namespace) -> int:
     return 0
 
 
+def response_json(eps: float, force: float, Q: float, harmonics: int) -> dict:
+    """The contract of ``lindstedt response … --json``: folds three ways, sweep jumps."""
+    d = Drive(eps, force, 1.0, Q)
+    if d.damping == 0:
+        raise InputError("Q inf: a response curve needs damping (finite Q) for a steady state")
+    folds1 = one_harmonic_folds(eps, force, Q)
+    lo = 0.5 * min([1.0, *folds1])
+    hi = 1.25 * max([1.0, *folds1])
+    cont = continue_balance(eps, force, Q, harmonics, lo, hi)
+    system = BalanceSystem(eps, force, d.damping, harmonics)
+    odd = system.odd
+    true_folds = []
+    for w in cont.folds:
+        x = cont.x[int(np.argmin(np.abs(cont.omega - w)))]
+        y0 = np.array([x[:harmonics].sum(), w * np.sum(odd * x[harmonics:])])
+        found = orbit_fold(eps, force, d.damping, w, y0)
+        if found is not None:
+            true_folds.append(found[0])
+    up = sweep(eps, force, d.damping, lo, hi)
+    down = sweep(eps, force, d.damping, hi, lo)
+    return {
+        "parameters": {"eps": eps, "force": force, "Q": Q, "harmonics": harmonics,
+                       "omega_range": [lo, hi]},
+        "one_harmonic": {"folds": [float(w) for w in folds1]},
+        "harmonic_balance": {"harmonics": harmonics, "folds": [float(w) for w in cont.folds]},
+        "numerical": {"folds": sorted(true_folds), "sweep_up_jump": up.jump,
+                      "sweep_down_jump": down.jump},
+    }
+
+
+def _cmd_response(args: argparse.Namespace) -> int:
+    data = response_json(args.eps, args.force, args.Q, args.harmonics)
+    if args.json:
+        print(json.dumps(data))
+        return 0
+    p = data["parameters"]
+    print(f"q'' + q'/Q + q + eps q^3 = f cos(w t): eps = {p['eps']}, f = {p['force']}, "
+          f"Q = {p['Q']}; w in [{p['omega_range'][0]:.4g}, {p['omega_range'][1]:.4g}]")
+    for label, folds in (("one harmonic", data["one_harmonic"]["folds"]),
+                         (f"harmonic balance N={args.harmonics}",
+                          data["harmonic_balance"]["folds"]),
+                         ("true orbit (Floquet +1)", data["numerical"]["folds"])):
+        print(f"{label:>26}: folds " + (", ".join(f"{w:.12f}" for w in folds) or "none"))
+    num = data["numerical"]
+    for label, key in (("sweep up jumps at", "sweep_up_jump"),
+                       ("sweep down jumps at", "sweep_down_jump")):
+        value = num[key]
+        print(f"{label:>26}: " + (f"{value:.4f}" if value is not None else "no jump"))
+    return 0
+
+
 def _order(text: str) -> int:
     try:
         return int(text)
@@ -293,6 +352,15 @@ def build_parser() -> argparse.ArgumentParser:
                    help="odd harmonics N of harmonic balance (default 4)")
     p.add_argument("--json", action="store_true", help="print the JSON contract")
     p.set_defaults(func=_cmd_driven)
+
+    p = sub.add_parser("response", help="folds and hysteresis of the damped driven oscillator")
+    p.add_argument("--eps", type=float, required=True)
+    p.add_argument("--force", type=float, required=True)
+    p.add_argument("--Q", type=float, required=True, help="quality factor (finite)")
+    p.add_argument("--harmonics", type=_order, default=8,
+                   help="odd harmonics N of the continued balance (default 8)")
+    p.add_argument("--json", action="store_true", help="print the JSON contract")
+    p.set_defaults(func=_cmd_response)
 
     p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults")
     p.add_argument("--out", default="generated", help="output folder (default generated/)")

@@ -238,51 +238,81 @@ class HarmonicBalance:
     converged: bool
 
 
-def harmonic_balance(d: Drive, start: Branch, harmonics: int, tol: float = 1e-13,
-                     max_iter: int = 50) -> HarmonicBalance:
-    """Newton's method on the Galerkin residual of eq. 10.60 (exact: products are
-    convolutions, no aliasing), started from a one-harmonic root."""
-    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 100:
-        raise InputError(f"harmonics {harmonics!r}: must be an integer in 1..100")
-    odd = np.arange(1, 2 * harmonics, 2)
-    M = 3 * (2 * harmonics - 1)
-    n = _harmonics(M)
-    # unknowns: a_k, b_k of q = Σ a_k cos kωt + b_k sin kωt
-    x = np.zeros(2 * len(odd))
-    x[0] = start.A1 * math.cos(start.delta0)
-    x[len(odd)] = start.A1 * math.sin(start.delta0)
-    drive = _cos_tau(M, d.force)
-    lin = -(n * d.omega) ** 2 + 1j * n * d.omega * d.damping + 1
+@dataclass(frozen=True)
+class BalanceSystem:
+    """The Galerkin residual of eq. 10.60 in ``x = (a_1, a_3, …, b_1, b_3, …)`` and ``ω``
+    (exact: products are convolutions, no aliasing), with its derivatives."""
 
-    def coeffs(x: np.ndarray) -> np.ndarray:
+    eps: float
+    force: float
+    damping: float
+    harmonics: int
+
+    @property
+    def odd(self) -> np.ndarray:
+        return np.arange(1, 2 * self.harmonics, 2)
+
+    @property
+    def M(self) -> int:
+        return 3 * (2 * self.harmonics - 1)
+
+    def coefficients(self, x: np.ndarray) -> np.ndarray:
+        """``c_n`` of ``e^{inωt}`` for ``q = Σ a_k cos kωt + b_k sin kωt``."""
+        odd, M, h = self.odd, self.M, self.harmonics
         c = np.zeros(2 * M + 1, dtype=complex)
-        z = (x[: len(odd)] - 1j * x[len(odd):]) / 2
+        z = (x[:h] - 1j * x[h:]) / 2
         c[M + odd] = z
         c[M - odd] = np.conj(z)
         return c
 
-    def project(R: np.ndarray) -> np.ndarray:
-        return np.concatenate([2 * R[M + odd].real, -2 * R[M + odd].imag])
+    def _project(self, R: np.ndarray) -> np.ndarray:
+        return np.concatenate([2 * R[self.M + self.odd].real, -2 * R[self.M + self.odd].imag])
 
-    def residual(x: np.ndarray) -> np.ndarray:
-        c = coeffs(x)
-        return project(lin * c + d.eps * _product(c, _product(c, c)) - drive)
+    def _linear(self, omega: float) -> np.ndarray:
+        n = _harmonics(self.M)
+        return -(n * omega) ** 2 + 1j * n * omega * self.damping + 1
 
+    def residual(self, x: np.ndarray, omega: float) -> np.ndarray:
+        c = self.coefficients(x)
+        return self._project(self._linear(omega) * c + self.eps * _product(c, _product(c, c))
+                             - _cos_tau(self.M, self.force))
+
+    def jacobian(self, x: np.ndarray, omega: float) -> np.ndarray:
+        """``∂R/∂x``: ``dR_n/dc_m = lin_n δ_nm + 3ε (q²)_{n−m}``, ``c_{±m} = (a_m ∓ i b_m)/2``."""
+        odd, M = self.odd, self.M
+        c = self.coefficients(x)
+        q2 = _product(c, c)
+        K_plus = np.diag(self._linear(omega)[M + odd]) + 3 * self.eps * q2[M + odd[:, None]
+                                                                           - odd[None, :]]
+        K_minus = 3 * self.eps * q2[M + odd[:, None] + odd[None, :]]
+        dR_da, dR_db = (K_plus + K_minus) / 2, -1j * (K_plus - K_minus) / 2
+        return np.block([[2 * dR_da.real, 2 * dR_db.real], [-2 * dR_da.imag, -2 * dR_db.imag]])
+
+    def d_omega(self, x: np.ndarray, omega: float) -> np.ndarray:
+        """``∂R/∂ω``: only the linear part depends on ω."""
+        n = _harmonics(self.M)
+        return self._project((-2 * n * n * omega + 1j * n * self.damping)
+                             * self.coefficients(x))
+
+
+def harmonic_balance(d: Drive, start: Branch, harmonics: int, tol: float = 1e-13,
+                     max_iter: int = 50) -> HarmonicBalance:
+    """Newton's method on :class:`BalanceSystem`, started from a one-harmonic root."""
+    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 100:
+        raise InputError(f"harmonics {harmonics!r}: must be an integer in 1..100")
+    system = BalanceSystem(d.eps, d.force, d.damping, harmonics)
+    x = np.zeros(2 * harmonics)
+    x[0] = start.A1 * math.cos(start.delta0)
+    x[harmonics] = start.A1 * math.sin(start.delta0)
     converged = False
     for _ in range(max_iter):
-        r = residual(x)
-        q2 = _product(coeffs(x), coeffs(x))
-        # dR_n/dc_m = lin_n δ_nm + 3ε (q²)_{n−m}; c_{±m} = (a_m ∓ i b_m)/2
-        K_plus = np.diag(lin[M + odd]) + 3 * d.eps * q2[M + odd[:, None] - odd[None, :]]
-        K_minus = 3 * d.eps * q2[M + odd[:, None] + odd[None, :]]
-        dR_da, dR_db = (K_plus + K_minus) / 2, -1j * (K_plus - K_minus) / 2
-        J = np.block([[2 * dR_da.real, 2 * dR_db.real], [-2 * dR_da.imag, -2 * dR_db.imag]])
-        step = np.linalg.solve(J, -r)
+        step = np.linalg.solve(system.jacobian(x, d.omega), -system.residual(x, d.omega))
         x = x + step
         if np.max(np.abs(step)) <= tol * (1 + np.max(np.abs(x))):
             converged = True
             break
-    return HarmonicBalance(harmonics, coeffs(x), float(np.max(np.abs(residual(x)))), converged)
+    residual = float(np.max(np.abs(system.residual(x, d.omega))))
+    return HarmonicBalance(harmonics, system.coefficients(x), residual, converged)
 
 
 # --- the first-order secular conditions, symbolically (display, tests) -----------------------

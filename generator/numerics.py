@@ -142,3 +142,100 @@ def shoot(eps: float, force: float, omega: float, damping: float, guess: np.ndar
     A = {n: float(2 * c[n].real) for n in range(1, harmonics + 1, 2)}
     B = {n: float(-2 * c[n].imag) for n in range(1, harmonics + 1, 2)}
     return PeriodicOrbit(y, A, B, lam, stable, float(np.max(np.abs(end[:2] - y))))
+
+
+@njit(cache=True)
+def _swept_force(t: float, q: float, p: float, eps: float, force: float, damping: float,
+                 omega0: float, beta: float) -> float:
+    """q̈ of eq. 10.60 under the drive f cos(ω₀t + βt²/2)."""
+    return force * np.cos(omega0 * t + 0.5 * beta * t * t) - damping * p - q - eps * q**3
+
+
+@njit(cache=True)
+def _sweep(eps: float, force: float, damping: float, omega0: float, omega1: float,
+           periods: int, steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """RK4 through a linear frequency sweep ``ω(t) = ω₀ + βt`` of ``periods`` drive periods;
+    per period: the mean ω and max |q|."""
+    mean = 0.5 * (omega0 + omega1)
+    duration = periods * 2 * np.pi / mean
+    beta = (omega1 - omega0) / duration
+    h = 2 * np.pi / (max(omega0, omega1) * steps)
+    n = int(duration / h) + 1
+    h = duration / n
+    q, p, t = 0.0, 0.0, 0.0
+    omegas = np.zeros(periods)
+    amps = np.zeros(periods)
+    counts = np.zeros(periods)
+    for _ in range(n):
+        phase = omega0 * t + 0.5 * beta * t * t
+        k = min(int(phase / (2 * np.pi)), periods - 1)
+        amps[k] = max(amps[k], abs(q))
+        omegas[k] += omega0 + beta * t
+        counts[k] += 1
+        args = (eps, force, damping, omega0, beta)
+        k1q, k1p = p, _swept_force(t, q, p, *args)
+        k2q = p + 0.5 * h * k1p
+        k2p = _swept_force(t + 0.5 * h, q + 0.5 * h * k1q, k2q, *args)
+        k3q = p + 0.5 * h * k2p
+        k3p = _swept_force(t + 0.5 * h, q + 0.5 * h * k2q, k3q, *args)
+        k4q = p + h * k3p
+        k4p = _swept_force(t + h, q + h * k3q, k4q, *args)
+        q += h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q)
+        p += h / 6 * (k1p + 2 * k2p + 2 * k3p + k4p)
+        t += h
+    return omegas / np.maximum(counts, 1), amps
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """A simulated slow sweep: amplitude per drive period and where it jumps."""
+
+    omega: np.ndarray
+    amplitude: np.ndarray
+    jump: float | None  # ω of the largest period-to-period change, if it is a jump
+
+
+SWEEP_STEPS = 64
+# NOTE: RK4 steps per drive period; the amplitude per period needs ~1e-6, not 1e-12.
+JUMP_RATIO = 2.0
+JUMP_WINDOW = 50
+# NOTE: the amplitude changing by 2× within 50 drive periods (a few damping times at the
+# Q of interest, a small step in ω at the default sweep rate) is a jump, not a slope.
+
+
+def sweep(eps: float, force: float, damping: float, omega_from: float, omega_to: float,
+          periods: int = 10_000) -> Sweep:
+    """Sweep the drive frequency slowly from ``omega_from`` to ``omega_to`` (compiled RK4)."""
+    omegas, amps = _sweep(eps, force, damping, omega_from, omega_to, periods, SWEEP_STEPS)
+    skip = periods // 20  # the start-up transient
+    a = amps[skip:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.maximum(a[JUMP_WINDOW:] / a[:-JUMP_WINDOW], a[:-JUMP_WINDOW] / a[JUMP_WINDOW:])
+    hits = np.nonzero(ratio > JUMP_RATIO)[0]
+    jump = float(omegas[skip + hits[0]]) if hits.size else None
+    return Sweep(omegas, amps, jump)
+
+
+def orbit_fold(eps: float, force: float, damping: float, omega: float, y0: np.ndarray,
+               tol: float = 1e-11) -> tuple[float, np.ndarray] | None:
+    """A fold of the true periodic orbit: ``φ_T(y₀) = y₀`` with a Floquet multiplier ``+1``
+    (``det(M − I) = 0``), by Newton's method in ``(y₀, ω)`` with a difference Jacobian."""
+    def F(z: np.ndarray) -> np.ndarray:
+        end, _ = flow(z[:2], 2 * np.pi / z[2], eps, force, z[2], damping, samples=1)
+        Mono = end[2:].reshape(2, 2).T
+        return np.array([*(end[:2] - z[:2]), np.linalg.det(Mono - np.eye(2))])
+
+    z = np.array([*y0, omega], dtype=float)
+    for _ in range(30):
+        f0 = F(z)
+        J = np.empty((3, 3))
+        for k in range(3):
+            h = 1e-7 * (1 + abs(z[k]))
+            e = np.zeros(3)
+            e[k] = h
+            J[:, k] = (F(z + e) - F(z - e)) / (2 * h)
+        dz = np.linalg.solve(J, -f0)
+        z = z + dz
+        if np.max(np.abs(dz)) < tol * (1 + np.max(np.abs(z))):
+            return float(z[2]), z[:2]
+    return None

@@ -1,0 +1,222 @@
+"""Frequency response of ``q̈ + q̇/Q + q + εq³ = f cos ωt``: branches, folds, hysteresis (§10.4).
+
+One harmonic: ``r²[(1 − ω² + ¾εr²)² + ω²/Q²] = f²`` is a cubic ``G(u) = 0`` in ``u = r²``.
+A branch is stable where ``∂G/∂u > 0`` (the slow flow of ``a, b`` has a saddle where it is
+negative, between the folds); the folds solve ``G = ∂G/∂u = 0``.  N harmonics: the balance of
+:class:`driven.BalanceSystem` continued in ω by pseudo-arclength through its folds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from .driven import BalanceSystem, Drive, first_order_branches
+from .errors import InputError
+
+_u, _w, _e, _f, _g = sp.symbols("u w e f g")  # u = r², w = ω², g = 1/Q
+_G = _u * ((1 - _w + sp.Rational(3, 4) * _e * _u) ** 2 + _w * _g**2) - _f**2
+_FOLD_POLY = sp.Poly(sp.resultant(_G, sp.diff(_G, _u), _u), _w)
+# NOTE: the resultant in u of G and ∂G/∂u is the cubic's discriminant, a polynomial in ω²
+# whose positive roots with a positive double root u are the folds.
+
+
+def amplitude_residual(u: np.ndarray, omega: np.ndarray, d: Drive) -> np.ndarray:
+    """``G(u) = u[(1 − ω² + ¾εu)² + ω²/Q²] − f²``."""
+    return u * ((1 - omega**2 + 0.75 * d.eps * u) ** 2 + omega**2 * d.damping**2) - d.force**2
+
+
+def amplitude_slope(u: np.ndarray, omega: np.ndarray, d: Drive) -> np.ndarray:
+    """``∂G/∂u``: positive on stable one-harmonic branches."""
+    a = 1 - omega**2 + 0.75 * d.eps * u
+    return a * a + omega**2 * d.damping**2 + 1.5 * d.eps * u * a
+
+
+@dataclass(frozen=True)
+class ResponseCurve:
+    """One-harmonic amplitudes ``r`` (NaN where a branch does not exist), largest first."""
+
+    omega: np.ndarray  # (n,)
+    r: np.ndarray  # (n, 3)
+    stable: np.ndarray  # (n, 3) bool
+
+
+def one_harmonic_curve(eps: float, force: float, Q: float, omega: np.ndarray) -> ResponseCurve:
+    """All real branches of the amplitude equation over ``omega``, vectorised.
+
+    The cubic in ``u`` is solved in closed form (trigonometric for three real roots, Cardano
+    for one), then each root is polished by two Newton steps on ``G``.
+    """
+    d = Drive(eps, force, 1.0, Q)
+    w = np.asarray(omega, dtype=float)
+    if np.any(~np.isfinite(w)) or np.any(w <= 0):
+        raise InputError("omega: every frequency must be finite and > 0")
+    if eps == 0:
+        u = force**2 / ((1 - w**2) ** 2 + w**2 * d.damping**2)
+        roots = np.stack([u, np.full_like(w, np.nan), np.full_like(w, np.nan)], axis=1)
+    else:
+        # (9/16)ε² u³ + (3/2)ε a u² + (a² + ω²g²) u − f² = 0, a = 1 − ω²
+        a = 1 - w**2
+        c3, c2, c1, c0 = 9 / 16 * eps**2, 1.5 * eps * a, a * a + w**2 * d.damping**2, -force**2
+        b, c, e = c2 / c3, c1 / c3, c0 / c3
+        p = c - b * b / 3
+        q = 2 * b**3 / 27 - b * c / 3 + e
+        disc = (q / 2) ** 2 + (p / 3) ** 3
+        with np.errstate(invalid="ignore", divide="ignore"):
+            m = 2 * np.sqrt(np.maximum(-p / 3, 0))
+            theta = np.arccos(np.clip(3 * q / (p * m), -1, 1)) / 3
+            trig = np.stack([m * np.cos(theta - 2 * np.pi * k / 3) for k in range(3)], axis=1)
+            s = np.sqrt(np.maximum(disc, 0))
+            cardano = np.cbrt(-q / 2 + s) + np.cbrt(-q / 2 - s)
+        one = disc > 0
+        roots = np.where(one[:, None], np.stack([cardano, np.full_like(w, np.nan),
+                                                 np.full_like(w, np.nan)], axis=1), trig)
+        roots = roots - (b / 3)[:, None]
+        for _ in range(2):
+            W = w[:, None]
+            G = amplitude_residual(roots, W, d)
+            dG = amplitude_slope(roots, W, d)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                roots = np.where(dG != 0, roots - G / dG, roots)
+    roots = np.where(roots > 0, roots, np.nan)
+    roots = -np.sort(-roots, axis=1)  # NaN last, largest first
+    r = np.sqrt(roots)
+    with np.errstate(invalid="ignore"):
+        stable = amplitude_slope(roots, w[:, None], d) > 0
+    return ResponseCurve(w, r, stable & np.isfinite(r))
+
+
+def one_harmonic_folds(eps: float, force: float, Q: float) -> list[float]:
+    """Fold frequencies (ascending) to full double precision: ``G = ∂G/∂u = 0``.
+
+    Candidates from the roots in ω² of the discriminant, polished by Newton's method on the
+    2×2 system in ``(u, ω)``.
+    """
+    d = Drive(eps, force, 1.0, Q)
+    if eps == 0:
+        return []
+    values = {_e: eps, _f: force, _g: d.damping}
+    coeffs = [float(c.subs(values)) for c in _FOLD_POLY.all_coeffs()]
+    folds = []
+    for w2 in np.roots(coeffs):
+        if abs(w2.imag) > 1e-8 * (1 + abs(w2)) or w2.real <= 0:
+            continue
+        omega = float(np.sqrt(w2.real))
+        # the double root u of the cubic: ∂G/∂u = 0 is quadratic in u
+        a = 1 - omega**2
+        us = np.roots([27 / 16 * eps**2, 3 * eps * a, a * a + omega**2 * d.damping**2])
+        us = [float(x.real) for x in us if abs(x.imag) < 1e-8 * (1 + abs(x)) and x.real > 0]
+        if not us:
+            continue
+        u = min(us, key=lambda x: abs(amplitude_residual(x, omega, d)))
+        for _ in range(20):
+            G, Gu = amplitude_residual(u, omega, d), amplitude_slope(u, omega, d)
+            A = 1 - omega**2 + 0.75 * eps * u
+            Gw = u * (-4 * omega * A + 2 * omega * d.damping**2)
+            Guu = 2 * A * 0.75 * eps + 1.5 * eps * A + 1.5 * eps * u * 0.75 * eps
+            Guw = 2 * A * (-2 * omega) + 2 * omega * d.damping**2 + 1.5 * eps * u * (-2 * omega)
+            step = np.linalg.solve([[Gu, Gw], [Guu, Guw]], [-G, -Gu])
+            u, omega = u + step[0], omega + step[1]
+            if np.max(np.abs(step)) < 1e-15 * (1 + abs(omega) + abs(u)):
+                break
+        if u > 0 and abs(amplitude_residual(u, omega, d)) < 1e-9 * (1 + force**2):
+            folds.append(float(omega))
+    return sorted({float(w) for w in folds})
+
+
+@dataclass(frozen=True)
+class Continuation:
+    """A branch of N-harmonic balance traced in ω by pseudo-arclength."""
+
+    omega: np.ndarray
+    x: np.ndarray  # (points, 2N): a_1, a_3, …, b_1, b_3, …
+    folds: list[float]  # where dω/ds changes sign, refined
+
+
+def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_start: float,
+                     omega_stop: float, step: float = 0.02,
+                     max_points: int = 20000) -> Continuation:
+    """Trace the harmonic-balance solution from ``omega_start`` (largest one-harmonic branch)
+    until ω leaves ``[min, max]`` of the two ends, through any number of folds."""
+    sysm = BalanceSystem(eps, force, 1 / Q if np.isfinite(Q) else 0.0, harmonics)
+    lo, hi = sorted((omega_start, omega_stop))
+    (br, *_) = first_order_branches(Drive(eps, force, omega_start, Q))
+    x = np.zeros(2 * harmonics)
+    x[0], x[harmonics] = br.A1 * np.cos(br.delta0), br.A1 * np.sin(br.delta0)
+    x = _newton_fixed_omega(sysm, x, omega_start)
+    y = np.append(x, omega_start)
+    direction = 1.0 if omega_stop > omega_start else -1.0
+    t = _tangent(sysm, y, None)
+    if t[-1] * direction < 0:
+        t = -t
+    points, folds = [y], []
+    for _ in range(max_points):
+        y_new = _corrector(sysm, y + step * t, t)
+        t_new = _tangent(sysm, y_new, t)
+        if t_new[-1] * t[-1] < 0:
+            folds.append(_refine_fold(sysm, y, t, step))
+        y, t = y_new, t_new
+        points.append(y)
+        if not lo <= y[-1] <= hi:
+            break
+    arr = np.array(points)
+    return Continuation(arr[:, -1], arr[:, :-1], sorted(folds))
+
+
+def _newton_fixed_omega(sysm: BalanceSystem, x: np.ndarray, omega: float) -> np.ndarray:
+    for _ in range(50):
+        dx = np.linalg.solve(sysm.jacobian(x, omega), -sysm.residual(x, omega))
+        x = x + dx
+        if np.max(np.abs(dx)) < 1e-14 * (1 + np.max(np.abs(x))):
+            break
+    return x
+
+
+def _extended_jacobian(sysm: BalanceSystem, y: np.ndarray) -> np.ndarray:
+    x, omega = y[:-1], y[-1]
+    return np.column_stack([sysm.jacobian(x, omega), sysm.d_omega(x, omega)])
+
+
+def _tangent(sysm: BalanceSystem, y: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
+    """Unit null vector of ``[R_x | R_ω]``, oriented along ``previous``."""
+    _, _, vt = np.linalg.svd(_extended_jacobian(sysm, y))
+    t = vt[-1]
+    if previous is not None and t @ previous < 0:
+        t = -t
+    return t
+
+
+def _corrector(sysm: BalanceSystem, y: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Newton on ``R(y) = 0`` with ``t·(y − y_pred) = 0``."""
+    y_pred = y.copy()
+    for _ in range(30):
+        x, omega = y[:-1], y[-1]
+        F = np.append(sysm.residual(x, omega), t @ (y - y_pred))
+        J = np.vstack([_extended_jacobian(sysm, y), t])
+        dy = np.linalg.solve(J, -F)
+        y = y + dy
+        if np.max(np.abs(dy)) < 1e-13 * (1 + np.max(np.abs(y))):
+            break
+    return y
+
+
+def _refine_fold(sysm: BalanceSystem, y: np.ndarray, t: np.ndarray, step: float) -> float:
+    """Secant on the step length for ``t_ω = 0`` between two continuation points."""
+    def t_omega(h: float) -> tuple[float, np.ndarray]:
+        z = _corrector(sysm, y + h * t, t)
+        return _tangent(sysm, z, t)[-1], z
+
+    h0, h1 = 0.0, step
+    f0, f1 = t[-1], t_omega(step)[0]
+    z = y
+    for _ in range(40):
+        if f1 == f0:
+            break
+        h2 = h1 - f1 * (h1 - h0) / (f1 - f0)
+        f2, z = t_omega(h2)
+        h0, f0, h1, f1 = h1, f1, h2, f2
+        if abs(f2) < 1e-13:
+            break
+    return float(z[-1])
