@@ -27,7 +27,7 @@ from .errors import InputError
 from .lindstedt import SeriesSolution, derive
 from .models import MODELS, check_order, model_by_name
 from .numerics import duffing_period_exact, orbit_fold, pendulum_period_exact, shoot, sweep
-from .response import continue_balance, one_harmonic_folds
+from .response import continue_balance, one_harmonic_folds, subharmonic
 
 DEFAULT_ORDER = 12
 # NOTE: order 12 keeps T(A) within 1e-6 for |εA²| ≤ 0.3 and the LaTeX a few pages long.
@@ -296,6 +296,43 @@ def _cmd_response(args: argparse.Namespace) -> int:
     return 0
 
 
+def subharmonic_json(eps: float, force: float, omega: float) -> dict:
+    """The contract of ``lindstedt subharmonic … --json`` (eq. 10.83–10.87)."""
+    exists, reason, solutions = subharmonic(eps, force, omega)
+    return {
+        "parameters": {"eps": eps, "force": force, "omega": omega, "drive": 3 * omega},
+        "exists": exists,
+        "reason": reason,
+        "solutions": [{
+            "root": s.root,
+            "a": s.a,
+            "F": s.F,
+            "hill_stable": s.hill_stable,
+            "floquet_moduli": sorted(float(abs(m)) for m in s.hill_multipliers),
+            "numerical": None if s.orbit is None else {
+                "a1": s.orbit.A[1], "a3": s.orbit.A[3], "stable": s.orbit.stable,
+                "floquet_moduli": sorted(float(abs(m)) for m in s.orbit.multipliers)},
+        } for s in solutions],
+    }
+
+
+def _cmd_subharmonic(args: argparse.Namespace) -> int:
+    data = subharmonic_json(args.eps, args.force, args.omega)
+    if args.json:
+        print(json.dumps(data))
+        return 0
+    print(f"omega^2 q'' + q + eps q^3 = f cos 3tau: eps = {args.eps}, f = {args.force}, "
+          f"omega = {args.omega} (drive at {3 * args.omega:g})")
+    print(("exists: " if data["exists"] else "no subharmonic: ") + data["reason"])
+    for s in data["solutions"]:
+        num = s["numerical"]
+        true = "no orbit found" if num is None else (
+            f"true orbit a1 = {num['a1']:.6f}, {'stable' if num['stable'] else 'unstable'}")
+        print(f"  root {s['root']}: a = {s['a']:.6f}, Hill: "
+              f"{'stable' if s['hill_stable'] else 'unstable'}; {true}")
+    return 0
+
+
 def _order(text: str) -> int:
     try:
         return int(text)
@@ -361,6 +398,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="odd harmonics N of the continued balance (default 8)")
     p.add_argument("--json", action="store_true", help="print the JSON contract")
     p.set_defaults(func=_cmd_response)
+
+    p = sub.add_parser("subharmonic", help="the 1/3 subharmonic of eq. 10.83 and its stability")
+    p.add_argument("--eps", type=float, required=True)
+    p.add_argument("--force", type=float, required=True)
+    p.add_argument("--omega", type=float, required=True,
+                   help="omega of eq. 10.83 (the drive is at 3*omega)")
+    p.add_argument("--json", action="store_true", help="print the JSON contract")
+    p.set_defaults(func=_cmd_subharmonic)
 
     p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults")
     p.add_argument("--out", default="generated", help="output folder (default generated/)")

@@ -410,7 +410,7 @@ def mu_expansion_exact(order: int) -> tuple[MuOrder, ...]:
 
 # --- harmonic balance, symbolically (emitted as compiled residual and Jacobian) --------------
 
-def _trig_product(x: dict, y: dict) -> dict:
+def trig_product(x: dict, y: dict) -> dict:
     """Product of real Fourier sums ``{(n, "c"|"s"): coeff}`` by product-to-sum."""
     out: dict = {}
 
@@ -455,7 +455,7 @@ def balance_equations(harmonics: int) -> BalanceEquations:
     w, eps, f, g = sp.symbols("omega eps force damping")
     q = {**{(k, "c"): ak for k, ak in zip(odd, a, strict=True)},
          **{(k, "s"): bk for k, bk in zip(odd, b, strict=True)}}
-    cube = _trig_product(_trig_product(q, q), q)
+    cube = trig_product(trig_product(q, q), q)
     cos_res, sin_res = [], []
     for k, ak, bk in zip(odd, a, b, strict=True):
         # q̇ contributes kω(b_k cos − a_k sin), q̈ contributes −(kω)² q

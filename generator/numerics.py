@@ -111,15 +111,18 @@ class PeriodicOrbit:
 
 
 def shoot(eps: float, force: float, omega: float, damping: float, guess: np.ndarray,
-          harmonics: int = 9, tol: float = 1e-12, max_iter: int = 30) -> PeriodicOrbit | None:
+          harmonics: int = 9, tol: float = 1e-12, max_iter: int = 30,
+          periods: int = 1) -> PeriodicOrbit | None:
     """Newton's method on ``φ_T(y₀) − y₀ = 0`` (the monodromy matrix is its Jacobian + I).
 
     Stability from the Floquet multipliers: damped, stable when all ``|λ| < 1``; undamped
     (Hamiltonian, ``det M = 1``), linearly stable when the pair lies on the unit circle,
     i.e. ``|tr M| < 2`` (a real pair ``λ, 1/λ`` with ``|tr M| > 2`` is unstable).
-    Returns ``None`` when Newton's method does not converge.
+    ``periods = p`` looks for an orbit of p drive periods; its ``A``, ``B`` are then the
+    coefficients of ``cos(nωt/p)``, ``sin(nωt/p)``.  Returns ``None`` when Newton's method
+    does not converge.
     """
-    T = 2 * np.pi / omega
+    T = periods * 2 * np.pi / omega  # periods = 3: the 1/3 subharmonic (eq. 10.83)
     y = np.array(guess, dtype=float)
     for _ in range(max_iter):
         end, _ = flow(y, T, eps, force, omega, damping)
@@ -239,3 +242,34 @@ def orbit_fold(eps: float, force: float, damping: float, omega: float, y0: np.nd
         if np.max(np.abs(dz)) < tol * (1 + np.max(np.abs(z))):
             return float(z[2]), z[:2]
     return None
+
+
+@njit(cache=True)
+def _hill(omega: float, eps: float, a: float, b: float, F: float, steps: int) -> np.ndarray:
+    """Monodromy over τ ∈ [0, 2π] of ω²ξ'' + (1 + 3εq₀²)ξ = 0, q₀ = a cos τ + b sin τ + F cos 3τ."""
+    h = 2 * np.pi / steps
+    M = np.eye(2)
+    for col in range(2):
+        x, v = M[0, col], M[1, col]
+        for i in range(steps):
+            tau = i * h
+
+            def k(tt: float, xx: float) -> float:  # ξ'' = −(1 + 3εq₀²)ξ / ω²
+                q0 = a * np.cos(tt) + b * np.sin(tt) + F * np.cos(3 * tt)
+                return -(1 + 3 * eps * q0 * q0) * xx / (omega * omega)
+
+            k1x, k1v = v, k(tau, x)
+            k2x, k2v = v + 0.5 * h * k1v, k(tau + 0.5 * h, x + 0.5 * h * k1x)
+            k3x, k3v = v + 0.5 * h * k2v, k(tau + 0.5 * h, x + 0.5 * h * k2x)
+            k4x, k4v = v + h * k3v, k(tau + h, x + h * k3x)
+            x += h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x)
+            v += h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
+        M[0, col], M[1, col] = x, v
+    return M
+
+
+def hill_multipliers(omega: float, eps: float, a: float, b: float, F: float,
+                     steps: int = 2048) -> np.ndarray:
+    """Floquet multipliers of the Hill equation (notes after eq. 10.87), Richardson-combined."""
+    coarse, fine = _hill(omega, eps, a, b, F, steps), _hill(omega, eps, a, b, F, 2 * steps)
+    return np.linalg.eigvals(fine + (fine - coarse) / 15)

@@ -13,8 +13,9 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from .driven import BalanceSystem, Drive, first_order_branches
+from .driven import BalanceSystem, Drive, first_order_branches, trig_product
 from .errors import InputError
+from .numerics import hill_multipliers, shoot
 
 _u, _w, _e, _f, _g = sp.symbols("u w e f g")  # u = r², w = ω², g = 1/Q
 _G = _u * ((1 - _w + sp.Rational(3, 4) * _e * _u) ** 2 + _w * _g**2) - _f**2
@@ -220,3 +221,66 @@ def _refine_fold(sysm: BalanceSystem, y: np.ndarray, t: np.ndarray, step: float)
         if abs(f2) < 1e-13:
             break
     return float(z[-1])
+
+
+# --- the 1/3 subharmonic (eq. 10.83–10.87) ---------------------------------------------------
+
+_a, _b, _F, _w1, _eps1 = sp.symbols("a b F omega epsilon")
+
+
+def subharmonic_secular() -> tuple[sp.Expr, sp.Expr]:
+    """The cos τ and sin τ coefficients of ``ω²q₀'' + q₀ + εq₀³ − f cos 3τ`` divided by ε,
+    ``q₀ = a cos τ + b sin τ + F cos 3τ``, ``F = f/(1 − 9ω²)`` (eq. 10.85, 10.86), by
+    product-to-sum."""
+    q = {(1, "c"): _a, (1, "s"): _b, (3, "c"): _F}
+    cube = trig_product(trig_product(q, q), q)
+    cos_eq = sp.expand(((1 - _w1**2) * _a + _eps1 * cube[(1, "c")]) / _eps1)
+    sin_eq = sp.expand(((1 - _w1**2) * _b + _eps1 * cube[(1, "s")]) / _eps1)
+    return cos_eq, sin_eq
+
+
+@dataclass(frozen=True)
+class Subharmonic:
+    """One root of eq. 10.87 with its Hill and true-orbit verdicts."""
+
+    root: str  # "+" or "-"
+    a: float
+    F: float  # f/(1 − 9ω²), the amplitude of cos 3τ
+    hill_multipliers: np.ndarray
+    hill_stable: bool
+    orbit: object | None  # numerics.PeriodicOrbit of period 2π/ω, or None
+
+
+ORBIT_MATCH = 0.25
+# NOTE: the true orbit differs from a(f) by O(ε); a first harmonic further off than 25 % is
+# another orbit that shooting fell onto (the 1:1 response, or the rotation −a/2 of the other root).
+
+
+def subharmonic(eps: float, force: float, omega: float) -> tuple[bool, str, list[Subharmonic]]:
+    """The b = 0 solutions ``a(f) = −F/2 ± √((16(ω² − 1)/ε − 21F²)/12)`` of eq. 10.87.
+
+    Returns ``(exists, reason, solutions)``; each solution's stability comes from the Hill
+    equation ``ω²ξ'' + (1 + 3εq₀²)ξ = 0`` (stable when ``|tr M| < 2``) and from the Floquet
+    multipliers of the true orbit found by shooting (period three drive periods).
+    """
+    d = Drive(eps, force, omega)  # validation
+    if abs(1 - 9 * omega**2) < 1e-12:
+        return False, "omega = 1/3: the drive is resonant with q'' + q itself (F infinite)", []
+    if d.eps == 0:
+        return False, "eps = 0: a linear oscillator has no subharmonic response", []
+    F = force / (1 - 9 * omega**2)
+    disc = (16 * (omega**2 - 1) / eps - 21 * F**2) / 12
+    if disc < 0:
+        return False, (f"16(omega^2 - 1)/eps = {16 * (omega**2 - 1) / eps:.6g} < 21 F^2 = "
+                       f"{21 * F**2:.6g}: eq. 10.87 has no real amplitude"), []
+    out = []
+    for sign in ("+", "-"):
+        a = -F / 2 + (1 if sign == "+" else -1) * np.sqrt(disc)
+        lam = hill_multipliers(omega, eps, a, 0.0, F)
+        orbit = shoot(eps, force, 3 * omega, 0.0, np.array([a + F, 0.0]), harmonics=5,
+                      periods=3)
+        if orbit is not None and abs(orbit.A[1] - a) > ORBIT_MATCH * abs(a):
+            orbit = None  # Newton fell onto another orbit (1:1, or a rotated root): not this one
+        out.append(Subharmonic(sign, float(a), float(F), lam,
+                               bool(abs(np.sum(lam).real) < 2), orbit))
+    return True, "16(omega^2 - 1)/eps >= 21 F^2", out

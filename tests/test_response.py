@@ -112,3 +112,66 @@ def test_curve_bad_frequency(omega):
 
     with pytest.raises(InputError):
         one_harmonic_curve(EPS, F, Q, omega)
+
+
+# --- the 1/3 subharmonic ----------------------------------------------------------------------
+
+def test_subharmonic_secular_conditions_are_the_notes():
+    import sympy as sp
+
+    from generator.response import subharmonic_secular
+
+    a, b, F, w, e = sp.symbols("a b F omega epsilon")
+    cos_eq, sin_eq = subharmonic_secular()
+    bracket = (1 - w**2) / e + 3 * F**2 / 2 + sp.Rational(3, 4) * (a**2 + b**2)
+    assert sp.expand(cos_eq - (a * bracket - 3 * F / 4 * (b**2 - a**2))) == 0  # eq. 10.85
+    assert sp.expand(sin_eq - (b * bracket - 3 * F / 4 * 2 * a * b)) == 0  # eq. 10.86
+    # b·(10.85) − a·(10.86) ∝ b(b² − 3a²): solutions b = 0 and a = ±b/√3
+    assert sp.factor(b * cos_eq - a * sin_eq) == sp.factor(-3 * F / 4 * b * (b**2 - 3 * a**2))
+    # eq. 10.87 solves the b = 0 condition
+    for sign in (1, -1):
+        root = -F / 2 + sign * sp.sqrt((16 * (w**2 - 1) / e - 21 * F**2) / 12)
+        assert sp.simplify(cos_eq.subs({b: 0}).subs(a, root)) == 0
+    # a rotation τ → τ + 2π/3 of the b = 0 solution is the a = −b/√3 one
+    vals = {F: sp.Rational(-1, 24), w: sp.Rational(6, 5), e: sp.Rational(1, 10)}
+    a0 = (-F / 2 + sp.sqrt((16 * (w**2 - 1) / e - 21 * F**2) / 12)).subs(vals)
+    rot = {a: -a0 / 2, b: -a0 * sp.sqrt(3) / 2}
+    assert sp.simplify(cos_eq.subs(vals).subs(rot)) == 0
+    assert sp.simplify(sin_eq.subs(vals).subs(rot)) == 0
+
+
+def test_subharmonic_against_true_orbit():
+    from generator.response import subharmonic
+
+    exists, _, sols = subharmonic(0.1, 0.5, 1.2)
+    assert exists and [s.root for s in sols] == ["+", "-"]
+    for s in sols:
+        assert s.orbit is not None
+        assert abs(s.orbit.A[1] - s.a) < 0.02 * abs(s.a)  # first order in ε
+        assert abs(s.orbit.A[3] - s.F) < 0.1  # the cos 3τ amplitude, to O(ε)
+        assert s.hill_stable == s.orbit.stable  # the notes' claim holds here
+    assert [s.orbit.stable for s in sols] == [True, False]
+
+
+def test_hill_verdict_fails_for_the_negative_root_at_small_eps(monkeypatch):
+    """Reported in the README: the Hill test with q₀ calls the negative root stable here, the
+    true orbit's multipliers (at two step sizes) say unstable."""
+    import generator.numerics as numerics
+    from generator.response import subharmonic
+
+    _, _, sols = subharmonic(0.05, 0.5, 1.3)
+    minus = sols[1]
+    assert minus.root == "-" and minus.hill_stable and not minus.orbit.stable
+    monkeypatch.setattr(numerics, "STEPS_PER_PERIOD", 2 * numerics.STEPS_PER_PERIOD)
+    _, _, again = subharmonic(0.05, 0.5, 1.3)
+    assert not again[1].orbit.stable
+    np.testing.assert_allclose(sorted(abs(again[1].orbit.multipliers)),
+                               sorted(abs(minus.orbit.multipliers)), rtol=1e-6)
+
+
+def test_subharmonic_does_not_exist_and_says_why():
+    out = subprocess.run([sys.executable, "-m", "generator", "subharmonic", "--eps", "0.1",
+                          "--force", "0.5", "--omega", "0.9", "--json"],
+                         capture_output=True, text=True, check=False)
+    data = json.loads(out.stdout)
+    assert data["exists"] is False and data["solutions"] == [] and "21 F^2" in data["reason"]
