@@ -26,8 +26,21 @@ from .emit import generate, generate_balance, generate_driven, load_generated
 from .errors import InputError
 from .lindstedt import SeriesSolution, derive
 from .models import MODELS, check_order, model_by_name
-from .numerics import duffing_period_exact, orbit_fold, pendulum_period_exact, shoot, sweep
-from .response import continue_balance, one_harmonic_folds, subharmonic
+from .numerics import (
+    duffing_period_exact,
+    orbit_fold,
+    pendulum_period_exact,
+    shoot,
+    steady_state_amplitudes,
+    sweep,
+)
+from .response import (
+    continue_balance,
+    mixing_tones,
+    one_harmonic_folds,
+    subharmonic,
+    tone_label,
+)
 
 DEFAULT_ORDER = 12
 # NOTE: order 12 keeps T(A) within 1e-6 for |εA²| ≤ 0.3 and the LaTeX a few pages long.
@@ -333,6 +346,43 @@ def _cmd_subharmonic(args: argparse.Namespace) -> int:
     return 0
 
 
+def mixing_json(eps: float, Q: float, drives: list[tuple[float, float]]) -> dict:
+    """The contract of ``lindstedt mixing … --json``: predicted and simulated tones."""
+    tones = mixing_tones(eps, Q, drives)
+    simulated = steady_state_amplitudes(eps, 1 / Q, [f for f, _ in drives],
+                                        [w for _, w in drives], [t.frequency for t in tones])
+    return {
+        "parameters": {"eps": eps, "Q": Q, "drives": [{"force": f, "omega": w}
+                                                      for f, w in drives]},
+        "tones": [{"frequency": t.frequency, "combination": tone_label(t.combination),
+                   "order": t.order, "predicted": t.predicted, "simulated": float(s)}
+                  for t, s in zip(tones, simulated, strict=True)],
+    }
+
+
+def _drive(text: str) -> tuple[float, float]:
+    try:
+        f, w = text.split("@")
+        return float(f), float(w)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"drive {text!r}: expected F@W, e.g. 0.3@1.3") from None
+
+
+def _cmd_mixing(args: argparse.Namespace) -> int:
+    data = mixing_json(args.eps, args.Q, args.drive)
+    if args.json:
+        print(json.dumps(data))
+        return 0
+    print(f"q'' + q'/Q + q + eps q^3 = sum f_i cos(w_i t): eps = {args.eps}, Q = {args.Q}, "
+          + ", ".join(f"w{i} = {d['omega']} (f = {d['force']})"
+                      for i, d in enumerate(data["parameters"]["drives"], 1)))
+    print(f"{'tone':>12} {'frequency':>10} {'order':>6} {'predicted':>11} {'simulated':>11}")
+    for t in data["tones"]:
+        print(f"{t['combination']:>12} {t['frequency']:>10.4f} {t['order']:>6} "
+              f"{t['predicted']:>11.3e} {t['simulated']:>11.3e}")
+    return 0
+
+
 def _order(text: str) -> int:
     try:
         return int(text)
@@ -406,6 +456,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="omega of eq. 10.83 (the drive is at 3*omega)")
     p.add_argument("--json", action="store_true", help="print the JSON contract")
     p.set_defaults(func=_cmd_subharmonic)
+
+    p = sub.add_parser("mixing", help="combination tones of a two-tone drive")
+    p.add_argument("--eps", type=float, required=True)
+    p.add_argument("--Q", type=float, required=True, help="quality factor (finite)")
+    p.add_argument("--drive", type=_drive, action="append", required=True,
+                   help="F@W: a drive f cos(w t); repeat for each tone")
+    p.add_argument("--json", action="store_true", help="print the JSON contract")
+    p.set_defaults(func=_cmd_mixing)
 
     p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults")
     p.add_argument("--out", default="generated", help="output folder (default generated/)")

@@ -273,3 +273,54 @@ def hill_multipliers(omega: float, eps: float, a: float, b: float, F: float,
     """Floquet multipliers of the Hill equation (notes after eq. 10.87), Richardson-combined."""
     coarse, fine = _hill(omega, eps, a, b, F, steps), _hill(omega, eps, a, b, F, 2 * steps)
     return np.linalg.eigvals(fine + (fine - coarse) / 15)
+
+
+@njit(cache=True)
+def _multi_tone(t: float, q: float, p: float, eps: float, damping: float, forces: np.ndarray,
+                omegas: np.ndarray) -> float:
+    drive = 0.0
+    for i in range(forces.size):
+        drive += forces[i] * np.cos(omegas[i] * t)
+    return drive - damping * p - q - eps * q**3
+
+
+@njit(cache=True)
+def _simulate(eps: float, damping: float, forces: np.ndarray, omegas: np.ndarray, h: float,
+              n_skip: int, n_keep: int, every: int) -> np.ndarray:
+    """RK4 from rest; after ``n_skip`` steps keep q every ``every`` steps, ``n_keep`` values."""
+    q = p = t = 0.0
+    out = np.empty(n_keep)
+    total = n_skip + n_keep * every
+    for i in range(total):
+        if i >= n_skip and (i - n_skip) % every == 0:
+            out[(i - n_skip) // every] = q
+        k1q, k1p = p, _multi_tone(t, q, p, eps, damping, forces, omegas)
+        k2q = p + 0.5 * h * k1p
+        k2p = _multi_tone(t + 0.5 * h, q + 0.5 * h * k1q, k2q, eps, damping, forces, omegas)
+        k3q = p + 0.5 * h * k2p
+        k3p = _multi_tone(t + 0.5 * h, q + 0.5 * h * k2q, k3q, eps, damping, forces, omegas)
+        k4q = p + h * k3p
+        k4p = _multi_tone(t + h, q + h * k3q, k4q, eps, damping, forces, omegas)
+        q += h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q)
+        p += h / 6 * (k1p + 2 * k2p + 2 * k3p + k4p)
+        t += h
+    return out
+
+
+def steady_state_amplitudes(eps: float, damping: float, forces: list[float],
+                            omegas: list[float], frequencies: list[float],
+                            settle: float | None = None, window: float = 2000.0) -> np.ndarray:
+    """Amplitudes of the simulated steady state at ``frequencies`` (least squares on cos/sin
+    over a long window after the transients, ~``20 Q`` time units, have died out)."""
+    settle = 40.0 / damping if settle is None else settle
+    h = 2 * np.pi / (max(max(omegas), max(frequencies)) * 64)
+    every = 4
+    n_keep = int(window / (h * every))
+    q = _simulate(eps, damping, np.array(forces, float), np.array(omegas, float), h,
+                  int(settle / h), n_keep, every)
+    t = settle + np.arange(n_keep) * h * every
+    basis = [np.ones_like(t)]
+    for nu in frequencies:
+        basis += [np.cos(nu * t), np.sin(nu * t)]
+    coef, *_ = np.linalg.lstsq(np.column_stack(basis), q, rcond=None)
+    return np.hypot(coef[1::2], coef[2::2])

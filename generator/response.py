@@ -284,3 +284,80 @@ def subharmonic(eps: float, force: float, omega: float) -> tuple[bool, str, list
         out.append(Subharmonic(sign, float(a), float(F), lam,
                                bool(abs(np.sum(lam).real) < 2), orbit))
     return True, "16(omega^2 - 1)/eps >= 21 F^2", out
+
+
+# --- frequency mixing ------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Tone:
+    """A combination tone ``m₁ω₁ + m₂ω₂ (+ …)`` of the response, its predicted amplitude
+    (through second order in ε) and the order at which it first appears."""
+
+    combination: tuple[int, ...]
+    frequency: float
+    predicted: float
+    order: int
+
+
+def tone_label(combo: tuple[int, ...]) -> str:
+    """``(2, -1)`` -> ``"2w1-w2"``, ``(-1, 2)`` -> ``"2w2-w1"`` (positive terms first)."""
+    terms = sorted(((m, i) for i, m in enumerate(combo, 1) if m), key=lambda mi: mi[0] < 0)
+    text = ""
+    for m, i in terms:
+        sign = "-" if m < 0 else ("+" if text else "")
+        text += f"{sign}{'' if abs(m) == 1 else abs(m)}w{i}"
+    return text or "0"
+
+
+def _cube(x: dict, y: dict) -> dict:
+    """Product of phasor sums ``{combination: c}`` (``Σ c e^{i(m·ω)t}``)."""
+    out: dict = {}
+    for ka, a in x.items():
+        for kb, b in y.items():
+            k = tuple(i + j for i, j in zip(ka, kb, strict=True))
+            out[k] = out.get(k, 0) + a * b
+    return out
+
+
+def mixing_tones(eps: float, Q: float, drives: list[tuple[float, float]]) -> list[Tone]:
+    """Combination tones of ``q̈ + q̇/Q + q + εq³ = Σ f_i cos ω_i t`` to second order in ε.
+
+    ``q₀ = Σ Re(χ(ω_i) f_i e^{iω_i t})``, ``χ(ν) = 1/(1 − ν² + iν/Q)``; ``q₁ = −χ·[q₀³]`` holds
+    the tones ``±ω_i ± ω_j ± ω_k`` (for two drives: ω₁, ω₂, 3ω₁, 3ω₂, 2ω₁ ± ω₂, 2ω₂ ± ω₁ —
+    not ω₁ ± ω₂, which a cubic force cannot make); ``q₂ = −3χ·[q₀²q₁]`` the five-fold ones.
+    """
+    if not drives:
+        raise InputError("mixing: give at least one drive F@W")
+    for f, w in drives:
+        Drive(eps, f, w, Q)  # validation of every number
+    if not np.isfinite(Q):
+        raise InputError("Q inf: mixing needs damping (finite Q) for a steady state")
+    k = len(drives)
+    omegas = np.array([w for _, w in drives])
+
+    def chi(combo: tuple[int, ...]) -> complex:
+        nu = float(np.dot(combo, omegas))
+        return 1 / (1 - nu * nu + 1j * nu / Q)
+
+    q0: dict = {}
+    for i, (f, _) in enumerate(drives):
+        e = tuple(int(j == i) for j in range(k))
+        q0[e] = chi(e) * f / 2
+        q0[tuple(-m for m in e)] = np.conj(q0[e])
+    cube0 = _cube(_cube(q0, q0), q0)
+    q1 = {c: -eps * chi(c) * v for c, v in cube0.items()}
+    q0sq = _cube(q0, q0)
+    q2 = {c: -3 * eps * chi(c) * v for c, v in _cube(q0sq, q1).items()}
+    tones: dict = {}
+    for order, part in ((0, q0), (1, q1), (2, q2)):
+        for c, v in part.items():
+            nu = float(np.dot(c, omegas))
+            if nu <= 1e-12:
+                continue
+            # combinations at the same frequency add; label by the lowest order's combination
+            key = round(nu, 12)
+            prev = tones.get(key)
+            tones[key] = (prev[0] if prev else c, (prev[1] if prev else 0) + v,
+                          min(order, prev[2]) if prev else order)
+    return sorted((Tone(c, nu, float(2 * abs(v)), order) for nu, (c, v, order) in tones.items()),
+                  key=lambda tone: (tone.order, tone.frequency))

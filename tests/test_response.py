@@ -175,3 +175,30 @@ def test_subharmonic_does_not_exist_and_says_why():
                          capture_output=True, text=True, check=False)
     data = json.loads(out.stdout)
     assert data["exists"] is False and data["solutions"] == [] and "21 F^2" in data["reason"]
+
+
+# --- frequency mixing -------------------------------------------------------------------------
+
+def test_cubic_mixing_makes_three_fold_combinations_not_sums():
+    from generator.response import mixing_tones, tone_label
+
+    tones = mixing_tones(0.1, 10.0, [(0.3, 1.3), (0.3, 1.7)])
+    first = {tone_label(t.combination) for t in tones if t.order <= 1}
+    assert first == {"w1", "w2", "3w1", "3w2", "2w1-w2", "2w1+w2", "2w2-w1", "w1+2w2"}
+    freqs = [t.frequency for t in tones]
+    for nu in (1.3 + 1.7, 1.7 - 1.3):  # ω₁ ± ω₂: absent at every order of a cubic force
+        assert all(abs(f - nu) > 1e-9 for f in freqs)
+
+
+def test_mixing_amplitudes_against_simulated_spectrum():
+    out = subprocess.run([sys.executable, "-m", "generator", "mixing", "--eps", "0.1", "--Q",
+                          "10", "--drive", "0.3@1.3", "--drive", "0.3@1.7", "--json"],
+                         capture_output=True, text=True, check=False)
+    assert out.returncode == 0, out.stderr
+    tones = json.loads(out.stdout)["tones"]
+    assert {"frequency", "combination", "predicted", "simulated"} <= tones[0].keys()
+    for t in tones:
+        # the next correction is one order of ε = 0.1 down
+        tol = {0: 0.01, 1: 0.05, 2: 0.2}[t["order"]] * t["predicted"] + 2e-6
+        assert abs(t["predicted"] - t["simulated"]) <= tol, t
+    assert next(t for t in tones if t["combination"] == "2w1-w2")["simulated"] > 5e-3
