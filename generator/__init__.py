@@ -11,6 +11,7 @@ The pipeline, one module per stage (input -> output)::
     lower      solutions -> IR records (Evaluator, Module)           Horner, Chebyshev recurrence
     printers   NumbaPrinter(PythonCodePrinter), LaTeX rationals      Expr -> str
     emit       strict Jinja2 environments, provenance, atomic writes IR -> files in generated/
+    charts     matplotlib figures                                results -> PNG/SVG/PDF
     cli        the command line
 """
 

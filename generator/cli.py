@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
+from .charts import check_plot_path, mixing_figure, response_figure, subharmonic_figure
 from .driven import (
     BalanceSystem,
     Drive,
@@ -169,6 +170,13 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     for d, ti, ei in zip(deg, pen.period(th), exact, strict=True):
         print(f"{d:>6.0f}° {ti:>20.15f} {ei:>20.15f} {abs(ti / ei - 1):>11.1e} "
               f"{86400 * abs(ti / ei - 1):>9.1e}")
+    figures = Path("docs/figures")
+    figures.mkdir(parents=True, exist_ok=True)
+    print("\nfigures:")
+    for path in (response_figure(0.1, 0.3, 20.0, 8, figures / "response.png"),
+                 subharmonic_figure(0.1, 0.5, figures / "subharmonic.png"),
+                 mixing_figure(0.1, 10.0, [(0.3, 1.3), (0.3, 1.7)], figures / "mixing.png")):
+        print(f"  {path}")
     if shutil.which("pdflatex"):
         pdf_dir = Path("out")
         pdf_dir.mkdir(exist_ok=True)
@@ -289,7 +297,11 @@ def response_json(eps: float, force: float, Q: float, harmonics: int) -> dict:
 
 
 def _cmd_response(args: argparse.Namespace) -> int:
+    if args.plot:
+        check_plot_path(Path(args.plot))
     data = response_json(args.eps, args.force, args.Q, args.harmonics)
+    if args.plot:
+        response_figure(args.eps, args.force, args.Q, args.harmonics, Path(args.plot))
     if args.json:
         print(json.dumps(data))
         return 0
@@ -330,7 +342,11 @@ def subharmonic_json(eps: float, force: float, omega: float) -> dict:
 
 
 def _cmd_subharmonic(args: argparse.Namespace) -> int:
+    if args.plot:
+        check_plot_path(Path(args.plot))
     data = subharmonic_json(args.eps, args.force, args.omega)
+    if args.plot:
+        subharmonic_figure(args.eps, args.force, Path(args.plot))
     if args.json:
         print(json.dumps(data))
         return 0
@@ -369,7 +385,11 @@ def _drive(text: str) -> tuple[float, float]:
 
 
 def _cmd_mixing(args: argparse.Namespace) -> int:
+    if args.plot:
+        check_plot_path(Path(args.plot))
     data = mixing_json(args.eps, args.Q, args.drive)
+    if args.plot:
+        mixing_figure(args.eps, args.Q, args.drive, Path(args.plot))
     if args.json:
         print(json.dumps(data))
         return 0
@@ -447,6 +467,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--harmonics", type=_order, default=8,
                    help="odd harmonics N of the continued balance (default 8)")
     p.add_argument("--json", action="store_true", help="print the JSON contract")
+    p.add_argument("--plot", metavar="FILE", help="also draw the figure (.png, .svg, .pdf)")
     p.set_defaults(func=_cmd_response)
 
     p = sub.add_parser("subharmonic", help="the 1/3 subharmonic of eq. 10.83 and its stability")
@@ -455,6 +476,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--omega", type=float, required=True,
                    help="omega of eq. 10.83 (the drive is at 3*omega)")
     p.add_argument("--json", action="store_true", help="print the JSON contract")
+    p.add_argument("--plot", metavar="FILE", help="also draw the figure (.png, .svg, .pdf)")
     p.set_defaults(func=_cmd_subharmonic)
 
     p = sub.add_parser("mixing", help="combination tones of a two-tone drive")
@@ -463,6 +485,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--drive", type=_drive, action="append", required=True,
                    help="F@W: a drive f cos(w t); repeat for each tone")
     p.add_argument("--json", action="store_true", help="print the JSON contract")
+    p.add_argument("--plot", metavar="FILE", help="also draw the figure (.png, .svg, .pdf)")
     p.set_defaults(func=_cmd_mixing)
 
     p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults")

@@ -1,0 +1,152 @@
+"""Figures (matplotlib, Agg): response curve with hysteresis, subharmonic region, mixing spectrum.
+
+Each function computes nothing new: it draws what :mod:`response` and :mod:`numerics` return,
+and writes the file atomically (a temporary file in the target folder, then a rename).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+from .errors import InputError
+from .numerics import steady_state_amplitudes, sweep
+from .response import (
+    continue_balance,
+    mixing_tones,
+    one_harmonic_curve,
+    one_harmonic_folds,
+    subharmonic,
+    tone_label,
+)
+
+FORMATS = (".png", ".svg", ".pdf")
+METADATA = {".png": {"Software": None}, ".svg": {"Date": None}, ".pdf": {"CreationDate": None}}
+# NOTE: no software version or date in the files: the same command writes the same bytes.
+
+
+def check_plot_path(path: Path) -> Path:
+    """A writable figure path with a known format, or :class:`InputError` (nothing written)."""
+    path = Path(path)
+    if path.suffix.lower() not in FORMATS:
+        raise InputError(f"--plot {path}: use one of {', '.join(FORMATS)}")
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir() or not os.access(folder, os.W_OK | os.X_OK):
+        raise InputError(f"--plot {path}: folder {folder} does not exist or is not writable")
+    return path
+
+
+def _save(fig: plt.Figure, path: Path) -> Path:
+    path = check_plot_path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=110, metadata=METADATA[path.suffix.lower()])
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    finally:
+        plt.close(fig)
+        Path(tmp).unlink(missing_ok=True)
+    return path
+
+
+def response_figure(eps: float, force: float, Q: float, harmonics: int, path: Path) -> Path:
+    """Response r(ω): one-harmonic branches (stable solid, unstable dashed), N-harmonic
+    continuation, simulated sweeps up and down, folds; and the linear curves of Fig. 1."""
+    check_plot_path(path)
+    folds = one_harmonic_folds(eps, force, Q)
+    lo, hi = 0.5 * min([1.0, *folds]), 1.25 * max([1.0, *folds])
+    omega = np.linspace(lo, hi, 2000)
+    curve = one_harmonic_curve(eps, force, Q, omega)
+    cont = continue_balance(eps, force, Q, harmonics, lo, hi)
+    up, down = sweep(eps, force, 1 / Q, lo, hi), sweep(eps, force, 1 / Q, hi, lo)
+    fig, (ax, lin) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [3, 2]})
+    count = np.isfinite(curve.r).sum(axis=1)
+    jumps = np.concatenate([[False], count[1:] != count[:-1]])  # branches appear/vanish here
+    for k in range(3):
+        r = np.where(jumps, np.nan, curve.r[:, k])
+        ax.plot(omega, np.where(curve.stable[:, k], r, np.nan), "C0-", lw=2,
+                label="one harmonic, stable" if k == 0 else None)
+        ax.plot(omega, np.where(~curve.stable[:, k], r, np.nan), "C0--", lw=1.5,
+                label="one harmonic, unstable" if k == 1 else None)
+    amp = np.hypot(cont.x[:, 0], cont.x[:, harmonics])
+    ax.plot(cont.omega, amp, "k-", lw=0.7, label=f"harmonic balance N = {harmonics}")
+    ax.plot(up.omega, up.amplitude, "C3.", ms=1.5, label="sweep up (max |q|)")
+    ax.plot(down.omega, down.amplitude, "C2.", ms=1.5, label="sweep down (max |q|)")
+    for w in cont.folds:
+        ax.axvline(w, color="grey", ls=":", lw=1)
+    ax.set(xlabel="drive frequency ω", ylabel="amplitude",
+           title=f"q̈ + q̇/Q + q + εq³ = f cos ωt  (ε = {eps}, f = {force}, Q = {Q})")
+    ax.legend(fontsize=8, loc="upper left")
+    w = np.linspace(0.5, 1.5, 1000)
+    for i, q in enumerate((2, 5, 10)):
+        lin.plot(w, 1 / np.sqrt((1 - w**2) ** 2 + w**2 / q**2), f"C{i}-", label=f"Q = {q} (3.79)")
+        lin.plot(w, 1 / np.sqrt(4 * (1 - w) ** 2 + 1 / q**2), f"C{i}:", label=f"Q = {q} (3.83)")
+    lin.set(xlabel="ω", ylabel="|q| / f", title="linear oscillator (notes' Fig. 1)")
+    lin.legend(fontsize=7)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def subharmonic_figure(eps: float, force: float, path: Path) -> Path:
+    """Amplitude a(ω) of both roots of eq. 10.87 where they exist; Hill verdict as line
+    style, the true orbit's verdict as markers."""
+    check_plot_path(path)
+    omega = np.linspace(1.0, 2.0, 161)
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    for sign, color in (("+", "C0"), ("-", "C3")):
+        a, hill, true_w, true_a, true_s = [], [], [], [], []
+        for w in omega:
+            exists, _, sols = subharmonic(eps, force, float(w))
+            s = next((s for s in sols if s.root == sign), None) if exists else None
+            a.append(np.nan if s is None else s.a)
+            hill.append(bool(s and s.hill_stable))
+            if s is not None and s.orbit is not None and round(w * 160) % 8 == 0:
+                true_w.append(w), true_a.append(s.orbit.A[1]), true_s.append(s.orbit.stable)
+        a, hill = np.array(a), np.array(hill)
+        ax.plot(omega, np.where(hill, a, np.nan), f"{color}-", lw=2,
+                label=f"root {sign}, Hill stable")
+        ax.plot(omega, np.where(~hill, a, np.nan), f"{color}--", lw=1.5,
+                label=f"root {sign}, Hill unstable")
+        ts = np.array(true_s, dtype=bool)
+        ax.plot(np.array(true_w)[ts], np.array(true_a)[ts], f"{color}o", ms=5, mfc="none")
+        ax.plot(np.array(true_w)[~ts], np.array(true_a)[~ts], f"{color}x", ms=5)
+    ax.axhline(0, color="grey", lw=0.5)
+    ax.set(xlabel="ω (drive at 3ω)", ylabel="a, first harmonic",
+           title=f"1/3 subharmonic (ε = {eps}, f = {force}); o stable, x unstable true orbit")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def mixing_figure(eps: float, Q: float, drives: list[tuple[float, float]], path: Path) -> Path:
+    """Spectrum of the steady state: predicted tones (stems) and simulated amplitudes."""
+    check_plot_path(path)
+    tones = mixing_tones(eps, Q, drives)
+    sim = steady_state_amplitudes(eps, 1 / Q, [f for f, _ in drives], [w for _, w in drives],
+                                  [t.frequency for t in tones])
+    fig, ax = plt.subplots(figsize=(8, 4.2))
+    for t, s in zip(tones, sim, strict=True):
+        ax.vlines(t.frequency, 1e-8, t.predicted, color=f"C{t.order}", lw=2)
+        ax.plot(t.frequency, s, "kx", ms=6)
+        if t.order <= 1:
+            ax.annotate(tone_label(t.combination), (t.frequency, t.predicted),
+                        textcoords="offset points", xytext=(0, 4), ha="center", fontsize=7)
+    for order in range(3):
+        ax.plot([], [], f"C{order}-", lw=2, label=f"predicted, order {order}")
+    ax.plot([], [], "kx", label="simulated steady state")
+    ax.set_yscale("log")
+    ax.set_ylim(1e-7, 2)
+    ax.set(xlabel="frequency", ylabel="amplitude",
+           title=f"frequency mixing (ε = {eps}, Q = {Q}, drives "
+                 + ", ".join(f"{f}@{w}" for f, w in drives) + ")")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return _save(fig, path)
