@@ -336,6 +336,7 @@ def subharmonic_json(eps: float, force: float, omega: float) -> dict:
             "floquet_moduli": sorted(float(abs(m)) for m in s.hill_multipliers),
             "numerical": None if s.orbit is None else {
                 "a1": s.orbit.A[1], "a3": s.orbit.A[3], "stable": s.orbit.stable,
+                "simulation_locks": s.locked,
                 "floquet_moduli": sorted(float(abs(m)) for m in s.orbit.multipliers)},
         } for s in solutions],
     }
@@ -356,7 +357,8 @@ def _cmd_subharmonic(args: argparse.Namespace) -> int:
     for s in data["solutions"]:
         num = s["numerical"]
         true = "no orbit found" if num is None else (
-            f"true orbit a1 = {num['a1']:.6f}, {'stable' if num['stable'] else 'unstable'}")
+            f"true orbit a1 = {num['a1']:.6f}, {'stable' if num['stable'] else 'unstable'}, "
+            f"a simulation 1% off it {'locks on' if num['simulation_locks'] else 'drifts away'}")
         print(f"  root {s['root']}: a = {s['a']:.6f}, Hill: "
               f"{'stable' if s['hill_stable'] else 'unstable'}; {true}")
     return 0

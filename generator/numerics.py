@@ -286,9 +286,9 @@ def _multi_tone(t: float, q: float, p: float, eps: float, damping: float, forces
 
 @njit(cache=True)
 def _simulate(eps: float, damping: float, forces: np.ndarray, omegas: np.ndarray, h: float,
-              n_skip: int, n_keep: int, every: int) -> np.ndarray:
-    """RK4 from rest; after ``n_skip`` steps keep q every ``every`` steps, ``n_keep`` values."""
-    q = p = t = 0.0
+              n_skip: int, n_keep: int, every: int, q0: float, p0: float) -> np.ndarray:
+    """RK4 from (q0, p0); after ``n_skip`` steps keep q every ``every`` steps, ``n_keep`` values."""
+    q, p, t = q0, p0, 0.0
     out = np.empty(n_keep)
     total = n_skip + n_keep * every
     for i in range(total):
@@ -309,15 +309,17 @@ def _simulate(eps: float, damping: float, forces: np.ndarray, omegas: np.ndarray
 
 def steady_state_amplitudes(eps: float, damping: float, forces: list[float],
                             omegas: list[float], frequencies: list[float],
-                            settle: float | None = None, window: float = 2000.0) -> np.ndarray:
+                            settle: float | None = None, window: float = 2000.0,
+                            initial: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
     """Amplitudes of the simulated steady state at ``frequencies`` (least squares on cos/sin
-    over a long window after the transients, ~``20 Q`` time units, have died out)."""
+    over a long window after the transients, ~``20 Q`` time units, have died out), starting
+    from ``initial`` = (q, q̇) — which decides the attractor where several coexist."""
     settle = 40.0 / damping if settle is None else settle
     h = 2 * np.pi / (max(max(omegas), max(frequencies)) * 64)
     every = 4
     n_keep = int(window / (h * every))
     q = _simulate(eps, damping, np.array(forces, float), np.array(omegas, float), h,
-                  int(settle / h), n_keep, every)
+                  int(settle / h), n_keep, every, float(initial[0]), float(initial[1]))
     t = settle + np.arange(n_keep) * h * every
     basis = [np.ones_like(t)]
     for nu in frequencies:

@@ -15,7 +15,7 @@ import sympy as sp
 
 from .driven import BalanceSystem, Drive, first_order_branches, trig_product
 from .errors import InputError
-from .numerics import hill_multipliers, shoot
+from .numerics import hill_multipliers, shoot, steady_state_amplitudes
 
 _u, _w, _e, _f, _g = sp.symbols("u w e f g")  # u = r², w = ω², g = 1/Q
 _G = _u * ((1 - _w + sp.Rational(3, 4) * _e * _u) ** 2 + _w * _g**2) - _f**2
@@ -249,8 +249,13 @@ class Subharmonic:
     hill_multipliers: np.ndarray
     hill_stable: bool
     orbit: object | None  # numerics.PeriodicOrbit of period 2π/ω, or None
+    locked: bool | None  # a simulation started 1 % off the true orbit stays on it
 
 
+LOCK_WINDOW = 400.0
+LOCK_TOLERANCE = 0.05
+# NOTE: ~75 periods of the subharmonic: a stable orbit keeps its first harmonic within 5 %
+# (the 1 % kick stays bounded), an unstable one loses it well within that window.
 ORBIT_MATCH = 0.25
 # NOTE: the true orbit differs from a(f) by O(ε); a first harmonic further off than 25 % is
 # another orbit that shooting fell onto (the 1:1 response, or the rotation −a/2 of the other root).
@@ -281,8 +286,14 @@ def subharmonic(eps: float, force: float, omega: float) -> tuple[bool, str, list
                       periods=3)
         if orbit is not None and abs(orbit.A[1] - a) > ORBIT_MATCH * abs(a):
             orbit = None  # Newton fell onto another orbit (1:1, or a rotated root): not this one
+        locked = None
+        if orbit is not None:
+            q0, p0 = orbit.initial
+            amp = steady_state_amplitudes(eps, 0.0, [force], [3 * omega], [omega], settle=0.0,
+                                          window=LOCK_WINDOW, initial=(1.01 * q0, p0))[0]
+            locked = bool(abs(amp - abs(orbit.A[1])) < LOCK_TOLERANCE * abs(orbit.A[1]))
         out.append(Subharmonic(sign, float(a), float(F), lam,
-                               bool(abs(np.sum(lam).real) < 2), orbit))
+                               bool(abs(np.sum(lam).real) < 2), orbit, locked))
     return True, "16(omega^2 - 1)/eps >= 21 F^2", out
 
 

@@ -151,6 +151,7 @@ def test_subharmonic_against_true_orbit():
         assert abs(s.orbit.A[3] - s.F) < 0.1  # the cos 3τ amplitude, to O(ε)
         assert s.hill_stable == s.orbit.stable  # the notes' claim holds here
     assert [s.orbit.stable for s in sols] == [True, False]
+    assert [s.locked for s in sols] == [True, False]  # direct simulation agrees
 
 
 def test_hill_verdict_fails_for_the_negative_root_at_small_eps(monkeypatch):
