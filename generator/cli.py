@@ -296,29 +296,40 @@ def response_json(eps: float, force: float, Q: float, harmonics: int) -> dict:
     }
 
 
+def _report(args: argparse.Namespace, compute, draw, table) -> int:
+    """The shape of every effect command: check the plot path first (nothing is computed for
+    a figure that cannot be written), compute, draw, print JSON or the table."""
+    plot = check_plot_path(Path(args.plot)) if args.plot else None
+    data = compute()
+    if plot is not None:
+        draw(plot)
+    print(json.dumps(data) if args.json else "\n".join(table(data)))
+    return 0
+
+
 def _cmd_response(args: argparse.Namespace) -> int:
-    if args.plot:
-        check_plot_path(Path(args.plot))
-    data = response_json(args.eps, args.force, args.Q, args.harmonics)
-    if args.plot:
-        response_figure(args.eps, args.force, args.Q, args.harmonics, Path(args.plot))
-    if args.json:
-        print(json.dumps(data))
-        return 0
+    return _report(
+        args, lambda: response_json(args.eps, args.force, args.Q, args.harmonics),
+        lambda path: response_figure(args.eps, args.force, args.Q, args.harmonics, path),
+        _response_table)
+
+
+def _response_table(data: dict) -> list[str]:
     p = data["parameters"]
-    print(f"q'' + q'/Q + q + eps q^3 = f cos(w t): eps = {p['eps']}, f = {p['force']}, "
-          f"Q = {p['Q']}; w in [{p['omega_range'][0]:.4g}, {p['omega_range'][1]:.4g}]")
+    harmonics = data["harmonic_balance"]["harmonics"]
+    lines = []
+    lines.append(f"q'' + q'/Q + q + eps q^3 = f cos(w t): eps = {p['eps']}, f = {p['force']}, "
+                 f"Q = {p['Q']}; w in [{p['omega_range'][0]:.4g}, {p['omega_range'][1]:.4g}]")
     for label, folds in (("one harmonic", data["one_harmonic"]["folds"]),
-                         (f"harmonic balance N={args.harmonics}",
-                          data["harmonic_balance"]["folds"]),
+                         (f"harmonic balance N={harmonics}", data["harmonic_balance"]["folds"]),
                          ("true orbit (Floquet +1)", data["numerical"]["folds"])):
-        print(f"{label:>26}: folds " + (", ".join(f"{w:.12f}" for w in folds) or "none"))
+        lines.append(f"{label:>26}: folds " + (", ".join(f"{w:.12f}" for w in folds) or "none"))
     num = data["numerical"]
     for label, key in (("sweep up jumps at", "sweep_up_jump"),
                        ("sweep down jumps at", "sweep_down_jump")):
         value = num[key]
-        print(f"{label:>26}: " + (f"{value:.4f}" if value is not None else "no jump"))
-    return 0
+        lines.append(f"{label:>26}: " + (f"{value:.4f}" if value is not None else "no jump"))
+    return lines
 
 
 def subharmonic_json(eps: float, force: float, omega: float) -> dict:
@@ -343,25 +354,24 @@ def subharmonic_json(eps: float, force: float, omega: float) -> dict:
 
 
 def _cmd_subharmonic(args: argparse.Namespace) -> int:
-    if args.plot:
-        check_plot_path(Path(args.plot))
-    data = subharmonic_json(args.eps, args.force, args.omega)
-    if args.plot:
-        subharmonic_figure(args.eps, args.force, Path(args.plot))
-    if args.json:
-        print(json.dumps(data))
-        return 0
-    print(f"omega^2 q'' + q + eps q^3 = f cos 3tau: eps = {args.eps}, f = {args.force}, "
-          f"omega = {args.omega} (drive at {3 * args.omega:g})")
-    print(("exists: " if data["exists"] else "no subharmonic: ") + data["reason"])
+    return _report(args, lambda: subharmonic_json(args.eps, args.force, args.omega),
+                   lambda path: subharmonic_figure(args.eps, args.force, path),
+                   _subharmonic_table)
+
+
+def _subharmonic_table(data: dict) -> list[str]:
+    p = data["parameters"]
+    lines = [f"omega^2 q'' + q + eps q^3 = f cos 3tau: eps = {p['eps']}, f = {p['force']}, "
+             f"omega = {p['omega']} (drive at {p['drive']:g})",
+             ("exists: " if data["exists"] else "no subharmonic: ") + data["reason"]]
     for s in data["solutions"]:
         num = s["numerical"]
         true = "no orbit found" if num is None else (
             f"true orbit a1 = {num['a1']:.6f}, {'stable' if num['stable'] else 'unstable'}, "
             f"a simulation 1% off it {'locks on' if num['simulation_locks'] else 'drifts away'}")
-        print(f"  root {s['root']}: a = {s['a']:.6f}, Hill: "
-              f"{'stable' if s['hill_stable'] else 'unstable'}; {true}")
-    return 0
+        lines.append(f"  root {s['root']}: a = {s['a']:.6f}, Hill: "
+                     f"{'stable' if s['hill_stable'] else 'unstable'}; {true}")
+    return lines
 
 
 def mixing_json(eps: float, Q: float, drives: list[tuple[float, float]]) -> dict:
@@ -387,22 +397,20 @@ def _drive(text: str) -> tuple[float, float]:
 
 
 def _cmd_mixing(args: argparse.Namespace) -> int:
-    if args.plot:
-        check_plot_path(Path(args.plot))
-    data = mixing_json(args.eps, args.Q, args.drive)
-    if args.plot:
-        mixing_figure(args.eps, args.Q, args.drive, Path(args.plot))
-    if args.json:
-        print(json.dumps(data))
-        return 0
-    print(f"q'' + q'/Q + q + eps q^3 = sum f_i cos(w_i t): eps = {args.eps}, Q = {args.Q}, "
-          + ", ".join(f"w{i} = {d['omega']} (f = {d['force']})"
-                      for i, d in enumerate(data["parameters"]["drives"], 1)))
-    print(f"{'tone':>12} {'frequency':>10} {'order':>6} {'predicted':>11} {'simulated':>11}")
+    return _report(args, lambda: mixing_json(args.eps, args.Q, args.drive),
+                   lambda path: mixing_figure(args.eps, args.Q, args.drive, path), _mixing_table)
+
+
+def _mixing_table(data: dict) -> list[str]:
+    p = data["parameters"]
+    lines = [f"q'' + q'/Q + q + eps q^3 = sum f_i cos(w_i t): eps = {p['eps']}, Q = {p['Q']}, "
+             + ", ".join(f"w{i} = {d['omega']} (f = {d['force']})"
+                         for i, d in enumerate(p["drives"], 1)),
+             f"{'tone':>12} {'frequency':>10} {'order':>6} {'predicted':>11} {'simulated':>11}"]
     for t in data["tones"]:
-        print(f"{t['combination']:>12} {t['frequency']:>10.4f} {t['order']:>6} "
-              f"{t['predicted']:>11.3e} {t['simulated']:>11.3e}")
-    return 0
+        lines.append(f"{t['combination']:>12} {t['frequency']:>10.4f} {t['order']:>6} "
+                     f"{t['predicted']:>11.3e} {t['simulated']:>11.3e}")
+    return lines
 
 
 def _order(text: str) -> int:
