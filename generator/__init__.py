@@ -7,6 +7,7 @@ The pipeline, one module per stage (input -> output)::
     lindstedt  L–P series, order-by-order equations, naive expansion Model, order -> SeriesSolution
     driven     μ-expansion with phase, harmonic balance          Drive, order -> branches
     response   one-harmonic curves and folds, balance continuation  Drive, ω range -> folds
+    choose     methods × orders, verified error and measured cost    tol, range -> Choice
     numerics   references: elliptic periods, Jacobi cn, shooting + Floquet, sweeps, true folds
     lower      solutions -> IR records (Evaluator, Module)           Horner, Chebyshev recurrence
     printers   NumbaPrinter(PythonCodePrinter), LaTeX rationals      Expr -> str

@@ -15,6 +15,7 @@ import numpy as np
 
 from . import __version__
 from .charts import check_plot_path, mixing_figure, response_figure, subharmonic_figure
+from .choose import choose_period
 from .driven import (
     BalanceSystem,
     Drive,
@@ -413,6 +414,25 @@ def _mixing_table(data: dict) -> list[str]:
     return lines
 
 
+def _cmd_choose(args: argparse.Namespace) -> int:
+    choice = choose_period(args.tol, args.x_min, args.x_max)
+    data = {"method": choice.method, "order": choice.order, "max_error": choice.max_error,
+            "ns_per_point": choice.ns_per_point, "verified_on": choice.verified_on,
+            "quantity": "period", "variable": "x = eps*A**2",
+            "considered": [{"method": m, "order": o, "max_error": e, "ns_per_point": ns}
+                           for m, o, e, ns in choice.considered]}
+    if args.json:
+        print(json.dumps(data))
+        return 0
+    print(f"period T(x), x = eps*A**2 in [{args.x_min:g}, {args.x_max:g}], tolerance "
+          f"{args.tol:g} (relative, verified on {choice.verified_on} points):")
+    print(f"  chosen: {choice.method} order {choice.order}: max error {choice.max_error:.1e}, "
+          f"{choice.ns_per_point:.2f} ns/point")
+    for m, o, e, ns in choice.considered:
+        print(f"  {m:>10} order {o:>2}: max error {e:.1e}, {ns:6.2f} ns/point")
+    return 0
+
+
 def _order(text: str) -> int:
     try:
         return int(text)
@@ -497,6 +517,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the JSON contract")
     p.add_argument("--plot", metavar="FILE", help="also draw the figure (.png, .svg, .pdf)")
     p.set_defaults(func=_cmd_mixing)
+
+    p = sub.add_parser("choose", help="the cheapest verified method for a tolerance and a range")
+    p.add_argument("quantity", choices=("period",))
+    p.add_argument("--tol", type=float, required=True, help="relative tolerance")
+    p.add_argument("--x-min", type=float, required=True, help="smallest x = eps*A**2")
+    p.add_argument("--x-max", type=float, required=True, help="largest x = eps*A**2")
+    p.add_argument("--json", action="store_true", help="print the JSON contract")
+    p.set_defaults(func=_cmd_choose)
 
     p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults")
     p.add_argument("--out", default="generated", help="output folder (default generated/)")

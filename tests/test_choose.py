@@ -1,0 +1,60 @@
+"""The smallest model for a scene: verified errors, the resummation, bad input."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from fractions import Fraction
+
+import mpmath
+import numpy as np
+import pytest
+from reference import duffing_period
+
+from generator.choose import candidates, choose_period, resummed_coefficients
+from generator.errors import InputError
+
+
+def test_resummed_lindstedt_series_is_the_hypergeometric_series_of_k():
+    """Re-expanding the exact L–P period series in m = x/(2(1+x)) gives (2/π)K(m)'s
+    coefficients [(2n)!/(4^n n!²)]² exactly — the L–P series *is* the elliptic period."""
+    from math import factorial
+
+    res = resummed_coefficients(duffing_period(25))
+    assert res == [Fraction(factorial(2 * n), 4**n * factorial(n) ** 2) ** 2 for n in range(26)]
+
+
+@pytest.mark.parametrize("tol,lo,hi", [(1e-12, -0.5, 0.5), (1e-8, 0.0, 1000.0),
+                                       (1e-4, 0.0, 0.1)])
+def test_choice_meets_the_tolerance_between_the_verification_points(tol, lo, hi):
+    choice = choose_period(tol, lo, hi)
+    cand = next(c for c in candidates() if (c.method, c.order) == (choice.method, choice.order))
+    x = np.random.default_rng(3).uniform(lo, hi, 300)
+    with mpmath.workdps(30):
+        ref = np.array([float(2 / mpmath.pi * mpmath.ellipk(mpmath.mpf(v) / (2 * (1 + v)))
+                              / mpmath.sqrt(1 + mpmath.mpf(v))) for v in x])
+    assert np.max(np.abs(cand(x) / ref - 1)) <= tol
+    assert choice.max_error <= tol and choice.verified_on >= 1000
+    assert choice.method != "exact"  # a series beats ellipk at these tolerances
+
+
+def test_choose_contract_and_bad_input():
+    run = subprocess.run([sys.executable, "-m", "generator", "choose", "period", "--tol", "1e-8",
+                          "--x-min", "0", "--x-max", "1000", "--json"],
+                         capture_output=True, text=True, check=False)
+    data = json.loads(run.stdout)
+    assert {"method", "order", "max_error", "ns_per_point", "verified_on"} <= data.keys()
+    assert data["max_error"] <= 1e-8
+    for args, needle in ((["--tol", "1e-3", "--x-min", "0.5", "--x-max", "0.1"], "reversed"),
+                         (["--tol", "1e-3", "--x-min", "-1.5", "--x-max", "0"], "separatrix"),
+                         (["--tol", "1e-19", "--x-min", "0", "--x-max", "1"], "best reachable"),
+                         (["--tol", "nan", "--x-min", "0", "--x-max", "1"], "not finite")):
+        bad = subprocess.run([sys.executable, "-m", "generator", "choose", "period", *args],
+                             capture_output=True, text=True, check=False)
+        assert bad.returncode == 2 and needle in bad.stderr, bad.stderr
+
+
+def test_negative_tolerance():
+    with pytest.raises(InputError, match="must be > 0"):
+        choose_period(-1e-3, 0.0, 1.0)
