@@ -216,3 +216,53 @@ def choose_period(tol: float, x_min: float, x_max: float) -> Choice:
     c, err, ns = min(timed, key=lambda t: t[2])
     return Choice(c.method, c.order, err, ns, len(x),
                   tuple((t[0].method, t[0].order, t[1], t[2]) for t in timed))
+
+
+# --- the grandfather's clock: the notes' appendix claims --------------------------------------
+
+APPENDIX_CLAIMS = (
+    ("theta^2/2 - theta^4/24", 1e-4, 17.0), ("theta^2/2 - theta^4/24", 1e-3, 44.0),
+    ("theta^2/2 - theta^4/24", 1e-2, 75.0), ("theta^2/2", 1e-4, 2.0),
+    ("theta^2/2", 1e-3, 6.0), ("theta^2/2", 1e-2, 19.0),
+)
+# NOTE: the notes (App. 4.2): relative accuracy of each approximation of 1 − cos θ up to the angle.
+
+
+@dataclass(frozen=True)
+class Threshold:
+    approximation: str
+    tolerance: float
+    claimed_deg: float
+    potential_deg: float  # largest angle where |V_approx/V − 1| ≤ tolerance
+    period_deg: float  # largest amplitude where the approximate period is within tolerance
+
+
+def _potential_error(approx: str, th: float) -> float:
+    v = 1 - mpmath.cos(th)
+    a = th**2 / 2 - (th**4 / 24 if "theta^4" in approx else 0)
+    return float(abs(a / v - 1))
+
+
+def _period_error(approx: str, th: float) -> float:
+    """Period of the approximate potential against the pendulum's ``4K(sin²(θ₀/2))``."""
+    exact = 4 * mpmath.ellipk(mpmath.sin(th / 2) ** 2)
+    if "theta^4" in approx:  # θ̈ + θ − θ³/6 = 0: Duffing with εA² = −θ₀²/6
+        x = -th**2 / 6
+        approx_t = 4 * mpmath.ellipk(x / (2 * (1 + x))) / mpmath.sqrt(1 + x)
+    else:
+        approx_t = 2 * mpmath.pi
+    return float(abs(approx_t / exact - 1))
+
+
+def appendix_thresholds() -> list[Threshold]:
+    """The true threshold angles of the notes' appendix claims (bisection in mpmath)."""
+    out = []
+    for approx, tol, claimed in APPENDIX_CLAIMS:
+        found = []
+        for err in (_potential_error, _period_error):
+            with mpmath.workdps(30):
+                th = mpmath.findroot(lambda t, err=err, a=approx, e=tol: err(a, t) - e,
+                                     (mpmath.mpf("1e-3"), mpmath.mpf(3.0)), solver="bisect")
+            found.append(float(mpmath.degrees(th)))
+        out.append(Threshold(approx, tol, claimed, *found))
+    return out

@@ -15,7 +15,7 @@ import numpy as np
 
 from . import __version__
 from .charts import check_plot_path, mixing_figure, response_figure, subharmonic_figure
-from .choose import choose_period
+from .choose import appendix_thresholds, choose_period
 from .driven import (
     BalanceSystem,
     Drive,
@@ -433,6 +433,28 @@ def _cmd_choose(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_clock(args: argparse.Namespace) -> int:
+    rows = [{"approximation": t.approximation, "tolerance": t.tolerance,
+             "claimed_deg": t.claimed_deg, "potential_deg": t.potential_deg,
+             "period_deg": t.period_deg, "holds_for_potential": t.potential_deg >= t.claimed_deg,
+             "holds_for_period": t.period_deg >= t.claimed_deg} for t in appendix_thresholds()]
+    if args.json:
+        print(json.dumps({"claims": rows}))
+        return 0
+    print("The notes' appendix: 1 - cos(theta) approximated, accurate to a tolerance "
+          "up to an angle")
+    print(f"{'approximation':>24} {'tol':>7} {'claimed':>8} {'potential':>10} {'period':>8}"
+          "  holds?")
+    for r in rows:
+        verdict = {(True, True): "yes", (False, False): "no"}.get(
+            (r["holds_for_potential"], r["holds_for_period"]),
+            "potential " + ("yes" if r["holds_for_potential"] else "no") + ", period "
+            + ("yes" if r["holds_for_period"] else "no"))
+        print(f"{r['approximation']:>24} {r['tolerance']:>7.0e} {r['claimed_deg']:>7.1f}° "
+              f"{r['potential_deg']:>9.2f}° {r['period_deg']:>7.2f}°  {verdict}")
+    return 0
+
+
 def _order(text: str) -> int:
     try:
         return int(text)
@@ -525,6 +547,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--x-max", type=float, required=True, help="largest x = eps*A**2")
     p.add_argument("--json", action="store_true", help="print the JSON contract")
     p.set_defaults(func=_cmd_choose)
+
+    p = sub.add_parser("clock", help="the notes' grandfather's-clock accuracy claims, checked")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=_cmd_clock)
 
     p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults")
     p.add_argument("--out", default="generated", help="output folder (default generated/)")

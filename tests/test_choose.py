@@ -58,3 +58,28 @@ def test_choose_contract_and_bad_input():
 def test_negative_tolerance():
     with pytest.raises(InputError, match="must be > 0"):
         choose_period(-1e-3, 0.0, 1.0)
+
+
+def test_appendix_thresholds_against_direct_evaluation():
+    """At each true threshold the error equals the tolerance (NumPy/SciPy, not mpmath)."""
+    from scipy.special import ellipk
+
+    from generator.choose import appendix_thresholds
+
+    rows = appendix_thresholds()
+    assert len(rows) == 6
+    for t in rows:
+        th = np.radians(t.potential_deg)
+        approx = th**2 / 2 - (th**4 / 24 if "theta^4" in t.approximation else 0)
+        assert abs(abs(approx / (1 - np.cos(th)) - 1) - t.tolerance) < 1e-3 * t.tolerance
+        th = np.radians(t.period_deg)
+        exact = 4 * ellipk(np.sin(th / 2) ** 2)
+        if "theta^4" in t.approximation:
+            x = -th**2 / 6
+            approx_t = 4 * ellipk(x / (2 * (1 + x))) / np.sqrt(1 + x)
+        else:
+            approx_t = 2 * np.pi
+        assert abs(abs(approx_t / exact - 1) - t.tolerance) < 1e-3 * t.tolerance
+    # the notes' 0.1 % up to 44° for the quartic potential is a hair too generous
+    quartic = {t.tolerance: t for t in rows if "theta^4" in t.approximation}
+    assert quartic[1e-3].potential_deg < 44.0 < quartic[1e-3].period_deg
