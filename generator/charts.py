@@ -16,6 +16,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .choose import candidates, pareto_front, reference_period, tradeoffs
 from .errors import InputError
 from .numerics import steady_state_amplitudes, sweep
 from .response import (
@@ -148,5 +149,59 @@ def mixing_figure(eps: float, Q: float, drives: list[tuple[float, float]], path:
            title=f"frequency mixing (ε = {eps}, Q = {Q}, drives "
                  + ", ".join(f"{f}@{w}" for f, w in drives) + ")")
     ax.legend(fontsize=8)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+CHART_X = (0.1, 0.5, 0.9, 5.0, 100.0)
+# NOTE: representative εA²: weak, moderate, near the L–P radius, strong, very strong springs.
+FLOOR = 1e-17
+# NOTE: errors below double precision are drawn at this floor (log axes).
+
+
+def speed_accuracy_figure(path: Path) -> Path:
+    """Error against measured cost, one point per method and order, per x; Pareto fronts."""
+    check_plot_path(path)
+    data = tradeoffs(np.array(CHART_X))
+    fig, axes = plt.subplots(1, len(CHART_X), figsize=(16, 3.8), sharex=True, sharey=True)
+    colors = {"lindstedt": "C0", "resummed": "C1", "pade": "C2", "exact": "k"}
+    cost = np.array([t.ns_per_point for t in data])
+    for k, (ax, x) in enumerate(zip(axes, CHART_X, strict=True)):
+        err = np.maximum(np.array([t.errors[k] for t in data]), FLOOR)
+        for method, color in colors.items():
+            sel = [i for i, t in enumerate(data) if t.method == method]
+            ax.plot(cost[sel], err[sel], "o", color=color, ms=3, label=method)
+        front = pareto_front(cost, err)
+        ax.plot(cost[front], err[front], "r-", lw=1, label="Pareto front")
+        ax.set(xscale="log", yscale="log", title=f"x = εA² = {x:g}", xlabel="ns / point")
+    axes[0].set_ylabel("relative error of T")
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def validity_figure(path: Path) -> Path:
+    """Error against x from the separatrix to εA² = 10³ for chosen orders of each method."""
+    check_plot_path(path)
+    x = np.concatenate([-1 + np.logspace(-3, np.log10(0.999), 200), np.logspace(-3, 3, 300)])
+    x = np.unique(x[x < 1000])
+    ref = reference_period(x)
+    picks = {("lindstedt", 4), ("lindstedt", 12), ("lindstedt", 40), ("resummed", 10),
+             ("resummed", 21), ("resummed", 40), ("pade", 4), ("pade", 12)}
+    styles = {"lindstedt": "-", "resummed": "--", "pade": ":"}
+    fig, ax = plt.subplots(figsize=(9, 4.5))
+    for c in candidates():
+        if (c.method, c.order) in picks:
+            with np.errstate(invalid="ignore"):
+                err = np.maximum(np.abs(c(x) / ref - 1), FLOOR)
+            ax.plot(x, err, styles[c.method], lw=1.2, label=f"{c.method} {c.order}")
+    for xv, text in ((-1, "separatrix x = −1"), (1, "L–P radius |x| = 1"),
+                     (-2 / 3, "m = −1: resummed limit")):
+        ax.axvline(xv, color="grey", lw=0.8, ls="-.")
+        ax.annotate(text, (xv, 1e-15), rotation=90, fontsize=7, va="bottom", ha="right")
+    ax.set(xscale="symlog", yscale="log", ylim=(FLOOR / 2, 10), xlim=(-1.05, 1000),
+           xlabel="x = εA² (symlog)",
+           ylabel="relative error of T", title="where each method holds (NaN = refused)")
+    ax.legend(fontsize=7, ncol=3)
     fig.tight_layout()
     return _save(fig, path)

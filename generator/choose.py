@@ -266,3 +266,37 @@ def appendix_thresholds() -> list[Threshold]:
             found.append(float(mpmath.degrees(th)))
         out.append(Threshold(approx, tol, claimed, *found))
     return out
+
+
+# --- the data behind the speed–accuracy chart and the validity map ---------------------------
+
+@dataclass(frozen=True)
+class Tradeoff:
+    """One candidate's measured cost and its relative error at each chart point."""
+
+    method: str
+    order: int
+    ns_per_point: float
+    errors: np.ndarray  # at the chart's x values (NaN: outside the candidate's domain)
+
+
+def tradeoffs(xs: np.ndarray, points: int = 200_000) -> list[Tradeoff]:
+    """Every candidate: measured ns/point (on [0, 0.5]) and its error at each ``x``."""
+    ref = reference_period(np.asarray(xs, dtype=float))
+    out = []
+    for c in candidates():
+        with np.errstate(invalid="ignore"):
+            err = np.abs(c(np.asarray(xs, dtype=float)) / ref - 1)
+        out.append(Tradeoff(c.method, c.order, ns_per_point(c, points=points), err))
+    return out
+
+
+def pareto_front(costs: np.ndarray, errors: np.ndarray) -> np.ndarray:
+    """Indices of the non-dominated (cost, error) pairs, cheapest first."""
+    order = np.lexsort((errors, costs))
+    front, best = [], np.inf
+    for i in order:
+        if np.isfinite(errors[i]) and errors[i] < best:
+            front.append(i)
+            best = errors[i]
+    return np.array(front, dtype=int)

@@ -83,3 +83,11 @@ def test_appendix_thresholds_against_direct_evaluation():
     # the notes' 0.1 % up to 44° for the quartic potential is a hair too generous
     quartic = {t.tolerance: t for t in rows if "theta^4" in t.approximation}
     assert quartic[1e-3].potential_deg < 44.0 < quartic[1e-3].period_deg
+
+
+def test_pareto_front():
+    from generator.choose import pareto_front
+
+    cost = np.array([1.0, 2.0, 3.0, 1.5, 4.0])
+    err = np.array([1e-3, 1e-6, 1e-5, 1e-2, 1e-9])
+    assert list(pareto_front(cost, err)) == [0, 1, 4]
