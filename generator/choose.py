@@ -24,11 +24,13 @@ from fractions import Fraction
 import mpmath
 import numpy as np
 from numba import njit
+from scipy.special import ellipk
 
+from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
 from .errors import InputError
 from .lindstedt import derive
-from .models import duffing
-from .numerics import duffing_period_exact
+from .models import duffing, pendulum
+from .numerics import duffing_period_exact, shoot
 
 MAX_ORDER = 60
 # NOTE: order 60 of the exact series takes ~0.1 s and reaches 1e-16 wherever |x| ≤ 0.5.
@@ -211,7 +213,7 @@ def choose_period(tol: float, x_min: float, x_max: float) -> Choice:
     if not best_per_method:
         raise InputError(f"tol {tol:g}: no method reaches it on [{x_min}, {x_max}]; the best "
                          f"reachable is {best_error:.1e}")
-    timed = [(c, err, ns_per_point(c, x_min=max(x_min, -0.6), x_max=min(x_max, 10.0)))
+    timed = [(c, err, ns_per_point(c, x_min=x_min, x_max=x_max))
              for c, err in best_per_method.values()]
     c, err, ns = min(timed, key=lambda t: t[2])
     return Choice(c.method, c.order, err, ns, len(x),
@@ -300,3 +302,69 @@ def pareto_front(costs: np.ndarray, errors: np.ndarray) -> np.ndarray:
             front.append(i)
             best = errors[i]
     return np.array(front, dtype=int)
+
+
+# --- named scenes ----------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class SceneResult:
+    scene: str
+    question: str
+    answer: str
+    details: dict
+
+
+def clock_scene(swing_deg: float = 10.0, seconds_per_day: float = 0.1) -> SceneResult:
+    """Grandfather's clock: the lowest L–P order of the pendulum period whose error stays
+    below ``seconds_per_day`` for every swing up to ``swing_deg`` (verified on 2001 angles)."""
+    if not 0 < swing_deg < 180:
+        raise InputError(f"swing {swing_deg}°: must be between 0° and 180° (no libration beyond)")
+    tol = seconds_per_day / 86_400
+    th = np.radians(verification_points(0.0, swing_deg))[1:]
+    exact = 4 * ellipk(np.sin(th / 2) ** 2) / (2 * np.pi)
+    t = th**2 / np.pi**2  # the series in θ₀² has radius π²: scaled to radius 1
+    for k in range(0, 41):
+        sol = derive(pendulum(k), k)
+        coeffs = np.array([float(sol.ground.to_fraction(c)) * np.pi ** (2 * j)
+                           for j, c in enumerate(sol.period)])
+        cand = Candidate("lindstedt", k, coeffs, np.ones(1))
+        err = float(np.max(np.abs(cand(t) / exact - 1)))
+        if err <= tol:
+            return SceneResult(
+                "clock", f"pendulum period to {seconds_per_day} s/day up to a {swing_deg}° swing",
+                f"L–P order {k} in θ₀² (T = 2π Σ τ_j θ₀^(2j), {k + 1} terms)",
+                {"order": k, "max_error": err, "seconds_per_day": err * 86_400,
+                 "ns_per_point": ns_per_point(cand, x_min=0.0, x_max=float(t.max())),
+                 "verified_on": int(th.size)})
+    raise InputError(f"swing {swing_deg}°: no L–P order up to 40 reaches {tol:.1e}")
+
+
+def hard_spring_scene(x: float = 50.0, tol: float = 1e-8) -> SceneResult:
+    """A hardening spring at ``εA² = x``: the cheapest verified period evaluator."""
+    c = choose_period(tol, x, x * (1 + 1e-12))
+    return SceneResult("hard-spring", f"Duffing period to {tol:g} at εA² = {x:g}",
+                       f"{c.method} order {c.order}",
+                       {"method": c.method, "order": c.order, "max_error": c.max_error,
+                        "ns_per_point": c.ns_per_point})
+
+
+def driven_scene(tol: float = 1e-4) -> SceneResult:
+    """The notes' driven table (ε = 0.1, f = 1, ω = 1): the smallest μ-order and the fewest
+    harmonics whose A₁, A₃, A₅ are within ``tol`` of the true orbit."""
+    d = Drive(0.1, 1.0, 1.0)
+    (branch,) = first_order_branches(d)
+    orbit = shoot(0.1, 1.0, 1.0, 0.0, np.array([2.4, 0.0]))
+    truth = np.array([orbit.A[n] for n in (1, 3, 5)])
+    mu = mu_expansion(d, branch, 12)
+    order = next(j for j in range(13) if np.max(np.abs(np.array(
+        [amplitudes(*mu.partial(j), 5)[0].get(n, 0.0) for n in (1, 3, 5)]) - truth)) <= tol)
+    harmonics = next(n for n in range(1, 13) if np.max(np.abs(np.array(
+        [amplitudes(harmonic_balance(d, branch, n).coefficients, 0.0, 2 * n - 1)[0].get(m, 0.0)
+         for m in (1, 3, 5)]) - truth)) <= tol)
+    return SceneResult("notes-driven", f"the notes' driven table (A1, A3, A5) to {tol:g}",
+                       f"μ-expansion order {order}, or harmonic balance with {harmonics} "
+                       "harmonics", {"mu_order": order, "harmonics": harmonics,
+                                     "truth": truth.tolist()})
+
+
+SCENES = {"clock": clock_scene, "hard-spring": hard_spring_scene, "notes-driven": driven_scene}

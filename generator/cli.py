@@ -22,7 +22,7 @@ from .charts import (
     subharmonic_figure,
     validity_figure,
 )
-from .choose import appendix_thresholds, choose_period
+from .choose import SCENES, appendix_thresholds, choose_period
 from .driven import (
     BalanceSystem,
     Drive,
@@ -466,6 +466,18 @@ def _cmd_clock(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_scene(args: argparse.Namespace) -> int:
+    result = SCENES[args.name]()
+    if args.json:
+        print(json.dumps({"scene": result.scene, "question": result.question,
+                          "answer": result.answer, **result.details}))
+    else:
+        print(f"{result.question}: {result.answer}")
+        for key, value in result.details.items():
+            print(f"  {key}: {value}")
+    return 0
+
+
 def _order(text: str) -> int:
     try:
         return int(text)
@@ -562,6 +574,11 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("clock", help="the notes' grandfather's-clock accuracy claims, checked")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=_cmd_clock)
+
+    p = sub.add_parser("scene", help="named scenes: the smallest model that meets each")
+    p.add_argument("name", choices=tuple(SCENES))
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=_cmd_scene)
 
     p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults")
     p.add_argument("--out", default="generated", help="output folder (default generated/)")

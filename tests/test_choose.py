@@ -91,3 +91,31 @@ def test_pareto_front():
     cost = np.array([1.0, 2.0, 3.0, 1.5, 4.0])
     err = np.array([1e-3, 1e-6, 1e-5, 1e-2, 1e-9])
     assert list(pareto_front(cost, err)) == [0, 1, 4]
+
+
+def test_clock_scene_against_the_elliptic_period():
+    from scipy.special import ellipk
+
+    from generator.choose import clock_scene
+
+    result = clock_scene(10.0, 0.1)
+    assert result.details["order"] == 2
+    th = np.radians(np.linspace(0.01, 10, 400))
+    exact = 4 * ellipk(np.sin(th / 2) ** 2)
+    order2 = 2 * np.pi * (1 + th**2 / 16 + 11 * th**4 / 3072)  # notes' series, one more term
+    order1 = 2 * np.pi * (1 + th**2 / 16)  # the notes' eq. 4.14
+    assert np.max(np.abs(order2 / exact - 1)) * 86400 <= 0.1
+    assert np.max(np.abs(order1 / exact - 1)) * 86400 > 0.1
+    with pytest.raises(InputError):
+        clock_scene(200.0)
+
+
+def test_driven_and_spring_scenes():
+    from generator.choose import driven_scene, hard_spring_scene
+
+    spring = hard_spring_scene(50.0, 1e-8)
+    assert spring.details["method"] == "resummed" and spring.details["max_error"] <= 1e-8
+    driven = driven_scene(1e-4)
+    # the notes' order 2 (A₁ = 2.35575 vs 2.35555) misses 1e-4; order 3 meets it
+    assert driven.details["mu_order"] == 3
+    assert 2 <= driven.details["harmonics"] <= 4
