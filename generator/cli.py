@@ -22,7 +22,7 @@ from .charts import (
     subharmonic_figure,
     validity_figure,
 )
-from .choose import SCENES, appendix_thresholds, choose_period
+from .choose import SCENES, appendix_thresholds, candidates, choose_period
 from .driven import (
     BalanceSystem,
     Drive,
@@ -31,7 +31,14 @@ from .driven import (
     harmonic_balance,
     mu_expansion,
 )
-from .emit import generate, generate_balance, generate_driven, load_generated
+from .emit import (
+    check_writable,
+    generate,
+    generate_balance,
+    generate_choice,
+    generate_driven,
+    load_generated,
+)
 from .errors import InputError
 from .lindstedt import SeriesSolution, derive
 from .models import MODELS, check_order, model_by_name
@@ -426,12 +433,20 @@ def _mixing_table(data: dict) -> list[str]:
 
 
 def _cmd_choose(args: argparse.Namespace) -> int:
+    if args.emit:
+        check_writable(Path(args.emit), ["chosen_period.py"])
     choice = choose_period(args.tol, args.x_min, args.x_max)
     data = {"method": choice.method, "order": choice.order, "max_error": choice.max_error,
             "ns_per_point": choice.ns_per_point, "verified_on": choice.verified_on,
             "quantity": "period", "variable": "x = eps*A**2",
             "considered": [{"method": m, "order": o, "max_error": e, "ns_per_point": ns}
                            for m, o, e, ns in choice.considered]}
+    if args.emit:
+        cand = next(c for c in candidates() if (c.method, c.order) == (choice.method,
+                                                                         choice.order))
+        command = (f"lindstedt choose period --tol {args.tol!r} --x-min {args.x_min!r} "
+                   f"--x-max {args.x_max!r}")
+        data["emitted"] = [str(p) for p in generate_choice(cand, command, Path(args.emit))]
     if args.json:
         print(json.dumps(data))
         return 0
@@ -441,6 +456,8 @@ def _cmd_choose(args: argparse.Namespace) -> int:
           f"{choice.ns_per_point:.2f} ns/point")
     for m, o, e, ns in choice.considered:
         print(f"  {m:>10} order {o:>2}: max error {e:.1e}, {ns:6.2f} ns/point")
+    for path in data.get("emitted", []):
+        print(f"  emitted {path}")
     return 0
 
 
@@ -568,6 +585,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--tol", type=float, required=True, help="relative tolerance")
     p.add_argument("--x-min", type=float, required=True, help="smallest x = eps*A**2")
     p.add_argument("--x-max", type=float, required=True, help="largest x = eps*A**2")
+    p.add_argument("--emit", metavar="DIR", help="write just the chosen evaluator into DIR")
     p.add_argument("--json", action="store_true", help="print the JSON contract")
     p.set_defaults(func=_cmd_choose)
 

@@ -38,6 +38,7 @@ from .lower import (
     Module,
     Provenance,
     lower_balance,
+    lower_choice,
     lower_driven,
     lower_free,
 )
@@ -355,3 +356,8 @@ def generate_balance(harmonics: int, out: Path) -> list[Path]:
     module = lower_balance(balance_equations(harmonics),
                            f"lindstedt generate balance --harmonics {harmonics}")
     return write_files(out, {"balance.py": render_module(module)})
+
+
+def generate_choice(candidate: object, command: str, out: Path) -> list[Path]:
+    """``lindstedt choose period … --emit DIR``: just the chosen evaluator."""
+    return write_files(out, {"chosen_period.py": render_module(lower_choice(candidate, command))})

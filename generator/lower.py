@@ -17,6 +17,7 @@ import sympy as sp
 
 from . import __version__
 from .driven import A1_, BalanceEquations, MuOrder, eps_, omega_
+from .errors import InputError
 from .lindstedt import SeriesSolution
 from .printers import identifier
 
@@ -312,4 +313,41 @@ def lower_balance(eqs: BalanceEquations, command: str) -> Module:
         provenance=provenance("balance", eqs.harmonics, command),
         kernels=tuple(kernels),
         newton=True,
+    )
+
+
+def lower_choice(candidate, command: str) -> Module:
+    """The period evaluator ``choose period`` picked, as one numba ufunc ``period(A, eps)``.
+
+    Coefficients enter as the exact binary values of the verified doubles (so the emitted
+    evaluator computes what was verified, up to FMA contraction)."""
+    if candidate.method == "exact":
+        raise InputError("the exact period (SciPy's ellipk) has no compiled evaluator to emit; "
+                         "loosen the tolerance or narrow the range")
+    A, eps, x, m = sp.symbols("A eps x m")
+
+    def coeffs(values) -> list[sp.Expr]:
+        return [sp.Rational(float(v)) for v in values]
+
+    guard = {"lindstedt": sp.And(x > -1, sp.Abs(x) < 1), "resummed": x > sp.Rational(-2, 3),
+             "pade": x > -1}[candidate.method]
+    body: tuple = ()
+    if candidate.method == "lindstedt":
+        out = horner(coeffs(candidate.num), x)
+    elif candidate.method == "resummed":
+        body = ((m, x / (2 + 2 * x)),)
+        out = sp.sqrt(1 - 2 * m) * horner(coeffs(candidate.num), m)
+    else:
+        out = horner(coeffs(candidate.num), x) / horner(coeffs(candidate.den), x)
+    ev = Evaluator("period", f"Duffing period T(A, eps): {candidate.method} order "
+                   f"{candidate.order}, the method `lindstedt choose` verified; NaN outside "
+                   "its domain.", (A, eps), ((x, eps * A**2),), guard, body, 2 * sp.pi * out)
+    return Module(
+        name="chosen_period",
+        doc=f"The period evaluator chosen by `{command}`.",
+        constants=(("METHOD", candidate.method), ("ORDER", candidate.order)),
+        evaluators=(ev,),
+        provenance=provenance("duffing", candidate.order, command, method=candidate.method,
+                              num=[float(v) for v in candidate.num],
+                              den=[float(v) for v in candidate.den]),
     )

@@ -119,3 +119,22 @@ def test_driven_and_spring_scenes():
     # the notes' order 2 (A₁ = 2.35575 vs 2.35555) misses 1e-4; order 3 meets it
     assert driven.details["mu_order"] == 3
     assert 2 <= driven.details["harmonics"] <= 4
+
+
+def test_choose_emits_just_the_chosen_evaluator(tmp_path):
+    from generator.emit import load_generated
+
+    run = subprocess.run([sys.executable, "-m", "generator", "choose", "period", "--tol", "1e-8",
+                          "--x-min", "0", "--x-max", "1000", "--emit", str(tmp_path), "--json"],
+                         capture_output=True, text=True, check=False)
+    data = json.loads(run.stdout)
+    assert data["emitted"] == [str(tmp_path / "chosen_period.py")]
+    mod = load_generated(tmp_path / "chosen_period.py")
+    assert (mod.METHOD, mod.ORDER) == (data["method"], data["order"])
+    x = np.random.default_rng(5).uniform(0, 1000, 200)
+    with mpmath.workdps(30):
+        ref = np.array([float(4 * mpmath.ellipk(mpmath.mpf(v) / (2 * (1 + v)))
+                              / mpmath.sqrt(1 + mpmath.mpf(v))) for v in x])
+    assert np.max(np.abs(mod.period(1.0, x) / ref - 1)) <= 1e-8
+    assert np.isnan(mod.period(1.0, -0.9))  # outside the resummed series' domain
+    del sys.modules["chosen_period"]
