@@ -130,7 +130,7 @@ def test_choose_emits_just_the_chosen_evaluator(tmp_path):
     data = json.loads(run.stdout)
     assert data["emitted"] == [str(tmp_path / "chosen_period.py")]
     mod = load_generated(tmp_path / "chosen_period.py")
-    assert (mod.METHOD, mod.ORDER) == (data["method"], data["order"])
+    assert (data["method"], data["order"]) == (mod.METHOD, mod.ORDER)
     x = np.random.default_rng(5).uniform(0, 1000, 200)
     with mpmath.workdps(30):
         ref = np.array([float(4 * mpmath.ellipk(mpmath.mpf(v) / (2 * (1 + v)))
