@@ -8,6 +8,7 @@ negative, between the folds); the folds solve ``G = ∂G/∂u = 0``.  N harmonic
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,9 +20,13 @@ from .numerics import hill_multipliers, shoot, steady_state_amplitudes
 
 _u, _w, _e, _f, _g = sp.symbols("u w e f g")  # u = r², w = ω², g = 1/Q
 _G = _u * ((1 - _w + sp.Rational(3, 4) * _e * _u) ** 2 + _w * _g**2) - _f**2
-_FOLD_POLY = sp.Poly(sp.resultant(_G, sp.diff(_G, _u), _u), _w)
-# NOTE: the resultant in u of G and ∂G/∂u is the cubic's discriminant, a polynomial in ω²
-# whose positive roots with a positive double root u are the folds.
+
+
+@functools.cache
+def _fold_polynomial() -> sp.Poly:
+    """The resultant in u of G and ∂G/∂u (the cubic's discriminant), a polynomial in ω² whose
+    positive roots with a positive double root u are the folds; derived once, on first use."""
+    return sp.Poly(sp.resultant(_G, sp.diff(_G, _u), _u), _w)
 
 
 def amplitude_residual(u: np.ndarray, omega: np.ndarray, d: Drive) -> np.ndarray:
@@ -99,7 +104,7 @@ def one_harmonic_folds(eps: float, force: float, Q: float) -> list[float]:
     if eps == 0:
         return []
     values = {_e: eps, _f: force, _g: d.damping}
-    coeffs = [float(c.subs(values)) for c in _FOLD_POLY.all_coeffs()]
+    coeffs = [float(c.subs(values)) for c in _fold_polynomial().all_coeffs()]
     folds = []
     for w2 in np.roots(coeffs):
         if abs(w2.imag) > 1e-8 * (1 + abs(w2)) or w2.real <= 0:
