@@ -17,6 +17,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .choose import candidates, pareto_front, reference_period, tradeoffs
+from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
 from .errors import InputError
 from .numerics import steady_state_amplitudes, sweep
 from .response import (
@@ -203,5 +204,42 @@ def validity_figure(path: Path) -> Path:
            xlabel="x = εA² (symlog)",
            ylabel="relative error of T", title="where each method holds (NaN = refused)")
     ax.legend(fontsize=7, ncol=3)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def driven_validity_figure(path: Path, eps: float = 0.1, force: float = 1.0) -> Path:
+    """Where the driven-oscillator formulas hold: the μ-expansion's error against harmonic
+    balance (N = 10, equal to the true orbit to ~1e-10) over ω on the largest branch, with the
+    folds where branches appear; and the region of ω, f where the 1/3 subharmonic exists."""
+    check_plot_path(path)
+    omegas = np.linspace(0.3, 2.5, 221)
+    orders = (1, 2, 4, 6)
+    errors = np.full((len(orders), omegas.size), np.nan)
+    counts = np.zeros(omegas.size, dtype=int)
+    for i, w in enumerate(omegas):
+        d = Drive(eps, force, float(w))
+        branches = first_order_branches(d)
+        counts[i] = len(branches)
+        truth = amplitudes(harmonic_balance(d, branches[0], 10).coefficients, 0.0, 1)[0][1]
+        mu = mu_expansion(d, branches[0], max(orders))
+        for k, j in enumerate(orders):
+            if j < len(mu.coefficients):
+                errors[k, i] = abs(amplitudes(*mu.partial(j), 1)[0][1] - truth)
+    fig, (ax, sub) = plt.subplots(1, 2, figsize=(12, 4.2))
+    for k, j in enumerate(orders):
+        ax.plot(omegas, np.maximum(errors[k], FLOOR), label=f"μ-expansion order {j}")
+    for i in np.nonzero(np.diff(counts))[0]:
+        ax.axvline(omegas[i + 1], color="grey", ls=":", lw=1)
+    ax.set(yscale="log", xlabel="ω", ylabel="|A₁(μ) − A₁(balance)|",
+           title=f"μ-expansion, largest branch (ε = {eps}, f = {force}); dotted: folds")
+    ax.legend(fontsize=8)
+    w = np.linspace(1.0, 2.5, 400)
+    for e in (0.05, 0.1, 0.3):
+        f_max = np.abs(1 - 9 * w**2) * np.sqrt(np.maximum(16 * (w**2 - 1) / (21 * e), 0))
+        sub.plot(w, f_max, label=f"ε = {e}")
+    sub.set(yscale="log", ylim=(1e-2, 1e3), xlabel="ω (drive at 3ω)", ylabel="f",
+            title="1/3 subharmonic exists below each curve (eq. 10.87)")
+    sub.legend(fontsize=8)
     fig.tight_layout()
     return _save(fig, path)

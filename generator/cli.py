@@ -16,6 +16,7 @@ import numpy as np
 from . import __version__
 from .charts import (
     check_plot_path,
+    driven_validity_figure,
     mixing_figure,
     response_figure,
     speed_accuracy_figure,
@@ -191,7 +192,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     for path in (response_figure(0.1, 0.3, 20.0, 8, figures / "response.png"),
                  subharmonic_figure(0.1, 0.5, figures / "subharmonic.png"),
                  mixing_figure(0.1, 10.0, [(0.3, 1.3), (0.3, 1.7)], figures / "mixing.png"),
-                 validity_figure(figures / "validity.png")):
+                 validity_figure(figures / "validity.png"),
+                 driven_validity_figure(figures / "driven_validity.png")):
         print(f"  {path}")
     pdf_dir = Path("out")
     pdf_dir.mkdir(exist_ok=True)
