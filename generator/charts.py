@@ -165,7 +165,8 @@ def speed_accuracy_figure(path: Path) -> Path:
     check_plot_path(path)
     data = tradeoffs(np.array(CHART_X))
     fig, axes = plt.subplots(1, len(CHART_X), figsize=(16, 3.8), sharex=True, sharey=True)
-    colors = {"lindstedt": "C0", "resummed": "C1", "pade": "C2", "exact": "k"}
+    colors = {"lindstedt": "C0", "resummed": "C1", "pade": "C2", "exact": "k",
+              "numerical": "C4"}
     cost = np.array([t.ns_per_point for t in data])
     for k, (ax, x) in enumerate(zip(axes, CHART_X, strict=True)):
         err = np.maximum(np.array([t.errors[k] for t in data]), FLOOR)

@@ -24,6 +24,7 @@ from fractions import Fraction
 import mpmath
 import numpy as np
 from numba import njit
+from scipy.integrate import solve_ivp
 from scipy.special import ellipk
 
 from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
@@ -282,14 +283,40 @@ class Tradeoff:
     errors: np.ndarray  # at the chart's x values (NaN: outside the candidate's domain)
 
 
+INTEGRATION_RTOLS = (1e-4, 1e-7, 1e-10, 1e-13)
+# NOTE: DOP853 tolerances for the "numerical" method: from plotting accuracy to nearly exact.
+
+
+def integrated_period(x: float, rtol: float) -> float:
+    """``T/2π`` by integrating ``u'' + u + x u³ = 0`` from ``u = 1`` to the half period
+    (``u'`` back to zero), SciPy's DOP853 at ``rtol``."""
+    def rhs(_t: float, y: np.ndarray) -> list[float]:
+        return [y[1], -y[0] - x * y[0] ** 3]
+
+    def half(_t: float, y: np.ndarray) -> float:
+        return y[1]
+
+    half.terminal, half.direction = True, 1.0
+    sol = solve_ivp(rhs, (0.0, 100.0 / np.sqrt(1 + max(x, 0.0)) + 100.0), [1.0, 0.0],
+                    method="DOP853", rtol=rtol, atol=rtol * 1e-3, events=half)
+    return float(2 * sol.t_events[0][0] / (2 * np.pi))
+
+
 def tradeoffs(xs: np.ndarray, points: int = 200_000) -> list[Tradeoff]:
-    """Every candidate: measured ns/point (on [0, 0.5]) and its error at each ``x``."""
-    ref = reference_period(np.asarray(xs, dtype=float))
+    """Every candidate: measured ns/point (on [0, 0.5]) and its error at each ``x``; plus
+    numerical integration at several tolerances (timed per call)."""
+    xs = np.asarray(xs, dtype=float)
+    ref = reference_period(xs)
     out = []
     for c in candidates():
         with np.errstate(invalid="ignore"):
-            err = np.abs(c(np.asarray(xs, dtype=float)) / ref - 1)
+            err = np.abs(c(xs) / ref - 1)
         out.append(Tradeoff(c.method, c.order, ns_per_point(c, points=points), err))
+    for k, rtol in enumerate(INTEGRATION_RTOLS):
+        t0 = time.perf_counter()
+        values = np.array([integrated_period(x, rtol) for x in xs])
+        ns = (time.perf_counter() - t0) / xs.size * 1e9
+        out.append(Tradeoff("numerical", k, ns, np.abs(values / ref - 1)))
     return out
 
 

@@ -138,3 +138,12 @@ def test_choose_emits_just_the_chosen_evaluator(tmp_path):
     assert np.max(np.abs(mod.period(1.0, x) / ref - 1)) <= 1e-8
     assert np.isnan(mod.period(1.0, -0.9))  # outside the resummed series' domain
     del sys.modules["chosen_period"]
+
+
+def test_integrated_period_reaches_its_tolerance():
+    from generator.choose import integrated_period, reference_period
+
+    for x in (0.1, 5.0, -0.5):
+        ref = reference_period(np.array([x]))[0]
+        assert abs(integrated_period(x, 1e-12) / ref - 1) < 1e-10
+        assert abs(integrated_period(x, 1e-4) / ref - 1) < 1e-2
