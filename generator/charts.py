@@ -165,8 +165,8 @@ def speed_accuracy_figure(path: Path) -> Path:
     check_plot_path(path)
     data = tradeoffs(np.array(CHART_X))
     fig, axes = plt.subplots(1, len(CHART_X), figsize=(16, 3.8), sharex=True, sharey=True)
-    colors = {"lindstedt": "C0", "resummed": "C1", "pade": "C2", "exact": "k",
-              "numerical": "C4"}
+    colors = {"lindstedt": "C0", "resummed": "C1", "pade": "C2", "modified": "C3",
+              "exact": "k", "numerical": "C4"}
     cost = np.array([t.ns_per_point for t in data])
     for k, (ax, x) in enumerate(zip(axes, CHART_X, strict=True)):
         err = np.maximum(np.array([t.errors[k] for t in data]), FLOOR)
@@ -189,8 +189,9 @@ def validity_figure(path: Path) -> Path:
     x = np.unique(x[x < 1000])
     ref = reference_period(x)
     picks = {("lindstedt", 4), ("lindstedt", 12), ("lindstedt", 40), ("resummed", 10),
-             ("resummed", 21), ("resummed", 40), ("pade", 4), ("pade", 12)}
-    styles = {"lindstedt": "-", "resummed": "--", "pade": ":"}
+             ("resummed", 21), ("resummed", 40), ("pade", 4), ("pade", 12), ("modified", 4),
+             ("modified", 12)}
+    styles = {"lindstedt": "-", "resummed": "--", "pade": ":", "modified": "-."}
     fig, ax = plt.subplots(figsize=(9, 4.5))
     for c in candidates():
         if (c.method, c.order) in picks:

@@ -57,7 +57,8 @@ def _horner_block(c: np.ndarray, t: np.ndarray, acc: np.ndarray) -> None:
 def _evaluate(kind: int, num: np.ndarray, den: np.ndarray, x: np.ndarray,
               out: np.ndarray) -> None:
     """Horner evaluation of a candidate; kind 0: Σ num_j x^j, 1: in m with √(1 − 2m),
-    2: Padé num(x)/den(x).  NaN outside the candidate's domain."""
+    2: Padé num(x)/den(x), 3: modified L–P 1/√((1 + 3x/4) g(α)).  NaN outside the
+    candidate's domain."""
     t = np.empty(BLOCK)
     p = np.empty(BLOCK)
     q = np.empty(BLOCK)
@@ -68,6 +69,9 @@ def _evaluate(kind: int, num: np.ndarray, den: np.ndarray, x: np.ndarray,
         if kind == 1:
             for i in range(n):
                 tv[i] = xs[i] / (2.0 + 2.0 * xs[i])
+        elif kind == 3:
+            for i in range(n):
+                tv[i] = 3.0 * xs[i] / (4.0 + 3.0 * xs[i])
         else:
             tv[:] = xs
         _horner_block(num, tv, pv)
@@ -79,12 +83,14 @@ def _evaluate(kind: int, num: np.ndarray, den: np.ndarray, x: np.ndarray,
                 value, ok = pv[i], abs(xi) < 1.0
             elif kind == 1:
                 value, ok = pv[i] * np.sqrt(1.0 - 2.0 * tv[i]), xi > -2.0 / 3.0
+            elif kind == 3:
+                value, ok = 1.0 / np.sqrt((1.0 + 0.75 * xi) * pv[i]), xi > -1.0
             else:
                 value, ok = pv[i] / qv[i], xi > -1.0
             out[start + i] = value if ok else np.nan
 
 
-KINDS = {"lindstedt": 0, "resummed": 1, "pade": 2}
+KINDS = {"lindstedt": 0, "resummed": 1, "pade": 2, "modified": 3}
 
 
 @dataclass(frozen=True)
@@ -102,27 +108,40 @@ class Candidate:
         return out
 
 
+def _mul(a: list[Fraction], b: list[Fraction]) -> list[Fraction]:
+    """Product of power series truncated to ``len(a)`` terms."""
+    return [sum(a[i] * b[n - i] for i in range(n + 1)) for n in range(len(a))]
+
+
+def _compose(outer: list[Fraction], inner: list[Fraction]) -> list[Fraction]:
+    """``outer(inner(t))`` truncated to ``len(outer)`` terms (``inner`` has no constant)."""
+    total = [Fraction(0)] * len(outer)
+    power = [Fraction(1)] + [Fraction(0)] * (len(outer) - 1)
+    for c in outer:
+        total = [s + c * p for s, p in zip(total, power, strict=True)]
+        power = _mul(power, inner)
+    return total
+
+
 def resummed_coefficients(tau: list[Fraction]) -> list[Fraction]:
-    """``c_n`` of ``(T/2π)(x(m)) / √(1 − 2m)``, ``x(m) = 2m/(1 − 2m)``, exactly.
-
-    ``x(m) = Σ_{n≥1} 2^n m^n``; composing the L–P series with it and dividing by
-    ``√(1 − 2m) = Σ binom(1/2, n)(−2m)^n`` uses ``τ_0..τ_k`` for the first k + 1 terms.
-    """
+    """``c_n`` of ``(T/2π)(x(m)) / √(1 − 2m)``, ``x(m) = 2m/(1 − 2m) = Σ_{n≥1} 2^n m^n``,
+    exactly; the first k + 1 terms use ``τ_0..τ_k``."""
     k = len(tau) - 1
-    xm = [Fraction(0)] + [Fraction(2**n) for n in range(1, k + 1)]
-
-    def mul(a: list, b: list) -> list:
-        return [sum(a[i] * b[n - i] for i in range(n + 1)) for n in range(k + 1)]
-
-    total = [Fraction(0)] * (k + 1)
-    power = [Fraction(1)] + [Fraction(0)] * k
-    for t in tau:
-        total = [s + t * p for s, p in zip(total, power, strict=True)]
-        power = mul(power, xm)
     inv_sqrt = [Fraction(1)]
     for n in range(1, k + 1):  # (1 − 2m)^(−1/2) = Σ binom(2n, n) (m/2)^n·2^n
         inv_sqrt.append(inv_sqrt[-1] * Fraction(2 * n - 1, n))
-    return mul(total, inv_sqrt)
+    xm = [Fraction(0)] + [Fraction(2**n) for n in range(1, k + 1)]
+    return _mul(_compose(tau, xm), inv_sqrt)
+
+
+def modified_coefficients(omega: list[Fraction]) -> list[Fraction]:
+    """The modified L–P of Cheung, Chen & Lau: ``ω² = (1 + 3x/4)·g(α)`` with
+    ``α = (3x/4)/(1 + 3x/4)``, which stays below 1 for every ``x > 0``; returns ``g``'s
+    coefficients exactly (``x(α) = (4/3) Σ_{n≥1} α^n``)."""
+    k = len(omega) - 1
+    w2 = _mul(omega, omega)
+    h = _mul(w2, [Fraction(-3, 4) ** n for n in range(k + 1)])  # ω² / (1 + 3x/4)
+    return _compose(h, [Fraction(0)] + [Fraction(4, 3)] * k)
 
 
 def _pade(tau: list[Fraction], k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -138,11 +157,14 @@ def candidates(max_order: int = MAX_ORDER) -> tuple[Candidate, ...]:
     sol = derive(duffing(), max_order)
     tau = [sol.ground.to_fraction(c) for c in sol.period]
     res = resummed_coefficients(tau)
+    mod = modified_coefficients([sol.ground.to_fraction(c) for c in sol.omega])
     out = [Candidate("exact", 0, np.zeros(1), np.ones(1))]
     for k in range(1, max_order + 1):
         out.append(Candidate("lindstedt", k, np.array([float(t) for t in tau[: k + 1]]),
                              np.ones(1)))
         out.append(Candidate("resummed", k, np.array([float(c) for c in res[: k + 1]]),
+                             np.ones(1)))
+        out.append(Candidate("modified", k, np.array([float(c) for c in mod[: k + 1]]),
                              np.ones(1)))
         if 2 * k <= max_order and k <= 12:
             out.append(Candidate("pade", k, *_pade(tau, k)))

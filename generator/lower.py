@@ -330,13 +330,16 @@ def lower_choice(candidate, command: str) -> Module:
         return [sp.Rational(float(v)) for v in values]
 
     guard = {"lindstedt": sp.And(x > -1, sp.Abs(x) < 1), "resummed": x > sp.Rational(-2, 3),
-             "pade": x > -1}[candidate.method]
+             "pade": x > -1, "modified": x > -1}[candidate.method]
     body: tuple = ()
     if candidate.method == "lindstedt":
         out = horner(coeffs(candidate.num), x)
     elif candidate.method == "resummed":
         body = ((m, x / (2 + 2 * x)),)
         out = sp.sqrt(1 - 2 * m) * horner(coeffs(candidate.num), m)
+    elif candidate.method == "modified":
+        body = ((m, 3 * x / (4 + 3 * x)),)
+        out = 1 / sp.sqrt((1 + sp.Rational(3, 4) * x) * horner(coeffs(candidate.num), m))
     else:
         out = horner(coeffs(candidate.num), x) / horner(coeffs(candidate.den), x)
     ev = Evaluator("period", f"Duffing period T(A, eps): {candidate.method} order "

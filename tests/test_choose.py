@@ -147,3 +147,18 @@ def test_integrated_period_reaches_its_tolerance():
         ref = reference_period(np.array([x]))[0]
         assert abs(integrated_period(x, 1e-12) / ref - 1) < 1e-10
         assert abs(integrated_period(x, 1e-4) / ref - 1) < 1e-2
+
+
+def test_modified_lindstedt_of_cheung_chen_lau():
+    """ω² = (1 + 3x/4) g(α), α = 3x/(4 + 3x): by construction g = 1 + O(α²) (CCL's choice of α
+    absorbs the first-order term), and the series holds out to x = 10³ and down to x = −0.9."""
+    from generator.choose import modified_coefficients, reference_period
+    from generator.lindstedt import derive
+    from generator.models import duffing
+
+    sol = derive(duffing(), 40)
+    g = modified_coefficients([sol.ground.to_fraction(c) for c in sol.omega])
+    assert g[0] == 1 and g[1] == 0
+    cand = next(c for c in candidates() if (c.method, c.order) == ("modified", 30))
+    x = np.array([-0.9, -0.5, 0.5, 5.0, 50.0, 1000.0])
+    np.testing.assert_allclose(cand(x), reference_period(x), rtol=1e-6)
