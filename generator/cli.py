@@ -23,7 +23,7 @@ from .charts import (
     subharmonic_figure,
     validity_figure,
 )
-from .choose import SCENES, appendix_thresholds, candidates, choose_period
+from .choose import SCENES, appendix_thresholds, candidates, choose_driven, choose_period
 from .driven import (
     BalanceSystem,
     Drive,
@@ -435,6 +435,11 @@ def _mixing_table(data: dict) -> list[str]:
 
 
 def _cmd_choose(args: argparse.Namespace) -> int:
+    if args.quantity == "amplitudes":
+        return _choose_amplitudes(args)
+    for name in ("tol", "x_min", "x_max"):
+        if getattr(args, name) is None:
+            raise InputError(f"choose period needs --{name.replace('_', '-')}")
     if args.emit:
         check_writable(Path(args.emit), ["chosen_period.py"])
     choice = choose_period(args.tol, args.x_min, args.x_max)
@@ -494,6 +499,25 @@ def _cmd_scene(args: argparse.Namespace) -> int:
         print(f"{result.question}: {result.answer}")
         for key, value in result.details.items():
             print(f"  {key}: {value}")
+    return 0
+
+
+def _choose_amplitudes(args: argparse.Namespace) -> int:
+    for name in ("eps", "force", "omega"):
+        if getattr(args, name) is None:
+            raise InputError(f"choose amplitudes needs --{name}")
+    c = choose_driven(args.eps, args.force, args.omega, args.Q, args.tol or 1e-4)
+    data = {"quantity": "amplitudes", "method": c.method, "order": c.order,
+            "max_error": c.max_error, "seconds": c.seconds, "alternatives": c.alternatives,
+            "truth": c.truth}
+    if args.json:
+        print(json.dumps(data))
+    else:
+        print(f"A1, A3, A5 (and B_n) to {args.tol or 1e-4:g}: {c.method} order {c.order}, "
+              f"max error {c.max_error:.1e}, {c.seconds * 1e3:.2f} ms")
+        for m, v in c.alternatives.items():
+            print(f"  also: {m} order {v['order']}, max error {v['max_error']:.1e}, "
+                  f"{v['seconds'] * 1e3:.2f} ms")
     return 0
 
 
@@ -583,10 +607,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_mixing)
 
     p = sub.add_parser("choose", help="the cheapest verified method for a tolerance and a range")
-    p.add_argument("quantity", choices=("period",))
-    p.add_argument("--tol", type=float, required=True, help="relative tolerance")
-    p.add_argument("--x-min", type=float, required=True, help="smallest x = eps*A**2")
-    p.add_argument("--x-max", type=float, required=True, help="largest x = eps*A**2")
+    p.add_argument("quantity", choices=("period", "amplitudes"))
+    p.add_argument("--tol", type=float, help="tolerance (period: relative; amplitudes: "
+                   "absolute, default 1e-4)")
+    p.add_argument("--x-min", type=float, help="period: smallest x = eps*A**2")
+    p.add_argument("--x-max", type=float, help="period: largest x = eps*A**2")
+    p.add_argument("--eps", type=float, help="amplitudes: ε of the driven oscillator")
+    p.add_argument("--force", type=float, help="amplitudes: f")
+    p.add_argument("--omega", type=float, help="amplitudes: ω")
+    p.add_argument("--Q", type=float, default=math.inf, help="amplitudes: Q (default undamped)")
     p.add_argument("--emit", metavar="DIR", help="write just the chosen evaluator into DIR")
     p.add_argument("--json", action="store_true", help="print the JSON contract")
     p.set_defaults(func=_cmd_choose)

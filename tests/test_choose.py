@@ -162,3 +162,18 @@ def test_modified_lindstedt_of_cheung_chen_lau():
     cand = next(c for c in candidates() if (c.method, c.order) == ("modified", 30))
     x = np.array([-0.9, -0.5, 0.5, 5.0, 50.0, 1000.0])
     np.testing.assert_allclose(cand(x), reference_period(x), rtol=1e-6)
+
+
+def test_choose_amplitudes_meets_the_tolerance_against_shooting():
+    from generator.choose import choose_driven
+    from generator.numerics import shoot
+
+    c = choose_driven(0.1, 0.3, 1.3, 20.0, tol=1e-8)
+    assert c.max_error <= 1e-8 and c.method in ("mu_expansion", "harmonic_balance")
+    # the truth it was judged against is the true orbit on the largest branch
+    orbit = shoot(0.1, 0.3, 1.3, 0.05, np.array([2.9, 1.2]))
+    assert abs(orbit.A[1] - c.truth[0]) < 1e-9
+    run = subprocess.run([sys.executable, "-m", "generator", "choose", "amplitudes", "--eps",
+                          "0.1", "--force", "1", "--json"], capture_output=True, text=True,
+                         check=False)
+    assert run.returncode == 2 and "--omega" in run.stderr
