@@ -17,17 +17,21 @@ requested range, measures its compiled cost, and returns the cheapest within the
 from __future__ import annotations
 
 import functools
+import sys
+import tempfile
 import time
 from dataclasses import dataclass
 from fractions import Fraction
+from pathlib import Path
 
 import mpmath
 import numpy as np
 from numba import njit
 from scipy.integrate import solve_ivp
-from scipy.special import ellipk
+from scipy.special import ellipj, ellipk
 
 from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
+from .emit import generate, load_generated
 from .errors import InputError
 from .lindstedt import derive
 from .models import duffing, pendulum
@@ -471,3 +475,86 @@ def driven_scene(tol: float = 1e-4) -> SceneResult:
 
 
 SCENES = {"clock": clock_scene, "hard-spring": hard_spring_scene, "notes-driven": driven_scene}
+
+
+# --- q(t): the lowest L–P order for a range of amplitudes ------------------------------------
+
+@dataclass(frozen=True)
+class SolutionChoice:
+    method: str  # "lindstedt" or "exact" (Jacobi cn)
+    order: int
+    max_error: float  # max |q − A cn| / A over the grid
+    ns_per_point: float
+    verified_on: int
+
+
+def _exact_q(t: np.ndarray, x: float) -> np.ndarray:
+    """``q/A = cn(√(1+x) t | m)``, ``m = x/(2(1+x))``: SciPy for m ≥ 0, mpmath below."""
+    m = x / (2 * (1 + x))
+    if m >= 0:
+        return ellipj(np.sqrt(1 + x) * t, m)[1]
+    with mpmath.workdps(20):
+        return np.array([float(mpmath.re(mpmath.ellipfun("cn", np.sqrt(1 + x) * v, m)))
+                         for v in t])
+
+
+def choose_solution(tol: float, x_min: float, x_max: float, t_max: float = 20.0,
+                    max_order: int = 30) -> SolutionChoice:
+    """The lowest L–P order whose q(t)/A is within ``tol`` of the exact solution for every
+    ``x = εA² ∈ [x_min, x_max]`` and ``t ∈ [0, t_max]``; else Jacobi cn (SciPy) if ``x ≥ 0``."""
+    for name, v in (("tol", tol), ("x-min", x_min), ("x-max", x_max), ("t-max", t_max)):
+        if not np.isfinite(v):
+            raise InputError(f"{name} {v}: not finite")
+    if tol <= 0 or t_max <= 0:
+        raise InputError("tol and t-max must be > 0")
+    if not x_min < x_max:
+        raise InputError(f"range [{x_min}, {x_max}]: empty or reversed")
+    if x_min <= -1:
+        raise InputError(f"range [{x_min}, {x_max}] reaches x = εA² ≤ -1: no periodic orbit")
+    xs = verification_points(x_min, x_max, 9)
+    t = np.linspace(0.0, t_max, 401)
+    exact = {x: _exact_q(t, x) for x in xs}
+    sol = derive(duffing(), max_order)
+    g = sol.ground.to_fraction
+    best = np.inf
+    for k in range(max_order + 1):
+        if np.max(np.abs(xs)) >= 1:
+            break  # beyond the radius the truncated series is no answer (the evaluators say NaN)
+        err = 0.0
+        for x in xs:
+            omega = sum(float(g(w)) * x**j for j, w in enumerate(sol.omega[: k + 1]))
+            q = sum(x**j * sum(float(g(c)) * np.cos(n * omega * t) for n, c in qj.items())
+                    for j, qj in enumerate(sol.q[: k + 1]))
+            err = max(err, float(np.max(np.abs(q - exact[x]))))
+        best = min(best, err)
+        if err <= tol:
+            return SolutionChoice("lindstedt", k, err, _generated_q_cost(k, x_min, x_max),
+                                  xs.size * t.size)
+    if x_min >= 0:
+        x = np.random.default_rng(0).uniform(x_min, x_max, 200_000)
+        tt = np.random.default_rng(1).uniform(0, t_max, x.size)
+        t0 = time.perf_counter()
+        ellipj(np.sqrt(1 + x) * tt, x / (2 * (1 + x)))
+        ns = (time.perf_counter() - t0) / x.size * 1e9
+        return SolutionChoice("exact", 0, 0.0, ns, xs.size * t.size)
+    raise InputError(f"tol {tol:g}: no L–P order up to {max_order} reaches it on "
+                     f"[{x_min}, {x_max}] (best {best:.1e}), and the exact cn needs x ≥ 0")
+
+
+def _generated_q_cost(order: int, x_min: float, x_max: float) -> float:
+    """ns/point of the generated ``q(t, A, eps)`` at ``order`` (generated into a temp folder)."""
+    with tempfile.TemporaryDirectory(prefix="lindstedt-choose-") as tmp:
+        generate("duffing", order, Path(tmp))
+        mod = load_generated(Path(tmp) / "duffing.py")
+        rng = np.random.default_rng(0)
+        eps = rng.uniform(x_min, x_max, 1_000_000)
+        t = rng.uniform(0, 20, eps.size)
+        out = np.empty_like(t)
+        mod.q(t[:10], 1.0, eps[:10])
+        best = np.inf
+        for _ in range(3):
+            t0 = time.perf_counter()
+            mod.q(t, 1.0, eps, out=out)
+            best = min(best, time.perf_counter() - t0)
+        sys.modules.pop("duffing", None)
+    return best / t.size * 1e9

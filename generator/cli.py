@@ -23,7 +23,14 @@ from .charts import (
     subharmonic_figure,
     validity_figure,
 )
-from .choose import SCENES, appendix_thresholds, candidates, choose_driven, choose_period
+from .choose import (
+    SCENES,
+    appendix_thresholds,
+    candidates,
+    choose_driven,
+    choose_period,
+    choose_solution,
+)
 from .driven import (
     BalanceSystem,
     Drive,
@@ -437,6 +444,8 @@ def _mixing_table(data: dict) -> list[str]:
 def _cmd_choose(args: argparse.Namespace) -> int:
     if args.quantity == "amplitudes":
         return _choose_amplitudes(args)
+    if args.quantity == "q":
+        return _choose_q(args)
     for name in ("tol", "x_min", "x_max"):
         if getattr(args, name) is None:
             raise InputError(f"choose period needs --{name.replace('_', '-')}")
@@ -499,6 +508,23 @@ def _cmd_scene(args: argparse.Namespace) -> int:
         print(f"{result.question}: {result.answer}")
         for key, value in result.details.items():
             print(f"  {key}: {value}")
+    return 0
+
+
+def _choose_q(args: argparse.Namespace) -> int:
+    for name in ("tol", "x_min", "x_max"):
+        if getattr(args, name) is None:
+            raise InputError(f"choose q needs --{name.replace('_', '-')}")
+    c = choose_solution(args.tol, args.x_min, args.x_max, args.t_max)
+    data = {"quantity": "q", "method": c.method, "order": c.order, "max_error": c.max_error,
+            "ns_per_point": c.ns_per_point, "verified_on": c.verified_on}
+    if args.json:
+        print(json.dumps(data))
+    else:
+        print(f"q(t)/A to {args.tol:g} for x in [{args.x_min:g}, {args.x_max:g}], "
+              f"t in [0, {args.t_max:g}]: {c.method} order {c.order}, max error "
+              f"{c.max_error:.1e}, {c.ns_per_point:.1f} ns/point "
+              f"(`lindstedt generate duffing --order {c.order}` writes it)")
     return 0
 
 
@@ -607,11 +633,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_mixing)
 
     p = sub.add_parser("choose", help="the cheapest verified method for a tolerance and a range")
-    p.add_argument("quantity", choices=("period", "amplitudes"))
+    p.add_argument("quantity", choices=("period", "q", "amplitudes"))
     p.add_argument("--tol", type=float, help="tolerance (period: relative; amplitudes: "
                    "absolute, default 1e-4)")
     p.add_argument("--x-min", type=float, help="period: smallest x = eps*A**2")
     p.add_argument("--x-max", type=float, help="period: largest x = eps*A**2")
+    p.add_argument("--t-max", type=float, default=20.0, help="q: times 0..t-max (default 20)")
     p.add_argument("--eps", type=float, help="amplitudes: ε of the driven oscillator")
     p.add_argument("--force", type=float, help="amplitudes: f")
     p.add_argument("--omega", type=float, help="amplitudes: ω")

@@ -177,3 +177,31 @@ def test_choose_amplitudes_meets_the_tolerance_against_shooting():
                           "0.1", "--force", "1", "--json"], capture_output=True, text=True,
                          check=False)
     assert run.returncode == 2 and "--omega" in run.stderr
+
+
+def test_choose_q_against_jacobi_cn():
+    from scipy.special import ellipj
+
+    from generator.choose import choose_solution
+    from generator.lindstedt import derive
+    from generator.models import duffing
+
+    c = choose_solution(1e-8, 0.0, 0.3)
+    assert c.method == "lindstedt" and c.max_error <= 1e-8
+    # independently: the chosen order meets the tolerance off the verification grid
+    sol = derive(duffing(), c.order)
+    t = np.linspace(0.05, 19.95, 333)
+
+    def worst(k):
+        err = 0.0
+        for x in (0.07, 0.21, 0.3):
+            w = sum(float(sol.ground.to_fraction(v)) * x**j
+                    for j, v in enumerate(sol.omega[:k + 1]))
+            q = sum(x**j * sum(float(sol.ground.to_fraction(a)) * np.cos(n * w * t)
+                               for n, a in qj.items()) for j, qj in enumerate(sol.q[:k + 1]))
+            err = max(err, np.max(np.abs(q - ellipj(np.sqrt(1 + x) * t, x / (2 + 2 * x))[1])))
+        return err
+
+    assert worst(c.order) <= 1e-8
+    with pytest.raises(InputError, match="exact cn needs"):
+        choose_solution(1e-6, -0.8, 0.5)
