@@ -4,14 +4,13 @@
 # inputs sha256: b5d2168261d8c00fcb65880bc8741f3c5a26a9f4dd1fe0fb56b56d98742758bc
 """Driven Duffing q'' + damping*q' + q + eps*q**3 = force*cos(omega t): harmonic balance with 4 odd harmonics.
 
-Every function is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
-or arrays.  Outside its domain it returns NaN (see each docstring).
-"""
+Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
+or arrays.  Outside its domain it returns NaN (see each docstring)."""
 
 import math
 
 import numpy as np
-from numba import njit, vectorize
+from numba import njit
 
 HARMONICS = 4
 UNKNOWNS = (

@@ -4,17 +4,47 @@
 # inputs sha256: cef33ff01dffb2211c3af2d37365f7b8bff5e57c04ba6b53bf77b6cbbf023e34
 """Driven Duffing q'' + q + eps*q**3 = f cos(omega t): μ-expansion to order 3.
 
-Every function is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
-or arrays.  Outside its domain it returns NaN (see each docstring).
-"""
+Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
+or arrays.  Outside its domain it returns NaN (see each docstring).  Its twin
+``<name>_into(out, ...)`` writes into a 1-D ``out``, each argument a float or a 1-D array of
+``out``'s length: a contiguous compiled loop that LLVM vectorises (the ufunc's strided loop
+cannot be)."""
 
 import math
 
 import numpy as np
-from numba import vectorize
+from numba import njit, types, vectorize
+from numba.extending import overload
 
 ORDER = 3
 MODEL = 'driven (undamped)'
+
+
+def _at(v, i):
+    """``v[i]`` for an array, ``v`` for a scalar (compiled only, through the overload)."""
+    raise NotImplementedError
+
+
+@overload(_at, inline="always")
+def _at_overload(v, i):
+    if isinstance(v, types.Array):
+        return lambda v, i: v[i]
+    return lambda v, i: v
+
+
+def _check(v, n):
+    """Raise unless an array argument has ``n`` elements (compiled only)."""
+    raise NotImplementedError
+
+
+@overload(_check)
+def _check_overload(v, n):
+    if isinstance(v, types.Array):
+        def check(v, n):
+            if v.ndim != 1 or v.size != n:
+                raise ValueError("each array argument must be 1-D with out's length")
+        return check
+    return lambda v, n: None
 
 
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -49,6 +79,49 @@ def A_1(omega, eps, force, branch):
     return (0.0001220703125)*A1*(8192*x_0*x_4 - 96*x_1*x_3**2*x_6*(-2*x_1 + 3*x_2 + 2)*(-x_1*x_8 - 16*x_1 + 8*x_5 + 45*x_6 + x_8 + 8) - 768*x_3**4*x_7 - 3*x_6*(66825*A1**12*eps**6 + 1024*omega**12 - x_0*x_14 - x_0*x_19 - x_0*x_20 - 20480*x_0 - 571680*x_1*x_15 - x_1*x_17 - x_1*x_18 - x_1*x_20 - x_1*x_21 - 6144*x_1 - x_10*x_11 - 6144*x_10 + x_11 + x_12*x_9 + x_12 + x_14 + x_16*x_5 + x_16 + x_17 + x_18*x_9 + x_19*x_5 + x_21*x_5 + 15360*x_5 + 421248*x_7 + 15360*x_9 + 1024))/(x_0*x_4)
 
 
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
+def A_1_into(out, omega_in, eps_in, force_in, branch_in):
+    """``A_1`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
+    _check(omega_in, out.size)
+    _check(eps_in, out.size)
+    _check(force_in, out.size)
+    _check(branch_in, out.size)
+    for i in range(out.size):
+        omega = _at(omega_in, i)
+        eps = _at(eps_in, i)
+        force = _at(force_in, i)
+        branch = _at(branch_in, i)
+        A1 = (((((0.6666666666666666)*math.sqrt(-(4 - 4*omega**2)/eps)*math.cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))))) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (abs(math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps)**(0.3333333333333333)*(0.0 if math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps)) + abs(math.sqrt((0.4444444444444444)*force**2/eps**2 - 0.0013717421124828531*(4*omega**2 - 4)**3/eps**3) - 0.6666666666666666*force/eps)**(0.3333333333333333)*(0.0 if -math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, -math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps))))) if (branch == 0) else (((-0.6666666666666666*math.sqrt(-(4 - 4*omega**2)/eps)*math.cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.3333333333333333)*math.pi)) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 1) else (((-0.6666666666666666*math.sqrt(-(4 - 4*omega**2)/eps)*math.sin((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.16666666666666666)*math.pi)) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 2) else (math.nan))
+        D = -2.25*A1**2*eps/omega**2 + 1 - 1/omega**2
+        if not (((0.0003662109375)*abs(A1**5*eps**2*(66825*A1**12*eps**6 - 219240*A1**10*eps**5*omega**2 + 219240*A1**10*eps**5 + 285840*A1**8*eps**4*omega**4 - 571680*A1**8*eps**4*omega**2 + 285840*A1**8*eps**4 - 191808*A1**6*eps**3*omega**6 + 575424*A1**6*eps**3*omega**4 - 575424*A1**6*eps**3*omega**2 + 191808*A1**6*eps**3 + 70208*A1**4*eps**2*omega**8 - 280832*A1**4*eps**2*omega**6 + 421248*A1**4*eps**2*omega**4 - 280832*A1**4*eps**2*omega**2 + 70208*A1**4*eps**2 - 13312*A1**2*eps*omega**10 + 66560*A1**2*eps*omega**8 - 133120*A1**2*eps*omega**6 + 133120*A1**2*eps*omega**4 - 66560*A1**2*eps*omega**2 + 13312*A1**2*eps + 1024*omega**12 - 6144*omega**10 + 15360*omega**8 - 20480*omega**6 + 15360*omega**4 - 6144*omega**2 + 1024)/(omega**6*(9*A1**2*eps - 4*omega**2 + 4)**5)) <= (0.01171875)*abs(A1**5*eps**2*(3*A1**2*eps - 2*omega**2 + 2)*(45*A1**4*eps**2 - 40*A1**2*eps*omega**2 + 40*A1**2*eps + 8*omega**4 - 16*omega**2 + 8)/(omega**4*(9*A1**2*eps - 4*omega**2 + 4)**3))) and (D != 0) and (eps != 0)):
+            out[i] = math.nan
+            continue
+        x_0 = omega**6
+        x_1 = omega**2
+        x_2 = A1**2*eps
+        x_3 = -4*x_1 + 9*x_2 + 4
+        x_4 = x_3**5
+        x_5 = omega**4
+        x_6 = A1**4*eps**2
+        x_7 = x_5*x_6
+        x_8 = 40*x_2
+        x_9 = omega**8
+        x_10 = omega**10
+        x_11 = 13312*x_2
+        x_12 = 70208*x_6
+        x_13 = A1**6*eps**3
+        x_14 = 191808*x_13
+        x_15 = A1**8*eps**4
+        x_16 = 285840*x_15
+        x_17 = 219240*A1**10*eps**5
+        x_18 = 66560*x_2
+        x_19 = 133120*x_2
+        x_20 = 280832*x_6
+        x_21 = 575424*x_13
+        out[i] = (0.0001220703125)*A1*(8192*x_0*x_4 - 96*x_1*x_3**2*x_6*(-2*x_1 + 3*x_2 + 2)*(-x_1*x_8 - 16*x_1 + 8*x_5 + 45*x_6 + x_8 + 8) - 768*x_3**4*x_7 - 3*x_6*(66825*A1**12*eps**6 + 1024*omega**12 - x_0*x_14 - x_0*x_19 - x_0*x_20 - 20480*x_0 - 571680*x_1*x_15 - x_1*x_17 - x_1*x_18 - x_1*x_20 - x_1*x_21 - 6144*x_1 - x_10*x_11 - 6144*x_10 + x_11 + x_12*x_9 + x_12 + x_14 + x_16*x_5 + x_16 + x_17 + x_18*x_9 + x_19*x_5 + x_21*x_5 + 15360*x_5 + 421248*x_7 + 15360*x_9 + 1024))/(x_0*x_4)
+    return out
+
+
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_3(omega, eps, force, branch):
     """Coefficient of cos 3ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
@@ -75,6 +148,43 @@ def A_3(omega, eps, force, branch):
     return (0.0001220703125)*A1**3*eps*(4131*A1**10*eps**5 - 256*omega**10 - x_0*x_13 - x_0*x_9 - 2560*x_0 - 33696*x_1*x_10 - x_1*x_12 - x_1*x_13 - x_1*x_14 + 8*x_1*x_3**2*(-x_1*x_15 - 32*x_1 + x_15 + 16*x_5 + 45*x_8 + 16) - 1280*x_1 + x_11*x_5 + x_11 + x_12 + x_14*x_5 + 14976*x_2*x_5 + 256*x_4*x_5 + 2560*x_5 + x_6*x_7 + 1280*x_6 + x_7 + x_9 + 256)/(x_0*x_4)
 
 
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
+def A_3_into(out, omega_in, eps_in, force_in, branch_in):
+    """``A_3`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
+    _check(omega_in, out.size)
+    _check(eps_in, out.size)
+    _check(force_in, out.size)
+    _check(branch_in, out.size)
+    for i in range(out.size):
+        omega = _at(omega_in, i)
+        eps = _at(eps_in, i)
+        force = _at(force_in, i)
+        branch = _at(branch_in, i)
+        A1 = (((((0.6666666666666666)*math.sqrt(-(4 - 4*omega**2)/eps)*math.cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))))) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (abs(math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps)**(0.3333333333333333)*(0.0 if math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps)) + abs(math.sqrt((0.4444444444444444)*force**2/eps**2 - 0.0013717421124828531*(4*omega**2 - 4)**3/eps**3) - 0.6666666666666666*force/eps)**(0.3333333333333333)*(0.0 if -math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, -math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps))))) if (branch == 0) else (((-0.6666666666666666*math.sqrt(-(4 - 4*omega**2)/eps)*math.cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.3333333333333333)*math.pi)) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 1) else (((-0.6666666666666666*math.sqrt(-(4 - 4*omega**2)/eps)*math.sin((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.16666666666666666)*math.pi)) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 2) else (math.nan))
+        D = -2.25*A1**2*eps/omega**2 + 1 - 1/omega**2
+        if not (((0.0003662109375)*abs(A1**5*eps**2*(66825*A1**12*eps**6 - 219240*A1**10*eps**5*omega**2 + 219240*A1**10*eps**5 + 285840*A1**8*eps**4*omega**4 - 571680*A1**8*eps**4*omega**2 + 285840*A1**8*eps**4 - 191808*A1**6*eps**3*omega**6 + 575424*A1**6*eps**3*omega**4 - 575424*A1**6*eps**3*omega**2 + 191808*A1**6*eps**3 + 70208*A1**4*eps**2*omega**8 - 280832*A1**4*eps**2*omega**6 + 421248*A1**4*eps**2*omega**4 - 280832*A1**4*eps**2*omega**2 + 70208*A1**4*eps**2 - 13312*A1**2*eps*omega**10 + 66560*A1**2*eps*omega**8 - 133120*A1**2*eps*omega**6 + 133120*A1**2*eps*omega**4 - 66560*A1**2*eps*omega**2 + 13312*A1**2*eps + 1024*omega**12 - 6144*omega**10 + 15360*omega**8 - 20480*omega**6 + 15360*omega**4 - 6144*omega**2 + 1024)/(omega**6*(9*A1**2*eps - 4*omega**2 + 4)**5)) <= (0.01171875)*abs(A1**5*eps**2*(3*A1**2*eps - 2*omega**2 + 2)*(45*A1**4*eps**2 - 40*A1**2*eps*omega**2 + 40*A1**2*eps + 8*omega**4 - 16*omega**2 + 8)/(omega**4*(9*A1**2*eps - 4*omega**2 + 4)**3))) and (D != 0) and (eps != 0)):
+            out[i] = math.nan
+            continue
+        x_0 = omega**6
+        x_1 = omega**2
+        x_2 = A1**2*eps
+        x_3 = -4*x_1 + 9*x_2 + 4
+        x_4 = x_3**3
+        x_5 = omega**4
+        x_6 = omega**8
+        x_7 = 2496*x_2
+        x_8 = A1**4*eps**2
+        x_9 = 9408*x_8
+        x_10 = A1**6*eps**3
+        x_11 = 16848*x_10
+        x_12 = 14013*A1**8*eps**4
+        x_13 = 9984*x_2
+        x_14 = 28224*x_8
+        x_15 = 60*x_2
+        out[i] = (0.0001220703125)*A1**3*eps*(4131*A1**10*eps**5 - 256*omega**10 - x_0*x_13 - x_0*x_9 - 2560*x_0 - 33696*x_1*x_10 - x_1*x_12 - x_1*x_13 - x_1*x_14 + 8*x_1*x_3**2*(-x_1*x_15 - 32*x_1 + x_15 + 16*x_5 + 45*x_8 + 16) - 1280*x_1 + x_11*x_5 + x_11 + x_12 + x_14*x_5 + 14976*x_2*x_5 + 256*x_4*x_5 + 2560*x_5 + x_6*x_7 + 1280*x_6 + x_7 + x_9 + 256)/(x_0*x_4)
+    return out
+
+
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_5(omega, eps, force, branch):
     """Coefficient of cos 5ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
@@ -90,6 +200,32 @@ def A_5(omega, eps, force, branch):
     return (2.0345052083333332e-05)*A1**5*x_0*(99*A1**4*x_0 + 32*omega**4 + 48*x_1*x_3 - x_1*x_4 - 64*x_1 + x_4 + 32)/(omega**6*x_3)
 
 
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
+def A_5_into(out, omega_in, eps_in, force_in, branch_in):
+    """``A_5`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
+    _check(omega_in, out.size)
+    _check(eps_in, out.size)
+    _check(force_in, out.size)
+    _check(branch_in, out.size)
+    for i in range(out.size):
+        omega = _at(omega_in, i)
+        eps = _at(eps_in, i)
+        force = _at(force_in, i)
+        branch = _at(branch_in, i)
+        A1 = (((((0.6666666666666666)*math.sqrt(-(4 - 4*omega**2)/eps)*math.cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))))) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (abs(math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps)**(0.3333333333333333)*(0.0 if math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps)) + abs(math.sqrt((0.4444444444444444)*force**2/eps**2 - 0.0013717421124828531*(4*omega**2 - 4)**3/eps**3) - 0.6666666666666666*force/eps)**(0.3333333333333333)*(0.0 if -math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, -math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps))))) if (branch == 0) else (((-0.6666666666666666*math.sqrt(-(4 - 4*omega**2)/eps)*math.cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.3333333333333333)*math.pi)) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 1) else (((-0.6666666666666666*math.sqrt(-(4 - 4*omega**2)/eps)*math.sin((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.16666666666666666)*math.pi)) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 2) else (math.nan))
+        D = -2.25*A1**2*eps/omega**2 + 1 - 1/omega**2
+        if not (((0.0003662109375)*abs(A1**5*eps**2*(66825*A1**12*eps**6 - 219240*A1**10*eps**5*omega**2 + 219240*A1**10*eps**5 + 285840*A1**8*eps**4*omega**4 - 571680*A1**8*eps**4*omega**2 + 285840*A1**8*eps**4 - 191808*A1**6*eps**3*omega**6 + 575424*A1**6*eps**3*omega**4 - 575424*A1**6*eps**3*omega**2 + 191808*A1**6*eps**3 + 70208*A1**4*eps**2*omega**8 - 280832*A1**4*eps**2*omega**6 + 421248*A1**4*eps**2*omega**4 - 280832*A1**4*eps**2*omega**2 + 70208*A1**4*eps**2 - 13312*A1**2*eps*omega**10 + 66560*A1**2*eps*omega**8 - 133120*A1**2*eps*omega**6 + 133120*A1**2*eps*omega**4 - 66560*A1**2*eps*omega**2 + 13312*A1**2*eps + 1024*omega**12 - 6144*omega**10 + 15360*omega**8 - 20480*omega**6 + 15360*omega**4 - 6144*omega**2 + 1024)/(omega**6*(9*A1**2*eps - 4*omega**2 + 4)**5)) <= (0.01171875)*abs(A1**5*eps**2*(3*A1**2*eps - 2*omega**2 + 2)*(45*A1**4*eps**2 - 40*A1**2*eps*omega**2 + 40*A1**2*eps + 8*omega**4 - 16*omega**2 + 8)/(omega**4*(9*A1**2*eps - 4*omega**2 + 4)**3))) and (D != 0) and (eps != 0)):
+            out[i] = math.nan
+            continue
+        x_0 = eps**2
+        x_1 = omega**2
+        x_2 = A1**2*eps
+        x_3 = -4*x_1 + 9*x_2 + 4
+        x_4 = 126*x_2
+        out[i] = (2.0345052083333332e-05)*A1**5*x_0*(99*A1**4*x_0 + 32*omega**4 + 48*x_1*x_3 - x_1*x_4 - 64*x_1 + x_4 + 32)/(omega**6*x_3)
+    return out
+
+
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_7(omega, eps, force, branch):
     """Coefficient of cos 7ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
@@ -100,6 +236,27 @@ def A_7(omega, eps, force, branch):
     return (3.0517578125e-05)*A1**7*eps**3/omega**6
 
 
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
+def A_7_into(out, omega_in, eps_in, force_in, branch_in):
+    """``A_7`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
+    _check(omega_in, out.size)
+    _check(eps_in, out.size)
+    _check(force_in, out.size)
+    _check(branch_in, out.size)
+    for i in range(out.size):
+        omega = _at(omega_in, i)
+        eps = _at(eps_in, i)
+        force = _at(force_in, i)
+        branch = _at(branch_in, i)
+        A1 = (((((0.6666666666666666)*math.sqrt(-(4 - 4*omega**2)/eps)*math.cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))))) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (abs(math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps)**(0.3333333333333333)*(0.0 if math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps)) + abs(math.sqrt((0.4444444444444444)*force**2/eps**2 - 0.0013717421124828531*(4*omega**2 - 4)**3/eps**3) - 0.6666666666666666*force/eps)**(0.3333333333333333)*(0.0 if -math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, -math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps))))) if (branch == 0) else (((-0.6666666666666666*math.sqrt(-(4 - 4*omega**2)/eps)*math.cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.3333333333333333)*math.pi)) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 1) else (((-0.6666666666666666*math.sqrt(-(4 - 4*omega**2)/eps)*math.sin((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.16666666666666666)*math.pi)) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 2) else (math.nan))
+        D = -2.25*A1**2*eps/omega**2 + 1 - 1/omega**2
+        if not (((0.0003662109375)*abs(A1**5*eps**2*(66825*A1**12*eps**6 - 219240*A1**10*eps**5*omega**2 + 219240*A1**10*eps**5 + 285840*A1**8*eps**4*omega**4 - 571680*A1**8*eps**4*omega**2 + 285840*A1**8*eps**4 - 191808*A1**6*eps**3*omega**6 + 575424*A1**6*eps**3*omega**4 - 575424*A1**6*eps**3*omega**2 + 191808*A1**6*eps**3 + 70208*A1**4*eps**2*omega**8 - 280832*A1**4*eps**2*omega**6 + 421248*A1**4*eps**2*omega**4 - 280832*A1**4*eps**2*omega**2 + 70208*A1**4*eps**2 - 13312*A1**2*eps*omega**10 + 66560*A1**2*eps*omega**8 - 133120*A1**2*eps*omega**6 + 133120*A1**2*eps*omega**4 - 66560*A1**2*eps*omega**2 + 13312*A1**2*eps + 1024*omega**12 - 6144*omega**10 + 15360*omega**8 - 20480*omega**6 + 15360*omega**4 - 6144*omega**2 + 1024)/(omega**6*(9*A1**2*eps - 4*omega**2 + 4)**5)) <= (0.01171875)*abs(A1**5*eps**2*(3*A1**2*eps - 2*omega**2 + 2)*(45*A1**4*eps**2 - 40*A1**2*eps*omega**2 + 40*A1**2*eps + 8*omega**4 - 16*omega**2 + 8)/(omega**4*(9*A1**2*eps - 4*omega**2 + 4)**3))) and (D != 0) and (eps != 0)):
+            out[i] = math.nan
+            continue
+        out[i] = (3.0517578125e-05)*A1**7*eps**3/omega**6
+    return out
+
+
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def first_order(omega, eps, force, branch):
     """A₁ of the branch: a real root of (ω² − 1)A₁ − ¾εA₁³ + f = 0."""
@@ -107,3 +264,23 @@ def first_order(omega, eps, force, branch):
     if not ((eps != 0)):
         return math.nan
     return A1
+
+
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
+def first_order_into(out, omega_in, eps_in, force_in, branch_in):
+    """``first_order`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
+    _check(omega_in, out.size)
+    _check(eps_in, out.size)
+    _check(force_in, out.size)
+    _check(branch_in, out.size)
+    for i in range(out.size):
+        omega = _at(omega_in, i)
+        eps = _at(eps_in, i)
+        force = _at(force_in, i)
+        branch = _at(branch_in, i)
+        A1 = (((((0.6666666666666666)*math.sqrt(-(4 - 4*omega**2)/eps)*math.cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))))) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (abs(math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps)**(0.3333333333333333)*(0.0 if math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps)) + abs(math.sqrt((0.4444444444444444)*force**2/eps**2 - 0.0013717421124828531*(4*omega**2 - 4)**3/eps**3) - 0.6666666666666666*force/eps)**(0.3333333333333333)*(0.0 if -math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, -math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3) + (0.6666666666666666)*force/eps))))) if (branch == 0) else (((-0.6666666666666666*math.sqrt(-(4 - 4*omega**2)/eps)*math.cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.3333333333333333)*math.pi)) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 1) else (((-0.6666666666666666*math.sqrt(-(4 - 4*omega**2)/eps)*math.sin((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.16666666666666666)*math.pi)) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 2) else (math.nan))
+        if not ((eps != 0)):
+            out[i] = math.nan
+            continue
+        out[i] = A1
+    return out

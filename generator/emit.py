@@ -101,6 +101,8 @@ def _evaluator_context(ev: Evaluator) -> dict:
         "name": ev.name,
         "doc": ev.doc,
         "args": ", ".join(str(a) for a in ev.args),
+        "arg_names": [str(a) for a in ev.args],
+        "into_args": ", ".join(f"{a}_in" for a in ev.args),
         "signature": "float64(" + ", ".join("float64" for _ in ev.args) + ")",
         "prelude": [(str(lhs), pycode(rhs)) for lhs, rhs in ev.prelude],
         "guard": pycode(ev.guard),

@@ -330,9 +330,17 @@ def lower_choice(candidate, command: str) -> Module:
         return [sp.Rational(float(v)) for v in values]
 
     guard = {"lindstedt": sp.And(x > -1, sp.Abs(x) < 1), "resummed": x > sp.Rational(-2, 3),
-             "pade": x > -1, "modified": x > -1}[candidate.method]
+             "pade": x > -1, "modified": x > -1, "agm": x > -1}[candidate.method]
     body: tuple = ()
-    if candidate.method == "lindstedt":
+    if candidate.method == "agm":
+        a, b = sp.symbols("a0 b0")
+        body = ((a, sp.sqrt(1 + x)), (b, sp.sqrt(1 + x / 2)))
+        for n in range(1, candidate.order + 1):
+            an, bn = sp.symbols(f"a{n} b{n}")
+            body += ((an, (a + b) / 2), (bn, sp.sqrt(a * b)))
+            a, b = an, bn
+        out = 2 / (a + b)
+    elif candidate.method == "lindstedt":
         out = horner(coeffs(candidate.num), x)
     elif candidate.method == "resummed":
         body = ((m, x / (2 + 2 * x)),)

@@ -36,7 +36,25 @@ def test_choice_meets_the_tolerance_between_the_verification_points(tol, lo, hi)
                               / mpmath.sqrt(1 + mpmath.mpf(v))) for v in x])
     assert np.max(np.abs(cand(x) / ref - 1)) <= tol
     assert choice.max_error <= tol and choice.verified_on >= 1000
-    assert choice.method != "exact"  # a series beats ellipk at these tolerances
+    assert choice.method != "exact"  # the AGM or a series beats ellipk at these tolerances
+
+
+RNG = np.random.default_rng(7)
+
+
+@pytest.mark.parametrize("steps,x,tol", [(2, RNG.uniform(-0.5, 0.5, 200), 1e-12),
+                                         (3, RNG.uniform(-0.5, 1000.0, 200), 1e-15),
+                                         (6, -1 + np.logspace(-12, -2, 200), 1e-15)])
+def test_agm_period_against_mpmath_elliptic_k(steps, x, tol):
+    """T/2π = 1/AGM(√(1+x), √(1+x/2)): each step squares the error, so a few steps reach
+    double precision; next to the separatrix it needs more."""
+    with mpmath.workdps(30):
+        ref = np.array([float(2 / mpmath.pi * mpmath.ellipk(mpmath.mpf(v) / (2 * (1 + v)))
+                              / mpmath.sqrt(1 + mpmath.mpf(v))) for v in x])
+    agm = {c.order: c for c in candidates() if c.method == "agm"}
+    assert np.max(np.abs(agm[steps](x) / ref - 1)) <= tol
+    assert np.max(np.abs(agm[steps - 1](x) / ref - 1)) > tol  # one step fewer is not enough
+    assert np.isnan(agm[steps](np.array([-1.0, -2.0]))).all()
 
 
 def test_choose_contract_and_bad_input():
@@ -114,7 +132,11 @@ def test_driven_and_spring_scenes():
     from generator.choose import driven_scene, hard_spring_scene
 
     spring = hard_spring_scene(50.0, 1e-8)
-    assert spring.details["method"] == "resummed" and spring.details["max_error"] <= 1e-8
+    assert spring.details["method"] != "exact" and spring.details["max_error"] <= 1e-8
+    ref = float(2 / mpmath.pi * mpmath.ellipk(mpmath.mpf(50) / 102) / mpmath.sqrt(51))
+    cand = next(c for c in candidates()
+                if (c.method, c.order) == (spring.details["method"], spring.details["order"]))
+    assert abs(cand(np.array([50.0]))[0] / ref - 1) <= 1e-8
     driven = driven_scene(1e-4)
     # the notes' order 2 (A₁ = 2.35575 vs 2.35555) misses 1e-4; order 3 meets it
     assert driven.details["mu_order"] == 3
@@ -136,7 +158,8 @@ def test_choose_emits_just_the_chosen_evaluator(tmp_path):
         ref = np.array([float(4 * mpmath.ellipk(mpmath.mpf(v) / (2 * (1 + v)))
                               / mpmath.sqrt(1 + mpmath.mpf(v))) for v in x])
     assert np.max(np.abs(mod.period(1.0, x) / ref - 1)) <= 1e-8
-    assert np.isnan(mod.period(1.0, -0.9))  # outside the resummed series' domain
+    assert np.array_equal(mod.period_into(np.empty_like(x), 1.0, x), mod.period(1.0, x))
+    assert np.isnan(mod.period(1.0, -1.5))  # beyond the separatrix: no periodic orbit
     del sys.modules["chosen_period"]
 
 

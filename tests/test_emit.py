@@ -209,6 +209,20 @@ def test_broadcasting(duf, pend):
     assert pend.theta(tt, 0.5).shape == (5, 1)
 
 
+def test_into_twins_equal_the_ufuncs(duf, pend):
+    """``<name>_into(out, …)``: scalars and 1-D arrays mixed, the ufunc's values and NaNs."""
+    t = np.linspace(0, 30, 101)
+    eps = np.linspace(-1.2, 1.2, 101)  # beyond both ends of the domain: NaN in both
+    for args in ((t, 0.7, 0.2), (t, 0.7, eps), (1.5, np.full(101, 0.7), eps)):
+        assert np.array_equal(duf.q_into(np.empty(101), *args), duf.q(*args), equal_nan=True)
+    assert np.array_equal(duf.period_into(np.empty(101), 1.0, eps), duf.period(1.0, eps),
+                          equal_nan=True)
+    th = np.linspace(0, 3.5, 101)
+    assert np.array_equal(pend.period_into(np.empty(101), th), pend.period(th), equal_nan=True)
+    with pytest.raises(ValueError, match="out's length"):
+        duf.period_into(np.empty(3), 1.0, eps)
+
+
 def test_cached_module_imports_without_recompiling(tmp_path):
     shutil.copy(GENERATED / "duffing.py", tmp_path / "duffing.py")
     code = "import duffing; duffing.q(1.0, 1.0, 0.1); duffing.period(1.0, 0.1)"
