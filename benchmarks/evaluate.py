@@ -1,5 +1,7 @@
 """ns/point of the generated numba evaluators against lambdify, numpy.polyval and C loops.
 
+"numba (generated)" is the ufunc (broadcasting, strided loop); "…_into" its contiguous twin.
+
     .venv/bin/python benchmarks/evaluate.py [--points 1000000 10000000] [--order 12]
 
 The C loops are printed from the same IR as the numba module (SymPy's C99 printer), compiled
@@ -105,6 +107,7 @@ def measure(n, rng, mod, libs, f_period, f_q) -> None:
 
     out2 = np.empty(n)  # every compiled variant writes into a preallocated array
     add("period: numba (generated)", lambda: mod.period(A_, e_, out=out2), lambda: out2, ref_T)
+    add("period: numba period_into", lambda: mod.period_into(out2, A_, e_), lambda: out2, ref_T)
     polyval = lambda: 2 * np.pi * np.polyval(tau, e_ * A_**2)  # noqa: E731
     add("period: numpy.polyval", polyval, polyval, ref_T)
     add("period: sympy.lambdify", lambda: f_period(A_, e_), lambda: f_period(A_, e_), ref_T)
@@ -112,6 +115,7 @@ def measure(n, rng, mod, libs, f_period, f_q) -> None:
         add(f"period: {tag}", lambda lib=lib: lib.period_c(n, p(A_), p(e_), p(out)),
             lambda: out.copy(), ref_T)
     add("q: numba (generated)", lambda: mod.q(t_, A_, e_, out=out2), lambda: out2, ref_q)
+    add("q: numba q_into", lambda: mod.q_into(out2, t_, A_, e_), lambda: out2, ref_q)
     add(f"q: sympy.lambdify ({k:,} pts)", lambda: f_q(ts, As, es), lambda: f_q(ts, As, es),
         ref_q[:k], k)
     for tag, lib in libs.items():

@@ -16,7 +16,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .choose import candidates, pareto_front, reference_period, tradeoffs
+from .choose import (
+    DRIVEN_QUANTITIES,
+    candidates,
+    driven_tradeoffs,
+    driven_truth,
+    pareto_front,
+    reference_period,
+    tradeoffs,
+)
 from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
 from .errors import InputError
 from .numerics import steady_state_amplitudes, sweep
@@ -178,6 +186,43 @@ def speed_accuracy_figure(path: Path) -> Path:
         ax.set(xscale="log", yscale="log", title=f"x = εA² = {x:g}", xlabel="ns / point")
     axes[0].set_ylabel("relative error of T")
     axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+DRIVEN_CHART_OMEGA = (0.5, 1.0, 1.6, 2.5)
+# NOTE: the notes' ε = 0.1, f = 1: below, at, and above the linear resonance, and beyond the
+# fold at ω ≈ 1.34 where only the large branch is followed.
+
+
+def driven_speed_accuracy_figure(path: Path, eps: float = 0.1, force: float = 1.0,
+                                 Q: float = np.inf) -> Path:
+    """Error of A_n (n = 1, 3, 5) and of r against the true orbit versus measured cost per
+    ω: one harmonic, μ-expansion orders 0..12, harmonic balance 1..12; Pareto fronts."""
+    check_plot_path(path)
+    truth = driven_truth(eps, force, Q, np.array(DRIVEN_CHART_OMEGA))
+    data = driven_tradeoffs(truth, eps, force, Q)
+    cost = np.array([t.ns_per_point for t in data]) / 1e3
+    colors = {"one_harmonic": "C3", "mu_expansion": "C0", "harmonic_balance": "C2"}
+    fig, axes = plt.subplots(2, len(DRIVEN_CHART_OMEGA), figsize=(15, 6.5), sharex=True,
+                             sharey=True)
+    for row, quantity in enumerate(DRIVEN_QUANTITIES):
+        for k, w in enumerate(DRIVEN_CHART_OMEGA):
+            ax = axes[row, k]
+            err = np.maximum(np.array([t.errors[quantity][k] for t in data]), FLOOR)
+            for method, color in colors.items():
+                sel = [i for i, t in enumerate(data) if t.method == method]
+                ax.plot(cost[sel], err[sel], "o", color=color, ms=3, label=method)
+            front = pareto_front(cost, err)
+            ax.plot(cost[front], err[front], "r-", lw=1, label="Pareto front")
+            ax.set(xscale="log", yscale="log", title=f"{quantity}, ω = {w:g}")
+            if row == 1:
+                ax.set_xlabel("µs per ω (measured)")
+        axes[row, 0].set_ylabel("max |A_n − A_n,true|" if quantity == "amplitudes"
+                                else "|r − r_true|")
+    axes[0, 0].legend(fontsize=7)
+    fig.suptitle(f"driven Duffing ε = {eps}, f = {force}" + ("" if np.isinf(Q) else f", Q = {Q}")
+                 + ": error against the true orbit (shooting) versus cost", fontsize=10)
     fig.tight_layout()
     return _save(fig, path)
 

@@ -16,6 +16,7 @@ import numpy as np
 from . import __version__
 from .charts import (
     check_plot_path,
+    driven_speed_accuracy_figure,
     driven_validity_figure,
     mixing_figure,
     response_figure,
@@ -24,6 +25,7 @@ from .charts import (
     validity_figure,
 )
 from .choose import (
+    DRIVEN_QUANTITIES,
     SCENES,
     appendix_thresholds,
     candidates,
@@ -205,8 +207,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     pdf_dir = Path("out")
     pdf_dir.mkdir(exist_ok=True)
     # NOTE: measured costs differ run to run, so this chart goes to out/, not docs/figures/
-    # (benchmarks/speed_accuracy.py refreshes the committed copy the README shows).
+    # (benchmarks/speed_accuracy.py refreshes the committed copies the README shows).
     print(f"  {speed_accuracy_figure(pdf_dir / 'speed_accuracy.png')}")
+    print(f"  {driven_speed_accuracy_figure(pdf_dir / 'driven_speed_accuracy.png')}")
     if shutil.which("pdflatex"):
         for tex in sorted(out.glob("*.tex")):
             for _ in range(2):  # longtable settles its column widths on the second pass
@@ -442,8 +445,8 @@ def _mixing_table(data: dict) -> list[str]:
 
 
 def _cmd_choose(args: argparse.Namespace) -> int:
-    if args.quantity == "amplitudes":
-        return _choose_amplitudes(args)
+    if args.quantity in DRIVEN_QUANTITIES:
+        return _choose_driven(args)
     if args.quantity == "q":
         return _choose_q(args)
     for name in ("tol", "x_min", "x_max"):
@@ -528,22 +531,41 @@ def _choose_q(args: argparse.Namespace) -> int:
     return 0
 
 
-def _choose_amplitudes(args: argparse.Namespace) -> int:
-    for name in ("eps", "force", "omega"):
+def _choose_driven(args: argparse.Namespace) -> int:
+    """``choose amplitudes`` and ``choose response``: one ω or a range of ω."""
+    for name in ("eps", "force"):
         if getattr(args, name) is None:
-            raise InputError(f"choose amplitudes needs --{name}")
-    c = choose_driven(args.eps, args.force, args.omega, args.Q, args.tol or 1e-4)
-    data = {"quantity": "amplitudes", "method": c.method, "order": c.order,
-            "max_error": c.max_error, "seconds": c.seconds, "alternatives": c.alternatives,
-            "truth": c.truth}
+            raise InputError(f"choose {args.quantity} needs --{name}")
+    if args.omega is None and (args.omega_min is None or args.omega_max is None):
+        raise InputError(f"choose {args.quantity} needs --omega, or --omega-min and --omega-max")
+    if args.omega is not None and (args.omega_min is not None or args.omega_max is not None):
+        raise InputError("give --omega or a range (--omega-min, --omega-max), not both")
+    tol = args.tol or 1e-4
+    lo, hi = (args.omega, None) if args.omega is not None else (args.omega_min, args.omega_max)
+    c = choose_driven(args.quantity, tol, args.eps, args.force, args.Q, lo, hi)
+    data = {"quantity": args.quantity, "method": c.method, "order": c.order,
+            "max_error": c.max_error, "ns_per_point": c.ns_per_point,
+            "verified_on": c.verified_on, "seconds": c.ns_per_point * 1e-9,
+            "alternatives": {m: {"order": o, "max_error": e, "seconds": ns * 1e-9}
+                             for m, o, e, ns in c.considered if m != c.method},
+            "considered": [{"method": m, "order": o, "max_error": e, "ns_per_point": ns}
+                           for m, o, e, ns in c.considered],
+            "truth_by_omega": [{"omega": float(w), "A": a.tolist(), "B": b.tolist()}
+                               for w, a, b in zip(c.truth.omega, c.truth.A, c.truth.B,
+                                                  strict=True)]}
+    if args.omega is not None:
+        data["truth"] = c.truth.A[0].tolist()
     if args.json:
         print(json.dumps(data))
-    else:
-        print(f"A1, A3, A5 (and B_n) to {args.tol or 1e-4:g}: {c.method} order {c.order}, "
-              f"max error {c.max_error:.1e}, {c.seconds * 1e3:.2f} ms")
-        for m, v in c.alternatives.items():
-            print(f"  also: {m} order {v['order']}, max error {v['max_error']:.1e}, "
-                  f"{v['seconds'] * 1e3:.2f} ms")
+        return 0
+    what = {"amplitudes": "A1, A3, A5 (and B_n)", "response": "r = sqrt(A1^2 + B1^2)"}
+    where = f"omega = {lo:g}" if hi is None else f"omega in [{lo:g}, {hi:g}]"
+    print(f"{what[args.quantity]} to {tol:g} (absolute, largest branch, {where}, verified on "
+          f"{c.verified_on} point{'s' * (c.verified_on > 1)} against shooting):")
+    print(f"  chosen: {c.method} order {c.order}: max error {c.max_error:.1e}, "
+          f"{c.ns_per_point / 1e3:.1f} µs/point")
+    for m, o, e, ns in c.considered:
+        print(f"  {m:>16} order {o:>2}: max error {e:.1e}, {ns / 1e3:8.1f} µs/point")
     return 0
 
 
@@ -633,16 +655,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_mixing)
 
     p = sub.add_parser("choose", help="the cheapest verified method for a tolerance and a range")
-    p.add_argument("quantity", choices=("period", "q", "amplitudes"))
-    p.add_argument("--tol", type=float, help="tolerance (period: relative; amplitudes: "
-                   "absolute, default 1e-4)")
+    p.add_argument("quantity", choices=("period", "q", *DRIVEN_QUANTITIES))
+    p.add_argument("--tol", type=float, help="tolerance (period, q: relative; amplitudes, "
+                   "response: absolute, default 1e-4)")
     p.add_argument("--x-min", type=float, help="period: smallest x = eps*A**2")
     p.add_argument("--x-max", type=float, help="period: largest x = eps*A**2")
     p.add_argument("--t-max", type=float, default=20.0, help="q: times 0..t-max (default 20)")
-    p.add_argument("--eps", type=float, help="amplitudes: ε of the driven oscillator")
-    p.add_argument("--force", type=float, help="amplitudes: f")
-    p.add_argument("--omega", type=float, help="amplitudes: ω")
-    p.add_argument("--Q", type=float, default=math.inf, help="amplitudes: Q (default undamped)")
+    p.add_argument("--eps", type=float, help="amplitudes, response: ε of the driven oscillator")
+    p.add_argument("--force", type=float, help="amplitudes, response: f")
+    p.add_argument("--omega", type=float, help="amplitudes, response: one drive frequency ω")
+    p.add_argument("--omega-min", type=float, help="amplitudes, response: lowest ω of a range")
+    p.add_argument("--omega-max", type=float, help="amplitudes, response: highest ω of a range")
+    p.add_argument("--Q", type=float, default=math.inf,
+                   help="amplitudes, response: Q (default undamped)")
     p.add_argument("--emit", metavar="DIR", help="write just the chosen evaluator into DIR")
     p.add_argument("--json", action="store_true", help="print the JSON contract")
     p.set_defaults(func=_cmd_choose)

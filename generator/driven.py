@@ -120,9 +120,15 @@ def first_order_branches(d: Drive) -> list[Branch]:
     roots = np.roots([9 / 16 * d.eps**2, 1.5 * d.eps * a, a * a + w2 * d.damping**2,
                       -d.force**2])
     out = []
-    for u in roots:
-        if abs(u.imag) <= 1e-9 * (1 + abs(u)) and u.real > 0:
-            r = math.sqrt(u.real)
+    for root in roots:
+        if abs(root.imag) <= 1e-9 * (1 + abs(root)) and root.real > 0:
+            u = root.real
+            for _ in range(3):  # Newton on the cubic: np.roots loses digits near a fold
+                s = a + 0.75 * d.eps * u
+                slope = s * s + w2 * d.damping**2 + 1.5 * d.eps * u * s
+                if slope != 0:
+                    u -= (u * (s * s + w2 * d.damping**2) - d.force**2) / slope
+            r = math.sqrt(u)
             delta = math.atan2(r * d.omega * d.damping, 0.75 * d.eps * r**3 - (w2 - 1) * r)
             out.append(Branch(r, delta))
     return sorted(out, key=lambda b: -b.A1)

@@ -191,15 +191,66 @@ def test_choose_amplitudes_meets_the_tolerance_against_shooting():
     from generator.choose import choose_driven
     from generator.numerics import shoot
 
-    c = choose_driven(0.1, 0.3, 1.3, 20.0, tol=1e-8)
+    c = choose_driven("amplitudes", 1e-8, 0.1, 0.3, 20.0, 1.3)
     assert c.max_error <= 1e-8 and c.method in ("mu_expansion", "harmonic_balance")
     # the truth it was judged against is the true orbit on the largest branch
     orbit = shoot(0.1, 0.3, 1.3, 0.05, np.array([2.9, 1.2]))
-    assert abs(orbit.A[1] - c.truth[0]) < 1e-9
+    assert abs(orbit.A[1] - c.truth.A[0, 0]) < 1e-9
     run = subprocess.run([sys.executable, "-m", "generator", "choose", "amplitudes", "--eps",
                           "0.1", "--force", "1", "--json"], capture_output=True, text=True,
                          check=False)
     assert run.returncode == 2 and "--omega" in run.stderr
+
+
+def test_one_harmonic_closed_form_is_mu_order_zero():
+    """The vectorised cubic and the μ-expansion's order 0 (np.roots) agree on every branch
+    point, damped and undamped, A₁ and B₁ (signs included: antiphase above resonance)."""
+    from generator.choose import one_harmonic_amplitudes
+    from generator.driven import Drive, amplitudes, first_order_branches, mu_expansion
+
+    for Q in (np.inf, 20.0):
+        omegas = np.array([0.4, 0.9, 1.0, 1.2, 2.0, 3.0])
+        a1, b1 = one_harmonic_amplitudes(0.1, 0.7, Q, omegas)
+        for w, a, b in zip(omegas, a1, b1, strict=True):
+            d = Drive(0.1, 0.7, float(w), Q)
+            A, B = amplitudes(*mu_expansion(d, first_order_branches(d)[0], 0).partial(0), 1)
+            assert abs(A[1] - a) < 1e-12 and abs(B[1] - b) < 1e-12
+
+
+def test_choose_response_over_a_range_holds_between_the_points():
+    """The chosen method's r(ω) meets the tolerance at ω off the verification grid, against
+    shooting started from the one-harmonic guess (not from the method's own answer)."""
+    from generator.choose import choose_driven
+    from generator.driven import (
+        Drive,
+        amplitudes,
+        first_order_branches,
+        harmonic_balance,
+        mu_expansion,
+    )
+    from generator.numerics import shoot
+
+    c = choose_driven("response", 1e-6, 0.1, 0.3, 20.0, 0.5, 1.0)
+    assert c.max_error <= 1e-6 and c.verified_on >= 20
+    for w in (0.53, 0.77, 0.98):
+        d = Drive(0.1, 0.3, w, 20.0)
+        branch = first_order_branches(d)[0]
+        if c.method == "harmonic_balance":
+            A, B = amplitudes(harmonic_balance(d, branch, c.order).coefficients, 0.0, 1)
+        else:
+            A, B = amplitudes(*mu_expansion(d, branch, c.order).partial(c.order), 1)
+        guess = np.array([branch.A1 * np.cos(branch.delta0),
+                          w * branch.A1 * np.sin(branch.delta0)])
+        orbit = shoot(0.1, 0.3, w, 0.05, guess)
+        assert abs(np.hypot(A[1], B[1]) - np.hypot(orbit.A[1], orbit.B[1])) <= 1e-6
+    for args, needle in ((["--omega", "1", "--omega-max", "2"], "not both"),
+                         (["--omega-min", "2", "--omega-max", "1"], "reversed"),
+                         (["--omega", "1", "--tol", "1e-17"], "best reachable"),
+                         (["--omega", "-1"], "must be > 0")):
+        bad = subprocess.run([sys.executable, "-m", "generator", "choose", "response", "--eps",
+                              "0.1", "--force", "1", *args], capture_output=True, text=True,
+                             check=False)
+        assert bad.returncode == 2 and needle in bad.stderr, bad.stderr
 
 
 def test_choose_q_against_jacobi_cn():
