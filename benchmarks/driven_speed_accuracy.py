@@ -27,7 +27,7 @@ def main() -> None:
             front = pareto_front(cost, err)
             print(f"{quantity} at ω = {w:g}: " + ", ".join(
                 f"{data[i].method} {data[i].order} ({cost[i]:.1f} µs, {err[i]:.0e})"
-                for i in front[:6]))
+                for i in front))
 
 
 if __name__ == "__main__":

@@ -25,7 +25,7 @@ def main() -> None:
         err = np.array([t.errors[k] for t in data])
         front = pareto_front(cost, err)
         print(f"x = {x:g}: " + ", ".join(f"{data[i].method} {data[i].order} "
-                                         f"({cost[i]:.2f} ns, {err[i]:.0e})" for i in front[:6]))
+                                         f"({cost[i]:.2f} ns, {err[i]:.0e})" for i in front))
 
 
 if __name__ == "__main__":

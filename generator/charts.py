@@ -169,23 +169,30 @@ FLOOR = 1e-17
 
 
 def speed_accuracy_figure(path: Path) -> Path:
-    """Error against measured cost, one point per method and order, per x; Pareto fronts."""
+    """Error against measured cost, one point per method and order, per x; Pareto fronts.
+    Bottom row: the compiled evaluators alone (0.3–40 ns), where the choice is made."""
     check_plot_path(path)
     data = tradeoffs(np.array(CHART_X))
-    fig, axes = plt.subplots(1, len(CHART_X), figsize=(16, 3.8), sharex=True, sharey=True)
+    fig, axes = plt.subplots(2, len(CHART_X), figsize=(16, 7), sharey=True)
     colors = {"lindstedt": "C0", "resummed": "C1", "pade": "C2", "modified": "C3",
-              "exact": "k", "numerical": "C4"}
+              "agm": "C5", "exact": "k", "numerical": "C4"}
     cost = np.array([t.ns_per_point for t in data])
-    for k, (ax, x) in enumerate(zip(axes, CHART_X, strict=True)):
+    for k, x in enumerate(CHART_X):
         err = np.maximum(np.array([t.errors[k] for t in data]), FLOOR)
-        for method, color in colors.items():
-            sel = [i for i, t in enumerate(data) if t.method == method]
-            ax.plot(cost[sel], err[sel], "o", color=color, ms=3, label=method)
         front = pareto_front(cost, err)
-        ax.plot(cost[front], err[front], "r-", lw=1, label="Pareto front")
-        ax.set(xscale="log", yscale="log", title=f"x = εA² = {x:g}", xlabel="ns / point")
-    axes[0].set_ylabel("relative error of T")
-    axes[0].legend(fontsize=7)
+        for row, ax in enumerate(axes[:, k]):
+            for method, color in colors.items():
+                sel = [i for i, t in enumerate(data) if t.method == method]
+                ax.plot(cost[sel], err[sel], "o", color=color, ms=3, label=method)
+            ax.plot(cost[front], err[front], "r-", lw=1, label="Pareto front")
+            ax.set(xscale="log", yscale="log", xlabel="ns / point")
+            if row == 0:
+                ax.set_title(f"x = εA² = {x:g}")
+            else:
+                ax.set_xlim(0.3, 40)
+    for ax in axes[:, 0]:
+        ax.set_ylabel("relative error of T")
+    axes[0, 0].legend(fontsize=7)
     fig.tight_layout()
     return _save(fig, path)
 
@@ -233,16 +240,17 @@ def validity_figure(path: Path) -> Path:
     x = np.concatenate([-1 + np.logspace(-3, np.log10(0.999), 200), np.logspace(-3, 3, 300)])
     x = np.unique(x[x < 1000])
     ref = reference_period(x)
-    picks = {("lindstedt", 4), ("lindstedt", 12), ("lindstedt", 40), ("resummed", 10),
+    picks = (("lindstedt", 4), ("lindstedt", 12), ("lindstedt", 40), ("resummed", 10),
              ("resummed", 21), ("resummed", 40), ("pade", 4), ("pade", 12), ("modified", 4),
-             ("modified", 12)}
-    styles = {"lindstedt": "-", "resummed": "--", "pade": ":", "modified": "-."}
+             ("modified", 12), ("agm", 2), ("agm", 4))
+    styles = {"lindstedt": "-", "resummed": "--", "pade": ":", "modified": "-.", "agm": "-"}
     fig, ax = plt.subplots(figsize=(9, 4.5))
     for c in candidates():
         if (c.method, c.order) in picks:
             with np.errstate(invalid="ignore"):
                 err = np.maximum(np.abs(c(x) / ref - 1), FLOOR)
-            ax.plot(x, err, styles[c.method], lw=1.2, label=f"{c.method} {c.order}")
+            ax.plot(x, err, styles[c.method], lw=1.2, label=f"{c.method} {c.order}",
+                    color=plt.cm.tab20(picks.index((c.method, c.order))))
     for xv, text in ((-1, "separatrix x = −1"), (1, "L–P radius |x| = 1"),
                      (-2 / 3, "m = −1: resummed limit")):
         ax.axvline(xv, color="grey", lw=0.8, ls="-.")
@@ -255,32 +263,42 @@ def validity_figure(path: Path) -> Path:
     return _save(fig, path)
 
 
+def _mu_errors(d: Drive, orders: tuple[int, ...]) -> tuple[np.ndarray, int]:
+    """|A₁(μ-order j) − A₁(balance, N = 10)| on the largest branch (NaN where the
+    μ-expansion refuses: a fold, a diverging or stalled series), and the branch count."""
+    branches = first_order_branches(d)
+    truth = amplitudes(harmonic_balance(d, branches[0], 10).coefficients, 0.0, 1)[0][1]
+    errors = np.full(len(orders), np.nan)
+    for k, j in enumerate(orders):
+        mu = mu_expansion(d, branches[0], j)
+        if len(mu.coefficients) > j and mu.converged:
+            errors[k] = abs(amplitudes(*mu.partial(j), 1)[0][1] - truth)
+    return errors, len(branches)
+
+
 def driven_validity_figure(path: Path, eps: float = 0.1, force: float = 1.0) -> Path:
     """Where the driven-oscillator formulas hold: the μ-expansion's error against harmonic
-    balance (N = 10, equal to the true orbit to ~1e-10) over ω on the largest branch, with the
-    folds where branches appear; and the region of ω, f where the 1/3 subharmonic exists."""
+    balance (N = 10, equal to the true orbit to ~1e-10) on the largest branch over ω and
+    over f, with the folds where branches appear; and the region of ω, f where the 1/3
+    subharmonic exists."""
     check_plot_path(path)
-    omegas = np.linspace(0.3, 2.5, 221)
-    orders = (1, 2, 4, 6)
-    errors = np.full((len(orders), omegas.size), np.nan)
-    counts = np.zeros(omegas.size, dtype=int)
-    for i, w in enumerate(omegas):
-        d = Drive(eps, force, float(w))
-        branches = first_order_branches(d)
-        counts[i] = len(branches)
-        truth = amplitudes(harmonic_balance(d, branches[0], 10).coefficients, 0.0, 1)[0][1]
-        mu = mu_expansion(d, branches[0], max(orders))
+    orders = (1, 2, 4, 6, 10)
+    fig, (ax, byf, sub) = plt.subplots(1, 3, figsize=(17, 4.2))
+    for axis, grid, label, make in (
+            (ax, np.linspace(0.3, 2.5, 221), "ω", lambda v: Drive(eps, force, float(v))),
+            (byf, np.logspace(-2, 1.2, 161), "f", lambda v: Drive(eps, float(v), 0.6))):
+        rows = [_mu_errors(make(v), orders) for v in grid]
+        errors = np.array([r[0] for r in rows])
+        counts = np.array([r[1] for r in rows])
         for k, j in enumerate(orders):
-            if j < len(mu.coefficients):
-                errors[k, i] = abs(amplitudes(*mu.partial(j), 1)[0][1] - truth)
-    fig, (ax, sub) = plt.subplots(1, 2, figsize=(12, 4.2))
-    for k, j in enumerate(orders):
-        ax.plot(omegas, np.maximum(errors[k], FLOOR), label=f"μ-expansion order {j}")
-    for i in np.nonzero(np.diff(counts))[0]:
-        ax.axvline(omegas[i + 1], color="grey", ls=":", lw=1)
-    ax.set(yscale="log", xlabel="ω", ylabel="|A₁(μ) − A₁(balance)|",
-           title=f"μ-expansion, largest branch (ε = {eps}, f = {force}); dotted: folds")
-    ax.legend(fontsize=8)
+            axis.plot(grid, np.maximum(errors[:, k], FLOOR), label=f"μ-expansion order {j}")
+        for i in np.nonzero(np.diff(counts))[0]:
+            axis.axvline(grid[i + 1], color="grey", ls=":", lw=1)
+        axis.set(yscale="log", xlabel=label, ylabel="|A₁(μ) − A₁(balance)|")
+    ax.set_title(f"over ω (ε = {eps}, f = {force}); dotted: folds", fontsize=9)
+    byf.set(xscale="log")
+    byf.set_title(f"over f (ε = {eps}, ω = 0.6): gaps = refused (not converging)", fontsize=9)
+    ax.legend(fontsize=7)
     w = np.linspace(1.0, 2.5, 400)
     for e in (0.05, 0.1, 0.3):
         f_max = np.abs(1 - 9 * w**2) * np.sqrt(np.maximum(16 * (w**2 - 1) / (21 * e), 0))

@@ -222,13 +222,17 @@ def mu_expansion(d: Drive, branch: Branch, order: int) -> MuExpansion:
 
 
 def _convergence(q: list[np.ndarray]) -> tuple[bool, str]:
-    """Judge the series by the size of its last terms (a growing tail is no answer)."""
+    """Judge the series by the size of its last terms: a growing tail, or a last term still
+    above 1 % of the leading one, is no answer."""
     sizes = [float(np.abs(c).sum()) for c in q]
     if len(sizes) < 4:
         return True, "too few orders to judge; terms: " + ", ".join(f"{s:.1e}" for s in sizes)
     tail = sizes[-3:]
     if tail[-1] > tail[0] and tail[-1] > 1e-14 * sizes[0]:
         return False, f"terms grow ({tail[0]:.1e} -> {tail[-1]:.1e}): the μ-series diverges here"
+    if tail[-1] > 1e-2 * sizes[0]:
+        return False, (f"last term {tail[-1]:.1e} is {tail[-1] / sizes[0]:.0%} of the first: "
+                       "the μ-series is not converging here")
     return True, f"last term {tail[-1]:.1e}"
 
 
