@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 import matplotlib
@@ -18,6 +19,7 @@ import numpy as np
 
 from .choose import (
     DRIVEN_QUANTITIES,
+    DrivenTradeoff,
     candidates,
     driven_tradeoffs,
     driven_truth,
@@ -203,14 +205,17 @@ DRIVEN_CHART_OMEGA = (0.5, 1.0, 1.6, 2.5)
 
 
 def driven_speed_accuracy_figure(path: Path, eps: float = 0.1, force: float = 1.0,
-                                 Q: float = np.inf) -> Path:
+                                 Q: float = np.inf, extra: Sequence[DrivenTradeoff] = ()) -> Path:
     """Error of A_n (n = 1, 3, 5) and of r against the true orbit versus measured cost per
-    ω: one harmonic, μ-expansion orders 0..12, harmonic balance 1..12; Pareto fronts."""
+    ω: one harmonic, μ-expansion orders 0..12, harmonic balance 1..12, shooting with plain
+    RK4, and ``extra`` points at the same ω (the benchmark's emitted modules); Pareto fronts."""
     check_plot_path(path)
     truth = driven_truth(eps, force, Q, np.array(DRIVEN_CHART_OMEGA))
-    data = driven_tradeoffs(truth, eps, force, Q)
+    data = driven_tradeoffs(truth, eps, force, Q) + list(extra)
     cost = np.array([t.ns_per_point for t in data]) / 1e3
-    colors = {"one_harmonic": "C3", "mu_expansion": "C0", "harmonic_balance": "C2"}
+    colors = {"one_harmonic": "C3", "mu_expansion": "C0", "harmonic_balance": "C2",
+              "shooting": "C4", "mu_expansion, emitted": "C9",
+              "harmonic_balance, emitted": "C8"}
     fig, axes = plt.subplots(2, len(DRIVEN_CHART_OMEGA), figsize=(15, 6.5), sharex=True,
                              sharey=True)
     for row, quantity in enumerate(DRIVEN_QUANTITIES):

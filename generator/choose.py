@@ -35,7 +35,7 @@ from scipy.integrate import solve_ivp
 from scipy.special import ellipj, ellipk
 
 from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
-from .emit import generate, load_generated
+from .emit import generate, generate_balance, generate_driven, load_generated
 from .errors import InputError
 from .lindstedt import derive
 from .models import duffing, pendulum
@@ -446,6 +446,9 @@ DRIVEN_MAX = 12
 # well before that; more only costs.
 DRIVEN_POINTS = 21
 # NOTE: ω points (Chebyshev-spaced) on which a range is verified; each costs one shooting.
+SHOOTING_STEPS = (64, 128, 256, 512, 1024)
+# NOTE: the "numerical" method: shooting from the one-harmonic guess with plain RK4 at these
+# steps per period (the truth uses 4096 and 8192, Richardson-combined).
 DRIVEN_QUANTITIES = ("amplitudes", "response")
 # NOTE: amplitudes: max |error| of A_n, B_n for n = 1, 3, 5; response: |r − r_true| with
 # r = √(A₁² + B₁²), the amplitude of the fundamental (eq. 10.79's r).
@@ -487,8 +490,8 @@ class DrivenTradeoff:
     """One method at one order: measured cost per ω and its errors at each ω (NaN where
     it refuses: a fold, a diverging μ-series, a balance that does not converge)."""
 
-    method: str  # "one_harmonic", "mu_expansion" or "harmonic_balance"
-    order: int  # μ-order, or number of odd harmonics (one_harmonic: 1)
+    method: str  # "one_harmonic", "mu_expansion", "harmonic_balance" or "shooting"
+    order: int  # μ-order, number of odd harmonics, or RK4 steps per period (one_harmonic: 1)
     ns_per_point: float
     errors: dict[str, np.ndarray]  # quantity -> error per ω
 
@@ -508,8 +511,9 @@ def one_harmonic_amplitudes(eps: float, force: float, Q: float,
 
 def driven_tradeoffs(truth: DrivenTruth, eps: float, force: float,
                      Q: float) -> list[DrivenTradeoff]:
-    """The one-harmonic closed form, the μ-expansion at orders 0..12 and harmonic balance
-    with 1..12 harmonics, each timed and judged at every ω of ``truth``."""
+    """The one-harmonic closed form, the μ-expansion at orders 0..12, harmonic balance with
+    1..12 harmonics and shooting with plain RK4, each timed and judged at every ω of
+    ``truth``."""
     n = truth.omega.size
     target = np.hstack([truth.A, truth.B])
 
@@ -527,7 +531,8 @@ def driven_tradeoffs(truth: DrivenTruth, eps: float, force: float,
     out = [DrivenTradeoff("one_harmonic", 1, ns, {"amplitudes": errs[:, 0],
                                                   "response": errs[:, 1]})]
     for method, orders in (("mu_expansion", range(DRIVEN_MAX + 1)),
-                           ("harmonic_balance", range(1, DRIVEN_MAX + 1))):
+                           ("harmonic_balance", range(1, DRIVEN_MAX + 1)),
+                           ("shooting", SHOOTING_STEPS)):
         for order in orders:
             errs = np.full((n, 2), np.nan)
             seconds = 0.0
@@ -539,16 +544,75 @@ def driven_tradeoffs(truth: DrivenTruth, eps: float, force: float,
                     mu = mu_expansion(d, branch, order)
                     ok = len(mu.coefficients) > order and mu.converged
                     values = amplitudes(*mu.partial(min(order, len(mu.coefficients) - 1)), 5)
-                else:
+                elif method == "harmonic_balance":
                     hb = harmonic_balance(d, branch, order)
                     ok = hb.converged
                     values = amplitudes(hb.coefficients, 0.0, 5)
+                else:
+                    guess = branch.A1 * np.array([np.cos(branch.delta0),
+                                                  w * np.sin(branch.delta0)])
+                    orbit = shoot(eps, force, float(w), d.damping, guess, steps=order)
+                    ok = orbit is not None
+                    values = (orbit.A, orbit.B) if ok else ({}, {})
                 seconds += time.perf_counter() - t0
                 if ok:
                     errs[i] = judge(i, *values)
             out.append(DrivenTradeoff(method, order, seconds / n * 1e9,
                                       {"amplitudes": errs[:, 0], "response": errs[:, 1]}))
     return out
+
+
+def _driven_errors(truth: DrivenTruth, A: np.ndarray, B: np.ndarray) -> dict[str, np.ndarray]:
+    """The two error measures for ``(n, 3)`` arrays of ``A_n``, ``B_n`` (n = 1, 3, 5)."""
+    return {"amplitudes": np.max(np.abs(np.hstack([A - truth.A, B - truth.B])), axis=1),
+            "response": np.abs(np.hypot(A[:, 0], B[:, 0]) - truth.r)}
+
+
+def emitted_driven(method: str, order: int, truth: DrivenTruth, eps: float, force: float,
+                   Q: float) -> DrivenTradeoff:
+    """The emitted module of ``method`` at ``order`` (``generate driven``: undamped μ-expansion
+    as compiled ufuncs, timed on 10⁵ ω through the ``_into`` twins; ``generate balance``:
+    compiled Newton, one solve per ω from the one-harmonic root), generated into a temporary
+    folder, timed and judged at every ω of ``truth``."""
+    n = truth.omega.size
+    A, B = np.zeros((n, 3)), np.zeros((n, 3))  # harmonics the module lacks are zero
+    with tempfile.TemporaryDirectory(prefix="lindstedt-emitted-") as tmp:
+        if method == "mu_expansion":
+            if not np.isinf(Q):
+                raise InputError("the damped μ-expansion has no emitted module (only the "
+                                 "undamped one is derived exactly)")
+            generate_driven(order, Path(tmp))
+            mod = load_generated(Path(tmp) / "driven.py")
+            fns = [getattr(mod, f"A_{k}_into", None) for k in (1, 3, 5)]
+            dense = np.resize(truth.omega, 100_000)
+            buf = np.empty_like(dense)
+            for k, f in enumerate(fns):
+                if f is not None:
+                    A[:, k] = f(np.empty(n), truth.omega, eps, force, 0.0)
+                    f(buf, dense, eps, force, 0.0)
+            t0 = time.perf_counter()
+            for f in fns:
+                if f is not None:
+                    f(buf, dense, eps, force, 0.0)
+            ns = (time.perf_counter() - t0) / dense.size * 1e9
+            sys.modules.pop("driven", None)
+        else:
+            generate_balance(order, Path(tmp))
+            mod = load_generated(Path(tmp) / "balance.py")
+            a1, b1 = one_harmonic_amplitudes(eps, force, Q, truth.omega)
+            x0 = np.zeros((n, 2 * order))
+            x0[:, 0], x0[:, order] = a1, b1
+            damping = Drive(eps, force, 1.0, Q).damping
+            mod.newton(x0[0], truth.omega[0], eps, force, damping)  # compile
+            t0 = time.perf_counter()
+            xs = [mod.newton(x, w, eps, force, damping)[0]
+                  for x, w in zip(x0, truth.omega, strict=True)]
+            ns = (time.perf_counter() - t0) / n * 1e9
+            for k in range(min(order, 3)):
+                A[:, k] = [x[k] for x in xs]
+                B[:, k] = [x[order + k] for x in xs]
+            sys.modules.pop("balance", None)
+    return DrivenTradeoff(f"{method}, emitted", order, ns, _driven_errors(truth, A, B))
 
 
 @dataclass(frozen=True)
@@ -567,10 +631,13 @@ class DrivenChoice:
 
 
 def choose_driven(quantity: str, tol: float, eps: float, force: float, Q: float,
-                  omega_min: float, omega_max: float | None = None) -> DrivenChoice:
-    """The cheapest of one harmonic, the μ-expansion (smallest order) and harmonic balance
-    (fewest harmonics) whose error in ``quantity`` is ≤ ``tol`` at every verified ω of
-    ``[omega_min, omega_max]`` (one ω when ``omega_max`` is None), on the largest branch."""
+                  omega_min: float, omega_max: float | None = None,
+                  emit_order: int | None = None) -> DrivenChoice:
+    """The cheapest of one harmonic, the μ-expansion (smallest order), harmonic balance
+    (fewest harmonics) and shooting (fewest RK4 steps) whose error in ``quantity`` is
+    ≤ ``tol`` at every verified ω of ``[omega_min, omega_max]`` (one ω when ``omega_max`` is
+    None), on the largest branch.  ``emit_order``: only what has an emitted module competes —
+    harmonic balance, and the undamped μ-expansion up to that order."""
     if quantity not in DRIVEN_QUANTITIES:
         raise InputError(f"quantity {quantity!r}: one of {', '.join(DRIVEN_QUANTITIES)}")
     for name, v in (("tol", tol), ("omega-min", omega_min), ("omega-max", omega_max)):
@@ -592,15 +659,30 @@ def choose_driven(quantity: str, tol: float, eps: float, force: float, Q: float,
         err = float(np.max(t.errors[quantity]))  # NaN anywhere: refused somewhere
         if np.isnan(err) or t.method in best:
             continue
+        if emit_order is not None and not (  # only what has an emitted module competes
+                t.method == "harmonic_balance" or (t.method == "mu_expansion" and np.isinf(Q)
+                                                   and t.order <= emit_order)):
+            continue
         reachable = min(reachable, err)
         if err <= tol:
             best[t.method] = (t, err)
     if not best:
-        raise InputError(f"tol {tol:g}: no method reaches it on the range (one harmonic, "
-                         f"μ-expansion to order {DRIVEN_MAX}, balance to {DRIVEN_MAX} "
-                         f"harmonics); the best reachable is {reachable:.1e}")
+        raise InputError(f"tol {tol:g}: no {'emittable ' * (emit_order is not None)}method "
+                         "reaches it on the range (one harmonic, "
+                         f"μ-expansion to order {DRIVEN_MAX}, balance to {DRIVEN_MAX} harmonics, "
+                         f"shooting to {SHOOTING_STEPS[-1]} RK4 steps); the best reachable is "
+                         f"{reachable:.1e}")
+    if emit_order is not None:  # rank by the emitted modules' own measured cost and error
+        emitted = [emitted_driven(v.method, v.order, truth, eps, force, Q)
+                   for v, _ in best.values()]
+        best = {t.method: (t, float(np.max(t.errors[quantity]))) for t in emitted}
+        best = {m: v for m, v in best.items() if v[1] <= tol}
+        if not best:
+            raise InputError(f"tol {tol:g}: the emitted modules miss it where the interpreted "
+                             "methods met it (rounding in the compiled formulas); loosen tol")
     t, err = min(best.values(), key=lambda v: v[0].ns_per_point)
-    return DrivenChoice(quantity, t.method, t.order, err, t.ns_per_point, omegas.size,
+    return DrivenChoice(quantity, t.method.removesuffix(", emitted"), t.order, err,
+                        t.ns_per_point, omegas.size,
                         tuple((v.method, v.order, e, v.ns_per_point) for v, e in best.values()),
                         truth)
 

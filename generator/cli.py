@@ -518,9 +518,17 @@ def _choose_q(args: argparse.Namespace) -> int:
     for name in ("tol", "x_min", "x_max"):
         if getattr(args, name) is None:
             raise InputError(f"choose q needs --{name.replace('_', '-')}")
+    if args.emit:
+        check_writable(Path(args.emit),
+                       ["duffing.py", "duffing_tables.tex", "duffing_derivation.tex"])
     c = choose_solution(args.tol, args.x_min, args.x_max, args.t_max)
     data = {"quantity": "q", "method": c.method, "order": c.order, "max_error": c.max_error,
             "ns_per_point": c.ns_per_point, "verified_on": c.verified_on}
+    if args.emit:
+        if c.method != "lindstedt":
+            raise InputError("the chosen method is the exact Jacobi cn (SciPy's ellipj), which "
+                             "has no emitted evaluator; loosen the tolerance or narrow the range")
+        data["emitted"] = [str(p) for p in generate("duffing", c.order, Path(args.emit))]
     if args.json:
         print(json.dumps(data))
     else:
@@ -528,6 +536,8 @@ def _choose_q(args: argparse.Namespace) -> int:
               f"t in [0, {args.t_max:g}]: {c.method} order {c.order}, max error "
               f"{c.max_error:.1e}, {c.ns_per_point:.1f} ns/point "
               f"(`lindstedt generate duffing --order {c.order}` writes it)")
+        for path in data.get("emitted", []):
+            print(f"  emitted {path}")
     return 0
 
 
@@ -542,7 +552,10 @@ def _choose_driven(args: argparse.Namespace) -> int:
         raise InputError("give --omega or a range (--omega-min, --omega-max), not both")
     tol = args.tol or 1e-4
     lo, hi = (args.omega, None) if args.omega is not None else (args.omega_min, args.omega_max)
-    c = choose_driven(args.quantity, tol, args.eps, args.force, args.Q, lo, hi)
+    if args.emit:
+        check_writable(Path(args.emit), ["driven.py", "driven_derivation.tex", "balance.py"])
+    c = choose_driven(args.quantity, tol, args.eps, args.force, args.Q, lo, hi,
+                      emit_order=DRIVEN_MAX_ORDER if args.emit else None)
     data = {"quantity": args.quantity, "method": c.method, "order": c.order,
             "max_error": c.max_error, "ns_per_point": c.ns_per_point,
             "verified_on": c.verified_on, "seconds": c.ns_per_point * 1e-9,
@@ -555,6 +568,9 @@ def _choose_driven(args: argparse.Namespace) -> int:
                                                   strict=True)]}
     if args.omega is not None:
         data["truth"] = c.truth.A[0].tolist()
+    if args.emit:
+        emit = generate_balance if c.method == "harmonic_balance" else generate_driven
+        data["emitted"] = [str(p) for p in emit(c.order, Path(args.emit))]
     if args.json:
         print(json.dumps(data))
         return 0
@@ -566,6 +582,8 @@ def _choose_driven(args: argparse.Namespace) -> int:
           f"{c.ns_per_point / 1e3:.1f} µs/point")
     for m, o, e, ns in c.considered:
         print(f"  {m:>16} order {o:>2}: max error {e:.1e}, {ns / 1e3:8.1f} µs/point")
+    for path in data.get("emitted", []):
+        print(f"  emitted {path}")
     return 0
 
 
@@ -668,7 +686,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--omega-max", type=float, help="amplitudes, response: highest ω of a range")
     p.add_argument("--Q", type=float, default=math.inf,
                    help="amplitudes, response: Q (default undamped)")
-    p.add_argument("--emit", metavar="DIR", help="write just the chosen evaluator into DIR")
+    p.add_argument("--emit", metavar="DIR", help="write just the chosen evaluator into DIR "
+                   "(period: chosen_period.py; q: duffing.py at the chosen order; amplitudes, "
+                   "response: driven.py or balance.py, only emittable methods compete)")
     p.add_argument("--json", action="store_true", help="print the JSON contract")
     p.set_defaults(func=_cmd_choose)
 

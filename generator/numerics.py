@@ -88,10 +88,14 @@ STEPS_PER_PERIOD = 4096
 
 
 def flow(y0: np.ndarray, period: float, eps: float, force: float, omega: float,
-         damping: float, samples: int = 64) -> tuple[np.ndarray, np.ndarray]:
+         damping: float, samples: int = 64,
+         steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """State after one period (with monodromy columns) and q sampled over it, Richardson-
-    extrapolated from two RK4 step sizes."""
+    extrapolated from two RK4 step sizes; or plain RK4 with ``steps`` steps (a multiple of
+    ``samples``) when given."""
     state = np.concatenate([y0, [1.0, 0.0, 0.0, 1.0]])
+    if steps is not None:
+        return _rk4(state, 0.0, period, steps, eps, force, omega, damping, samples)
     coarse, qc = _rk4(state, 0.0, period, STEPS_PER_PERIOD, eps, force, omega, damping, samples)
     fine, qf = _rk4(state, 0.0, period, 2 * STEPS_PER_PERIOD, eps, force, omega, damping,
                     samples)
@@ -112,20 +116,21 @@ class PeriodicOrbit:
 
 def shoot(eps: float, force: float, omega: float, damping: float, guess: np.ndarray,
           harmonics: int = 9, tol: float = 1e-12, max_iter: int = 30,
-          periods: int = 1) -> PeriodicOrbit | None:
+          periods: int = 1, steps: int | None = None) -> PeriodicOrbit | None:
     """Newton's method on ``φ_T(y₀) − y₀ = 0`` (the monodromy matrix is its Jacobian + I).
 
     Stability from the Floquet multipliers: damped, stable when all ``|λ| < 1``; undamped
     (Hamiltonian, ``det M = 1``), linearly stable when the pair lies on the unit circle,
     i.e. ``|tr M| < 2`` (a real pair ``λ, 1/λ`` with ``|tr M| > 2`` is unstable).
     ``periods = p`` looks for an orbit of p drive periods; its ``A``, ``B`` are then the
-    coefficients of ``cos(nωt/p)``, ``sin(nωt/p)``.  Returns ``None`` when Newton's method
-    does not converge.
+    coefficients of ``cos(nωt/p)``, ``sin(nωt/p)``.  ``steps``: plain RK4 with that many
+    steps per orbit instead of the Richardson pair (cheaper, less accurate).  Returns ``None``
+    when Newton's method does not converge.
     """
     T = periods * 2 * np.pi / omega  # periods = 3: the 1/3 subharmonic (eq. 10.83)
     y = np.array(guess, dtype=float)
     for _ in range(max_iter):
-        end, _ = flow(y, T, eps, force, omega, damping)
+        end, _ = flow(y, T, eps, force, omega, damping, steps=steps)
         Mono = end[2:].reshape(2, 2).T
         r = end[:2] - y
         try:
@@ -137,7 +142,7 @@ def shoot(eps: float, force: float, omega: float, damping: float, guess: np.ndar
             break
     else:
         return None
-    end, qs = flow(y, T, eps, force, omega, damping)
+    end, qs = flow(y, T, eps, force, omega, damping, steps=steps)
     Mono = end[2:].reshape(2, 2).T
     lam = np.linalg.eigvals(Mono)
     stable = bool(np.all(np.abs(lam) < 1) if damping > 0 else abs(np.trace(Mono)) < 2)

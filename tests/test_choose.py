@@ -279,3 +279,24 @@ def test_choose_q_against_jacobi_cn():
     assert worst(c.order) <= 1e-8
     with pytest.raises(InputError, match="exact cn needs"):
         choose_solution(1e-6, -0.8, 0.5)
+
+
+def test_choose_emits_the_driven_module_it_verified(tmp_path):
+    """With --emit only emittable methods compete, ranked by their emitted modules' measured
+    cost: undamped, the compiled μ-expansion; its A₁ off the grid agrees with shooting."""
+    from generator.emit import load_generated
+    from generator.numerics import shoot
+
+    run = subprocess.run([sys.executable, "-m", "generator", "choose", "response", "--eps", "0.1",
+                          "--force", "1", "--omega-min", "0.8", "--omega-max", "1.2", "--tol",
+                          "1e-4", "--emit", str(tmp_path), "--json"],
+                         capture_output=True, text=True, check=False)
+    data = json.loads(run.stdout)
+    assert data["method"] == "mu_expansion" and data["max_error"] <= 1e-4
+    assert str(tmp_path / "driven.py") in data["emitted"]
+    mod = load_generated(tmp_path / "driven.py")
+    assert data["order"] == mod.ORDER
+    for w in (0.85, 1.13):
+        orbit = shoot(0.1, 1.0, w, 0.0, np.array([2.4, 0.0]))
+        assert abs(mod.A_1(w, 0.1, 1.0, 0) - orbit.A[1]) <= 1e-4
+    del sys.modules["driven"]
