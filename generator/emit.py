@@ -103,11 +103,18 @@ def _evaluator_context(ev: Evaluator) -> dict:
         "args": ", ".join(str(a) for a in ev.args),
         "arg_names": [str(a) for a in ev.args],
         "into_args": ", ".join(f"{a}_in" for a in ev.args),
+        "at_args": ", ".join(f"_at({a}_in, i)" for a in ev.args),
         "signature": "float64(" + ", ".join("float64" for _ in ev.args) + ")",
         "prelude": [(str(lhs), pycode(rhs)) for lhs, rhs in ev.prelude],
         "guard": pycode(ev.guard),
         "body": [(str(lhs), pycode(rhs)) for lhs, rhs in ev.body],
         "output": pycode(ev.output),
+        "into_prelude": [(str(lhs), pycode(rhs, simd=True)) for lhs, rhs in ev.prelude],
+        "into_guard": pycode(ev.guard, simd=True),
+        "into_body": [(str(lhs), pycode(rhs, simd=True)) for lhs, rhs in ev.body],
+        "into_output": pycode(ev.output, simd=True),
+        "trig": any(e.has(sp.sin, sp.cos) for e in (ev.guard, ev.output,
+                                                     *(r for _, r in (*ev.prelude, *ev.body)))),
     }
 
 
@@ -130,7 +137,8 @@ def render_module(module: Module) -> str:
         doc=module.doc,
         fastmath=FASTMATH,
         constants=[(name, pyliteral(value)) for name, value in module.constants],
-        evaluators=[_evaluator_context(ev) for ev in module.evaluators],
+        evaluators=(evaluators := [_evaluator_context(ev) for ev in module.evaluators]),
+        trig=any(ev["trig"] for ev in evaluators),
         kernels=[_kernel_context(k) for k in module.kernels],
         newton=module.newton,
     )

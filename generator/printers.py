@@ -32,6 +32,17 @@ class NumbaPrinter(PythonCodePrinter):
         return "0.5"
 
 
+class SimdPrinter(NumbaPrinter):
+    """:class:`NumbaPrinter` with ``cos``/``sin`` as the generated module's branch-free
+    ``_cos``/``_sin``, which LLVM vectorises (``math.cos`` stays a scalar libm call)."""
+
+    def _print_cos(self, expr: sp.cos) -> str:
+        return f"_cos({self._print(expr.args[0])})"
+
+    def _print_sin(self, expr: sp.sin) -> str:
+        return f"_sin({self._print(expr.args[0])})"
+
+
 def identifier(name: str) -> str:
     """``name`` if it may appear in generated code: a Python identifier, not a keyword.
 
@@ -45,9 +56,9 @@ def identifier(name: str) -> str:
     return name
 
 
-def pycode(expr: sp.Basic) -> str:
-    """One expression as numba source."""
-    return NumbaPrinter({"fully_qualified_modules": True}).doprint(expr)
+def pycode(expr: sp.Basic, simd: bool = False) -> str:
+    """One expression as numba source (``simd``: vectorisable ``_cos``/``_sin``)."""
+    return (SimdPrinter if simd else NumbaPrinter)({"fully_qualified_modules": True}).doprint(expr)
 
 
 LATEX_FRAC_DIGITS = 30

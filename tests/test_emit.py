@@ -79,7 +79,8 @@ def test_templates_get_exactly_the_variables_they_use():
     sol = derive(duffing(), 5)
     module = lower_free(sol, "cmd")
     latex_ctx = set(latex_context(sol, 3)) | {"banner"}
-    module_ctx = {"banner", "doc", "constants", "evaluators", "fastmath", "kernels", "newton"}
+    module_ctx = {"banner", "doc", "constants", "evaluators", "fastmath", "kernels", "newton",
+                  "trig"}
     for name, env, ctx in [
         ("module.py.j2", environment(False), module_ctx),
         ("tables.tex.j2", environment(True), latex_ctx),
@@ -210,11 +211,18 @@ def test_broadcasting(duf, pend):
 
 
 def test_into_twins_equal_the_ufuncs(duf, pend):
-    """``<name>_into(out, …)``: scalars and 1-D arrays mixed, the ufunc's values and NaNs."""
-    t = np.linspace(0, 30, 101)
+    """``<name>_into(out, …)``: scalars and 1-D arrays mixed, the ufunc's values and NaNs;
+    its vectorised cos/sin within 2 ulp of libm's, phases beyond 2**20 through libm."""
+    t = np.concatenate([np.linspace(0, 30, 95), [1e5, 9e5, 2e6, 1e8, 1e12, -3e6]])
     eps = np.linspace(-1.2, 1.2, 101)  # beyond both ends of the domain: NaN in both
     for args in ((t, 0.7, 0.2), (t, 0.7, eps), (1.5, np.full(101, 0.7), eps)):
-        assert np.array_equal(duf.q_into(np.empty(101), *args), duf.q(*args), equal_nan=True)
+        np.testing.assert_allclose(duf.q_into(np.empty(101), *args), duf.q(*args), rtol=0,
+                                   atol=4e-16)
+        np.testing.assert_allclose(duf.qdot_into(np.empty(101), *args), duf.qdot(*args),
+                                   rtol=0, atol=4e-16)
+    x = np.random.default_rng(11).uniform(-1e6, 1e6, 10**5)  # the phase alone: q with ε = 0
+    np.testing.assert_allclose(duf.q_into(np.empty_like(x), x, 1.0, 0.0), np.cos(x), rtol=0,
+                               atol=2.3e-16)
     assert np.array_equal(duf.period_into(np.empty(101), 1.0, eps), duf.period(1.0, eps),
                           equal_nan=True)
     th = np.linspace(0, 3.5, 101)
