@@ -521,23 +521,27 @@ def _choose_q(args: argparse.Namespace) -> int:
     if args.emit:
         check_writable(Path(args.emit),
                        ["duffing.py", "duffing_tables.tex", "duffing_derivation.tex"])
-    c = choose_solution(args.tol, args.x_min, args.x_max, args.t_max)
+    c = choose_solution(args.tol, args.x_min, args.x_max, args.t_max,
+                        emittable=bool(args.emit))
     data = {"quantity": "q", "method": c.method, "order": c.order, "max_error": c.max_error,
-            "ns_per_point": c.ns_per_point, "verified_on": c.verified_on}
+            "ns_per_point": c.ns_per_point, "verified_on": c.verified_on,
+            "considered": [{"method": m, "order": o, "max_error": e, "ns_per_point": ns}
+                           for m, o, e, ns in c.considered]}
     if args.emit:
-        if c.method != "lindstedt":
-            raise InputError("the chosen method is the exact Jacobi cn (SciPy's ellipj), which "
-                             "has no emitted evaluator; loosen the tolerance or narrow the range")
         data["emitted"] = [str(p) for p in generate("duffing", c.order, Path(args.emit))]
     if args.json:
         print(json.dumps(data))
-    else:
-        print(f"q(t)/A to {args.tol:g} for x in [{args.x_min:g}, {args.x_max:g}], "
-              f"t in [0, {args.t_max:g}]: {c.method} order {c.order}, max error "
-              f"{c.max_error:.1e}, {c.ns_per_point:.1f} ns/point "
-              f"(`lindstedt generate duffing --order {c.order}` writes it)")
-        for path in data.get("emitted", []):
-            print(f"  emitted {path}")
+        return 0
+    print(f"q(t)/A to {args.tol:g} for x in [{args.x_min:g}, {args.x_max:g}], t in "
+          f"[0, {args.t_max:g}] (verified on {c.verified_on} points):")
+    print(f"  chosen: {c.method} order {c.order}: max error {c.max_error:.1e}, "
+          f"{c.ns_per_point:.1f} ns/point")
+    for m, o, e, ns in c.considered:
+        print(f"  {m:>10} order {o:>2}: max error {e:.1e}, {ns:7.1f} ns/point")
+    if c.method == "lindstedt" and not args.emit:
+        print(f"  (`lindstedt generate duffing --order {c.order}` or --emit DIR writes it)")
+    for path in data.get("emitted", []):
+        print(f"  emitted {path}")
     return 0
 
 

@@ -192,7 +192,7 @@ def test_choose_amplitudes_meets_the_tolerance_against_shooting():
     from generator.numerics import shoot
 
     c = choose_driven("amplitudes", 1e-8, 0.1, 0.3, 20.0, 1.3)
-    assert c.max_error <= 1e-8 and c.method in ("mu_expansion", "harmonic_balance")
+    assert c.max_error <= 1e-8 and c.method in ("mu_expansion", "harmonic_balance", "shooting")
     # the truth it was judged against is the true orbit on the largest branch
     orbit = shoot(0.1, 0.3, 1.3, 0.05, np.array([2.9, 1.2]))
     assert abs(orbit.A[1] - c.truth.A[0, 0]) < 1e-9
@@ -277,8 +277,40 @@ def test_choose_q_against_jacobi_cn():
         return err
 
     assert worst(c.order) <= 1e-8
-    with pytest.raises(InputError, match="exact cn needs"):
-        choose_solution(1e-6, -0.8, 0.5)
+    with pytest.raises(InputError, match="no L–P order reaches it"):
+        choose_solution(1e-10, -0.95, 0.0, emittable=True)
+
+
+@pytest.mark.parametrize("x", [-0.99, -0.6, 0.3, 7.0, 1000.0])
+def test_exact_fourier_series_of_the_solution(x):
+    """The nome series against mpmath's cn (any m < 1): double precision with enough
+    harmonics, on a softening spring next to the separatrix too."""
+    from generator.choose import cn_fourier
+
+    t = np.linspace(0.0, 15.0, 61)
+    m = x / (2 * (1 + x))
+    with mpmath.workdps(30):
+        ref = np.array([float(mpmath.re(mpmath.ellipfun("cn", mpmath.sqrt(1 + x) * v, m)))
+                        for v in t])
+    got = cn_fourier(t, np.full_like(t, x), 30, np.empty_like(t))
+    assert np.max(np.abs(got - ref)) <= 2e-13 * (1 + np.sqrt(1 + x))
+    assert np.isnan(cn_fourier(t[:2], np.array([-1.0, -3.0]), 5, np.empty(2))).all()
+
+
+def test_choose_q_for_a_softening_spring_beyond_the_series():
+    """On [−0.95, 0] the L–P series cannot reach 1e-10 and SciPy's cn does not take m < 0:
+    the exact Fourier series does, and the choice holds off the verification grid."""
+    from generator.choose import choose_solution, cn_fourier
+
+    c = choose_solution(1e-10, -0.95, 0.0)
+    assert c.method == "fourier" and c.max_error <= 1e-10
+    t = np.linspace(0.1, 19.9, 47)
+    for x in (-0.93, -0.41):
+        with mpmath.workdps(30):
+            ref = np.array([float(mpmath.re(mpmath.ellipfun(
+                "cn", mpmath.sqrt(1 + x) * v, x / (2 * (1 + x))))) for v in t])
+        got = cn_fourier(t, np.full_like(t, x), c.order, np.empty_like(t))
+        assert np.max(np.abs(got - ref)) <= 1e-10
 
 
 def test_choose_emits_the_driven_module_it_verified(tmp_path):
