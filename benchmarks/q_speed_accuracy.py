@@ -1,5 +1,6 @@
 """Speed against accuracy for q(t): generated L–P evaluators at several orders, the exact
-Jacobi-cn solution (SciPy's ellipj) and numerical integration (DOP853) at several tolerances.
+Fourier (nome) series at several truncations, the exact Jacobi-cn solution (SciPy's ellipj)
+and numerical integration (DOP853) at several tolerances.
 
     .venv/bin/python benchmarks/q_speed_accuracy.py
 
@@ -24,11 +25,13 @@ from scipy.integrate import solve_ivp
 from scipy.special import ellipj
 from timing import best
 
+from generator.choose import cn_fourier
 from generator.emit import generate, load_generated
 
 X = (0.1, 0.5)
 ORDERS = (1, 2, 4, 8, 12, 16)
 RTOLS = (1e-4, 1e-7, 1e-10, 1e-13)
+HARMONICS = (2, 4, 8, 12)
 
 
 def exact(t: np.ndarray, x: float) -> np.ndarray:
@@ -55,6 +58,13 @@ def main() -> None:
     for x in X:
         ns = best(lambda x=x: exact(t_cost, x)) / t_cost.size * 1e9
         rows.append(("Jacobi cn (SciPy)", 0, x, 0.0, ns))
+        xs, buf = np.full_like(t_cost, x), np.empty_like(t_cost)
+        for n in HARMONICS:
+            err = np.max(np.abs(cn_fourier(t_err, np.full_like(t_err, x), n,
+                                           np.empty_like(t_err)) - exact(t_err, x)))
+            cn_fourier(t_cost[:10], xs[:10], n, buf[:10])
+            ns = best(lambda n=n, xs=xs, buf=buf: cn_fourier(t_cost, xs, n, buf)) / t_cost.size
+            rows.append(("exact Fourier", n, x, err, ns * 1e9))
         for rtol in RTOLS:
             def run(rtol=rtol, x=x):
                 return solve_ivp(lambda _t, y: [y[1], -y[0] - x * y[0] ** 3], (0, 20), [1.0, 0.0],
@@ -71,7 +81,8 @@ def main() -> None:
         print(f"{method:<18} {p:>10g} {x:>5g} {err:>10.1e} {ns:>9.2f}")
     fig, axes = plt.subplots(1, len(X), figsize=(10, 4), sharey=True)
     for ax, x in zip(axes, X, strict=True):
-        for method, style in (("L–P", "C0o-"), ("DOP853", "C4s-"), ("Jacobi cn (SciPy)", "k*")):
+        for method, style in (("L–P", "C0o-"), ("exact Fourier", "C2^-"), ("DOP853", "C4s-"),
+                              ("Jacobi cn (SciPy)", "k*")):
             pts = [(ns, max(err, 1e-17)) for m, _, xx, err, ns in rows if m == method and xx == x]
             ax.plot(*zip(*pts, strict=True), style, label=method)
         ax.set(xscale="log", yscale="log", title=f"q(t), x = εA² = {x}", xlabel="ns / point")

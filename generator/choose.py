@@ -747,35 +747,44 @@ def cn_fourier(t: np.ndarray, x: np.ndarray, harmonics: int, out: np.ndarray) ->
     for ``m ≥ 0``, and for ``m < 0`` the imaginary-modulus transform ``cn(u|−μ) =
     cd(√(1+μ) u | μ/(1+μ))`` with ``cd``'s series (signs ``(−1)ⁿ``, denominators
     ``1 − q²ⁿ⁺¹``).  The L–P series in x is its expansion; this one converges for every
-    ``x > −1``.  NaN for ``x ≤ −1``."""
+    ``x > −1``.  NaN for ``x ≤ −1``.  The coefficients (two AGMs and an exp) are recomputed
+    only where x changes, so a run of points at one amplitude costs a cos and a recurrence."""
+    b = np.zeros(max(harmonics, 1))
+    last, omega = np.nan, 1.0  # the coefficients are recomputed only when x changes
     for i in range(t.size):
         xi = x[i]
         if not xi > -1.0:
             out[i] = np.nan
             continue
-        m = xi / (2.0 + 2.0 * xi)
-        if m == 0.0:
-            out[i] = np.cos(t[i])
-            continue
-        if m > 0.0:
-            mm, scale, alt = m, np.sqrt(1.0 + xi), 1.0
-        else:
-            mm = -m / (1.0 - m)
-            scale, alt = np.sqrt((1.0 + xi) * (1.0 - m)), -1.0
-        K = 0.5 * np.pi / _agm(1.0, np.sqrt(1.0 - mm))
-        K_prime = 0.5 * np.pi / _agm(1.0, np.sqrt(mm))
-        nome = np.exp(-np.pi * K_prime / K)
-        c1 = np.cos(0.5 * np.pi * scale * t[i] / K)
+        if xi != last:
+            last = xi
+            m = xi / (2.0 + 2.0 * xi)
+            if m == 0.0:
+                b[:] = 0.0
+                b[0], omega = 1.0, 1.0
+            else:
+                if m > 0.0:
+                    mm, scale, alt = m, np.sqrt(1.0 + xi), 1.0
+                else:
+                    mm = -m / (1.0 - m)
+                    scale, alt = np.sqrt((1.0 + xi) * (1.0 - m)), -1.0
+                K = 0.5 * np.pi / _agm(1.0, np.sqrt(1.0 - mm))
+                nome = np.exp(-np.pi * (0.5 * np.pi / _agm(1.0, np.sqrt(mm))) / K)
+                omega = 0.5 * np.pi * scale / K
+                qn, q2n1, sign = np.sqrt(nome), nome, 2.0 * np.pi / (np.sqrt(mm) * K)
+                for n in range(harmonics):
+                    b[n] = sign * qn / (1.0 + alt * q2n1)
+                    qn *= nome
+                    q2n1 *= nome * nome
+                    sign *= alt
+        c1 = np.cos(omega * t[i])
         w = 4.0 * c1 * c1 - 2.0
         prev, cur = c1, c1  # cos((2n+1)v) by the recurrence c_{n+2} = w c_n − c_{n−2}
-        qn, q2n1, sign, total = np.sqrt(nome), nome, 1.0, 0.0
-        for _ in range(harmonics):
-            total += sign * qn / (1.0 + alt * q2n1) * cur
+        total = 0.0
+        for n in range(harmonics):
+            total += b[n] * cur
             prev, cur = cur, w * cur - prev
-            qn *= nome
-            q2n1 *= nome * nome
-            sign *= alt
-        out[i] = 2.0 * np.pi / (np.sqrt(mm) * K) * total
+        out[i] = total
     return out
 
 
