@@ -182,11 +182,18 @@ def _extend(q: list, squares: list, cubes: list, E: list, deltas: list, m: int) 
     E.append(1j * sum(k * deltas[k] * E[m - k] for k in range(1, m + 1)) / m)
 
 
+JUDGED_FROM = 3
+# NOTE: the convergence test reads four terms: below order 3 the expansion is carried to order
+# 3 to be judged, and returned at the order asked (a first-order answer is never unjudged).
+
+
 def mu_expansion(d: Drive, branch: Branch, order: int) -> MuExpansion:
-    """The μ-expansion (eq. 10.66–10.72) to ``order`` on ``branch``, numerically (float64)."""
+    """The μ-expansion (eq. 10.66–10.72) to ``order`` on ``branch``, numerically (float64),
+    judged by the size of its terms up to ``max(order, 3)``."""
     if isinstance(order, bool) or not isinstance(order, int) or not 0 <= order <= 200:
         raise InputError(f"order {order!r}: must be an integer in 0..200")
-    M = 2 * order + 5
+    top = max(order, JUDGED_FROM)
+    M = 2 * top + 5
     n = _harmonics(M)
     q = [_cos_tau(M, branch.A1)]
     deltas = [branch.delta0]
@@ -195,7 +202,7 @@ def mu_expansion(d: Drive, branch: Branch, order: int) -> MuExpansion:
     E = [1.0 + 0j]
     dets: list[float] = []
     resonant = np.abs(n) == 1
-    for j in range(1, order + 1):
+    for j in range(1, top + 1):
         F = _forcing(d, q, cubes, E, branch.delta0, j)
         p = np.where(resonant, 0, F / np.where(resonant, 1, 1 - n * n))
 
@@ -211,22 +218,22 @@ def mu_expansion(d: Drive, branch: Branch, order: int) -> MuExpansion:
         det = float(np.linalg.det(J))
         dets.append(det)
         if abs(det) < 1e-12 * (1 + d.force + abs(d.eps) * branch.A1**2):
-            return MuExpansion(branch, tuple(q), tuple(deltas), tuple(dets), False,
+            return MuExpansion(branch, tuple(q[: order + 1]), tuple(deltas[: order + 1]),
+                               tuple(dets[:order]), False,
                                f"order {j}: singular secular system (a fold: branches merge)")
         b, delta = np.linalg.solve(J, -s0)
         q.append(p + _cos_tau(M, b))
         deltas.append(float(delta))
         _extend(q, squares, cubes, E, deltas, j)
     converged, reason = _convergence(q)
-    return MuExpansion(branch, tuple(q), tuple(deltas), tuple(dets), converged, reason)
+    return MuExpansion(branch, tuple(q[: order + 1]), tuple(deltas[: order + 1]),
+                       tuple(dets[:order]), converged, reason)
 
 
 def _convergence(q: list[np.ndarray]) -> tuple[bool, str]:
     """Judge the series by the size of its last terms: a growing tail, or a last term still
     above 1 % of the leading one, is no answer."""
     sizes = [float(np.abs(c).sum()) for c in q]
-    if len(sizes) < 4:
-        return True, "too few orders to judge; terms: " + ", ".join(f"{s:.1e}" for s in sizes)
     tail = sizes[-3:]
     if tail[-1] > tail[0] and tail[-1] > 1e-14 * sizes[0]:
         return False, f"terms grow ({tail[0]:.1e} -> {tail[-1]:.1e}): the μ-series diverges here"
