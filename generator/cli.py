@@ -453,7 +453,7 @@ def _cmd_choose(args: argparse.Namespace) -> int:
         if getattr(args, name) is None:
             raise InputError(f"choose period needs --{name.replace('_', '-')}")
     if args.emit:
-        check_writable(Path(args.emit), ["chosen_period.py"])
+        check_writable(Path(args.emit), ["chosen_period.py"], "--emit")
     choice = choose_period(args.tol, args.x_min, args.x_max)
     data = {"method": choice.method, "order": choice.order, "max_error": choice.max_error,
             "ns_per_point": choice.ns_per_point, "verified_on": choice.verified_on,
@@ -520,7 +520,7 @@ def _choose_q(args: argparse.Namespace) -> int:
             raise InputError(f"choose q needs --{name.replace('_', '-')}")
     if args.emit:
         check_writable(Path(args.emit),
-                       ["duffing.py", "duffing_tables.tex", "duffing_derivation.tex"])
+                       ["duffing.py", "duffing_tables.tex", "duffing_derivation.tex"], "--emit")
     c = choose_solution(args.tol, args.x_min, args.x_max, args.t_max,
                         emittable=bool(args.emit))
     data = {"quantity": "q", "method": c.method, "order": c.order, "max_error": c.max_error,
@@ -557,7 +557,8 @@ def _choose_driven(args: argparse.Namespace) -> int:
     tol = args.tol or 1e-4
     lo, hi = (args.omega, None) if args.omega is not None else (args.omega_min, args.omega_max)
     if args.emit:
-        check_writable(Path(args.emit), ["driven.py", "driven_derivation.tex", "balance.py"])
+        check_writable(Path(args.emit), ["driven.py", "driven_derivation.tex", "balance.py"],
+                       "--emit")
     c = choose_driven(args.quantity, tol, args.eps, args.force, args.Q, lo, hi,
                       emit_order=DRIVEN_MAX_ORDER if args.emit else None)
     data = {"quantity": args.quantity, "method": c.method, "order": c.order,

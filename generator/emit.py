@@ -225,13 +225,13 @@ def render_latex(solution: SeriesSolution, order: int, p: Provenance) -> dict[st
     }
 
 
-def check_writable(out: Path, names: list[str]) -> None:
+def check_writable(out: Path, names: list[str], flag: str = "--out") -> None:
     """Refuse before writing anything: unusable folder, or a file this tool did not write."""
     if out.exists() and not out.is_dir():
-        raise InputError(f"--out {out}: exists and is not a folder")
+        raise InputError(f"{flag} {out}: exists and is not a folder")
     parent = out if out.exists() else next((a for a in out.parents if a.exists()), Path("."))
     if not os.access(parent, os.W_OK | os.X_OK):
-        raise InputError(f"--out {out}: not writable")
+        raise InputError(f"{flag} {out}: not writable")
     for name in names:
         target = out / name
         if target.exists():
