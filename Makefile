@@ -34,6 +34,9 @@ lint: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python benchmarks/derive.py
 	$(BIN)/python benchmarks/evaluate.py
+	$(BIN)/python benchmarks/speed_accuracy.py
+	$(BIN)/python benchmarks/q_speed_accuracy.py
+	$(BIN)/python benchmarks/driven_speed_accuracy.py
 
 clean:
 	rm -rf $(VENV) out .pytest_cache
