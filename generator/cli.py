@@ -47,6 +47,7 @@ from .emit import (
     generate_balance,
     generate_choice,
     generate_driven,
+    generate_fourier,
     load_generated,
 )
 from .errors import InputError
@@ -141,12 +142,14 @@ def _cmd_generate(args: argparse.Namespace) -> int:
                          f"{DRIVEN_MAX_ORDER} (its rational functions grow fast)")
     if cost > COST_LIMIT_SECONDS and not args.force:
         raise InputError(f"order {order}: about {cost:,.0f} s of derivation; pass --force")
-    if args.model in ("driven", "balance") and args.allow_divergent:
+    if args.model in ("driven", "balance", "fourier") and args.allow_divergent:
         raise InputError(f"--allow-divergent: the {args.model} evaluators have no radius to lift")
     if args.model == "driven":
         paths = generate_driven(order, Path(args.out))
     elif args.model == "balance":
         paths = generate_balance(args.harmonics, Path(args.out))
+    elif args.model == "fourier":
+        paths = generate_fourier(args.harmonics, Path(args.out))
     else:
         paths = generate(args.model, order, Path(args.out), args.allow_divergent)
     for path in paths:
@@ -519,8 +522,8 @@ def _choose_q(args: argparse.Namespace) -> int:
         if getattr(args, name) is None:
             raise InputError(f"choose q needs --{name.replace('_', '-')}")
     if args.emit:
-        check_writable(Path(args.emit),
-                       ["duffing.py", "duffing_tables.tex", "duffing_derivation.tex"], "--emit")
+        check_writable(Path(args.emit), ["duffing.py", "duffing_tables.tex",
+                                         "duffing_derivation.tex", "fourier.py"], "--emit")
     c = choose_solution(args.tol, args.x_min, args.x_max, args.t_max,
                         emittable=bool(args.emit))
     data = {"quantity": "q", "method": c.method, "order": c.order, "max_error": c.max_error,
@@ -528,7 +531,9 @@ def _choose_q(args: argparse.Namespace) -> int:
             "considered": [{"method": m, "order": o, "max_error": e, "ns_per_point": ns}
                            for m, o, e, ns in c.considered]}
     if args.emit:
-        data["emitted"] = [str(p) for p in generate("duffing", c.order, Path(args.emit))]
+        paths = (generate("duffing", c.order, Path(args.emit)) if c.method == "lindstedt"
+                 else generate_fourier(c.order, Path(args.emit)))
+        data["emitted"] = [str(p) for p in paths]
     if args.json:
         print(json.dumps(data))
         return 0
@@ -625,14 +630,14 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser(
         "generate", help="write a numba evaluator module and LaTeX tables and derivation"
     )
-    p.add_argument("model", choices=(*MODELS, "driven", "balance"))
+    p.add_argument("model", choices=(*MODELS, "driven", "balance", "fourier"))
     p.add_argument("--order", type=_order, default=DEFAULT_ORDER,
                    help=f"highest order K (default {DEFAULT_ORDER})")
     p.add_argument("--out", default="generated", help="output folder (default generated/)")
     p.add_argument("--latex", action="store_true",
                    help="accepted for clarity: the LaTeX files are always written")
     p.add_argument("--harmonics", type=_order, default=BALANCE_HARMONICS,
-                   help=f"balance: odd harmonics N (default {BALANCE_HARMONICS})")
+                   help=f"balance, fourier: odd harmonics N (default {BALANCE_HARMONICS})")
     p.add_argument("--allow-divergent", action="store_true",
                    help="evaluate beyond the radius of convergence instead of returning NaN")
     p.add_argument("--force", action="store_true", help="run even when it would take minutes")
@@ -692,7 +697,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--Q", type=float, default=math.inf,
                    help="amplitudes, response: Q (default undamped)")
     p.add_argument("--emit", metavar="DIR", help="write just the chosen evaluator into DIR "
-                   "(period: chosen_period.py; q: duffing.py at the chosen order; amplitudes, "
+                   "(period: chosen_period.py; q: duffing.py or fourier.py; amplitudes, "
                    "response: driven.py or balance.py, only emittable methods compete)")
     p.add_argument("--json", action="store_true", help="print the JSON contract")
     p.set_defaults(func=_cmd_choose)

@@ -40,6 +40,7 @@ from .lower import (
     lower_balance,
     lower_choice,
     lower_driven,
+    lower_fourier,
     lower_free,
 )
 from .models import check_order, model_by_name
@@ -366,6 +367,14 @@ def generate_balance(harmonics: int, out: Path) -> list[Path]:
     module = lower_balance(balance_equations(harmonics),
                            f"lindstedt generate balance --harmonics {harmonics}")
     return write_files(out, {"balance.py": render_module(module)})
+
+
+def generate_fourier(harmonics: int, out: Path) -> list[Path]:
+    """``lindstedt generate fourier``: the exact Fourier series of the free Duffing solution."""
+    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 60:
+        raise InputError(f"harmonics {harmonics!r}: must be an integer in 1..60")
+    module = lower_fourier(harmonics, f"lindstedt generate fourier --harmonics {harmonics}")
+    return write_files(out, {"fourier.py": render_module(module)})
 
 
 def generate_choice(candidate: object, command: str, out: Path) -> list[Path]:

@@ -316,6 +316,60 @@ def lower_balance(eqs: BalanceEquations, command: str) -> Module:
     )
 
 
+def agm_steps(a: sp.Expr, b: sp.Expr, steps: int, prefix: str) -> tuple[list[Assign], sp.Expr]:
+    """``steps`` steps of the arithmetic–geometric mean as assignments, and ``(a + b)/2``
+    after them (a converged AGM stays put, so a fixed count serves every argument)."""
+    a0, b0 = sp.symbols(f"{prefix}a0 {prefix}b0")
+    lines: list[Assign] = [(a0, a), (b0, b)]
+    a, b = a0, b0
+    for n in range(1, steps + 1):
+        an, bn = sp.symbols(f"{prefix}a{n} {prefix}b{n}")
+        lines += [(an, (a + b) / 2), (bn, sp.sqrt(a * b))]
+        a, b = an, bn
+    return lines, (a + b) / 2
+
+
+FOURIER_AGM_STEPS = 16
+# NOTE: AGM(1, b) converges for any b ≥ 1e-300 within 16 steps (about log₂ ln(1/b) + 5).
+
+
+def lower_fourier(terms: int, command: str) -> Module:
+    """``q(t, A, eps)`` and ``omega(A, eps)`` of the free Duffing oscillator from the exact
+    Fourier series of its elliptic-function solution in the nome ``q = exp(−πK′/K)``,
+    truncated to ``terms`` odd harmonics; ``K``, ``K′`` by the AGM (see
+    ``choose.cn_fourier``, which the chooser verifies; same formulas)."""
+    t, A, eps, x, m, mm, scale, alt, K, Kp, nome, w = sp.symbols(
+        "t A eps x m mm scale alt K K_prime nome w")
+    hardening = m >= 0
+    body: list[Assign] = [
+        (m, x / (2 + 2 * x)),
+        (mm, sp.Piecewise((m, hardening), (-m / (1 - m), True))),
+        (scale, sp.Piecewise((sp.sqrt(1 + x), hardening), (sp.sqrt((1 + x) * (1 - m)), True))),
+        (alt, sp.Piecewise((1, hardening), (-1, True))),
+    ]
+    for symbol, arg, prefix in ((K, sp.sqrt(1 - mm), "k"), (Kp, sp.sqrt(mm), "kp")):
+        lines, mean = agm_steps(sp.Integer(1), arg, FOURIER_AGM_STEPS, prefix)
+        body += [*lines, (symbol, sp.pi / (2 * mean))]
+    body += [(nome, sp.exp(-sp.pi * Kp / K)), (w, sp.pi * scale / (2 * K))]
+    lines, cos_of, _ = harmonics(2 * terms - 1, True, w * t, False)
+    series = sum(2 * sp.pi / (sp.sqrt(mm) * K) * alt**n * sp.sqrt(nome) * nome**n
+                 / (1 + alt * nome ** (2 * n + 1)) * cos_of[2 * n + 1] for n in range(terms))
+    prelude = ((x, eps * A**2),)
+    q = Evaluator("q", f"q(t, A, eps): exact Fourier series, {terms} odd harmonics; NaN for "
+                  "eps*A**2 <= -1.", (t, A, eps), prelude, x > -1, (*body, *lines),
+                  A * sp.Piecewise((sp.cos(t), sp.Eq(m, 0)), (series, True)))
+    omega = Evaluator("omega", "omega(A, eps) = 2 pi / T, exact (AGM); NaN for eps*A**2 <= -1.",
+                      (A, eps), prelude, x > -1, tuple(body), w)
+    return Module(
+        name="fourier",
+        doc=f"Duffing q'' + q + eps*q**3 = 0: the exact solution A cn(sqrt(1+x) t | m) as its "
+            f"Fourier series in the nome, {terms} odd harmonics.",
+        constants=(("HARMONICS", terms),),
+        evaluators=(q, omega),
+        provenance=provenance("fourier", terms, command),
+    )
+
+
 def lower_choice(candidate, command: str) -> Module:
     """The period evaluator ``choose period`` picked, as one numba ufunc ``period(A, eps)``.
 
@@ -333,13 +387,8 @@ def lower_choice(candidate, command: str) -> Module:
              "pade": x > -1, "modified": x > -1, "agm": x > -1}[candidate.method]
     body: tuple = ()
     if candidate.method == "agm":
-        a, b = sp.symbols("a0 b0")
-        body = ((a, sp.sqrt(1 + x)), (b, sp.sqrt(1 + x / 2)))
-        for n in range(1, candidate.order + 1):
-            an, bn = sp.symbols(f"a{n} b{n}")
-            body += ((an, (a + b) / 2), (bn, sp.sqrt(a * b)))
-            a, b = an, bn
-        out = 2 / (a + b)
+        lines, mean = agm_steps(sp.sqrt(1 + x), sp.sqrt(1 + x / 2), candidate.order, "")
+        body, out = tuple(lines), 1 / mean
     elif candidate.method == "lindstedt":
         out = horner(coeffs(candidate.num), x)
     elif candidate.method == "resummed":

@@ -277,8 +277,6 @@ def test_choose_q_against_jacobi_cn():
         return err
 
     assert worst(c.order) <= 1e-8
-    with pytest.raises(InputError, match="no L–P order reaches it"):
-        choose_solution(1e-10, -0.95, 0.0, emittable=True)
 
 
 @pytest.mark.parametrize("x", [-0.99, -0.6, 0.3, 7.0, 1000.0])
@@ -311,6 +309,32 @@ def test_choose_q_for_a_softening_spring_beyond_the_series():
                 "cn", mpmath.sqrt(1 + x) * v, x / (2 * (1 + x))))) for v in t])
         got = cn_fourier(t, np.full_like(t, x), c.order, np.empty_like(t))
         assert np.max(np.abs(got - ref)) <= 1e-10
+
+
+def test_choose_q_emits_the_exact_fourier_module(tmp_path):
+    """`choose q --emit` on a softening range writes fourier.py: its q and q_into match mpmath's
+    cn off the grid, its omega is 2π/T with T = 4K(m)/√(1+x) (mpmath), NaN past the separatrix."""
+    from generator.emit import load_generated
+
+    run = subprocess.run([sys.executable, "-m", "generator", "choose", "q", "--tol", "1e-10",
+                          "--x-min", "-0.95", "--x-max", "0", "--emit", str(tmp_path), "--json"],
+                         capture_output=True, text=True, check=False)
+    data = json.loads(run.stdout)
+    assert data["method"] == "fourier" and data["emitted"] == [str(tmp_path / "fourier.py")]
+    mod = load_generated(tmp_path / "fourier.py")
+    assert data["order"] == mod.HARMONICS
+    t = np.linspace(0.05, 19.95, 37)
+    for x in (-0.93, -0.5, -0.07):
+        with mpmath.workdps(30):
+            m = mpmath.mpf(x) / (2 * (1 + x))
+            ref = np.array([float(mpmath.re(mpmath.ellipfun("cn", mpmath.sqrt(1 + x) * v, m)))
+                            for v in t])
+            omega = float(mpmath.pi * mpmath.sqrt(1 + x) / (2 * mpmath.ellipk(m)))
+        assert np.max(np.abs(mod.q(t, 1.0, x) - ref)) <= 1e-10
+        assert np.max(np.abs(mod.q_into(np.empty_like(t), t, 1.0, x) - ref)) <= 1e-10
+        assert abs(mod.omega(1.0, x) / omega - 1) <= 1e-14
+    assert np.isnan(mod.q(1.0, 1.0, -1.0)) and np.isnan(mod.omega(2.0, -0.3))
+    del sys.modules["fourier"]
 
 
 def test_choose_emits_the_driven_module_it_verified(tmp_path):
