@@ -1,6 +1,13 @@
-"""The smallest model a scene needs: the cheapest verified method for the Duffing period.
+"""The smallest model a scene needs: for each quantity, every method at every order, verified
+against an independent reference and timed; the cheapest within the tolerance wins.
 
-Candidates for ``T/2π`` as a function of ``x = εA²`` (all from the exact L–P series):
+* :func:`choose_period`: the Duffing period (below);
+* :func:`choose_solution`: q(t) — L–P orders against the exact Fourier series (nome) of cn;
+* :func:`choose_driven`: the driven amplitudes A_n(ω) and the response r(ω) — one harmonic,
+  μ-expansion orders, harmonic balance, shooting; with ``emit_order``, the emitted modules;
+* named scenes (:data:`SCENES`) and the appendix's pendulum claims.
+
+Candidates for ``T/2π`` as a function of ``x = εA²``:
 
 * ``lindstedt``: the L–P series ``Σ τ_j x^j`` truncated at order k (radius |x| < 1, set by the
   separatrix at x = −1);
@@ -8,6 +15,7 @@ Candidates for ``T/2π`` as a function of ``x = εA²`` (all from the exact L–
   ``T/2π = √(1 − 2m) Σ c_n m^n`` — analytic for ``|m| < 1``, i.e. ``x > −2/3``, and
   ``m < 1/2`` for every ``x ≥ 0``, so it converges out to ``εA² → ∞``;
 * ``pade``: the diagonal Padé approximant ``[k/k]`` of the L–P series;
+* ``modified``: the modified L–P of Cheung, Chen & Lau, re-expanded from the exact series;
 * ``agm``: the exact period through Gauss's arithmetic–geometric mean,
   ``T/2π = 1/AGM(√(1+x), √(1+x/2))`` (``K(m) = π/(2 AGM(1, √(1−m)))``, scaled), stopped after
   n steps — the order; each step squares the relative error, so 2–3 steps are exact to
