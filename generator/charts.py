@@ -274,7 +274,7 @@ VALIDITY_METHODS = (("mu_expansion", 1), ("mu_expansion", 2), ("mu_expansion", 4
 # NOTE: what the driven validity map draws; harmonic balance with 10 harmonics is the judge.
 
 
-def _driven_errors(d: Drive) -> tuple[np.ndarray, int]:
+def _validity_errors(d: Drive) -> tuple[np.ndarray, int]:
     """|A₁ − A₁(balance, N = 10)| on the largest branch for each of VALIDITY_METHODS (NaN
     where it refuses: a fold, a diverging or stalled μ-series, a balance that does not
     converge), and the branch count."""
@@ -303,7 +303,7 @@ def driven_validity_figure(path: Path, eps: float = 0.1, force: float = 1.0) -> 
     for axis, grid, label, make in (
             (ax, np.linspace(0.3, 2.5, 221), "ω", lambda v: Drive(eps, force, float(v))),
             (byf, np.logspace(-2, 1.2, 161), "f", lambda v: Drive(eps, float(v), 0.6))):
-        rows = [_driven_errors(make(v)) for v in grid]
+        rows = [_validity_errors(make(v)) for v in grid]
         errors = np.array([r[0] for r in rows])
         counts = np.array([r[1] for r in rows])
         for k, (method, order) in enumerate(VALIDITY_METHODS):

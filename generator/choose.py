@@ -231,6 +231,18 @@ def verification_points(x_min: float, x_max: float, n: int = VERIFY_POINTS) -> n
     return x_min + (x_max - x_min) * (1 - np.cos(np.linspace(0, np.pi, n))) / 2
 
 
+def best_seconds(run: Callable[[], object], runs: int = 3) -> float:
+    """Wall time of ``run()``: one warm-up call (compilation, first touch), then the best of
+    ``runs``."""
+    run()
+    best = np.inf
+    for _ in range(runs):
+        t0 = time.perf_counter()
+        run()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
 def ns_per_point(c: Candidate, points: int = 1_000_000, x_min: float = 0.0,
                  x_max: float = 0.5) -> float:
     """Measured cost of the compiled candidate on uniform points of the range, into a
@@ -238,15 +250,13 @@ def ns_per_point(c: Candidate, points: int = 1_000_000, x_min: float = 0.0,
     stay in cache, are evaluated repeatedly)."""
     x = np.random.default_rng(0).uniform(x_min, x_max, points)
     out = np.empty_like(x)
-    c(x[:10])
     repeats = max(1, 1_000_000 // points)
-    best = np.inf
-    for _ in range(5):
-        t0 = time.perf_counter()
+
+    def run() -> None:
         for _ in range(repeats):
             c(x, out)
-        best = min(best, time.perf_counter() - t0)
-    return best / (points * repeats) * 1e9
+
+    return best_seconds(run, 5) / (points * repeats) * 1e9
 
 
 T = TypeVar("T")
@@ -535,32 +545,39 @@ def one_harmonic_amplitudes(eps: float, force: float, Q: float,
     return r * np.cos(delta), r * np.sin(delta)
 
 
+def driven_errors(truth: DrivenTruth, A: np.ndarray, B: np.ndarray) -> dict[str, np.ndarray]:
+    """Both error measures per ω for ``(n, 3)`` arrays of ``A_n``, ``B_n`` (n = 1, 3, 5; a
+    NaN row — a refused ω — stays NaN)."""
+    return {"amplitudes": np.max(np.abs(np.hstack([A - truth.A, B - truth.B])), axis=1),
+            "response": np.abs(np.hypot(A[:, 0], B[:, 0]) - truth.r)}
+
+
+def _harmonics_135(values: tuple[dict, dict]) -> tuple[list[float], list[float]]:
+    """``A_n``, ``B_n`` for n = 1, 3, 5 from the dicts of :func:`driven.amplitudes`."""
+    A, B = values
+    return [A.get(k, 0.0) for k in (1, 3, 5)], [B.get(k, 0.0) for k in (1, 3, 5)]
+
+
 def driven_tradeoffs(truth: DrivenTruth, eps: float, force: float,
                      Q: float) -> list[DrivenTradeoff]:
     """The one-harmonic closed form, the μ-expansion at orders 0..12, harmonic balance with
     1..12 harmonics and shooting with plain RK4, each timed and judged at every ω of
     ``truth``."""
     n = truth.omega.size
-    target = np.hstack([truth.A, truth.B])
-
-    def judge(i: int, A: dict, B: dict) -> tuple[float, float]:
-        got = np.array([A.get(k, 0.0) for k in (1, 3, 5)] + [B.get(k, 0.0) for k in (1, 3, 5)])
-        return float(np.max(np.abs(got - target[i]))), abs(np.hypot(got[0], got[3])
-                                                            - truth.r[i])
-
     a1, b1 = one_harmonic_amplitudes(eps, force, Q, truth.omega)
     dense = np.resize(truth.omega, 100_000)  # timed where per-call overhead is amortised
     t0 = time.perf_counter()
     one_harmonic_amplitudes(eps, force, Q, dense)
     ns = (time.perf_counter() - t0) / dense.size * 1e9
-    errs = np.array([judge(i, {1: a1[i]}, {1: b1[i]}) for i in range(n)])
-    out = [DrivenTradeoff("one_harmonic", 1, ns, {"amplitudes": errs[:, 0],
-                                                  "response": errs[:, 1]})]
+    zeros = np.zeros((n, 2))
+    out = [DrivenTradeoff("one_harmonic", 1, ns,
+                          driven_errors(truth, np.column_stack([a1, zeros]),
+                                        np.column_stack([b1, zeros])))]
     for method, orders in (("mu_expansion", range(DRIVEN_MAX + 1)),
                            ("harmonic_balance", range(1, DRIVEN_MAX + 1)),
                            ("shooting", SHOOTING_STEPS)):
         for order in orders:
-            errs = np.full((n, 2), np.nan)
+            A, B = np.full((n, 3), np.nan), np.full((n, 3), np.nan)
             seconds = 0.0
             for i, w in enumerate(truth.omega):
                 d = Drive(eps, force, float(w), Q)
@@ -582,16 +599,10 @@ def driven_tradeoffs(truth: DrivenTruth, eps: float, force: float,
                     values = (orbit.A, orbit.B) if ok else ({}, {})
                 seconds += time.perf_counter() - t0
                 if ok:
-                    errs[i] = judge(i, *values)
+                    A[i], B[i] = _harmonics_135(values)
             out.append(DrivenTradeoff(method, order, seconds / n * 1e9,
-                                      {"amplitudes": errs[:, 0], "response": errs[:, 1]}))
+                                      driven_errors(truth, A, B)))
     return out
-
-
-def _driven_errors(truth: DrivenTruth, A: np.ndarray, B: np.ndarray) -> dict[str, np.ndarray]:
-    """The two error measures for ``(n, 3)`` arrays of ``A_n``, ``B_n`` (n = 1, 3, 5)."""
-    return {"amplitudes": np.max(np.abs(np.hstack([A - truth.A, B - truth.B])), axis=1),
-            "response": np.abs(np.hypot(A[:, 0], B[:, 0]) - truth.r)}
 
 
 def emitted_driven(method: str, order: int, truth: DrivenTruth, eps: float, force: float,
@@ -609,18 +620,14 @@ def emitted_driven(method: str, order: int, truth: DrivenTruth, eps: float, forc
                                  "undamped one is derived exactly)")
             generate_driven(order, Path(tmp))
             mod = load_generated(Path(tmp) / "driven.py")
-            fns = [getattr(mod, f"A_{k}_into", None) for k in (1, 3, 5)]
+            fns = {k: getattr(mod, f"A_{h}_into") for k, h in enumerate((1, 3, 5))
+                   if hasattr(mod, f"A_{h}_into")}  # the order's harmonics; the rest stay 0
+            for k, f in fns.items():
+                A[:, k] = f(np.empty(n), truth.omega, eps, force, 0.0)
             dense = np.resize(truth.omega, 100_000)
             buf = np.empty_like(dense)
-            for k, f in enumerate(fns):
-                if f is not None:
-                    A[:, k] = f(np.empty(n), truth.omega, eps, force, 0.0)
-                    f(buf, dense, eps, force, 0.0)
-            t0 = time.perf_counter()
-            for f in fns:
-                if f is not None:
-                    f(buf, dense, eps, force, 0.0)
-            ns = (time.perf_counter() - t0) / dense.size * 1e9
+            ns = best_seconds(lambda: [f(buf, dense, eps, force, 0.0) for f in fns.values()],
+                              1) / dense.size * 1e9
             sys.modules.pop("driven", None)
         else:
             generate_balance(order, Path(tmp))
@@ -629,16 +636,16 @@ def emitted_driven(method: str, order: int, truth: DrivenTruth, eps: float, forc
             x0 = np.zeros((n, 2 * order))
             x0[:, 0], x0[:, order] = a1, b1
             damping = Drive(eps, force, 1.0, Q).damping
-            mod.newton(x0[0], truth.omega[0], eps, force, damping)  # compile
-            t0 = time.perf_counter()
             xs = [mod.newton(x, w, eps, force, damping)[0]
                   for x, w in zip(x0, truth.omega, strict=True)]
-            ns = (time.perf_counter() - t0) / n * 1e9
+            ns = best_seconds(lambda: [mod.newton(x, w, eps, force, damping)
+                                       for x, w in zip(x0, truth.omega, strict=True)],
+                              1) / n * 1e9
             for k in range(min(order, 3)):
                 A[:, k] = [x[k] for x in xs]
                 B[:, k] = [x[order + k] for x in xs]
             sys.modules.pop("balance", None)
-    return DrivenTradeoff(f"{method}, emitted", order, ns, _driven_errors(truth, A, B))
+    return DrivenTradeoff(f"{method}, emitted", order, ns, driven_errors(truth, A, B))
 
 
 @dataclass(frozen=True)
@@ -820,13 +827,7 @@ def _fourier_cost(harmonics: int, x_min: float, x_max: float) -> float:
     x = rng.uniform(x_min, x_max, 200_000)
     t = rng.uniform(0, 20, x.size)
     out = np.empty_like(t)
-    cn_fourier(t[:10], x[:10], harmonics, out[:10])
-    best = np.inf
-    for _ in range(3):
-        t0 = time.perf_counter()
-        cn_fourier(t, x, harmonics, out)
-        best = min(best, time.perf_counter() - t0)
-    return best / t.size * 1e9
+    return best_seconds(lambda: cn_fourier(t, x, harmonics, out)) / t.size * 1e9
 
 
 def choose_solution(tol: float, x_min: float, x_max: float, t_max: float = 20.0,
@@ -898,11 +899,6 @@ def _generated_q_cost(order: int, x_min: float, x_max: float) -> float:
         eps = rng.uniform(x_min, x_max, 1_000_000)
         t = rng.uniform(0, 20, eps.size)
         out = np.empty_like(t)
-        mod.q_into(out[:10], t[:10], 1.0, eps[:10])
-        best = np.inf
-        for _ in range(3):
-            t0 = time.perf_counter()
-            mod.q_into(out, t, 1.0, eps)
-            best = min(best, time.perf_counter() - t0)
+        seconds = best_seconds(lambda: mod.q_into(out, t, 1.0, eps))
         sys.modules.pop("duffing", None)
-    return best / t.size * 1e9
+    return seconds / t.size * 1e9

@@ -447,6 +447,24 @@ def _mixing_table(data: dict) -> list[str]:
     return lines
 
 
+def _considered(rows: Sequence[tuple[str, int, float, float]]) -> list[dict]:
+    """``choose``'s per-method rows as JSON records."""
+    return [{"method": m, "order": o, "max_error": e, "ns_per_point": ns} for m, o, e, ns in rows]
+
+
+def _print_choice(header: str, chosen: tuple[str, int, float, float],
+                  rows: Sequence[tuple[str, int, float, float]], micro: bool = False) -> None:
+    """The text report of every ``choose``: the header, the choice, each method considered
+    (cost in ns/point, or µs when ``micro``)."""
+    unit, scale = ("µs/point", 1e-3) if micro else ("ns/point", 1.0)
+    print(header)
+    m, o, e, ns = chosen
+    print(f"  chosen: {m} order {o}: max error {e:.1e}, {ns * scale:.2f} {unit}")
+    width = max(len(r[0]) for r in rows)
+    for m, o, e, ns in rows:
+        print(f"  {m:>{width}} order {o:>2}: max error {e:.1e}, {ns * scale:8.2f} {unit}")
+
+
 def _cmd_choose(args: argparse.Namespace) -> int:
     if args.quantity in DRIVEN_QUANTITIES:
         return _choose_driven(args)
@@ -461,8 +479,7 @@ def _cmd_choose(args: argparse.Namespace) -> int:
     data = {"method": choice.method, "order": choice.order, "max_error": choice.max_error,
             "ns_per_point": choice.ns_per_point, "verified_on": choice.verified_on,
             "quantity": "period", "variable": "x = eps*A**2",
-            "considered": [{"method": m, "order": o, "max_error": e, "ns_per_point": ns}
-                           for m, o, e, ns in choice.considered]}
+            "considered": _considered(choice.considered)}
     if args.emit:
         cand = next(c for c in candidates() if (c.method, c.order) == (choice.method,
                                                                          choice.order))
@@ -472,12 +489,10 @@ def _cmd_choose(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(data))
         return 0
-    print(f"period T(x), x = eps*A**2 in [{args.x_min:g}, {args.x_max:g}], tolerance "
-          f"{args.tol:g} (relative, verified on {choice.verified_on} points):")
-    print(f"  chosen: {choice.method} order {choice.order}: max error {choice.max_error:.1e}, "
-          f"{choice.ns_per_point:.2f} ns/point")
-    for m, o, e, ns in choice.considered:
-        print(f"  {m:>10} order {o:>2}: max error {e:.1e}, {ns:6.2f} ns/point")
+    _print_choice(f"period T(x), x = eps*A**2 in [{args.x_min:g}, {args.x_max:g}], tolerance "
+                  f"{args.tol:g} (relative, verified on {choice.verified_on} points):",
+                  (choice.method, choice.order, choice.max_error, choice.ns_per_point),
+                  choice.considered)
     for path in data.get("emitted", []):
         print(f"  emitted {path}")
     return 0
@@ -528,8 +543,7 @@ def _choose_q(args: argparse.Namespace) -> int:
                         emittable=bool(args.emit))
     data = {"quantity": "q", "method": c.method, "order": c.order, "max_error": c.max_error,
             "ns_per_point": c.ns_per_point, "verified_on": c.verified_on,
-            "considered": [{"method": m, "order": o, "max_error": e, "ns_per_point": ns}
-                           for m, o, e, ns in c.considered]}
+            "considered": _considered(c.considered)}
     if args.emit:
         paths = (generate("duffing", c.order, Path(args.emit)) if c.method == "lindstedt"
                  else generate_fourier(c.order, Path(args.emit)))
@@ -537,12 +551,9 @@ def _choose_q(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(data))
         return 0
-    print(f"q(t)/A to {args.tol:g} for x in [{args.x_min:g}, {args.x_max:g}], t in "
-          f"[0, {args.t_max:g}] (verified on {c.verified_on} points):")
-    print(f"  chosen: {c.method} order {c.order}: max error {c.max_error:.1e}, "
-          f"{c.ns_per_point:.1f} ns/point")
-    for m, o, e, ns in c.considered:
-        print(f"  {m:>10} order {o:>2}: max error {e:.1e}, {ns:7.1f} ns/point")
+    _print_choice(f"q(t)/A to {args.tol:g} for x in [{args.x_min:g}, {args.x_max:g}], t in "
+                  f"[0, {args.t_max:g}] (verified on {c.verified_on} points):",
+                  (c.method, c.order, c.max_error, c.ns_per_point), c.considered)
     if c.method == "lindstedt" and not args.emit:
         print(f"  (`lindstedt generate duffing --order {c.order}` or --emit DIR writes it)")
     for path in data.get("emitted", []):
@@ -571,8 +582,7 @@ def _choose_driven(args: argparse.Namespace) -> int:
             "verified_on": c.verified_on, "seconds": c.ns_per_point * 1e-9,
             "alternatives": {m: {"order": o, "max_error": e, "seconds": ns * 1e-9}
                              for m, o, e, ns in c.considered if m != c.method},
-            "considered": [{"method": m, "order": o, "max_error": e, "ns_per_point": ns}
-                           for m, o, e, ns in c.considered],
+            "considered": _considered(c.considered),
             "truth_by_omega": [{"omega": float(w), "A": a.tolist(), "B": b.tolist()}
                                for w, a, b in zip(c.truth.omega, c.truth.A, c.truth.B,
                                                   strict=True)]}
@@ -586,12 +596,10 @@ def _choose_driven(args: argparse.Namespace) -> int:
         return 0
     what = {"amplitudes": "A1, A3, A5 (and B_n)", "response": "r = sqrt(A1^2 + B1^2)"}
     where = f"omega = {lo:g}" if hi is None else f"omega in [{lo:g}, {hi:g}]"
-    print(f"{what[args.quantity]} to {tol:g} (absolute, largest branch, {where}, verified on "
-          f"{c.verified_on} point{'s' * (c.verified_on > 1)} against shooting):")
-    print(f"  chosen: {c.method} order {c.order}: max error {c.max_error:.1e}, "
-          f"{c.ns_per_point / 1e3:.1f} µs/point")
-    for m, o, e, ns in c.considered:
-        print(f"  {m:>16} order {o:>2}: max error {e:.1e}, {ns / 1e3:8.1f} µs/point")
+    _print_choice(f"{what[args.quantity]} to {tol:g} (absolute, largest branch, {where}, "
+                  f"verified on {c.verified_on} point{'s' * (c.verified_on > 1)} against "
+                  "shooting):", (c.method, c.order, c.max_error, c.ns_per_point), c.considered,
+                  micro=True)
     for path in data.get("emitted", []):
         print(f"  emitted {path}")
     return 0
