@@ -13,11 +13,10 @@ from __future__ import annotations
 import argparse
 
 import sympy as sp
+from lindstedt.lindstedt import derive
+from lindstedt.models import duffing, pendulum
 from sympy.simplify.fu import TR8
 from timing import best
-
-from generator.lindstedt import derive
-from generator.models import duffing, pendulum
 
 
 def textbook(order: int) -> list[sp.Rational]:

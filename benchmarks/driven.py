@@ -10,12 +10,11 @@ import time
 from pathlib import Path
 
 import numpy as np
+from lindstedt.driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
+from lindstedt.emit import generate_balance, load_generated
+from lindstedt.numerics import shoot, sweep
+from lindstedt.response import continue_balance, one_harmonic_curve
 from timing import best
-
-from generator.driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
-from generator.emit import generate_balance, load_generated
-from generator.numerics import shoot, sweep
-from generator.response import continue_balance, one_harmonic_curve
 
 
 def main() -> None:

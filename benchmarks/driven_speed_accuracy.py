@@ -15,9 +15,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-
-from generator.charts import DRIVEN_CHART_OMEGA, driven_speed_accuracy_figure
-from generator.choose import (
+from lindstedt.charts import DRIVEN_CHART_OMEGA, driven_speed_accuracy_figure
+from lindstedt.choose import (
     DRIVEN_QUANTITIES,
     driven_tradeoffs,
     driven_truth,

@@ -24,14 +24,13 @@ from pathlib import Path
 
 import numpy as np
 import sympy as sp
+from lindstedt.emit import generate, load_generated
+from lindstedt.lindstedt import derive, period_series, solution_expression
+from lindstedt.lower import Evaluator, lower_free
+from lindstedt.models import A, duffing, eps, t
 from sympy.codegen.rewriting import create_expand_pow_optimization, optimize
 from sympy.printing.c import C99CodePrinter
 from timing import best
-
-from generator.emit import generate, load_generated
-from generator.lindstedt import derive, period_series, solution_expression
-from generator.lower import Evaluator, lower_free
-from generator.models import A, duffing, eps, t
 
 
 def c_function(ev: Evaluator, name: str, per_harmonic_cos: bool = False) -> str:

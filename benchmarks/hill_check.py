@@ -11,8 +11,7 @@ from __future__ import annotations
 from collections import Counter
 
 import numpy as np
-
-from generator.response import subharmonic
+from lindstedt.response import subharmonic
 
 
 def main() -> None:

@@ -21,12 +21,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+from lindstedt.choose import cn_fourier
+from lindstedt.emit import generate, load_generated
 from scipy.integrate import solve_ivp
 from scipy.special import ellipj
 from timing import best
-
-from generator.choose import cn_fourier
-from generator.emit import generate, load_generated
 
 X = (0.1, 0.5)
 ORDERS = (1, 2, 4, 8, 12, 16)

@@ -17,12 +17,11 @@ import time
 from unittest import mock
 
 from flint import fmpq, fmpq_poly
+from lindstedt import lindstedt
+from lindstedt.models import duffing
+from lindstedt.series import Ground
 from sympy.external.gmpy import GROUND_TYPES
 from sympy.polys.domains import QQ
-
-from generator import lindstedt
-from generator.models import duffing
-from generator.series import Ground
 
 
 def laurent(order: int) -> list[fmpq]:

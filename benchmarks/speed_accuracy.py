@@ -11,9 +11,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-
-from generator.charts import CHART_X, speed_accuracy_figure
-from generator.choose import pareto_front, tradeoffs
+from lindstedt.charts import CHART_X, speed_accuracy_figure
+from lindstedt.choose import pareto_front, tradeoffs
 
 
 def main() -> None:

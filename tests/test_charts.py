@@ -6,9 +6,8 @@ import subprocess
 import sys
 
 import pytest
-
-from generator.charts import check_plot_path, mixing_figure
-from generator.errors import InputError
+from lindstedt.charts import check_plot_path, mixing_figure
+from lindstedt.errors import InputError
 
 
 def test_mixing_figure_is_a_reproducible_png(tmp_path):
@@ -27,7 +26,7 @@ def test_bad_plot_paths(bad):
 
 
 def test_cli_refuses_bad_plot_path_before_computing(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "generator", "response", "--eps", "0.1",
+    run = subprocess.run([sys.executable, "-m", "lindstedt", "response", "--eps", "0.1",
                           "--force", "0.3", "--Q", "20", "--plot", str(tmp_path / "x.gif")],
                          capture_output=True, text=True, check=False)
     assert run.returncode == 2 and run.stdout == "" and "--plot" in run.stderr

@@ -10,10 +10,9 @@ from fractions import Fraction
 import mpmath
 import numpy as np
 import pytest
+from lindstedt.choose import candidates, choose_period, resummed_coefficients
+from lindstedt.errors import InputError
 from reference import duffing_period
-
-from generator.choose import candidates, choose_period, resummed_coefficients
-from generator.errors import InputError
 
 
 def test_resummed_lindstedt_series_is_the_hypergeometric_series_of_k():
@@ -58,7 +57,7 @@ def test_agm_period_against_mpmath_elliptic_k(steps, x, tol):
 
 
 def test_choose_contract_and_bad_input():
-    run = subprocess.run([sys.executable, "-m", "generator", "choose", "period", "--tol", "1e-8",
+    run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "period", "--tol", "1e-8",
                           "--x-min", "0", "--x-max", "1000", "--json"],
                          capture_output=True, text=True, check=False)
     data = json.loads(run.stdout)
@@ -68,7 +67,7 @@ def test_choose_contract_and_bad_input():
                          (["--tol", "1e-3", "--x-min", "-1.5", "--x-max", "0"], "separatrix"),
                          (["--tol", "1e-19", "--x-min", "0", "--x-max", "1"], "best reachable"),
                          (["--tol", "nan", "--x-min", "0", "--x-max", "1"], "not finite")):
-        bad = subprocess.run([sys.executable, "-m", "generator", "choose", "period", *args],
+        bad = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "period", *args],
                              capture_output=True, text=True, check=False)
         assert bad.returncode == 2 and needle in bad.stderr, bad.stderr
 
@@ -80,9 +79,8 @@ def test_negative_tolerance():
 
 def test_appendix_thresholds_against_direct_evaluation():
     """At each true threshold the error equals the tolerance (NumPy/SciPy, not mpmath)."""
+    from lindstedt.choose import appendix_thresholds
     from scipy.special import ellipk
-
-    from generator.choose import appendix_thresholds
 
     rows = appendix_thresholds()
     assert len(rows) == 6
@@ -104,7 +102,7 @@ def test_appendix_thresholds_against_direct_evaluation():
 
 
 def test_pareto_front():
-    from generator.choose import pareto_front
+    from lindstedt.choose import pareto_front
 
     cost = np.array([1.0, 2.0, 3.0, 1.5, 4.0])
     err = np.array([1e-3, 1e-6, 1e-5, 1e-2, 1e-9])
@@ -112,9 +110,8 @@ def test_pareto_front():
 
 
 def test_clock_scene_against_the_elliptic_period():
+    from lindstedt.choose import clock_scene
     from scipy.special import ellipk
-
-    from generator.choose import clock_scene
 
     result = clock_scene(10.0, 0.1)
     assert result.details["order"] == 2
@@ -129,7 +126,7 @@ def test_clock_scene_against_the_elliptic_period():
 
 
 def test_driven_and_spring_scenes():
-    from generator.choose import driven_scene, hard_spring_scene
+    from lindstedt.choose import driven_scene, hard_spring_scene
 
     spring = hard_spring_scene(50.0, 1e-8)
     assert spring.details["method"] != "exact" and spring.details["max_error"] <= 1e-8
@@ -144,9 +141,9 @@ def test_driven_and_spring_scenes():
 
 
 def test_choose_emits_just_the_chosen_evaluator(tmp_path):
-    from generator.emit import load_generated
+    from lindstedt.emit import load_generated
 
-    run = subprocess.run([sys.executable, "-m", "generator", "choose", "period", "--tol", "1e-8",
+    run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "period", "--tol", "1e-8",
                           "--x-min", "0", "--x-max", "1000", "--emit", str(tmp_path), "--json"],
                          capture_output=True, text=True, check=False)
     data = json.loads(run.stdout)
@@ -164,7 +161,7 @@ def test_choose_emits_just_the_chosen_evaluator(tmp_path):
 
 
 def test_integrated_period_reaches_its_tolerance():
-    from generator.choose import integrated_period, reference_period
+    from lindstedt.choose import integrated_period, reference_period
 
     for x in (0.1, 5.0, -0.5):
         ref = reference_period(np.array([x]))[0]
@@ -175,9 +172,9 @@ def test_integrated_period_reaches_its_tolerance():
 def test_modified_lindstedt_of_cheung_chen_lau():
     """ω² = (1 + 3x/4) g(α), α = 3x/(4 + 3x): by construction g = 1 + O(α²) (CCL's choice of α
     absorbs the first-order term), and the series holds out to x = 10³ and down to x = −0.9."""
-    from generator.choose import modified_coefficients, reference_period
-    from generator.lindstedt import derive
-    from generator.models import duffing
+    from lindstedt.choose import modified_coefficients, reference_period
+    from lindstedt.lindstedt import derive
+    from lindstedt.models import duffing
 
     sol = derive(duffing(), 40)
     g = modified_coefficients([sol.ground.to_fraction(c) for c in sol.omega])
@@ -188,15 +185,15 @@ def test_modified_lindstedt_of_cheung_chen_lau():
 
 
 def test_choose_amplitudes_meets_the_tolerance_against_shooting():
-    from generator.choose import choose_driven
-    from generator.numerics import shoot
+    from lindstedt.choose import choose_driven
+    from lindstedt.numerics import shoot
 
     c = choose_driven("amplitudes", 1e-8, 0.1, 0.3, 20.0, 1.3)
     assert c.max_error <= 1e-8 and c.method in ("mu_expansion", "harmonic_balance", "shooting")
     # the truth it was judged against is the true orbit on the largest branch
     orbit = shoot(0.1, 0.3, 1.3, 0.05, np.array([2.9, 1.2]))
     assert abs(orbit.A[1] - c.truth.A[0, 0]) < 1e-9
-    run = subprocess.run([sys.executable, "-m", "generator", "choose", "amplitudes", "--eps",
+    run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "amplitudes", "--eps",
                           "0.1", "--force", "1", "--json"], capture_output=True, text=True,
                          check=False)
     assert run.returncode == 2 and "--omega" in run.stderr
@@ -205,8 +202,8 @@ def test_choose_amplitudes_meets_the_tolerance_against_shooting():
 def test_one_harmonic_closed_form_is_mu_order_zero():
     """The vectorised cubic and the μ-expansion's order 0 (np.roots) agree on every branch
     point, damped and undamped, A₁ and B₁ (signs included: antiphase above resonance)."""
-    from generator.choose import one_harmonic_amplitudes
-    from generator.driven import Drive, amplitudes, first_order_branches, mu_expansion
+    from lindstedt.choose import one_harmonic_amplitudes
+    from lindstedt.driven import Drive, amplitudes, first_order_branches, mu_expansion
 
     for Q in (np.inf, 20.0):
         omegas = np.array([0.4, 0.9, 1.0, 1.2, 2.0, 3.0])
@@ -220,15 +217,15 @@ def test_one_harmonic_closed_form_is_mu_order_zero():
 def test_choose_response_over_a_range_holds_between_the_points():
     """The chosen method's r(ω) meets the tolerance at ω off the verification grid, against
     shooting started from the one-harmonic guess (not from the method's own answer)."""
-    from generator.choose import choose_driven
-    from generator.driven import (
+    from lindstedt.choose import choose_driven
+    from lindstedt.driven import (
         Drive,
         amplitudes,
         first_order_branches,
         harmonic_balance,
         mu_expansion,
     )
-    from generator.numerics import shoot
+    from lindstedt.numerics import shoot
 
     c = choose_driven("response", 1e-6, 0.1, 0.3, 20.0, 0.5, 1.0)
     assert c.max_error <= 1e-6 and c.verified_on >= 20
@@ -247,18 +244,17 @@ def test_choose_response_over_a_range_holds_between_the_points():
                          (["--omega-min", "2", "--omega-max", "1"], "reversed"),
                          (["--omega", "1", "--tol", "1e-17"], "best reachable"),
                          (["--omega", "-1"], "must be > 0")):
-        bad = subprocess.run([sys.executable, "-m", "generator", "choose", "response", "--eps",
+        bad = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "response", "--eps",
                               "0.1", "--force", "1", *args], capture_output=True, text=True,
                              check=False)
         assert bad.returncode == 2 and needle in bad.stderr, bad.stderr
 
 
 def test_choose_q_against_jacobi_cn():
+    from lindstedt.choose import choose_solution
+    from lindstedt.lindstedt import derive
+    from lindstedt.models import duffing
     from scipy.special import ellipj
-
-    from generator.choose import choose_solution
-    from generator.lindstedt import derive
-    from generator.models import duffing
 
     c = choose_solution(1e-8, 0.0, 0.3)
     assert c.method == "lindstedt" and c.max_error <= 1e-8
@@ -283,7 +279,7 @@ def test_choose_q_against_jacobi_cn():
 def test_exact_fourier_series_of_the_solution(x):
     """The nome series against mpmath's cn (any m < 1): double precision with enough
     harmonics, on a softening spring next to the separatrix too."""
-    from generator.choose import cn_fourier
+    from lindstedt.choose import cn_fourier
 
     t = np.linspace(0.0, 15.0, 61)
     m = x / (2 * (1 + x))
@@ -298,7 +294,7 @@ def test_exact_fourier_series_of_the_solution(x):
 def test_choose_q_for_a_softening_spring_beyond_the_series():
     """On [−0.95, 0] the L–P series cannot reach 1e-10 and SciPy's cn does not take m < 0:
     the exact Fourier series does, and the choice holds off the verification grid."""
-    from generator.choose import choose_solution, cn_fourier
+    from lindstedt.choose import choose_solution, cn_fourier
 
     c = choose_solution(1e-10, -0.95, 0.0)
     assert c.method == "fourier" and c.max_error <= 1e-10
@@ -314,9 +310,9 @@ def test_choose_q_for_a_softening_spring_beyond_the_series():
 def test_choose_q_emits_the_exact_fourier_module(tmp_path):
     """`choose q --emit` on a softening range writes fourier.py: its q and q_into match mpmath's
     cn off the grid, its omega is 2π/T with T = 4K(m)/√(1+x) (mpmath), NaN past the separatrix."""
-    from generator.emit import load_generated
+    from lindstedt.emit import load_generated
 
-    run = subprocess.run([sys.executable, "-m", "generator", "choose", "q", "--tol", "1e-10",
+    run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "q", "--tol", "1e-10",
                           "--x-min", "-0.95", "--x-max", "0", "--emit", str(tmp_path), "--json"],
                          capture_output=True, text=True, check=False)
     data = json.loads(run.stdout)
@@ -340,10 +336,10 @@ def test_choose_q_emits_the_exact_fourier_module(tmp_path):
 def test_choose_emits_the_driven_module_it_verified(tmp_path):
     """With --emit only emittable methods compete, ranked by their emitted modules' measured
     cost: undamped, the compiled μ-expansion; its A₁ off the grid agrees with shooting."""
-    from generator.emit import load_generated
-    from generator.numerics import shoot
+    from lindstedt.emit import load_generated
+    from lindstedt.numerics import shoot
 
-    run = subprocess.run([sys.executable, "-m", "generator", "choose", "response", "--eps", "0.1",
+    run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "response", "--eps", "0.1",
                           "--force", "1", "--omega-min", "0.8", "--omega-max", "1.2", "--tol",
                           "1e-4", "--emit", str(tmp_path), "--json"],
                          capture_output=True, text=True, check=False)

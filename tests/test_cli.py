@@ -13,7 +13,7 @@ from reference import duffing_period, pendulum_period, reciprocal
 
 def run(*args):
     return subprocess.run(
-        [sys.executable, "-m", "generator", *args], capture_output=True, text=True, check=False
+        [sys.executable, "-m", "lindstedt", *args], capture_output=True, text=True, check=False
     )
 
 

@@ -11,8 +11,7 @@ import sys
 import numpy as np
 import pytest
 import sympy as sp
-
-from generator.driven import (
+from lindstedt.driven import (
     Drive,
     amplitudes,
     first_order_branches,
@@ -20,8 +19,8 @@ from generator.driven import (
     harmonic_balance,
     mu_expansion,
 )
-from generator.errors import InputError
-from generator.numerics import shoot
+from lindstedt.errors import InputError
+from lindstedt.numerics import shoot
 
 NOTES = Drive(eps=0.1, force=1.0, omega=1.0)
 
@@ -132,7 +131,7 @@ def test_bad_drive(kwargs):
 
 def test_driven_contract():
     out = subprocess.run(
-        [sys.executable, "-m", "generator", "driven", "--eps", "0.1", "--force", "0.3",
+        [sys.executable, "-m", "lindstedt", "driven", "--eps", "0.1", "--force", "0.3",
          "--omega", "1.3", "--Q", "20", "--order", "3", "--harmonics", "5", "--json"],
         capture_output=True, text=True, check=False)
     assert out.returncode == 0, out.stderr
@@ -147,7 +146,7 @@ def test_driven_contract():
         num = br["numerical"]
         assert set(num) >= {"A", "floquet_moduli", "stable"}
         assert abs(num["A"]["1"] - br["harmonic_balance"]["A"]["1"]) < 1e-9
-    bad = subprocess.run([sys.executable, "-m", "generator", "driven", "--eps", "0.1",
+    bad = subprocess.run([sys.executable, "-m", "lindstedt", "driven", "--eps", "0.1",
                           "--force", "1", "--omega", "1", "--Q", "0"],
                          capture_output=True, text=True, check=False)
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1

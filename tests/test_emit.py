@@ -13,31 +13,30 @@ import mpmath
 import numpy as np
 import pytest
 import sympy as sp
-from scipy.special import ellipj, ellipk
-
-from generator.cli import BALANCE_HARMONICS, DRIVEN_ORDER
-from generator.driven import (
+from lindstedt.cli import BALANCE_HARMONICS, DRIVEN_ORDER
+from lindstedt.driven import (
     Drive,
     amplitudes,
     first_order_branches,
     harmonic_balance,
     mu_expansion,
 )
-from generator.emit import (
-    TEMPLATES,
+from lindstedt.emit import (
     environment,
     generate,
     generate_balance,
     generate_driven,
     latex_context,
     render_module,
+    template_folder,
 )
-from generator.emit import load_generated as load
-from generator.errors import InputError
-from generator.lindstedt import derive, omega_coefficients, period_series, solution_expression
-from generator.lower import lower_free
-from generator.models import A, duffing, eps, pendulum, t, theta0
-from generator.printers import identifier, latex_rational, pycode
+from lindstedt.emit import load_generated as load
+from lindstedt.errors import InputError
+from lindstedt.lindstedt import derive, omega_coefficients, period_series, solution_expression
+from lindstedt.lower import lower_free
+from lindstedt.models import A, duffing, eps, pendulum, t, theta0
+from lindstedt.printers import identifier, latex_rational, pycode
+from scipy.special import ellipj, ellipk
 
 ROOT = Path(__file__).resolve().parent.parent
 GENERATED = ROOT / "generated"
@@ -87,7 +86,8 @@ def test_templates_get_exactly_the_variables_they_use():
         ("derivation.tex.j2", environment(True), latex_ctx),
         ("mu_derivation.tex.j2", environment(True), {"banner", "order", "orders", "table"}),
     ]:
-        used = jinja2.meta.find_undeclared_variables(env.parse((TEMPLATES / name).read_text()))
+        source = (template_folder() / name).read_text()
+        used = jinja2.meta.find_undeclared_variables(env.parse(source))
         assert used <= ctx, (name, used - ctx)
         if name == "module.py.j2":
             assert used == ctx
@@ -304,7 +304,7 @@ def test_refuses_to_overwrite_foreign_file(tmp_path):
 
 
 def run_cli(*args):
-    return subprocess.run([sys.executable, "-m", "generator", *args],
+    return subprocess.run([sys.executable, "-m", "lindstedt", *args],
                           capture_output=True, text=True, check=False)
 
 

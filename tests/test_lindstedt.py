@@ -6,10 +6,8 @@ from fractions import Fraction
 
 import pytest
 import sympy as sp
-from reference import duffing_period, pendulum_period, reciprocal
-
-from generator.errors import InputError
-from generator.lindstedt import (
+from lindstedt.errors import InputError
+from lindstedt.lindstedt import (
     derive,
     naive_expansion,
     naive_expression,
@@ -18,7 +16,8 @@ from generator.lindstedt import (
     period_series,
     q_expression,
 )
-from generator.models import A, duffing, eps, pendulum, polynomial, t
+from lindstedt.models import A, duffing, eps, pendulum, polynomial, t
+from reference import duffing_period, pendulum_period, reciprocal
 
 
 def fractions(sol, key):

@@ -8,10 +8,9 @@ import sys
 
 import numpy as np
 import pytest
-
-from generator.driven import Drive
-from generator.numerics import orbit_fold, shoot, sweep
-from generator.response import (
+from lindstedt.driven import Drive
+from lindstedt.numerics import orbit_fold, shoot, sweep
+from lindstedt.response import (
     amplitude_residual,
     amplitude_slope,
     continue_balance,
@@ -90,7 +89,7 @@ def test_sweep_jumps_near_the_folds():
 
 
 def test_response_contract_and_bad_input():
-    out = subprocess.run([sys.executable, "-m", "generator", "response", "--eps", "0.1",
+    out = subprocess.run([sys.executable, "-m", "lindstedt", "response", "--eps", "0.1",
                           "--force", "0.3", "--Q", "20", "--harmonics", "4", "--json"],
                          capture_output=True, text=True, check=False)
     assert out.returncode == 0, out.stderr
@@ -100,7 +99,7 @@ def test_response_contract_and_bad_input():
     assert len(data["numerical"]["folds"]) == 2
     assert {"sweep_up_jump", "sweep_down_jump"} <= data["numerical"].keys()
     for bad in (["--Q", "inf"], ["--Q", "0"], ["--Q", "nan"]):
-        run = subprocess.run([sys.executable, "-m", "generator", "response", "--eps", "0.1",
+        run = subprocess.run([sys.executable, "-m", "lindstedt", "response", "--eps", "0.1",
                               "--force", "0.3", *bad], capture_output=True, text=True,
                              check=False)
         assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1
@@ -108,7 +107,7 @@ def test_response_contract_and_bad_input():
 
 @pytest.mark.parametrize("omega", [np.array([0.0]), np.array([np.nan])])
 def test_curve_bad_frequency(omega):
-    from generator.errors import InputError
+    from lindstedt.errors import InputError
 
     with pytest.raises(InputError):
         one_harmonic_curve(EPS, F, Q, omega)
@@ -118,8 +117,7 @@ def test_curve_bad_frequency(omega):
 
 def test_subharmonic_secular_conditions_are_the_notes():
     import sympy as sp
-
-    from generator.response import subharmonic_secular
+    from lindstedt.response import subharmonic_secular
 
     a, b, F, w, e = sp.symbols("a b F omega epsilon")
     cos_eq, sin_eq = subharmonic_secular()
@@ -141,7 +139,7 @@ def test_subharmonic_secular_conditions_are_the_notes():
 
 
 def test_subharmonic_against_true_orbit():
-    from generator.response import subharmonic
+    from lindstedt.response import subharmonic
 
     exists, _, sols = subharmonic(0.1, 0.5, 1.2)
     assert exists and [s.root for s in sols] == ["+", "-"]
@@ -157,8 +155,8 @@ def test_subharmonic_against_true_orbit():
 def test_hill_verdict_fails_for_the_negative_root_at_small_eps(monkeypatch):
     """Reported in the README: the Hill test with q₀ calls the negative root stable here, the
     true orbit's multipliers (at two step sizes) say unstable."""
-    import generator.numerics as numerics
-    from generator.response import subharmonic
+    import lindstedt.numerics as numerics
+    from lindstedt.response import subharmonic
 
     _, _, sols = subharmonic(0.05, 0.5, 1.3)
     minus = sols[1]
@@ -171,7 +169,7 @@ def test_hill_verdict_fails_for_the_negative_root_at_small_eps(monkeypatch):
 
 
 def test_subharmonic_does_not_exist_and_says_why():
-    out = subprocess.run([sys.executable, "-m", "generator", "subharmonic", "--eps", "0.1",
+    out = subprocess.run([sys.executable, "-m", "lindstedt", "subharmonic", "--eps", "0.1",
                           "--force", "0.5", "--omega", "0.9", "--json"],
                          capture_output=True, text=True, check=False)
     data = json.loads(out.stdout)
@@ -181,7 +179,7 @@ def test_subharmonic_does_not_exist_and_says_why():
 # --- frequency mixing -------------------------------------------------------------------------
 
 def test_cubic_mixing_makes_three_fold_combinations_not_sums():
-    from generator.response import mixing_tones, tone_label
+    from lindstedt.response import mixing_tones, tone_label
 
     tones = mixing_tones(0.1, 10.0, [(0.3, 1.3), (0.3, 1.7)])
     first = {tone_label(t.combination) for t in tones if t.order <= 1}
@@ -192,7 +190,7 @@ def test_cubic_mixing_makes_three_fold_combinations_not_sums():
 
 
 def test_mixing_amplitudes_against_simulated_spectrum():
-    out = subprocess.run([sys.executable, "-m", "generator", "mixing", "--eps", "0.1", "--Q",
+    out = subprocess.run([sys.executable, "-m", "lindstedt", "mixing", "--eps", "0.1", "--Q",
                           "10", "--drive", "0.3@1.3", "--drive", "0.3@1.7", "--json"],
                          capture_output=True, text=True, check=False)
     assert out.returncode == 0, out.stderr

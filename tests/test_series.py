@@ -6,8 +6,7 @@ from fractions import Fraction
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
-from generator.series import Basis, Ground, from_fourier, solve_oscillator, to_fourier
+from lindstedt.series import Basis, Ground, from_fourier, solve_oscillator, to_fourier
 
 QQ = Ground.for_coefficients([])
 rationals = st.builds(Fraction, st.integers(-99, 99).filter(bool), st.integers(1, 50))
