@@ -44,6 +44,7 @@ from numba import njit
 from scipy.integrate import solve_ivp
 from scipy.special import ellipj, ellipk
 
+from .display import html_table
 from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
 from .emit import generate, generate_balance, generate_driven, load_generated
 from .errors import InputError
@@ -283,6 +284,21 @@ class Choice:
     ns_per_point: float
     verified_on: int
     considered: tuple[tuple[str, int, float, float], ...]  # per method: order, error, ns
+
+    def _repr_html_(self) -> str:
+        return choice_table(self, "choose_period: T/2π, max relative error")
+
+
+def choice_table(c: Choice | DrivenChoice | SolutionChoice, what: str) -> str:
+    """The methods a choice considered (each at its smallest sufficient order), the chosen one
+    marked: the HTML of every choice record in Jupyter."""
+    chosen = next((i for i, (m, o, _, _) in enumerate(c.considered)
+                   if m.removesuffix(", emitted") == c.method and o == c.order), None)
+    return html_table(
+        f"{what}: {c.method} order {c.order}, error {c.max_error:.1e}, "
+        f"{c.ns_per_point:.3g} ns/point, verified on {c.verified_on} points",
+        ("method", "order", "max error", "ns/point"),
+        [(m, o, f"{e:.1e}", f"{ns:.3g}") for m, o, e, ns in c.considered], marked=chosen)
 
 
 def choose_period(tol: float, x_min: float, x_max: float) -> Choice:
@@ -662,6 +678,9 @@ class DrivenChoice:
     # meets the tolerance, its error, its ns per point
     truth: DrivenTruth
 
+    def _repr_html_(self) -> str:
+        return choice_table(self, f"choose_driven: {self.quantity}, max error")
+
 
 def choose_driven(quantity: str, tol: float, eps: float, force: float, Q: float,
                   omega_min: float, omega_max: float | None = None,
@@ -750,6 +769,9 @@ class SolutionChoice:
     ns_per_point: float
     verified_on: int
     considered: tuple[tuple[str, int, float, float], ...] = ()  # method, order, error, ns
+
+    def _repr_html_(self) -> str:
+        return choice_table(self, "choose_solution: q(t)/A, max error")
 
 
 def _exact_q(t: np.ndarray, x: float) -> np.ndarray:

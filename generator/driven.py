@@ -24,6 +24,7 @@ import numpy as np
 import sympy as sp
 from sympy.polys.domains import QQ
 
+from .display import SHOWN_ROWS, harmonics_table, html_table
 from .errors import InputError
 from .series import Basis, Ground, solve_oscillator, to_fourier
 
@@ -101,6 +102,10 @@ class Branch:
     A1: float
     delta0: float
 
+    def _repr_html_(self) -> str:
+        return html_table("first-order branch: q₀ = A₁ cos τ, τ = ωt − δ₀", ("A₁", "δ₀"),
+                          [(self.A1, self.delta0)])
+
 
 def first_order_branches(d: Drive) -> list[Branch]:
     """All real roots of the secular conditions at order 1, largest ``A₁`` first.
@@ -162,6 +167,21 @@ class MuExpansion:
     def partial(self, j: int) -> tuple[np.ndarray, float]:
         """Coefficients of ``q₀ + … + q_j`` and the phase ``δ₀ + … + δ_j``."""
         return sum(self.coefficients[: j + 1]), sum(self.deltas[: j + 1])
+
+    def _repr_html_(self) -> str:
+        """``A_n`` (and ``B_n`` when damped) of ``q₀ + … + q_j`` per order, the last orders."""
+        K = len(self.coefficients)
+        rows = [(j, *amplitudes(*self.partial(j), 2 * j + 1)) for j in range(K)]
+        damped = any(abs(b) > 1e-14 for _, _, B in rows for b in B.values())
+        heads = [f"A{n}" for n in (1, 3, 5)] + [f"B{n}" for n in (1, 3, 5) if damped]
+        table = [(j, *(A.get(n) for n in (1, 3, 5)),
+                  *(B.get(n) for n in (1, 3, 5) if damped), self.partial(j)[1])
+                 for j, A, B in rows[-SHOWN_ROWS:]]
+        verdict = "converged" if self.converged else "NOT converged"
+        skipped = f"orders 0–{K - SHOWN_ROWS - 1} not shown; " if K > SHOWN_ROWS else ""
+        return html_table(f"μ-expansion on the branch A₁ = {self.branch.A1:.6g} "
+                          "(order j: q₀ + … + q_j)", ("order", *heads, "δ"), table,
+                          note=f"{skipped}{verdict}: {self.reason}")
 
 
 def _forcing(d: Drive, q: list, cubes: list, E: list, delta0: float, j: int) -> np.ndarray:
@@ -253,6 +273,12 @@ class HarmonicBalance:
     coefficients: np.ndarray  # c_n of e^{inωt}, index n + M
     residual: float
     converged: bool
+
+    def _repr_html_(self) -> str:
+        A, B = amplitudes(self.coefficients, 0.0, 2 * self.harmonics - 1)
+        return harmonics_table(f"harmonic balance, N = {self.harmonics} odd harmonics", A, B,
+                               f"residual {self.residual:.1e}, "
+                               f"{'converged' if self.converged else 'NOT converged'}")
 
 
 @dataclass(frozen=True)

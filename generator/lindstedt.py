@@ -20,6 +20,7 @@ from typing import Any
 
 import sympy as sp
 
+from .display import SHOWN_ORDERS, latex_aligned, latex_sum, latex_text, more
 from .models import Model, check_order, t
 from .series import Basis, Ground, solve_oscillator, to_fourier
 
@@ -43,6 +44,36 @@ class SeriesSolution:
     q: tuple[dict[int, Any], ...]
     forcing: tuple  # F_j without its W_j cos s term, in the kernel's basis (display only)
     convention: str = CONVENTION
+
+    def _repr_latex_(self) -> str:
+        """ω, T/2π and the first q_j in y (Jupyter), the first orders only."""
+        m, g = self.model, self.ground.to_sympy
+        shown = min(self.order, SHOWN_ORDERS)
+        tail = (r" + \cdots" if shown < self.order else "") + f" + O(y^{{{self.order + 1}}})"
+
+        def series(coeffs: tuple) -> str:
+            return latex_sum((g(c), _power("y", j)) for j, c in enumerate(coeffs[: shown + 1]))
+
+        amp, coord = sp.latex(m.amplitude), sp.latex(m.coordinate)
+        lines = [rf"&{m.latex}, \qquad y = {sp.latex(m.y)}, \quad {latex_text('order')}\ "
+                 rf"{self.order}",
+                 rf"\omega &= {series(self.omega)}{tail}",
+                 rf"\frac{{T}}{{2\pi}} &= {series(self.period)}{tail}",
+                 rf"{coord} &= {amp} \sum_{{j}} y^{{j}} q_j(s), \quad s = \omega t"]
+        lines += [rf"q_{{{j}}}(s) &= "
+                  + latex_sum((g(c), _cosine(n)) for n, c in sorted(self.q[j].items()))
+                  for j in range(shown + 1)]
+        if shown < self.order:
+            lines.append("&" + latex_text(more(self.order, shown)))
+        return latex_aligned(lines)
+
+
+def _power(var: str, j: int) -> str:
+    return "" if j == 0 else var if j == 1 else f"{var}^{{{j}}}"
+
+
+def _cosine(n: int) -> str:
+    return "" if n == 0 else r"\cos s" if n == 1 else rf"\cos {n}s"
 
 
 def derive(model: Model, order: int) -> SeriesSolution:
@@ -220,6 +251,13 @@ class OrderEquation:
     secular_condition: sp.Eq  # [cos s] F_j = 0
     omega: sp.Eq  # ω_j = … (the secular condition solved)
     solution: sp.Eq  # q_j(s) = …
+
+    def _repr_latex_(self) -> str:
+        """The four equations of order j, aligned (Jupyter)."""
+        labels = ("equation", "secular condition", "solved", "solution")
+        eqs = (self.equation, self.secular_condition, self.omega, self.solution)
+        return latex_aligned(f"{latex_text(k)}: &\\ {sp.latex(e)}"
+                             for k, e in zip(labels, eqs, strict=True))
 
 
 def order_equation(solution: SeriesSolution, j: int) -> OrderEquation:

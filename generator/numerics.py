@@ -10,6 +10,8 @@ from numba import njit
 from numpy.typing import ArrayLike
 from scipy.special import ellipj, ellipk
 
+from .display import harmonics_table
+
 
 def duffing_period_exact(A: ArrayLike, eps: ArrayLike) -> np.ndarray:
     """``T = 4K(m)/√(1+x)``, ``m = x/(2(1+x))``, ``x = εA²`` (notes App. 4.9); NaN for x ≤ -1.
@@ -112,6 +114,14 @@ class PeriodicOrbit:
     multipliers: np.ndarray
     stable: bool
     residual: float
+
+    def _repr_html_(self) -> str:
+        moduli = ", ".join(f"{abs(m):.6g}" for m in self.multipliers)
+        return harmonics_table(
+            f"periodic orbit by shooting: q(0) = {self.initial[0]:.6g}, "
+            f"q̇(0) = {self.initial[1]:.6g}", self.A, self.B,
+            f"Floquet |λ| = {moduli}: {'stable' if self.stable else 'unstable'}; "
+            f"residual {self.residual:.1e}")
 
 
 def shoot(eps: float, force: float, omega: float, damping: float, guess: np.ndarray,
