@@ -5,7 +5,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test tex lint bench clean
+.PHONY: demo test tex lint bench figures generated clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -21,8 +21,9 @@ tex:
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends \
 	    texlive-latex-base texlive-latex-recommended texlive-latex-extra >/dev/null; }
 
+# Writes only under out/ (ignored by git): the checkout stays clean.
 demo: $(STAMP) tex
-	$(BIN)/lindstedt demo
+	$(BIN)/lindstedt demo --out out
 
 test: $(STAMP) tex
 	$(BIN)/ruff check generator tests benchmarks
@@ -37,6 +38,17 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/speed_accuracy.py
 	$(BIN)/python benchmarks/q_speed_accuracy.py
 	$(BIN)/python benchmarks/driven_speed_accuracy.py
+
+# The committed copies: docs/figures (the README's computed figures, byte-identical run to run)
+# and generated/ (the default evaluators and LaTeX).
+figures: $(STAMP)
+	$(BIN)/python -c "from lindstedt.charts import gallery; gallery('docs/figures')"
+
+generated: $(STAMP)
+	$(BIN)/lindstedt generate duffing --order 12 --out generated
+	$(BIN)/lindstedt generate pendulum --order 12 --out generated
+	$(BIN)/lindstedt generate driven --order 3 --out generated
+	$(BIN)/lindstedt generate balance --harmonics 4 --out generated
 
 clean:
 	rm -rf $(VENV) out .pytest_cache
