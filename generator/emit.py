@@ -202,7 +202,8 @@ def latex_context(solution: SeriesSolution, order: int) -> dict:
         secular = _signed(t.resonant, scale, first=True) + f" + 2{amp}\\,\\omega_{{{j}}}"
         orders.append({
             "j": j,
-            "forcing": [f"\\bigl({secular}\\bigr)\\cos s",
+            # \left(: the resonant coefficient can be a fraction of many stacked lines
+            "forcing": [f"\\left({secular}\\right)\\cos s",
                         *_harmonic_terms(t.forcing, scale, leading=False)],
             "secular": secular,
             "omega": _signed(t.omega, latex_expr(m.order_factor**j), first=True),

@@ -5,7 +5,9 @@ Templates never see a SymPy object: everything reaches them through these functi
 
 from __future__ import annotations
 
+import itertools
 import keyword
+import math
 
 import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
@@ -61,28 +63,43 @@ def pycode(expr: sp.Basic, simd: bool = False) -> str:
     return (SimdPrinter if simd else NumbaPrinter)({"fully_qualified_modules": True}).doprint(expr)
 
 
-LATEX_FRAC_DIGITS = 30
-# NOTE: a \frac wider than ~30 digits no longer fits a line; longer numbers wrap via seqsplit.
+LATEX_LINE_DIGITS = 30
+# NOTE: 30 digits in groups of 3 set ~181pt wide at 11pt; with a minus sign they fit the tables'
+# 0.42\linewidth columns (~203pt with 2cm margins), so longer integers go on several lines.
 
 
-def latex_rational(r: sp.Rational, wrap: bool = True) -> str:
-    """An exact rational for LaTeX: ``\\frac`` when it fits a line, else a wrapping digit run.
+def latex_digits(n: int) -> str:
+    r"""A non-negative integer in groups of 3 digits (thin spaces); longer than
+    ``LATEX_LINE_DIGITS``, it is stacked in right-aligned lines broken only between groups,
+    the lines differing by at most one group.
+
+    >>> latex_digits(57594037927936)
+    '57\\,594\\,037\\,927\\,936'
+    """
+    text = str(n)
+    if len(text) <= 4:
+        return text  # four digits read at a glance (siunitx's default minimum for grouping)
+    head = len(text) % 3 or 3
+    groups = [text[:head], *(text[i:i + 3] for i in range(head, len(text), 3))]
+    lines = math.ceil(len(groups) / (LATEX_LINE_DIGITS // 3))
+    if lines == 1:
+        return r"\,".join(groups)
+    cuts = [i * len(groups) // lines for i in range(lines + 1)]
+    rows = [r"\,".join(groups[a:b]) for a, b in itertools.pairwise(cuts)]
+    # right-aligned, so the groups of every line stand in columns under one another
+    return r"\begin{array}{@{}r@{}}" + r"\\".join(rows) + r"\end{array}"
+
+
+def latex_rational(r: sp.Rational) -> str:
+    """An exact rational for LaTeX math: ``\\frac`` of grouped digits (:func:`latex_digits`).
 
     >>> latex_rational(sp.Rational(-21, 256))
     '-\\\\frac{21}{256}'
     """
     r = sp.Rational(r)
-    p, q = int(r.p), int(r.q)
-    sign = "-" if p < 0 else ""
-    p = abs(p)
-    if q == 1:
-        body = str(p)
-        if len(body) <= LATEX_FRAC_DIGITS or not wrap:
-            return f"{sign}{body}"
-    elif len(str(p)) + len(str(q)) <= LATEX_FRAC_DIGITS or not wrap:
-        return f"{sign}\\frac{{{p}}}{{{q}}}"
-    text = f"{p}/{q}" if q != 1 else str(p)
-    return f"{sign}\\parbox[t]{{0.5\\linewidth}}{{\\raggedright\\seqsplit{{{text}}}}}"
+    sign = "-" if r < 0 else ""
+    p, q = latex_digits(abs(int(r.p))), latex_digits(int(r.q))
+    return sign + (p if q == "1" else rf"\frac{{{p}}}{{{q}}}")
 
 
 def latex_expr(expr: sp.Basic) -> str:
