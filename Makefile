@@ -19,7 +19,7 @@ tex:
 	  SUDO=$$( [ "$$(id -u)" -eq 0 ] || echo sudo ); \
 	  $$SUDO apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends \
-	    texlive-latex-base texlive-latex-recommended texlive-latex-extra >/dev/null; }
+	    texlive-latex-base texlive-latex-recommended >/dev/null; }
 
 # Writes only under out/ (ignored by git): the checkout stays clean.
 demo: $(STAMP) tex

@@ -164,6 +164,25 @@ def mixing_figure(eps: float, Q: float, drives: list[tuple[float, float]], path:
     return _save(fig, path)
 
 
+GALLERY = (
+    ("response.png", lambda path: response_figure(0.1, 0.3, 20.0, 8, path)),
+    ("subharmonic.png", lambda path: subharmonic_figure(0.1, 0.5, path)),
+    ("mixing.png", lambda path: mixing_figure(0.1, 10.0, [(0.3, 1.3), (0.3, 1.7)], path)),
+    ("validity.png", lambda path: validity_figure(path)),
+    ("driven_validity.png", lambda path: driven_validity_figure(path)),
+)
+# NOTE: the figures the README shows whose content is pure computation (no measured time):
+# the demo draws them into its --out, `make figures` into docs/figures, byte-identical each run.
+
+
+def gallery(folder: Path) -> list[Path]:
+    """Draw every figure of :data:`GALLERY` into ``folder`` (created if missing)."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, _ in GALLERY:
+        check_plot_path(folder / name)
+    return [draw(folder / name) for name, draw in GALLERY]
+
 CHART_X = (0.1, 0.5, 0.9, 5.0, 100.0)
 # NOTE: representative εA²: weak, moderate, near the L–P radius, strong, very strong springs.
 FLOOR = 1e-17

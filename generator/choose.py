@@ -52,6 +52,14 @@ from .lindstedt import derive
 from .models import duffing, pendulum
 from .numerics import duffing_period_exact, shoot
 
+Progress = Callable[[int, int], None]
+# NOTE: ``progress(done, total)`` lets the command line draw a bar over the long loops.
+
+
+def quiet(done: int, total: int) -> None:
+    """The default progress report: none."""
+
+
 MAX_ORDER = 60
 # NOTE: order 60 of the exact series takes ~0.1 s and reaches 1e-16 wherever |x| ≤ 0.5.
 AGM_STEPS = 8
@@ -301,8 +309,10 @@ def choice_table(c: Choice | DrivenChoice | SolutionChoice, what: str) -> str:
         [(m, o, f"{e:.1e}", f"{ns:.3g}") for m, o, e, ns in c.considered], marked=chosen)
 
 
-def choose_period(tol: float, x_min: float, x_max: float) -> Choice:
-    """The cheapest method whose verified relative error on ``[x_min, x_max]`` is ≤ ``tol``."""
+def choose_period(tol: float, x_min: float, x_max: float,
+                  progress: Progress = quiet) -> Choice:
+    """The cheapest method whose verified relative error on ``[x_min, x_max]`` is ≤ ``tol``
+    (``progress(done, total)`` follows the timing of the candidates)."""
     for name, v in (("tol", tol), ("x-min", x_min), ("x-max", x_max)):
         if not np.isfinite(v):
             raise InputError(f"{name} {v}: not finite")
@@ -330,8 +340,10 @@ def choose_period(tol: float, x_min: float, x_max: float) -> Choice:
     if not best_per_method:
         raise InputError(f"tol {tol:g}: no method reaches it on [{x_min}, {x_max}]; the best "
                          f"reachable is {best_error:.1e}")
-    timed = [(c, err, ns_per_point(c, x_min=x_min, x_max=x_max))
-             for c, err in best_per_method.values()]
+    timed = []
+    for i, (c, err) in enumerate(best_per_method.values()):
+        progress(i, len(best_per_method))
+        timed.append((c, err, ns_per_point(c, x_min=x_min, x_max=x_max)))
     c, err, ns = cheapest(timed, lambda t: t[2], lambda t: t[0].method)
     return Choice(c.method, c.order, err, ns, len(x),
                   tuple((t[0].method, t[0].order, t[1], t[2]) for t in timed))
@@ -520,10 +532,12 @@ class DrivenTruth:
         return np.hypot(self.A[:, 0], self.B[:, 0])
 
 
-def driven_truth(eps: float, force: float, Q: float, omegas: np.ndarray) -> DrivenTruth:
+def driven_truth(eps: float, force: float, Q: float, omegas: np.ndarray,
+                 progress: Progress = quiet) -> DrivenTruth:
     """Shooting from harmonic balance with 12 harmonics on the largest first-order branch."""
     A, B = [], []
-    for w in omegas:
+    for i, w in enumerate(omegas):
+        progress(i, len(omegas))
         d = Drive(eps, force, float(w), Q)
         hb = harmonic_balance(d, first_order_branches(d)[0], DRIVEN_MAX)
         a, b = amplitudes(hb.coefficients, 0.0, 4 * DRIVEN_MAX)
@@ -684,7 +698,7 @@ class DrivenChoice:
 
 def choose_driven(quantity: str, tol: float, eps: float, force: float, Q: float,
                   omega_min: float, omega_max: float | None = None,
-                  emit_order: int | None = None) -> DrivenChoice:
+                  emit_order: int | None = None, progress: Progress = quiet) -> DrivenChoice:
     """The cheapest of one harmonic, the μ-expansion (smallest order), harmonic balance
     (fewest harmonics) and shooting (fewest RK4 steps) whose error in ``quantity`` is
     ≤ ``tol`` at every verified ω of ``[omega_min, omega_max]`` (one ω when ``omega_max`` is
@@ -704,7 +718,7 @@ def choose_driven(quantity: str, tol: float, eps: float, force: float, Q: float,
         omegas = verification_points(omega_min, omega_max, DRIVEN_POINTS)
     else:
         raise InputError(f"range [{omega_min}, {omega_max}]: empty or reversed")
-    truth = driven_truth(eps, force, Q, omegas)
+    truth = driven_truth(eps, force, Q, omegas, progress)
     best: dict[str, tuple[DrivenTradeoff, float]] = {}
     reachable = np.inf
     for t in driven_tradeoffs(truth, eps, force, Q):
@@ -853,7 +867,8 @@ def _fourier_cost(harmonics: int, x_min: float, x_max: float) -> float:
 
 
 def choose_solution(tol: float, x_min: float, x_max: float, t_max: float = 20.0,
-                    max_order: int = 30, emittable: bool = False) -> SolutionChoice:
+                    max_order: int = 30, emittable: bool = False,
+                    progress: Progress = quiet) -> SolutionChoice:
     """The cheapest of the lowest L–P order and the fewest exact Fourier harmonics whose
     q(t)/A is within ``tol`` of the exact solution for every ``x = εA² ∈ [x_min, x_max]`` and
     ``t ∈ [0, t_max]`` (and SciPy's cn when ``x ≥ 0``); ``emittable``: not SciPy's cn, which
@@ -876,6 +891,7 @@ def choose_solution(tol: float, x_min: float, x_max: float, t_max: float = 20.0,
         sol = derive(duffing(), max_order)
         g = sol.ground.to_fraction
         for k in range(max_order + 1):
+            progress(k, max_order + 1)
             err = 0.0
             for x in xs:
                 omega = sum(float(g(w)) * x**j for j, w in enumerate(sol.omega[: k + 1]))

@@ -5,74 +5,61 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import shutil
-import subprocess
+import re
 import sys
+import time
 from collections.abc import Sequence
 from pathlib import Path
 
-import numpy as np
-
 from . import __version__
-from .charts import (
-    check_plot_path,
-    driven_speed_accuracy_figure,
-    driven_validity_figure,
-    mixing_figure,
-    response_figure,
-    speed_accuracy_figure,
-    subharmonic_figure,
-    validity_figure,
-)
-from .choose import (
-    DRIVEN_QUANTITIES,
-    SCENES,
-    appendix_thresholds,
-    candidates,
-    choose_driven,
-    choose_period,
-    choose_solution,
-)
-from .driven import (
-    BalanceSystem,
-    Drive,
-    amplitudes,
-    first_order_branches,
-    harmonic_balance,
-    mu_expansion,
-)
-from .emit import (
-    check_writable,
-    generate,
-    generate_balance,
-    generate_choice,
-    generate_driven,
-    generate_fourier,
-    load_generated,
-)
 from .errors import InputError
-from .lindstedt import SeriesSolution, derive
-from .models import MODELS, check_order, model_by_name
-from .numerics import (
-    duffing_period_exact,
-    orbit_fold,
-    pendulum_period_exact,
-    shoot,
-    steady_state_amplitudes,
-    sweep,
-)
-from .response import (
-    continue_balance,
-    mixing_tones,
-    one_harmonic_folds,
-    subharmonic,
-    tone_label,
-)
 
-DEFAULT_ORDER = 12
-# NOTE: order 12 keeps T(A) within 1e-6 for |εA²| ≤ 0.3 and the LaTeX a few pages long.
+# NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
+# well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
+
+FREE_MODELS = ("duffing", "pendulum")
+# NOTE: models.MODELS, restated so that parsing arguments needs no SymPy (a test keeps them equal).
+SCENE_NAMES = ("clock", "hard-spring", "notes-driven")
+# NOTE: choose.SCENES's keys, likewise.
+DRIVEN_QUANTITIES = ("amplitudes", "response")
+# NOTE: choose.DRIVEN_QUANTITIES, likewise.
+DEFAULT_ORDER = 4
+# NOTE: one default for every --order: it works for every command (`generate driven` at order 4
+# takes ~13 s, at 6 about 4 min) and keeps T(A) within 1e-4 for |εA²| ≤ 0.3; ask for more.
+DEFAULT_HARMONICS = 8
+# NOTE: one default for every --harmonics: 8 odd harmonics put the response's folds on the true
+# orbit's to 12 digits at the notes' parameters (`generate balance` compiles them in ~20 s).
 COST_LIMIT_SECONDS = 60.0
-# NOTE: above this estimate the CLI asks for --force instead of running for minutes or hours.
+# NOTE: above this estimate the CLI asks for --allow-slow instead of running for minutes or hours.
+PROGRESS_AFTER_SECONDS = 2.0
+# NOTE: work shorter than this shows no progress bar (it would only flicker).
+
+
+class Progress:
+    """A one-line progress bar on stderr, drawn only when stderr is a terminal and the output is
+    not JSON, and only once the work has taken ``PROGRESS_AFTER_SECONDS``; call it as
+    ``progress(done, total)``, then ``progress.close()``."""
+
+    def __init__(self, label: str, enabled: bool = True) -> None:
+        self.label = label
+        self.enabled = enabled and sys.stderr.isatty()
+        self.start = time.monotonic()
+        self.drawn = False
+
+    def __call__(self, done: int, total: int) -> None:
+        if not self.enabled or time.monotonic() - self.start < PROGRESS_AFTER_SECONDS:
+            return
+        width = 30
+        filled = width * done // max(total, 1)
+        sys.stderr.write(f"\r{self.label} [{'#' * filled}{'.' * (width - filled)}] "
+                         f"{done}/{total}")
+        sys.stderr.flush()
+        self.drawn = True
+
+    def close(self) -> None:
+        if self.drawn:
+            sys.stderr.write("\r\033[K")
+            sys.stderr.flush()
 
 
 def estimated_seconds(model: str, order: int) -> float:
@@ -86,12 +73,18 @@ def estimated_seconds(model: str, order: int) -> float:
     return 13.6 * (order / 300) ** 3.5
 
 
+def _check_cost(args: argparse.Namespace, cost: float, what: str) -> None:
+    if cost > COST_LIMIT_SECONDS and not args.allow_slow:
+        raise InputError(f"order {args.order}: about {cost:,.0f} s of {what} on this machine; "
+                         "pass --allow-slow to run it")
+
+
 def _rational(c: object) -> str:
     """Exact ``"p/q"`` (always with a denominator, so scripts can split on '/')."""
     return f"{int(c.p)}/{int(c.q)}"
 
 
-def series_json(sol: SeriesSolution) -> dict:
+def series_json(sol) -> dict:
     """The contract of ``lindstedt series MODEL --order K --json`` (keys are stable)."""
     return {
         "model": sol.model.name,
@@ -105,7 +98,7 @@ def series_json(sol: SeriesSolution) -> dict:
     }
 
 
-def series_table(sol: SeriesSolution) -> str:
+def series_table(sol) -> str:
     """Readable table: ω_j, T_j/2π and the harmonics of q_j per order."""
     m = sol.model
     lines = [
@@ -122,57 +115,92 @@ def series_table(sol: SeriesSolution) -> str:
 
 
 def _cmd_series(args: argparse.Namespace) -> int:
-    order = check_order(args.order)
-    cost = estimated_seconds(args.model, order)
-    if cost > COST_LIMIT_SECONDS and not args.force:
-        raise InputError(
-            f"order {order}: about {cost:,.0f} s of derivation for {args.model} on this machine; "
-            "pass --force to run it"
-        )
-    sol = derive(model_by_name(args.model, order), order)
+    _check_cost(args, estimated_seconds(args.model, args.order), f"derivation for {args.model}")
+    from .lindstedt import derive
+    from .models import model_by_name
+
+    progress = Progress(f"deriving {args.model} to order {args.order}", not args.json)
+    sol = derive(model_by_name(args.model, args.order), args.order, progress)
+    progress.close()
     print(json.dumps(series_json(sol)) if args.json else series_table(sol))
     return 0
 
 
 def _cmd_generate(args: argparse.Namespace) -> int:
-    order = check_order(args.order)
-    cost = estimated_seconds(args.model, order + 2)
+    order = args.order
     if args.model == "driven" and order > DRIVEN_MAX_ORDER:
         raise InputError(f"order {order}: the exact μ-expansion is emitted up to order "
                          f"{DRIVEN_MAX_ORDER} (its rational functions grow fast)")
-    if cost > COST_LIMIT_SECONDS and not args.force:
-        raise InputError(f"order {order}: about {cost:,.0f} s of derivation; pass --force")
+    _check_cost(args, estimated_seconds(args.model, order + 2), "derivation")
     if args.model in ("driven", "balance", "fourier") and args.allow_divergent:
         raise InputError(f"--allow-divergent: the {args.model} evaluators have no radius to lift")
+    from . import emit
+
+    out = _out_folder(args.out)
     if args.model == "driven":
-        paths = generate_driven(order, Path(args.out))
+        paths = emit.generate_driven(order, out)
     elif args.model == "balance":
-        paths = generate_balance(args.harmonics, Path(args.out))
+        paths = emit.generate_balance(args.harmonics, out)
     elif args.model == "fourier":
-        paths = generate_fourier(args.harmonics, Path(args.out))
+        paths = emit.generate_fourier(args.harmonics, out)
     else:
-        paths = generate(args.model, order, Path(args.out), args.allow_divergent)
+        progress = Progress(f"deriving {args.model} to order {order + 2}")
+        paths = emit.generate(args.model, order, out, args.allow_divergent, progress)
+        progress.close()
     for path in paths:
         print(path)
     return 0
 
 
-DEMO_MODELS = (("duffing", DEFAULT_ORDER), ("pendulum", DEFAULT_ORDER))
+def _out_folder(text: str, flag: str = "--out") -> Path:
+    if not text.strip():
+        raise InputError(f"{flag} {text!r}: empty; name a folder")
+    return Path(text)
+
+
+DEMO_ORDER = 12
+# NOTE: the demo's free evaluators: order 12 keeps T(A) within 1e-6 for |εA²| ≤ 0.3 and the
+# LaTeX a few pages long.
 DRIVEN_ORDER = 3
 # NOTE: the exact μ-expansion's rational functions grow fast; order 3 keeps the derivation
 # readable and the emitted A_n(ω) within 1e-5 of the true orbit at the notes' parameters.
 DRIVEN_MAX_ORDER = 6
 BALANCE_HARMONICS = 4
-# NOTE: 4 odd harmonics reach 1e-7 at the notes' parameters and compile in seconds.
+# NOTE: the demo's balance module: 4 odd harmonics reach 1e-7 at the notes' parameters and
+# compile in seconds.
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
-    """The main job on the built-in defaults: derive, emit, evaluate against exact, typeset."""
+    """The main job on the built-in defaults: derive, emit, evaluate against exact, typeset.
+    Everything it writes goes under ``--out``: evaluators and LaTeX, ``figures/``, the PDFs."""
+    import shutil
+    import subprocess
+
+    import numpy as np
+
+    from .charts import (
+        check_plot_path,
+        driven_speed_accuracy_figure,
+        gallery,
+        speed_accuracy_figure,
+    )
+    from .emit import check_writable, generate, generate_balance, generate_driven, load_generated
+    from .lindstedt import derive
+    from .models import model_by_name
+    from .numerics import duffing_period_exact, pendulum_period_exact
+
+    out = _out_folder(args.out)
+    figures = out / "figures"
+    modules = ["duffing", "pendulum", "driven", "balance"]
+    check_writable(out, [*(f"{m}.py" for m in modules), "duffing_tables.tex",
+                         "duffing_derivation.tex", "pendulum_tables.tex",
+                         "pendulum_derivation.tex", "driven_derivation.tex"])
+    figures.mkdir(parents=True, exist_ok=True)
+    check_plot_path(figures / "speed_accuracy.png")
     print(series_table(derive(model_by_name("duffing", 6), 6)))
-    out = Path(args.out)
     print(f"\nwriting the default evaluators and LaTeX into {out}/")
-    for name, order in DEMO_MODELS:
-        for path in generate(name, order, out):
+    for name in ("duffing", "pendulum"):
+        for path in generate(name, DEMO_ORDER, out):
             print(f"  {path}")
     for path in [*generate_driven(DRIVEN_ORDER, out), *generate_balance(BALANCE_HARMONICS, out)]:
         print(f"  {path}")
@@ -198,35 +226,32 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     for d, ti, ei in zip(deg, pen.period(th), exact, strict=True):
         print(f"{d:>6.0f}° {ti:>20.15f} {ei:>20.15f} {abs(ti / ei - 1):>11.1e} "
               f"{86400 * abs(ti / ei - 1):>9.1e}")
-    figures = Path("docs/figures")
-    figures.mkdir(parents=True, exist_ok=True)
     print("\nfigures:")
-    for path in (response_figure(0.1, 0.3, 20.0, 8, figures / "response.png"),
-                 subharmonic_figure(0.1, 0.5, figures / "subharmonic.png"),
-                 mixing_figure(0.1, 10.0, [(0.3, 1.3), (0.3, 1.7)], figures / "mixing.png"),
-                 validity_figure(figures / "validity.png"),
-                 driven_validity_figure(figures / "driven_validity.png")):
+    for path in gallery(figures):
         print(f"  {path}")
-    pdf_dir = Path("out")
-    pdf_dir.mkdir(exist_ok=True)
-    # NOTE: measured costs differ run to run, so this chart goes to out/, not docs/figures/
-    # (benchmarks/speed_accuracy.py refreshes the committed copies the README shows).
-    print(f"  {speed_accuracy_figure(pdf_dir / 'speed_accuracy.png')}")
-    print(f"  {driven_speed_accuracy_figure(pdf_dir / 'driven_speed_accuracy.png')}")
+    # NOTE: measured costs differ run to run: these two charts are the run's own
+    # (benchmarks/*speed_accuracy.py refresh the committed copies the README shows).
+    print(f"  {speed_accuracy_figure(figures / 'speed_accuracy.png')}")
+    print(f"  {driven_speed_accuracy_figure(figures / 'driven_speed_accuracy.png')}")
     if shutil.which("pdflatex"):
         for tex in sorted(out.glob("*.tex")):
             for _ in range(2):  # longtable settles its column widths on the second pass
                 subprocess.run(["pdflatex", "-interaction=batchmode", "-halt-on-error",
-                                "-output-directory", str(pdf_dir), str(tex)],
+                                "-output-directory", str(out), str(tex)],
                                check=True, stdout=subprocess.DEVNULL)
-            print(f"  typeset {pdf_dir / tex.with_suffix('.pdf').name}")
+            print(f"  typeset {tex.with_suffix('.pdf')}")
     else:
         print("\npdflatex not found: `make demo` installs it; LaTeX sources are in", out)
     return 0
 
 
-def driven_json(d: Drive, order: int, harmonics: int) -> dict:
+def driven_json(d, order: int, harmonics: int) -> dict:
     """The contract of ``lindstedt driven … --json``: every 1:1 branch, three ways."""
+    import numpy as np
+
+    from .driven import amplitudes, first_order_branches, harmonic_balance, mu_expansion
+    from .numerics import shoot
+
     damped = d.damping > 0
     top = max(2 * harmonics - 1, 2 * order + 1)
     branches = []
@@ -294,6 +319,8 @@ def driven_table(data: dict) -> str:
 
 
 def _cmd_driven(args: argparse.Namespace) -> int:
+    from .driven import Drive
+
     d = Drive(args.eps, args.force, args.omega, args.Q)
     data = driven_json(d, args.order, args.harmonics)
     print(json.dumps(data) if args.json else driven_table(data))
@@ -302,6 +329,12 @@ def _cmd_driven(args: argparse.Namespace) -> int:
 
 def response_json(eps: float, force: float, Q: float, harmonics: int) -> dict:
     """The contract of ``lindstedt response … --json``: folds three ways, sweep jumps."""
+    import numpy as np
+
+    from .driven import BalanceSystem, Drive
+    from .numerics import orbit_fold, sweep
+    from .response import continue_balance, one_harmonic_folds
+
     d = Drive(eps, force, 1.0, Q)
     if d.damping == 0:
         raise InputError("Q inf: a response curve needs damping (finite Q) for a steady state")
@@ -333,6 +366,8 @@ def response_json(eps: float, force: float, Q: float, harmonics: int) -> dict:
 def _report(args: argparse.Namespace, compute, draw, table) -> int:
     """The shape of every effect command: check the plot path first (nothing is computed for
     a figure that cannot be written), compute, draw, print JSON or the table."""
+    from .charts import check_plot_path
+
     plot = check_plot_path(Path(args.plot)) if args.plot else None
     data = compute()
     if plot is not None:
@@ -342,6 +377,8 @@ def _report(args: argparse.Namespace, compute, draw, table) -> int:
 
 
 def _cmd_response(args: argparse.Namespace) -> int:
+    from .charts import response_figure
+
     return _report(
         args, lambda: response_json(args.eps, args.force, args.Q, args.harmonics),
         lambda path: response_figure(args.eps, args.force, args.Q, args.harmonics, path),
@@ -368,6 +405,8 @@ def _response_table(data: dict) -> list[str]:
 
 def subharmonic_json(eps: float, force: float, omega: float) -> dict:
     """The contract of ``lindstedt subharmonic … --json`` (eq. 10.83–10.87)."""
+    from .response import subharmonic
+
     exists, reason, solutions = subharmonic(eps, force, omega)
     return {
         "parameters": {"eps": eps, "force": force, "omega": omega, "drive": 3 * omega},
@@ -388,6 +427,8 @@ def subharmonic_json(eps: float, force: float, omega: float) -> dict:
 
 
 def _cmd_subharmonic(args: argparse.Namespace) -> int:
+    from .charts import subharmonic_figure
+
     return _report(args, lambda: subharmonic_json(args.eps, args.force, args.omega),
                    lambda path: subharmonic_figure(args.eps, args.force, path),
                    _subharmonic_table)
@@ -410,6 +451,9 @@ def _subharmonic_table(data: dict) -> list[str]:
 
 def mixing_json(eps: float, Q: float, drives: list[tuple[float, float]]) -> dict:
     """The contract of ``lindstedt mixing … --json``: predicted and simulated tones."""
+    from .numerics import steady_state_amplitudes
+    from .response import mixing_tones, tone_label
+
     tones = mixing_tones(eps, Q, drives)
     simulated = steady_state_amplitudes(eps, 1 / Q, [f for f, _ in drives],
                                         [w for _, w in drives], [t.frequency for t in tones])
@@ -431,6 +475,8 @@ def _drive(text: str) -> tuple[float, float]:
 
 
 def _cmd_mixing(args: argparse.Namespace) -> int:
+    from .charts import mixing_figure
+
     return _report(args, lambda: mixing_json(args.eps, args.Q, args.drive),
                    lambda path: mixing_figure(args.eps, args.Q, args.drive, path), _mixing_table)
 
@@ -473,9 +519,14 @@ def _cmd_choose(args: argparse.Namespace) -> int:
     for name in ("tol", "x_min", "x_max"):
         if getattr(args, name) is None:
             raise InputError(f"choose period needs --{name.replace('_', '-')}")
+    from .choose import candidates, choose_period
+    from .emit import check_writable, generate_choice
+
     if args.emit:
-        check_writable(Path(args.emit), ["chosen_period.py"], "--emit")
-    choice = choose_period(args.tol, args.x_min, args.x_max)
+        check_writable(_out_folder(args.emit, "--emit"), ["chosen_period.py"], "--emit")
+    progress = Progress("timing the verified methods", not args.json)
+    choice = choose_period(args.tol, args.x_min, args.x_max, progress)
+    progress.close()
     data = {"method": choice.method, "order": choice.order, "max_error": choice.max_error,
             "ns_per_point": choice.ns_per_point, "verified_on": choice.verified_on,
             "quantity": "period", "variable": "x = eps*A**2",
@@ -499,6 +550,8 @@ def _cmd_choose(args: argparse.Namespace) -> int:
 
 
 def _cmd_clock(args: argparse.Namespace) -> int:
+    from .choose import appendix_thresholds
+
     rows = [{"approximation": t.approximation, "tolerance": t.tolerance,
              "claimed_deg": t.claimed_deg, "potential_deg": t.potential_deg,
              "period_deg": t.period_deg, "holds_for_potential": t.potential_deg >= t.claimed_deg,
@@ -521,6 +574,8 @@ def _cmd_clock(args: argparse.Namespace) -> int:
 
 
 def _cmd_scene(args: argparse.Namespace) -> int:
+    from .choose import SCENES
+
     result = SCENES[args.name]()
     if args.json:
         print(json.dumps({"scene": result.scene, "question": result.question,
@@ -536,11 +591,16 @@ def _choose_q(args: argparse.Namespace) -> int:
     for name in ("tol", "x_min", "x_max"):
         if getattr(args, name) is None:
             raise InputError(f"choose q needs --{name.replace('_', '-')}")
+    from .choose import choose_solution
+    from .emit import check_writable, generate, generate_fourier
+
     if args.emit:
-        check_writable(Path(args.emit), ["duffing.py", "duffing_tables.tex",
+        check_writable(_out_folder(args.emit, "--emit"), ["duffing.py", "duffing_tables.tex",
                                          "duffing_derivation.tex", "fourier.py"], "--emit")
+    progress = Progress("verifying the L–P orders", not args.json)
     c = choose_solution(args.tol, args.x_min, args.x_max, args.t_max,
-                        emittable=bool(args.emit))
+                        emittable=bool(args.emit), progress=progress)
+    progress.close()
     data = {"quantity": "q", "method": c.method, "order": c.order, "max_error": c.max_error,
             "ns_per_point": c.ns_per_point, "verified_on": c.verified_on,
             "considered": _considered(c.considered)}
@@ -572,11 +632,16 @@ def _choose_driven(args: argparse.Namespace) -> int:
         raise InputError("give --omega or a range (--omega-min, --omega-max), not both")
     tol = args.tol or 1e-4
     lo, hi = (args.omega, None) if args.omega is not None else (args.omega_min, args.omega_max)
+    from .choose import choose_driven
+    from .emit import check_writable, generate_balance, generate_driven
+
     if args.emit:
-        check_writable(Path(args.emit), ["driven.py", "driven_derivation.tex", "balance.py"],
-                       "--emit")
+        check_writable(_out_folder(args.emit, "--emit"),
+                       ["driven.py", "driven_derivation.tex", "balance.py"], "--emit")
+    progress = Progress("shooting the true orbits", not args.json)
     c = choose_driven(args.quantity, tol, args.eps, args.force, args.Q, lo, hi,
-                      emit_order=DRIVEN_MAX_ORDER if args.emit else None)
+                      emit_order=DRIVEN_MAX_ORDER if args.emit else None, progress=progress)
+    progress.close()
     data = {"quantity": args.quantity, "method": c.method, "order": c.order,
             "max_error": c.max_error, "ns_per_point": c.ns_per_point,
             "verified_on": c.verified_on, "seconds": c.ns_per_point * 1e-9,
@@ -606,17 +671,120 @@ def _choose_driven(args: argparse.Namespace) -> int:
 
 
 def _order(text: str) -> int:
+    """An order K: a non-negative integer."""
     try:
-        return int(text)
+        value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"order {text!r}: not an integer") from None
+        raise argparse.ArgumentTypeError(f"{text!r}: not an integer") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{value}: must be ≥ 0")
+    return value
+
+
+def _count(text: str) -> int:
+    """A number of harmonics: a positive integer."""
+    value = _order(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value}: must be ≥ 1")
+    return value
+
+
+def _real(text: str) -> float:
+    """A finite real number (scientific notation and a leading minus welcome)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r}: not finite")
+    return value
+
+
+def _quality(text: str) -> float:
+    """A quality factor Q > 0; ``inf`` means undamped."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: not a number") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be > 0 (inf: undamped)")
+    return value
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with the project's one-line errors (no usage dump), exit status 2."""
+    """argparse with the project's one-line errors (no usage dump), exit status 2, and any token
+    that starts like a number (``-1e-8``, ``-.5``, ``-0.3@1.3``) taken as a value, not a flag."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
 
     def error(self, message: str) -> None:  # type: ignore[override]
         self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+class _DeprecatedForce(argparse.Action):
+    """``--force`` in series/generate: the old spelling of ``--allow-slow`` (one release)."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str, **kwargs) -> None:
+        super().__init__(option_strings, dest, nargs=0, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        print("lindstedt: note: --force here is deprecated, use --allow-slow (--force F is the "
+              "drive amplitude in driven, response, subharmonic, mixing, choose)", file=sys.stderr)
+        namespace.allow_slow = True
+
+
+# One definition per flag: the same name means the same thing, with one help text and one
+# default, in every command.
+
+def _flag_order(p: argparse.ArgumentParser, what: str) -> None:
+    p.add_argument("--order", type=_order, default=DEFAULT_ORDER, metavar="K",
+                   help=f"{what}, an integer ≥ 0 (default {DEFAULT_ORDER})")
+
+
+def _flag_harmonics(p: argparse.ArgumentParser, what: str) -> None:
+    p.add_argument("--harmonics", type=_count, default=DEFAULT_HARMONICS, metavar="N",
+                   help=f"{what}, an integer ≥ 1 (default {DEFAULT_HARMONICS})")
+
+
+def _flag_allow_slow(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--allow-slow", action="store_true",
+                   help=f"run even when the estimate exceeds {COST_LIMIT_SECONDS:.0f} s "
+                   "(default: refuse)")
+    p.add_argument("--force", action=_DeprecatedForce, dest="allow_slow",
+                   help="deprecated spelling of --allow-slow")
+
+
+def _flag_json(p: argparse.ArgumentParser, what: str = "the JSON contract") -> None:
+    p.add_argument("--json", action="store_true",
+                   help=f"print {what} on stdout instead of the table (no progress bar)")
+
+
+def _flag_plot(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--plot", metavar="FILE",
+                   help="also draw the figure into FILE (.png, .svg or .pdf; default: none)")
+
+
+def _flag_drive(p: argparse.ArgumentParser, required: bool, omega: str | None,
+                Q: str = "optional") -> None:
+    """--eps, --force, --omega, --Q of q'' + q'/Q + q + eps q^3 = f cos(w t)."""
+    need = " (required)" if required else ""
+    p.add_argument("--eps", type=_real, required=required, metavar="EPS",
+                   help=f"ε, the cubic stiffness coefficient (dimensionless; > 0 hardens, "
+                   f"< 0 softens){need}")
+    p.add_argument("--force", type=_real, required=required, metavar="F",
+                   help=f"f, the drive amplitude, in units of the linear stiffness × length "
+                   f"(q is dimensionless){need}")
+    if omega is not None:
+        p.add_argument("--omega", type=_real, required=required, metavar="W",
+                       help=f"{omega}, in units of the linear natural frequency{need}")
+    if Q == "required":
+        p.add_argument("--Q", type=_quality, required=True, metavar="Q",
+                       help="quality factor Q > 0 of the damping q'/Q (finite; required)")
+    else:
+        p.add_argument("--Q", type=_quality, default=math.inf, metavar="Q",
+                       help="quality factor Q > 0 of the damping q'/Q (default inf: undamped)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -626,101 +794,117 @@ def build_parser() -> argparse.ArgumentParser:
         "emitted as numba evaluators and LaTeX.",
     )
     parser.add_argument("--version", action="version", version=f"lindstedt {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = sub.add_parser("series", help="derive the L–P series of a free oscillator")
-    p.add_argument("model", choices=MODELS)
-    p.add_argument("--order", type=_order, default=4, help="highest order K (default 4)")
-    p.add_argument("--json", action="store_true", help="print the JSON contract")
-    p.add_argument("--force", action="store_true", help="run even when it would take minutes")
+    p = sub.add_parser("series", help="derive the L–P series of a free oscillator",
+                       description="Derive ω_j, (T/2π)_j and q_j of the L–P series exactly.")
+    p.add_argument("model", choices=FREE_MODELS, help="the oscillator")
+    _flag_order(p, "highest order K of the series")
+    _flag_json(p)
+    _flag_allow_slow(p)
     p.set_defaults(func=_cmd_series)
 
     p = sub.add_parser(
-        "generate", help="write a numba evaluator module and LaTeX tables and derivation"
-    )
-    p.add_argument("model", choices=(*MODELS, "driven", "balance", "fourier"))
-    p.add_argument("--order", type=_order, default=DEFAULT_ORDER,
-                   help=f"highest order K (default {DEFAULT_ORDER})")
-    p.add_argument("--out", default="generated", help="output folder (default generated/)")
-    p.add_argument("--latex", action="store_true",
-                   help="accepted for clarity: the LaTeX files are always written")
-    p.add_argument("--harmonics", type=_order, default=BALANCE_HARMONICS,
-                   help=f"balance, fourier: odd harmonics N (default {BALANCE_HARMONICS})")
+        "generate", help="write a numba evaluator module and LaTeX tables and derivation",
+        description="Write a numba evaluator module (and for duffing, pendulum, driven its "
+        "LaTeX tables and derivation) into --out.")
+    p.add_argument("model", choices=(*FREE_MODELS, "driven", "balance", "fourier"),
+                   help="duffing, pendulum: L–P series; driven: μ-expansion A_n(ω); balance: "
+                   "harmonic-balance Newton solver; fourier: exact Fourier series of Duffing")
+    _flag_order(p, f"highest order K (duffing, pendulum; driven up to {DRIVEN_MAX_ORDER})")
+    p.add_argument("--out", default="out", metavar="DIR",
+                   help="output folder, created if missing (default out/)")
+    _flag_harmonics(p, "balance, fourier: odd harmonics N")
     p.add_argument("--allow-divergent", action="store_true",
-                   help="evaluate beyond the radius of convergence instead of returning NaN")
-    p.add_argument("--force", action="store_true", help="run even when it would take minutes")
+                   help="evaluate beyond the radius of convergence instead of returning NaN "
+                   "(default: NaN)")
+    _flag_allow_slow(p)
     p.set_defaults(func=_cmd_generate)
 
-    p = sub.add_parser("driven", help="steady 1:1 response of the driven Duffing oscillator")
-    p.add_argument("--eps", type=float, required=True)
-    p.add_argument("--force", type=float, required=True)
-    p.add_argument("--omega", type=float, required=True)
-    p.add_argument("--Q", type=float, default=math.inf, help="quality factor (default: undamped)")
-    p.add_argument("--order", type=_order, default=4, help="μ-expansion order K (default 4)")
-    p.add_argument("--harmonics", type=_order, default=4,
-                   help="odd harmonics N of harmonic balance (default 4)")
-    p.add_argument("--json", action="store_true", help="print the JSON contract")
+    p = sub.add_parser("driven", help="steady 1:1 response of the driven Duffing oscillator",
+                       description="q'' + q'/Q + q + eps q^3 = f cos(w t): every 1:1 branch by "
+                       "the μ-expansion, harmonic balance and shooting.")
+    _flag_drive(p, required=True, omega="ω, the drive frequency")
+    _flag_order(p, "μ-expansion order K")
+    _flag_harmonics(p, "odd harmonics N of harmonic balance")
+    _flag_json(p)
     p.set_defaults(func=_cmd_driven)
 
-    p = sub.add_parser("response", help="folds and hysteresis of the damped driven oscillator")
-    p.add_argument("--eps", type=float, required=True)
-    p.add_argument("--force", type=float, required=True)
-    p.add_argument("--Q", type=float, required=True, help="quality factor (finite)")
-    p.add_argument("--harmonics", type=_order, default=8,
-                   help="odd harmonics N of the continued balance (default 8)")
-    p.add_argument("--json", action="store_true", help="print the JSON contract")
-    p.add_argument("--plot", metavar="FILE", help="also draw the figure (.png, .svg, .pdf)")
+    p = sub.add_parser("response", help="folds and hysteresis of the damped driven oscillator",
+                       description="Response curve over ω: folds three ways, sweep jumps.")
+    _flag_drive(p, required=True, omega=None, Q="required")
+    _flag_harmonics(p, "odd harmonics N of the continued balance")
+    _flag_json(p)
+    _flag_plot(p)
     p.set_defaults(func=_cmd_response)
 
-    p = sub.add_parser("subharmonic", help="the 1/3 subharmonic of eq. 10.83 and its stability")
-    p.add_argument("--eps", type=float, required=True)
-    p.add_argument("--force", type=float, required=True)
-    p.add_argument("--omega", type=float, required=True,
-                   help="omega of eq. 10.83 (the drive is at 3*omega)")
-    p.add_argument("--json", action="store_true", help="print the JSON contract")
-    p.add_argument("--plot", metavar="FILE", help="also draw the figure (.png, .svg, .pdf)")
+    p = sub.add_parser("subharmonic", help="the 1/3 subharmonic of eq. 10.83 and its stability",
+                       description="omega^2 q'' + q + eps q^3 = f cos 3τ: the 1/3 subharmonic.")
+    p.add_argument("--eps", type=_real, required=True, metavar="EPS",
+                   help="ε, the cubic stiffness coefficient (dimensionless; required)")
+    p.add_argument("--force", type=_real, required=True, metavar="F",
+                   help="f, the drive amplitude (units of the linear stiffness; required)")
+    p.add_argument("--omega", type=_real, required=True, metavar="W",
+                   help="ω of eq. 10.83, the subharmonic's frequency: the drive is at 3ω "
+                   "(units of the linear natural frequency; required)")
+    _flag_json(p)
+    _flag_plot(p)
     p.set_defaults(func=_cmd_subharmonic)
 
-    p = sub.add_parser("mixing", help="combination tones of a two-tone drive")
-    p.add_argument("--eps", type=float, required=True)
-    p.add_argument("--Q", type=float, required=True, help="quality factor (finite)")
-    p.add_argument("--drive", type=_drive, action="append", required=True,
-                   help="F@W: a drive f cos(w t); repeat for each tone")
-    p.add_argument("--json", action="store_true", help="print the JSON contract")
-    p.add_argument("--plot", metavar="FILE", help="also draw the figure (.png, .svg, .pdf)")
+    p = sub.add_parser("mixing", help="combination tones of a two-tone drive",
+                       description="q'' + q'/Q + q + eps q^3 = Σ f_i cos(w_i t): "
+                       "predicted and simulated combination tones.")
+    p.add_argument("--eps", type=_real, required=True, metavar="EPS",
+                   help="ε, the cubic stiffness coefficient (dimensionless; required)")
+    p.add_argument("--Q", type=_quality, required=True, metavar="Q",
+                   help="quality factor Q > 0 of the damping q'/Q (finite; required)")
+    p.add_argument("--drive", type=_drive, action="append", required=True, metavar="F@W",
+                   help="a drive f cos(w t): amplitude F at frequency W (units of the linear "
+                   "natural frequency), e.g. 0.3@1.3; repeat for each tone (required)")
+    _flag_json(p)
+    _flag_plot(p)
     p.set_defaults(func=_cmd_mixing)
 
-    p = sub.add_parser("choose", help="the cheapest verified method for a tolerance and a range")
-    p.add_argument("quantity", choices=("period", "q", *DRIVEN_QUANTITIES))
-    p.add_argument("--tol", type=float, help="tolerance (period, q: relative; amplitudes, "
-                   "response: absolute, default 1e-4)")
-    p.add_argument("--x-min", type=float, help="period: smallest x = eps*A**2")
-    p.add_argument("--x-max", type=float, help="period: largest x = eps*A**2")
-    p.add_argument("--t-max", type=float, default=20.0, help="q: times 0..t-max (default 20)")
-    p.add_argument("--eps", type=float, help="amplitudes, response: ε of the driven oscillator")
-    p.add_argument("--force", type=float, help="amplitudes, response: f")
-    p.add_argument("--omega", type=float, help="amplitudes, response: one drive frequency ω")
-    p.add_argument("--omega-min", type=float, help="amplitudes, response: lowest ω of a range")
-    p.add_argument("--omega-max", type=float, help="amplitudes, response: highest ω of a range")
-    p.add_argument("--Q", type=float, default=math.inf,
-                   help="amplitudes, response: Q (default undamped)")
+    p = sub.add_parser("choose", help="the cheapest verified method for a tolerance and a range",
+                       description="Time and verify every method, report the cheapest that "
+                       "meets the tolerance on the range.")
+    p.add_argument("quantity", choices=("period", "q", *DRIVEN_QUANTITIES),
+                   help="period T(x); q(t); amplitudes A_n, B_n; response r(ω)")
+    p.add_argument("--tol", type=_real, metavar="TOL",
+                   help="tolerance > 0 (period, q: relative, required; amplitudes, response: "
+                   "absolute, default 1e-4)")
+    p.add_argument("--x-min", type=_real, metavar="X",
+                   help="period, q: smallest x = εA² of the range (required)")
+    p.add_argument("--x-max", type=_real, metavar="X",
+                   help="period, q: largest x = εA² of the range (required)")
+    p.add_argument("--t-max", type=_real, default=20.0, metavar="T",
+                   help="q: times 0..T, in units of 1/(linear natural frequency) (default 20)")
+    _flag_drive(p, required=False, omega="amplitudes, response: one drive frequency ω")
+    p.add_argument("--omega-min", type=_real, metavar="W",
+                   help="amplitudes, response: lowest ω of a range (instead of --omega)")
+    p.add_argument("--omega-max", type=_real, metavar="W",
+                   help="amplitudes, response: highest ω of a range (instead of --omega)")
     p.add_argument("--emit", metavar="DIR", help="write just the chosen evaluator into DIR "
                    "(period: chosen_period.py; q: duffing.py or fourier.py; amplitudes, "
-                   "response: driven.py or balance.py, only emittable methods compete)")
-    p.add_argument("--json", action="store_true", help="print the JSON contract")
+                   "response: driven.py or balance.py, only emittable methods compete; "
+                   "default: write nothing)")
+    _flag_json(p)
     p.set_defaults(func=_cmd_choose)
 
     p = sub.add_parser("clock", help="the notes' grandfather's-clock accuracy claims, checked")
-    p.add_argument("--json", action="store_true", help="print JSON")
+    _flag_json(p, "JSON")
     p.set_defaults(func=_cmd_clock)
 
     p = sub.add_parser("scene", help="named scenes: the smallest model that meets each")
-    p.add_argument("name", choices=tuple(SCENES))
-    p.add_argument("--json", action="store_true", help="print JSON")
+    p.add_argument("name", choices=SCENE_NAMES, help="the scene")
+    _flag_json(p, "JSON")
     p.set_defaults(func=_cmd_scene)
 
-    p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults")
-    p.add_argument("--out", default="generated", help="output folder (default generated/)")
+    p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults",
+                       description="The main job on the built-in defaults; writes only under "
+                       "--out.")
+    p.add_argument("--out", default="out", metavar="DIR",
+                   help="output folder for evaluators, LaTeX, PDFs and figures/ (default out/)")
     p.set_defaults(func=_cmd_demo)
     return parser
 

@@ -13,7 +13,7 @@ import math
 import os
 import sys
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from types import ModuleType
 
@@ -279,15 +279,17 @@ def write_files(out: Path, files: Mapping[str, str]) -> list[Path]:
     return written
 
 
-def generate(model: str, order: int, out: Path, allow_divergent: bool = False) -> list[Path]:
+def generate(model: str, order: int, out: Path, allow_divergent: bool = False,
+             progress: Callable[[int, int], None] | None = None) -> list[Path]:
     """``lindstedt generate``: the numba module and the LaTeX of ``model`` at ``order``.
 
-    The series is derived to ``order + 2`` so the module can estimate its truncation error.
+    The series is derived to ``order + 2`` so the module can estimate its truncation error
+    (``progress`` follows the derivation, as in :func:`lindstedt.derive`).
     """
     order = check_order(order)
     command = f"lindstedt generate {model} --order {order}" + (
         " --allow-divergent" if allow_divergent else "")
-    solution = derive(model_by_name(model, order + 2), order + 2)
+    solution = derive(model_by_name(model, order + 2), order + 2, progress)
     module = lower_free(solution, command, allow_divergent)
     files = {f"{model}.py": render_module(module)}
     files.update(render_latex(solution, order, module.provenance))

@@ -13,6 +13,7 @@ it; the first-harmonic convention would give other coefficients).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from fractions import Fraction
 from math import factorial
@@ -76,8 +77,10 @@ def _cosine(n: int) -> str:
     return "" if n == 0 else r"\cos s" if n == 1 else rf"\cos {n}s"
 
 
-def derive(model: Model, order: int) -> SeriesSolution:
-    """ω₀…ω_K, u₀…u_K and T/2π of ``model`` to order K (notes §10.3, carried to order K)."""
+def derive(model: Model, order: int,
+           progress: Callable[[int, int], None] | None = None) -> SeriesSolution:
+    """ω₀…ω_K, u₀…u_K and T/2π of ``model`` to order K (notes §10.3, carried to order K);
+    ``progress(j, K)`` is called after each order (the command line draws a bar with it)."""
     order = check_order(order)
     basis = Basis(model.odd)
     ground = Ground.for_coefficients(model.coefficients())
@@ -111,6 +114,8 @@ def derive(model: Model, order: int) -> SeriesSolution:
         g[r] = g[r] + Wj
         DP.append(ground.poly(g) - Pj)  # u_j'' = F_j - u_j
         rests.append(G)
+        if progress is not None:
+            progress(j, order)
     period = [one]
     for j in range(1, order + 1):
         period.append(-sum((omega[a] * period[j - a] for a in range(1, j + 1)), zero))

@@ -48,11 +48,18 @@ def test_table_is_readable():
 @pytest.mark.parametrize(
     "args,needle",
     [
-        (["series", "duffing", "--order", "-3"], "order -3"),
-        (["series", "duffing", "--order", "2.5"], "order '2.5'"),
+        (["series", "duffing", "--order", "-3"], "--order: -3: must be ≥ 0"),
+        (["series", "duffing", "--order", "2.5"], "--order: '2.5'"),
         (["series", "nosuch"], "nosuch"),
-        (["series", "duffing", "--order", "5000"], "--force"),
-        (["series", "pendulum", "--order", "400"], "--force"),
+        (["series", "duffing", "--order", "5000"], "--allow-slow"),
+        (["series", "pendulum", "--order", "400"], "--allow-slow"),
+        (["generate", "duffing", "--out", ""], "--out ''"),
+        (["driven", "--eps", "0.1", "--force", "1", "--omega", "nan"], "--omega: 'nan'"),
+        (["driven", "--eps", "0.1", "--force", "1", "--omega", "1", "--harmonics", "0"],
+         "--harmonics: 0"),
+        (["choose", "period", "--tol", "-1e-8", "--x-min", "0", "--x-max", "0.1"],
+         "tol -1e-08: must be > 0"),
+        (["mixing", "--eps", "0.1", "--Q", "10", "--drive", "0.3"], "F@W"),
     ],
 )
 def test_bad_input_one_line_exit_2(args, needle):
@@ -62,3 +69,79 @@ def test_bad_input_one_line_exit_2(args, needle):
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0]
     assert "Traceback" not in out.stderr
+
+
+def test_negative_and_scientific_values_are_values_not_flags():
+    """``--eps -1e-1`` and ``--drive -0.3@1.3`` are read as numbers (argparse alone calls them
+    unknown flags); the result equals the one with the same value written plainly."""
+    neg = run("subharmonic", "--eps", "-1e-1", "--force", "0.5", "--omega", "0.9", "--json")
+    plain = run("subharmonic", "--eps=-0.1", "--force", "0.5", "--omega", "0.9", "--json")
+    assert neg.returncode == 0, neg.stderr
+    assert json.loads(neg.stdout) == json.loads(plain.stdout)
+    assert json.loads(neg.stdout)["parameters"]["eps"] == -0.1
+
+
+def test_force_in_series_is_the_old_spelling_of_allow_slow():
+    out = run("series", "duffing", "--order", "2", "--force", "--json")
+    assert out.returncode == 0
+    assert "deprecated" in out.stderr and "--allow-slow" in out.stderr
+    assert json.loads(out.stdout)["omega"][1] == "3/8"
+
+
+def test_light_constants_match_the_stages():
+    """The parser's choices are restated in cli (no SymPy at start-up): they must agree."""
+    from lindstedt import choose, cli, models
+
+    assert cli.FREE_MODELS == models.MODELS
+    assert tuple(choose.SCENES) == cli.SCENE_NAMES
+    assert cli.DRIVEN_QUANTITIES == choose.DRIVEN_QUANTITIES
+
+
+def test_help_imports_no_heavy_stage():
+    """``lindstedt --help`` and argument errors load neither SymPy, numba, SciPy nor
+    matplotlib (the start-up target is 0.3 s; benchmarks/startup.py measures it)."""
+    probe = ("import sys, lindstedt.cli as c\n"
+             "try:\n    c.main(['series', '--help'])\nexcept SystemExit:\n    pass\n"
+             "try:\n    c.main(['driven', '--eps', 'x'])\nexcept SystemExit:\n    pass\n"
+             "heavy = {'sympy', 'numba', 'scipy', 'matplotlib', 'numpy'} & set(sys.modules)\n"
+             "print(sorted(heavy))")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_every_flag_has_help_and_states_its_default():
+    from lindstedt.cli import build_parser
+
+    parser = build_parser()
+    commands = parser._subparsers._group_actions[0].choices
+    for name, sub in commands.items():
+        for action in sub._actions:
+            if action.dest == "help":
+                continue
+            assert action.help, (name, action.option_strings)
+            if action.option_strings and not action.required and action.default not in (
+                    None, False) and action.nargs != 0:
+                assert "default" in action.help, (name, action.option_strings)
+
+
+def test_progress_bar_only_on_a_terminal_and_never_with_json(monkeypatch):
+    import io
+
+    from lindstedt import cli
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    monkeypatch.setattr(cli, "PROGRESS_AFTER_SECONDS", 0.0)
+    for stream, enabled, drawn in ((Terminal(), True, True), (Terminal(), False, False),
+                                   (io.StringIO(), True, False)):
+        monkeypatch.setattr(sys, "stderr", stream)
+        bar = cli.Progress("work", enabled)
+        for done in range(1, 5):
+            bar(done, 4)
+        bar.close()
+        text = stream.getvalue()
+        assert ("[" + "#" * 30 + "] 4/4" in text) == drawn
+        assert text.endswith("\r\033[K") == drawn
