@@ -9,6 +9,7 @@ The pipeline, one module per stage (input -> output)::
     response   one-harmonic curves and folds, balance continuation  Drive, ω range -> folds
     choose     methods × orders, verified error and measured cost    tol, range -> Choice
     numerics   references: elliptic periods, Jacobi cn, shooting + Floquet, sweeps, true folds
+    sweep      grids of driven maps on dask.distributed into resumable Zarr  kind, axes -> Dataset
     lower      solutions -> IR records (Evaluator, Module)           Horner, Chebyshev recurrence
     printers   NumbaPrinter(PythonCodePrinter), LaTeX rationals      Expr -> str
     emit       strict Jinja2 environments, provenance, atomic writes IR -> files in generated/

@@ -346,3 +346,82 @@ def driven_validity_figure(path: Path, eps: float = 0.1, force: float = 1.0) -> 
     sub.legend(fontsize=8)
     fig.tight_layout()
     return _save(fig, path)
+
+
+SWEEP_AXES = ("omega", "force", "eps", "Q")
+# NOTE: the grid axes of lindstedt.sweep (every other dimension of a field is drawn at its last
+# entry: the highest order, the last branch or root).
+SWEEP_CUTS = 5
+# NOTE: at most five cuts along the first axis: more lines than that cannot be told apart.
+
+
+def sweep_figure(ds: object, path: Path) -> Path:
+    """A finished sweep (the xarray Dataset of :func:`lindstedt.sweep.run_sweep`): its
+    headline field (``ds.attrs["headline"]``) as a map over the first two axes that have more
+    than one value (further axes at their first value), beside cuts along the first axis at up
+    to :data:`SWEEP_CUTS` values of the second; one axis: a curve. Errors on a log scale;
+    counts and flags of −1 (none) left blank."""
+    check_plot_path(path)
+    done = ds["done"].values
+    if not done.all():
+        raise InputError(f"sweep figure: {int(done.sum())} of {done.size} blocks are done; "
+                         "resume the sweep first")
+    name = ds.attrs["headline"]
+    field = ds[name]
+    extra = [d for d in field.dims if d not in SWEEP_AXES]
+    picked = [f"{d} = {ds[d].values[-1]}" for d in extra if d in ds.coords]
+    field = field.isel({d: -1 for d in extra})
+    varying = [a for a in field.dims if field.sizes[a] > 1]
+    field = field.isel({a: 0 for a in field.dims if a not in varying[:2]})
+    values = field.values.astype(float)
+    values[values < 0] = np.nan  # −1: no branch, no orbit, not computed
+    log = name.endswith("error")
+    if log:
+        values = np.maximum(values, FLOOR)
+    fixed = ", ".join([*picked, *(f"{a} = {ds[a].values[0]:g}" for a in SWEEP_AXES
+                                  if a in ds.dims and a not in varying[:2])])
+    label = field.attrs.get("long_name", name)
+
+    def positions(axis: str) -> tuple[np.ndarray, bool]:
+        """Coordinates to draw at (indices where Q = inf is among them), and a log axis?"""
+        v = ds[axis].values.astype(float)
+        if not np.all(np.isfinite(v)):
+            return np.arange(v.size, dtype=float), False
+        return v, bool(v.min() > 0 and v.max() / v.min() > 20)
+
+    def ticks(ax: plt.Axes, axis: str, which: str) -> None:
+        v = ds[axis].values
+        if not np.all(np.isfinite(v)):
+            getattr(ax, f"set_{which}ticks")(np.arange(v.size), [f"{x:g}" for x in v])
+
+    if len(varying) >= 2:
+        xa, ya = varying[:2]
+        (x, xlog), (y, ylog) = positions(xa), positions(ya)
+        grid = values.reshape(field.sizes[xa], field.sizes[ya]).T
+        fig, (ax, cuts) = plt.subplots(1, 2, figsize=(12, 4.4))
+        mesh = ax.pcolormesh(x, y, np.log10(grid) if log else grid, shading="nearest",
+                             cmap="viridis")
+        fig.colorbar(mesh, ax=ax, label=f"log10 {name}" if log else name)
+        ax.set(xscale="log" if xlog else "linear", yscale="log" if ylog else "linear",
+               xlabel=xa, ylabel=ya)
+        ticks(ax, xa, "x"), ticks(ax, ya, "y")
+        for j in np.unique(np.linspace(0, y.size - 1, min(SWEEP_CUTS, y.size)).round()):
+            cuts.plot(x, grid[int(j)], ".-", ms=3, label=f"{ya} = {ds[ya].values[int(j)]:g}")
+        cuts.legend(fontsize=8)
+        cuts.set(xscale="log" if xlog else "linear", yscale="log" if log else "linear",
+                 xlabel=xa, ylabel=name)
+        ticks(cuts, xa, "x")
+    else:
+        fig, cuts = plt.subplots(figsize=(7, 4.4))
+        xa = varying[0] if varying else next(a for a in SWEEP_AXES if a in field.dims)
+        x, xlog = positions(xa)
+        if not varying:
+            x = x[:1]
+        cuts.plot(x, values.ravel(), "o-", ms=3)
+        cuts.set(xscale="log" if xlog else "linear", yscale="log" if log else "linear",
+                 xlabel=xa, ylabel=name)
+        ticks(cuts, xa, "x")
+    fig.suptitle(f"{ds.attrs['kind']} sweep: {label}" + (f"  ({fixed})" if fixed else ""),
+                 fontsize=10)
+    fig.tight_layout()
+    return _save(fig, path)

@@ -1,0 +1,829 @@
+"""Maps of the driven oscillator ``q̈ + q̇/Q + q + εq³ = f cos ωt`` over parameter grids.
+
+A grid is a few named axes (``omega``, ``force``, ``eps``, ``Q``), each a list of values; a
+*kind* of map (:data:`KINDS`) says which axes it takes, what it computes at one point and
+what it stores:
+
+* ``response``: the steady amplitude ``r = √(A₁² + B₁²)`` of every 1:1 branch (harmonic
+  balance with 10 harmonics from each first-order root), its one-harmonic stability
+  (``∂G/∂u > 0``), and the largest and smallest stable amplitude;
+* ``stability``: shooting from each branch's balance solution: the distinct periodic orbits,
+  how many are Floquet-stable, their largest Floquet modulus;
+* ``subharmonic``: the 1/3 subharmonic (eq. 10.87, undamped; ``omega`` is its frequency, the
+  drive is at ``3ω``): whether it exists, both roots, Hill and true-orbit stability;
+* ``validity``: the μ-expansion's and low-order harmonic balance's error in ``A₁`` against
+  harmonic balance with 10 harmonics on the largest branch (the driven validity chart).
+
+Every point is computed by the existing solvers of :mod:`driven`, :mod:`response` and
+:mod:`numerics`; nothing here solves anything itself.
+
+The grid is cut into rectangular blocks (contiguous in C order, aligned with the Zarr chunks).
+Each block is one task on ``dask.distributed`` — a :class:`~distributed.LocalCluster` of
+single-threaded worker processes by default, or an existing scheduler — and the client writes
+each finished block into a Zarr store (into the block's region of a store whose metadata
+``to_zarr(compute=False)`` wrote first), then that block's ``done`` flag. Zarr's local store
+writes each chunk file atomically, so a flag is never half-written, and a block whose data was
+written but whose flag was not is simply computed again: an interrupted sweep resumes where
+it stopped. :func:`serial_sweep` computes
+the same map in this process, block by block, without dask: the reference and the baseline.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import itertools
+import json
+import logging
+import math
+import os
+import shutil
+import socket
+import tempfile
+import threading
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, replace
+from numbers import Real
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+from distributed import WorkerPlugin
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+# NOTE: xarray and zarr are imported where the client uses them: every worker imports this
+# module to run its blocks and needs neither (~1.3 s of each worker's start-up, measured).
+
+from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
+from .errors import InputError
+from .numerics import shoot
+from .response import amplitude_slope, subharmonic
+
+# --- what one point computes -------------------------------------------------------------------
+
+BRANCHES = 3
+# NOTE: the first-order amplitude equation is a cubic in r²: at most three 1:1 branches.
+RESPONSE_HARMONICS = 10
+# NOTE: harmonic balance with 10 odd harmonics equals the true orbit to ~1e-10 at the notes'
+# parameters (the judge of the validity chart), at ~1 ms a branch.
+GUESS_HARMONICS = 10
+# NOTE: shooting starts from the balance solution; from 10 harmonics Newton needs one flow
+# fewer than from 5 and the stability map is fastest (14.5 against 16.6 ms a point, measured).
+SAME_ORBIT = 1e-8
+# NOTE: shooting converges to 1e-12; two branches that shoot onto one orbit agree to far below
+# 1e-8, distinct orbits differ by O(amplitude).
+MU_ORDERS = (1, 2, 4, 6, 10)
+BALANCE_HARMONICS = (2, 4)
+JUDGE_HARMONICS = 10
+# NOTE: the methods and the judge of charts.driven_validity_figure (its VALIDITY_METHODS).
+
+
+def _balance(d: Drive, branch: object, harmonics: int) -> object | None:
+    """Harmonic balance from a first-order root, or ``None`` where it refuses (does not
+    converge, or meets a singular Jacobian exactly at a fold)."""
+    try:
+        hb = harmonic_balance(d, branch, harmonics)
+    except np.linalg.LinAlgError:
+        return None
+    return hb if hb.converged else None
+
+
+def _response(omega: float, force: float, eps: float, Q: float) -> dict:
+    d = Drive(eps, force, omega, Q)
+    branches = first_order_branches(d)[:BRANCHES]
+    r, stable = [math.nan] * BRANCHES, [-1] * BRANCHES
+    for k, br in enumerate(branches):
+        stable[k] = int(amplitude_slope(br.A1**2, omega, d) > 0)
+        hb = _balance(d, br, RESPONSE_HARMONICS)
+        if hb is not None:
+            A, B = amplitudes(hb.coefficients, 0.0, 1)
+            r[k] = math.hypot(A[1], B[1])
+    kept = [r[k] for k in range(len(branches)) if stable[k] == 1 and math.isfinite(r[k])]
+    return {"branches": len(branches), "r": r, "stable": stable,
+            "r_stable_max": max(kept, default=math.nan),
+            "r_stable_min": min(kept, default=math.nan)}
+
+
+def _stability(omega: float, force: float, eps: float, Q: float) -> dict:
+    d = Drive(eps, force, omega, Q)
+    branches = first_order_branches(d)[:BRANCHES]
+    r, floquet, stable = [math.nan] * BRANCHES, [math.nan] * BRANCHES, [-1] * BRANCHES
+    distinct: list = []
+    for k, br in enumerate(branches):
+        hb = _balance(d, br, GUESS_HARMONICS)
+        if hb is not None:  # the start of cli.driven_json: q(0) = ΣA_n, q̇(0) = ω Σ n B_n
+            A, B = amplitudes(hb.coefficients, 0.0, 2 * GUESS_HARMONICS - 1)
+            guess = np.array([sum(A.values()), omega * sum(n * b for n, b in B.items())])
+        else:  # the first-order root itself (choose.driven_tradeoffs' start)
+            guess = br.A1 * np.array([math.cos(br.delta0), omega * math.sin(br.delta0)])
+        orbit = shoot(eps, force, omega, d.damping, guess, harmonics=1)
+        if orbit is None:
+            continue
+        r[k] = math.hypot(orbit.A[1], orbit.B[1])
+        floquet[k] = float(np.max(np.abs(orbit.multipliers)))
+        stable[k] = int(orbit.stable)
+        scale = 1 + float(np.max(np.abs(orbit.initial)))
+        if all(np.max(np.abs(orbit.initial - o.initial)) > SAME_ORBIT * scale for o in distinct):
+            distinct.append(orbit)
+    return {"branches": len(branches), "orbits": len(distinct),
+            "stable_orbits": sum(o.stable for o in distinct),
+            "max_floquet": max((float(np.max(np.abs(o.multipliers))) for o in distinct),
+                               default=math.nan),
+            "r": r, "floquet": floquet, "orbit_stable": stable}
+
+
+def _subharmonic(omega: float, force: float, eps: float) -> dict:
+    exists, _, solutions = subharmonic(eps, force, omega)
+    out = {"exists": int(exists), "F": solutions[0].F if solutions else math.nan,
+           "a": [math.nan] * 2, "hill_stable": [-1] * 2, "orbit_a1": [math.nan] * 2,
+           "orbit_floquet": [math.nan] * 2, "orbit_stable": [-1] * 2, "locked": [-1] * 2}
+    for s in solutions:
+        k = 0 if s.root == "+" else 1
+        out["a"][k], out["hill_stable"][k] = s.a, int(s.hill_stable)
+        if s.orbit is not None:
+            out["orbit_a1"][k] = s.orbit.A[1]
+            out["orbit_floquet"][k] = float(np.max(np.abs(s.orbit.multipliers)))
+            out["orbit_stable"][k] = int(s.orbit.stable)
+            out["locked"][k] = int(bool(s.locked))
+    out["stable_roots"] = sum(v == 1 for v in out["orbit_stable"])
+    return out
+
+
+def validity_errors(d: Drive) -> tuple[np.ndarray, np.ndarray, int]:
+    """``|A₁ − A₁(balance, N = 10)|`` on the largest branch for the μ-expansion at
+    :data:`MU_ORDERS` and harmonic balance with :data:`BALANCE_HARMONICS` harmonics (NaN where a
+    method refuses: a fold, a diverging μ-series, a balance that does not converge — and
+    everywhere when the judge itself does not converge), and the branch count.
+
+    The measure of ``charts._validity_errors``, with the judge's convergence checked."""
+    mu_err = np.full(len(MU_ORDERS), np.nan)
+    hb_err = np.full(len(BALANCE_HARMONICS), np.nan)
+    branches = first_order_branches(d)
+    judge = _balance(d, branches[0], JUDGE_HARMONICS) if branches else None
+    if judge is None:
+        return mu_err, hb_err, len(branches)
+    truth = amplitudes(judge.coefficients, 0.0, 1)[0][1]
+    for k, order in enumerate(MU_ORDERS):
+        mu = mu_expansion(d, branches[0], order)
+        if len(mu.coefficients) > order and mu.converged:
+            mu_err[k] = abs(amplitudes(*mu.partial(order), 1)[0][1] - truth)
+    for k, harmonics in enumerate(BALANCE_HARMONICS):
+        hb = _balance(d, branches[0], harmonics)
+        if hb is not None:
+            hb_err[k] = abs(amplitudes(hb.coefficients, 0.0, 1)[0][1] - truth)
+    return mu_err, hb_err, len(branches)
+
+
+def _validity(omega: float, force: float, eps: float, Q: float) -> dict:
+    mu_err, hb_err, count = validity_errors(Drive(eps, force, omega, Q))
+    return {"mu_error": mu_err, "balance_error": hb_err, "branches": count}
+
+
+# --- the kinds of map ----------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Field:
+    """One stored variable: ``float64`` (NaN = none) or an ``int8`` count or flag (−1 = none)."""
+
+    name: str
+    long_name: str
+    dtype: str = "float64"
+    dims: tuple[str, ...] = ()  # beyond the grid's axes
+    flag: bool = False  # int8 verdict: 1 yes, 0 no, −1 none
+
+    @property
+    def fill(self) -> float | int:
+        return math.nan if self.dtype == "float64" else -1
+
+    def attrs(self) -> dict:
+        out: dict = {"long_name": self.long_name}
+        if self.flag:
+            out |= {"flag_values": [-1, 0, 1], "flag_meanings": "none no yes"}
+        elif self.dtype == "int8":
+            out["comment"] = "-1: not computed"
+        return out
+
+
+@dataclass(frozen=True)
+class Kind:
+    """A kind of map: its axes, the dimensions its fields add, what one point computes."""
+
+    name: str
+    description: str
+    axes: tuple[str, ...]
+    extra: tuple[tuple[str, tuple[int, ...]], ...]  # dimension -> coordinate values
+    fields: tuple[Field, ...]
+    point: Callable[..., dict]  # axis values (floats, by name) -> field values
+    warm_up: tuple[tuple[str, float], ...]  # a point that runs every compiled kernel it uses
+    points_per_chunk: int  # default block size: ~1 s of work
+    headline: str  # the field a figure draws (its last entry along any extra dimension)
+    settings: tuple[tuple[str, object], ...]  # constants its numbers depend on
+
+    @property
+    def extra_sizes(self) -> dict[str, int]:
+        return {dim: len(values) for dim, values in self.extra}
+
+
+AXES = ("omega", "force", "eps", "Q")
+# NOTE: the order of every grid's dimensions. Blocks take whole trailing axes, so the axes that
+# usually have few values (ε, Q) come last and ω, the one swept finely, first.
+BRANCH = ("branch", (1, 2, 3))
+# NOTE: branches are numbered by first-order amplitude, largest first (first_order_branches).
+
+RESPONSE = Kind(
+    "response", "steady 1:1 amplitude r of every branch (harmonic balance, N = 10) and its "
+    "one-harmonic stability", AXES, (BRANCH,),
+    (Field("branches", "number of first-order 1:1 branches", "int8"),
+     Field("r", "r = sqrt(A1^2 + B1^2), harmonic balance N = 10", dims=("branch",)),
+     Field("stable", "one-harmonic stability dG/du > 0", "int8", ("branch",), flag=True),
+     Field("r_stable_max", "largest stable r"),
+     Field("r_stable_min", "smallest stable r")),
+    _response, (("omega", 1.2), ("force", 0.3), ("eps", 0.1), ("Q", 20.0)),
+    256, "r_stable_max", (("harmonics", RESPONSE_HARMONICS),))
+# NOTE: 256 points: ~3 ms a point (balance on up to three branches), ~1 s a task.
+
+STABILITY = Kind(
+    "stability", "Floquet stability of the 1:1 orbits found by shooting from every branch",
+    AXES, (BRANCH,),
+    (Field("branches", "number of first-order 1:1 branches", "int8"),
+     Field("orbits", "distinct periodic orbits found by shooting", "int8"),
+     Field("stable_orbits", "distinct Floquet-stable orbits", "int8"),
+     Field("max_floquet", "largest Floquet modulus over the orbits"),
+     Field("r", "r = sqrt(A1^2 + B1^2) of the orbit shot from the branch", dims=("branch",)),
+     Field("floquet", "largest Floquet modulus of the orbit shot from the branch",
+           dims=("branch",)),
+     Field("orbit_stable", "Floquet stability of the orbit shot from the branch", "int8",
+           ("branch",), flag=True)),
+    _stability, (("omega", 1.2), ("force", 0.3), ("eps", 0.1), ("Q", 20.0)),
+    64, "stable_orbits",
+    (("guess_harmonics", GUESS_HARMONICS), ("same_orbit", SAME_ORBIT)))
+# NOTE: 64 points: ~15 ms a point (two RK4 passes per Newton step per branch), ~1 s a task.
+
+SUBHARMONIC = Kind(
+    "subharmonic", "the 1/3 subharmonic of the undamped oscillator (eq. 10.87), omega its "
+    "frequency, the drive at 3 omega", ("omega", "force", "eps"), (("root", (1, -1)),),
+    (Field("exists", "eq. 10.87 has real amplitudes", "int8", flag=True),
+     Field("F", "F = f/(1 - 9 omega^2), the cos 3tau amplitude"),
+     Field("a", "a(f), the first harmonic of root +/-", dims=("root",)),
+     Field("hill_stable", "Hill-equation stability", "int8", ("root",), flag=True),
+     Field("orbit_a1", "first harmonic of the true orbit (shooting, 3 drive periods)",
+           dims=("root",)),
+     Field("orbit_floquet", "largest Floquet modulus of the true orbit", dims=("root",)),
+     Field("orbit_stable", "Floquet stability of the true orbit", "int8", ("root",),
+           flag=True),
+     Field("locked", "a simulation 1 % off the true orbit stays on it", "int8", ("root",),
+           flag=True),
+     Field("stable_roots", "roots whose true orbit is stable", "int8")),
+    _subharmonic, (("omega", 1.5), ("force", 0.1), ("eps", 0.1)),
+    8, "stable_roots", ())
+# NOTE: 8 points: ~0.12 s a point (Hill, shooting over 3 periods, a locking simulation).
+
+VALIDITY = Kind(
+    "validity", "error in A1 of the mu-expansion and of low-order harmonic balance against "
+    "harmonic balance N = 10, largest branch", AXES,
+    (("mu_order", MU_ORDERS), ("harmonics", BALANCE_HARMONICS)),
+    (Field("mu_error", "|A1 - A1(balance N = 10)|, mu-expansion", dims=("mu_order",)),
+     Field("balance_error", "|A1 - A1(balance N = 10)|, harmonic balance",
+           dims=("harmonics",)),
+     Field("branches", "number of first-order 1:1 branches", "int8")),
+    _validity, (("omega", 0.6), ("force", 1.0), ("eps", 0.1), ("Q", math.inf)),
+    32, "mu_error", (("judge_harmonics", JUDGE_HARMONICS),))
+# NOTE: 32 points: ~25 ms a point (μ-expansion to order 10 five times, three balances).
+
+KINDS: Mapping[str, Kind] = {k.name: k for k in (RESPONSE, STABILITY, SUBHARMONIC, VALIDITY)}
+
+
+def kind_named(name: str) -> Kind:
+    """The :class:`Kind` called ``name``, or :class:`InputError` listing the kinds."""
+    if name not in KINDS:
+        raise InputError(f"sweep kind {name!r}: use one of {', '.join(KINDS)}")
+    return KINDS[name]
+
+
+# --- the grid and its blocks ---------------------------------------------------------------------
+
+FORMAT = 1
+# NOTE: the layout version in every store's identity: a store of another layout is refused.
+
+
+@dataclass(frozen=True)
+class Grid:
+    """The axes of one sweep (in the kind's order) and the block each task computes."""
+
+    kind: Kind
+    values: tuple[np.ndarray, ...]
+    block: tuple[int, ...]
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(v.size for v in self.values)
+
+    @property
+    def points(self) -> int:
+        return math.prod(self.shape)
+
+    @property
+    def blocks(self) -> tuple[int, ...]:
+        """Blocks along each axis."""
+        return tuple(-(-n // b) for n, b in zip(self.shape, self.block, strict=True))
+
+    @property
+    def chunks(self) -> int:
+        return math.prod(self.blocks)
+
+    def region(self, chunk: int) -> tuple[slice, ...]:
+        """The index slices of block number ``chunk`` (C order over :attr:`blocks`)."""
+        out = []
+        for n, b, nb in reversed(list(zip(self.shape, self.block, self.blocks, strict=True))):
+            chunk, k = divmod(chunk, nb)
+            out.append(slice(k * b, min((k + 1) * b, n)))
+        return tuple(reversed(out))
+
+    def block_values(self, chunk: int) -> tuple[np.ndarray, ...]:
+        return tuple(v[s] for v, s in zip(self.values, self.region(chunk), strict=True))
+
+    def identity(self) -> dict:
+        """What a store must match to be resumed: kind, axes, blocks, settings, layout."""
+        return {"format": FORMAT, "kind": self.kind.name,
+                "axes": {a: [float(x) for x in v]
+                         for a, v in zip(self.kind.axes, self.values, strict=True)},
+                "block": list(self.block), "settings": dict(self.kind.settings)}
+
+
+def block_shape(shape: Sequence[int], points: int) -> tuple[int, ...]:
+    """Blocks of at most ``points`` points that are contiguous in C order: whole trailing axes
+    while they fit, then a slab of the next axis, one index of the axes before it."""
+    block = [1] * len(shape)
+    size = 1
+    for k in reversed(range(len(shape))):
+        if size * shape[k] <= points:
+            block[k], size = shape[k], size * shape[k]
+        else:
+            block[k] = max(1, points // size)
+            break
+    return tuple(block)
+
+
+_PROBE = {"eps": 0.1, "force": 1.0, "omega": 1.0, "Q": math.inf}
+# NOTE: a valid drive each axis value is checked against, one field at a time.
+
+
+def _axis(name: str, values: object) -> np.ndarray:
+    """One axis as float64, each value checked by :class:`Drive`'s rules (finite, ω > 0,
+    Q > 0 or inf), no repeats."""
+    if isinstance(values, (str, bytes)) or not isinstance(values, (Sequence, np.ndarray)):
+        raise InputError(f"axis {name}: give a list of values, not {values!r}")
+    out = []
+    for v in values:
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, Real):
+            raise InputError(f"axis {name}: {v!r} is not a number")
+        Drive(**{**_PROBE, name: float(v)})
+        out.append(float(v))
+    if not out:
+        raise InputError(f"axis {name}: no values")
+    arr = np.array(out)
+    if np.unique(arr).size != arr.size:
+        raise InputError(f"axis {name}: repeated values")
+    return arr
+
+
+def make_grid(kind: str | Kind, axes: Mapping[str, Sequence[float]],
+              chunk: int | None = None) -> Grid:
+    """The checked grid of ``kind`` over ``axes`` (exactly the kind's axes, each a list of
+    values) in blocks of at most ``chunk`` points (default: the kind's, ~1 s of work)."""
+    kind = kind if isinstance(kind, Kind) else kind_named(kind)
+    if not isinstance(axes, Mapping):
+        raise InputError(f"sweep axes: give a mapping of axis name to values, not {axes!r}")
+    missing = [a for a in kind.axes if a not in axes]
+    unknown = [a for a in axes if a not in kind.axes]
+    if missing or unknown:
+        what = "; ".join(part for part in (
+            missing and f"missing {', '.join(missing)}",
+            unknown and f"unknown {', '.join(map(str, unknown))}") if part)
+        raise InputError(f"sweep {kind.name}: axes {what} (it takes {', '.join(kind.axes)})")
+    values = tuple(_axis(a, axes[a]) for a in kind.axes)
+    points = kind.points_per_chunk if chunk is None else chunk
+    if isinstance(points, bool) or not isinstance(points, int) or points < 1:
+        raise InputError(f"chunk {chunk!r}: must be a whole number of points >= 1")
+    return Grid(kind, values, block_shape([v.size for v in values], points))
+
+
+# --- computing blocks ----------------------------------------------------------------------------
+
+def compute_block(kind_name: str, values: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
+    """Every field of ``kind_name`` on the block spanned by ``values`` (one array per axis):
+    the task each worker runs, and the serial loop's body."""
+    kind = KINDS[kind_name]
+    shape = tuple(v.size for v in values)
+    sizes = kind.extra_sizes
+    out = {f.name: np.full(shape + tuple(sizes[d] for d in f.dims), f.fill, dtype=f.dtype)
+           for f in kind.fields}
+    for index in itertools.product(*(range(n) for n in shape)):
+        point = {a: float(v[i]) for a, v, i in zip(kind.axes, values, index, strict=True)}
+        for name, value in kind.point(**point).items():
+            out[name][index] = value
+    return out
+
+
+def kernel_signatures() -> dict[str, int]:
+    """Compiled signatures of each numba kernel in :mod:`numerics` in this process: a warm
+    worker's counts stay fixed from task to task (no recompiling)."""
+    from numba.core.registry import CPUDispatcher
+
+    from . import numerics
+
+    return {name: len(f.signatures) for name, f in vars(numerics).items()
+            if isinstance(f, CPUDispatcher)}
+
+
+def warm_up(kind_name: str) -> dict[str, int]:
+    """Run the kind's warm-up point: loads (or compiles, once, into numba's on-disk cache)
+    every kernel its tasks call, so that no task pays for it. Returns
+    :func:`kernel_signatures`."""
+    kind = KINDS[kind_name]
+    compute_block(kind_name, tuple(np.array([dict(kind.warm_up)[a]]) for a in kind.axes))
+    return kernel_signatures()
+
+
+class WarmUp(WorkerPlugin):
+    """A worker plugin: :func:`warm_up` once on every worker, including workers that join
+    later (``distributed`` runs ``setup`` when a worker starts or the plugin is registered)."""
+
+    def __init__(self, kind_name: str) -> None:
+        self.kind_name = kind_name
+        self.name = f"lindstedt-sweep-warm-up-{kind_name}"
+
+    def setup(self, worker: object) -> None:
+        warm_up(self.kind_name)
+
+
+# --- the dataset and its store -------------------------------------------------------------------
+
+def _dataset(grid: Grid, data: Mapping[str, np.ndarray] | None, done: np.ndarray | None
+             ) -> xr.Dataset:
+    """The sweep's Dataset: ``data`` given, in memory; else lazy fill arrays chunked like the
+    blocks (a template whose ``to_zarr(compute=False)`` writes only metadata and coordinates)."""
+    import dask.array as da
+    import xarray as xr
+
+    kind = grid.kind
+    sizes = kind.extra_sizes
+    coords = {a: (a, v) for a, v in zip(kind.axes, grid.values, strict=True)}
+    coords |= {dim: (dim, np.array(values)) for dim, values in kind.extra}
+    variables = {}
+    for f in kind.fields:
+        dims = (*kind.axes, *f.dims)
+        if data is None:
+            shape = grid.shape + tuple(sizes[d] for d in f.dims)
+            array = da.full(shape, f.fill, dtype=f.dtype,
+                            chunks=grid.block + tuple(sizes[d] for d in f.dims))
+        else:
+            array = data[f.name]
+        variables[f.name] = xr.Variable(dims, array, f.attrs())
+    variables["done"] = xr.Variable(
+        ("chunk",), da.zeros(grid.chunks, dtype=bool, chunks=1) if done is None else done,
+        {"long_name": "block finished: its data is written (C order over the blocks)"})
+    return xr.Dataset(variables, coords, attrs={
+        "kind": kind.name, "title": kind.description, "headline": kind.headline,
+        "sweep": json.dumps(grid.identity())})
+
+
+def _encoding(grid: Grid) -> dict:
+    sizes = grid.kind.extra_sizes
+    enc = {f.name: {"chunks": grid.block + tuple(sizes[d] for d in f.dims),
+                    "fill_value": f.fill} for f in grid.kind.fields}
+    # one flag per Zarr chunk: each is its own file, written atomically after its block
+    enc["done"] = {"chunks": (1,), "fill_value": False}
+    return enc
+
+
+FS_BLOCK = 4096
+# NOTE: every Zarr chunk is a file; a file takes whole 4 KiB blocks on ext4 and xfs.
+METADATA_BYTES = 1 << 20
+# NOTE: the zarr.json files and coordinate arrays: a few KiB; 1 MiB is a generous bound.
+
+
+def estimate_bytes(grid: Grid, chunks: int | None = None) -> int:
+    """Disk a store needs for ``chunks`` blocks (default all): every field uncompressed (NaN
+    and random doubles barely compress), each chunk file rounded up to :data:`FS_BLOCK`."""
+    sizes = grid.kind.extra_sizes
+    per_block = math.prod(grid.block)
+    per_chunk = FS_BLOCK  # the done flag
+    for f in grid.kind.fields:
+        nbytes = per_block * math.prod(sizes[d] for d in f.dims) * np.dtype(f.dtype).itemsize
+        per_chunk += -(-nbytes // FS_BLOCK) * FS_BLOCK
+    coords = 8 * sum(grid.shape)
+    return (grid.chunks if chunks is None else chunks) * per_chunk + coords + METADATA_BYTES
+
+
+def _probe_writable(folder: Path, what: str) -> None:
+    """Create and remove a file in ``folder`` (``os.access`` says yes to root on read-only
+    mounts and says nothing about a full disk)."""
+    try:
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=".lindstedt-probe-")
+        os.close(fd)
+        os.unlink(tmp)
+    except OSError as e:
+        raise InputError(f"store {what}: cannot write in {folder} ({e.strerror})") from None
+
+
+def _stored_identity(path: Path) -> dict:
+    """The identity a sweep's store carries (its ``sweep`` attribute), or :class:`InputError`
+    for anything that is not such a store."""
+    import zarr
+
+    try:
+        attrs = zarr.open_group(str(path), mode="r").attrs
+    except Exception:  # zarr raises several kinds here: the message is ours
+        raise InputError(f"store {path}: exists and is not a Zarr store (and not empty): "
+                         "give a new path") from None
+    if "sweep" not in attrs:
+        raise InputError(f"store {path}: a Zarr store, but not a lindstedt sweep")
+    return json.loads(attrs["sweep"])
+
+
+def _adopt_block(path: Path, grid: Grid) -> Grid:
+    """``grid`` in the blocks of the sweep stored at ``path``, when there is one over the same
+    axes (anything else is left for :func:`check_store` to judge)."""
+    import zarr
+
+    try:
+        stored = json.loads(zarr.open_group(str(path), mode="r").attrs["sweep"])
+        block = tuple(int(b) for b in stored["block"])
+    except Exception:  # no store, not a sweep: check_store says which
+        return grid
+    if len(block) != len(grid.shape) or any(b < 1 for b in block):
+        return grid
+    return replace(grid, block=block)
+
+
+def _mismatch(path: Path, stored: dict, grid: Grid) -> str | None:
+    """What differs between a store's identity and this sweep's, in words (None: nothing)."""
+    asked = grid.identity()
+    if stored.get("format") != asked["format"]:
+        return f"store {path}: layout {stored.get('format')}, this version writes {FORMAT}"
+    if stored["kind"] != asked["kind"]:
+        return f"store {path}: holds a {stored['kind']} sweep, not {asked['kind']}"
+    for axis in sorted(set(stored["axes"]) | set(asked["axes"])):
+        a, b = stored["axes"].get(axis), asked["axes"].get(axis)
+        if a != b:
+            def show(v: list | None) -> str:
+                return "none" if v is None else f"{len(v)} values {min(v):g}..{max(v):g}"
+            return f"store {path}: axis {axis} differs (stored {show(a)}, asked {show(b)})"
+    if stored["settings"] != asked["settings"]:
+        return (f"store {path}: made with settings {stored['settings']}, this version uses "
+                f"{asked['settings']}")
+    if stored["block"] != asked["block"]:
+        return (f"store {path}: made in blocks of {stored['block']} points; resume with "
+                f"chunk={math.prod(stored['block'])} or without chunk")
+    return None
+
+
+@dataclass(frozen=True)
+class StoreState:
+    """A checked store: where, and which blocks are already done (``None``: a new store)."""
+
+    path: Path
+    done: np.ndarray | None
+
+
+def check_store(store: Path | str, grid: Grid) -> StoreState:
+    """Refuse, before any work, a store that is not this sweep's, that cannot be written, or
+    whose disk cannot hold what is left to compute; else report the finished blocks."""
+    import zarr
+
+    path = Path(store)
+    done = None
+    if path.exists():
+        if not path.is_dir():
+            raise InputError(f"store {path}: exists and is not a directory")
+        if any(path.iterdir()):
+            problem = _mismatch(path, _stored_identity(path), grid)
+            if problem:
+                raise InputError(f"{problem}; give a new store path or delete it")
+            done = np.asarray(zarr.open_array(str(path / "done"), mode="r")[:], dtype=bool)
+        folder = path
+    else:
+        folder = path.parent if str(path.parent) else Path(".")
+        if not folder.is_dir():
+            raise InputError(f"store {path}: folder {folder} does not exist")
+    _probe_writable(folder, str(path))
+    left = grid.chunks - (0 if done is None else int(done.sum()))
+    need, free = estimate_bytes(grid, left), shutil.disk_usage(folder).free
+    if need > free:
+        raise InputError(f"store {path}: the sweep needs ~{need / 1e9:.3g} GB "
+                         f"({grid.points} points), {folder} has {free / 1e9:.3g} GB free")
+    return StoreState(path, done)
+
+
+@dataclass(frozen=True)
+class _Arrays:
+    """The Zarr arrays of an initialised store, opened once for a run's writes."""
+
+    fields: Mapping[str, object]  # field name -> zarr.Array
+    done: object  # zarr.Array of the flags
+
+
+def _open_arrays(path: Path, grid: Grid) -> _Arrays:
+    import zarr
+
+    group = zarr.open_group(str(path), mode="r+")
+    return _Arrays({f.name: group[f.name] for f in grid.kind.fields}, group["done"])
+
+
+def _write_block(arrays: _Arrays, grid: Grid, chunk: int,
+                 data: Mapping[str, np.ndarray]) -> None:
+    """The block's data into its region: whole Zarr chunks, so nothing else is touched (zarr
+    directly: a third of the cost of xarray's ``region=`` writes, which re-open and check the
+    store every call; the client shares the cores with the workers)."""
+    region = grid.region(chunk)
+    for name, array in arrays.fields.items():
+        array[region] = data[name]
+
+
+def _mark_done(arrays: _Arrays, chunk: int) -> None:
+    """The block's flag, written only after its data (its own chunk file, atomic)."""
+    arrays.done[chunk] = True
+
+
+def open_sweep(store: Path | str) -> xr.Dataset:
+    """A sweep's store as a Dataset (lazily read, no dask); ``done`` says which blocks are."""
+    import xarray as xr
+
+    path = Path(store)
+    _stored_identity(path)
+    return xr.open_zarr(str(path), consolidated=False, chunks=None)
+
+
+# --- running ------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Progress:
+    """Reported after each block is written: which, and how many of all are done."""
+
+    chunk: int
+    finished: int  # blocks done in the store, earlier runs included
+    total: int
+    seconds: float  # since this run started computing
+
+
+SCHEDULER_TIMEOUT = 4.0
+# NOTE: a live scheduler answers a TCP connect in milliseconds and the handshake in well under
+# a second; two such waits (connect, then the client's handshake) stay inside 10 s.
+MAX_WORKERS = 64
+# NOTE: a bound against typos (workers=1000 on a laptop), far above this machine's 2 cores.
+
+
+def _probe_scheduler(address: str) -> None:
+    """A TCP connect to a ``tcp://``/``tls://`` scheduler within :data:`SCHEDULER_TIMEOUT`,
+    name resolution included (in a thread: ``getaddrinfo`` takes no timeout)."""
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    try:
+        scheme, location = parse_address(address)
+        if scheme not in ("tcp", "tls"):
+            return  # other transports: the client's own timeout below
+        host, port = parse_host_port(location)
+    except (ValueError, TypeError) as e:
+        raise InputError(f"scheduler {address}: not an address ({e})") from None
+    failure: list[str] = []
+
+    def connect() -> None:
+        try:
+            socket.create_connection((host, port), timeout=SCHEDULER_TIMEOUT).close()
+        except OSError as e:
+            failure.append(e.strerror or type(e).__name__)
+
+    probe = threading.Thread(target=connect, daemon=True)
+    probe.start()
+    probe.join(SCHEDULER_TIMEOUT)
+    if probe.is_alive():
+        failure.append(f"no answer within {SCHEDULER_TIMEOUT:g} s")
+    if failure:
+        raise InputError(f"scheduler {address}: {failure[0]}")
+
+
+def _connect(scheduler: str | None, workers: int, stack: contextlib.ExitStack) -> object:
+    """A client: to ``scheduler``, or to a new LocalCluster of ``workers`` single-threaded
+    processes (closed with ``stack``)."""
+    from distributed import Client, LocalCluster
+
+    if scheduler is None:
+        cluster = stack.enter_context(LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+            silence_logs=logging.ERROR))
+        return stack.enter_context(Client(cluster, set_as_default=False))
+    _probe_scheduler(scheduler)
+    try:
+        client = Client(scheduler, timeout=SCHEDULER_TIMEOUT, set_as_default=False)
+    except Exception as e:  # OSError, TimeoutError, ValueError, or garbage from a non-scheduler
+        first = str(e).splitlines()[0] if str(e) else type(e).__name__
+        raise InputError(f"scheduler {scheduler}: no dask scheduler answers ({first})") from None
+    return stack.enter_context(client)
+
+
+def run_sweep(kind: str, axes: Mapping[str, Sequence[float]], store: Path | str,
+              scheduler: str | None = None, workers: int = 2, chunk: int | None = None,
+              progress: Callable[[Progress], None] | None = None,
+              stop_after: int | None = None) -> xr.Dataset:
+    """Map ``kind`` over the grid ``axes`` on dask.distributed into the Zarr store ``store``.
+
+    ``scheduler``: an address (``tcp://host:port``) of a running scheduler whose workers can
+    import lindstedt; ``None`` starts a LocalCluster of ``workers`` processes, one thread each
+    (``workers`` is ignored with a scheduler). ``chunk``: points per task (default the
+    kind's, ~1 s of work; resuming, the store's). A store of this sweep resumes: only blocks
+    without their ``done`` flag are computed. ``stop_after``: write at most this many blocks
+    in this run, then stop (the store resumes later). ``progress`` is called after each block.
+
+    Refused with :class:`InputError` before any work: a bad kind, axis or chunk; a store of
+    another sweep or that cannot be written or whose disk is too small; a scheduler that does
+    not answer (within ~2 × :data:`SCHEDULER_TIMEOUT`). Returns :func:`open_sweep` of the store.
+    """
+    grid = make_grid(kind, axes, chunk)
+    if scheduler is None and (isinstance(workers, bool) or not isinstance(workers, int)
+                              or not 1 <= workers <= MAX_WORKERS):
+        raise InputError(f"workers {workers!r}: must be a whole number in 1..{MAX_WORKERS}")
+    if stop_after is not None and (isinstance(stop_after, bool)
+                                   or not isinstance(stop_after, int) or stop_after < 0):
+        raise InputError(f"stop_after {stop_after!r}: must be a whole number >= 0")
+    if chunk is None:  # resuming without chunk: the store's blocks
+        grid = _adopt_block(Path(store), grid)
+    state = check_store(store, grid)
+    path = state.path
+    done = np.zeros(grid.chunks, dtype=bool) if state.done is None else state.done
+    todo = [int(i) for i in np.flatnonzero(~done)]
+    if stop_after is not None:
+        todo = todo[:stop_after]
+    if not todo:
+        return open_sweep(path) if state.done is not None else _initialise(path, grid)
+    with contextlib.ExitStack() as stack:
+        client = _connect(scheduler, workers, stack)
+        if state.done is None:
+            _initialise(path, grid)
+        client.register_plugin(WarmUp(grid.kind.name))
+        _gather(client, grid, path, todo, int(done.sum()), progress)
+    return open_sweep(path)
+
+
+def _initialise(path: Path, grid: Grid) -> xr.Dataset:
+    """Metadata, coordinates and fill values of a new store (no block is written)."""
+    _dataset(grid, None, None).to_zarr(str(path), mode="w", compute=False, consolidated=False,
+                                       encoding=_encoding(grid))
+    return open_sweep(path)
+
+
+def _gather(client: object, grid: Grid, path: Path, todo: list[int], finished: int,
+            progress: Callable[[Progress], None] | None) -> None:
+    """Keep every worker busy with one block running and one queued; write each block (then
+    its flag) as it arrives; cancel what is left if stopped early or on an error."""
+    from distributed import as_completed
+
+    start = time.perf_counter()
+    window = 2 * max(1, sum(client.nthreads().values()))
+    queue = iter(todo)
+    index: dict = {}
+    arrays = _open_arrays(path, grid)
+
+    def submit(chunk: int) -> object:
+        future = client.submit(compute_block, grid.kind.name, grid.block_values(chunk),
+                               pure=False)
+        index[future] = chunk
+        return future
+
+    running = as_completed([submit(c) for c in itertools.islice(queue, window)],
+                           loop=client.loop)
+    try:
+        for future in running:
+            chunk = index.pop(future)
+            data = future.result()
+            _write_block(arrays, grid, chunk, data)
+            _mark_done(arrays, chunk)
+            finished += 1
+            if progress is not None:
+                progress(Progress(chunk, finished, grid.chunks, time.perf_counter() - start))
+            following = next(queue, None)
+            if following is not None:
+                running.add(submit(following))
+    finally:
+        if index:
+            client.cancel(list(index))
+
+
+def serial_sweep(kind: str, axes: Mapping[str, Sequence[float]], chunk: int | None = None,
+                 progress: Callable[[Progress], None] | None = None) -> xr.Dataset:
+    """The same map in this process, block by block, no dask and no store: the reference of
+    :func:`run_sweep` (value for value) and its one-core baseline."""
+    grid = make_grid(kind, axes, chunk)
+    sizes = grid.kind.extra_sizes
+    data = {f.name: np.full(grid.shape + tuple(sizes[d] for d in f.dims), f.fill, f.dtype)
+            for f in grid.kind.fields}
+    start = time.perf_counter()
+    for c in range(grid.chunks):
+        block = compute_block(grid.kind.name, grid.block_values(c))
+        for name, values in block.items():
+            data[name][grid.region(c)] = values
+        if progress is not None:
+            progress(Progress(c, c + 1, grid.chunks, time.perf_counter() - start))
+    return _dataset(grid, data, np.ones(grid.chunks, dtype=bool))

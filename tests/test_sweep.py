@@ -1,0 +1,275 @@
+"""Parameter sweeps on dask.distributed into Zarr: the same numbers as the serial loop,
+independent checks of single points, resuming after a stop or a kill, refusals before work."""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+from lindstedt.charts import _validity_errors, sweep_figure
+from lindstedt.driven import Drive, first_order_branches
+from lindstedt.errors import InputError
+from lindstedt.numerics import shoot
+from lindstedt.response import one_harmonic_curve
+from lindstedt.sweep import (
+    MU_ORDERS,
+    WarmUp,
+    estimate_bytes,
+    kernel_signatures,
+    make_grid,
+    open_sweep,
+    run_sweep,
+    serial_sweep,
+    validity_errors,
+)
+
+EPS, FORCE, Q = 0.1, 0.3, 20.0
+# the notes' hardening spring: one branch below ω ≈ 1.1, three between the folds, one above
+STABILITY_AXES = {"omega": [0.9, 1.1, 1.25, 1.4, 1.6, 1.8], "force": [FORCE], "eps": [EPS],
+                  "Q": [Q, math.inf]}
+RESPONSE_AXES = {"omega": [0.7, 1.2, 1.5], "force": [0.1, FORCE], "eps": [EPS], "Q": [Q]}
+SUBHARMONIC_AXES = {"omega": [0.9, 1.5], "force": [0.1], "eps": [EPS]}
+VALIDITY_AXES = {"omega": [0.6, 1.0, 1.6], "force": [1.0], "eps": [EPS], "Q": [math.inf, Q]}
+
+
+@pytest.fixture(scope="module")
+def scheduler():
+    """One 2-worker cluster for the module: its start-up (seconds) is paid once."""
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=None, silence_logs=logging.ERROR) as cluster:
+        yield cluster.scheduler_address
+
+
+def test_local_cluster_equals_serial_and_shooting(tmp_path):
+    """The default path (its own LocalCluster, 2 processes) against the serial loop, value for
+    value; one point against a direct shooting call from the first-order root."""
+    ds = run_sweep("stability", STABILITY_AXES, tmp_path / "s.zarr", workers=2, chunk=2)
+    serial = serial_sweep("stability", STABILITY_AXES, chunk=2)
+    xr.testing.assert_identical(ds.load(), serial)
+    point = ds.sel(omega=1.25, force=FORCE, eps=EPS, Q=Q)
+    assert (int(point.branches), int(point.orbits), int(point.stable_orbits)) == (3, 3, 2)
+    d = Drive(EPS, FORCE, 1.25, Q)
+    for k, br in enumerate(first_order_branches(d)):
+        orbit = shoot(EPS, FORCE, 1.25, d.damping,
+                      br.A1 * np.array([math.cos(br.delta0), 1.25 * math.sin(br.delta0)]))
+        assert abs(float(point.r[k]) - math.hypot(orbit.A[1], orbit.B[1])) < 1e-9
+        assert int(point.orbit_stable[k]) == int(orbit.stable)
+    # the one-harmonic criterion (∂G/∂u > 0) counts the same stable branches, damped
+    curve = one_harmonic_curve(EPS, FORCE, Q, np.array(STABILITY_AXES["omega"]))
+    assert list(ds.stable_orbits.sel(Q=Q).values.ravel()) == list(curve.stable.sum(axis=1))
+
+
+@pytest.mark.parametrize(("kind", "axes"), [("response", RESPONSE_AXES),
+                                            ("subharmonic", SUBHARMONIC_AXES),
+                                            ("validity", VALIDITY_AXES)])
+def test_every_kind_on_a_running_scheduler_equals_serial(scheduler, tmp_path, kind, axes):
+    ds = run_sweep(kind, axes, tmp_path / f"{kind}.zarr", scheduler=scheduler, chunk=2)
+    xr.testing.assert_identical(ds.load(), serial_sweep(kind, axes, chunk=2))
+
+
+def test_response_against_shooting_and_one_harmonic():
+    ds = serial_sweep("response", RESPONSE_AXES)
+    d = Drive(EPS, FORCE, 1.2, Q)
+    branches = first_order_branches(d)
+    point = ds.sel(omega=1.2, force=FORCE, eps=EPS, Q=Q)
+    assert int(point.branches) == len(branches) == 3
+    for k, br in enumerate(branches):
+        orbit = shoot(EPS, FORCE, 1.2, d.damping,
+                      br.A1 * np.array([math.cos(br.delta0), 1.2 * math.sin(br.delta0)]))
+        assert abs(float(point.r[k]) - math.hypot(orbit.A[1], orbit.B[1])) < 1e-8
+    # weak drive far from resonance: balance and one harmonic agree to O(ε r³)
+    r1 = one_harmonic_curve(EPS, 0.1, Q, np.array([0.7])).r[0, 0]
+    assert abs(float(ds.r.sel(omega=0.7, force=0.1, eps=EPS, Q=Q, branch=1)) - r1) < 1e-4
+    assert float(point.r_stable_max) == float(point.r[0])
+    assert float(point.r_stable_min) == float(point.r[2])  # the middle branch is the saddle
+
+
+def test_validity_is_the_charts_measure():
+    ds = serial_sweep("validity", VALIDITY_AXES)
+    for w in VALIDITY_AXES["omega"]:
+        errors, count = _validity_errors(Drive(EPS, 1.0, w))
+        point = ds.sel(omega=w, force=1.0, eps=EPS, Q=math.inf)
+        np.testing.assert_array_equal(point.mu_error.values, errors[:len(MU_ORDERS)])
+        np.testing.assert_array_equal(point.balance_error.values, errors[len(MU_ORDERS):])
+        assert int(point.branches) == count
+    mu, _, _ = validity_errors(Drive(EPS, 1.0, 1.0))
+    assert np.all(np.diff(np.log10(mu)) < 0)  # error falls with the order at ω = 1
+
+
+def test_subharmonic_against_eq_10_87():
+    ds = serial_sweep("subharmonic", SUBHARMONIC_AXES)
+    w, f = 1.5, 0.1
+    F = f / (1 - 9 * w**2)
+    disc = (16 * (w**2 - 1) / EPS - 21 * F**2) / 12
+    point = ds.sel(omega=w, force=f, eps=EPS)
+    assert int(point.exists) == 1
+    np.testing.assert_allclose(point.a.values, [-F / 2 + disc**0.5, -F / 2 - disc**0.5],
+                               rtol=1e-14)
+    assert int(ds.exists.sel(omega=0.9, force=f, eps=EPS)) == 0  # ω < 1: no real amplitude
+    assert np.isnan(ds.a.sel(omega=0.9, force=f, eps=EPS)).all()
+
+
+def test_workers_are_warmed_once_and_never_recompile(scheduler, tmp_path):
+    from distributed import Client
+
+    with Client(scheduler, set_as_default=False) as client:
+        client.register_plugin(WarmUp("stability"))
+        warm = client.run(kernel_signatures)
+        run_sweep("stability", STABILITY_AXES, tmp_path / "a.zarr", scheduler=scheduler,
+                  chunk=1)
+        ints = {"omega": [1, 2], "force": [1], "eps": [0], "Q": [10]}  # ints: still float64
+        run_sweep("stability", ints, tmp_path / "b.zarr", scheduler=scheduler, chunk=1)
+        after = client.run(kernel_signatures)
+    assert len(warm) == 2 and after == warm
+    assert all(sigs["_rk4"] == 1 for sigs in after.values())
+
+
+def _block_files(store: Path, grid, chunk: int) -> dict[Path, int]:
+    """The chunk files of every field in block ``chunk`` and their mtimes (ns)."""
+    start = [s.start // b for s, b in zip(grid.region(chunk), grid.block, strict=True)]
+    out = {}
+    for field in grid.kind.fields:
+        key = [*start, *([0] * len(field.dims))]
+        path = store / field.name / "c" / Path(*map(str, key))
+        out[path] = path.stat().st_mtime_ns
+    return out
+
+
+def test_stopped_sweep_resumes_without_recomputing(scheduler, tmp_path):
+    store = tmp_path / "s.zarr"
+    first = run_sweep("stability", STABILITY_AXES, store, scheduler=scheduler, chunk=2,
+                      stop_after=2)
+    done = [int(i) for i in np.flatnonzero(first.done.values)]
+    assert len(done) == 2
+    grid = make_grid("stability", STABILITY_AXES, 2)
+    before = {p: t for c in done for p, t in _block_files(store, grid, c).items()}
+    computed = []
+    ds = run_sweep("stability", STABILITY_AXES, store, scheduler=scheduler,
+                   progress=lambda p: computed.append(p.chunk))  # chunk: the store's blocks
+    assert sorted(computed + done) == list(range(grid.chunks))
+    assert {p: p.stat().st_mtime_ns for p in before} == before  # finished blocks untouched
+    xr.testing.assert_identical(ds.load(), serial_sweep("stability", STABILITY_AXES, chunk=2))
+    # a finished store: nothing to compute, so no scheduler is even asked
+    calls = []
+    run_sweep("stability", STABILITY_AXES, store, scheduler="tcp://127.0.0.1:1",
+              progress=calls.append)
+    assert calls == []
+
+
+KILLED = """
+import json, os, signal, sys
+import lindstedt.sweep as sweep
+kind, axes, store, address = json.loads(sys.argv[1])
+marked = []
+write_flag = sweep._mark_done
+
+def mark(arrays, chunk):
+    if len(marked) == 2:  # the third block's data is written, its flag is not: die here
+        os.kill(os.getpid(), signal.SIGKILL)
+    marked.append(chunk)
+    write_flag(arrays, chunk)
+
+sweep._mark_done = mark
+sweep.run_sweep(kind, axes, store, scheduler=address, chunk=2)
+"""
+
+
+def test_killed_sweep_resumes_and_recomputes_the_half_written_block(scheduler, tmp_path):
+    store = tmp_path / "k.zarr"
+    args = json.dumps(["stability", STABILITY_AXES, str(store), scheduler])
+    run = subprocess.run([sys.executable, "-c", KILLED, args], capture_output=True, text=True,
+                         timeout=120, check=False)
+    assert run.returncode == -9, run.stderr
+    grid = make_grid("stability", STABILITY_AXES, 2)
+    killed = open_sweep(store)
+    done = set(np.flatnonzero(killed.done.values).tolist())
+    assert len(done) == 2
+    # some block not marked done holds data: the one the kill interrupted
+    half = [c for c in range(grid.chunks) if c not in done
+            and (killed.branches.values[grid.region(c)] >= 0).any()]
+    assert len(half) == 1
+    before = {p: t for c in done for p, t in _block_files(store, grid, c).items()}
+    computed = []
+    ds = run_sweep("stability", STABILITY_AXES, store, scheduler=scheduler,
+                   progress=lambda p: computed.append(p.chunk))
+    assert set(computed) == set(range(grid.chunks)) - done and half[0] in computed
+    assert {p: p.stat().st_mtime_ns for p in before} == before
+    xr.testing.assert_identical(ds.load(), serial_sweep("stability", STABILITY_AXES, chunk=2))
+
+
+def test_unanswering_scheduler_is_refused_within_10_s(tmp_path):
+    t0 = time.perf_counter()
+    with pytest.raises(InputError, match=r"scheduler tcp://127\.0\.0\.1:1") as err:
+        run_sweep("response", RESPONSE_AXES, tmp_path / "s.zarr", scheduler="tcp://127.0.0.1:1")
+    assert time.perf_counter() - t0 < 10
+    assert "\n" not in str(err.value)
+    assert not (tmp_path / "s.zarr").exists()  # refused before the store was made
+
+
+def test_store_of_another_sweep_is_refused(tmp_path):
+    store = tmp_path / "s.zarr"
+    run_sweep("stability", STABILITY_AXES, store, stop_after=0)  # metadata only, no cluster
+    with pytest.raises(InputError, match="holds a stability sweep, not response"):
+        run_sweep("response", STABILITY_AXES, store, scheduler="tcp://127.0.0.1:1")
+    other = {**STABILITY_AXES, "omega": [0.9, 1.1]}
+    with pytest.raises(InputError, match="axis omega differs"):
+        run_sweep("stability", other, store, scheduler="tcp://127.0.0.1:1")
+    with pytest.raises(InputError, match="chunk=12"):
+        run_sweep("stability", STABILITY_AXES, store, chunk=5, scheduler="tcp://127.0.0.1:1")
+    (tmp_path / "notes").mkdir()
+    (tmp_path / "notes" / "a.txt").write_text("x")
+    with pytest.raises(InputError, match="not a Zarr store"):
+        run_sweep("stability", STABILITY_AXES, tmp_path / "notes")
+
+
+@pytest.mark.parametrize("where", ["under_a_file", "proc", "missing_folder"])
+def test_unwritable_store_is_refused_before_work(tmp_path, where):
+    (tmp_path / "file").write_text("x")
+    store = {"under_a_file": tmp_path / "file" / "s.zarr", "proc": Path("/proc/s.zarr"),
+             "missing_folder": tmp_path / "no" / "s.zarr"}[where]
+    with pytest.raises(InputError, match="store"):
+        run_sweep("stability", STABILITY_AXES, store, scheduler="tcp://127.0.0.1:1")
+
+
+def test_grid_too_large_for_the_disk_is_refused_before_work(tmp_path):
+    axes = {"omega": list(np.linspace(0.5, 2, 10_000)), "force": list(np.linspace(0.1, 1, 1000)),
+            "eps": list(np.linspace(0.01, 0.2, 1000)), "Q": [10.0, 20.0]}
+    assert estimate_bytes(make_grid("response", axes)) > 1e12
+    t0 = time.perf_counter()
+    with pytest.raises(InputError, match="GB"):
+        run_sweep("response", axes, tmp_path / "s.zarr", scheduler="tcp://127.0.0.1:1")
+    assert time.perf_counter() - t0 < 5 and os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize(("kind", "axes", "chunk", "match"), [
+    ("orbits", RESPONSE_AXES, None, "use one of response"),
+    ("response", {"omega": [1.0]}, None, "missing force, eps, Q"),
+    ("subharmonic", {**SUBHARMONIC_AXES, "Q": [20.0]}, None, "unknown Q"),
+    ("response", {**RESPONSE_AXES, "Q": [0.0]}, None, "Q 0.0"),
+    ("response", {**RESPONSE_AXES, "omega": [1.0, 1.0]}, None, "repeated"),
+    ("response", {**RESPONSE_AXES, "omega": "1.0"}, None, "list of values"),
+    ("response", RESPONSE_AXES, 0, "chunk"),
+])
+def test_bad_grids(kind, axes, chunk, match):
+    with pytest.raises(InputError, match=match):
+        make_grid(kind, axes, chunk)
+
+
+def test_sweep_figure(tmp_path):
+    ds = serial_sweep("response", RESPONSE_AXES)
+    path = sweep_figure(ds, tmp_path / "r.png")
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    partial = run_sweep("response", RESPONSE_AXES, tmp_path / "p.zarr", stop_after=0)
+    with pytest.raises(InputError, match="0 of 1 blocks"):
+        sweep_figure(partial, tmp_path / "p.png")
