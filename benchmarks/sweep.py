@@ -13,7 +13,6 @@ work, "busy" (CPU / wall per worker) below 1 is time the operating system gave t
 from __future__ import annotations
 
 import argparse
-import logging
 import os
 import tempfile
 import time
@@ -23,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from distributed import Client, LocalCluster
-from lindstedt.sweep import WarmUp, make_grid, run_sweep, serial_sweep, warm_up
+from distributed import Client
+from lindstedt.sweep import WarmUp, local_cluster, make_grid, run_sweep, serial_sweep, warm_up
 
 KIND = "stability"
 SPEED_UP_TARGET = 1.7
@@ -69,9 +68,7 @@ def distributed_runs(grid_axes: dict, workers: int, folder: Path, reference: xr.
     """(start-up + warm-up seconds, the fastest of ``repeat`` runs, each into a new store) on a
     fresh LocalCluster of ``workers``."""
     t0 = time.perf_counter()
-    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                      dashboard_address=None, silence_logs=logging.ERROR) as cluster, \
-            Client(cluster, set_as_default=False) as client:
+    with local_cluster(workers) as cluster, Client(cluster, set_as_default=False) as client:
         client.register_plugin(WarmUp(KIND))
         start_up = time.perf_counter() - t0
 

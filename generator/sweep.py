@@ -705,15 +705,35 @@ def _probe_scheduler(address: str) -> None:
         raise InputError(f"scheduler {address}: {failure[0]}")
 
 
+QUIET = {"distributed.worker.profile.enabled": False,
+         "distributed.admin.tick.interval": "1s",
+         "distributed.admin.system-monitor.interval": "5s",
+         "distributed.admin.system-monitor.gil.enabled": False,
+         "distributed.worker.memory.monitor-interval": "1s"}
+# NOTE: what a dashboard needs and a sweep does not: each worker samples its stacks every 10 ms
+# for the profile, every process checks its event loop every 20 ms and its memory every 0.1 s.
+# A 2-worker LocalCluster idles at 18 % of a core with them (client 7.7 %, workers 5 % each)
+# and 2.4 % without (measured): on two cores that is CPU taken from the workers.
+
+
+def local_cluster(workers: int) -> object:
+    """A LocalCluster of ``workers`` single-threaded processes, no dashboard, monitors quiet
+    (:data:`QUIET`; the nannies hand the configuration to the workers they start)."""
+    import dask
+    from distributed import LocalCluster
+
+    with dask.config.set(QUIET):
+        return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                            dashboard_address=None, silence_logs=logging.ERROR)
+
+
 def _connect(scheduler: str | None, workers: int, stack: contextlib.ExitStack) -> object:
-    """A client: to ``scheduler``, or to a new LocalCluster of ``workers`` single-threaded
-    processes (closed with ``stack``)."""
-    from distributed import Client, LocalCluster
+    """A client: to ``scheduler``, or to a new :func:`local_cluster` of ``workers`` (closed
+    with ``stack``)."""
+    from distributed import Client
 
     if scheduler is None:
-        cluster = stack.enter_context(LocalCluster(
-            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-            silence_logs=logging.ERROR))
+        cluster = stack.enter_context(local_cluster(workers))
         return stack.enter_context(Client(cluster, set_as_default=False))
     _probe_scheduler(scheduler)
     try:

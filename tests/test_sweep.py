@@ -4,7 +4,6 @@ independent checks of single points, resuming after a stop or a kill, refusals b
 from __future__ import annotations
 
 import json
-import logging
 import math
 import os
 import subprocess
@@ -25,6 +24,7 @@ from lindstedt.sweep import (
     WarmUp,
     estimate_bytes,
     kernel_signatures,
+    local_cluster,
     make_grid,
     open_sweep,
     run_sweep,
@@ -44,10 +44,7 @@ VALIDITY_AXES = {"omega": [0.6, 1.0, 1.6], "force": [1.0], "eps": [EPS], "Q": [m
 @pytest.fixture(scope="module")
 def scheduler():
     """One 2-worker cluster for the module: its start-up (seconds) is paid once."""
-    from distributed import LocalCluster
-
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None, silence_logs=logging.ERROR) as cluster:
+    with local_cluster(2) as cluster:
         yield cluster.scheduler_address
 
 
