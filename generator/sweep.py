@@ -30,6 +30,7 @@ the same map in this process, block by block, without dask: the reference and th
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import itertools
 import json
@@ -676,33 +677,60 @@ MAX_WORKERS = 64
 # NOTE: a bound against typos (workers=1000 on a laptop), far above this machine's 2 cores.
 
 
+def _first_line(e: BaseException) -> str:
+    return (str(e).splitlines() or [type(e).__name__])[0]
+
+
+async def _identity(address: str) -> object:
+    """distributed's handshake and an ``identity`` call: what answers at ``address``."""
+    from distributed.comm import connect
+
+    comm = await connect(address, timeout=SCHEDULER_TIMEOUT)
+    try:
+        await comm.write({"op": "identity", "reply": True})
+        return await comm.read()
+    finally:
+        await comm.close()
+
+
 def _probe_scheduler(address: str) -> None:
-    """A TCP connect to a ``tcp://``/``tls://`` scheduler within :data:`SCHEDULER_TIMEOUT`,
-    name resolution included (in a thread: ``getaddrinfo`` takes no timeout)."""
+    """Ask ``address`` what it is before a client is made (a client that fails half-way
+    lingers and stalls the interpreter's exit): a TCP connect for ``tcp://``/``tls://``, then
+    the handshake and ``identity``, within :data:`SCHEDULER_TIMEOUT` in all. In a thread:
+    ``getaddrinfo`` takes no timeout, and the caller may be inside an event loop."""
     from distributed.comm.addressing import parse_address, parse_host_port
 
     try:
         scheme, location = parse_address(address)
-        if scheme not in ("tcp", "tls"):
-            return  # other transports: the client's own timeout below
-        host, port = parse_host_port(location)
+        host_port = parse_host_port(location) if scheme in ("tcp", "tls") else None
     except (ValueError, TypeError) as e:
         raise InputError(f"scheduler {address}: not an address ({e})") from None
+    answer: list = []
     failure: list[str] = []
 
-    def connect() -> None:
+    def ask() -> None:
         try:
-            socket.create_connection((host, port), timeout=SCHEDULER_TIMEOUT).close()
-        except OSError as e:
-            failure.append(e.strerror or type(e).__name__)
+            if host_port is not None:
+                socket.create_connection(host_port, timeout=SCHEDULER_TIMEOUT).close()
+            answer.append(asyncio.run(asyncio.wait_for(_identity(address), SCHEDULER_TIMEOUT)))
+        except TimeoutError:
+            failure.append(f"no answer within {SCHEDULER_TIMEOUT:g} s")
+        except OSError as e:  # refused, unreachable, unknown host
+            failure.append(e.strerror or _first_line(e))
+        except Exception as e:  # a stranger's bytes can fail to decode in any way
+            failure.append(f"no dask scheduler answers ({_first_line(e)})")
 
-    probe = threading.Thread(target=connect, daemon=True)
+    probe = threading.Thread(target=ask, daemon=True)
     probe.start()
     probe.join(SCHEDULER_TIMEOUT)
     if probe.is_alive():
         failure.append(f"no answer within {SCHEDULER_TIMEOUT:g} s")
     if failure:
         raise InputError(f"scheduler {address}: {failure[0]}")
+    kind = answer[0].get("type") if isinstance(answer[0], dict) else None
+    if kind != "Scheduler":
+        raise InputError(f"scheduler {address}: answers, but as {kind or 'something else'}, "
+                         "not a dask scheduler")
 
 
 QUIET = {"distributed.worker.profile.enabled": False,
@@ -738,9 +766,9 @@ def _connect(scheduler: str | None, workers: int, stack: contextlib.ExitStack) -
     _probe_scheduler(scheduler)
     try:
         client = Client(scheduler, timeout=SCHEDULER_TIMEOUT, set_as_default=False)
-    except Exception as e:  # OSError, TimeoutError, ValueError, or garbage from a non-scheduler
-        first = str(e).splitlines()[0] if str(e) else type(e).__name__
-        raise InputError(f"scheduler {scheduler}: no dask scheduler answers ({first})") from None
+    except Exception as e:  # it answered the probe a moment ago: OSError, TimeoutError, …
+        raise InputError(f"scheduler {scheduler}: no dask scheduler answers "
+                         f"({_first_line(e)})") from None
     return stack.enter_context(client)
 
 

@@ -214,6 +214,18 @@ def test_unanswering_scheduler_is_refused_within_10_s(tmp_path):
     assert not (tmp_path / "s.zarr").exists()  # refused before the store was made
 
 
+def test_a_worker_or_a_stranger_is_not_a_scheduler(scheduler, tmp_path):
+    from distributed import Client
+
+    with Client(scheduler, set_as_default=False) as client:
+        worker = next(iter(client.scheduler_info()["workers"]))
+    with pytest.raises(InputError, match="answers, but as Worker"):
+        run_sweep("response", RESPONSE_AXES, tmp_path / "s.zarr", scheduler=worker)
+    with pytest.raises(InputError, match="not an address"):
+        run_sweep("response", RESPONSE_AXES, tmp_path / "s.zarr", scheduler="nonsense")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_store_of_another_sweep_is_refused(tmp_path):
     store = tmp_path / "s.zarr"
     run_sweep("stability", STABILITY_AXES, store, stop_after=0)  # metadata only, no cluster
