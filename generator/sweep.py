@@ -779,11 +779,12 @@ def run_sweep(kind: str, axes: Mapping[str, Sequence[float]], store: Path | str,
     """Map ``kind`` over the grid ``axes`` on dask.distributed into the Zarr store ``store``.
 
     ``scheduler``: an address (``tcp://host:port``) of a running scheduler whose workers can
-    import lindstedt; ``None`` starts a LocalCluster of ``workers`` processes, one thread each
-    (``workers`` is ignored with a scheduler). ``chunk``: points per task (default the
-    kind's, ~1 s of work; resuming, the store's). A store of this sweep resumes: only blocks
-    without their ``done`` flag are computed. ``stop_after``: write at most this many blocks
-    in this run, then stop (the store resumes later). ``progress`` is called after each block.
+    import lindstedt (blocks wait until it has some); ``None`` starts a :func:`local_cluster` of
+    ``workers`` processes, one thread each (``workers`` is ignored with a scheduler).
+    ``chunk``: points per task (default the kind's, ~1 s of work; resuming, the store's).
+    A store of this sweep resumes: only blocks without their ``done`` flag are computed.
+    ``stop_after``: write at most this many blocks in this run, then stop (the store resumes
+    later). ``progress`` is called after each block is written.
 
     Refused with :class:`InputError` before any work: a bad kind, axis or chunk; a store of
     another sweep or that cannot be written or whose disk is too small; a scheduler that does
