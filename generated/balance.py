@@ -5,12 +5,15 @@
 """Driven Duffing q'' + damping*q' + q + eps*q**3 = force*cos(omega t): harmonic balance with 4 odd harmonics.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
-or arrays.  Outside its domain it returns NaN (see each docstring)."""
+or arrays.  Outside its domain it returns NaN (see each docstring).  The compiled kernels take ``x``, a 1-D
+array of ``len(UNKNOWNS)`` real numbers (converted to float64), and real numbers; anything else
+raises TypeError or ValueError."""
 
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 HARMONICS = 4
 UNKNOWNS = (
@@ -25,9 +28,89 @@ UNKNOWNS = (
 )
 
 
+def _is_vector(v):
+    """Whether ``v`` is a 1-D array of real numbers, known when compiling (compiled only)."""
+    raise NotImplementedError
+
+
+@overload(_is_vector, inline="always")
+def _is_vector_overload(v):
+    ok = (isinstance(v, types.Array) and v.ndim == 1
+          and isinstance(v.dtype, (types.Integer, types.Float, types.Boolean)))
+    return (lambda v: True) if ok else (lambda v: False)
+
+
+def _vector(v):
+    """``v`` as a C-contiguous float64 array (``v`` itself if it is one); an empty stand-in
+    for anything else, which the caller has refused already (compiled only)."""
+    raise NotImplementedError
+
+
+@overload(_vector)
+def _vector_overload(v):
+    if not (isinstance(v, types.Array) and v.ndim == 1
+            and isinstance(v.dtype, (types.Integer, types.Float, types.Boolean))):
+        return lambda v: np.zeros(0)
+    if v.dtype == types.float64 and v.layout == "C":
+        return lambda v: v
+
+    def convert(v):
+        w = np.empty(v.size)
+        for i in range(v.size):
+            w[i] = v[i]
+        return w
+    return convert
+
+
+def _is_real(v):
+    """Whether ``v`` is a real number, known when compiling (compiled only)."""
+    raise NotImplementedError
+
+
+@overload(_is_real, inline="always")
+def _is_real_overload(v):
+    ok = isinstance(v, (types.Integer, types.Float, types.Boolean))
+    return (lambda v: True) if ok else (lambda v: False)
+
+
+def _real(v):
+    """``v`` as a float64; 0.0 for anything else, which the caller has refused (compiled only)."""
+    raise NotImplementedError
+
+
+@overload(_real, inline="always")
+def _real_overload(v):
+    if isinstance(v, (types.Integer, types.Float, types.Boolean)):
+        return lambda v: np.float64(v)  # float() keeps a float32 a float32
+    return lambda v: 0.0
+
+
+def _is_integer(v):
+    """Whether ``v`` is an integer, known when compiling (compiled only)."""
+    raise NotImplementedError
+
+
+@overload(_is_integer, inline="always")
+def _is_integer_overload(v):
+    ok = isinstance(v, types.Integer)
+    return (lambda v: True) if ok else (lambda v: False)
+
+
+def _integer(v):
+    """``v`` as an int64; 0 for anything else, which the caller has refused (compiled only)."""
+    raise NotImplementedError
+
+
+@overload(_integer, inline="always")
+def _integer_overload(v):
+    if isinstance(v, types.Integer):
+        return lambda v: np.int64(v)
+    return lambda v: np.int64(0)
+
+
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
-def residual(x, omega, eps, force, damping):
-    """Galerkin residual: cos and sin components for k = 1, 3, …"""
+def _residual(x, omega, eps, force, damping):
+    """The kernel behind ``residual``, which checks and converts the arguments."""
     a_1 = x[0]
     a_3 = x[1]
     a_5 = x[2]
@@ -148,9 +231,31 @@ def residual(x, omega, eps, force, damping):
     return out
 
 
+@njit(cache=True)
+def residual(x, omega, eps, force, damping):
+    """Galerkin residual: cos and sin components for k = 1, 3, …
+
+    ``x``: a 1-D array of the 8 UNKNOWNS; the rest real numbers.  TypeError or
+    ValueError for anything else."""
+    if not _is_vector(x):
+        raise TypeError("residual: x must be a 1-D array of 8 real numbers (UNKNOWNS)")
+    v = _vector(x)
+    if v.size != 8:
+        raise ValueError("residual: x must have 8 elements, one per UNKNOWNS")
+    if not _is_real(omega):
+        raise TypeError("residual: omega must be a real number")
+    if not _is_real(eps):
+        raise TypeError("residual: eps must be a real number")
+    if not _is_real(force):
+        raise TypeError("residual: force must be a real number")
+    if not _is_real(damping):
+        raise TypeError("residual: damping must be a real number")
+    return _residual(v, _real(omega), _real(eps), _real(force), _real(damping))
+
+
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
-def jacobian(x, omega, eps, force, damping):
-    """d residual / d (a_1, a_3, …, b_1, b_3, …)"""
+def _jacobian(x, omega, eps, force, damping):
+    """The kernel behind ``jacobian``, which checks and converts the arguments."""
     a_1 = x[0]
     a_3 = x[1]
     a_5 = x[2]
@@ -380,13 +485,60 @@ def jacobian(x, omega, eps, force, damping):
 
 
 @njit(cache=True)
-def newton(x0, omega, eps, force, damping, tol=1e-13, max_iter=50):
-    """Newton's method on residual() with jacobian(); returns (x, converged)."""
+def jacobian(x, omega, eps, force, damping):
+    """d residual / d (a_1, a_3, …, b_1, b_3, …)
+
+    ``x``: a 1-D array of the 8 UNKNOWNS; the rest real numbers.  TypeError or
+    ValueError for anything else."""
+    if not _is_vector(x):
+        raise TypeError("jacobian: x must be a 1-D array of 8 real numbers (UNKNOWNS)")
+    v = _vector(x)
+    if v.size != 8:
+        raise ValueError("jacobian: x must have 8 elements, one per UNKNOWNS")
+    if not _is_real(omega):
+        raise TypeError("jacobian: omega must be a real number")
+    if not _is_real(eps):
+        raise TypeError("jacobian: eps must be a real number")
+    if not _is_real(force):
+        raise TypeError("jacobian: force must be a real number")
+    if not _is_real(damping):
+        raise TypeError("jacobian: damping must be a real number")
+    return _jacobian(v, _real(omega), _real(eps), _real(force), _real(damping))
+
+
+@njit(cache=True)
+def _newton(x0, omega, eps, force, damping, tol, max_iter):
+    """The iteration behind ``newton``, which checks and converts the arguments."""
     x = x0.copy()
     for _ in range(max_iter):
-        step = np.linalg.solve(jacobian(x, omega, eps, force, damping),
-                               -residual(x, omega, eps, force, damping))
+        step = np.linalg.solve(_jacobian(x, omega, eps, force, damping), -_residual(x, omega, eps, force, damping))
         x = x + step
         if np.max(np.abs(step)) <= tol * (1.0 + np.max(np.abs(x))):
             return x, True
     return x, False
+
+
+@njit(cache=True)
+def newton(x0, omega, eps, force, damping, tol=1e-13, max_iter=50):
+    """Newton's method on residual() with jacobian(); returns (x, converged).
+
+    ``x0``: a 1-D array of the 8 UNKNOWNS; the rest real numbers, ``max_iter`` an
+    integer.  TypeError or ValueError for anything else."""
+    if not _is_vector(x0):
+        raise TypeError("newton: x0 must be a 1-D array of 8 real numbers (UNKNOWNS)")
+    v = _vector(x0)
+    if v.size != 8:
+        raise ValueError("newton: x0 must have 8 elements, one per UNKNOWNS")
+    if not _is_real(omega):
+        raise TypeError("newton: omega must be a real number")
+    if not _is_real(eps):
+        raise TypeError("newton: eps must be a real number")
+    if not _is_real(force):
+        raise TypeError("newton: force must be a real number")
+    if not _is_real(damping):
+        raise TypeError("newton: damping must be a real number")
+    if not _is_real(tol):
+        raise TypeError("newton: tol must be a real number")
+    if not _is_integer(max_iter):
+        raise TypeError("newton: max_iter must be an integer")
+    return _newton(v, _real(omega), _real(eps), _real(force), _real(damping), _real(tol), _integer(max_iter))

@@ -6,9 +6,11 @@
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
 or arrays.  Outside its domain it returns NaN (see each docstring).  Its twin
-``<name>_into(out, ...)`` writes into a 1-D ``out``, each argument a float or a 1-D array of
-``out``'s length: a contiguous compiled loop that LLVM vectorises (the ufunc's strided loop
-cannot be)."""
+``<name>_into(out, ...)`` writes into ``out``, a writable 1-D C-contiguous float64 array, each
+argument a real number or a 1-D array of ``out``'s length (converted to float64; one that
+overlaps ``out`` is copied first): a contiguous compiled loop that LLVM vectorises (the
+ufunc's strided loop cannot be).  Anything else raises TypeError or ValueError before a single
+element is read or written."""
 
 import math
 
@@ -32,19 +34,74 @@ def _at_overload(v, i):
     return lambda v, i: v
 
 
-def _check(v, n):
-    """Raise unless an array argument has ``n`` elements (compiled only)."""
+def _apart(v, out):
+    """``v``, or a copy of it if it overlaps ``out`` (compiled only, through the overload):
+    every argument is then read as it was before the loop writes, as a ufunc reads it."""
     raise NotImplementedError
 
 
-@overload(_check)
-def _check_overload(v, n):
+@overload(_apart, inline="always")
+def _apart_overload(v, out):
     if isinstance(v, types.Array):
-        def check(v, n):
-            if v.ndim != 1 or v.size != n:
-                raise ValueError("each array argument must be 1-D with out's length")
-        return check
-    return lambda v, n: None
+        def apart(v, out):
+            start, end = v.ctypes.data, v.ctypes.data + v.size * v.itemsize
+            if start < out.ctypes.data + out.size * out.itemsize and out.ctypes.data < end:
+                return v.copy()
+            return v
+        return apart
+    return lambda v, out: v
+
+
+_FLOAT64 = np.dtype(np.float64)
+
+
+def _out(out, where):
+    """Raise unless ``out`` is a writable 1-D C-contiguous float64 array (O(1): no element is
+    read); the first line is the fast path."""
+    if type(out) is np.ndarray and out.dtype is _FLOAT64 and out.ndim == 1 and out.flags.carray:
+        return
+    if not isinstance(out, np.ndarray) or isinstance(out, np.ma.MaskedArray):
+        raise TypeError(f"{where}: out must be a numpy array of float64, got "
+                        f"{type(out).__name__}")
+    if out.dtype != _FLOAT64:
+        raise TypeError(f"{where}: out must have dtype float64, got {out.dtype}")
+    if out.ndim != 1:
+        raise ValueError(f"{where}: out must be 1-D, got shape {out.shape}")
+    if not out.flags.c_contiguous:
+        raise ValueError(f"{where}: out must be C-contiguous, got a strided view (strides "
+                         f"{out.strides}); pass a contiguous array, or use the ufunc's out=")
+    if not out.flags.writeable:
+        raise ValueError(f"{where}: out is read-only")
+
+
+def _arg(v, out, where, name):
+    """Argument ``name`` for the compiled loop: a float, or a C-contiguous float64 array of
+    ``out``'s length (``v`` itself if it is one, else a converted copy); TypeError or
+    ValueError for anything else.  O(1) unless a conversion is needed; the first test is the
+    fast path."""
+    if type(v) is np.ndarray and v.dtype is _FLOAT64 and v.ndim == 1 and v.flags.c_contiguous:
+        if v.size == out.size:
+            return v
+    elif isinstance(v, (float, int)):
+        try:
+            return float(v)
+        except OverflowError:
+            raise ValueError(f"{where}: {name} = {v} is beyond the range of float64") from None
+    else:
+        try:
+            v = np.asarray(v)
+        except (TypeError, ValueError) as exc:
+            raise TypeError(f"{where}: {name} must be a real number or a 1-D array of real "
+                            f"numbers ({exc})") from None
+        if v.dtype.kind not in "biuf":
+            raise TypeError(f"{where}: {name} must be a real number or a 1-D array of real "
+                            f"numbers, got dtype {v.dtype}")
+        if v.ndim == 0:
+            return float(v)
+        if v.shape == out.shape:
+            return np.ascontiguousarray(v, dtype=_FLOAT64)
+    raise ValueError(f"{where}: {name} must be a real number or a 1-D array of out's length "
+                     f"{out.size}, got shape {v.shape}")
 
 
 TRIG_LIMIT = 1048576.0
@@ -128,12 +185,12 @@ def A_1(omega, eps, force, branch):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def A_1_into(out, omega_in, eps_in, force_in, branch_in):
-    """``A_1`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(omega_in, out.size)
-    _check(eps_in, out.size)
-    _check(force_in, out.size)
-    _check(branch_in, out.size)
+def _A_1_into(out, omega_in, eps_in, force_in, branch_in):
+    """The loop behind ``A_1_into``, which checks and converts the arguments."""
+    omega_in = _apart(omega_in, out)
+    eps_in = _apart(eps_in, out)
+    force_in = _apart(force_in, out)
+    branch_in = _apart(branch_in, out)
     for i in range(out.size):
         omega = _at(omega_in, i)
         eps = _at(eps_in, i)
@@ -173,6 +230,23 @@ def A_1_into(out, omega_in, eps_in, force_in, branch_in):
     return out
 
 
+def A_1_into(out, omega, eps, force, branch):
+    """``A_1`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "A_1_into")
+    omega = _arg(omega, out, "A_1_into", "omega")
+    eps = _arg(eps, out, "A_1_into", "eps")
+    force = _arg(force, out, "A_1_into", "force")
+    branch = _arg(branch, out, "A_1_into", "branch")
+    if type(omega) is float and type(eps) is float and type(force) is float and type(branch) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(A_1(omega, eps, force, branch))
+        return out
+    return _A_1_into(out, omega, eps, force, branch)
+
+
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_3(omega, eps, force, branch):
     """Coefficient of cos 3ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
@@ -200,12 +274,12 @@ def A_3(omega, eps, force, branch):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def A_3_into(out, omega_in, eps_in, force_in, branch_in):
-    """``A_3`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(omega_in, out.size)
-    _check(eps_in, out.size)
-    _check(force_in, out.size)
-    _check(branch_in, out.size)
+def _A_3_into(out, omega_in, eps_in, force_in, branch_in):
+    """The loop behind ``A_3_into``, which checks and converts the arguments."""
+    omega_in = _apart(omega_in, out)
+    eps_in = _apart(eps_in, out)
+    force_in = _apart(force_in, out)
+    branch_in = _apart(branch_in, out)
     for i in range(out.size):
         omega = _at(omega_in, i)
         eps = _at(eps_in, i)
@@ -239,6 +313,23 @@ def A_3_into(out, omega_in, eps_in, force_in, branch_in):
     return out
 
 
+def A_3_into(out, omega, eps, force, branch):
+    """``A_3`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "A_3_into")
+    omega = _arg(omega, out, "A_3_into", "omega")
+    eps = _arg(eps, out, "A_3_into", "eps")
+    force = _arg(force, out, "A_3_into", "force")
+    branch = _arg(branch, out, "A_3_into", "branch")
+    if type(omega) is float and type(eps) is float and type(force) is float and type(branch) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(A_3(omega, eps, force, branch))
+        return out
+    return _A_3_into(out, omega, eps, force, branch)
+
+
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_5(omega, eps, force, branch):
     """Coefficient of cos 5ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
@@ -255,12 +346,12 @@ def A_5(omega, eps, force, branch):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def A_5_into(out, omega_in, eps_in, force_in, branch_in):
-    """``A_5`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(omega_in, out.size)
-    _check(eps_in, out.size)
-    _check(force_in, out.size)
-    _check(branch_in, out.size)
+def _A_5_into(out, omega_in, eps_in, force_in, branch_in):
+    """The loop behind ``A_5_into``, which checks and converts the arguments."""
+    omega_in = _apart(omega_in, out)
+    eps_in = _apart(eps_in, out)
+    force_in = _apart(force_in, out)
+    branch_in = _apart(branch_in, out)
     for i in range(out.size):
         omega = _at(omega_in, i)
         eps = _at(eps_in, i)
@@ -283,6 +374,23 @@ def A_5_into(out, omega_in, eps_in, force_in, branch_in):
     return out
 
 
+def A_5_into(out, omega, eps, force, branch):
+    """``A_5`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "A_5_into")
+    omega = _arg(omega, out, "A_5_into", "omega")
+    eps = _arg(eps, out, "A_5_into", "eps")
+    force = _arg(force, out, "A_5_into", "force")
+    branch = _arg(branch, out, "A_5_into", "branch")
+    if type(omega) is float and type(eps) is float and type(force) is float and type(branch) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(A_5(omega, eps, force, branch))
+        return out
+    return _A_5_into(out, omega, eps, force, branch)
+
+
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_7(omega, eps, force, branch):
     """Coefficient of cos 7ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
@@ -294,12 +402,12 @@ def A_7(omega, eps, force, branch):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def A_7_into(out, omega_in, eps_in, force_in, branch_in):
-    """``A_7`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(omega_in, out.size)
-    _check(eps_in, out.size)
-    _check(force_in, out.size)
-    _check(branch_in, out.size)
+def _A_7_into(out, omega_in, eps_in, force_in, branch_in):
+    """The loop behind ``A_7_into``, which checks and converts the arguments."""
+    omega_in = _apart(omega_in, out)
+    eps_in = _apart(eps_in, out)
+    force_in = _apart(force_in, out)
+    branch_in = _apart(branch_in, out)
     for i in range(out.size):
         omega = _at(omega_in, i)
         eps = _at(eps_in, i)
@@ -317,6 +425,23 @@ def A_7_into(out, omega_in, eps_in, force_in, branch_in):
     return out
 
 
+def A_7_into(out, omega, eps, force, branch):
+    """``A_7`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "A_7_into")
+    omega = _arg(omega, out, "A_7_into", "omega")
+    eps = _arg(eps, out, "A_7_into", "eps")
+    force = _arg(force, out, "A_7_into", "force")
+    branch = _arg(branch, out, "A_7_into", "branch")
+    if type(omega) is float and type(eps) is float and type(force) is float and type(branch) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(A_7(omega, eps, force, branch))
+        return out
+    return _A_7_into(out, omega, eps, force, branch)
+
+
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def first_order(omega, eps, force, branch):
     """A₁ of the branch: a real root of (ω² − 1)A₁ − ¾εA₁³ + f = 0."""
@@ -327,12 +452,12 @@ def first_order(omega, eps, force, branch):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def first_order_into(out, omega_in, eps_in, force_in, branch_in):
-    """``first_order`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(omega_in, out.size)
-    _check(eps_in, out.size)
-    _check(force_in, out.size)
-    _check(branch_in, out.size)
+def _first_order_into(out, omega_in, eps_in, force_in, branch_in):
+    """The loop behind ``first_order_into``, which checks and converts the arguments."""
+    omega_in = _apart(omega_in, out)
+    eps_in = _apart(eps_in, out)
+    force_in = _apart(force_in, out)
+    branch_in = _apart(branch_in, out)
     for i in range(out.size):
         omega = _at(omega_in, i)
         eps = _at(eps_in, i)
@@ -347,3 +472,20 @@ def first_order_into(out, omega_in, eps_in, force_in, branch_in):
         if math.isnan(out[i]):
             out[i] = first_order(_at(omega_in, i), _at(eps_in, i), _at(force_in, i), _at(branch_in, i))
     return out
+
+
+def first_order_into(out, omega, eps, force, branch):
+    """``first_order`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "first_order_into")
+    omega = _arg(omega, out, "first_order_into", "omega")
+    eps = _arg(eps, out, "first_order_into", "eps")
+    force = _arg(force, out, "first_order_into", "force")
+    branch = _arg(branch, out, "first_order_into", "branch")
+    if type(omega) is float and type(eps) is float and type(force) is float and type(branch) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(first_order(omega, eps, force, branch))
+        return out
+    return _first_order_into(out, omega, eps, force, branch)

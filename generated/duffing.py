@@ -6,9 +6,11 @@
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
 or arrays.  Outside its domain it returns NaN (see each docstring).  Its twin
-``<name>_into(out, ...)`` writes into a 1-D ``out``, each argument a float or a 1-D array of
-``out``'s length: a contiguous compiled loop that LLVM vectorises (the ufunc's strided loop
-cannot be)."""
+``<name>_into(out, ...)`` writes into ``out``, a writable 1-D C-contiguous float64 array, each
+argument a real number or a 1-D array of ``out``'s length (converted to float64; one that
+overlaps ``out`` is copied first): a contiguous compiled loop that LLVM vectorises (the
+ufunc's strided loop cannot be).  Anything else raises TypeError or ValueError before a single
+element is read or written."""
 
 import math
 
@@ -111,19 +113,74 @@ def _at_overload(v, i):
     return lambda v, i: v
 
 
-def _check(v, n):
-    """Raise unless an array argument has ``n`` elements (compiled only)."""
+def _apart(v, out):
+    """``v``, or a copy of it if it overlaps ``out`` (compiled only, through the overload):
+    every argument is then read as it was before the loop writes, as a ufunc reads it."""
     raise NotImplementedError
 
 
-@overload(_check)
-def _check_overload(v, n):
+@overload(_apart, inline="always")
+def _apart_overload(v, out):
     if isinstance(v, types.Array):
-        def check(v, n):
-            if v.ndim != 1 or v.size != n:
-                raise ValueError("each array argument must be 1-D with out's length")
-        return check
-    return lambda v, n: None
+        def apart(v, out):
+            start, end = v.ctypes.data, v.ctypes.data + v.size * v.itemsize
+            if start < out.ctypes.data + out.size * out.itemsize and out.ctypes.data < end:
+                return v.copy()
+            return v
+        return apart
+    return lambda v, out: v
+
+
+_FLOAT64 = np.dtype(np.float64)
+
+
+def _out(out, where):
+    """Raise unless ``out`` is a writable 1-D C-contiguous float64 array (O(1): no element is
+    read); the first line is the fast path."""
+    if type(out) is np.ndarray and out.dtype is _FLOAT64 and out.ndim == 1 and out.flags.carray:
+        return
+    if not isinstance(out, np.ndarray) or isinstance(out, np.ma.MaskedArray):
+        raise TypeError(f"{where}: out must be a numpy array of float64, got "
+                        f"{type(out).__name__}")
+    if out.dtype != _FLOAT64:
+        raise TypeError(f"{where}: out must have dtype float64, got {out.dtype}")
+    if out.ndim != 1:
+        raise ValueError(f"{where}: out must be 1-D, got shape {out.shape}")
+    if not out.flags.c_contiguous:
+        raise ValueError(f"{where}: out must be C-contiguous, got a strided view (strides "
+                         f"{out.strides}); pass a contiguous array, or use the ufunc's out=")
+    if not out.flags.writeable:
+        raise ValueError(f"{where}: out is read-only")
+
+
+def _arg(v, out, where, name):
+    """Argument ``name`` for the compiled loop: a float, or a C-contiguous float64 array of
+    ``out``'s length (``v`` itself if it is one, else a converted copy); TypeError or
+    ValueError for anything else.  O(1) unless a conversion is needed; the first test is the
+    fast path."""
+    if type(v) is np.ndarray and v.dtype is _FLOAT64 and v.ndim == 1 and v.flags.c_contiguous:
+        if v.size == out.size:
+            return v
+    elif isinstance(v, (float, int)):
+        try:
+            return float(v)
+        except OverflowError:
+            raise ValueError(f"{where}: {name} = {v} is beyond the range of float64") from None
+    else:
+        try:
+            v = np.asarray(v)
+        except (TypeError, ValueError) as exc:
+            raise TypeError(f"{where}: {name} must be a real number or a 1-D array of real "
+                            f"numbers ({exc})") from None
+        if v.dtype.kind not in "biuf":
+            raise TypeError(f"{where}: {name} must be a real number or a 1-D array of real "
+                            f"numbers, got dtype {v.dtype}")
+        if v.ndim == 0:
+            return float(v)
+        if v.shape == out.shape:
+            return np.ascontiguousarray(v, dtype=_FLOAT64)
+    raise ValueError(f"{where}: {name} must be a real number or a 1-D array of out's length "
+                     f"{out.size}, got shape {v.shape}")
 
 
 TRIG_LIMIT = 1048576.0
@@ -184,10 +241,10 @@ def omega(A, eps):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def omega_into(out, A_in, eps_in):
-    """``omega`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(A_in, out.size)
-    _check(eps_in, out.size)
+def _omega_into(out, A_in, eps_in):
+    """The loop behind ``omega_into``, which checks and converts the arguments."""
+    A_in = _apart(A_in, out)
+    eps_in = _apart(eps_in, out)
     for i in range(out.size):
         A = _at(A_in, i)
         eps = _at(eps_in, i)
@@ -197,6 +254,21 @@ def omega_into(out, A_in, eps_in):
             continue
         out[i] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + 0.011320983991026878) - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + 0.03955078125) - 0.08203125) + 0.375) + 1
     return out
+
+
+def omega_into(out, A, eps):
+    """``omega`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "omega_into")
+    A = _arg(A, out, "omega_into", "A")
+    eps = _arg(eps, out, "omega_into", "eps")
+    if type(A) is float and type(eps) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(omega(A, eps))
+        return out
+    return _omega_into(out, A, eps)
 
 
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -209,10 +281,10 @@ def period(A, eps):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def period_into(out, A_in, eps_in):
-    """``period`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(A_in, out.size)
-    _check(eps_in, out.size)
+def _period_into(out, A_in, eps_in):
+    """The loop behind ``period_into``, which checks and converts the arguments."""
+    A_in = _apart(A_in, out)
+    eps_in = _apart(eps_in, out)
     for i in range(out.size):
         A = _at(A_in, i)
         eps = _at(eps_in, i)
@@ -222,6 +294,21 @@ def period_into(out, A_in, eps_in):
             continue
         out[i] = 2*math.pi*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) - 0.0651973094791174) + 0.07641269266605377) - 0.09219503402709961) + 0.11575698852539062) - 0.15380859375) + 0.22265625) - 0.375) + 1)
     return out
+
+
+def period_into(out, A, eps):
+    """``period`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "period_into")
+    A = _arg(A, out, "period_into", "A")
+    eps = _arg(eps, out, "period_into", "eps")
+    if type(A) is float and type(eps) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(period(A, eps))
+        return out
+    return _period_into(out, A, eps)
 
 
 @vectorize(["float64(float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -250,11 +337,11 @@ def q(t, A, eps):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def q_into(out, t_in, A_in, eps_in):
-    """``q`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(t_in, out.size)
-    _check(A_in, out.size)
-    _check(eps_in, out.size)
+def _q_into(out, t_in, A_in, eps_in):
+    """The loop behind ``q_into``, which checks and converts the arguments."""
+    t_in = _apart(t_in, out)
+    A_in = _apart(A_in, out)
+    eps_in = _apart(eps_in, out)
     for i in range(out.size):
         t = _at(t_in, i)
         A = _at(A_in, i)
@@ -284,6 +371,22 @@ def q_into(out, t_in, A_in, eps_in):
         if math.isnan(out[i]):
             out[i] = q(_at(t_in, i), _at(A_in, i), _at(eps_in, i))
     return out
+
+
+def q_into(out, t, A, eps):
+    """``q`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "q_into")
+    t = _arg(t, out, "q_into", "t")
+    A = _arg(A, out, "q_into", "A")
+    eps = _arg(eps, out, "q_into", "eps")
+    if type(t) is float and type(A) is float and type(eps) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(q(t, A, eps))
+        return out
+    return _q_into(out, t, A, eps)
 
 
 @vectorize(["float64(float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -325,11 +428,11 @@ def qdot(t, A, eps):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def qdot_into(out, t_in, A_in, eps_in):
-    """``qdot`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(t_in, out.size)
-    _check(A_in, out.size)
-    _check(eps_in, out.size)
+def _qdot_into(out, t_in, A_in, eps_in):
+    """The loop behind ``qdot_into``, which checks and converts the arguments."""
+    t_in = _apart(t_in, out)
+    A_in = _apart(A_in, out)
+    eps_in = _apart(eps_in, out)
     for i in range(out.size):
         t = _at(t_in, i)
         A = _at(A_in, i)
@@ -374,6 +477,22 @@ def qdot_into(out, t_in, A_in, eps_in):
     return out
 
 
+def qdot_into(out, t, A, eps):
+    """``qdot`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "qdot_into")
+    t = _arg(t, out, "qdot_into", "t")
+    A = _arg(A, out, "qdot_into", "A")
+    eps = _arg(eps, out, "qdot_into", "eps")
+    if type(t) is float and type(A) is float and type(eps) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(qdot(t, A, eps))
+        return out
+    return _qdot_into(out, t, A, eps)
+
+
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def error_estimate(A, eps):
     """Relative truncation error of period(), from the first omitted term |τ_{K+1} y^(K+1)| / (1 - |y|/R) over the truncated sum."""
@@ -385,10 +504,10 @@ def error_estimate(A, eps):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def error_estimate_into(out, A_in, eps_in):
-    """``error_estimate`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(A_in, out.size)
-    _check(eps_in, out.size)
+def _error_estimate_into(out, A_in, eps_in):
+    """The loop behind ``error_estimate_into``, which checks and converts the arguments."""
+    A_in = _apart(A_in, out)
+    eps_in = _apart(eps_in, out)
     for i in range(out.size):
         A = _at(A_in, i)
         eps = _at(eps_in, i)
@@ -399,3 +518,18 @@ def error_estimate_into(out, A_in, eps_in):
         T = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) - 0.0651973094791174) + 0.07641269266605377) - 0.09219503402709961) + 0.11575698852539062) - 0.15380859375) + 0.22265625) - 0.375) + 1
         out[i] = (0.03473509559274875)*abs(x)**13/((1 - abs(x))*abs(T))
     return out
+
+
+def error_estimate_into(out, A, eps):
+    """``error_estimate`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "error_estimate_into")
+    A = _arg(A, out, "error_estimate_into", "A")
+    eps = _arg(eps, out, "error_estimate_into", "eps")
+    if type(A) is float and type(eps) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(error_estimate(A, eps))
+        return out
+    return _error_estimate_into(out, A, eps)

@@ -6,9 +6,11 @@
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
 or arrays.  Outside its domain it returns NaN (see each docstring).  Its twin
-``<name>_into(out, ...)`` writes into a 1-D ``out``, each argument a float or a 1-D array of
-``out``'s length: a contiguous compiled loop that LLVM vectorises (the ufunc's strided loop
-cannot be)."""
+``<name>_into(out, ...)`` writes into ``out``, a writable 1-D C-contiguous float64 array, each
+argument a real number or a 1-D array of ``out``'s length (converted to float64; one that
+overlaps ``out`` is copied first): a contiguous compiled loop that LLVM vectorises (the
+ufunc's strided loop cannot be).  Anything else raises TypeError or ValueError before a single
+element is read or written."""
 
 import math
 
@@ -111,19 +113,74 @@ def _at_overload(v, i):
     return lambda v, i: v
 
 
-def _check(v, n):
-    """Raise unless an array argument has ``n`` elements (compiled only)."""
+def _apart(v, out):
+    """``v``, or a copy of it if it overlaps ``out`` (compiled only, through the overload):
+    every argument is then read as it was before the loop writes, as a ufunc reads it."""
     raise NotImplementedError
 
 
-@overload(_check)
-def _check_overload(v, n):
+@overload(_apart, inline="always")
+def _apart_overload(v, out):
     if isinstance(v, types.Array):
-        def check(v, n):
-            if v.ndim != 1 or v.size != n:
-                raise ValueError("each array argument must be 1-D with out's length")
-        return check
-    return lambda v, n: None
+        def apart(v, out):
+            start, end = v.ctypes.data, v.ctypes.data + v.size * v.itemsize
+            if start < out.ctypes.data + out.size * out.itemsize and out.ctypes.data < end:
+                return v.copy()
+            return v
+        return apart
+    return lambda v, out: v
+
+
+_FLOAT64 = np.dtype(np.float64)
+
+
+def _out(out, where):
+    """Raise unless ``out`` is a writable 1-D C-contiguous float64 array (O(1): no element is
+    read); the first line is the fast path."""
+    if type(out) is np.ndarray and out.dtype is _FLOAT64 and out.ndim == 1 and out.flags.carray:
+        return
+    if not isinstance(out, np.ndarray) or isinstance(out, np.ma.MaskedArray):
+        raise TypeError(f"{where}: out must be a numpy array of float64, got "
+                        f"{type(out).__name__}")
+    if out.dtype != _FLOAT64:
+        raise TypeError(f"{where}: out must have dtype float64, got {out.dtype}")
+    if out.ndim != 1:
+        raise ValueError(f"{where}: out must be 1-D, got shape {out.shape}")
+    if not out.flags.c_contiguous:
+        raise ValueError(f"{where}: out must be C-contiguous, got a strided view (strides "
+                         f"{out.strides}); pass a contiguous array, or use the ufunc's out=")
+    if not out.flags.writeable:
+        raise ValueError(f"{where}: out is read-only")
+
+
+def _arg(v, out, where, name):
+    """Argument ``name`` for the compiled loop: a float, or a C-contiguous float64 array of
+    ``out``'s length (``v`` itself if it is one, else a converted copy); TypeError or
+    ValueError for anything else.  O(1) unless a conversion is needed; the first test is the
+    fast path."""
+    if type(v) is np.ndarray and v.dtype is _FLOAT64 and v.ndim == 1 and v.flags.c_contiguous:
+        if v.size == out.size:
+            return v
+    elif isinstance(v, (float, int)):
+        try:
+            return float(v)
+        except OverflowError:
+            raise ValueError(f"{where}: {name} = {v} is beyond the range of float64") from None
+    else:
+        try:
+            v = np.asarray(v)
+        except (TypeError, ValueError) as exc:
+            raise TypeError(f"{where}: {name} must be a real number or a 1-D array of real "
+                            f"numbers ({exc})") from None
+        if v.dtype.kind not in "biuf":
+            raise TypeError(f"{where}: {name} must be a real number or a 1-D array of real "
+                            f"numbers, got dtype {v.dtype}")
+        if v.ndim == 0:
+            return float(v)
+        if v.shape == out.shape:
+            return np.ascontiguousarray(v, dtype=_FLOAT64)
+    raise ValueError(f"{where}: {name} must be a real number or a 1-D array of out's length "
+                     f"{out.size}, got shape {v.shape}")
 
 
 TRIG_LIMIT = 1048576.0
@@ -184,9 +241,9 @@ def omega(theta0):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def omega_into(out, theta0_in):
-    """``omega`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(theta0_in, out.size)
+def _omega_into(out, theta0_in):
+    """The loop behind ``omega_into``, which checks and converts the arguments."""
+    theta0_in = _apart(theta0_in, out)
     for i in range(out.size):
         theta0 = _at(theta0_in, i)
         x = theta0**2
@@ -195,6 +252,20 @@ def omega_into(out, theta0_in):
             continue
         out[i] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) - 9.840751922602837e-10) - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) - 3.1195746527777775e-05) + 0.0003255208333333333) - 0.0625) + 1
     return out
+
+
+def omega_into(out, theta0):
+    """``omega`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "omega_into")
+    theta0 = _arg(theta0, out, "omega_into", "theta0")
+    if type(theta0) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(omega(theta0))
+        return out
+    return _omega_into(out, theta0)
 
 
 @vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -207,9 +278,9 @@ def period(theta0):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def period_into(out, theta0_in):
-    """``period`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(theta0_in, out.size)
+def _period_into(out, theta0_in):
+    """The loop behind ``period_into``, which checks and converts the arguments."""
+    theta0_in = _apart(theta0_in, out)
     for i in range(out.size):
         theta0 = _at(theta0_in, i)
         x = theta0**2
@@ -218,6 +289,20 @@ def period_into(out, theta0_in):
             continue
         out[i] = 2*math.pi*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.225550505750492e-14)*x + 6.706433207421971e-13) + 7.286018609303663e-12) + 7.997964280393218e-11) + 8.893476960263209e-10) + 1.0054783016898737e-08) + 1.162356190273135e-07) + 1.3867625063268805e-06) + 1.735611567421565e-05) + 0.00023464626736111112) + 0.0035807291666666665) + 0.0625) + 1)
     return out
+
+
+def period_into(out, theta0):
+    """``period`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "period_into")
+    theta0 = _arg(theta0, out, "period_into", "theta0")
+    if type(theta0) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(period(theta0))
+        return out
+    return _period_into(out, theta0)
 
 
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -246,10 +331,10 @@ def theta(t, theta0):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def theta_into(out, t_in, theta0_in):
-    """``theta`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(t_in, out.size)
-    _check(theta0_in, out.size)
+def _theta_into(out, t_in, theta0_in):
+    """The loop behind ``theta_into``, which checks and converts the arguments."""
+    t_in = _apart(t_in, out)
+    theta0_in = _apart(theta0_in, out)
     for i in range(out.size):
         t = _at(t_in, i)
         theta0 = _at(theta0_in, i)
@@ -278,6 +363,21 @@ def theta_into(out, t_in, theta0_in):
         if math.isnan(out[i]):
             out[i] = theta(_at(t_in, i), _at(theta0_in, i))
     return out
+
+
+def theta_into(out, t, theta0):
+    """``theta`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "theta_into")
+    t = _arg(t, out, "theta_into", "t")
+    theta0 = _arg(theta0, out, "theta_into", "theta0")
+    if type(t) is float and type(theta0) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(theta(t, theta0))
+        return out
+    return _theta_into(out, t, theta0)
 
 
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -319,10 +419,10 @@ def thetadot(t, theta0):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def thetadot_into(out, t_in, theta0_in):
-    """``thetadot`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(t_in, out.size)
-    _check(theta0_in, out.size)
+def _thetadot_into(out, t_in, theta0_in):
+    """The loop behind ``thetadot_into``, which checks and converts the arguments."""
+    t_in = _apart(t_in, out)
+    theta0_in = _apart(theta0_in, out)
     for i in range(out.size):
         t = _at(t_in, i)
         theta0 = _at(theta0_in, i)
@@ -366,6 +466,21 @@ def thetadot_into(out, t_in, theta0_in):
     return out
 
 
+def thetadot_into(out, t, theta0):
+    """``thetadot`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "thetadot_into")
+    t = _arg(t, out, "thetadot_into", "t")
+    theta0 = _arg(theta0, out, "thetadot_into", "theta0")
+    if type(t) is float and type(theta0) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(thetadot(t, theta0))
+        return out
+    return _thetadot_into(out, t, theta0)
+
+
 @vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def error_estimate(theta0):
     """Relative truncation error of period(), from the first omitted term |τ_{K+1} y^(K+1)| / (1 - |y|/R) over the truncated sum."""
@@ -377,9 +492,9 @@ def error_estimate(theta0):
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def error_estimate_into(out, theta0_in):
-    """``error_estimate`` into ``out`` (1-D); each argument a float or a 1-D array of its length."""
-    _check(theta0_in, out.size)
+def _error_estimate_into(out, theta0_in):
+    """The loop behind ``error_estimate_into``, which checks and converts the arguments."""
+    theta0_in = _apart(theta0_in, out)
     for i in range(out.size):
         theta0 = _at(theta0_in, i)
         x = theta0**2
@@ -389,3 +504,17 @@ def error_estimate_into(out, theta0_in):
         T = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.225550505750492e-14)*x + 6.706433207421971e-13) + 7.286018609303663e-12) + 7.997964280393218e-11) + 8.893476960263209e-10) + 1.0054783016898737e-08) + 1.162356190273135e-07) + 1.3867625063268805e-06) + 1.735611567421565e-05) + 0.00023464626736111112) + 0.0035807291666666665) + 0.0625) + 1
         out[i] = (5.8202915552354634e-15)*abs(x)**13/((-abs(x)/math.pi**2 + 1)*abs(T))
     return out
+
+
+def error_estimate_into(out, theta0):
+    """``error_estimate`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
+    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
+    anything else, before ``out`` is touched."""
+    _out(out, "error_estimate_into")
+    theta0 = _arg(theta0, out, "error_estimate_into", "theta0")
+    if type(theta0) is float:
+        # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
+        # whose arguments are all scalars.
+        out.fill(error_estimate(theta0))
+        return out
+    return _error_estimate_into(out, theta0)

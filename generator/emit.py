@@ -134,6 +134,8 @@ def _kernel_context(k: ArrayKernel) -> dict:
         "name": k.name,
         "doc": k.doc,
         "args": ", ".join(["x", *(str(a) for a in k.args)]),
+        "params": [str(a) for a in k.args],
+        "size": len(k.unpack),
         "unpack": [(str(u), i) for i, u in enumerate(k.unpack)],
         "shape": repr(k.shape),
         "subexprs": [(str(lhs), pycode(rhs)) for lhs, rhs in k.subexprs],
