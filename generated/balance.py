@@ -2,6 +2,7 @@
 # model: balance, order: 4
 # command: lindstedt generate balance --harmonics 4
 # inputs sha256: b5d2168261d8c00fcb65880bc8741f3c5a26a9f4dd1fe0fb56b56d98742758bc
+# body sha256: 26d52aa1d27e02143bf258444cddc84165038a951d2d4c2fbd927bef3263e467
 """Driven Duffing q'' + damping*q' + q + eps*q**3 = force*cos(omega t): harmonic balance with 4 odd harmonics.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars

@@ -2,6 +2,7 @@
 # model: driven, order: 3
 # command: lindstedt generate driven --order 3
 # inputs sha256: cef33ff01dffb2211c3af2d37365f7b8bff5e57c04ba6b53bf77b6cbbf023e34
+# body sha256: 9998673c12fd021a29a58a19e23c9173d23dc985709e2b10770f65dd8288f3c7
 """Driven Duffing q'' + q + eps*q**3 = f cos(omega t): μ-expansion to order 3.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars

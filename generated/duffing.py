@@ -2,6 +2,7 @@
 # model: duffing, order: 12
 # command: lindstedt generate duffing --order 12
 # inputs sha256: 66ca4a0e4d6afa8046c93839a6f1efa563f457106a4ae4f18222a37b87ca56f2
+# body sha256: 3a70d70b14f4880e71753e10e366799935997e881fa2357ca2b835a986090f01
 """q'' + q + eps*q**3 = 0: L–P evaluators to order 12 in x = eps*A**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars

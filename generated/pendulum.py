@@ -2,6 +2,7 @@
 # model: pendulum, order: 12
 # command: lindstedt generate pendulum --order 12
 # inputs sha256: 6fcce3511537eefba5811a51b08a2782afc0aa28c580df8a68986c0c25550d54
+# body sha256: 02abd87bf19b3fc9def935225c900db19d7196ec5b0b4d8407e0f565eaecf297
 """theta'' + sin(theta) = 0: L–P evaluators to order 12 in theta0**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import unicodedata
 from dataclasses import dataclass
 
 import sympy as sp
@@ -24,6 +25,30 @@ from .printers import identifier
 Assign = tuple[sp.Symbol, sp.Expr]
 
 
+def _unsafe(ch: str) -> bool:
+    """Control, format, surrogate, private or unassigned, line or paragraph separator."""
+    category = unicodedata.category(ch)
+    return category[0] == "C" or category in ("Zl", "Zp")
+
+
+def one_line(text: str) -> str:
+    """``text`` as data on one line of a generated file: every character that could end a
+    comment line or hide text (newline, other controls, separators) becomes a visible escape.
+
+    >>> one_line("lindstedt generate\\nimport os")
+    'lindstedt generate\\\\nimport os'
+    """
+    return "".join(ch.encode("unicode_escape").decode("ascii") if _unsafe(ch) else ch
+                   for ch in str(text))
+
+
+def docstring_text(text: str) -> str:
+    """``text`` as data inside a generated ``\"\"\"`` docstring: backslashes and quotes
+    escaped (no quote can close it), lines kept, other unsafe characters escaped."""
+    text = str(text).replace("\\", "\\\\").replace('"', '\\"')
+    return "\n".join(one_line(line) for line in text.split("\n"))
+
+
 @dataclass(frozen=True)
 class Evaluator:
     """Everything needed to emit one numba ufunc."""
@@ -35,6 +60,9 @@ class Evaluator:
     guard: sp.Basic  # SymPy boolean; false -> NaN
     body: tuple[Assign, ...]
     output: sp.Expr
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "doc", docstring_text(self.doc))
 
 
 @dataclass(frozen=True)
@@ -50,6 +78,9 @@ class ArrayKernel:
     subexprs: tuple[Assign, ...]
     entries: tuple[tuple[tuple[int, ...], sp.Expr], ...]
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "doc", docstring_text(self.doc))
+
 
 @dataclass(frozen=True)
 class Provenance:
@@ -59,6 +90,10 @@ class Provenance:
     order: int
     command: str
     inputs: str  # sha256 of the canonical description of the inputs
+
+    def __post_init__(self) -> None:
+        # NOTE: the command is the caller's text: it reaches the banner only as one line of data.
+        object.__setattr__(self, "command", one_line(self.command))
 
     @property
     def version(self) -> str:
@@ -76,6 +111,9 @@ class Module:
     provenance: Provenance
     kernels: tuple[ArrayKernel, ...] = ()
     newton: bool = False  # emit newton(x0, …) driving the kernels "residual" and "jacobian"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "doc", docstring_text(self.doc))
 
 
 def provenance(model: str, order: int, command: str, **inputs: object) -> Provenance:

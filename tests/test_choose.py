@@ -352,3 +352,22 @@ def test_choose_emits_the_driven_module_it_verified(tmp_path):
         orbit = shoot(0.1, 1.0, w, 0.0, np.array([2.4, 0.0]))
         assert abs(mod.A_1(w, 0.1, 1.0, 0) - orbit.A[1]) <= 1e-4
     del sys.modules["driven"]
+
+
+def test_period_choice_ignores_the_runs_timings(monkeypatch):
+    """The choice is made by the recorded cost model: timings that would rank the methods in
+    the opposite order (a loaded machine) change the reported costs, never the choice."""
+    from lindstedt import choose
+
+    picks = set()
+    for slow_first in (False, True):
+        rank = {m: i for i, m in enumerate(sorted(choose.COST_MODEL["period"],
+                                                  reverse=slow_first))}
+        monkeypatch.setattr(choose, "ns_per_point", lambda c, rank=rank, **kw: 1.0 + rank[c.method])
+        c = choose_period(1e-12, -0.5, 0.5)
+        picks.add((c.method, c.order))
+        assert dict((m, ns) for m, _, _, ns in c.considered)[c.method] == 1.0 + rank[c.method]
+    assert len(picks) == 1
+    method, order = picks.pop()
+    floor = min(choose.modelled_ns("period", m, o) for m, o, _, _ in c.considered)
+    assert choose.modelled_ns("period", method, order) <= (1 + choose.TIE) * floor
