@@ -1,20 +1,23 @@
 """lindstedt: exact perturbation series for nonlinear oscillators, emitted as code and LaTeX.
 
-The pipeline, one module per stage (input -> output)::
+The pipeline, one module per stage (input -> output); a stage imports only stages above it::
 
-    models     oscillator definitions (frozen dataclasses)           -> Model
-    series     exact Fourier algebra in the monomial basis of cos s  (the fast kernel)
-    lindstedt  L–P series, order-by-order equations, naive expansion Model, order -> SeriesSolution
-    driven     μ-expansion with phase, harmonic balance          Drive, order -> branches
-    response   one-harmonic curves and folds, balance continuation  Drive, ω range -> folds
-    choose     methods × orders, verified error and measured cost    tol, range -> Choice
+    models     oscillator definitions (frozen dataclasses)              -> Model
+    series     exact Fourier algebra in the monomial basis of cos s     (the fast kernel)
+    lindstedt  L–P series, order-by-order equations, naive expansion    Model, K -> SeriesSolution
     numerics   references: elliptic periods, Jacobi cn, shooting + Floquet, sweeps, true folds
-    sweep      grids of driven maps on dask.distributed into resumable Zarr  kind, axes -> Dataset
-    lower      solutions -> IR records (Evaluator, Module)           Horner, Chebyshev recurrence
-    printers   NumbaPrinter(PythonCodePrinter), LaTeX rationals      Expr -> str
-    emit       strict Jinja2 environments, provenance, atomic writes IR -> files in generated/
-    charts     matplotlib figures                                results -> PNG/SVG/PDF
-    cli        the command line
+    driven     μ-expansion with phase, harmonic balance                 Drive, order -> branches
+    response   one-harmonic curves and folds, balance continuation      Drive, ω range -> folds
+    printers   NumbaPrinter(PythonCodePrinter), LaTeX rationals         Expr -> str
+    lower      solutions -> IR records (Evaluator, Module)              Horner, Chebyshev recurrence
+    emit       strict Jinja2 environments, provenance, one-unit writes  IR -> files
+    choose     methods × orders, verified error, recorded cost model    tol, range -> Choice
+    sweep      driven maps over grids on dask.distributed, into Zarr    kind, axes -> Dataset
+    charts     matplotlib figures                                       results -> PNG/SVG/PDF
+    cli        the command line (each command imports its stages itself)
+
+Beside the stages: ``errors`` (the one-line InputError) and ``display`` (Jupyter's LaTeX and
+HTML reprs), which import no stage.
 """
 
 __version__ = "0.1.0"
