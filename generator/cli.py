@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import re
 import sys
 import time
@@ -23,12 +24,19 @@ SCENE_NAMES = ("clock", "hard-spring", "notes-driven")
 # NOTE: choose.SCENES's keys, likewise.
 DRIVEN_QUANTITIES = ("amplitudes", "response")
 # NOTE: choose.DRIVEN_QUANTITIES, likewise.
+SWEEP_KINDS = ("response", "stability", "subharmonic", "validity")
+# NOTE: sweep.KINDS's keys, likewise.
 DEFAULT_ORDER = 4
 # NOTE: one default for every --order: it works for every command (`generate driven` at order 4
 # takes ~13 s, at 6 about 4 min) and keeps T(A) within 1e-4 for |εA²| ≤ 0.3; ask for more.
 DEFAULT_HARMONICS = 8
 # NOTE: one default for every --harmonics: 8 odd harmonics put the response's folds on the true
 # orbit's to 12 digits at the notes' parameters (`generate balance` compiles them in ~20 s).
+MAX_HARMONICS = 100
+# NOTE: driven.MAX_HARMONICS, restated (a test keeps them equal): one bound for every
+# --harmonics.  The numerical balance and shooting's sampling take up to 100; the emitted
+# modules stop earlier (balance 12, fourier 60) and say so; the response's continuation
+# refuses what it estimates at over a minute.
 COST_LIMIT_SECONDS = 60.0
 # NOTE: above this estimate the CLI asks for --allow-slow instead of running for minutes or hours.
 PROGRESS_AFTER_SECONDS = 2.0
@@ -68,14 +76,42 @@ def estimated_seconds(model: str, order: int) -> float:
     Duffing grows like K^3.5 (13.6 s at K = 300); the pendulum, which needs every power
     u^(2k+1) up to k = K, like K^4.6 (22 s at K = 100).
     """
-    if model == "pendulum":
-        return 22.0 * (order / 100) ** 4.6
-    return 13.6 * (order / 300) ** 3.5
+    scale, seconds, power = (100, 22.0, 4.6) if model == "pendulum" else (300, 13.6, 3.5)
+    log = math.log(seconds) + power * (math.log(max(order, 1)) - math.log(scale))
+    return math.exp(log) if log < 700 else math.inf  # an order of 10**100 digits is inf s
 
 
-def _check_cost(args: argparse.Namespace, cost: float, what: str) -> None:
+GENERATE_COSTS = {
+    # model: (fixed s, s at the reference size, reference size, growth: power, or "exp" base)
+    "duffing": (2.5, 80.0, 100, 2.2),
+    "pendulum": (2.5, 76.0, 80, 4.0),
+    "balance": (3.0, 59.0, 12, 4.0),
+    "fourier": (3.5, 0.0, 60, 1.0),
+    "driven": (12.0, 29.0, 5, "6"),
+}
+# NOTE: wall time of `lindstedt generate MODEL` (derive, lower, print, compile) against its size
+# (--order; --harmonics for balance and fourier), each fitted to its own runs of
+# benchmarks/command_costs.py on the 2-core machine; the fit is compared with fresh runs there.
+GENERATE_MAX_ORDER = 130
+# NOTE: SymPy's printer recurses once per level of a Horner form: duffing at order 140 exceeds
+# Python's recursion limit (130 prints), so generate stops there, whatever --allow-slow says.
+
+
+def generate_seconds(model: str, size: int) -> float:
+    """Estimated wall time of ``lindstedt generate MODEL`` at ``size`` (see GENERATE_COSTS)."""
+    fixed, at_reference, reference, growth = GENERATE_COSTS[model]
+    if isinstance(growth, str):  # exponential in the order: base per order
+        log = math.log(at_reference) + (size - reference) * math.log(float(growth))
+    else:
+        log = math.log(at_reference or 1e-300) + growth * math.log(max(size, 1) / reference)
+    return fixed + (math.exp(log) if log < 700 else math.inf)
+
+
+def _check_cost(args: argparse.Namespace, cost: float, what: str,
+                subject: str | None = None) -> None:
     if cost > COST_LIMIT_SECONDS and not args.allow_slow:
-        raise InputError(f"order {args.order}: about {cost:,.0f} s of {what} on this machine; "
+        about = f"about {cost:,.0f} s" if math.isfinite(cost) else "more than 1e300 s"
+        raise InputError(f"{subject or f'order {args.order}'}: {about} of {what} on this machine; "
                          "pass --allow-slow to run it")
 
 
@@ -131,21 +167,27 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     if args.model == "driven" and order > DRIVEN_MAX_ORDER:
         raise InputError(f"order {order}: the exact μ-expansion is emitted up to order "
                          f"{DRIVEN_MAX_ORDER} (its rational functions grow fast)")
-    _check_cost(args, estimated_seconds(args.model, order + 2), "derivation")
+    if args.model in FREE_MODELS and order > GENERATE_MAX_ORDER:
+        raise InputError(f"order {order}: generate stops at order {GENERATE_MAX_ORDER} (the code "
+                         "printer's nesting limit); `lindstedt series` derives higher orders")
+    size = args.harmonics if args.model in ("balance", "fourier") else order
+    subject = f"--harmonics {size}" if args.model in ("balance", "fourier") else None
+    _check_cost(args, generate_seconds(args.model, size), f"generating {args.model}", subject)
     if args.model in ("driven", "balance", "fourier") and args.allow_divergent:
         raise InputError(f"--allow-divergent: the {args.model} evaluators have no radius to lift")
     from . import emit
 
     out = _out_folder(args.out)
     if args.model == "driven":
-        paths = emit.generate_driven(order, out)
+        paths = emit.generate_driven(order, out, overwrite_edited=args.overwrite_edited)
     elif args.model == "balance":
-        paths = emit.generate_balance(args.harmonics, out)
+        paths = emit.generate_balance(args.harmonics, out, overwrite_edited=args.overwrite_edited)
     elif args.model == "fourier":
-        paths = emit.generate_fourier(args.harmonics, out)
+        paths = emit.generate_fourier(args.harmonics, out, overwrite_edited=args.overwrite_edited)
     else:
         progress = Progress(f"deriving {args.model} to order {order + 2}")
-        paths = emit.generate(args.model, order, out, args.allow_divergent, progress)
+        paths = emit.generate(args.model, order, out, args.allow_divergent, progress,
+                              overwrite_edited=args.overwrite_edited)
         progress.close()
     for path in paths:
         print(path)
@@ -173,6 +215,7 @@ BALANCE_HARMONICS = 4
 def _cmd_demo(args: argparse.Namespace) -> int:
     """The main job on the built-in defaults: derive, emit, evaluate against exact, typeset.
     Everything it writes goes under ``--out``: evaluators and LaTeX, ``figures/``, the PDFs."""
+    out = _out_folder(args.out)  # before the heavy imports: an empty --out answers at once
     import shutil
     import subprocess
 
@@ -189,20 +232,21 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from .models import model_by_name
     from .numerics import duffing_period_exact, pendulum_period_exact
 
-    out = _out_folder(args.out)
     figures = out / "figures"
     modules = ["duffing", "pendulum", "driven", "balance"]
     check_writable(out, [*(f"{m}.py" for m in modules), "duffing_tables.tex",
                          "duffing_derivation.tex", "pendulum_tables.tex",
-                         "pendulum_derivation.tex", "driven_derivation.tex"])
+                         "pendulum_derivation.tex", "driven_derivation.tex"],
+                   overwrite_edited=args.overwrite_edited)
     figures.mkdir(parents=True, exist_ok=True)
     check_plot_path(figures / "speed_accuracy.png")
     print(series_table(derive(model_by_name("duffing", 6), 6)))
     print(f"\nwriting the default evaluators and LaTeX into {out}/")
     for name in ("duffing", "pendulum"):
-        for path in generate(name, DEMO_ORDER, out):
+        for path in generate(name, DEMO_ORDER, out, overwrite_edited=args.overwrite_edited):
             print(f"  {path}")
-    for path in [*generate_driven(DRIVEN_ORDER, out), *generate_balance(BALANCE_HARMONICS, out)]:
+    for path in [*generate_driven(DRIVEN_ORDER, out, overwrite_edited=args.overwrite_edited),
+                 *generate_balance(BALANCE_HARMONICS, out, overwrite_edited=args.overwrite_edited)]:
         print(f"  {path}")
     duf = load_generated(out / "duffing.py")
     x = np.array([-0.9, -0.5, -0.1, 0.1, 0.5, 0.9])
@@ -319,9 +363,10 @@ def driven_table(data: dict) -> str:
 
 
 def _cmd_driven(args: argparse.Namespace) -> int:
-    from .driven import Drive
+    from .driven import Drive, check_steady_state
 
     d = Drive(args.eps, args.force, args.omega, args.Q)
+    check_steady_state(d.eps, d.Q, d.omega)
     data = driven_json(d, args.order, args.harmonics)
     print(json.dumps(data) if args.json else driven_table(data))
     return 0
@@ -365,10 +410,9 @@ def response_json(eps: float, force: float, Q: float, harmonics: int) -> dict:
 
 def _report(args: argparse.Namespace, compute, draw, table) -> int:
     """The shape of every effect command: check the plot path first (nothing is computed for
-    a figure that cannot be written), compute, draw, print JSON or the table."""
-    from .charts import check_plot_path
-
-    plot = check_plot_path(Path(args.plot)) if args.plot else None
+    a figure that cannot be written), compute, draw, print JSON or the table.  matplotlib
+    is imported only for --plot (a refused input answers without it)."""
+    plot = _charts().check_plot_path(Path(args.plot)) if args.plot else None
     data = compute()
     if plot is not None:
         draw(plot)
@@ -376,12 +420,17 @@ def _report(args: argparse.Namespace, compute, draw, table) -> int:
     return 0
 
 
-def _cmd_response(args: argparse.Namespace) -> int:
-    from .charts import response_figure
+def _charts():
+    from . import charts
 
+    return charts
+
+
+def _cmd_response(args: argparse.Namespace) -> int:
     return _report(
         args, lambda: response_json(args.eps, args.force, args.Q, args.harmonics),
-        lambda path: response_figure(args.eps, args.force, args.Q, args.harmonics, path),
+        lambda path: _charts().response_figure(args.eps, args.force, args.Q, args.harmonics,
+                                               path),
         _response_table)
 
 
@@ -427,10 +476,8 @@ def subharmonic_json(eps: float, force: float, omega: float) -> dict:
 
 
 def _cmd_subharmonic(args: argparse.Namespace) -> int:
-    from .charts import subharmonic_figure
-
     return _report(args, lambda: subharmonic_json(args.eps, args.force, args.omega),
-                   lambda path: subharmonic_figure(args.eps, args.force, path),
+                   lambda path: _charts().subharmonic_figure(args.eps, args.force, path),
                    _subharmonic_table)
 
 
@@ -451,12 +498,10 @@ def _subharmonic_table(data: dict) -> list[str]:
 
 def mixing_json(eps: float, Q: float, drives: list[tuple[float, float]]) -> dict:
     """The contract of ``lindstedt mixing … --json``: predicted and simulated tones."""
-    from .numerics import steady_state_amplitudes
-    from .response import mixing_tones, tone_label
+    from .response import mixing_tones, simulated_tones, tone_label
 
     tones = mixing_tones(eps, Q, drives)
-    simulated = steady_state_amplitudes(eps, 1 / Q, [f for f, _ in drives],
-                                        [w for _, w in drives], [t.frequency for t in tones])
+    simulated = simulated_tones(eps, Q, drives, tones)
     return {
         "parameters": {"eps": eps, "Q": Q, "drives": [{"force": f, "omega": w}
                                                       for f, w in drives]},
@@ -475,10 +520,9 @@ def _drive(text: str) -> tuple[float, float]:
 
 
 def _cmd_mixing(args: argparse.Namespace) -> int:
-    from .charts import mixing_figure
-
     return _report(args, lambda: mixing_json(args.eps, args.Q, args.drive),
-                   lambda path: mixing_figure(args.eps, args.Q, args.drive, path), _mixing_table)
+                   lambda path: _charts().mixing_figure(args.eps, args.Q, args.drive, path),
+                   _mixing_table)
 
 
 def _mixing_table(data: dict) -> list[str]:
@@ -519,16 +563,19 @@ def _cmd_choose(args: argparse.Namespace) -> int:
     for name in ("tol", "x_min", "x_max"):
         if getattr(args, name) is None:
             raise InputError(f"choose period needs --{name.replace('_', '-')}")
-    from .choose import candidates, choose_period
+    from .choose import candidates, choose_period, modelled_ns
     from .emit import check_writable, generate_choice
 
     if args.emit:
-        check_writable(_out_folder(args.emit, "--emit"), ["chosen_period.py"], "--emit")
+        check_writable(_out_folder(args.emit, "--emit"), ["chosen_period.py"], "--emit",
+                       args.overwrite_edited)
     progress = Progress("timing the verified methods", not args.json)
     choice = choose_period(args.tol, args.x_min, args.x_max, progress)
     progress.close()
     data = {"method": choice.method, "order": choice.order, "max_error": choice.max_error,
             "ns_per_point": choice.ns_per_point, "verified_on": choice.verified_on,
+            "modelled_ns_per_point": modelled_ns("period", choice.method, choice.order),
+            "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
             "quantity": "period", "variable": "x = eps*A**2",
             "considered": _considered(choice.considered)}
     if args.emit:
@@ -536,7 +583,8 @@ def _cmd_choose(args: argparse.Namespace) -> int:
                                                                          choice.order))
         command = (f"lindstedt choose period --tol {args.tol!r} --x-min {args.x_min!r} "
                    f"--x-max {args.x_max!r}")
-        data["emitted"] = [str(p) for p in generate_choice(cand, command, Path(args.emit))]
+        data["emitted"] = [str(p) for p in generate_choice(
+            cand, command, Path(args.emit), overwrite_edited=args.overwrite_edited)]
     if args.json:
         print(json.dumps(data))
         return 0
@@ -591,7 +639,7 @@ def _choose_q(args: argparse.Namespace) -> int:
     for name in ("tol", "x_min", "x_max"):
         if getattr(args, name) is None:
             raise InputError(f"choose q needs --{name.replace('_', '-')}")
-    from .choose import choose_solution
+    from .choose import choose_solution, modelled_ns
     from .emit import check_writable, generate, generate_fourier
 
     if args.emit:
@@ -603,10 +651,14 @@ def _choose_q(args: argparse.Namespace) -> int:
     progress.close()
     data = {"quantity": "q", "method": c.method, "order": c.order, "max_error": c.max_error,
             "ns_per_point": c.ns_per_point, "verified_on": c.verified_on,
+            "modelled_ns_per_point": modelled_ns("q", c.method, c.order),
+            "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
             "considered": _considered(c.considered)}
     if args.emit:
-        paths = (generate("duffing", c.order, Path(args.emit)) if c.method == "lindstedt"
-                 else generate_fourier(c.order, Path(args.emit)))
+        options = {"flag": "--emit", "overwrite_edited": args.overwrite_edited}
+        paths = (generate("duffing", c.order, Path(args.emit), **options)
+                 if c.method == "lindstedt" else
+                 generate_fourier(c.order, Path(args.emit), **options))
         data["emitted"] = [str(p) for p in paths]
     if args.json:
         print(json.dumps(data))
@@ -632,6 +684,9 @@ def _choose_driven(args: argparse.Namespace) -> int:
         raise InputError("give --omega or a range (--omega-min, --omega-max), not both")
     tol = args.tol or 1e-4
     lo, hi = (args.omega, None) if args.omega is not None else (args.omega_min, args.omega_max)
+    from .driven import check_steady_state
+
+    check_steady_state(args.eps, args.Q, lo, hi)
     from .choose import choose_driven
     from .emit import check_writable, generate_balance, generate_driven
 
@@ -655,7 +710,8 @@ def _choose_driven(args: argparse.Namespace) -> int:
         data["truth"] = c.truth.A[0].tolist()
     if args.emit:
         emit = generate_balance if c.method == "harmonic_balance" else generate_driven
-        data["emitted"] = [str(p) for p in emit(c.order, Path(args.emit))]
+        data["emitted"] = [str(p) for p in emit(c.order, Path(args.emit), flag="--emit",
+                                                overwrite_edited=args.overwrite_edited)]
     if args.json:
         print(json.dumps(data))
         return 0
@@ -670,6 +726,69 @@ def _choose_driven(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    """A map over a parameter grid on dask.distributed, into a resumable Zarr store."""
+    if args.plot:
+        from .charts import check_plot_path
+
+        check_plot_path(Path(args.plot))
+    from .sweep import run_sweep
+
+    axes = {name: getattr(args, name) for name in ("omega", "force", "eps", "Q")
+            if getattr(args, name) is not None}
+    bar = Progress(f"sweep {args.kind}", not args.json)
+    ds = run_sweep(args.kind, axes, _out_folder(args.store, "--store"), args.scheduler,
+                   args.workers, args.chunk, lambda p: bar(p.finished, p.total))
+    bar.close()
+    if args.plot:
+        from .charts import sweep_figure
+
+        sweep_figure(ds, Path(args.plot))
+    done = ds["done"].values
+    data = {"kind": args.kind, "store": str(args.store),
+            "axes": {name: [float(v) for v in ds[name].values]
+                     for name in ("omega", "force", "eps", "Q") if name in ds.coords},
+            "fields": sorted(name for name in ds.data_vars if name != "done"),
+            "blocks": int(done.size), "finished": int(done.sum()),
+            "complete": bool(done.all())}
+    if args.plot:
+        data["plot"] = args.plot
+    if args.json:
+        print(json.dumps(data))
+        return 0
+    shape = " × ".join(f"{len(v)} {k}" for k, v in data["axes"].items())
+    print(f"sweep {args.kind}: {shape} into {args.store}: {data['finished']}/{data['blocks']} "
+          f"blocks done; fields {', '.join(data['fields'])}")
+    if args.plot:
+        print(f"  figure {args.plot}")
+    return 0
+
+
+SWEEP_MAX_VALUES = 100_000
+# NOTE: values per axis: a bound against typos in A:B:N; the store's size is checked against
+# the free disk before any work.
+
+
+def _axis_values(text: str) -> list[float]:
+    """Axis values: ``A:B:N`` (N evenly spaced from A to B), ``v1,v2,…`` or one value."""
+    try:
+        if ":" in text:
+            start, stop, count = text.split(":")
+            n = int(count)
+            if not 1 <= n <= SWEEP_MAX_VALUES:
+                raise argparse.ArgumentTypeError(f"{text!r}: N must be 1..{SWEEP_MAX_VALUES}")
+            a, b = float(start), float(stop)
+            values = [a + (b - a) * i / (n - 1) for i in range(n)] if n > 1 else [a]
+        else:
+            values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected A:B:N, v1,v2,… or a number"
+                                         ) from None
+    if any(math.isnan(v) for v in values):
+        raise argparse.ArgumentTypeError(f"{text!r}: not a number")
+    return values
+
+
 def _order(text: str) -> int:
     """An order K: a non-negative integer."""
     try:
@@ -682,10 +801,10 @@ def _order(text: str) -> int:
 
 
 def _count(text: str) -> int:
-    """A number of harmonics: a positive integer."""
+    """A number of harmonics: an integer in 1..MAX_HARMONICS."""
     value = _order(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{value}: must be ≥ 1")
+    if not 1 <= value <= MAX_HARMONICS:
+        raise argparse.ArgumentTypeError(f"{value}: must be in 1..{MAX_HARMONICS}")
     return value
 
 
@@ -745,7 +864,7 @@ def _flag_order(p: argparse.ArgumentParser, what: str) -> None:
 
 def _flag_harmonics(p: argparse.ArgumentParser, what: str) -> None:
     p.add_argument("--harmonics", type=_count, default=DEFAULT_HARMONICS, metavar="N",
-                   help=f"{what}, an integer ≥ 1 (default {DEFAULT_HARMONICS})")
+                   help=f"{what}, an integer in 1..{MAX_HARMONICS} (default {DEFAULT_HARMONICS})")
 
 
 def _flag_allow_slow(p: argparse.ArgumentParser) -> None:
@@ -754,6 +873,12 @@ def _flag_allow_slow(p: argparse.ArgumentParser) -> None:
                    "(default: refuse)")
     p.add_argument("--force", action=_DeprecatedForce, dest="allow_slow",
                    help="deprecated spelling of --allow-slow")
+
+
+def _flag_overwrite_edited(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--overwrite-edited", action="store_true",
+                   help="replace generated files even when they were edited by hand since "
+                   "(default: refuse, so an edit is never lost silently)")
 
 
 def _flag_json(p: argparse.ArgumentParser, what: str = "the JSON contract") -> None:
@@ -814,11 +939,12 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_order(p, f"highest order K (duffing, pendulum; driven up to {DRIVEN_MAX_ORDER})")
     p.add_argument("--out", default="out", metavar="DIR",
                    help="output folder, created if missing (default out/)")
-    _flag_harmonics(p, "balance, fourier: odd harmonics N")
+    _flag_harmonics(p, "balance (up to 12), fourier (up to 60): odd harmonics N")
     p.add_argument("--allow-divergent", action="store_true",
                    help="evaluate beyond the radius of convergence instead of returning NaN "
                    "(default: NaN)")
     _flag_allow_slow(p)
+    _flag_overwrite_edited(p)
     p.set_defaults(func=_cmd_generate)
 
     p = sub.add_parser("driven", help="steady 1:1 response of the driven Duffing oscillator",
@@ -889,7 +1015,36 @@ def build_parser() -> argparse.ArgumentParser:
                    "response: driven.py or balance.py, only emittable methods compete; "
                    "default: write nothing)")
     _flag_json(p)
+    _flag_overwrite_edited(p)
     p.set_defaults(func=_cmd_choose)
+
+    p = sub.add_parser("sweep", help="maps over (ω, f, ε, Q) grids on a Dask cluster, resumable",
+                       description="Map the driven oscillator over a grid of parameters on "
+                       "dask.distributed (a LocalCluster here by default), block by block into "
+                       "a Zarr store; run the same command again to resume an interrupted sweep.")
+    p.add_argument("kind", choices=SWEEP_KINDS,
+                   help="response: r of every branch; stability: Floquet verdicts of the true "
+                   "orbits; subharmonic: the 1/3 subharmonic; validity: μ-expansion error")
+    for name, meaning in (("omega", "ω, drive frequency (subharmonic: its own, drive at 3ω)"),
+                          ("force", "f, drive amplitude"), ("eps", "ε, cubic stiffness"),
+                          ("Q", "quality factor (inf: undamped)")):
+        p.add_argument(f"--{name}", type=_axis_values, metavar="VALUES",
+                       help=f"{meaning}: A:B:N (N values from A to B), v1,v2,… or one value "
+                       "(each axis the kind takes is required: response, stability, validity "
+                       "take all four, subharmonic omega, force, eps)")
+    p.add_argument("--store", required=True, metavar="PATH",
+                   help="the Zarr store (a folder) the map is written into, block by block "
+                   "(required; an existing store of the same sweep resumes)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="tcp://host:port of a running dask scheduler whose workers have "
+                   "lindstedt (default: a LocalCluster on this machine)")
+    p.add_argument("--workers", type=_count, default=2, metavar="N",
+                   help="worker processes of the LocalCluster, one thread each (default 2)")
+    p.add_argument("--chunk", type=_count, default=None, metavar="POINTS",
+                   help="grid points per task (default: the kind's, about 1 s of work)")
+    _flag_json(p, "a JSON summary")
+    _flag_plot(p)
+    p.set_defaults(func=_cmd_sweep)
 
     p = sub.add_parser("clock", help="the notes' grandfather's-clock accuracy claims, checked")
     _flag_json(p, "JSON")
@@ -905,6 +1060,7 @@ def build_parser() -> argparse.ArgumentParser:
                        "--out.")
     p.add_argument("--out", default="out", metavar="DIR",
                    help="output folder for evaluators, LaTeX, PDFs and figures/ (default out/)")
+    _flag_overwrite_edited(p)
     p.set_defaults(func=_cmd_demo)
     return parser
 
@@ -913,7 +1069,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return args.func(args)
+        status = args.func(args)
+        sys.stdout.flush()  # a reader that went away (`| head`) is noticed here, not at exit
+        return status
     except InputError as exc:
         print(f"lindstedt: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # The Python docs' recipe (signal module, "Note on SIGPIPE"): stdout's reader closed
+        # the pipe; point stdout at devnull so the interpreter's final flush cannot fail
+        # again, and exit 1 as Python does on EPIPE.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 1

@@ -28,6 +28,12 @@ from .display import SHOWN_ROWS, harmonics_table, html_table
 from .errors import InputError
 from .series import Basis, Ground, solve_oscillator, to_fourier
 
+MAGNITUDES = (1e-16, 1e16)
+# NOTE: every nonzero |ε|, |f|, ω and finite Q lies in this window.  The closed-form cubic in
+# u = r² raises (1 − ω²)/ε to the sixth power, shooting cubes amplitudes up to fQ: within
+# 1e±16 every such combination stays inside double precision (1e±288), beyond it some overflow.
+# (Only εf² matters for the shape: q → λq maps ε, f to ελ², f/λ — rescale rather than widen.)
+
 
 @dataclass(frozen=True)
 class Drive:
@@ -49,11 +55,31 @@ class Drive:
             raise InputError(f"Q {self.Q}: must be > 0 (Q = inf for no damping)")
         if self.omega <= 0:
             raise InputError(f"omega {self.omega}: must be > 0")
+        if self.force == 0:
+            raise InputError("force 0: no drive, the response is q = 0 (free oscillations: "
+                             "`lindstedt series duffing`)")
+        low, high = MAGNITUDES
+        for name, also in (("eps", " (or 0)"), ("force", ""), ("omega", ""), ("Q", " (or inf)")):
+            value = getattr(self, name)
+            if value != 0 and not math.isinf(value) and not low <= abs(value) <= high:
+                raise InputError(f"{name} {value!r}: |{name}| outside {low:g}..{high:g}{also}; "
+                                 "the methods square and cube it, which must stay normal doubles")
 
     @property
     def damping(self) -> float:
         """``1/Q`` (zero when undamped)."""
         return 0.0 if math.isinf(self.Q) else 1.0 / self.Q
+
+
+def check_steady_state(eps: float, Q: float, omega_min: float,
+                       omega_max: float | None = None) -> None:
+    """:class:`InputError` where no method can answer: the undamped linear oscillator driven
+    at its resonance ω = 1 (in ``[omega_min, omega_max]``) has no steady state."""
+    hi = omega_min if omega_max is None else omega_max
+    if eps == 0 and math.isinf(Q) and omega_min <= 1 <= hi:
+        where = "omega 1" if omega_max is None else f"omega in [{omega_min:g}, {hi:g}]"
+        raise InputError(f"eps 0, Q inf, {where}: an undamped linear oscillator driven at its "
+                         "resonance has no steady state (its amplitude grows like f t/2)")
 
 
 # --- Fourier sums as complex coefficient arrays, index n + M --------------------------------
@@ -124,18 +150,28 @@ def first_order_branches(d: Drive) -> list[Branch]:
     a = 1 - w2
     roots = np.roots([9 / 16 * d.eps**2, 1.5 * d.eps * a, a * a + w2 * d.damping**2,
                       -d.force**2])
+    found = [root.real for root in roots
+             if abs(root.imag) <= 1e-9 * (1 + abs(root)) and root.real > 0]
+    steps = 3  # Newton on the cubic: np.roots loses digits near a fold
+    if not found:
+        # G(0) = −f² < 0 < G(∞): a positive root exists, but np.roots lost it among roots
+        # many decades larger (Q ≪ 1, ω ≫ 1): start from the linear response instead
+        found, steps = [d.force**2 / (a * a + w2 * d.damping**2)], 60
     out = []
-    for root in roots:
-        if abs(root.imag) <= 1e-9 * (1 + abs(root)) and root.real > 0:
-            u = root.real
-            for _ in range(3):  # Newton on the cubic: np.roots loses digits near a fold
-                s = a + 0.75 * d.eps * u
-                slope = s * s + w2 * d.damping**2 + 1.5 * d.eps * u * s
-                if slope != 0:
-                    u -= (u * (s * s + w2 * d.damping**2) - d.force**2) / slope
-            r = math.sqrt(u)
-            delta = math.atan2(r * d.omega * d.damping, 0.75 * d.eps * r**3 - (w2 - 1) * r)
-            out.append(Branch(r, delta))
+    for u in found:
+        for _ in range(steps):
+            s = a + 0.75 * d.eps * u
+            slope = s * s + w2 * d.damping**2 + 1.5 * d.eps * u * s
+            if slope != 0:
+                u -= (u * (s * s + w2 * d.damping**2) - d.force**2) / slope
+        if not u > 0:
+            continue
+        if steps > 3 and not abs(u * ((a + 0.75 * d.eps * u) ** 2 + w2 * d.damping**2)
+                                 - d.force**2) <= 1e-9 * d.force**2:
+            continue
+        r = math.sqrt(u)
+        delta = math.atan2(r * d.omega * d.damping, 0.75 * d.eps * r**3 - (w2 - 1) * r)
+        out.append(Branch(r, delta))
     return sorted(out, key=lambda b: -b.A1)
 
 
@@ -222,29 +258,42 @@ def mu_expansion(d: Drive, branch: Branch, order: int) -> MuExpansion:
     E = [1.0 + 0j]
     dets: list[float] = []
     resonant = np.abs(n) == 1
+
+    def stop(j: int, reason: str) -> MuExpansion:
+        """The orders found before order ``j`` failed, not converged, with the reason."""
+        return MuExpansion(branch, tuple(q[: order + 1]), tuple(deltas[: order + 1]),
+                           tuple(dets[:order]), False, f"order {j}: {reason}")
+
     for j in range(1, top + 1):
-        F = _forcing(d, q, cubes, E, branch.delta0, j)
-        p = np.where(resonant, 0, F / np.where(resonant, 1, 1 - n * n))
+        with np.errstate(over="ignore", invalid="ignore"):
+            F = _forcing(d, q, cubes, E, branch.delta0, j)
+            p = np.where(resonant, 0, F / np.where(resonant, 1, 1 - n * n))
 
-        def secular_next(b: float, delta: float, p: np.ndarray = p, j: int = j) -> np.ndarray:
-            """Secular part of F_{j+1} for trial b_j, δ_j (it is affine in both)."""
-            qs, ds = [*q, p + _cos_tau(M, b)], [*deltas, delta]
-            sq, cb, Es = list(squares), list(cubes), list(E)
-            _extend(qs, sq, cb, Es, ds, j)
-            return _secular(_forcing(d, qs, cb, Es, branch.delta0, j + 1))
+            def secular_next(b: float, delta: float, p: np.ndarray = p,
+                             j: int = j) -> np.ndarray:
+                """Secular part of F_{j+1} for trial b_j, δ_j (it is affine in both)."""
+                qs, ds = [*q, p + _cos_tau(M, b)], [*deltas, delta]
+                sq, cb, Es = list(squares), list(cubes), list(E)
+                _extend(qs, sq, cb, Es, ds, j)
+                return _secular(_forcing(d, qs, cb, Es, branch.delta0, j + 1))
 
-        s0 = secular_next(0.0, 0.0)
-        J = np.column_stack([secular_next(1.0, 0.0) - s0, secular_next(0.0, 1.0) - s0])
+            s0 = secular_next(0.0, 0.0)
+            J = np.column_stack([secular_next(1.0, 0.0) - s0, secular_next(0.0, 1.0) - s0])
+        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(J)) and np.all(np.isfinite(s0))):
+            return stop(j, "the terms overflow double precision (the μ-series diverges here)")
         det = float(np.linalg.det(J))
         dets.append(det)
-        if abs(det) < 1e-12 * (1 + d.force + abs(d.eps) * branch.A1**2):
-            return MuExpansion(branch, tuple(q[: order + 1]), tuple(deltas[: order + 1]),
-                               tuple(dets[:order]), False,
-                               f"order {j}: singular secular system (a fold: branches merge)")
+        if abs(det) < 1e-12 * (1 + abs(d.force) + abs(d.eps) * branch.A1**2):
+            return stop(j, "singular secular system (a fold: branches merge)")
         b, delta = np.linalg.solve(J, -s0)
         q.append(p + _cos_tau(M, b))
         deltas.append(float(delta))
-        _extend(q, squares, cubes, E, deltas, j)
+        with np.errstate(over="ignore", invalid="ignore"):
+            _extend(q, squares, cubes, E, deltas, j)
+        if not (np.all(np.isfinite(q[-1])) and np.all(np.isfinite(cubes[-1]))
+                and np.isfinite(delta)):
+            q.pop(), deltas.pop()
+            return stop(j, "the terms overflow double precision (the μ-series diverges here)")
     converged, reason = _convergence(q)
     return MuExpansion(branch, tuple(q[: order + 1]), tuple(deltas[: order + 1]),
                        tuple(dets[:order]), converged, reason)
@@ -338,23 +387,41 @@ class BalanceSystem:
                              * self.coefficients(x))
 
 
+MAX_HARMONICS = 100
+# NOTE: the numerical balance's bound (200 unknowns, dense 200×200 Newton steps): the CLI's
+# --harmonics takes the same range in every command.
+
+
+def check_harmonics(harmonics: object) -> None:
+    """:class:`InputError` unless ``harmonics`` is an integer in 1..MAX_HARMONICS."""
+    if isinstance(harmonics, bool) or not isinstance(harmonics, (int, np.integer)) \
+            or not 1 <= harmonics <= MAX_HARMONICS:
+        raise InputError(f"harmonics {harmonics!r}: must be an integer in 1..{MAX_HARMONICS}")
+
+
 def harmonic_balance(d: Drive, start: Branch, harmonics: int, tol: float = 1e-13,
                      max_iter: int = 50) -> HarmonicBalance:
     """Newton's method on :class:`BalanceSystem`, started from a one-harmonic root."""
-    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 100:
-        raise InputError(f"harmonics {harmonics!r}: must be an integer in 1..100")
+    check_harmonics(harmonics)
     system = BalanceSystem(d.eps, d.force, d.damping, harmonics)
     x = np.zeros(2 * harmonics)
     x[0] = start.A1 * math.cos(start.delta0)
     x[harmonics] = start.A1 * math.sin(start.delta0)
     converged = False
-    for _ in range(max_iter):
-        step = np.linalg.solve(system.jacobian(x, d.omega), -system.residual(x, d.omega))
-        x = x + step
-        if np.max(np.abs(step)) <= tol * (1 + np.max(np.abs(x))):
-            converged = True
-            break
-    residual = float(np.max(np.abs(system.residual(x, d.omega))))
+    with np.errstate(over="ignore", invalid="ignore"):
+        for _ in range(max_iter):
+            try:
+                step = np.linalg.solve(system.jacobian(x, d.omega),
+                                       -system.residual(x, d.omega))
+            except np.linalg.LinAlgError:  # a singular Jacobian: a fold, Newton cannot go on
+                break
+            if not np.all(np.isfinite(step)):  # Newton diverged (overflow)
+                break
+            x = x + step
+            if np.max(np.abs(step)) <= tol * (1 + np.max(np.abs(x))):
+                converged = True
+                break
+        residual = float(np.max(np.abs(system.residual(x, d.omega))))
     return HarmonicBalance(harmonics, system.coefficients(x), residual, converged)
 
 

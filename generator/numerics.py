@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike
 from scipy.special import ellipj, ellipk
 
 from .display import harmonics_table
+from .errors import InputError
 
 
 def duffing_period_exact(A: ArrayLike, eps: ArrayLike) -> np.ndarray:
@@ -124,6 +125,26 @@ class PeriodicOrbit:
             f"residual {self.residual:.1e}")
 
 
+SAMPLES = 64
+# NOTE: q is sampled 64 times per orbit for its harmonics (up to 31); more harmonics take the
+# next power of two above twice their number, a divisor of the RK4 step count.
+
+
+def _samples(harmonics: int, steps: int) -> int:
+    """Samples of q per orbit that resolve ``harmonics`` (FFT bins 0..samples/2) and divide
+    ``steps``; :class:`InputError` when the steps cannot carry that many."""
+    if isinstance(harmonics, bool) or not isinstance(harmonics, (int, np.integer)) \
+            or harmonics < 1:
+        raise InputError(f"harmonics {harmonics!r}: must be an integer ≥ 1")
+    samples = SAMPLES
+    while samples // 2 <= harmonics:
+        samples *= 2
+    if samples > steps or steps % samples:
+        raise InputError(f"harmonics {harmonics}: shooting with {steps} RK4 steps per orbit "
+                         f"resolves at most harmonic {steps // 2 - 1}")
+    return samples
+
+
 def shoot(eps: float, force: float, omega: float, damping: float, guess: np.ndarray,
           harmonics: int = 9, tol: float = 1e-12, max_iter: int = 30,
           periods: int = 1, steps: int | None = None) -> PeriodicOrbit | None:
@@ -138,9 +159,12 @@ def shoot(eps: float, force: float, omega: float, damping: float, guess: np.ndar
     when Newton's method does not converge.
     """
     T = periods * 2 * np.pi / omega  # periods = 3: the 1/3 subharmonic (eq. 10.83)
+    samples = _samples(harmonics, STEPS_PER_PERIOD if steps is None else steps)
     y = np.array(guess, dtype=float)
     for _ in range(max_iter):
         end, _ = flow(y, T, eps, force, omega, damping, steps=steps)
+        if not np.all(np.isfinite(end)):  # RK4 overflowed: the orbit escapes, or h is too big
+            return None
         Mono = end[2:].reshape(2, 2).T
         r = end[:2] - y
         try:
@@ -152,7 +176,9 @@ def shoot(eps: float, force: float, omega: float, damping: float, guess: np.ndar
             break
     else:
         return None
-    end, qs = flow(y, T, eps, force, omega, damping, steps=steps)
+    end, qs = flow(y, T, eps, force, omega, damping, samples=samples, steps=steps)
+    if not (np.all(np.isfinite(end)) and np.all(np.isfinite(qs))):
+        return None
     Mono = end[2:].reshape(2, 2).T
     lam = np.linalg.eigvals(Mono)
     stable = bool(np.all(np.abs(lam) < 1) if damping > 0 else abs(np.trace(Mono)) < 2)
@@ -245,6 +271,8 @@ def orbit_fold(eps: float, force: float, damping: float, omega: float, y0: np.nd
 
     z = np.array([*y0, omega], dtype=float)
     for _ in range(30):
+        if not z[2] > 0:  # Newton left the frequencies: no fold near this guess
+            return None
         f0 = F(z)
         J = np.empty((3, 3))
         for k in range(3):
@@ -252,7 +280,12 @@ def orbit_fold(eps: float, force: float, damping: float, omega: float, y0: np.nd
             e = np.zeros(3)
             e[k] = h
             J[:, k] = (F(z + e) - F(z - e)) / (2 * h)
-        dz = np.linalg.solve(J, -f0)
+        if not (np.all(np.isfinite(J)) and np.all(np.isfinite(f0))):
+            return None  # RK4 overflowed: no orbit near this guess
+        try:
+            dz = np.linalg.solve(J, -f0)
+        except np.linalg.LinAlgError:  # singular: no isolated fold here
+            return None
         z = z + dz
         if np.max(np.abs(dz)) < tol * (1 + np.max(np.abs(z))):
             return float(z[2]), z[:2]
@@ -287,7 +320,11 @@ def hill_multipliers(omega: float, eps: float, a: float, b: float, F: float,
                      steps: int = 2048) -> np.ndarray:
     """Floquet multipliers of the Hill equation (notes after eq. 10.87), Richardson-combined."""
     coarse, fine = _hill(omega, eps, a, b, F, steps), _hill(omega, eps, a, b, F, 2 * steps)
-    return np.linalg.eigvals(fine + (fine - coarse) / 15)
+    with np.errstate(over="ignore", invalid="ignore"):
+        M = fine + (fine - coarse) / 15
+    if not np.all(np.isfinite(M)):  # ξ grows past 1e308 within one period: λ = ∞ and 1/λ = 0
+        return np.array([np.inf, 0.0], dtype=complex)
+    return np.linalg.eigvals(M)
 
 
 @njit(cache=True)
@@ -322,19 +359,51 @@ def _simulate(eps: float, damping: float, forces: np.ndarray, omegas: np.ndarray
     return out
 
 
+MAX_STEPS = 100_000_000
+MAX_FIT_ENTRIES = 30_000_000
+# NOTE: 1e8 compiled RK4 steps are ~20 s with four drives; 3e7 entries (240 MB) hold the
+# least-squares fit of four drives' 228 tones at drive frequencies up to ~2.5.
+
+
 def steady_state_amplitudes(eps: float, damping: float, forces: list[float],
                             omegas: list[float], frequencies: list[float],
                             settle: float | None = None, window: float = 2000.0,
                             initial: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
     """Amplitudes of the simulated steady state at ``frequencies`` (least squares on cos/sin
     over a long window after the transients, ~``20 Q`` time units, have died out), starting
-    from ``initial`` = (q, q̇) — which decides the attractor where several coexist."""
-    settle = 40.0 / damping if settle is None else settle
-    h = 2 * np.pi / (max(max(omegas), max(frequencies)) * 64)
+    from ``initial`` = (q, q̇) — which decides the attractor where several coexist.
+
+    NaN amplitudes when the simulated orbit overflows (it escapes to infinity: a softening
+    spring driven over its barrier, or RK4 unstable at that amplitude).  :class:`InputError`
+    when the simulation would exceed :data:`MAX_STEPS` or its fit :data:`MAX_FIT_ENTRIES`."""
+    if settle is None:
+        if not damping > 0:
+            raise InputError("damping 0 (Q inf): the transients never die out, there is no "
+                             "steady state to settle into")
+        settle = 40.0 / damping
+    fastest = max(max(omegas), max(frequencies))
     every = 4
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        h = 2 * np.pi / (np.float64(fastest) * 64)
+        steps = (settle + window) / h
+        entries = window / (h * every) * (2 * len(frequencies) + 1)
+    if not steps <= MAX_STEPS:
+        if settle > window:
+            raise InputError(f"Q {1 / damping:g}: the transients die out over 40Q = {settle:.3g} "
+                             f"time units, {steps:.2g} RK4 steps at 64 a period of frequency "
+                             f"{fastest:g}; the limit is {MAX_STEPS:.0e} steps")
+        raise InputError(f"frequency {fastest:g} (a drive or its tone): 64 RK4 steps a period "
+                         f"over {settle + window:g} time units is {steps:.2g} steps; the limit "
+                         f"is {MAX_STEPS:.0e}")
+    if not entries <= MAX_FIT_ENTRIES:
+        raise InputError(f"frequency {fastest:g} with {len(frequencies)} tones: the fit over "
+                         f"{window:g} time units needs {entries:.2g} matrix entries; the limit is "
+                         f"{MAX_FIT_ENTRIES:.0e}")
     n_keep = int(window / (h * every))
-    q = _simulate(eps, damping, np.array(forces, float), np.array(omegas, float), h,
+    q = _simulate(eps, damping, np.array(forces, float), np.array(omegas, float), float(h),
                   int(settle / h), n_keep, every, float(initial[0]), float(initial[1]))
+    if not np.all(np.isfinite(q)):
+        return np.full(len(frequencies), np.nan)
     t = settle + np.arange(n_keep) * h * every
     basis = [np.ones_like(t)]
     for nu in frequencies:

@@ -9,12 +9,13 @@ negative, between the folds); the folds solve ``G = ∂G/∂u = 0``.  N harmonic
 from __future__ import annotations
 
 import functools
+import time
 from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
 
-from .driven import BalanceSystem, Drive, first_order_branches, trig_product
+from .driven import BalanceSystem, Drive, check_harmonics, first_order_branches, trig_product
 from .errors import InputError
 from .numerics import hill_multipliers, shoot, steady_state_amplitudes
 
@@ -104,7 +105,14 @@ def one_harmonic_folds(eps: float, force: float, Q: float) -> list[float]:
     if eps == 0:
         return []
     values = {_e: eps, _f: force, _g: d.damping}
-    coeffs = [float(c.subs(values)) for c in _fold_polynomial().all_coeffs()]
+    # SymPy's floats do not overflow: scale by the largest coefficient before rounding to
+    # float64 (ε = 1e100 puts ε⁴f² far beyond 1e308, yet the roots in ω² are ordinary)
+    exact = [sp.Float(c.subs(values), 30) for c in _fold_polynomial().all_coeffs()]
+    scale = max(abs(c) for c in exact)
+    coeffs = [float(c / scale) for c in exact] if scale != 0 else []
+    if not coeffs or not all(np.isfinite(coeffs)):
+        raise InputError(f"eps {eps:g}, force {force:g}, Q {Q:g}: the fold polynomial's "
+                         "coefficients leave double precision")
     folds = []
     for w2 in np.roots(coeffs):
         if abs(w2.imag) > 1e-8 * (1 + abs(w2)) or w2.real <= 0:
@@ -123,7 +131,10 @@ def one_harmonic_folds(eps: float, force: float, Q: float) -> list[float]:
             Gw = u * (-4 * omega * A + 2 * omega * d.damping**2)
             Guu = 2 * A * 0.75 * eps + 1.5 * eps * A + 1.5 * eps * u * 0.75 * eps
             Guw = 2 * A * (-2 * omega) + 2 * omega * d.damping**2 + 1.5 * eps * u * (-2 * omega)
-            step = np.linalg.solve([[Gu, Gw], [Guu, Guw]], [-G, -Gu])
+            try:
+                step = np.linalg.solve([[Gu, Gw], [Guu, Guw]], [-G, -Gu])
+            except np.linalg.LinAlgError:  # singular (a cusp, or the scale of u swamps ω)
+                break
             u, omega = u + step[0], omega + step[1]
             if np.max(np.abs(step)) < 1e-15 * (1 + abs(omega) + abs(u)):
                 break
@@ -141,32 +152,109 @@ class Continuation:
     folds: list[float]  # where dω/ds changes sign, refined
 
 
+MAX_POINTS = 20000
+CONTINUATION_SECONDS = 60.0
+# NOTE: the continuation refuses a curve it estimates at more than 20000 steps or a minute of
+# work (the CLI's COST_LIMIT_SECONDS) instead of running for ten minutes: `response --force 1e30
+# --harmonics 60` once ran 590 s and stopped short of the range, reporting a partial curve.
+MAX_Q = 1e12
+# NOTE: near the resonance x(ω) changes by ~Q·2e-16 relative between neighbouring doubles in ω:
+# the corrector's 1e-13 then needs Q ≲ 1e3 (above, some steps take all 30 iterations: slower,
+# still right); by Q ~ 1e16 the peak is narrower than the doubles around ω = 1 and the
+# continuation wanders for good.  Below 1e12 it is only slower.
+
+
+def point_seconds(harmonics: int) -> float:
+    """Seconds per continuation point (predictor, corrector, two SVDs) on this 2-core machine,
+    single-threaded BLAS: 2 ms at N = 8, 42 ms at N = 100."""
+    return 1.5e-3 + 4e-6 * harmonics**2
+
+
+def _curve_extent(eps: float, force: float, Q: float, lo: float, hi: float) -> float:
+    """The largest one-harmonic amplitude on ``[lo, hi]`` (a grid, ω = 1 and the folds)."""
+    folds = [w for w in one_harmonic_folds(eps, force, Q) if lo <= w <= hi]
+    omega = np.unique(np.concatenate([np.linspace(lo, hi, 2001), [1.0] if lo <= 1 <= hi else [],
+                                      folds, np.nextafter(folds, -np.inf)]))
+    with np.errstate(divide="ignore"):  # undamped and linear at ω = 1: r = ∞, said as such
+        r = one_harmonic_curve(eps, force, Q, omega).r
+    return float(np.nanmax(r)) if np.any(~np.isnan(r)) else 0.0
+
+
 def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_start: float,
                      omega_stop: float, step: float = 0.02,
-                     max_points: int = 20000) -> Continuation:
+                     max_points: int = MAX_POINTS) -> Continuation:
     """Trace the harmonic-balance solution from ``omega_start`` (largest one-harmonic branch)
-    until ω leaves ``[min, max]`` of the two ends, through any number of folds."""
-    sysm = BalanceSystem(eps, force, 1 / Q if np.isfinite(Q) else 0.0, harmonics)
+    until ω leaves ``[min, max]`` of the two ends, through any number of folds.
+
+    Refuses (:class:`InputError`) a curve too long to trace: its length in (a, b, ω) is about
+    ``(hi − lo) + π r_max`` (up the resonant branch to its peak r_max and back down while the
+    phase turns through π; within a factor 0.4–1.4 of the traced length from ε = −0.1 to 1,
+    f = 0.05 to 10, Q = 5 to 1000), so ``length/step`` points at
+    :func:`point_seconds` each must stay within ``max_points`` and :data:`CONTINUATION_SECONDS`;
+    and a continuation whose linear algebra fails or that does not leave the range."""
+    check_harmonics(harmonics)
+    d = Drive(eps, force, omega_start, Q)
+    Drive(eps, force, omega_stop, Q)
+    sysm = BalanceSystem(eps, force, d.damping, harmonics)
     lo, hi = sorted((omega_start, omega_stop))
-    (br, *_) = first_order_branches(Drive(eps, force, omega_start, Q))
-    x = np.zeros(2 * harmonics)
-    x[0], x[harmonics] = br.A1 * np.cos(br.delta0), br.A1 * np.sin(br.delta0)
-    x = _newton_fixed_omega(sysm, x, omega_start)
-    y = np.append(x, omega_start)
-    direction = 1.0 if omega_stop > omega_start else -1.0
-    t = _tangent(sysm, y, None)
-    if t[-1] * direction < 0:
-        t = -t
-    points, folds = [y], []
-    for _ in range(max_points):
-        y_new = _corrector(sysm, y + step * t, t)
-        t_new = _tangent(sysm, y_new, t)
-        if t_new[-1] * t[-1] < 0:
-            folds.append(_refine_fold(sysm, y, t, step))
-        y, t = y_new, t_new
-        points.append(y)
-        if not lo <= y[-1] <= hi:
-            break
+    where = f"force {force:g} (eps {eps:g}, Q {Q:g})"
+    if np.isfinite(Q) and Q > MAX_Q:
+        raise InputError(f"Q {Q:g}: the resonance is {1 / Q:.0e} wide in ω, too narrow for the "
+                         f"continuation to follow in double precision; Q up to {MAX_Q:.0e}")
+    r_max = _curve_extent(eps, force, Q, lo, hi)
+    length = (hi - lo) + np.pi * r_max
+    estimate = length / step
+    if not estimate <= max_points:
+        raise InputError(f"{where}: the response curve spans ω in [{lo:.3g}, {hi:.3g}] with "
+                         f"amplitudes up to {r_max:.3g}, about {estimate:.2g} continuation steps "
+                         f"of {step:g}; the limit is {max_points}")
+    seconds = estimate * point_seconds(harmonics)
+    if seconds > CONTINUATION_SECONDS:
+        raise InputError(f"harmonics {harmonics}: about {seconds:.0f} s of continuation "
+                         f"({estimate:.0f} points × {1e3 * point_seconds(harmonics):.0f} ms) for "
+                         f"{where}; the limit is {CONTINUATION_SECONDS:.0f} s, ask for fewer")
+    branches = first_order_branches(d)
+    if not branches:
+        raise InputError(f"{where}: no one-harmonic branch at ω = {omega_start:g} to start from")
+    br = branches[0]
+    limit = min(max_points, int(2 * CONTINUATION_SECONDS / point_seconds(harmonics)))
+    y = None
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):
+            x = np.zeros(2 * harmonics)
+            x[0], x[harmonics] = br.A1 * np.cos(br.delta0), br.A1 * np.sin(br.delta0)
+            x = _newton_fixed_omega(sysm, x, omega_start)
+            y = np.append(x, omega_start)
+            direction = 1.0 if omega_stop > omega_start else -1.0
+            t = _tangent(sysm, y, None)
+            if t[-1] * direction < 0:
+                t = -t
+            points, folds = [y], []
+            deadline = time.monotonic() + 2 * CONTINUATION_SECONDS
+            for _ in range(limit):
+                if time.monotonic() > deadline:
+                    raise InputError(f"{where}: the continuation gave up after "
+                                     f"{2 * CONTINUATION_SECONDS:.0f} s at ω = {y[-1]:.6g}, "
+                                     f"{len(points)} points in (its estimate: {estimate:.0f}): "
+                                     "the corrector does not converge there")
+                y_new = _corrector(sysm, y + step * t, t)
+                t_new = _tangent(sysm, y_new, t)
+                if not (np.all(np.isfinite(y_new)) and np.all(np.isfinite(t_new))):
+                    raise np.linalg.LinAlgError("the balance overflowed")
+                if t_new[-1] * t[-1] < 0:
+                    folds.append(_refine_fold(sysm, y, t, step))
+                y, t = y_new, t_new
+                points.append(y)
+                if not lo <= y[-1] <= hi:
+                    break
+            else:
+                raise InputError(f"{where}: the continuation did not leave ω in [{lo:.3g}, "
+                                 f"{hi:.3g}] within {limit} steps of {step:g} (the estimate was "
+                                 f"{estimate:.0f}); the curve is longer than it looks")
+    except np.linalg.LinAlgError as exc:
+        at = "" if y is None else f" at ω = {y[-1]:.4g}"
+        raise InputError(f"{where}: the harmonic-balance continuation failed{at} ({exc}): "
+                         "its Jacobian is singular or the balance overflowed") from None
     arr = np.array(points)
     return Continuation(arr[:, -1], arr[:, :-1], sorted(folds))
 
@@ -266,6 +354,10 @@ ORBIT_MATCH = 0.25
 # another orbit that shooting fell onto (the 1:1 response, or the rotation −a/2 of the other root).
 
 
+MAX_AMPLITUDE = 1e100
+# NOTE: the Hill equation and shooting cube the orbit: its cube must stay below ~1e300.
+
+
 def subharmonic(eps: float, force: float, omega: float) -> tuple[bool, str, list[Subharmonic]]:
     """The b = 0 solutions ``a(f) = −F/2 ± √((16(ω² − 1)/ε − 21F²)/12)`` of eq. 10.87.
 
@@ -283,6 +375,11 @@ def subharmonic(eps: float, force: float, omega: float) -> tuple[bool, str, list
     if disc < 0:
         return False, (f"16(omega^2 - 1)/eps = {16 * (omega**2 - 1) / eps:.6g} < 21 F^2 = "
                        f"{21 * F**2:.6g}: eq. 10.87 has no real amplitude"), []
+    size = abs(F) / 2 + np.sqrt(disc)
+    if not size <= MAX_AMPLITUDE:
+        raise InputError(f"eps {eps:g}, omega {omega:g}: the subharmonic's amplitude |a| = "
+                         f"{size:.3g} (eps a^2 ≈ 4(omega^2 - 1)/3) exceeds {MAX_AMPLITUDE:g}, "
+                         "where its cube stops being a normal double")
     out = []
     for sign in ("+", "-"):
         a = -F / 2 + (1 if sign == "+" else -1) * np.sqrt(disc)
@@ -335,6 +432,14 @@ def _cube(x: dict, y: dict) -> dict:
     return out
 
 
+MAX_DRIVES = 4
+MIN_DRIVE_OMEGA = 2 * np.pi / 2000
+# NOTE: numerics.steady_state_amplitudes fits the tones over a 2000-unit window: a drive must
+# complete a period in it (slower tones, which near-commensurate drives make, fit poorly).
+# NOTE: four drives make at most 228 tones to second order, fitted in ~3 s; the count grows like
+# (2k)^5 combinations before the equal frequencies merge.
+
+
 def mixing_tones(eps: float, Q: float, drives: list[tuple[float, float]]) -> list[Tone]:
     """Combination tones of ``q̈ + q̇/Q + q + εq³ = Σ f_i cos ω_i t`` to second order in ε.
 
@@ -344,8 +449,19 @@ def mixing_tones(eps: float, Q: float, drives: list[tuple[float, float]]) -> lis
     """
     if not drives:
         raise InputError("mixing: give at least one drive F@W")
+    if len(drives) > MAX_DRIVES:
+        raise InputError(f"drives: {len(drives)} given, at most {MAX_DRIVES} (the tones to second "
+                         "order grow like (2k)^5: 5 drives make 591 tones and 12 s of fitting, "
+                         "6 make 1334 and a minute)")
+    Drive(eps, 1.0, 1.0, Q)  # ε and Q first, then every drive's numbers
     for f, w in drives:
-        Drive(eps, f, w, Q)  # validation of every number
+        try:
+            Drive(eps, f, w, Q)
+        except InputError as exc:
+            raise InputError(f"drive {f!r}@{w!r}: {exc}") from None
+        if w < MIN_DRIVE_OMEGA:
+            raise InputError(f"drive {f!r}@{w!r}: frequency below {MIN_DRIVE_OMEGA:.2g}, where "
+                             "the simulation's 2000-unit window holds less than one period")
     if not np.isfinite(Q):
         raise InputError("Q inf: mixing needs damping (finite Q) for a steady state")
     k = len(drives)
@@ -356,14 +472,20 @@ def mixing_tones(eps: float, Q: float, drives: list[tuple[float, float]]) -> lis
         return 1 / (1 - nu * nu + 1j * nu / Q)
 
     q0: dict = {}
-    for i, (f, _) in enumerate(drives):
-        e = tuple(int(j == i) for j in range(k))
-        q0[e] = chi(e) * f / 2
-        q0[tuple(-m for m in e)] = np.conj(q0[e])
-    cube0 = _cube(_cube(q0, q0), q0)
-    q1 = {c: -eps * chi(c) * v for c, v in cube0.items()}
-    q0sq = _cube(q0, q0)
-    q2 = {c: -3 * eps * chi(c) * v for c, v in _cube(q0sq, q1).items()}
+    with np.errstate(over="ignore", invalid="ignore"):
+        for i, (f, _) in enumerate(drives):
+            e = tuple(int(j == i) for j in range(k))
+            q0[e] = chi(e) * f / 2
+            q0[tuple(-m for m in e)] = np.conj(q0[e])
+        cube0 = _cube(_cube(q0, q0), q0)
+        q1 = {c: -eps * chi(c) * v for c, v in cube0.items()}
+        q0sq = _cube(q0, q0)
+        q2 = {c: -3 * eps * chi(c) * v for c, v in _cube(q0sq, q1).items()}
+    if not all(np.isfinite(v) for part in (q0, q1, q2) for v in part.values()):
+        size = max(abs(v) for v in q0.values())
+        raise InputError(f"drives {' '.join(f'{f:g}@{w:g}' for f, w in drives)} (Q {Q:g}): the "
+                         f"linear response {2 * size:.3g} makes the second-order tones overflow; "
+                         "the expansion in eps needs eps q0^2 small")
     tones: dict = {}
     for order, part in ((0, q0), (1, q1), (2, q2)):
         for c, v in part.items():
@@ -377,3 +499,21 @@ def mixing_tones(eps: float, Q: float, drives: list[tuple[float, float]]) -> lis
                           min(order, prev[2]) if prev else order)
     return sorted((Tone(c, nu, float(2 * abs(v)), order) for nu, (c, v, order) in tones.items()),
                   key=lambda tone: (tone.order, tone.frequency))
+
+
+def simulated_tones(eps: float, Q: float, drives: list[tuple[float, float]],
+                    tones: list[Tone]) -> np.ndarray:
+    """The simulated steady state's amplitude at each tone (from rest, after the transients),
+    or :class:`InputError` when the simulated orbit overflows: no steady state to compare."""
+    sim = steady_state_amplitudes(eps, 1 / Q, [f for f, _ in drives], [w for _, w in drives],
+                                  [t.frequency for t in tones])
+    if np.any(np.isnan(sim)):
+        given = " ".join(f"{f:g}@{w:g}" for f, w in drives)
+        why = ("RK4 at 64 steps a period is unstable there: a stiff damping 1/Q or a large "
+               "eps q^2")
+        if eps < 0:
+            why = (f"a softening spring (eps {eps:g}) driven over its barrier at |q| = "
+                   f"{1 / np.sqrt(-eps):.3g} escapes to infinity, or {why}")
+        raise InputError(f"drives {given}: the simulated orbit overflows ({why}); there is no "
+                         "steady state to compare the tones with")
+    return sim

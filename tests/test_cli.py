@@ -90,9 +90,10 @@ def test_force_in_series_is_the_old_spelling_of_allow_slow():
 
 def test_light_constants_match_the_stages():
     """The parser's choices are restated in cli (no SymPy at start-up): they must agree."""
-    from lindstedt import choose, cli, models
+    from lindstedt import choose, cli, driven, models
 
     assert cli.FREE_MODELS == models.MODELS
+    assert cli.MAX_HARMONICS == driven.MAX_HARMONICS
     assert tuple(choose.SCENES) == cli.SCENE_NAMES
     assert cli.DRIVEN_QUANTITIES == choose.DRIVEN_QUANTITIES
 

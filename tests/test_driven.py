@@ -150,3 +150,50 @@ def test_driven_contract():
                           "--force", "1", "--omega", "1", "--Q", "0"],
                          capture_output=True, text=True, check=False)
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("kwargs,needle", [
+    (dict(eps=0.1, force=0.0, omega=1.0), "force 0: no drive"),
+    (dict(eps=0.1, force=1.0, omega=1e-300), "omega 1e-300"),
+    (dict(eps=1e-308, force=1.0, omega=1.0), "eps 1e-308"),
+    (dict(eps=0.1, force=1.0, omega=1.0, Q=1e-308), "Q 1e-308"),
+])
+def test_drive_domain_says_why(kwargs, needle):
+    with pytest.raises(InputError, match=needle):
+        Drive(**kwargs)
+
+
+def test_shooting_resolves_every_harmonic_asked():
+    """64 samples per orbit resolve harmonics up to 31; more take more samples (once an
+    IndexError for ``driven --order 16``)."""
+    low = shoot(0.1, 1.0, 1.0, 0.0, np.array([2.4, 0.0]), harmonics=9)
+    high = shoot(0.1, 1.0, 1.0, 0.0, np.array([2.4, 0.0]), harmonics=199)
+    assert sorted(high.A) == list(range(1, 200, 2))
+    assert all(abs(high.A[n] - low.A[n]) < 1e-12 for n in low.A)
+    assert abs(high.A[199]) < 1e-14
+
+
+@pytest.mark.parametrize("eps,force,omega,Q", [
+    (1e-16, 1e-16, 1e-16, math.inf), (10.0, 1e-16, 1e-16, 10.0), (1e16, 1e16, 1e16, 1e-16),
+    (-1e16, 1e16, 1.0, 1e16), (1e-16, 1e16, 1e16, math.inf)])
+def test_corners_of_the_domain_give_finite_answers_or_say_why(eps, force, omega, Q):
+    """Each edge of ``Drive``'s window: the μ-series stays finite (a series whose terms would
+    overflow, or a fold, stops early and says so), the balance ends without an error, and
+    neither warns."""
+    import warnings
+
+    d = Drive(eps, force, omega, Q)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for br in first_order_branches(d):
+            mu = mu_expansion(d, br, 12)
+            assert all(np.all(np.isfinite(c)) for c in mu.coefficients)
+            assert mu.converged or mu.reason.startswith("order ")
+            harmonic_balance(d, br, 4)
+
+
+def test_tiny_linear_response_is_found():
+    """Q = 1e-16 puts u = r² ~ 1e-32 beside roots ~1e16 that np.roots cannot tell apart."""
+    (br,) = first_order_branches(Drive(-0.1, 1.0, 0.5, 1e-16))
+    r_linear = 1.0 / abs(1 - 0.25 + 0.5j * 1e16)
+    assert abs(br.A1 / r_linear - 1) < 1e-9

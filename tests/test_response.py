@@ -201,3 +201,29 @@ def test_mixing_amplitudes_against_simulated_spectrum():
         tol = {0: 0.01, 1: 0.05, 2: 0.2}[t["order"]] * t["predicted"] + 2e-6
         assert abs(t["predicted"] - t["simulated"]) <= tol, t
     assert next(t for t in tones if t["combination"] == "2w1-w2")["simulated"] > 5e-3
+
+
+@pytest.mark.parametrize("eps,force,Q,harmonics,needle", [
+    (0.1, 1e6, 185.0, 8, "the limit is 20000"),
+    (0.1, 0.3, 20.0, 100_000, "harmonics 100000"),
+    (0.1, 0.3, 1e16, 4, "too narrow for the continuation"),
+])
+def test_continuation_refuses_what_it_cannot_finish(eps, force, Q, harmonics, needle):
+    from lindstedt.errors import InputError
+
+    with pytest.raises(InputError, match=needle):
+        continue_balance(eps, force, Q, harmonics, 0.5, 2.0)
+
+
+def test_mixing_bounds_and_escapes():
+    from lindstedt.errors import InputError
+    from lindstedt.response import mixing_tones, simulated_tones
+
+    with pytest.raises(InputError, match="at most 4"):
+        mixing_tones(0.1, 10.0, [(0.1, 1 + k / 10) for k in range(5)])
+    with pytest.raises(InputError, match="transients die out"):
+        drives = [(0.3, 1.3)]
+        simulated_tones(0.1, 1e12, drives, mixing_tones(0.1, 1e12, drives))
+    drives = [(3.0, 1.0)]  # softening: driven over the barrier at |q| = 1/√0.1
+    with pytest.raises(InputError, match="escapes to infinity"):
+        simulated_tones(-0.1, 10.0, drives, mixing_tones(-0.1, 10.0, drives))
