@@ -5,9 +5,9 @@ Every run must end with exit status 0 or 2 within ``TIMEOUT``, never print a tra
 refusal (exit 2) must be one line on stderr, nothing on stdout, nothing written — not even its
 --out, --emit or --plot target.  Seeded (``derandomize``) so CI draws the same runs each time,
 and bounded (``max_examples`` pairs of runs per command, ~60 s for the file on a loaded
-2-core machine): valid runs use small orders and harmonics, and known-slow
-valid regions (a subharmonic figure, the demo, the slower scenes, --allow-slow with a large
-order, `generate balance` at its default 8 harmonics) are left out of the strategies.
+2-core machine): valid runs use small orders and harmonics, and known-slow valid regions (a
+subharmonic figure, the demo, the slower scenes, --allow-slow with a large order, `generate
+balance` at its default 8 harmonics) are left out of the strategies.
 
 The second half replays, in-process and each once, the crashes and hangs known before this
 fuzzing and those it found.
