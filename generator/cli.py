@@ -800,20 +800,32 @@ def _order(text: str) -> int:
     return value
 
 
+def _positive(text: str) -> int:
+    """A positive integer (workers, points per task)."""
+    value = _order(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value}: must be ≥ 1")
+    return value
+
+
 def _count(text: str) -> int:
     """A number of harmonics: an integer in 1..MAX_HARMONICS."""
-    value = _order(text)
-    if not 1 <= value <= MAX_HARMONICS:
+    value = _positive(text)
+    if value > MAX_HARMONICS:
         raise argparse.ArgumentTypeError(f"{value}: must be in 1..{MAX_HARMONICS}")
     return value
 
 
-def _real(text: str) -> float:
-    """A finite real number (scientific notation and a leading minus welcome)."""
+def _number(text: str) -> float:
     try:
-        value = float(text)
+        return float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r}: not a number") from None
+
+
+def _real(text: str) -> float:
+    """A finite real number (scientific notation and a leading minus welcome)."""
+    value = _number(text)
     if not math.isfinite(value):
         raise argparse.ArgumentTypeError(f"{text!r}: not finite")
     return value
@@ -821,13 +833,9 @@ def _real(text: str) -> float:
 
 def _quality(text: str) -> float:
     """A quality factor Q > 0; ``inf`` means undamped."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: not a number") from None
-    if not value > 0:
+    if not _number(text) > 0:
         raise argparse.ArgumentTypeError(f"{text!r}: must be > 0 (inf: undamped)")
-    return value
+    return float(text)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -892,22 +900,24 @@ def _flag_plot(p: argparse.ArgumentParser) -> None:
 
 
 def _flag_drive(p: argparse.ArgumentParser, required: bool, omega: str | None,
-                Q: str = "optional") -> None:
-    """--eps, --force, --omega, --Q of q'' + q'/Q + q + eps q^3 = f cos(w t)."""
+                Q: str | None = "optional", force: bool = True) -> None:
+    """--eps, --force, --omega, --Q of q'' + q'/Q + q + eps q^3 = f cos(w t) (``omega``: its
+    meaning, None for none; ``Q``: "optional", "required" or None for none)."""
     need = " (required)" if required else ""
     p.add_argument("--eps", type=_real, required=required, metavar="EPS",
                    help=f"ε, the cubic stiffness coefficient (dimensionless; > 0 hardens, "
                    f"< 0 softens){need}")
-    p.add_argument("--force", type=_real, required=required, metavar="F",
-                   help=f"f, the drive amplitude, in units of the linear stiffness × length "
-                   f"(q is dimensionless){need}")
+    if force:
+        p.add_argument("--force", type=_real, required=required, metavar="F",
+                       help=f"f, the drive amplitude, in units of the linear stiffness × length "
+                       f"(q is dimensionless){need}")
     if omega is not None:
         p.add_argument("--omega", type=_real, required=required, metavar="W",
                        help=f"{omega}, in units of the linear natural frequency{need}")
     if Q == "required":
         p.add_argument("--Q", type=_quality, required=True, metavar="Q",
                        help="quality factor Q > 0 of the damping q'/Q (finite; required)")
-    else:
+    elif Q == "optional":
         p.add_argument("--Q", type=_quality, default=math.inf, metavar="Q",
                        help="quality factor Q > 0 of the damping q'/Q (default inf: undamped)")
 
@@ -966,13 +976,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("subharmonic", help="the 1/3 subharmonic of eq. 10.83 and its stability",
                        description="omega^2 q'' + q + eps q^3 = f cos 3τ: the 1/3 subharmonic.")
-    p.add_argument("--eps", type=_real, required=True, metavar="EPS",
-                   help="ε, the cubic stiffness coefficient (dimensionless; required)")
-    p.add_argument("--force", type=_real, required=True, metavar="F",
-                   help="f, the drive amplitude (units of the linear stiffness; required)")
-    p.add_argument("--omega", type=_real, required=True, metavar="W",
-                   help="ω of eq. 10.83, the subharmonic's frequency: the drive is at 3ω "
-                   "(units of the linear natural frequency; required)")
+    _flag_drive(p, required=True, omega="ω of eq. 10.83, the subharmonic's frequency: the "
+                "drive is at 3ω", Q=None)
     _flag_json(p)
     _flag_plot(p)
     p.set_defaults(func=_cmd_subharmonic)
@@ -980,10 +985,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("mixing", help="combination tones of a two-tone drive",
                        description="q'' + q'/Q + q + eps q^3 = Σ f_i cos(w_i t): "
                        "predicted and simulated combination tones.")
-    p.add_argument("--eps", type=_real, required=True, metavar="EPS",
-                   help="ε, the cubic stiffness coefficient (dimensionless; required)")
-    p.add_argument("--Q", type=_quality, required=True, metavar="Q",
-                   help="quality factor Q > 0 of the damping q'/Q (finite; required)")
+    _flag_drive(p, required=True, omega=None, Q="required", force=False)
     p.add_argument("--drive", type=_drive, action="append", required=True, metavar="F@W",
                    help="a drive f cos(w t): amplitude F at frequency W (units of the linear "
                    "natural frequency), e.g. 0.3@1.3; repeat for each tone (required)")
@@ -1038,9 +1040,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="tcp://host:port of a running dask scheduler whose workers have "
                    "lindstedt (default: a LocalCluster on this machine)")
-    p.add_argument("--workers", type=_count, default=2, metavar="N",
+    p.add_argument("--workers", type=_positive, default=2, metavar="N",
                    help="worker processes of the LocalCluster, one thread each (default 2)")
-    p.add_argument("--chunk", type=_count, default=None, metavar="POINTS",
+    p.add_argument("--chunk", type=_positive, default=None, metavar="POINTS",
                    help="grid points per task (default: the kind's, about 1 s of work)")
     _flag_json(p, "a JSON summary")
     _flag_plot(p)
