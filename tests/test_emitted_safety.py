@@ -5,8 +5,8 @@ chosen_period) is called with wrong shapes, views, dtypes and lengths in a child
 file run as a script), so that a crash fails the test instead of killing pytest.  Each bad call
 must raise TypeError or ValueError naming the function and the argument, and leave every array
 it was given (and the array a view was cut from) exactly as it was; arguments of another real
-dtype, huge int64 values included, must give the float64 answer; the good calls still equal the
-ufuncs.
+dtype, huge int64 values included, must give the float64 answer (to a few ulp: each argument type
+is its own compilation); the good calls still equal the ufuncs.
 """
 
 from __future__ import annotations
@@ -46,7 +46,10 @@ HUGE = {  # int64 arguments that overflow int64 arithmetic (4e9² > 2⁶³), wit
     "branch": np.array([0, 0, 1, 2, 0, 1, 2]),
 }
 INTS = np.array([0, 1, 2, 3, 4_000_000_000, -4_000_000_000, 3_037_000_500])
-# NOTE: the ufuncs' values and the _into loops' agree to a few ulp (vectorised cos and sin).
+# NOTE: the ufuncs' values and the _into loops' agree to a few ulp (vectorised cos and sin), and
+# so do two compilations of one kernel for different argument types: numba specialises per type,
+# and with "reassoc" LLVM may group a sum differently in each (seen on CPUs other than this
+# project's usual machine).  Overflowing int64 arithmetic is wrong in the leading digit.
 RTOL, ATOL = 1e-13, 1e-15
 
 
@@ -191,13 +194,13 @@ def into_cases(calls: Calls, kind: str, mod, fname: str) -> None:
             return tuple(v if i == j else g for i, g in enumerate(good))
         calls.equal(f"{tag}: {a} int64 with huge values",
                     lambda w=with_arg: into(np.empty(N), *w(INTS)),
-                    lambda w=with_arg: into(np.empty(N), *w(INTS.astype(np.float64))), True)
+                    lambda w=with_arg: into(np.empty(N), *w(INTS.astype(np.float64))), False)
         other = {"int32": good[j].astype(np.int32), "bool": good[j] > good[j].mean(),
                  "float32": good[j].astype(np.float32), "big-endian": good[j].astype(">f8")}
         for label, v in other.items():
             calls.equal(f"{tag}: {a} {label}", lambda w=with_arg, v=v: into(np.empty(N), *w(v)),
                         lambda w=with_arg, v=v: into(np.empty(N), *w(v.astype(np.float64))),
-                        True)
+                        False)
         strided = np.repeat(good[j], 2)[::2]
         backwards = good[j][::-1].copy()[::-1]
         column = np.column_stack([good[j], good[j]])[:, 1]
@@ -276,17 +279,17 @@ def kernel_cases(calls: Calls, mod) -> None:
                              "bool": True}.items():
                 args = tuple(v if i == j else q for i, q in enumerate(params))
                 calls.equal(f"{tag}: {p} {label}", lambda fn=fn, good=good, args=args: fn(
-                    good, *args), fn(good, *(float(a) for a in args)), True)
+                    good, *args), fn(good, *(float(a) for a in args)), False)
         huge = np.full(size, 4_000_000_000)
         calls.equal(f"{tag}: {arg} int64 with huge values, omega a huge int",
                     lambda fn=fn, huge=huge: fn(huge, 4_000_000_000, 0.1, 1, 0.05),
-                    fn(huge.astype(float), 4e9, 0.1, 1.0, 0.05), True)
+                    fn(huge.astype(float), 4e9, 0.1, 1.0, 0.05), False)
         spread = good.copy()
         spread[1::2] = 0  # integers for the integer dtypes
         for label, v in {"int32": spread.astype(np.int32), "bool": spread != 0,
                          "float32": good.astype(np.float32)}.items():
             calls.equal(f"{tag}: {arg} {label}", lambda fn=fn, v=v: fn(v, *params),
-                        fn(v.astype(np.float64), *params), True, (v,))
+                        fn(v.astype(np.float64), *params), False, (v,))
         wide = filled(2 * size)
         wide[::2] = good
         rows = filled((3, size))
@@ -294,7 +297,7 @@ def kernel_cases(calls: Calls, mod) -> None:
         for label, v, kept in (("strided view", wide[::2], wide),
                                ("reversed view", good[::-1].copy()[::-1], good),
                                ("row of a 2-D array", rows[1], rows)):
-            calls.equal(f"{tag}: {arg} a {label}", lambda fn=fn, v=v: fn(v, *params), ref, True,
+            calls.equal(f"{tag}: {arg} a {label}", lambda fn=fn, v=v: fn(v, *params), ref, False,
                         (kept,))
     calls.refused("balance.newton: tol complex", mod.newton, (x0, *params, 1j), "newton", "tol")
     calls.refused("balance.newton: max_iter a float", mod.newton, (x0, *params, 1e-13, 2.5),
@@ -319,7 +322,7 @@ def run_all(folders: dict[str, Path]) -> list[dict]:
     duffing = sys.modules["duffing"]
     calls.equal("duffing.period_into(out, np.full(3, 4_000_000_000), 1e-20)",
                 lambda: duffing.period_into(np.zeros(3), np.full(3, 4_000_000_000), 1e-20),
-                duffing.period(np.full(3, 4e9), 1e-20), True)
+                duffing.period(np.full(3, 4e9), 1e-20), False)
     calls.equal("... and the ufunc's value is 5.9385",
                 lambda: round(float(duffing.period(4e9, 1e-20)), 4), 5.9385, True)
     calls.refused("duffing.q_into(int64 out)", duffing.q_into,
