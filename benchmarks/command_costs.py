@@ -1,11 +1,11 @@
-"""The command line's cost estimates against the measured wall time of the same commands.
+"""Every command's cost estimate against the measured wall time of the same command.
 
     .venv/bin/python benchmarks/command_costs.py [--quick]
 
-Each `lindstedt generate MODEL` runs at several sizes (into a temporary folder, with
---allow-slow); the table prints the estimate `lindstedt.cli.generate_seconds` gives, the
-measured time and their ratio, and `series` likewise against `estimated_seconds`. The
-estimates decide when a command asks for --allow-slow (above 60 s).
+Each command runs at several sizes (into a temporary folder, with --allow-slow where it has
+one); the table prints the estimate `lindstedt.costs.COSTS` gives for the same command line,
+the measured time and their ratio.  The estimates decide when a command asks for --allow-slow
+(above 60 s).
 """
 
 from __future__ import annotations
@@ -16,13 +16,43 @@ import tempfile
 import time
 from pathlib import Path
 
-from lindstedt.cli import estimated_seconds, generate_seconds
+from lindstedt.cli import build_parser, check_cost
+from lindstedt.costs import COSTS
 
 BIN = Path(sys.executable).parent / "lindstedt"
-GENERATE = (("duffing", "--order", (20, 60, 100, 130)), ("pendulum", "--order", (20, 40, 60, 80)),
-            ("balance", "--harmonics", (2, 4, 8, 12)), ("fourier", "--harmonics", (8, 40)),
-            ("driven", "--order", (3, 4, 5)))
-SERIES = (("duffing", (100, 200, 300)), ("pendulum", (40, 70, 100)))
+DRIVE = ["--eps", "0.1", "--force", "0.3"]
+CASES = [
+    *[["generate", "duffing", "--order", str(k)] for k in (20, 60, 100, 130)],
+    *[["generate", "pendulum", "--order", str(k)] for k in (20, 40, 60, 80)],
+    *[["generate", "balance", "--harmonics", str(n)] for n in (2, 4, 8, 12)],
+    *[["generate", "fourier", "--harmonics", str(n)] for n in (8, 40)],
+    *[["generate", "driven", "--order", str(k)] for k in (3, 4, 5)],
+    *[["series", "duffing", "--order", str(k), "--json"] for k in (100, 200, 300)],
+    *[["series", "pendulum", "--order", str(k), "--json"] for k in (40, 70, 100)],
+    *[["driven", *DRIVE, "--omega", "1.3", "--order", str(k), "--json"] for k in (4, 64, 100,
+                                                                               150, 200)],
+    *[["driven", *DRIVE, "--omega", "1.3", "--Q", "20", "--order", str(k), "--json"]
+      for k in (4, 100)],
+    *[["response", *DRIVE, "--Q", "20", "--harmonics", str(n), "--json"] for n in (8, 40)],
+    ["response", "--eps", "0.1", "--force", "3", "--Q", "100", "--harmonics", "60", "--json"],
+    ["subharmonic", *DRIVE, "--omega", "1.05", "--json"],
+    ["mixing", "--eps", "0.1", "--Q", "20", "--drive", "0.3@0.8", "--drive", "0.2@1.9",
+     "--drive", "0.1@2.7", "--drive", "0.1@3.3", "--json"],
+    ["choose", "period", "--tol", "1e-8", "--x-min", "-0.5", "--x-max", "0.5", "--json"],
+    ["choose", "q", "--tol", "1e-6", "--x-min", "0", "--x-max", "0.5", "--json"],
+    ["choose", "amplitudes", *DRIVE, "--Q", "20", "--omega", "1.3", "--json"],
+    ["choose", "response", *DRIVE, "--Q", "20", "--omega-min", "0.5", "--omega-max", "1.5",
+     "--json"],
+    ["choose", "amplitudes", *DRIVE, "--omega", "1.3", "--tol", "1e-6", "--json"],
+    ["clock", "--json"],
+    *[["scene", name, "--json"] for name in ("clock", "hard-spring", "notes-driven")],
+    *[["sweep", "stability", "--omega", f"1.0:1.5:{n}", "--force", "0.3", "--eps", "0.1",
+       "--Q", "20", "--json"] for n in (64, 512)],
+    ["sweep", "validity", "--omega", "0.5:1.5:128", "--force", "0.3", "--eps", "0.1", "--Q",
+     "inf", "--json"],
+]
+SLOW = {"series", "generate", "driven", "response", "choose", "sweep"}
+# NOTE: the commands that take --allow-slow (the others never exceed the limit).
 
 
 def wall(args: list[str]) -> float:
@@ -32,21 +62,25 @@ def wall(args: list[str]) -> float:
 
 
 def main(quick: bool) -> None:
-    print(f"{'command':<48} {'estimate s':>10} {'measured s':>10} {'ratio':>6}")
+    print(f"{'command':<78} {'estimate s':>10} {'measured s':>10} {'ratio':>6}")
     with tempfile.TemporaryDirectory() as tmp:
-        for model, flag, sizes in GENERATE:
-            for size in sizes[:2] if quick else sizes:
-                args = ["generate", model, flag, str(size), "--out", f"{tmp}/{model}{size}",
-                        "--allow-slow"]
-                estimate, measured = generate_seconds(model, size), wall(args)
-                print(f"{' '.join(args[:4]):<48} {estimate:>10.1f} {measured:>10.1f} "
-                      f"{measured / estimate:>6.2f}")
-    for model, orders in SERIES:
-        for order in orders[:1] if quick else orders:
-            args = ["series", model, "--order", str(order), "--json", "--allow-slow"]
-            estimate, measured = estimated_seconds(model, order), wall(args)
-            print(f"{' '.join(args[:4]):<48} {estimate:>10.1f} {measured:>10.1f} "
-                  f"{measured / estimate:>6.2f}")
+        for i, case in enumerate(CASES):
+            args = list(case)
+            if args[0] == "generate":
+                args += ["--out", f"{tmp}/g{i}"]
+            if args[0] == "sweep":
+                args += ["--store", f"{tmp}/s{i}.zarr"]
+            if args[0] in SLOW:
+                args.append("--allow-slow")
+            parsed = build_parser().parse_args(args)
+            check_cost(parsed)  # bounds hold
+            estimate = COSTS[parsed.command](parsed).seconds
+            if quick and estimate > 30:
+                continue
+            measured = wall(args)
+            label = " ".join(a for a in case if a != "--json")
+            print(f"{label:<78} {estimate:>10.1f} {measured:>10.1f} {measured / estimate:>6.2f}",
+                  flush=True)
 
 
 if __name__ == "__main__":

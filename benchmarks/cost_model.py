@@ -1,6 +1,7 @@
-"""The cost model `choose period` and `choose q` decide by: ns/point ≈ fixed + per_order ·
-order of each method's compiled evaluator, fitted here by least squares on this machine's
-timings and recorded in lindstedt.choose.COST_MODEL; printed beside this run's measurements.
+"""The cost model every `choose` decides by: ns/point ≈ c₀ + c₁·order + c₂·order² of each
+method (period, q: the compiled evaluators; amplitudes and response: each driven method per ω,
+interpreted and emitted), fitted here by least squares on this machine's timings and recorded
+in lindstedt.choose.COST_MODEL; printed beside this run's measurements.
 
     .venv/bin/python benchmarks/cost_model.py [--fit]
 
@@ -20,14 +21,37 @@ from lindstedt.choose import (
     _fourier_cost,
     _generated_q_cost,
     candidates,
+    driven_tradeoffs,
+    driven_truth,
+    emitted_driven,
     modelled_ns,
     ns_per_point,
 )
+from scipy.optimize import nnls
 from scipy.special import ellipj
 
 Q_ORDERS = (1, 2, 4, 6, 8, 12, 16, 20)
 FOURIER_HARMONICS = (1, 2, 4, 8, 12, 20, 30, 40)
 # NOTE: enough orders for a straight line; each generated q(t) module compiles in seconds.
+DRIVEN_CASES = ((0.1, 0.3, np.inf), (0.1, 0.3, 20.0))
+DRIVEN_OMEGAS = np.linspace(1.2, 1.4, 5)
+EMITTED_MU_ORDERS = (1, 2, 3, 4, 5)
+EMITTED_HARMONICS = (1, 2, 4, 6, 8)
+# NOTE: the driven methods at the notes' ε and f, undamped and Q = 20, on the large branch;
+# the emitted μ-expansion to order 5 (order 6 takes minutes to generate).
+
+
+def driven_measurements(rows: dict[tuple[str, str], list[tuple[int, float]]]) -> None:
+    for eps, force, Q in DRIVEN_CASES:
+        truth = driven_truth(eps, force, Q, DRIVEN_OMEGAS)
+        for t in driven_tradeoffs(truth, eps, force, Q):
+            rows["driven", t.method].append((t.order, t.ns_per_point))
+        orders = [("harmonic_balance", n) for n in EMITTED_HARMONICS]
+        if np.isinf(Q):  # only the undamped μ-expansion has an emitted module
+            orders += [("mu_expansion", k) for k in EMITTED_MU_ORDERS]
+        for method, order in orders:
+            t = emitted_driven(method, order, truth, eps, force, Q)
+            rows["driven", t.method].append((t.order, t.ns_per_point))
 
 
 def measurements() -> dict[tuple[str, str], list[tuple[int, float]]]:
@@ -47,6 +71,7 @@ def measurements() -> dict[tuple[str, str], list[tuple[int, float]]]:
         ellipj(np.sqrt(1 + x) * t, x / (2 * (1 + x)))
         best = min(best, time.perf_counter() - t0)
     rows["q", "exact"].append((0, best / x.size * 1e9))
+    driven_measurements(rows)
     return rows
 
 
@@ -55,8 +80,12 @@ def main(fit: bool) -> None:
     if fit:
         for (quantity, method), data in rows.items():
             k, ns = np.array(data).T
-            per_order, fixed = np.polyfit(k, ns, 1) if np.ptp(k) > 0 else (0.0, ns.mean())
-            print(f'{quantity:>6}  "{method}": ({fixed:.3f}, {per_order:.4f}),')
+            if np.ptp(k) == 0:
+                coefficients = [ns.mean()]
+            else:  # c₀ + c₁k + c₂k², every coefficient ≥ 0 (a cost never falls with order)
+                coefficients, _ = nnls(np.column_stack([np.ones_like(k), k, k**2]), ns)
+            print(f'{quantity:>6}  "{method}": '
+                  f'({", ".join(f"{c:.3g}" for c in coefficients)},),')
         return
     print(f"{'quantity':>8} {'method':>10} {'order':>5} {'measured ns':>12} {'model ns':>9} "
           f"{'ratio':>6}")

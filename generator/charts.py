@@ -31,10 +31,11 @@ from .emit import check_folder, check_target, write_files
 from .errors import InputError
 from .numerics import steady_state_amplitudes, sweep
 from .response import (
+    CONTINUATION_SECONDS,
     continue_balance,
     mixing_tones,
     one_harmonic_curve,
-    one_harmonic_folds,
+    response_range,
     subharmonic,
     tone_label,
 )
@@ -83,15 +84,16 @@ def _save(fig: plt.Figure, path: Path) -> Path:
     return path
 
 
-def response_figure(eps: float, force: float, Q: float, harmonics: int, path: Path) -> Path:
+def response_figure(eps: float, force: float, Q: float, harmonics: int, path: Path,
+                    max_seconds: float = CONTINUATION_SECONDS) -> Path:
     """Response r(ω): one-harmonic branches (stable solid, unstable dashed), N-harmonic
-    continuation, simulated sweeps up and down, folds; and the linear curves of Fig. 1."""
+    continuation, simulated sweeps up and down, folds; and the linear curves of Fig. 1
+    (``max_seconds``: the continuation's cost limit)."""
     check_plot_path(path)
-    folds = one_harmonic_folds(eps, force, Q)
-    lo, hi = 0.5 * min([1.0, *folds]), 1.25 * max([1.0, *folds])
+    lo, hi = response_range(eps, force, Q)
     omega = np.linspace(lo, hi, 2000)
     curve = one_harmonic_curve(eps, force, Q, omega)
-    cont = continue_balance(eps, force, Q, harmonics, lo, hi)
+    cont = continue_balance(eps, force, Q, harmonics, lo, hi, max_seconds=max_seconds)
     up, down = sweep(eps, force, 1 / Q, lo, hi), sweep(eps, force, 1 / Q, hi, lo)
     fig, (ax, lin) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [3, 2]})
     count = np.isfinite(curve.r).sum(axis=1)

@@ -4,7 +4,7 @@ against an independent reference and timed; the cheapest within the tolerance wi
 * :func:`choose_period`: the Duffing period (below);
 * :func:`choose_solution`: q(t) — L–P orders against the exact Fourier series (nome) of cn;
 * :func:`choose_driven`: the driven amplitudes A_n(ω) and the response r(ω) — one harmonic,
-  μ-expansion orders, harmonic balance, shooting; with ``emit_order``, the emitted modules;
+  μ-expansion orders, harmonic balance, shooting; with ``emit``, the emitted modules;
 * named scenes (:data:`SCENES`) and the appendix's pendulum claims.
 
 Candidates for ``T/2π`` as a function of ``x = εA²``:
@@ -29,6 +29,7 @@ requested range, measures its compiled cost, and returns the cheapest within the
 from __future__ import annotations
 
 import functools
+import math
 import sys
 import tempfile
 import time
@@ -271,9 +272,8 @@ def ns_per_point(c: Candidate, points: int = 1_000_000, x_min: float = 0.0,
 T = TypeVar("T")
 TIE = 0.15
 # NOTE: costs within 15 % of the cheapest count as a tie, broken by a fixed order of methods
-# (the simplest formula first). Period and q(t) compare the recorded COST_MODEL, so their
-# choice never depends on this run's timings; the driven quantities compare measured costs,
-# which for the emitted modules differ ~100× (μ-expansion against balance), beyond any noise.
+# (the simplest formula first). Every choice compares the recorded COST_MODEL, so it never
+# depends on this run's timings (and what --emit writes is the same on every run).
 SIMPLEST_FIRST = ("lindstedt", "one_harmonic", "pade", "resummed", "modified", "agm",
                   "mu_expansion", "harmonic_balance", "fourier", "shooting", "exact")
 
@@ -292,17 +292,27 @@ COST_MODEL = {
         "lindstedt": (3.1, 0.21),
         "fourier": (86.0, 1.2),
     },
+    "driven": {  # per ω, on the largest branch
+        "one_harmonic": (800.0,),
+        "mu_expansion": (9.98e5, 0.0, 7.27e4),
+        "harmonic_balance": (6.61e5, 8.42e4),
+        "shooting": (5.09e5, 920.0),
+        "mu_expansion, emitted": (110.0, 26.0),
+        "harmonic_balance, emitted": (1960.0, 3794.0),
+    },
 }
-# NOTE: ns/point ≈ fixed + per_order · order of each method's compiled evaluator, per
-# quantity, fitted once on the 2-core reference machine by `benchmarks/cost_model.py --fit`
-# (docs/benchmarks.md). `choose period|q` decide by it, so the choice — and what --emit
-# writes — does not depend on the machine's load; each run's own timings are reported beside.
+# NOTE: ns/point ≈ c₀ + c₁·order + c₂·order² (the coefficients ≥ 0) of each method, per
+# quantity: period and q(t) of the compiled evaluators; for the driven quantities, each method
+# per ω as `choose` runs it (interpreted: the μ-expansion's series products grow with the
+# order squared) and the emitted modules. Fitted once on the 2-core reference machine by
+# `benchmarks/cost_model.py --fit` (docs/benchmarks.md). Every `choose` decides by it, so the
+# choice — and what --emit writes — does not depend on the machine's load; each run's own
+# timings are reported beside.
 
 
 def modelled_ns(quantity: str, method: str, order: int) -> float:
     """The recorded cost of ``method`` at ``order`` for ``quantity`` (ns per point)."""
-    fixed, per_order = COST_MODEL[quantity][method]
-    return fixed + per_order * order
+    return sum(c * order**i for i, c in enumerate(COST_MODEL[quantity][method]))
 
 
 def cheapest(items: list[T], cost: Callable[[T], float], method: Callable[[T], str]) -> T:
@@ -718,8 +728,9 @@ class DrivenChoice:
     ns_per_point: float  # measured wall time per ω
     verified_on: int
     considered: tuple[tuple[str, int, float, float], ...]  # per method: smallest order that
-    # meets the tolerance, its error, its ns per point
+    # meets the tolerance, its error, its ns per point (measured); emitted modules after
     truth: DrivenTruth
+    modelled_ns_per_point: float = math.nan  # COST_MODEL["driven"]: what the choice compared
 
     def _repr_html_(self) -> str:
         return choice_table(self, f"choose_driven: {self.quantity}, max error")
@@ -727,12 +738,17 @@ class DrivenChoice:
 
 def choose_driven(quantity: str, tol: float, eps: float, force: float, Q: float,
                   omega_min: float, omega_max: float | None = None,
-                  emit_order: int | None = None, progress: Progress = quiet) -> DrivenChoice:
+                  emit: tuple[int, int] | None = None,
+                  progress: Progress = quiet) -> DrivenChoice:
     """The cheapest of one harmonic, the μ-expansion (smallest order), harmonic balance
     (fewest harmonics) and shooting (fewest RK4 steps) whose error in ``quantity`` is
     ≤ ``tol`` at every verified ω of ``[omega_min, omega_max]`` (one ω when ``omega_max`` is
-    None), on the largest branch.  ``emit_order``: only what has an emitted module competes —
-    harmonic balance, and the undamped μ-expansion up to that order."""
+    None), on the largest branch; "cheapest" by the recorded ``COST_MODEL["driven"]``, so the
+    choice does not depend on this run's timings (which are reported).  ``emit`` = (highest
+    μ-order, most harmonics): only what has an emitted module within those bounds competes —
+    harmonic balance, and the undamped μ-expansion; the modules are generated in the order of
+    their modelled cost, the first that meets ``tol`` is chosen (only it and the ones before
+    it are generated)."""
     if quantity not in DRIVEN_QUANTITIES:
         raise InputError(f"quantity {quantity!r}: one of {', '.join(DRIVEN_QUANTITIES)}")
     for name, v in (("tol", tol), ("omega-min", omega_min), ("omega-max", omega_max)):
@@ -754,32 +770,43 @@ def choose_driven(quantity: str, tol: float, eps: float, force: float, Q: float,
         err = float(np.max(t.errors[quantity]))  # NaN anywhere: refused somewhere
         if np.isnan(err) or t.method in best:
             continue
-        if emit_order is not None and not (  # only what has an emitted module competes
-                t.method == "harmonic_balance" or (t.method == "mu_expansion" and np.isinf(Q)
-                                                   and t.order <= emit_order)):
+        if emit is not None and not (  # only what has an emitted module competes
+                (t.method == "harmonic_balance" and t.order <= emit[1])
+                or (t.method == "mu_expansion" and np.isinf(Q) and t.order <= emit[0])):
             continue
         reachable = min(reachable, err)
         if err <= tol:
             best[t.method] = (t, err)
     if not best:
-        raise InputError(f"tol {tol:g}: no {'emittable ' * (emit_order is not None)}method "
+        within = ("" if emit is None else f" (emittable: μ-expansion to order {emit[0]}, "
+                  f"balance to {emit[1]} harmonics; --allow-slow admits more)")
+        raise InputError(f"tol {tol:g}: no {'emittable ' * (emit is not None)}method "
                          "reaches it on the range (one harmonic, "
                          f"μ-expansion to order {DRIVEN_MAX}, balance to {DRIVEN_MAX} harmonics, "
-                         f"shooting to {SHOOTING_STEPS[-1]} RK4 steps); the best reachable is "
-                         f"{reachable:.1e}")
-    if emit_order is not None:  # rank by the emitted modules' own measured cost and error
-        emitted = [emitted_driven(v.method, v.order, truth, eps, force, Q)
-                   for v, _ in best.values()]
-        best = {t.method: (t, float(np.max(t.errors[quantity]))) for t in emitted}
-        best = {m: v for m, v in best.items() if v[1] <= tol}
-        if not best:
+                         f"shooting to {SHOOTING_STEPS[-1]} RK4 steps){within}; the best "
+                         f"reachable is {reachable:.1e}")
+    suffix = "" if emit is None else ", emitted"
+    pool, ranked = list(best.values()), []
+    while pool:  # cheapest first by the model, ties to the simplest method
+        ranked.append(cheapest(pool, lambda v: modelled_ns("driven", v[0].method + suffix,
+                                                           v[0].order), lambda v: v[0].method))
+        pool.remove(ranked[-1])
+    considered = [(v.method, v.order, e, v.ns_per_point) for v, e in ranked]
+    if emit is None:
+        t, err = ranked[0]
+    else:  # the emitted module's own error decides; its own timing is reported
+        for v, _ in ranked:
+            t = emitted_driven(v.method, v.order, truth, eps, force, Q)
+            err = float(np.max(t.errors[quantity]))
+            considered.append((t.method, t.order, err, t.ns_per_point))
+            if err <= tol:
+                break
+        else:
             raise InputError(f"tol {tol:g}: the emitted modules miss it where the interpreted "
                              "methods met it (rounding in the compiled formulas); loosen tol")
-    t, err = cheapest(list(best.values()), lambda v: v[0].ns_per_point, lambda v: v[0].method)
     return DrivenChoice(quantity, t.method.removesuffix(", emitted"), t.order, err,
-                        t.ns_per_point, omegas.size,
-                        tuple((v.method, v.order, e, v.ns_per_point) for v, e in best.values()),
-                        truth)
+                        t.ns_per_point, omegas.size, tuple(considered), truth,
+                        modelled_ns("driven", t.method, t.order))
 
 
 def driven_scene(tol: float = 1e-4) -> SceneResult:

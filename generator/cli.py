@@ -13,6 +13,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import __version__
+from .costs import COST_LIMIT_SECONDS, COSTS, DRIVEN_MAX_ORDER, emit_bounds
 from .errors import InputError
 
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
@@ -37,8 +38,6 @@ MAX_HARMONICS = 100
 # --harmonics.  The numerical balance and shooting's sampling take up to 100; the emitted
 # modules stop earlier (balance 12, fourier 60) and say so; the response's continuation
 # refuses what it estimates at over a minute.
-COST_LIMIT_SECONDS = 60.0
-# NOTE: above this estimate the CLI asks for --allow-slow instead of running for minutes or hours.
 PROGRESS_AFTER_SECONDS = 2.0
 # NOTE: work shorter than this shows no progress bar (it would only flicker).
 
@@ -68,51 +67,6 @@ class Progress:
         if self.drawn:
             sys.stderr.write("\r\033[K")
             sys.stderr.flush()
-
-
-def estimated_seconds(model: str, order: int) -> float:
-    """Wall time of ``derive`` on this 2-core machine, fitted to docs/benchmarks.md.
-
-    Duffing grows like K^3.5 (13.6 s at K = 300); the pendulum, which needs every power
-    u^(2k+1) up to k = K, like K^4.6 (22 s at K = 100).
-    """
-    scale, seconds, power = (100, 22.0, 4.6) if model == "pendulum" else (300, 13.6, 3.5)
-    log = math.log(seconds) + power * (math.log(max(order, 1)) - math.log(scale))
-    return math.exp(log) if log < 700 else math.inf  # an order of 10**100 digits is inf s
-
-
-GENERATE_COSTS = {
-    # model: (fixed s, s at the reference size, reference size, growth: power, or "exp" base)
-    "duffing": (2.5, 80.0, 100, 2.2),
-    "pendulum": (2.5, 76.0, 80, 4.0),
-    "balance": (3.0, 59.0, 12, 4.0),
-    "fourier": (3.5, 0.0, 60, 1.0),
-    "driven": (12.0, 29.0, 5, "6"),
-}
-# NOTE: wall time of `lindstedt generate MODEL` (derive, lower, print, compile) against its size
-# (--order; --harmonics for balance and fourier), each fitted to its own runs of
-# benchmarks/command_costs.py on the 2-core machine; the fit is compared with fresh runs there.
-GENERATE_MAX_ORDER = 130
-# NOTE: SymPy's printer recurses once per level of a Horner form: duffing at order 140 exceeds
-# Python's recursion limit (130 prints), so generate stops there, whatever --allow-slow says.
-
-
-def generate_seconds(model: str, size: int) -> float:
-    """Estimated wall time of ``lindstedt generate MODEL`` at ``size`` (see GENERATE_COSTS)."""
-    fixed, at_reference, reference, growth = GENERATE_COSTS[model]
-    if isinstance(growth, str):  # exponential in the order: base per order
-        log = math.log(at_reference) + (size - reference) * math.log(float(growth))
-    else:
-        log = math.log(at_reference or 1e-300) + growth * math.log(max(size, 1) / reference)
-    return fixed + (math.exp(log) if log < 700 else math.inf)
-
-
-def _check_cost(args: argparse.Namespace, cost: float, what: str,
-                subject: str | None = None) -> None:
-    if cost > COST_LIMIT_SECONDS and not args.allow_slow:
-        about = f"about {cost:,.0f} s" if math.isfinite(cost) else "more than 1e300 s"
-        raise InputError(f"{subject or f'order {args.order}'}: {about} of {what} on this machine; "
-                         "pass --allow-slow to run it")
 
 
 def _rational(c: object) -> str:
@@ -151,7 +105,6 @@ def series_table(sol) -> str:
 
 
 def _cmd_series(args: argparse.Namespace) -> int:
-    _check_cost(args, estimated_seconds(args.model, args.order), f"derivation for {args.model}")
     from .lindstedt import derive
     from .models import model_by_name
 
@@ -164,15 +117,6 @@ def _cmd_series(args: argparse.Namespace) -> int:
 
 def _cmd_generate(args: argparse.Namespace) -> int:
     order = args.order
-    if args.model == "driven" and order > DRIVEN_MAX_ORDER:
-        raise InputError(f"order {order}: the exact μ-expansion is emitted up to order "
-                         f"{DRIVEN_MAX_ORDER} (its rational functions grow fast)")
-    if args.model in FREE_MODELS and order > GENERATE_MAX_ORDER:
-        raise InputError(f"order {order}: generate stops at order {GENERATE_MAX_ORDER} (the code "
-                         "printer's nesting limit); `lindstedt series` derives higher orders")
-    size = args.harmonics if args.model in ("balance", "fourier") else order
-    subject = f"--harmonics {size}" if args.model in ("balance", "fourier") else None
-    _check_cost(args, generate_seconds(args.model, size), f"generating {args.model}", subject)
     if args.model in ("driven", "balance", "fourier") and args.allow_divergent:
         raise InputError(f"--allow-divergent: the {args.model} evaluators have no radius to lift")
     from . import emit
@@ -206,7 +150,6 @@ DEMO_ORDER = 12
 DRIVEN_ORDER = 3
 # NOTE: the exact μ-expansion's rational functions grow fast; order 3 keeps the derivation
 # readable and the emitted A_n(ω) within 1e-5 of the true orbit at the notes' parameters.
-DRIVEN_MAX_ORDER = 6
 BALANCE_HARMONICS = 4
 # NOTE: the demo's balance module: 4 odd harmonics reach 1e-7 at the notes' parameters and
 # compile in seconds.
@@ -372,21 +315,22 @@ def _cmd_driven(args: argparse.Namespace) -> int:
     return 0
 
 
-def response_json(eps: float, force: float, Q: float, harmonics: int) -> dict:
-    """The contract of ``lindstedt response … --json``: folds three ways, sweep jumps."""
+def response_json(eps: float, force: float, Q: float, harmonics: int,
+                  max_seconds: float = COST_LIMIT_SECONDS) -> dict:
+    """The contract of ``lindstedt response … --json``: folds three ways, sweep jumps
+    (``max_seconds``: the continuation's cost limit)."""
     import numpy as np
 
     from .driven import BalanceSystem, Drive
     from .numerics import orbit_fold, sweep
-    from .response import continue_balance, one_harmonic_folds
+    from .response import continue_balance, one_harmonic_folds, response_range
 
     d = Drive(eps, force, 1.0, Q)
     if d.damping == 0:
         raise InputError("Q inf: a response curve needs damping (finite Q) for a steady state")
     folds1 = one_harmonic_folds(eps, force, Q)
-    lo = 0.5 * min([1.0, *folds1])
-    hi = 1.25 * max([1.0, *folds1])
-    cont = continue_balance(eps, force, Q, harmonics, lo, hi)
+    lo, hi = response_range(eps, force, Q)
+    cont = continue_balance(eps, force, Q, harmonics, lo, hi, max_seconds=max_seconds)
     system = BalanceSystem(eps, force, d.damping, harmonics)
     odd = system.odd
     true_folds = []
@@ -428,9 +372,11 @@ def _charts():
 
 def _cmd_response(args: argparse.Namespace) -> int:
     return _report(
-        args, lambda: response_json(args.eps, args.force, args.Q, args.harmonics),
-        lambda path: _charts().response_figure(args.eps, args.force, args.Q, args.harmonics,
-                                               path),
+        args, lambda: response_json(args.eps, args.force, args.Q, args.harmonics,
+                                    math.inf if args.allow_slow else COST_LIMIT_SECONDS),
+        lambda path: _charts().response_figure(
+            args.eps, args.force, args.Q, args.harmonics, path,
+            math.inf if args.allow_slow else COST_LIMIT_SECONDS),
         _response_table)
 
 
@@ -687,7 +633,7 @@ def _choose_driven(args: argparse.Namespace) -> int:
     from .driven import check_steady_state
 
     check_steady_state(args.eps, args.Q, lo, hi)
-    from .choose import choose_driven
+    from .choose import DRIVEN_MAX, choose_driven
     from .emit import check_writable, generate_balance, generate_driven
 
     if args.emit:
@@ -695,11 +641,15 @@ def _choose_driven(args: argparse.Namespace) -> int:
                        ["driven.py", "driven_derivation.tex", "balance.py"], "--emit")
     progress = Progress("shooting the true orbits", not args.json)
     c = choose_driven(args.quantity, tol, args.eps, args.force, args.Q, lo, hi,
-                      emit_order=DRIVEN_MAX_ORDER if args.emit else None, progress=progress)
+                      emit=(emit_bounds(args.allow_slow, DRIVEN_MAX, args.quantity)
+                            if args.emit else None),
+                      progress=progress)
     progress.close()
     data = {"quantity": args.quantity, "method": c.method, "order": c.order,
             "max_error": c.max_error, "ns_per_point": c.ns_per_point,
             "verified_on": c.verified_on, "seconds": c.ns_per_point * 1e-9,
+            "modelled_ns_per_point": c.modelled_ns_per_point,
+            "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
             "alternatives": {m: {"order": o, "max_error": e, "seconds": ns * 1e-9}
                              for m, o, e, ns in c.considered if m != c.method},
             "considered": _considered(c.considered),
@@ -875,12 +825,15 @@ def _flag_harmonics(p: argparse.ArgumentParser, what: str) -> None:
                    help=f"{what}, an integer in 1..{MAX_HARMONICS} (default {DEFAULT_HARMONICS})")
 
 
-def _flag_allow_slow(p: argparse.ArgumentParser) -> None:
+def _flag_allow_slow(p: argparse.ArgumentParser, deprecated_force: bool = True) -> None:
+    """--allow-slow (and in series/generate its old spelling --force, which elsewhere is the
+    drive amplitude)."""
     p.add_argument("--allow-slow", action="store_true",
                    help=f"run even when the estimate exceeds {COST_LIMIT_SECONDS:.0f} s "
                    "(default: refuse)")
-    p.add_argument("--force", action=_DeprecatedForce, dest="allow_slow",
-                   help="deprecated spelling of --allow-slow")
+    if deprecated_force:
+        p.add_argument("--force", action=_DeprecatedForce, dest="allow_slow",
+                       help="deprecated spelling of --allow-slow")
 
 
 def _flag_overwrite_edited(p: argparse.ArgumentParser) -> None:
@@ -964,6 +917,7 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_order(p, "μ-expansion order K")
     _flag_harmonics(p, "odd harmonics N of harmonic balance")
     _flag_json(p)
+    _flag_allow_slow(p, deprecated_force=False)
     p.set_defaults(func=_cmd_driven)
 
     p = sub.add_parser("response", help="folds and hysteresis of the damped driven oscillator",
@@ -972,6 +926,7 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_harmonics(p, "odd harmonics N of the continued balance")
     _flag_json(p)
     _flag_plot(p)
+    _flag_allow_slow(p, deprecated_force=False)
     p.set_defaults(func=_cmd_response)
 
     p = sub.add_parser("subharmonic", help="the 1/3 subharmonic of eq. 10.83 and its stability",
@@ -1018,6 +973,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "default: write nothing)")
     _flag_json(p)
     _flag_overwrite_edited(p)
+    _flag_allow_slow(p, deprecated_force=False)
     p.set_defaults(func=_cmd_choose)
 
     p = sub.add_parser("sweep", help="maps over (ω, f, ε, Q) grids on a Dask cluster, resumable",
@@ -1046,6 +1002,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="grid points per task (default: the kind's, about 1 s of work)")
     _flag_json(p, "a JSON summary")
     _flag_plot(p)
+    _flag_allow_slow(p, deprecated_force=False)
     p.set_defaults(func=_cmd_sweep)
 
     p = sub.add_parser("clock", help="the notes' grandfather's-clock accuracy claims, checked")
@@ -1067,10 +1024,22 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def check_cost(args: argparse.Namespace) -> None:
+    """Every command's estimate (lindstedt.costs.COSTS) before it runs: bounds that no switch
+    lifts, then a refusal above COST_LIMIT_SECONDS without --allow-slow."""
+    estimate = COSTS.get(args.command)
+    if estimate is None:
+        return
+    cost = estimate(args)
+    if cost.seconds > COST_LIMIT_SECONDS and not getattr(args, "allow_slow", False):
+        raise InputError(cost.refusal())
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        check_cost(args)
         status = args.func(args)
         sys.stdout.flush()  # a reader that went away (`| head`) is noticed here, not at exit
         return status

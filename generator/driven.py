@@ -17,6 +17,7 @@ Both work on Fourier sums stored as complex coefficients ``c_n`` of ``e^{inτ}``
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -459,6 +460,7 @@ class MuOrder:
     q: dict[int, sp.Expr]  # q_j: coefficients of cos nτ, b_j (fixed at order j+1) included
 
 
+@functools.lru_cache(maxsize=4)
 def mu_expansion_exact(order: int) -> tuple[MuOrder, ...]:
     """Orders 1..K of eq. 10.68 (``Q → ∞``, so ``δ = 0``) with exact rational functions.
 

@@ -155,8 +155,9 @@ class Continuation:
 MAX_POINTS = 20000
 CONTINUATION_SECONDS = 60.0
 # NOTE: the continuation refuses a curve it estimates at more than 20000 steps or a minute of
-# work (the CLI's COST_LIMIT_SECONDS) instead of running for ten minutes: `response --force 1e30
-# --harmonics 60` once ran 590 s and stopped short of the range, reporting a partial curve.
+# work (its max_seconds: the CLI's cost limit, lifted by --allow-slow) instead of running for
+# ten minutes: `response --force 1e30 --harmonics 60` once ran 590 s and stopped short of the
+# range, reporting a partial curve.
 MAX_Q = 1e12
 # NOTE: near the resonance x(ω) changes by ~Q·2e-16 relative between neighbouring doubles in ω:
 # the corrector's 1e-13 then needs Q ≲ 1e3 (above, some steps take all 30 iterations: slower,
@@ -180,9 +181,29 @@ def _curve_extent(eps: float, force: float, Q: float, lo: float, hi: float) -> f
     return float(np.nanmax(r)) if np.any(~np.isnan(r)) else 0.0
 
 
+def continuation_points(eps: float, force: float, Q: float, lo: float, hi: float,
+                        step: float = 0.02) -> float:
+    """About how many continuation steps the response curve on ``[lo, hi]`` takes: its length
+    in (a, b, ω) is about ``(hi − lo) + π r_max`` (see :func:`continue_balance`)."""
+    return ((hi - lo) + np.pi * _curve_extent(eps, force, Q, lo, hi)) / step
+
+
+def continuation_seconds(eps: float, force: float, Q: float, harmonics: int, lo: float,
+                         hi: float) -> float:
+    """The estimated wall time of :func:`continue_balance` (points × :func:`point_seconds`)."""
+    return continuation_points(eps, force, Q, lo, hi) * point_seconds(harmonics)
+
+
+def response_range(eps: float, force: float, Q: float) -> tuple[float, float]:
+    """The ω range a response curve is drawn on: half the lowest to 1.25 × the highest of
+    ω = 1 and the one-harmonic folds."""
+    folds = one_harmonic_folds(eps, force, Q)
+    return 0.5 * min([1.0, *folds]), 1.25 * max([1.0, *folds])
+
+
 def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_start: float,
-                     omega_stop: float, step: float = 0.02,
-                     max_points: int = MAX_POINTS) -> Continuation:
+                     omega_stop: float, step: float = 0.02, max_points: int = MAX_POINTS,
+                     max_seconds: float = CONTINUATION_SECONDS) -> Continuation:
     """Trace the harmonic-balance solution from ``omega_start`` (largest one-harmonic branch)
     until ω leaves ``[min, max]`` of the two ends, through any number of folds.
 
@@ -190,7 +211,7 @@ def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_s
     ``(hi − lo) + π r_max`` (up the resonant branch to its peak r_max and back down while the
     phase turns through π; within a factor 0.4–1.4 of the traced length from ε = −0.1 to 1,
     f = 0.05 to 10, Q = 5 to 1000), so ``length/step`` points at
-    :func:`point_seconds` each must stay within ``max_points`` and :data:`CONTINUATION_SECONDS`;
+    :func:`point_seconds` each must stay within ``max_points`` and ``max_seconds``;
     and a continuation whose linear algebra fails or that does not leave the range."""
     check_harmonics(harmonics)
     d = Drive(eps, force, omega_start, Q)
@@ -202,22 +223,21 @@ def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_s
         raise InputError(f"Q {Q:g}: the resonance is {1 / Q:.0e} wide in ω, too narrow for the "
                          f"continuation to follow in double precision; Q up to {MAX_Q:.0e}")
     r_max = _curve_extent(eps, force, Q, lo, hi)
-    length = (hi - lo) + np.pi * r_max
-    estimate = length / step
+    estimate = continuation_points(eps, force, Q, lo, hi, step)
     if not estimate <= max_points:
         raise InputError(f"{where}: the response curve spans ω in [{lo:.3g}, {hi:.3g}] with "
                          f"amplitudes up to {r_max:.3g}, about {estimate:.2g} continuation steps "
                          f"of {step:g}; the limit is {max_points}")
     seconds = estimate * point_seconds(harmonics)
-    if seconds > CONTINUATION_SECONDS:
+    if seconds > max_seconds:
         raise InputError(f"harmonics {harmonics}: about {seconds:.0f} s of continuation "
                          f"({estimate:.0f} points × {1e3 * point_seconds(harmonics):.0f} ms) for "
-                         f"{where}; the limit is {CONTINUATION_SECONDS:.0f} s, ask for fewer")
+                         f"{where}; the limit is {max_seconds:.0f} s, ask for fewer")
     branches = first_order_branches(d)
     if not branches:
         raise InputError(f"{where}: no one-harmonic branch at ω = {omega_start:g} to start from")
     br = branches[0]
-    limit = min(max_points, int(2 * CONTINUATION_SECONDS / point_seconds(harmonics)))
+    limit = min(max_points, int(2 * max(seconds, CONTINUATION_SECONDS) / point_seconds(harmonics)))
     y = None
     try:
         with np.errstate(over="ignore", invalid="ignore"):
@@ -230,11 +250,12 @@ def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_s
             if t[-1] * direction < 0:
                 t = -t
             points, folds = [y], []
-            deadline = time.monotonic() + 2 * CONTINUATION_SECONDS
+            allowed = 2 * max(seconds, CONTINUATION_SECONDS)
+            deadline = time.monotonic() + allowed
             for _ in range(limit):
                 if time.monotonic() > deadline:
                     raise InputError(f"{where}: the continuation gave up after "
-                                     f"{2 * CONTINUATION_SECONDS:.0f} s at ω = {y[-1]:.6g}, "
+                                     f"{allowed:.0f} s at ω = {y[-1]:.6g}, "
                                      f"{len(points)} points in (its estimate: {estimate:.0f}): "
                                      "the corrector does not converge there")
                 y_new = _corrector(sysm, y + step * t, t)

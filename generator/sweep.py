@@ -223,6 +223,11 @@ class Kind:
     settings: tuple[tuple[str, object], ...]  # constants its numbers depend on
 
     @property
+    def point_seconds(self) -> float:
+        """The wall time of one point on one worker: a default block is ~1 s of work."""
+        return 1.0 / self.points_per_chunk
+
+    @property
     def extra_sizes(self) -> dict[str, int]:
         return {dim: len(values) for dim, values in self.extra}
 

@@ -1,0 +1,213 @@
+"""What each command costs: an estimate of its wall time from its own measured fit, and the
+bounds of what it accepts.  The command line asks :data:`COSTS` before it runs a command and
+refuses above :data:`COST_LIMIT_SECONDS` unless ``--allow-slow`` is given.
+
+Every fit was measured on the project's 2-core reference machine; `benchmarks/command_costs.py`
+runs the commands and prints each estimate beside the measured time (docs/benchmarks.md).
+Nothing heavy is imported here: the estimators of cheap commands answer in microseconds, and
+those that need a stage (the response curve's length, a sweep's kind) import it themselves,
+as the command they precede would.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+from .errors import InputError
+
+COST_LIMIT_SECONDS = 60.0
+# NOTE: above this estimate the CLI asks for --allow-slow instead of running for minutes or hours.
+GENERATE_MAX_ORDER = 130
+# NOTE: SymPy's printer recurses once per level of a Horner form: duffing at order 140 exceeds
+# Python's recursion limit (130 prints), so generate stops there, whatever --allow-slow says.
+DRIVEN_MAX_ORDER = 6
+# NOTE: the exact μ-expansion's rational functions grow fast: `generate driven` at order 6 takes
+# about 3 minutes, at 7 it would take about 20.
+
+
+@dataclass(frozen=True)
+class Cost:
+    """A command's estimated wall time, and the input it grows with (named in a refusal)."""
+
+    seconds: float
+    subject: str  # e.g. "order 200", "--harmonics 60", "a 10⁶-point grid"
+    what: str  # e.g. "the μ-expansion", "generating duffing"
+
+    def refusal(self) -> str:
+        about = (f"about {self.seconds:,.0f} s" if math.isfinite(self.seconds)
+                 else "more than 1e300 s")
+        return (f"{self.subject}: {about} of {self.what} on this machine; pass --allow-slow "
+                "to run it")
+
+
+def power_law(fixed: float, at_reference: float, reference: float, growth: float | str,
+              size: float) -> float:
+    """``fixed + at_reference · (size/reference)^growth`` seconds, or, for a string ``growth``
+    (the base per unit of size), ``fixed + at_reference · growth^(size − reference)``; inf
+    where that overflows."""
+    if isinstance(growth, str):
+        log = math.log(at_reference) + (size - reference) * math.log(float(growth))
+    else:
+        log = math.log(at_reference or 1e-300) + growth * math.log(max(size, 1) / reference)
+    return fixed + (math.exp(log) if log < 700 else math.inf)
+
+
+SERIES_COSTS = {
+    "duffing": (0.9, 13.6, 300, 3.5),
+    "pendulum": (0.9, 22.0, 100, 4.6),
+}
+# NOTE: `lindstedt series MODEL --order K` (start-up, then derive): Duffing grows like K^3.5
+# (13.6 s at K = 300); the pendulum, which needs every power u^(2k+1) up to k = K, like K^4.6.
+
+GENERATE_COSTS = {
+    # model: (fixed s, s at the reference size, reference size, growth: power, or "exp" base)
+    "duffing": (2.5, 80.0, 100, 2.2),
+    "pendulum": (2.5, 76.0, 80, 4.0),
+    "balance": (3.0, 59.0, 12, 4.0),
+    "fourier": (3.5, 0.0, 60, 1.0),
+    "driven": (12.0, 29.0, 5, "6"),
+}
+# NOTE: wall time of `lindstedt generate MODEL` (derive, lower, print, compile) against its size
+# (--order; --harmonics for balance and fourier), each fitted to its own runs.
+
+DRIVEN_COSTS = (3.0, 13.3, 100, 3.5)
+# NOTE: `lindstedt driven --order K`: start-up, the numba kernels from cache, balance and
+# shooting on every branch (~3 s, whatever --harmonics up to 100 says), then the numerical
+# μ-expansion to order K on every branch: 16 s at K = 100, 57 s at 150, undamped or not.
+
+FIXED_COSTS = {
+    "subharmonic": 6.0,
+    "mixing": 12.0,
+    "clock": 2.0,
+    "scene": 20.0,
+    "choose period": 15.0,
+    "choose q": 25.0,
+    "choose amplitudes": 20.0,
+    "choose response": 20.0,
+}
+# NOTE: commands whose work no input scales (bounded by the inputs' own bounds: at most four
+# drives, a fixed set of candidates and verification points), their wall time at most.
+
+RESPONSE_FIXED = 6.0
+# NOTE: `lindstedt response`: start-up, the Floquet fold refinements and the two simulated sweeps
+# (compiled RK4, 10⁴ drive periods each), on top of the continuation's own estimate.
+
+SWEEP_START = 8.0
+# NOTE: a LocalCluster's start-up and warm-up (5–10 s), on top of the points' work.
+
+
+def series_cost(args: argparse.Namespace) -> Cost:
+    return Cost(power_law(*SERIES_COSTS[args.model], args.order), f"order {args.order}",
+                f"derivation for {args.model}")
+
+
+def generate_seconds(model: str, size: int) -> float:
+    """Estimated wall time of ``lindstedt generate MODEL`` at ``size`` (GENERATE_COSTS)."""
+    return power_law(*GENERATE_COSTS[model], size)
+
+
+def generate_cost(args: argparse.Namespace) -> Cost:
+    """Bounds first (no switch lifts them), then the model's own fit."""
+    if args.model == "driven" and args.order > DRIVEN_MAX_ORDER:
+        raise InputError(f"order {args.order}: the exact μ-expansion is emitted up to order "
+                         f"{DRIVEN_MAX_ORDER} (its rational functions grow fast)")
+    if args.model in SERIES_COSTS and args.order > GENERATE_MAX_ORDER:
+        raise InputError(f"order {args.order}: generate stops at order {GENERATE_MAX_ORDER} (the "
+                         "code printer's nesting limit); `lindstedt series` derives higher orders")
+    harmonic = args.model in ("balance", "fourier")
+    size = args.harmonics if harmonic else args.order
+    return Cost(generate_seconds(args.model, size),
+                f"--harmonics {size}" if harmonic else f"order {size}",
+                f"generating {args.model}")
+
+
+def driven_cost(args: argparse.Namespace) -> Cost:
+    return Cost(power_law(*DRIVEN_COSTS, args.order), f"order {args.order}",
+                "the μ-expansion on every branch")
+
+
+def response_cost(args: argparse.Namespace) -> Cost:
+    from .response import continuation_seconds, response_range
+
+    lo, hi = response_range(args.eps, args.force, args.Q)
+    return Cost(RESPONSE_FIXED + continuation_seconds(args.eps, args.force, args.Q,
+                                                      args.harmonics, lo, hi),
+                f"--harmonics {args.harmonics}", "continuation and simulated sweeps")
+
+
+def sweep_cost(args: argparse.Namespace) -> Cost:
+    """The grid's points times its kind's cost per point, over the local workers (a running
+    scheduler's workers are not known before connecting: its estimate is the CPU time)."""
+    from .sweep import kind_named
+
+    kind = kind_named(args.kind)
+    points = math.prod(len(getattr(args, a) or [0]) for a in kind.axes)
+    workers = 1 if args.scheduler else args.workers
+    return Cost(SWEEP_START + points * kind.point_seconds / workers,
+                f"a grid of {points:,} points", f"{args.kind} sweep on {workers} "
+                f"worker{'s' * (workers > 1)}")
+
+
+def fixed_cost(name: str) -> Callable[[argparse.Namespace], Cost]:
+    def cost(args: argparse.Namespace) -> Cost:
+        return Cost(FIXED_COSTS[name], name, name)
+    return cost
+
+
+EMIT_FACTOR = 2.0
+# NOTE: `choose amplitudes|response --emit` generates a candidate's module, imports (compiles)
+# it to judge and time it, and writes it again into --emit (the derivation is cached): about
+# twice `generate` (order 4: 7.5 s to generate, 17 s to compile, against 17 s estimated).
+
+
+def emission_seconds(model: str, size: int) -> float:
+    """The estimated cost of trying one emitted module in ``choose … --emit``."""
+    return EMIT_FACTOR * generate_seconds(model, size)
+
+
+def choose_cost(args: argparse.Namespace) -> Cost:
+    """The choice's fixed work, and for the driven quantities with --emit the dearest module
+    :func:`emit_bounds` lets compete."""
+    fixed = FIXED_COSTS[f"choose {args.quantity}"]
+    seconds = fixed
+    if args.emit and args.quantity in ("amplitudes", "response"):
+        mu, harmonics = emit_bounds(args.allow_slow, EMIT_MAX_HARMONICS, args.quantity)
+        seconds += max(emission_seconds("driven", mu), emission_seconds("balance", harmonics))
+    return Cost(seconds, f"choose {args.quantity}", "verifying the candidates")
+
+
+EMIT_MAX_HARMONICS = 12
+# NOTE: choose.DRIVEN_MAX, restated (a test keeps them equal): the most harmonics a choice tries.
+
+
+def emit_bounds(allow_slow: bool, max_harmonics: int = EMIT_MAX_HARMONICS,
+                quantity: str = "amplitudes") -> tuple[int, int]:
+    """The highest μ-order (up to DRIVEN_MAX_ORDER) and the most harmonics (up to
+    ``max_harmonics``) whose emitted module ``choose QUANTITY --emit`` can try within the cost
+    limit, after its fixed work; with ``allow_slow`` every one: what may compete."""
+    budget = COST_LIMIT_SECONDS - FIXED_COSTS[f"choose {quantity}"]
+
+    def largest(model: str, top: int) -> int:
+        fits = [k for k in range(1, top + 1)
+                if allow_slow or emission_seconds(model, k) <= budget]
+        return max(fits, default=0)
+    return largest("driven", DRIVEN_MAX_ORDER), largest("balance", max_harmonics)
+
+
+COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
+    "series": series_cost,
+    "generate": generate_cost,
+    "driven": driven_cost,
+    "response": response_cost,
+    "subharmonic": fixed_cost("subharmonic"),
+    "mixing": fixed_cost("mixing"),
+    "choose": choose_cost,
+    "sweep": sweep_cost,
+    "clock": fixed_cost("clock"),
+    "scene": fixed_cost("scene"),
+}
+# NOTE: one estimator per command; `demo` has none: its work is the fixed built-in job
+# (`make demo`), which nothing on its command line scales.

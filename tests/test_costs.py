@@ -1,0 +1,138 @@
+"""Every command estimates its cost before it works and refuses above a minute without
+--allow-slow; `choose` decides by the recorded cost model, never by this run's timings.
+
+(The estimates against measured wall time are a benchmark, benchmarks/command_costs.py, not a
+timed test.)
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+
+def run(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
+                          text=True, check=False, cwd=cwd)
+
+
+def commands() -> dict[str, argparse.ArgumentParser]:
+    from lindstedt.cli import build_parser
+
+    return build_parser()._subparsers._group_actions[0].choices
+
+
+def test_every_command_but_the_demo_has_an_estimate_and_the_slow_ones_a_switch():
+    from lindstedt.costs import COSTS
+
+    names = set(commands())
+    assert set(COSTS) == names - {"demo"}
+    scalable = {"series", "generate", "driven", "response", "choose", "sweep"}
+    for name, sub in commands().items():
+        has = any("--allow-slow" in a.option_strings for a in sub._actions)
+        assert has == (name in scalable), name
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["driven", "--eps", "0.1", "--force", "0.3", "--omega", "1.3", "--order", "200"],
+     "order 200: about"),
+    (["response", "--eps", "0.1", "--force", "30", "--Q", "200", "--harmonics", "100"],
+     "--harmonics 100: about"),
+    (["sweep", "stability", "--omega", "0.5:1.5:40000", "--force", "0.3", "--eps", "0.1",
+      "--Q", "20", "--store", "map.zarr"], "a grid of 40,000 points: about"),
+    (["generate", "duffing", "--order", "120", "--out", "gen"], "order 120: about"),
+])
+def test_a_long_command_is_refused_at_once_and_writes_nothing(tmp_path, args, needle):
+    out = run(*args, cwd=tmp_path)
+    assert out.returncode == 2, out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0] and "--allow-slow" in lines[0], lines
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_estimates_grow_with_the_work_and_bounds_come_first():
+    """Orders the printer cannot print are refused whatever --allow-slow says; the driven
+    estimate follows its fit (16 s measured at order 100, 57 s at 150)."""
+    from lindstedt import costs
+    from lindstedt.cli import build_parser
+    from lindstedt.errors import InputError
+
+    def parsed(*argv):
+        return build_parser().parse_args(list(argv))
+
+    est = [costs.COSTS["driven"](parsed("driven", "--eps", "0.1", "--force", "0.3", "--omega",
+                                         "1.3", "--order", str(k))).seconds
+           for k in (4, 100, 150, 200)]
+    assert est[0] < 5 and 10 < est[1] < 25 and 40 < est[2] < 80 and est[3] > 60
+    with pytest.raises(InputError, match="stops at order 130"):
+        costs.COSTS["generate"](parsed("generate", "duffing", "--order", "131", "--allow-slow"))
+    with pytest.raises(InputError, match="up to order 6"):
+        costs.COSTS["generate"](parsed("generate", "driven", "--order", "7"))
+
+
+def test_choose_driven_decides_by_the_model_not_the_timings(monkeypatch):
+    """The same choice when this run's measured costs are reversed in order."""
+    from lindstedt import choose
+
+    plain = choose.choose_driven("amplitudes", 1e-6, 0.1, 0.3, 20.0, 1.3)
+    real = choose.driven_tradeoffs
+
+    def reversed_timings(*args):
+        out = real(*args)
+        ns = sorted((t.ns_per_point for t in out), reverse=True)
+        order = np.argsort([t.ns_per_point for t in out])
+        return [dataclasses.replace(out[i], ns_per_point=ns[k]) for k, i in enumerate(order)]
+
+    monkeypatch.setattr(choose, "driven_tradeoffs", reversed_timings)
+    flipped = choose.choose_driven("amplitudes", 1e-6, 0.1, 0.3, 20.0, 1.3)
+    assert (flipped.method, flipped.order) == (plain.method, plain.order)
+    assert flipped.modelled_ns_per_point == plain.modelled_ns_per_point
+    assert plain.modelled_ns_per_point == choose.modelled_ns("driven", plain.method, plain.order)
+
+
+def test_choose_emit_generates_the_modelled_cheapest_first_and_only_what_it_needs(monkeypatch):
+    """With --emit the emitted modules are tried cheapest-by-model first; the first whose own
+    error meets the tolerance is chosen, the rest are never generated; the bounds keep out
+    what would take over a minute to generate."""
+    from lindstedt import choose
+
+    tried = []
+
+    def fake_emitted(method, order, truth, eps, force, Q):
+        tried.append((method, order))
+        errors = {k: np.full(truth.omega.size, 1e-12 if method == "harmonic_balance" else 1.0)
+                  for k in choose.DRIVEN_QUANTITIES}
+        return choose.DrivenTradeoff(f"{method}, emitted", order, 123.0, errors)
+
+    monkeypatch.setattr(choose, "emitted_driven", fake_emitted)
+    c = choose.choose_driven("amplitudes", 1e-6, 0.1, 0.3, np.inf, 1.3, emit=(4, 8))
+    model = {m: choose.modelled_ns("driven", f"{m}, emitted", o) for m, o in tried}
+    assert c.method == "harmonic_balance" and c.ns_per_point == 123.0
+    assert tried[-1][0] == "harmonic_balance"
+    assert all(model[m] <= model["harmonic_balance"] for m, _ in tried)  # cheaper ones first
+    assert all(o <= (4 if m == "mu_expansion" else 8) for m, o in tried)
+
+
+def test_emit_bounds_keep_choose_emit_within_the_limit():
+    """What competes in ``choose … --emit`` is the most whose trial fits the limit after the
+    choice's fixed work (one more would not); the command's estimate stays within the limit."""
+    from lindstedt import choose, costs
+    from lindstedt.cli import build_parser
+
+    assert costs.EMIT_MAX_HARMONICS == choose.DRIVEN_MAX
+    budget = costs.COST_LIMIT_SECONDS - costs.FIXED_COSTS["choose amplitudes"]
+    mu, n = costs.emit_bounds(False)
+    for model, k in (("driven", mu), ("balance", n)):
+        assert costs.emission_seconds(model, k) <= budget < costs.emission_seconds(model, k + 1)
+    assert costs.emit_bounds(True) == (costs.DRIVEN_MAX_ORDER, choose.DRIVEN_MAX)
+    argv = ["choose", "amplitudes", "--eps", "0.1", "--force", "0.3", "--omega", "1.3",
+            "--emit", "e"]
+    cost = costs.COSTS["choose"](build_parser().parse_args(argv))
+    assert costs.FIXED_COSTS["choose amplitudes"] < cost.seconds <= costs.COST_LIMIT_SECONDS
+    slow = costs.COSTS["choose"](build_parser().parse_args([*argv, "--allow-slow"]))
+    assert slow.seconds > costs.COST_LIMIT_SECONDS
