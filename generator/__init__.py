@@ -14,6 +14,7 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
     choose     methods × orders, verified error, recorded cost model    tol, range -> Choice
     sweep      driven maps over grids on dask.distributed, into Zarr    kind, axes -> Dataset
     charts     matplotlib figures                                       results -> PNG/SVG/PDF
+    costs      each command's estimated wall time and bounds            arguments -> Cost
     cli        the command line (each command imports its stages itself)
 
 Beside the stages: ``errors`` (the one-line InputError) and ``display`` (Jupyter's LaTeX and

@@ -48,10 +48,13 @@ def power_law(fixed: float, at_reference: float, reference: float, growth: float
     """``fixed + at_reference · (size/reference)^growth`` seconds, or, for a string ``growth``
     (the base per unit of size), ``fixed + at_reference · growth^(size − reference)``; inf
     where that overflows."""
+    if size > 1e100:  # an order of a hundred digits: inf s (and no float overflow below)
+        return math.inf
     if isinstance(growth, str):
         log = math.log(at_reference) + (size - reference) * math.log(float(growth))
     else:
-        log = math.log(at_reference or 1e-300) + growth * math.log(max(size, 1) / reference)
+        log = math.log(at_reference or 1e-300) + growth * (math.log(max(size, 1))
+                                                           - math.log(reference))
     return fixed + (math.exp(log) if log < 700 else math.inf)
 
 

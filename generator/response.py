@@ -182,15 +182,24 @@ def _curve_extent(eps: float, force: float, Q: float, lo: float, hi: float) -> f
 
 
 def continuation_points(eps: float, force: float, Q: float, lo: float, hi: float,
-                        step: float = 0.02) -> float:
-    """About how many continuation steps the response curve on ``[lo, hi]`` takes: its length
-    in (a, b, ω) is about ``(hi − lo) + π r_max`` (see :func:`continue_balance`)."""
-    return ((hi - lo) + np.pi * _curve_extent(eps, force, Q, lo, hi)) / step
+                        step: float = 0.02, max_points: int = MAX_POINTS) -> float:
+    """About how many continuation steps the response curve on ``[lo, hi]`` takes — its length
+    in (a, b, ω) is about ``(hi − lo) + π r_max`` (see :func:`continue_balance`) —, or
+    :class:`InputError` above ``max_points``."""
+    r_max = _curve_extent(eps, force, Q, lo, hi)
+    estimate = ((hi - lo) + np.pi * r_max) / step
+    if not estimate <= max_points:
+        raise InputError(f"force {force:g} (eps {eps:g}, Q {Q:g}): the response curve spans ω "
+                         f"in [{lo:.3g}, {hi:.3g}] with amplitudes up to {r_max:.3g}, about "
+                         f"{estimate:.2g} continuation steps of {step:g}; the limit is "
+                         f"{max_points}")
+    return estimate
 
 
 def continuation_seconds(eps: float, force: float, Q: float, harmonics: int, lo: float,
                          hi: float) -> float:
-    """The estimated wall time of :func:`continue_balance` (points × :func:`point_seconds`)."""
+    """The estimated wall time of :func:`continue_balance` (points × :func:`point_seconds`);
+    :class:`InputError` for a curve over MAX_POINTS steps."""
     return continuation_points(eps, force, Q, lo, hi) * point_seconds(harmonics)
 
 
@@ -222,12 +231,7 @@ def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_s
     if np.isfinite(Q) and Q > MAX_Q:
         raise InputError(f"Q {Q:g}: the resonance is {1 / Q:.0e} wide in ω, too narrow for the "
                          f"continuation to follow in double precision; Q up to {MAX_Q:.0e}")
-    r_max = _curve_extent(eps, force, Q, lo, hi)
-    estimate = continuation_points(eps, force, Q, lo, hi, step)
-    if not estimate <= max_points:
-        raise InputError(f"{where}: the response curve spans ω in [{lo:.3g}, {hi:.3g}] with "
-                         f"amplitudes up to {r_max:.3g}, about {estimate:.2g} continuation steps "
-                         f"of {step:g}; the limit is {max_points}")
+    estimate = continuation_points(eps, force, Q, lo, hi, step, max_points)
     seconds = estimate * point_seconds(harmonics)
     if seconds > max_seconds:
         raise InputError(f"harmonics {harmonics}: about {seconds:.0f} s of continuation "
