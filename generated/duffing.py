@@ -2,7 +2,7 @@
 # model: duffing, order: 12
 # command: lindstedt generate duffing --order 12
 # inputs sha256: 66ca4a0e4d6afa8046c93839a6f1efa563f457106a4ae4f18222a37b87ca56f2
-# body sha256: 3a70d70b14f4880e71753e10e366799935997e881fa2357ca2b835a986090f01
+# body sha256: 183d576e0598b1658f3b0fa3e26940007132df5948b22c9eb27cdceb6bda6071
 """q'' + q + eps*q**3 = 0: L–P evaluators to order 12 in x = eps*A**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -496,12 +496,12 @@ def qdot_into(out, t, A, eps):
 
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def error_estimate(A, eps):
-    """Relative truncation error of period(), from the first omitted term |τ_{K+1} y^(K+1)| / (1 - |y|/R) over the truncated sum."""
+    """Relative truncation error of period(), from the first omitted term |τ_{K+1} y^(K+1)| / (1 - |y|/R) over the truncated sum (inf from the radius R on: no bound there)."""
     x = A**2*eps
     if not ((x > -1) and (abs(x) < 1)):
         return math.nan
     T = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) - 0.0651973094791174) + 0.07641269266605377) - 0.09219503402709961) + 0.11575698852539062) - 0.15380859375) + 0.22265625) - 0.375) + 1
-    return (0.03473509559274875)*abs(x)**13/((1 - abs(x))*abs(T))
+    return (((0.03473509559274875)*abs(x)**13/((1 - abs(x))*abs(T))) if (abs(x) < 1) else (math.inf))
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
@@ -517,7 +517,7 @@ def _error_estimate_into(out, A_in, eps_in):
             out[i] = math.nan
             continue
         T = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) - 0.0651973094791174) + 0.07641269266605377) - 0.09219503402709961) + 0.11575698852539062) - 0.15380859375) + 0.22265625) - 0.375) + 1
-        out[i] = (0.03473509559274875)*abs(x)**13/((1 - abs(x))*abs(T))
+        out[i] = (((0.03473509559274875)*abs(x)**13/((1 - abs(x))*abs(T))) if (abs(x) < 1) else (math.inf))
     return out
 
 

@@ -198,8 +198,9 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     )
     tail = abs(g.to_sympy(solution.period[order + 1]))
     estimate = tail * sp.Abs(x) ** (order + 1) / sp.Abs(total)
-    if radius is not None:
-        estimate = estimate / (1 - sp.Abs(x) / radius)
+    if radius is not None:  # inf at and beyond the radius (--allow-divergent): never negative
+        estimate = sp.Piecewise((estimate / (1 - sp.Abs(x) / radius), sp.Abs(x) < radius),
+                                (sp.oo, True))
     evaluators = (
         Evaluator("omega", f"Frequency ω to order {order} ({domain}).", params, prelude, guard,
                   (), horner(omega, x)),
@@ -220,7 +221,8 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
         Evaluator(
             "error_estimate",
             "Relative truncation error of period(), from the first omitted term "
-            "|τ_{K+1} y^(K+1)| / (1 - |y|/R) over the truncated sum.",
+            "|τ_{K+1} y^(K+1)| / (1 - |y|/R) over the truncated sum (inf from the radius R "
+            "on: no bound there).",
             params, prelude, guard, ((total, horner(tau, x)),), estimate,
         ),
     )

@@ -199,6 +199,18 @@ def test_allow_divergent_opt_in(tmp_path):
     assert np.isfinite(mod.period(1.0, 3.0))  # divergent sum, explicitly requested
     assert np.isnan(mod.period(1.0, -1.5))  # still no orbit beyond the separatrix
     assert "--allow-divergent" in (tmp_path / "duffing.py").read_text().splitlines()[2]
+    # the error estimate is never negative: inf from the radius on (the series bounds nothing
+    # there), and inside it bounds the true error (elliptic period), down to the separatrix
+    x = np.array([-0.95, -0.5, 0.3, 0.9, 0.999, 1.0, 1.5, 3.0, 1e4])
+    est = mod.error_estimate(1.0, x)
+    inside = np.abs(x) < 1
+    assert np.all(np.isinf(est[~inside])) and np.all(est[inside] > 0)
+    exact = 4 * ellipk(x[inside] / (2 * (1 + x[inside]))) / np.sqrt(1 + x[inside])
+    rel = np.abs(mod.period(1.0, x[inside]) / exact - 1)
+    assert np.all(rel <= 3 * est[inside]), (rel, est[inside])
+    out = np.empty(x.size)
+    mod.error_estimate_into(out, np.ones(x.size), x)
+    assert np.allclose(out, est, rtol=1e-13)  # inf equals inf
 
 
 def test_broadcasting(duf, pend):
