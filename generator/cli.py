@@ -530,7 +530,8 @@ def _cmd_choose(args: argparse.Namespace) -> int:
         command = (f"lindstedt choose period --tol {args.tol!r} --x-min {args.x_min!r} "
                    f"--x-max {args.x_max!r}")
         data["emitted"] = [str(p) for p in generate_choice(
-            cand, command, Path(args.emit), overwrite_edited=args.overwrite_edited)]
+            cand, command, Path(args.emit), (args.x_min, args.x_max),
+            overwrite_edited=args.overwrite_edited)]
     if args.json:
         print(json.dumps(data))
         return 0

@@ -526,8 +526,9 @@ def generate_fourier(harmonics: int, out: Path, *, overwrite_edited: bool = Fals
     return write_files(out, {"fourier.py": render_module(module)}, flag, overwrite_edited)
 
 
-def generate_choice(candidate: object, command: str, out: Path, *,
-                    overwrite_edited: bool = False, flag: str = "--emit") -> list[Path]:
-    """``lindstedt choose period … --emit DIR``: just the chosen evaluator."""
-    return write_files(out, {"chosen_period.py": render_module(lower_choice(candidate, command))},
-                       flag, overwrite_edited)
+def generate_choice(candidate: object, command: str, out: Path, verified: tuple[float, float],
+                    *, overwrite_edited: bool = False, flag: str = "--emit") -> list[Path]:
+    """``lindstedt choose period … --emit DIR``: just the chosen evaluator, NaN outside the
+    range ``verified`` of x = εA² it was verified on."""
+    module = lower_choice(candidate, command, verified)
+    return write_files(out, {"chosen_period.py": render_module(module)}, flag, overwrite_edited)

@@ -410,11 +410,13 @@ def lower_fourier(terms: int, command: str) -> Module:
     )
 
 
-def lower_choice(candidate, command: str) -> Module:
-    """The period evaluator ``choose period`` picked, as one numba ufunc ``period(A, eps)``.
+def lower_choice(candidate, command: str, verified: tuple[float, float]) -> Module:
+    """The period evaluator ``choose period`` picked, as one numba ufunc ``period(A, eps)``,
+    NaN outside the range ``verified = (x_min, x_max)`` of ``x = εA²`` it was verified on (as
+    well as outside the method's domain).
 
-    Coefficients enter as the exact binary values of the verified doubles (so the emitted
-    evaluator computes what was verified, up to FMA contraction)."""
+    Coefficients and bounds enter as the exact binary values of the verified doubles (so the
+    emitted evaluator computes what was verified, up to FMA contraction)."""
     if candidate.method == "exact":
         raise InputError("the exact period (SciPy's ellipk) has no compiled evaluator to emit; "
                          "loosen the tolerance or narrow the range")
@@ -423,8 +425,10 @@ def lower_choice(candidate, command: str) -> Module:
     def coeffs(values) -> list[sp.Expr]:
         return [sp.Rational(float(v)) for v in values]
 
-    guard = {"lindstedt": sp.And(x > -1, sp.Abs(x) < 1), "resummed": x > sp.Rational(-2, 3),
-             "pade": x > -1, "modified": x > -1, "agm": x > -1}[candidate.method]
+    domain = {"lindstedt": sp.And(x > -1, sp.Abs(x) < 1), "resummed": x > sp.Rational(-2, 3),
+              "pade": x > -1, "modified": x > -1, "agm": x > -1}[candidate.method]
+    lo, hi = (sp.Rational(float(v)) for v in verified)
+    guard = sp.And(domain, x >= lo, x <= hi)
     body: tuple = ()
     if candidate.method == "agm":
         lines, mean = agm_steps(sp.sqrt(1 + x), sp.sqrt(1 + x / 2), candidate.order, "")
@@ -440,12 +444,14 @@ def lower_choice(candidate, command: str) -> Module:
     else:
         out = horner(coeffs(candidate.num), x) / horner(coeffs(candidate.den), x)
     ev = Evaluator("period", f"Duffing period T(A, eps): {candidate.method} order "
-                   f"{candidate.order}, the method `lindstedt choose` verified; NaN outside "
-                   "its domain.", (A, eps), ((x, eps * A**2),), guard, body, 2 * sp.pi * out)
+                   f"{candidate.order}, the method `lindstedt choose` verified for x = eps*A**2 "
+                   f"in [{float(lo)!r}, {float(hi)!r}]; NaN outside that range.", (A, eps),
+                   ((x, eps * A**2),), guard, body, 2 * sp.pi * out)
     return Module(
         name="chosen_period",
         doc=f"The period evaluator chosen by `{command}`.",
-        constants=(("METHOD", candidate.method), ("ORDER", candidate.order)),
+        constants=(("METHOD", candidate.method), ("ORDER", candidate.order),
+                   ("VERIFIED_X", (float(lo), float(hi)))),
         evaluators=(ev,),
         provenance=provenance("duffing", candidate.order, command, method=candidate.method,
                               num=[float(v) for v in candidate.num],

@@ -157,6 +157,12 @@ def test_choose_emits_just_the_chosen_evaluator(tmp_path):
     assert np.max(np.abs(mod.period(1.0, x) / ref - 1)) <= 1e-8
     assert np.array_equal(mod.period_into(np.empty_like(x), 1.0, x), mod.period(1.0, x))
     assert np.isnan(mod.period(1.0, -1.5))  # beyond the separatrix: no periodic orbit
+    # outside the verified range the module answers NaN, not an unverified number (a Padé
+    # chosen for [−0.3, 0.3] gave 0.8128 at x = 1e4, true 0.0742); its bounds are inclusive
+    assert tuple(mod.VERIFIED_X) == (0.0, 1000.0)
+    assert np.isnan(mod.period(1.0, np.array([-1e-9, 1000.5, 1e4]))).all()
+    assert np.isfinite(mod.period(1.0, np.array([0.0, 1000.0]))).all()
+    assert "NaN outside that range" in mod.period.__doc__
     del sys.modules["chosen_period"]
 
 

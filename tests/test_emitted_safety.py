@@ -333,7 +333,7 @@ def run_all(folders: dict[str, Path]) -> list[dict]:
 def test_every_emitted_function_refuses_what_it_cannot_handle(tmp_path):
     """One child process calls everything; it must exit normally, every call must behave."""
     for args in (["generate", "fourier", "--harmonics", "4", "--out", str(tmp_path)],
-                 ["choose", "period", "--tol", "1e-6", "--x-min", "-0.5", "--x-max", "0.5",
+                 ["choose", "period", "--tol", "1e-6", "--x-min", "-0.5", "--x-max", "0.7",
                   "--emit", str(tmp_path)]):
         made = subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
                               text=True, check=False)
