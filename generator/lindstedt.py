@@ -22,6 +22,7 @@ from typing import Any
 import sympy as sp
 
 from .display import SHOWN_ORDERS, latex_aligned, latex_sum, latex_text, more
+from .errors import InputError
 from .models import Model, check_order, t
 from .series import Basis, Ground, solve_oscillator, to_fourier
 
@@ -82,6 +83,10 @@ def derive(model: Model, order: int,
     """ω₀…ω_K, u₀…u_K and T/2π of ``model`` to order K (notes §10.3, carried to order K);
     ``progress(j, K)`` is called after each order (the command line draws a bar with it)."""
     order = check_order(order)
+    if model.exact_to is not None and order > model.exact_to:
+        raise InputError(f"order {order}: the {model.name} model holds its equation's terms to "
+                         f"order {model.exact_to} only, so orders above it would be wrong; "
+                         f"build it for order {order} (e.g. {model.name}({order}))")
     basis = Basis(model.odd)
     ground = Ground.for_coefficients(model.coefficients())
     zero, one = ground.scalar(0), ground.scalar(1)

@@ -39,6 +39,7 @@ class Model:
     radius: sp.Expr | None  # radius of convergence of ω(y), T(y) in |y| (None: unknown)
     parameters: tuple[tuple[str, sp.Symbol], ...] = ()  # argument name -> symbol, in order
     orbit_condition: sp.Basic = sp.true  # in the symbol Y = y: a periodic orbit exists
+    exact_to: int | None = None  # the highest order its forcing is complete for (None: all)
 
     @property
     def odd(self) -> bool:
@@ -100,6 +101,7 @@ def pendulum(order: int) -> Model:
         radius=sp.pi**2,
         parameters=(("theta0", theta0),),
         orbit_condition=sp.Lt(Y, sp.pi**2),  # |θ₀| ≥ π: over the top, no libration
+        exact_to=order,
     )
 
 
@@ -160,7 +162,7 @@ def model_by_name(name: str, order: int) -> Model:
 
 
 MAX_ORDER = 100_000
-# NOTE: a hard sanity bound only; the CLI asks for --force far below it (cost estimate).
+# NOTE: a hard sanity bound only; the CLI asks for --allow-slow far below it (cost estimate).
 
 
 def check_order(order: object) -> int:

@@ -171,3 +171,14 @@ def test_order_zero():
     sol = derive(duffing(), 0)
     assert fractions(sol, "omega") == [Fraction(1)]
     assert sol.q[0] == {1: sol.ground.scalar(1)}
+
+
+def test_a_model_too_small_for_the_order_is_refused():
+    """pendulum(4) holds sin's Taylor terms to θ₀⁸ only: its order-8 series would be wrong
+    from j = 5 on, so derive refuses; pendulum(8) gives the elliptic-integral coefficients."""
+    with pytest.raises(InputError, match=r"order 8: the pendulum model holds .* to order 4"):
+        derive(pendulum(4), 8)
+    exact = pendulum_period(8)
+    got = derive(pendulum(8), 8)
+    assert [got.ground.to_fraction(c) for c in got.period] == exact
+    assert [got.ground.to_fraction(c) for c in derive(pendulum(4), 4).period] == exact[:5]
