@@ -248,14 +248,14 @@ def driven_json(d, order: int, harmonics: int) -> dict:
         for j in range(len(mu.coefficients)):
             c, phase = mu.partial(j)
             A, B = amplitudes(c, phase, 2 * j + 1)
-            entry = {"order": j, "A": _keyed(A), "delta": phase}
+            entry = {"order": j, "A": _keyed(A), "delta": phase, "r": _first_harmonic(A, B)}
             if damped:
                 entry["B"] = _keyed(B)
             orders.append(entry)
         hb = harmonic_balance(d, br, harmonics)
         A, B = amplitudes(hb.coefficients, 0.0, 2 * harmonics - 1)
         hb_json = {"harmonics": harmonics, "A": _keyed(A), "residual": hb.residual,
-                   "converged": hb.converged}
+                   "converged": hb.converged, "r": _first_harmonic(A, B)}
         if damped:
             hb_json["B"] = _keyed(B)
         guess = np.array([sum(A.values()), d.omega * sum(n * b for n, b in B.items())])
@@ -263,11 +263,12 @@ def driven_json(d, order: int, harmonics: int) -> dict:
         numerical = None
         if orbit is not None:
             numerical = {"A": _keyed(orbit.A), "floquet_moduli": sorted(
-                float(abs(m)) for m in orbit.multipliers), "stable": orbit.stable}
+                float(abs(m)) for m in orbit.multipliers), "stable": orbit.stable,
+                "r": _first_harmonic(orbit.A, orbit.B)}
             if damped:
                 numerical["B"] = _keyed(orbit.B)
         branches.append({
-            "A1": br.A1, "delta0": br.delta0, "mu_expansion": orders,
+            "A1": br.A1, "r": abs(br.A1), "delta0": br.delta0, "mu_expansion": orders,
             "mu_converged": mu.converged, "mu_note": mu.reason,
             "harmonic_balance": hb_json, "numerical": numerical,
         })
@@ -283,22 +284,37 @@ def _keyed(values: dict) -> dict:
     return {str(n): float(v) for n, v in sorted(values.items())}
 
 
+def _first_harmonic(A: dict, B: dict) -> float:
+    """r = √(A₁² + B₁²), the amplitude of the first harmonic whatever its phase."""
+    return float(math.hypot(A.get(1, 0.0), B.get(1, 0.0)))
+
+
 def driven_table(data: dict) -> str:
     p = data["parameters"]
     lines = [f"q'' + q'/Q + q + eps q^3 = f cos(w t): eps = {p['eps']}, f = {p['force']}, "
              f"w = {p['omega']}, Q = {p['Q'] if p['Q'] is not None else 'inf (undamped)'}"]
+    damped = p["Q"] is not None
+    columns = ("r", "A1", "B1", "A3", "A5") if damped else ("A1", "A3", "A5")
     for i, br in enumerate(data["branches"], 1):
         num = br["numerical"]
         verdict = "no orbit found" if num is None else ("stable" if num["stable"] else "unstable")
-        lines.append(f"\nbranch {i}: first-order A1 = {br['A1']:.6f} ({verdict})")
-        lines.append(f"{'':>22} {'A1':>12} {'A3':>12} {'A5':>12}")
-        rows = [(f"mu-expansion order {e['order']}", e["A"]) for e in br["mu_expansion"]]
-        rows.append((f"harmonic balance N={br['harmonic_balance']['harmonics']}",
-                     br["harmonic_balance"]["A"]))
+        first = (f"r = {br['r']:.6f}, phase delta0 = {br['delta0']:.6f}" if damped
+                 else f"A1 = {br['A1']:.6f}")
+        lines.append(f"\nbranch {i}: first-order {first} ({verdict})")
+        lines.append(f"{'':>22} " + " ".join(f"{c:>12}" for c in columns))
+        hb = br["harmonic_balance"]
+        rows = [(f"mu-expansion order {e['order']}", e) for e in br["mu_expansion"]]
+        rows.append((f"harmonic balance N={hb['harmonics']}", hb))
         if num is not None:
-            rows.append(("numerical (shooting)", num["A"]))
-        for label, A in rows:
-            cells = " ".join(f"{A[k]:>12.6f}" if k in A else f"{'':>12}" for k in "135")
+            rows.append(("numerical (shooting)", num))
+        for label, row in rows:
+            if row is hb and not hb["converged"]:
+                lines.append(f"{label:>22} (did not converge: residual {hb['residual']:.1e})")
+                continue
+            values = {"r": row["r"], **{f"A{k}": v for k, v in row["A"].items()},
+                      **{f"B{k}": v for k, v in row.get("B", {}).items()}}
+            cells = " ".join(f"{values[c]:>12.6f}" if c in values else f"{'':>12}"
+                             for c in columns)
             lines.append(f"{label:>22} {cells}")
         if not br["mu_converged"]:
             lines.append(f"  warning: {br['mu_note']}")

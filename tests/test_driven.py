@@ -197,3 +197,29 @@ def test_tiny_linear_response_is_found():
     (br,) = first_order_branches(Drive(-0.1, 1.0, 0.5, 1e-16))
     r_linear = 1.0 / abs(1 - 0.25 + 0.5j * 1e16)
     assert abs(br.A1 / r_linear - 1) < 1e-9
+
+
+def test_damped_output_shows_r_and_both_phases_parts():
+    """Damped, the first harmonic is A₁ cos + B₁ sin: the JSON gives r = √(A₁² + B₁²) at every
+    level (the branch's first-order r, each μ order, the balance, the true orbit) and the text
+    table shows r, A1 and B1; checked against an independent shooting of the true orbit."""
+    args = ["driven", "--eps", "0.1", "--force", "0.3", "--omega", "1.3", "--Q", "20"]
+    run = [sys.executable, "-m", "lindstedt", *args]
+    data = json.loads(subprocess.run([*run, "--json"], capture_output=True, text=True,
+                                     check=True).stdout)
+    top = data["branches"][0]
+    orbit = shoot(0.1, 0.3, 1.3, 0.05, np.array([2.3, 1.3 * 2.2]))
+    r_true = math.hypot(orbit.A[1], orbit.B[1])
+    assert abs(r_true - 3.150203) < 1e-6
+    assert abs(top["numerical"]["r"] - r_true) < 1e-9
+    assert abs(top["harmonic_balance"]["r"] - r_true) < 1e-8
+    assert abs(top["mu_expansion"][-1]["r"] - r_true) < 1e-4
+    assert top["r"] == top["A1"] > 0  # damped: the first-order amplitude r, its phase delta0
+    assert abs(top["r"] - r_true) < 0.05
+    text = subprocess.run(run, capture_output=True, text=True, check=True).stdout
+    header = next(line for line in text.splitlines() if line.split()[:2] == ["r", "A1"])
+    assert header.split() == ["r", "A1", "B1", "A3", "A5"]
+    shooting = next(line for line in text.splitlines() if "shooting" in line).split()[-5:]
+    assert abs(float(shooting[0]) - r_true) < 1e-6
+    assert abs(float(shooting[1]) - orbit.A[1]) < 1e-6
+    assert abs(float(shooting[2]) - orbit.B[1]) < 1e-6
