@@ -460,16 +460,22 @@ def _subharmonic_table(data: dict) -> list[str]:
 
 def mixing_json(eps: float, Q: float, drives: list[tuple[float, float]]) -> dict:
     """The contract of ``lindstedt mixing … --json``: predicted and simulated tones."""
-    from .response import mixing_tones, simulated_tones, tone_label
+    from .response import mixing_series, simulated_fit, tone_label
 
-    tones = mixing_tones(eps, Q, drives)
-    simulated = simulated_tones(eps, Q, drives, tones)
+    series = mixing_series(eps, Q, drives)
+    fit = simulated_fit(eps, Q, drives, list(series.tones))
     return {
         "parameters": {"eps": eps, "Q": Q, "drives": [{"force": f, "omega": w}
                                                       for f, w in drives]},
+        "expansion_parameter": series.expansion_parameter,
+        "converged": series.converged,
+        "reason": series.reason,
+        "simulated_rms_residual": fit.rms_residual,
         "tones": [{"frequency": t.frequency, "combination": tone_label(t.combination),
-                   "order": t.order, "predicted": t.predicted, "simulated": float(s)}
-                  for t, s in zip(tones, simulated, strict=True)],
+                   "order": t.order, "predicted": t.predicted, "simulated": float(a),
+                   "simulated_uncertainty": float(u), "resolved": bool(a > 3 * u)}
+                  for t, a, u in zip(series.tones, fit.amplitudes, fit.uncertainty,
+                                     strict=True)],
     }
 
 
@@ -492,10 +498,14 @@ def _mixing_table(data: dict) -> list[str]:
     lines = [f"q'' + q'/Q + q + eps q^3 = sum f_i cos(w_i t): eps = {p['eps']}, Q = {p['Q']}, "
              + ", ".join(f"w{i} = {d['omega']} (f = {d['force']})"
                          for i, d in enumerate(p["drives"], 1)),
-             f"{'tone':>12} {'frequency':>10} {'order':>6} {'predicted':>11} {'simulated':>11}"]
+             ("" if data["converged"] else "warning: ") + data["reason"],
+             f"{'tone':>12} {'frequency':>10} {'order':>6} {'predicted':>11} {'simulated':>11} "
+             f"{'+/-':>9}"]
     for t in data["tones"]:
         lines.append(f"{t['combination']:>12} {t['frequency']:>10.4f} {t['order']:>6} "
-                     f"{t['predicted']:>11.3e} {t['simulated']:>11.3e}")
+                     f"{t['predicted']:>11.3e} {t['simulated']:>11.3e} "
+                     f"{t['simulated_uncertainty']:>9.1e}"
+                     + ("" if t["resolved"] else "  (below the fit's noise)"))
     return lines
 
 

@@ -3,6 +3,7 @@ periodic orbits of the driven oscillator by shooting, and their Floquet multipli
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -365,13 +366,34 @@ MAX_FIT_ENTRIES = 30_000_000
 # least-squares fit of four drives' 228 tones at drive frequencies up to ~2.5.
 
 
+@dataclass(frozen=True)
+class ToneFit:
+    """The simulated steady state's amplitude at each frequency, its standard error, and the
+    rms of what the fit leaves (every tone not asked for counts as noise)."""
+
+    amplitudes: np.ndarray
+    uncertainty: np.ndarray
+    rms_residual: float
+
+
 def steady_state_amplitudes(eps: float, damping: float, forces: list[float],
                             omegas: list[float], frequencies: list[float],
                             settle: float | None = None, window: float = 2000.0,
                             initial: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
+    """The amplitudes of :func:`steady_state_fit`."""
+    return steady_state_fit(eps, damping, forces, omegas, frequencies, settle, window,
+                            initial).amplitudes
+
+
+def steady_state_fit(eps: float, damping: float, forces: list[float],
+                     omegas: list[float], frequencies: list[float],
+                     settle: float | None = None, window: float = 2000.0,
+                     initial: tuple[float, float] = (0.0, 0.0)) -> ToneFit:
     """Amplitudes of the simulated steady state at ``frequencies`` (least squares on cos/sin
     over a long window after the transients, ~``20 Q`` time units, have died out), starting
-    from ``initial`` = (q, q̇) — which decides the attractor where several coexist.
+    from ``initial`` = (q, q̇) — which decides the attractor where several coexist — with
+    their standard errors: the covariance ``σ²(XᵀX)⁻¹`` of the fit, ``σ`` the rms residual,
+    carried to each amplitude ``√(c² + s²)`` (``√((var c + var s)/2)`` where it is 0).
 
     NaN amplitudes when the simulated orbit overflows (it escapes to infinity: a softening
     spring driven over its barrier, or RK4 unstable at that amplitude).  :class:`InputError`
@@ -403,10 +425,22 @@ def steady_state_amplitudes(eps: float, damping: float, forces: list[float],
     q = _simulate(eps, damping, np.array(forces, float), np.array(omegas, float), float(h),
                   int(settle / h), n_keep, every, float(initial[0]), float(initial[1]))
     if not np.all(np.isfinite(q)):
-        return np.full(len(frequencies), np.nan)
+        nan = np.full(len(frequencies), np.nan)
+        return ToneFit(nan, nan, math.nan)
     t = settle + np.arange(n_keep) * h * every
     basis = [np.ones_like(t)]
     for nu in frequencies:
         basis += [np.cos(nu * t), np.sin(nu * t)]
-    coef, *_ = np.linalg.lstsq(np.column_stack(basis), q, rcond=None)
-    return np.hypot(coef[1::2], coef[2::2])
+    X = np.column_stack(basis)
+    coef, *_ = np.linalg.lstsq(X, q, rcond=None)
+    residual = q - X @ coef
+    sigma2 = float(residual @ residual) / max(len(q) - X.shape[1], 1)
+    cov = sigma2 * np.linalg.pinv(X.T @ X)
+    c, s = coef[1::2], coef[2::2]
+    var_c, var_s = np.diag(cov)[1::2], np.diag(cov)[2::2]
+    cov_cs = np.diag(cov, 1)[1::2]
+    amp = np.hypot(c, s)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        var = np.where(amp > 0, (c * c * var_c + s * s * var_s + 2 * c * s * cov_cs)
+                       / np.where(amp > 0, amp * amp, 1.0), (var_c + var_s) / 2)
+    return ToneFit(amp, np.sqrt(np.maximum(var, 0.0)), math.sqrt(sigma2))

@@ -17,7 +17,7 @@ import sympy as sp
 
 from .driven import BalanceSystem, Drive, check_harmonics, first_order_branches, trig_product
 from .errors import InputError
-from .numerics import hill_multipliers, shoot, steady_state_amplitudes
+from .numerics import ToneFit, hill_multipliers, shoot, steady_state_amplitudes, steady_state_fit
 
 _u, _w, _e, _f, _g = sp.symbols("u w e f g")  # u = r², w = ω², g = 1/Q
 _G = _u * ((1 - _w + sp.Rational(3, 4) * _e * _u) ** 2 + _w * _g**2) - _f**2
@@ -465,8 +465,32 @@ MIN_DRIVE_OMEGA = 2 * np.pi / 2000
 # (2k)^5 combinations before the equal frequencies merge.
 
 
+MIXING_CONVERGED = 0.2
+# NOTE: the expansion parameter ρ (the larger of ‖q₁‖/‖q₀‖ and ‖q₂‖/‖q₁‖, ‖·‖ the sum of the
+# tones' amplitudes) must stay ≤ 0.2, so the first omitted order is ~ρ³ ≤ 1 % of q₀: the rule of
+# the μ-expansion, whose last term must fall below 1 % of the first. At ρ ≈ 0.5
+# (ε = 0.2, Q = 15, drives 0.4@0.8 and 0.3@1.9) q₀ + q₁ + q₂ put the ω₁ tone 61 % off the
+# simulated one, worse than q₀ alone.
+
+
+@dataclass(frozen=True)
+class MixingSeries:
+    """The combination tones to second order and the verdict on the expansion."""
+
+    tones: tuple[Tone, ...]
+    expansion_parameter: float  # ρ = max(‖q₁‖/‖q₀‖, ‖q₂‖/‖q₁‖)
+    converged: bool  # ρ ≤ MIXING_CONVERGED
+    reason: str
+
+
 def mixing_tones(eps: float, Q: float, drives: list[tuple[float, float]]) -> list[Tone]:
-    """Combination tones of ``q̈ + q̇/Q + q + εq³ = Σ f_i cos ω_i t`` to second order in ε.
+    """The tones of :func:`mixing_series`."""
+    return list(mixing_series(eps, Q, drives).tones)
+
+
+def mixing_series(eps: float, Q: float, drives: list[tuple[float, float]]) -> MixingSeries:
+    """Combination tones of ``q̈ + q̇/Q + q + εq³ = Σ f_i cos ω_i t`` to second order in ε,
+    with the expansion parameter ρ and whether the series converges (:data:`MIXING_CONVERGED`).
 
     ``q₀ = Σ Re(χ(ω_i) f_i e^{iω_i t})``, ``χ(ν) = 1/(1 − ν² + iν/Q)``; ``q₁ = −χ·[q₀³]`` holds
     the tones ``±ω_i ± ω_j ± ω_k`` (for two drives: ω₁, ω₂, 3ω₁, 3ω₂, 2ω₁ ± ω₂, 2ω₂ ± ω₁ —
@@ -522,16 +546,35 @@ def mixing_tones(eps: float, Q: float, drives: list[tuple[float, float]]) -> lis
             prev = tones.get(key)
             tones[key] = (prev[0] if prev else c, (prev[1] if prev else 0) + v,
                           min(order, prev[2]) if prev else order)
-    return sorted((Tone(c, nu, float(2 * abs(v)), order) for nu, (c, v, order) in tones.items()),
-                  key=lambda tone: (tone.order, tone.frequency))
+    norms = [sum(abs(v) for v in part.values()) for part in (q0, q1, q2)]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rho = float(max(norms[1] / norms[0], norms[2] / norms[1] if norms[1] > 0 else 0.0))
+    converged = rho <= MIXING_CONVERGED
+    reason = (f"expansion parameter {rho:.3g} ≤ {MIXING_CONVERGED}: the first omitted order is "
+              f"~{rho**3:.1e} of q0" if converged else
+              f"expansion parameter {rho:.3g} > {MIXING_CONVERGED} (eps q0^2 |chi| not small): "
+              "q0 + q1 + q2 is not converging, the predicted tones can be off by tens of "
+              "percent; trust the simulated ones")
+    ordered = sorted((Tone(c, nu, float(2 * abs(v)), order)
+                      for nu, (c, v, order) in tones.items()),
+                     key=lambda tone: (tone.order, tone.frequency))
+    return MixingSeries(tuple(ordered), rho, converged, reason)
 
 
 def simulated_tones(eps: float, Q: float, drives: list[tuple[float, float]],
                     tones: list[Tone]) -> np.ndarray:
-    """The simulated steady state's amplitude at each tone (from rest, after the transients),
-    or :class:`InputError` when the simulated orbit overflows: no steady state to compare."""
-    sim = steady_state_amplitudes(eps, 1 / Q, [f for f, _ in drives], [w for _, w in drives],
-                                  [t.frequency for t in tones])
+    """The amplitudes of :func:`simulated_fit`."""
+    return simulated_fit(eps, Q, drives, tones).amplitudes
+
+
+def simulated_fit(eps: float, Q: float, drives: list[tuple[float, float]],
+                  tones: list[Tone]) -> ToneFit:
+    """The simulated steady state's amplitude at each tone (from rest, after the transients)
+    and its standard error, or :class:`InputError` when the simulated orbit overflows: no
+    steady state to compare."""
+    fit = steady_state_fit(eps, 1 / Q, [f for f, _ in drives], [w for _, w in drives],
+                           [t.frequency for t in tones])
+    sim = fit.amplitudes
     if np.any(np.isnan(sim)):
         given = " ".join(f"{f:g}@{w:g}" for f, w in drives)
         why = ("RK4 at 64 steps a period is unstable there: a stiff damping 1/Q or a large "
@@ -541,4 +584,4 @@ def simulated_tones(eps: float, Q: float, drives: list[tuple[float, float]],
                    f"{1 / np.sqrt(-eps):.3g} escapes to infinity, or {why}")
         raise InputError(f"drives {given}: the simulated orbit overflows ({why}); there is no "
                          "steady state to compare the tones with")
-    return sim
+    return fit

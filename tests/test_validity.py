@@ -1,0 +1,71 @@
+"""Every perturbative answer carries its validity: frequency mixing's expansion parameter and
+verdict, and the simulated tones' uncertainty, against an independent DOP853 reference."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+
+def reference_tones(eps, Q, drives, frequencies, window=2000.0):
+    """The steady state's amplitude at each frequency: DOP853 at rtol 1e-11 from rest, 40 Q
+    time units of transients, then a least-squares fit over ``window``."""
+    F = np.array([f for f, _ in drives])
+    W = np.array([w for _, w in drives])
+
+    def rhs(t, y):
+        return [y[1], -y[1] / Q - y[0] - eps * y[0] ** 3 + np.sum(F * np.cos(W * t))]
+
+    settle = 40 * Q
+    ts = np.linspace(settle, settle + window, 40001)
+    sol = solve_ivp(rhs, (0, settle + window), [0.0, 0.0], method="DOP853", rtol=1e-11,
+                    atol=1e-13, t_eval=ts)
+    X = np.column_stack([np.ones_like(ts)] + [f(nu * ts) for nu in frequencies
+                                              for f in (np.cos, np.sin)])
+    c, *_ = np.linalg.lstsq(X, sol.y[0], rcond=None)
+    return np.hypot(c[1::2], c[2::2])
+
+
+def mixing(*args):
+    out = subprocess.run([sys.executable, "-m", "lindstedt", "mixing", *args],
+                         capture_output=True, text=True, check=True)
+    return out.stdout
+
+
+def test_converged_mixing_meets_the_reference_and_its_uncertainty_covers_the_simulation():
+    """The README's case: ρ ≈ 0.08, converged; the drives' tones within 1e-3 (~ρ³) and the
+    first-order ones within 2 % of the reference; each simulated tone within 3 of its own
+    standard errors of the reference (the uncertainty is honest, and not vacuous: below 1e-6)."""
+    args = ["--eps", "0.1", "--Q", "10", "--drive", "0.3@1.3", "--drive", "0.3@1.7"]
+    data = json.loads(mixing(*args, "--json"))
+    assert data["converged"] is True and 0.05 < data["expansion_parameter"] < 0.12
+    tones = data["tones"]
+    ref = reference_tones(0.1, 10.0, [(0.3, 1.3), (0.3, 1.7)], [t["frequency"] for t in tones])
+    for t, r in zip(tones, ref, strict=True):
+        assert abs(t["simulated"] - r) <= 3 * t["simulated_uncertainty"] + 1e-12, (t, r)
+        assert 0 < t["simulated_uncertainty"] < 1e-6
+        if t["order"] == 0:
+            assert abs(t["predicted"] / r - 1) < 1e-3  # ~ρ³
+        elif t["order"] == 1:
+            assert abs(t["predicted"] / r - 1) < 0.02
+    assert "warning" not in mixing(*args).splitlines()[1]
+
+
+def test_mixing_outside_its_validity_says_so():
+    """ε = 0.2, Q = 15, drives 0.4@0.8 and 0.3@1.9: ρ > 1, not converged, and rightly so: the
+    predicted ω₁ tone is more than 30 % off the reference (1.358 against 0.843)."""
+    args = ["--eps", "0.2", "--Q", "15", "--drive", "0.4@0.8", "--drive", "0.3@1.9"]
+    data = json.loads(mixing(*args, "--json"))
+    assert data["converged"] is False and data["expansion_parameter"] > 0.2
+    assert "not converging" in data["reason"]
+    k, w1 = next((k, t) for k, t in enumerate(data["tones"]) if t["combination"] == "w1")
+    ref = reference_tones(0.2, 15.0, [(0.4, 0.8), (0.3, 1.9)],
+                          [t["frequency"] for t in data["tones"]])[k]
+    assert abs(ref - 0.8427) < 1e-3
+    assert abs(w1["simulated"] - ref) <= 3 * w1["simulated_uncertainty"]
+    assert abs(w1["predicted"] / ref - 1) > 0.3
+    assert mixing(*args).splitlines()[1].startswith("warning: expansion parameter")
