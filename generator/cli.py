@@ -18,6 +18,10 @@ from .errors import InputError
 
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
 # well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+# NOTE: before NumPy is imported: the continuation's and the fits' matrices (≤ 200 × 200) run
+# twice as fast on one BLAS thread as on OpenBLAS's pool on a busy machine (`response
+# --harmonics 40`: 8.7 s against 17.3 s), and the cost estimates assume one thread.
 
 FREE_MODELS = ("duffing", "pendulum")
 # NOTE: models.MODELS, restated so that parsing arguments needs no SymPy (a test keeps them equal).
