@@ -84,22 +84,24 @@ DRIVEN_COSTS = (3.0, 13.3, 100, 3.5)
 FIXED_COSTS = {
     "subharmonic": 6.0,
     "mixing": 12.0,
-    "clock": 2.0,
-    "scene": 20.0,
-    "choose period": 15.0,
-    "choose q": 25.0,
-    "choose amplitudes": 20.0,
-    "choose response": 20.0,
+    "clock": 5.0,
+    "scene": 12.0,
+    "choose period": 10.0,
+    "choose q": 20.0,
+    "choose amplitudes": 12.0,
+    "choose response": 12.0,
 }
 # NOTE: commands whose work no input scales (bounded by the inputs' own bounds: at most four
-# drives, a fixed set of candidates and verification points), their wall time at most.
+# drives, a fixed set of candidates and verification points): their wall time at most, from
+# benchmarks/command_costs.py (measured 3.3–14.6 s under load).
 
 RESPONSE_FIXED = 6.0
 # NOTE: `lindstedt response`: start-up, the Floquet fold refinements and the two simulated sweeps
 # (compiled RK4, 10⁴ drive periods each), on top of the continuation's own estimate.
 
-SWEEP_START = 8.0
-# NOTE: a LocalCluster's start-up and warm-up (5–10 s), on top of the points' work.
+SWEEP_START = 15.0
+# NOTE: start-up, a LocalCluster's start and warm-up, the store (15–17 s measured for small
+# grids on the loaded machine), on top of the points' work.
 
 
 def series_cost(args: argparse.Namespace) -> Cost:
