@@ -368,7 +368,7 @@ def response_json(eps: float, force: float, Q: float, harmonics: int,
         "one_harmonic": {"folds": [float(w) for w in folds1]},
         "harmonic_balance": {"harmonics": harmonics, "folds": [float(w) for w in cont.folds]},
         "numerical": {"folds": sorted(true_folds), "sweep_up_jump": up.jump,
-                      "sweep_down_jump": down.jump},
+                      "sweep_down_jump": down.jump, "sweep_resolution": up.resolution},
     }
 
 
@@ -414,7 +414,8 @@ def _response_table(data: dict) -> list[str]:
     for label, key in (("sweep up jumps at", "sweep_up_jump"),
                        ("sweep down jumps at", "sweep_down_jump")):
         value = num[key]
-        lines.append(f"{label:>26}: " + (f"{value:.4f}" if value is not None else "no jump"))
+        lines.append(f"{label:>26}: " + (f"{value:.4f} (sweep step {num['sweep_resolution']:.1e} "
+                                         "per period)" if value is not None else "no jump"))
     return lines
 
 

@@ -237,7 +237,8 @@ class Sweep:
 
     omega: np.ndarray
     amplitude: np.ndarray
-    jump: float | None  # ω of the largest period-to-period change, if it is a jump
+    jump: float | None  # ω where the amplitude crosses between the branches, if it jumps
+    resolution: float = float("nan")  # the change of ω per drive period (the sweep's step)
 
 
 SWEEP_STEPS = 64
@@ -257,8 +258,18 @@ def sweep(eps: float, force: float, damping: float, omega_from: float, omega_to:
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.maximum(a[JUMP_WINDOW:] / a[:-JUMP_WINDOW], a[:-JUMP_WINDOW] / a[JUMP_WINDOW:])
     hits = np.nonzero(ratio > JUMP_RATIO)[0]
-    jump = float(omegas[skip + hits[0]]) if hits.size else None
-    return Sweep(omegas, amps, jump)
+    step = abs(omega_to - omega_from) / periods
+    if not hits.size:
+        return Sweep(omegas, amps, None, step)
+    # the jump is where the amplitude crosses the geometric mean of the two branches' amplitudes
+    # around it, inside the window that detected it (interpolated in log amplitude)
+    i = int(hits[0])
+    seg = np.log(a[i:i + JUMP_WINDOW + 1])
+    middle = 0.5 * (seg[0] + seg[-1])
+    k = int(np.argmax(np.sign(seg - middle) != np.sign(seg[0] - middle)))
+    frac = (middle - seg[k - 1]) / (seg[k] - seg[k - 1]) if k > 0 and seg[k] != seg[k - 1] else 0
+    w0, w1 = omegas[skip + i + k - 1], omegas[skip + i + k]
+    return Sweep(omegas, amps, float(w0 + frac * (w1 - w0)), step)
 
 
 def orbit_fold(eps: float, force: float, damping: float, omega: float, y0: np.ndarray,

@@ -69,3 +69,21 @@ def test_mixing_outside_its_validity_says_so():
     assert abs(w1["simulated"] - ref) <= 3 * w1["simulated_uncertainty"]
     assert abs(w1["predicted"] / ref - 1) > 0.3
     assert mixing(*args).splitlines()[1].startswith("warning: expansion parameter")
+
+
+def test_sweep_jumps_are_where_the_amplitude_crosses_past_the_fold():
+    """ε = 0.1, f = 0.3, Q = 30: the true lower fold is at 1.16379 (DOP853 shooting); sweeping
+    down the small branch stays stable until it, so the jump lies below it, where the simulated
+    amplitude crosses between the branches (≈ 1.1603), not at the start of the detecting window
+    (1.16971 before: above the fold). Sweeping up, the jump lies above the upper fold."""
+    data = json.loads(subprocess.run(
+        [sys.executable, "-m", "lindstedt", "response", "--eps", "0.1", "--force", "0.3", "--Q",
+         "30", "--json"], capture_output=True, text=True, check=True).stdout)
+    num = data["numerical"]
+    lower, upper = num["folds"]
+    assert abs(lower - 1.16379) < 1e-5
+    step = num["sweep_resolution"]
+    assert 1e-4 < step < 3e-4  # (2.17 − 0.5)/10⁴ per drive period
+    assert lower - 0.005 < num["sweep_down_jump"] < lower
+    assert abs(num["sweep_down_jump"] - 1.1603) < 0.002
+    assert upper < num["sweep_up_jump"] < upper + 0.01
