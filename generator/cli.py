@@ -368,7 +368,8 @@ def response_json(eps: float, force: float, Q: float, harmonics: int,
         "one_harmonic": {"folds": [float(w) for w in folds1]},
         "harmonic_balance": {"harmonics": harmonics, "folds": [float(w) for w in cont.folds]},
         "numerical": {"folds": sorted(true_folds), "sweep_up_jump": up.jump,
-                      "sweep_down_jump": down.jump, "sweep_resolution": up.resolution},
+                      "sweep_down_jump": down.jump, "sweep_resolution": up.resolution,
+                      "sweep_up_escape": up.escape, "sweep_down_escape": down.escape},
     }
 
 
@@ -411,11 +412,16 @@ def _response_table(data: dict) -> list[str]:
                          ("true orbit (Floquet +1)", data["numerical"]["folds"])):
         lines.append(f"{label:>26}: folds " + (", ".join(f"{w:.12f}" for w in folds) or "none"))
     num = data["numerical"]
-    for label, key in (("sweep up jumps at", "sweep_up_jump"),
-                       ("sweep down jumps at", "sweep_down_jump")):
-        value = num[key]
-        lines.append(f"{label:>26}: " + (f"{value:.4f} (sweep step {num['sweep_resolution']:.1e} "
-                                         "per period)" if value is not None else "no jump"))
+    for way in ("up", "down"):
+        value, escape = num[f"sweep_{way}_jump"], num[f"sweep_{way}_escape"]
+        if escape is not None:
+            text = (f"escapes the well at {escape:.4f} (over the barrier |q| = "
+                    f"{1 / math.sqrt(-p['eps']):.3g}: no steady state beyond)")
+        elif value is not None:
+            text = f"jumps at {value:.4f} (sweep step {num['sweep_resolution']:.1e} per period)"
+        else:
+            text = "no jump"
+        lines.append(f"{'sweep ' + way:>26}: {text}")
     return lines
 
 

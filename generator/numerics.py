@@ -239,6 +239,7 @@ class Sweep:
     amplitude: np.ndarray
     jump: float | None  # ω where the amplitude crosses between the branches, if it jumps
     resolution: float = float("nan")  # the change of ω per drive period (the sweep's step)
+    escape: float | None = None  # ω where a softening spring left its well (then no jump)
 
 
 SWEEP_STEPS = 64
@@ -251,14 +252,23 @@ JUMP_WINDOW = 50
 
 def sweep(eps: float, force: float, damping: float, omega_from: float, omega_to: float,
           periods: int = 10_000) -> Sweep:
-    """Sweep the drive frequency slowly from ``omega_from`` to ``omega_to`` (compiled RK4)."""
+    """Sweep the drive frequency slowly from ``omega_from`` to ``omega_to`` (compiled RK4): the
+    amplitude per drive period, the jump between branches if any, or — a softening spring
+    driven over its barrier ``|q| = 1/√−ε`` — the ω where it escapes (amplitudes NaN from there,
+    no jump reported)."""
     omegas, amps = _sweep(eps, force, damping, omega_from, omega_to, periods, SWEEP_STEPS)
+    step = abs(omega_to - omega_from) / periods
+    barrier = 1 / np.sqrt(-eps) if eps < 0 else np.inf  # the potential's maxima, |q| = 1/√−ε
+    out = ~np.isfinite(amps) | (amps > barrier)
+    if out.any():  # over the barrier the orbit runs off to infinity: no branch to jump to
+        first = int(np.argmax(out))
+        amps = np.where(np.arange(amps.size) < first, amps, np.nan)
+        return Sweep(omegas, amps, None, step, float(omegas[first]))
     skip = periods // 20  # the start-up transient
     a = amps[skip:]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.maximum(a[JUMP_WINDOW:] / a[:-JUMP_WINDOW], a[:-JUMP_WINDOW] / a[JUMP_WINDOW:])
     hits = np.nonzero(ratio > JUMP_RATIO)[0]
-    step = abs(omega_to - omega_from) / periods
     if not hits.size:
         return Sweep(omegas, amps, None, step)
     # the jump is where the amplitude crosses the geometric mean of the two branches' amplitudes

@@ -87,3 +87,25 @@ def test_sweep_jumps_are_where_the_amplitude_crosses_past_the_fold():
     assert lower - 0.005 < num["sweep_down_jump"] < lower
     assert abs(num["sweep_down_jump"] - 1.1603) < 0.002
     assert upper < num["sweep_up_jump"] < upper + 0.01
+
+
+def test_a_softening_spring_over_its_barrier_escapes_and_is_reported_so():
+    """ε = −0.1, f = 0.3, Q = 20: sweeping up, the resonance carries |q| past the barrier
+    1/√0.1 = 3.16 near ω = 0.81 and the orbit leaves the well (before: "sweep up jumps at
+    0.8016" with amplitudes of 1e214). Reported as an escape, never as a jump."""
+    from lindstedt.numerics import sweep
+
+    data = json.loads(subprocess.run(
+        [sys.executable, "-m", "lindstedt", "response", "--eps", "-0.1", "--force", "0.3",
+         "--Q", "20", "--json"], capture_output=True, text=True, check=True).stdout)
+    num = data["numerical"]
+    assert num["sweep_up_jump"] is None and 0.7 < num["sweep_up_escape"] < 0.9
+    run = sweep(-0.1, 0.3, 0.05, 0.5, 1.5)
+    before = run.amplitude[run.omega < run.escape]
+    assert np.all(np.isfinite(before)) and np.nanmax(before) <= 1 / np.sqrt(0.1)
+    assert np.all(np.isnan(run.amplitude[run.omega > run.escape + 1e-3]))
+    assert sweep(0.1, 0.3, 0.05, 0.5, 1.9).escape is None  # a hardening spring never escapes
+    text = subprocess.run([sys.executable, "-m", "lindstedt", "response", "--eps", "-0.1",
+                           "--force", "0.3", "--Q", "20"], capture_output=True, text=True,
+                          check=True).stdout
+    assert "escapes the well" in text and "jumps" not in text
