@@ -375,8 +375,11 @@ LOCK_TOLERANCE = 0.05
 # NOTE: ~75 periods of the subharmonic: a stable orbit keeps its first harmonic within 5 %
 # (the 1 % kick stays bounded), an unstable one loses it well within that window.
 ORBIT_MATCH = 0.25
-# NOTE: the true orbit differs from a(f) by O(ε); a first harmonic further off than 25 % is
-# another orbit that shooting fell onto (the 1:1 response, or the rotation −a/2 of the other root).
+# NOTE: the true orbit's phase: its sin τ part within 25 % of its cos τ part (the b = 0 family;
+# a copy shifted by a drive period has b = ±(√3/2)a).  Which root it belongs to: its first
+# harmonic is nearer that root's a(f) than the other root's, their shifted copies (−a/2) and the
+# 1:1 response (0).  Near the existence boundary a(f) is O(ε) off: at f = 7.8, ω = 1.05 the
+# unstable orbit has a₁ = 0.3727 against a(f) = 0.266 (40 %).
 
 
 MAX_AMPLITUDE = 1e100
@@ -406,13 +409,18 @@ def subharmonic(eps: float, force: float, omega: float) -> tuple[bool, str, list
                          f"{size:.3g} (eps a^2 ≈ 4(omega^2 - 1)/3) exceeds {MAX_AMPLITUDE:g}, "
                          "where its cube stops being a normal double")
     out = []
+    roots = {"+": -F / 2 + np.sqrt(disc), "-": -F / 2 - np.sqrt(disc)}
+    marks = [0.0, *roots.values(), *(-r / 2 for r in roots.values())]
     for sign in ("+", "-"):
-        a = -F / 2 + (1 if sign == "+" else -1) * np.sqrt(disc)
+        a = roots[sign]
         lam = hill_multipliers(omega, eps, a, 0.0, F)
         orbit = shoot(eps, force, 3 * omega, 0.0, np.array([a + F, 0.0]), harmonics=5,
                       periods=3)
-        if orbit is not None and abs(orbit.A[1] - a) > ORBIT_MATCH * abs(a):
-            orbit = None  # Newton fell onto another orbit (1:1, or a rotated root): not this one
+        if orbit is not None:
+            a1, b1 = orbit.A[1], orbit.B.get(1, 0.0)
+            nearest = min(marks, key=lambda m: abs(a1 - m))
+            if nearest != a or abs(b1) > ORBIT_MATCH * abs(a1):
+                orbit = None  # Newton fell onto another orbit (1:1, the other root, a copy)
         locked = None
         if orbit is not None:
             q0, p0 = orbit.initial

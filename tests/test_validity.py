@@ -109,3 +109,40 @@ def test_a_softening_spring_over_its_barrier_escapes_and_is_reported_so():
                            "--force", "0.3", "--Q", "20"], capture_output=True, text=True,
                           check=True).stdout
     assert "escapes the well" in text and "jumps" not in text
+
+
+def test_the_unstable_subharmonic_near_its_existence_boundary_is_found():
+    """f = 7.8, ω = 1.05 (ε = 0.1): eq. 10.87's root − has a(f) = 0.266, 40 % from the true
+    orbit's a₁ = 0.3727 — it was reported as "no orbit found". Reference: an even orbit
+    (q̇(0) = q̇(T/2) = 0) found by brentq on DOP853 at rtol 1e-12, a₁ by quadrature, tr M by
+    finite differences of the flow."""
+    from scipy.optimize import brentq
+
+    eps, f, w = 0.1, 7.8, 1.05
+    period = 2 * np.pi / w
+
+    def flow(y0, t_end):
+        sol = solve_ivp(lambda t, y: [y[1], -y[0] - eps * y[0] ** 3 + f * np.cos(3 * w * t)],
+                        (0, t_end), y0, method="DOP853", rtol=1e-12, atol=1e-13,
+                        dense_output=True)
+        return sol
+
+    q0 = brentq(lambda q: flow([q, 0.0], period / 2).y[1, -1], -0.53, -0.49, xtol=1e-13)
+    assert abs(q0 - (-0.50852167)) < 1e-7
+    sol = flow([q0, 0.0], period)
+    t = np.linspace(0, period, 4001)
+    a1 = 2 / period * np.trapezoid(sol.sol(t)[0] * np.cos(w * t), t)
+    h = 1e-6
+    cols = [(flow(np.array([q0, 0.0]) + h * e, period).y[:, -1]
+             - flow(np.array([q0, 0.0]) - h * e, period).y[:, -1]) / (2 * h)
+            for e in np.eye(2)]
+    trace = cols[0][0] + cols[1][1]
+    assert trace > 2  # unstable (a real pair λ, 1/λ)
+    data = json.loads(subprocess.run(
+        [sys.executable, "-m", "lindstedt", "subharmonic", "--eps", "0.1", "--force", "7.8",
+         "--omega", "1.05", "--json"], capture_output=True, text=True, check=True).stdout)
+    minus = next(s for s in data["solutions"] if s["root"] == "-")
+    plus = next(s for s in data["solutions"] if s["root"] == "+")
+    assert minus["numerical"] is not None, "the unstable orbit is missed"
+    assert abs(minus["numerical"]["a1"] - a1) < 1e-6 and minus["numerical"]["stable"] is False
+    assert abs(plus["numerical"]["a1"] - minus["numerical"]["a1"]) > 0.05  # two orbits
