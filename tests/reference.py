@@ -1,7 +1,9 @@
-"""Independent references for the tests: exact series of the elliptic-integral periods.
+"""Independent references for the tests: exact series of the elliptic-integral periods, and
+the driven oscillator's periodic orbit by SciPy.
 
 Nothing here calls the package: the Taylor coefficients come from the hypergeometric series
-``K(m) = π/2 Σ [(1/2)_n / n!]² m^n`` with plain ``fractions.Fraction`` arithmetic.
+``K(m) = π/2 Σ [(1/2)_n / n!]² m^n`` with plain ``fractions.Fraction`` arithmetic, the orbit
+from ``scipy.integrate.solve_ivp``.
 """
 
 from __future__ import annotations
@@ -68,3 +70,40 @@ def reciprocal(series: list[Fraction]) -> list[Fraction]:
     for j in range(1, len(series)):
         out.append(-sum(series[a] * out[j - a] for a in range(1, j + 1)))
     return out
+
+
+def periodic_orbit(eps: float, force: float, omega: float, q0: float,
+                   rtol: float = 1e-12, samples: int = 64) -> tuple:
+    """The periodic orbit of the undamped ``q'' + q + εq³ = f cos ωt`` through ``q(0) ≈ q0``,
+    ``q'(0) ≈ 0``: Newton's method on the period map ``y(0) ↦ y(2π/ω)`` (SciPy's DOP853 at
+    ``rtol``, the Jacobian from the variational equations), then the Fourier coefficients of
+    ``q = Σ A_n cos nωt + B_n sin nωt`` from ``samples`` points of one period (arrays indexed
+    by n).  SciPy and NumPy only."""
+    import numpy as np
+    from scipy.integrate import solve_ivp
+
+    period = 2 * np.pi / omega
+
+    def rhs(t, y):
+        k = -1 - 3 * eps * y[0] ** 2
+        return [y[1], -y[0] - eps * y[0] ** 3 + force * np.cos(omega * t),
+                y[4], y[5], k * y[2], k * y[3]]
+
+    def flow(y0, t_eval=None):
+        return solve_ivp(rhs, (0, period), [*y0, 1.0, 0.0, 0.0, 1.0], method="DOP853",
+                         rtol=rtol, atol=rtol * 1e-3, t_eval=t_eval)
+
+    y0 = np.array([q0, 0.0])
+    for _ in range(30):
+        end = flow(y0).y[:, -1]
+        step = np.linalg.solve(end[2:].reshape(2, 2) - np.eye(2), y0 - end[:2])
+        y0 = y0 + step
+        if np.max(np.abs(step)) < 1e-13 * (1 + np.max(np.abs(y0))):
+            break
+    else:
+        raise RuntimeError(f"no periodic orbit near q0 = {q0}")
+    q = flow(y0, np.arange(samples) * period / samples).y[0]
+    c = np.fft.rfft(q) / samples
+    A, B = 2 * c.real, -2 * c.imag
+    A[0] /= 2  # the mean
+    return A, B

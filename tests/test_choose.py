@@ -166,6 +166,37 @@ def test_choose_emits_just_the_chosen_evaluator(tmp_path):
     del sys.modules["chosen_period"]
 
 
+@pytest.mark.parametrize("method,order,lo,hi,tol", [
+    ("lindstedt", 12, -0.3, 0.3, 1e-8),
+    ("resummed", 20, -0.4, 10.0, 5e-9),
+    ("pade", 6, -0.5, 2.0, 2e-7),
+    ("modified", 12, -0.5, 1000.0, 5e-9),
+    ("agm", 3, -0.5, 1000.0, 1e-15),
+])
+def test_every_method_emits_its_period(tmp_path, method, order, lo, hi, tol):
+    """Each branch of lower_choice, not only the one the timings pick: the emitted module's
+    period(A, eps) against T = 4K(m)/√(1+x) (mpmath) on the verified range, its ends
+    included, and NaN just outside it (and beyond the separatrix)."""
+    from lindstedt.emit import generate_choice, load_generated
+
+    cand = next(c for c in candidates() if (c.method, c.order) == (method, order))
+    generate_choice(cand, "test", tmp_path, (lo, hi))
+    mod = load_generated(tmp_path / "chosen_period.py")
+    try:
+        assert (mod.METHOD, mod.ORDER, tuple(mod.VERIFIED_X)) == (method, order, (lo, hi))
+        x = np.concatenate([[lo, hi], np.random.default_rng(9).uniform(lo, hi, 150)])
+        with mpmath.workdps(30):
+            ref = np.array([float(4 * mpmath.ellipk(mpmath.mpf(v) / (2 * (1 + v)))
+                                  / mpmath.sqrt(1 + mpmath.mpf(v))) for v in x])
+        A_ = np.where(np.arange(x.size) < 2, 1.0, 1.7)  # the ends exactly: A = 1, eps = x
+        assert np.max(np.abs(mod.period(A_, x / A_**2) / ref - 1)) <= tol
+        outside = np.array([np.nextafter(lo, -np.inf), np.nextafter(hi, np.inf), -1.0, -3.0])
+        assert np.isnan(mod.period(1.0, outside)).all()
+        assert np.isnan(mod.period_into(np.empty(4), 1.0, outside)).all()
+    finally:
+        del sys.modules["chosen_period"]
+
+
 def test_integrated_period_reaches_its_tolerance():
     from lindstedt.choose import integrated_period, reference_period
 
@@ -206,16 +237,28 @@ def test_choose_amplitudes_meets_the_tolerance_against_shooting():
 
 
 def test_one_harmonic_closed_form_is_mu_order_zero():
-    """The vectorised cubic and the μ-expansion's order 0 (np.roots) agree on every branch
-    point, damped and undamped, A₁ and B₁ (signs included: antiphase above resonance)."""
+    """The vectorised cubic solves the one-harmonic balance of q̈ + q̇/Q + q + εq³ = f cos ωt
+    for q = A₁ cos ωt + B₁ sin ωt (cos: (1 − ω²)A₁ + ωB₁/Q + ¾εr²A₁ = f, sin: (1 − ω²)B₁ −
+    ωA₁/Q + ¾εr²B₁ = 0, r² = A₁² + B₁²: signs included) on the largest branch (numpy.roots of
+    the cubic in r²), damped and undamped; and it is the μ-expansion's order 0."""
     from lindstedt.choose import one_harmonic_amplitudes
     from lindstedt.driven import Drive, amplitudes, first_order_branches, mu_expansion
 
+    eps, f = 0.1, 0.7
     for Q in (np.inf, 20.0):
+        g = 0.0 if np.isinf(Q) else 1 / Q
         omegas = np.array([0.4, 0.9, 1.0, 1.2, 2.0, 3.0])
-        a1, b1 = one_harmonic_amplitudes(0.1, 0.7, Q, omegas)
+        a1, b1 = one_harmonic_amplitudes(eps, f, Q, omegas)
         for w, a, b in zip(omegas, a1, b1, strict=True):
-            d = Drive(0.1, 0.7, float(w), Q)
+            r2 = a * a + b * b
+            scale = f + abs(a) * (abs(1 - w * w) + w * g + 0.75 * eps * r2)
+            assert abs((1 - w * w) * a + w * g * b + 0.75 * eps * r2 * a - f) < 1e-13 * scale
+            assert abs((1 - w * w) * b - w * g * a + 0.75 * eps * r2 * b) < 1e-13 * scale
+            k = 1 - w * w
+            u = np.roots([9 / 16 * eps**2, 1.5 * eps * k, k * k + (w * g) ** 2, -f * f])
+            largest = max(x.real for x in u if abs(x.imag) < 1e-9 * abs(x) and x.real > 0)
+            assert abs(r2 / largest - 1) < 1e-12, (Q, w, r2, largest)
+            d = Drive(eps, f, float(w), Q)
             A, B = amplitudes(*mu_expansion(d, first_order_branches(d)[0], 0).partial(0), 1)
             assert abs(A[1] - a) < 1e-12 and abs(B[1] - b) < 1e-12
 

@@ -109,7 +109,9 @@ def test_floquet_multipliers_of_linear_damped_oscillator():
 
 
 def test_fold_is_reported_not_summed():
-    """At a fold of the undamped cubic the secular system is singular: say so."""
+    """At a fold of the undamped cubic the secular system is singular: say so (that reason,
+    not any failure), keep the orders found before it, and only there: a little off the fold
+    the same branch converges."""
     eps, f = 0.1, 1.0
     # double root of (ω² − 1)A − ¾εA³ + f: (ω² − 1) = (9/4)εA², f = −(3/2)εA³ → A < 0
     A = -((2 * f) / (3 * eps)) ** (1 / 3)
@@ -118,6 +120,16 @@ def test_fold_is_reported_not_summed():
     br = min(first_order_branches(d), key=lambda b: abs(b.A1 - A))
     mu = mu_expansion(d, br, 4)
     assert not mu.converged
+    where, reason = mu.reason.split(": ", 1)
+    assert reason == "singular secular system (a fold: branches merge)", mu.reason
+    j = int(where.removeprefix("order "))  # 1 or 2: A₁ is a double root only to ~1e-8
+    assert 1 <= j <= 4 and len(mu.coefficients) == j and len(mu.determinants) == j
+    # the secular determinant is D = 1 − 1/ω² − 9εA₁²/(4ω²) up to a factor, and D = 0 here
+    assert abs(1 - 1 / w**2 - 2.25 * eps * A**2 / w**2) < 1e-15
+    assert all(abs(det) < 1e-7 for det in mu.determinants)
+    near = Drive(eps, f, w * (1 + 1e-3))
+    br = min(first_order_branches(near), key=lambda b: abs(b.A1 - A))
+    assert mu_expansion(near, br, 4).converged
 
 
 @pytest.mark.parametrize("kwargs", [dict(eps=float("nan"), force=1, omega=1),

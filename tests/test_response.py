@@ -77,6 +77,9 @@ def test_balance_folds_are_true_folds_with_floquet_multiplier_one():
 
 
 def test_sweep_jumps_near_the_folds():
+    """Up the sweep falls off the upper branch past the upper fold, down it climbs onto it past
+    the lower fold: each jump just beyond that fold, the amplitude on either side on the branch
+    the cubic (numpy.roots) says it is on."""
     lo, hi = one_harmonic_folds(EPS, F, Q)
     cont = continue_balance(EPS, F, Q, 8, 0.6, 1.9)
     up = sweep(EPS, F, 1 / Q, 0.6, 1.9)
@@ -84,8 +87,18 @@ def test_sweep_jumps_near_the_folds():
     resolution = 0.01  # Δω of the jump window at 10⁴ periods, and the slow-passage lag
     assert abs(up.jump - cont.folds[1]) < resolution
     assert abs(down.jump - cont.folds[0]) < resolution
+    # past the fold, never before it: the slow passage lags (by 4.9e-3 up, 2.6e-3 down here)
+    assert up.jump > cont.folds[1] and down.jump < cont.folds[0]
+    # the one-harmonic folds are 4e-3 off the true ones here (O(ε)): within twice the window
+    assert abs(up.jump - hi) < 2 * resolution and abs(down.jump - lo) < 2 * resolution
+    for run, before, after in ((up, max, min), (down, min, max)):
+        i = int(np.argmin(np.abs(run.omega - run.jump)))
+        # 100 samples (Δω ≈ 0.011) before the jump, 150 (Δω ≈ 0.016) after it; max |q| per
+        # period: the third harmonic and the lag put it within 1.5 % of r here
+        for k, pick in ((i - 100, before), (i + 150, after)):
+            r = np.sqrt(pick(cubic_roots(run.omega[k])))
+            assert abs(run.amplitude[k] / r - 1) < 0.05, (run.omega[k], run.amplitude[k], r)
     assert sweep(EPS, 0.05, 1 / Q, 0.6, 1.9).jump is None  # no hysteresis, no jump
-    assert lo < hi
 
 
 def test_response_contract_and_bad_input():
