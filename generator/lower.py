@@ -260,7 +260,7 @@ def cubic_branches(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol) -> tuple[
 
     ``A³ + pA + q = 0`` with ``p = −4(ω² − 1)/(3ε)``, ``q = −4f/(3ε)``: three real roots by the
     trigonometric formula when ``4p³ + 27q² < 0`` (NaN for the missing ones otherwise), else
-    Cardano's single root.
+    Cardano's single root in its stable form.
     """
     p = -4 * (omega**2 - 1) / (3 * eps)
     q = -4 * force / (3 * eps)
@@ -272,7 +272,11 @@ def cubic_branches(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol) -> tuple[
     def cbrt(z: sp.Expr) -> sp.Expr:
         return sp.sign(z) * sp.Abs(z) ** sp.Rational(1, 3)
 
-    cardano = cbrt(-q / 2 + sp.sqrt(delta)) + cbrt(-q / 2 - sp.sqrt(delta))
+    # u from the sum that does not cancel (√Δ taken with −q/2's sign), v = −p/(3u): the
+    # difference −q/2 − √Δ loses every digit near ω = 1, where p → 0 (A₁ was 1e-5 off there)
+    half = -q / 2
+    u = cbrt(half + sp.sign(half) * sp.sqrt(delta))
+    cardano = u - p / (3 * u)
     return (
         sp.Piecewise((trig[0], three), (cardano, True)),
         sp.Piecewise((trig[1], three), (sp.nan, True)),

@@ -313,10 +313,9 @@ def test_driven_module_against_the_true_orbit():
         assert np.isnan(drv.A_1(1.0, 0.0, 1.0, 0))  # ε = 0: not a Duffing oscillator
 
 
-@pytest.mark.xfail(strict=True, reason="the emitted Cardano root cancels near ω = 1: A₁ is off "
-                   "by ~(ulp)^(1/3), 1e-5 at eps 0.01, f 0.1, omega 1 (generated/driven.py)")
 def test_driven_module_at_the_linear_resonance():
-    """ω = 1 (λ = 0.01 of the notes' ε = 0.1, f = 1): order 3 is 1.6e-9 off the true orbit."""
+    """ω = 1 (λ = 0.01 of the notes' ε = 0.1, f = 1): order 3 is 1.6e-9 off the true orbit.
+    (Cardano's root in its naive form cancelled here: A₁ was 1e-5 off, ~(ulp)^(1/3).)"""
     drv = load(GENERATED / "driven.py")
     eps_, f, w = 0.01, 0.1, 1.0
     a = max(r.real for r in np.roots([-0.75 * eps_, 0.0, 0.0, f]) if abs(r.imag) < 1e-9)
