@@ -237,50 +237,70 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def driven_json(d, order: int, harmonics: int) -> dict:
-    """The contract of ``lindstedt driven … --json``: every 1:1 branch, three ways."""
-    import numpy as np
+    """The contract of ``lindstedt driven … --json``: every distinct 1:1 orbit found
+    (:func:`driven.periodic_orbits`), largest first, each three ways where it can be.
 
-    from .driven import amplitudes, first_order_branches, harmonic_balance, mu_expansion
-    from .numerics import shoot
+    A branch carries the first-order root that stands for it (``seed`` says how the orbit was
+    found, ``first_order`` how the root was paired with it); an orbit that no one-harmonic root
+    stands for (found by continuing the balance through a fold the cubic does not have) has
+    ``A1``, ``r``, ``delta0`` null and no μ-expansion, with ``mu_note`` saying why."""
+    from .driven import amplitudes, mu_expansion, periodic_orbits
 
     damped = d.damping > 0
     top = max(2 * harmonics - 1, 2 * order + 1)
+    found = periodic_orbits(d, harmonics, shoot_harmonics=top)
     branches = []
-    for br in first_order_branches(d):
-        mu = mu_expansion(d, br, order)
-        orders = []
-        for j in range(len(mu.coefficients)):
-            c, phase = mu.partial(j)
-            A, B = amplitudes(c, phase, 2 * j + 1)
-            entry = {"order": j, "A": _keyed(A), "delta": phase, "r": _first_harmonic(A, B)}
+    for orb in found.orbits:
+        br, orbit, hb = orb.branch, orb.orbit, orb.balance
+        orders: list[dict] = []
+        if br is not None:
+            mu = mu_expansion(d, br, order)
+            for j in range(len(mu.coefficients)):
+                c, phase = mu.partial(j)
+                A, B = amplitudes(c, phase, 2 * j + 1)
+                entry = {"order": j, "A": _keyed(A), "delta": phase, "r": _first_harmonic(A, B)}
+                if damped:
+                    entry["B"] = _keyed(B)
+                orders.append(entry)
+            mu_converged, mu_note = mu.converged, mu.reason
+        else:
+            mu_converged = False
+            mu_note = ("no one-harmonic root stands for this orbit (found by continuing the "
+                       "harmonic balance through a fold the one-harmonic cubic does not have "
+                       "at this omega): no first-order data, no mu-expansion")
+        if hb is not None:
+            A, B = amplitudes(hb.coefficients, 0.0, 2 * harmonics - 1)
+            hb_json = {"harmonics": harmonics, "A": _keyed(A), "residual": hb.residual,
+                       "converged": hb.converged, "r": _first_harmonic(A, B)}
             if damped:
-                entry["B"] = _keyed(B)
-            orders.append(entry)
-        hb = harmonic_balance(d, br, harmonics)
-        A, B = amplitudes(hb.coefficients, 0.0, 2 * harmonics - 1)
-        hb_json = {"harmonics": harmonics, "A": _keyed(A), "residual": hb.residual,
-                   "converged": hb.converged, "r": _first_harmonic(A, B)}
-        if damped:
-            hb_json["B"] = _keyed(B)
-        guess = np.array([sum(A.values()), d.omega * sum(n * b for n, b in B.items())])
-        orbit = shoot(d.eps, d.force, d.omega, d.damping, guess, harmonics=top)
+                hb_json["B"] = _keyed(B)
+        else:
+            hb_json = {"harmonics": harmonics, "A": {}, "residual": None, "converged": False,
+                       "r": None}
         numerical = None
         if orbit is not None:
             numerical = {"A": _keyed(orbit.A), "floquet_moduli": sorted(
                 float(abs(m)) for m in orbit.multipliers), "stable": orbit.stable,
-                "r": _first_harmonic(orbit.A, orbit.B)}
+                "r": _first_harmonic(orbit.A, orbit.B),
+                "initial": [float(v) for v in orbit.initial]}
             if damped:
                 numerical["B"] = _keyed(orbit.B)
         branches.append({
-            "A1": br.A1, "r": abs(br.A1), "delta0": br.delta0, "mu_expansion": orders,
-            "mu_converged": mu.converged, "mu_note": mu.reason,
+            "A1": None if br is None else br.A1, "r": None if br is None else abs(br.A1),
+            "delta0": None if br is None else br.delta0, "seed": orb.seed,
+            "first_order": orb.paired, "mu_expansion": orders,
+            "mu_converged": mu_converged, "mu_note": mu_note,
             "harmonic_balance": hb_json, "numerical": numerical,
         })
+    roots = [{"A1": br.A1, "r": abs(br.A1), "delta0": br.delta0, "branch": j}
+             for br, j in found.roots]
     return {
         "parameters": {"eps": d.eps, "force": d.force, "omega": d.omega,
                        "Q": None if math.isinf(d.Q) else d.Q, "order": order,
                        "harmonics": harmonics},
         "branches": branches,
+        "one_harmonic_roots": roots,
+        "seeding": {"complete": found.complete, "note": found.note},
     }
 
 
@@ -302,9 +322,14 @@ def driven_table(data: dict) -> str:
     for i, br in enumerate(data["branches"], 1):
         num = br["numerical"]
         verdict = "no orbit found" if num is None else ("stable" if num["stable"] else "unstable")
-        first = (f"r = {br['r']:.6f}, phase delta0 = {br['delta0']:.6f}" if damped
-                 else f"A1 = {br['A1']:.6f}")
-        lines.append(f"\nbranch {i}: first-order {first} ({verdict})")
+        if br["A1"] is None:
+            found = (f"true r = {num['r']:.6f}, " if num is not None else "") + \
+                "found by continuation, no one-harmonic root"
+            lines.append(f"\nbranch {i}: {found} ({verdict})")
+        else:
+            first = (f"r = {br['r']:.6f}, phase delta0 = {br['delta0']:.6f}" if damped
+                     else f"A1 = {br['A1']:.6f}")
+            lines.append(f"\nbranch {i}: first-order {first} ({verdict})")
         lines.append(f"{'':>22} " + " ".join(f"{c:>12}" for c in columns))
         hb = br["harmonic_balance"]
         rows = [(f"mu-expansion order {e['order']}", e) for e in br["mu_expansion"]]
@@ -313,15 +338,29 @@ def driven_table(data: dict) -> str:
             rows.append(("numerical (shooting)", num))
         for label, row in rows:
             if row is hb and not hb["converged"]:
-                lines.append(f"{label:>22} (did not converge: residual {hb['residual']:.1e})")
+                why = "" if hb["residual"] is None else f": residual {hb['residual']:.1e}"
+                lines.append(f"{label:>22} (did not converge{why})")
                 continue
             values = {"r": row["r"], **{f"A{k}": v for k, v in row["A"].items()},
                       **{f"B{k}": v for k, v in row.get("B", {}).items()}}
             cells = " ".join(f"{values[c]:>12.6f}" if c in values else f"{'':>12}"
                              for c in columns)
             lines.append(f"{label:>22} {cells}")
+        if br.get("first_order") == "rank":
+            lines.append("  note: the first-order root of the same rank in amplitude (shooting "
+                         "from it reached another orbit)")
         if not br["mu_converged"]:
             lines.append(f"  warning: {br['mu_note']}")
+    for root in data.get("one_harmonic_roots", []):
+        if root["branch"] is None:
+            first = (f"r = {root['r']:.6f}, phase delta0 = {root['delta0']:.6f}" if damped
+                     else f"A1 = {root['A1']:.6f}")
+            lines.append(f"\nwarning: the one-harmonic root {first} stands for no orbit found "
+                         "(shooting from it reached none, or one a nearer root stands for)")
+    seeding = data.get("seeding")
+    if damped and seeding is not None and not seeding["complete"]:
+        lines.append(f"\nwarning: seeds from the one-harmonic roots only ({seeding['note']}); "
+                     "orbits beyond them may be missing")
     return "\n".join(lines)
 
 
