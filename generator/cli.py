@@ -238,13 +238,14 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 def driven_json(d, order: int, harmonics: int) -> dict:
     """The contract of ``lindstedt driven … --json``: every distinct 1:1 orbit found
-    (:func:`driven.periodic_orbits`), largest first, each three ways where it can be.
+    (:func:`response.periodic_orbits`), largest first, each three ways where it can be.
 
     A branch carries the first-order root that stands for it (``seed`` says how the orbit was
     found, ``first_order`` how the root was paired with it); an orbit that no one-harmonic root
     stands for (found by continuing the balance through a fold the cubic does not have) has
     ``A1``, ``r``, ``delta0`` null and no μ-expansion, with ``mu_note`` saying why."""
-    from .driven import amplitudes, mu_expansion, periodic_orbits
+    from .driven import amplitudes, mu_expansion
+    from .response import periodic_orbits
 
     damped = d.damping > 0
     top = max(2 * harmonics - 1, 2 * order + 1)

@@ -9,15 +9,35 @@ negative, between the folds); the folds solve ``G = ∂G/∂u = 0``.  N harmonic
 from __future__ import annotations
 
 import functools
+import itertools
+import math
 import time
 from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
 
-from .driven import BalanceSystem, Drive, check_harmonics, first_order_branches, trig_product
+from .driven import (
+    MAGNITUDES,
+    BalanceSystem,
+    Branch,
+    Drive,
+    HarmonicBalance,
+    amplitudes,
+    check_harmonics,
+    first_order_branches,
+    harmonic_balance,
+    trig_product,
+)
 from .errors import InputError
-from .numerics import ToneFit, hill_multipliers, shoot, steady_state_amplitudes, steady_state_fit
+from .numerics import (
+    PeriodicOrbit,
+    ToneFit,
+    hill_multipliers,
+    shoot,
+    steady_state_amplitudes,
+    steady_state_fit,
+)
 
 _u, _w, _e, _f, _g = sp.symbols("u w e f g")  # u = r², w = ω², g = 1/Q
 _G = _u * ((1 - _w + sp.Rational(3, 4) * _e * _u) ** 2 + _w * _g**2) - _f**2
@@ -593,3 +613,247 @@ def simulated_fit(eps: float, Q: float, drives: list[tuple[float, float]],
         raise InputError(f"drives {given}: the simulated orbit overflows ({why}); there is no "
                          "steady state to compare the tones with")
     return fit
+
+
+# --- every distinct periodic orbit at one ω: seeds, shooting, deduplication -----------------
+# (here, after the continuation: its crossings with ω are the seeds the one-harmonic cubic lacks)
+
+SAME_ORBIT = 1e-8
+# NOTE: two shot orbits are one when their states (q(0), q̇(0)/ω) differ by at most 1e-8 of the
+# larger state's norm (≈ the orbit's first-harmonic amplitude r).  Shooting converges to ~1e-12
+# (near a fold, with its multiplier near +1, to ~1e-10); two distinct orbits a distance Δω from
+# a fold differ by ~r·√Δω, so only orbits within ~1e-16 of a fold (one orbit, in double
+# precision) are merged.
+SHOOTING_TOLERANCES = (1e-12, 1e-10)
+# NOTE: near a fold a Floquet multiplier nears +1, M − I is nearly singular and amplifies the
+# integrator's ~1e-13 into Newton steps that never fall below 1e-12 (shooting gave up 2e-6 from
+# the fold at ω = 1.49323, ε 0.1, f 0.3, Q 20): each seed is tried again at 1e-10.
+BALANCE_NEAR = 1e-3
+# NOTE: a converged balance is the orbit's own when its (q(0), q̇(0)) lies within 1e-3 (relative,
+# as SAME_ORBIT) of the orbit's (8 harmonics: ~1e-10; the other orbits lie O(1) away, or
+# ~√(distance to the fold) near one); a seed whose balance converged onto another orbit and
+# whose shooting did not follow it is shown with the balance of a seed that did.
+CONTINUATION_HARMONICS = 8
+# NOTE: the continuation that seeds the orbits carries at most 8 harmonics (2 ms a point; its
+# crossings are then polished at the harmonics asked): a seed, not an answer.
+CONTINUATION_BUDGET = 15.0
+# NOTE: seconds the seeding continuation may take (its own estimate, checked before it starts);
+# above, the seeds are the one-harmonic roots only and the result says it may be incomplete.
+
+
+@dataclass(frozen=True)
+class Orbit:
+    """One distinct periodic orbit of period ``2π/ω`` with how it was found.
+
+    ``seed``: ``"one_harmonic"`` when shooting from a one-harmonic root reached it,
+    ``"continuation"`` when only a crossing of the continued harmonic balance did.
+    ``branch``: the one-harmonic root that stands for it at first order (the root whose shooting
+    reached it, the nearest when several did; or, when as many roots as orbits are left over,
+    the one of the same rank in amplitude), ``None`` when no root does.
+    ``balance``: the harmonic balance whose solution led to the orbit.  ``orbit`` is ``None``
+    for a root whose balance converged but whose shooting did not (at the corners of the
+    domain): then the branch is that balance alone (``paired = "balance"``)."""
+
+    orbit: PeriodicOrbit | None  # None: shooting found no orbit (see periodic_orbits)
+    balance: HarmonicBalance | None
+    branch: Branch | None
+    seed: str
+    paired: str | None  # "shot" (its shooting reached it), "rank", "balance", None (no root)
+
+    @property
+    def r(self) -> float:
+        """The first-harmonic amplitude ``√(A₁² + B₁²)`` of the true orbit (of the balance
+        where shooting found none)."""
+        return _amplitude({"orbit": self.orbit, "balance": self.balance})
+
+
+@dataclass(frozen=True)
+class Orbits:
+    """Every distinct orbit found at one drive, largest first, and the one-harmonic roots."""
+
+    orbits: tuple[Orbit, ...]
+    roots: tuple[tuple[Branch, int | None], ...]  # each root, the index of the orbit it stands for
+    complete: bool  # whether the seeds cover the whole response curve (balance_crossings)
+    note: str  # how the seeds were found
+
+
+def _guess(hb: HarmonicBalance, omega: float) -> np.ndarray:
+    """``(q(0), q̇(0)) = (Σ A_n, ω Σ n B_n)`` of a balance solution."""
+    A, B = amplitudes(hb.coefficients, 0.0, 2 * hb.harmonics - 1)
+    return np.array([sum(A.values()), omega * sum(n * b for n, b in B.items())])
+
+
+def _state_distance(a: np.ndarray, b: np.ndarray, omega: float) -> float:
+    """``|Δ(q, q̇/ω)|`` relative to the larger of the two states' norms (see SAME_ORBIT)."""
+    u, v = np.array([a[0], a[1] / omega]), np.array([b[0], b[1] / omega])
+    size = max(float(np.linalg.norm(u)), float(np.linalg.norm(v)))
+    return float(np.linalg.norm(u - v)) / size if size > 0 else 0.0
+
+
+def _first_harmonic_gap(br: Branch, found: dict) -> float:
+    """Distance of a root's ``(A₁ cos δ₀, A₁ sin δ₀)`` from an orbit's ``(A₁, B₁)`` (its
+    balance's, where shooting found none)."""
+    if found["orbit"] is None:
+        A, B = amplitudes(found["balance"].coefficients, 0.0, 1)
+    else:
+        A, B = found["orbit"].A, found["orbit"].B
+    return math.hypot(br.A1 * math.cos(br.delta0) - A[1], br.A1 * math.sin(br.delta0) - B[1])
+
+
+def _amplitude(found: dict) -> float:
+    """r of a found orbit, or of its balance when shooting found none."""
+    if found["orbit"] is None:
+        A, B = amplitudes(found["balance"].coefficients, 0.0, 1)
+        return math.hypot(A[1], B[1])
+    return math.hypot(found["orbit"].A[1], found["orbit"].B[1])
+
+
+def _balance(d: Drive, start: Branch | np.ndarray, harmonics: int) -> HarmonicBalance | None:
+    try:
+        return harmonic_balance(d, start, harmonics)
+    except np.linalg.LinAlgError:
+        return None
+
+
+@functools.lru_cache(maxsize=16)
+def _traced(eps: float, force: float, Q: float, harmonics: int, lo: float,
+            hi: float) -> tuple[object, str]:
+    """The continued balance on ``[lo, hi]`` (cached: one curve serves every ω on it), or
+    ``None`` and the reason it was refused."""
+    try:
+        return continue_balance(eps, force, Q, harmonics, lo, hi,
+                                max_seconds=CONTINUATION_BUDGET), ""
+    except InputError as exc:
+        return None, str(exc)
+
+
+def balance_crossings(d: Drive, harmonics: int = CONTINUATION_HARMONICS
+                      ) -> tuple[list[np.ndarray], str, bool]:
+    """Every point of the continued harmonic-balance curve at ``d.omega`` (damped only), as
+    balance vectors ``x`` with ``harmonics`` harmonics, interpolated between continuation
+    points (linearly; quadratically around each turn of ω, where both crossings near a fold
+    may lie between two points): seeds, not solutions.  With how they were found, and whether
+    they are complete: the curve traced across the whole range, or none needed (linear, one
+    orbit; ω above the range, where ``response`` has one branch too).  ``False``: undamped
+    (no continuation), refused, or the curve left the range where it began."""
+    if d.damping == 0:
+        return [], "undamped: no continuation (the response curve needs damping)", False
+    if d.eps == 0:  # linear: one orbit, the root's (and the curve, up to r = fQ, is long)
+        return [], "linear (eps 0): one orbit, no continuation needed", True
+    lo, hi = response_range(d.eps, d.force, d.Q)
+    if d.omega > hi:
+        return [], (f"omega above the response curve's range (up to {hi:.6g}, 1.25 x its "
+                    "highest one-harmonic fold): no continuation"), True
+    lo = min(lo, max(0.98 * d.omega, MAGNITUDES[0]))
+    cont, why = _traced(d.eps, d.force, d.Q, harmonics, lo, hi)
+    if cont is None:
+        return [], f"continuation refused ({why})", False
+    w, x = cont.omega - d.omega, cont.x
+    seeds = []
+    for i in range(len(w) - 1):
+        if w[i] * w[i + 1] <= 0 and w[i] != w[i + 1]:
+            t = w[i] / (w[i] - w[i + 1])
+            seeds.append(x[i] + t * (x[i + 1] - x[i]))
+    for i in range(1, len(w) - 1):
+        if (w[i] - w[i - 1]) * (w[i + 1] - w[i]) >= 0:
+            continue
+        # w(s) = w_i + b s + c s² through s = −1, 0, 1 (equal arclength steps), w(s) = 0
+        b, c = (w[i + 1] - w[i - 1]) / 2, (w[i + 1] - 2 * w[i] + w[i - 1]) / 2
+        disc = b * b - 4 * c * w[i]
+        if c == 0 or disc < 0:
+            continue
+        for s in ((-b - math.sqrt(disc)) / (2 * c), (-b + math.sqrt(disc)) / (2 * c)):
+            if abs(s) <= 1:
+                seeds.append(x[i] + s * (x[i + 1] - x[i - 1]) / 2
+                             + s * s * (x[i + 1] - 2 * x[i] + x[i - 1]) / 2)
+    note = f"continued harmonic balance (N = {harmonics}) on [{lo:.6g}, {hi:.6g}]"
+    if not cont.omega[-1] > hi:  # it turned back and left below lo: part of the curve only
+        return seeds, (f"{note}: the curve left the range at omega {cont.omega[-1]:.6g} "
+                       "without crossing it"), False
+    return seeds, note, True
+
+
+def periodic_orbits(d: Drive, harmonics: int = 8, shoot_harmonics: int = 9) -> Orbits:
+    """Every distinct periodic orbit of period ``2π/ω`` that the seeds reach, largest ``r``
+    first, each once, with its Floquet multipliers (:func:`numerics.shoot`).
+
+    Seeds: every real root of the one-harmonic equation (through its harmonic balance with
+    ``harmonics`` harmonics, or the root itself where that balance does not converge) and,
+    damped, every crossing of the continued harmonic-balance curve with this ω
+    (:func:`balance_crossings`, polished at ``harmonics``): the true folds are not the
+    one-harmonic ones, so near a fold the cubic has too few roots or too many.  Orbits are
+    one when their states differ by at most SAME_ORBIT.  Undamped there is no continuation:
+    the one-harmonic seeds only, deduplicated."""
+    check_harmonics(harmonics)
+    roots = first_order_branches(d)
+    seeds: list[tuple[int | None, list[np.ndarray], HarmonicBalance | None]] = []
+    for k, br in enumerate(roots):
+        hb = _balance(d, br, harmonics)
+        first = br.A1 * np.array([math.cos(br.delta0), d.omega * math.sin(br.delta0)])
+        guesses = [_guess(hb, d.omega), first] if hb is not None and hb.converged else [first]
+        seeds.append((k, guesses, hb))
+    crossings, note, complete = balance_crossings(d, min(harmonics, CONTINUATION_HARMONICS))
+    for x in crossings:
+        hb = _balance(d, x, harmonics)
+        h = len(x) // 2
+        raw = np.array([x[:h].sum(), d.omega * np.sum(np.arange(1, 2 * h, 2) * x[h:])])
+        seeds.append((None, [_guess(hb, d.omega), raw] if hb is not None and hb.converged
+                      else [raw], hb))
+    found: list[dict] = []  # orbit, balance, whether that balance is the orbit's, seed
+    reached: dict[int, int] = {}  # root index -> orbit index
+    for k, guesses, hb in seeds:
+        orbit = None
+        for tol, guess in itertools.product(SHOOTING_TOLERANCES, guesses):
+            orbit = shoot(d.eps, d.force, d.omega, d.damping, guess,
+                          harmonics=shoot_harmonics, tol=tol)
+            if orbit is not None:
+                break
+        if orbit is None:
+            continue
+        j = next((j for j, f in enumerate(found) if _state_distance(
+            f["orbit"].initial, orbit.initial, d.omega) <= SAME_ORBIT), None)
+        # the balance shown beside the orbit: one that converged onto it, if any seed's did
+        own = hb is not None and hb.converged and _state_distance(
+            _guess(hb, d.omega), orbit.initial, d.omega) <= BALANCE_NEAR
+        if j is None:
+            j = len(found)
+            found.append({"orbit": orbit, "balance": hb, "own": own,
+                          "seed": "one_harmonic" if k is not None else "continuation"})
+        elif own and not found[j]["own"]:
+            found[j].update(balance=hb, own=True)
+        if k is not None:
+            reached[k] = j
+    # a root whose shooting failed but whose balance converged elsewhere than every orbit found
+    # (the corners of the domain, where RK4 cannot follow the scales): its balance, no orbit
+    for k, _, hb in seeds:
+        if k is None or k in reached or hb is None or not hb.converged:
+            continue
+        state = _guess(hb, d.omega)
+        if all(_state_distance(state, f["orbit"].initial if f["orbit"] is not None
+                               else _guess(f["balance"], d.omega), d.omega)
+               > (BALANCE_NEAR if f["orbit"] is not None else SAME_ORBIT) for f in found):
+            reached[k] = len(found)
+            found.append({"orbit": None, "balance": hb, "own": True, "seed": "one_harmonic"})
+    rank = sorted(range(len(found)), key=lambda j: -_amplitude(found[j]))
+    found = [found[j] for j in rank]
+    new_index = {old: new for new, old in enumerate(rank)}
+    # the first-order root standing for each orbit: the nearest root whose shooting reached it
+    owner: dict[int, int] = {}  # orbit index -> root index
+    for k, old in reached.items():
+        j = new_index[old]
+        if j not in owner or _first_harmonic_gap(roots[k], found[j]) \
+                < _first_harmonic_gap(roots[owner[j]], found[j]):
+            owner[j] = k
+    # ... then, when as many roots as orbits are left over, the leftovers by rank in amplitude
+    free_roots = [k for k in range(len(roots)) if k not in owner.values()]
+    free_orbits = [j for j in range(len(found)) if j not in owner]
+    paired = {j: "shot" if found[j]["orbit"] is not None else "balance" for j in owner}
+    if len(free_roots) == len(free_orbits):
+        owner.update(zip(free_orbits, sorted(free_roots, key=lambda k: -abs(roots[k].A1)),
+                         strict=True))
+        paired.update(dict.fromkeys(free_orbits, "rank"))
+    stands = {k: j for j, k in owner.items()}
+    orbits = tuple(Orbit(f["orbit"], f["balance"], roots[owner[j]] if j in owner else None,
+                         f["seed"], paired.get(j)) for j, f in enumerate(found))
+    return Orbits(orbits, tuple((br, stands.get(k)) for k, br in enumerate(roots)),
+                  complete, note)

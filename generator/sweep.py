@@ -60,7 +60,7 @@ if TYPE_CHECKING:
 from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
 from .errors import InputError
 from .numerics import shoot
-from .response import amplitude_slope, subharmonic
+from .response import SAME_ORBIT, amplitude_slope, subharmonic
 
 # --- what one point computes -------------------------------------------------------------------
 
@@ -72,9 +72,6 @@ RESPONSE_HARMONICS = 10
 GUESS_HARMONICS = 10
 # NOTE: shooting starts from the balance solution; from 10 harmonics Newton needs one flow
 # fewer than from 5 and the stability map is fastest (14.5 against 16.6 ms a point, measured).
-SAME_ORBIT = 1e-8
-# NOTE: shooting converges to 1e-12; two branches that shoot onto one orbit agree to far below
-# 1e-8, distinct orbits differ by O(amplitude).
 MU_ORDERS = (1, 2, 4, 6, 10)
 BALANCE_HARMONICS = (2, 4)
 JUDGE_HARMONICS = 10
