@@ -768,8 +768,8 @@ def choose_driven(quantity: str, tol: float, eps: float, force: float, Q: float,
     reachable = np.inf
     for t in driven_tradeoffs(truth, eps, force, Q):
         err = float(np.max(t.errors[quantity]))  # NaN anywhere: refused somewhere
-        if np.isnan(err) or t.method in best:
-            continue
+        if np.isnan(err) or (t.method in best and best[t.method][0].order <= t.order):
+            continue  # each method at its smallest sufficient order, whatever the list's order
         if emit is not None and not (  # only what has an emitted module competes
                 (t.method == "harmonic_balance" and t.order <= emit[1])
                 or (t.method == "mu_expansion" and np.isinf(Q) and t.order <= emit[0])):

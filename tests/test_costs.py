@@ -83,10 +83,12 @@ def test_choose_driven_decides_by_the_model_not_the_timings(monkeypatch):
     real = choose.driven_tradeoffs
 
     def reversed_timings(*args):
-        out = real(*args)
+        out = real(*args)  # the same records in the same order, the costs' ranks reversed
         ns = sorted((t.ns_per_point for t in out), reverse=True)
-        order = np.argsort([t.ns_per_point for t in out])
-        return [dataclasses.replace(out[i], ns_per_point=ns[k]) for k, i in enumerate(order)]
+        flipped = list(out)
+        for k, i in enumerate(np.argsort([t.ns_per_point for t in out])):
+            flipped[i] = dataclasses.replace(out[i], ns_per_point=ns[k])
+        return flipped
 
     monkeypatch.setattr(choose, "driven_tradeoffs", reversed_timings)
     flipped = choose.choose_driven("amplitudes", 1e-6, 0.1, 0.3, 20.0, 1.3)
