@@ -105,7 +105,9 @@ def response_figure(eps: float, force: float, Q: float, harmonics: int, path: Pa
         ax.plot(omega, np.where(~curve.stable[:, k], r, np.nan), "C0--", lw=1.5,
                 label="one harmonic, unstable" if k == 1 else None)
     amp = np.hypot(cont.x[:, 0], cont.x[:, harmonics])
-    ax.plot(cont.omega, amp, "k-", lw=0.7, label=f"harmonic balance N = {harmonics}")
+    for k, piece in enumerate(cont.piece_slices()):  # a softening spring's curve: two pieces
+        ax.plot(cont.omega[piece], amp[piece], "k-", lw=0.7,
+                label=f"harmonic balance N = {harmonics}" if k == 0 else None)
     ax.plot(up.omega, up.amplitude, "C3.", ms=1.5, label="sweep up (max |q|)")
     ax.plot(down.omega, down.amplitude, "C2.", ms=1.5, label="sweep down (max |q|)")
     for w in cont.folds:

@@ -292,9 +292,11 @@ def driven_json(d, order: int, harmonics: int) -> dict:
             "first_order": orb.paired, "mu_expansion": orders,
             "mu_converged": mu_converged, "mu_note": mu_note,
             "harmonic_balance": hb_json, "numerical": numerical,
+            **_shooting_json(orb.failure),
         })
-    roots = [{"A1": br.A1, "r": abs(br.A1), "delta0": br.delta0, "branch": j}
-             for br, j in found.roots]
+    failures = found.failures or (None,) * len(found.roots)
+    roots = [{"A1": br.A1, "r": abs(br.A1), "delta0": br.delta0, "branch": j,
+              **_shooting_json(why)} for (br, j), why in zip(found.roots, failures, strict=True)]
     return {
         "parameters": {"eps": d.eps, "force": d.force, "omega": d.omega,
                        "Q": None if math.isinf(d.Q) else d.Q, "order": order,
@@ -303,6 +305,13 @@ def driven_json(d, order: int, harmonics: int) -> dict:
         "one_harmonic_roots": roots,
         "seeding": {"complete": found.complete, "note": found.note},
     }
+
+
+def _shooting_json(failure) -> dict:
+    """Why shooting found no orbit (``None`` where it found one); ``escapes``: the trajectory
+    from the seed left the well (a softening spring: it runs off to infinity)."""
+    return {"escapes": bool(failure is not None and failure.escaped),
+            "shooting_note": None if failure is None else failure.reason}
 
 
 def _keyed(values: dict) -> dict:
@@ -322,7 +331,8 @@ def driven_table(data: dict) -> str:
     columns = ("r", "A1", "B1", "A3", "A5") if damped else ("A1", "A3", "A5")
     for i, br in enumerate(data["branches"], 1):
         num = br["numerical"]
-        verdict = "no orbit found" if num is None else ("stable" if num["stable"] else "unstable")
+        verdict = (("escapes the well" if br.get("escapes") else "no orbit found") if num is None
+                   else "stable" if num["stable"] else "unstable")
         if br["A1"] is None:
             found = (f"true r = {num['r']:.6f}, " if num is not None else "") + \
                 "found by continuation, no one-harmonic root"
@@ -352,12 +362,19 @@ def driven_table(data: dict) -> str:
                          "from it reached another orbit)")
         if not br["mu_converged"]:
             lines.append(f"  warning: {br['mu_note']}")
+        if num is None and br.get("shooting_note"):
+            lines.append(f"  shooting: {br['shooting_note']}")
     for root in data.get("one_harmonic_roots", []):
         if root["branch"] is None:
             first = (f"r = {root['r']:.6f}, phase delta0 = {root['delta0']:.6f}" if damped
                      else f"A1 = {root['A1']:.6f}")
-            lines.append(f"\nwarning: the one-harmonic root {first} stands for no orbit found "
-                         "(shooting from it reached none, or one a nearer root stands for)")
+            if root.get("escapes"):
+                lines.append(f"\nwarning: the one-harmonic root {first} stands for no orbit: "
+                             f"{root['shooting_note']}")
+            else:
+                lines.append(f"\nwarning: the one-harmonic root {first} stands for no orbit "
+                             "found (shooting from it reached none, or one a nearer root "
+                             "stands for)")
     seeding = data.get("seeding")
     if damped and seeding is not None and not seeding["complete"]:
         lines.append(f"\nwarning: seeds from the one-harmonic roots only ({seeding['note']}); "

@@ -62,15 +62,19 @@ def _rhs(t: float, y: np.ndarray, eps: float, force: float, omega: float, dampin
 
 @njit(cache=True)
 def _rk4(y0: np.ndarray, t0: float, t1: float, steps: int, eps: float, force: float,
-         omega: float, damping: float, samples: int) -> tuple[np.ndarray, np.ndarray]:
-    """Classical RK4 with ``steps`` steps; returns the end state and ``samples`` equispaced
-    values of q on [t0, t1) (``steps`` must be a multiple of ``samples``)."""
+         omega: float, damping: float, samples: int,
+         bound: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """Classical RK4 with ``steps`` steps; returns the end state, ``samples`` equispaced
+    values of q on [t0, t1) (``steps`` must be a multiple of ``samples``) and the time the
+    trajectory escaped (−1 if it did not): ``|q| > bound`` moving outward (``q q̇ ≥ 0``), where
+    it stops, the state and the samples not reached NaN."""
     h = (t1 - t0) / steps
     y = y0.copy()
     k1, k2, k3, k4 = np.empty(6), np.empty(6), np.empty(6), np.empty(6)
     tmp = np.empty(6)
     qs = np.empty(samples)
     every = steps // samples
+    escaped = -1.0
     for i in range(steps):
         if i % every == 0:
             qs[i // every] = y[0]
@@ -83,7 +87,13 @@ def _rk4(y0: np.ndarray, t0: float, t1: float, steps: int, eps: float, force: fl
         tmp[:] = y + h * k3
         _rhs(t + h, tmp, eps, force, omega, damping, k4)
         y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-    return y, qs
+        if abs(y[0]) > bound and y[0] * y[1] >= 0.0:
+            escaped = t + h
+            for j in range(i // every + 1, samples):
+                qs[j] = np.nan
+            y[:] = np.nan
+            break
+    return y, qs, escaped
 
 
 STEPS_PER_PERIOD = 4096
@@ -91,19 +101,53 @@ STEPS_PER_PERIOD = 4096
 # the remaining O(h⁶) is ~1e-13 for the amplitudes of the notes' table.
 
 
+def escape_bound(eps: float, force: float) -> float:
+    """The largest ``|q|`` any periodic orbit reaches, and past which nothing returns: ``inf``
+    for ``ε ≥ 0``; for a softening spring the positive root of ``|ε|x³ − x − |f| = 0`` (just
+    beyond the barrier ``1/√−ε``).
+
+    At the largest ``|q|`` of an orbit ``q̇ = 0`` and ``q q̈ ≤ 0``: ``q² (|ε|q² − 1) ≤ |f q|``.
+    Past the root, ``q q̈ > 0`` wherever ``q̇ = 0``, so a trajectory there moving outward
+    (``q q̇ ≥ 0``) never turns back: ``|q|`` grows without bound (it escapes the well)."""
+    if not eps < 0:
+        return math.inf
+    k, f = -float(eps), abs(float(force))
+    x = max(math.sqrt(2 / k), (2 * f / k) ** (1 / 3))  # right of the root: g(x) ≥ 0
+    for _ in range(100):  # Newton on the convex g from the right: monotone
+        step = (k * x**3 - x - f) / (3 * k * x * x - 1)
+        x -= step
+        if step <= 1e-15 * x:
+            break
+    return x
+
+
+def flow_escape(y0: np.ndarray, period: float, eps: float, force: float, omega: float,
+                damping: float, samples: int = 64, steps: int | None = None,
+                bound: float = math.inf) -> tuple[np.ndarray, np.ndarray, float]:
+    """:func:`flow` and the time the trajectory escaped past ``bound`` (−1 if it did not; the
+    state and the samples from there are NaN)."""
+    state = np.concatenate([y0, [1.0, 0.0, 0.0, 1.0]])
+    bound = float(bound)
+    if steps is not None:
+        return _rk4(state, 0.0, period, steps, eps, force, omega, damping, samples, bound)
+    coarse, qc, tc = _rk4(state, 0.0, period, STEPS_PER_PERIOD, eps, force, omega, damping,
+                          samples, bound)
+    fine, qf, tf = _rk4(state, 0.0, period, 2 * STEPS_PER_PERIOD, eps, force, omega, damping,
+                        samples, bound)
+    escaped = min((t for t in (tc, tf) if t >= 0), default=-1.0)
+    return fine + (fine - coarse) / 15, qf + (qf - qc) / 15, escaped
+
+
 def flow(y0: np.ndarray, period: float, eps: float, force: float, omega: float,
          damping: float, samples: int = 64,
          steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """State after one period (with monodromy columns) and q sampled over it, Richardson-
     extrapolated from two RK4 step sizes; or plain RK4 with ``steps`` steps (a multiple of
-    ``samples``) when given."""
-    state = np.concatenate([y0, [1.0, 0.0, 0.0, 1.0]])
-    if steps is not None:
-        return _rk4(state, 0.0, period, steps, eps, force, omega, damping, samples)
-    coarse, qc = _rk4(state, 0.0, period, STEPS_PER_PERIOD, eps, force, omega, damping, samples)
-    fine, qf = _rk4(state, 0.0, period, 2 * STEPS_PER_PERIOD, eps, force, omega, damping,
-                    samples)
-    return fine + (fine - coarse) / 15, qf + (qf - qc) / 15
+    ``samples``) when given.  NaN where the trajectory escaped the well
+    (:func:`escape_bound`)."""
+    end, qs, _ = flow_escape(y0, period, eps, force, omega, damping, samples, steps,
+                             escape_bound(eps, force))
+    return end, qs
 
 
 @dataclass(frozen=True)
@@ -146,9 +190,30 @@ def _samples(harmonics: int, steps: int) -> int:
     return samples
 
 
+@dataclass(frozen=True)
+class ShootingFailure:
+    """Why shooting found no orbit.  ``escaped``: the trajectory from the guess itself left the
+    well (:func:`escape_bound`): a state there runs off to infinity, no orbit passes through
+    it; an orbit near it, if any, is too unstable for single shooting to reach."""
+
+    reason: str
+    escaped: bool
+    bound: float  # the escape bound |q| of these parameters (inf: no well to leave)
+
+
 def shoot(eps: float, force: float, omega: float, damping: float, guess: np.ndarray,
           harmonics: int = 9, tol: float = 1e-12, max_iter: int = 30,
           periods: int = 1, steps: int | None = None) -> PeriodicOrbit | None:
+    """The orbit of :func:`shoot_explained`, or ``None`` where it found none."""
+    found = shoot_explained(eps, force, omega, damping, guess, harmonics, tol, max_iter,
+                            periods, steps)
+    return found if isinstance(found, PeriodicOrbit) else None
+
+
+def shoot_explained(eps: float, force: float, omega: float, damping: float, guess: np.ndarray,
+                    harmonics: int = 9, tol: float = 1e-12, max_iter: int = 30,
+                    periods: int = 1, steps: int | None = None
+                    ) -> PeriodicOrbit | ShootingFailure:
     """Newton's method on ``φ_T(y₀) − y₀ = 0`` (the monodromy matrix is its Jacobian + I).
 
     Stability from the Floquet multipliers: damped, stable when all ``|λ| < 1``; undamped
@@ -156,30 +221,54 @@ def shoot(eps: float, force: float, omega: float, damping: float, guess: np.ndar
     i.e. ``|tr M| < 2`` (a real pair ``λ, 1/λ`` with ``|tr M| > 2`` is unstable).
     ``periods = p`` looks for an orbit of p drive periods; its ``A``, ``B`` are then the
     coefficients of ``cos(nωt/p)``, ``sin(nωt/p)``.  ``steps``: plain RK4 with that many
-    steps per orbit instead of the Richardson pair (cheaper, less accurate).  Returns ``None``
-    when Newton's method does not converge.
+    steps per orbit instead of the Richardson pair (cheaper, less accurate).  Where Newton's
+    method finds no orbit, a :class:`ShootingFailure` says why: a trajectory that escapes the
+    well (a softening spring: ``|q|`` past :func:`escape_bound` moving outward, from the guess
+    or from a Newton iterate), RK4 overflowing, a singular ``M − I``, or no convergence.
     """
     T = periods * 2 * np.pi / omega  # periods = 3: the 1/3 subharmonic (eq. 10.83)
     samples = _samples(harmonics, STEPS_PER_PERIOD if steps is None else steps)
+    bound = escape_bound(eps, force)
     y = np.array(guess, dtype=float)
-    for _ in range(max_iter):
-        end, _ = flow(y, T, eps, force, omega, damping, steps=steps)
-        if not np.all(np.isfinite(end)):  # RK4 overflowed: the orbit escapes, or h is too big
-            return None
+
+    def escape(k: int | None, y: np.ndarray, at: float) -> ShootingFailure:
+        where = ("the trajectory from the guess" if k == 0 else "the converged trajectory"
+                 if k is None else f"the trajectory from Newton's iterate {k}")
+        return ShootingFailure(
+            f"{where} (q, q') = ({y[0]:.6g}, {y[1]:.6g}) escapes the well at t = {at:.4g} "
+            f"(of a period {T:.4g}): |q| passes {bound:.6g} moving outward, past which no "
+            "trajectory returns and no periodic orbit reaches", k == 0, bound)
+
+    step = np.full(2, np.nan)
+    for k in range(max_iter):
+        end, _, at = flow_escape(y, T, eps, force, omega, damping, steps=steps, bound=bound)
+        if at >= 0:
+            return escape(k, y, at)
+        if not np.all(np.isfinite(end)):  # RK4 overflowed: h is too big for the amplitude
+            return ShootingFailure(
+                f"RK4 overflowed from (q, q') = ({y[0]:.6g}, {y[1]:.6g})"
+                + (f" (Newton's iterate {k})" if k else "") + ": its step is too large for "
+                "this amplitude", False, bound)
         Mono = end[2:].reshape(2, 2).T
         r = end[:2] - y
         try:
             step = np.linalg.solve(Mono - np.eye(2), -r)
         except np.linalg.LinAlgError:
-            return None
+            return ShootingFailure(f"M - I is singular at Newton's iterate {k} (a Floquet "
+                                   "multiplier +1: a fold)", False, bound)
         y = y + step
         if np.max(np.abs(step)) < tol * (1 + np.max(np.abs(y))):
             break
     else:
-        return None
-    end, qs = flow(y, T, eps, force, omega, damping, samples=samples, steps=steps)
+        return ShootingFailure(f"Newton's method did not converge in {max_iter} iterations "
+                               f"(last step {np.max(np.abs(step)):.1e}, tolerance {tol:g})",
+                               False, bound)
+    end, qs, at = flow_escape(y, T, eps, force, omega, damping, samples=samples, steps=steps,
+                              bound=bound)
+    if at >= 0:
+        return escape(None, y, at)
     if not (np.all(np.isfinite(end)) and np.all(np.isfinite(qs))):
-        return None
+        return ShootingFailure("RK4 overflowed on the converged orbit", False, bound)
     Mono = end[2:].reshape(2, 2).T
     lam = np.linalg.eigvals(Mono)
     stable = bool(np.all(np.abs(lam) < 1) if damping > 0 else abs(np.trace(Mono)) < 2)

@@ -32,9 +32,11 @@ from .driven import (
 from .errors import InputError
 from .numerics import (
     PeriodicOrbit,
+    ShootingFailure,
     ToneFit,
     hill_multipliers,
     shoot,
+    shoot_explained,
     steady_state_amplitudes,
     steady_state_fit,
 )
@@ -165,11 +167,20 @@ def one_harmonic_folds(eps: float, force: float, Q: float) -> list[float]:
 
 @dataclass(frozen=True)
 class Continuation:
-    """A branch of N-harmonic balance traced in ω by pseudo-arclength."""
+    """The N-harmonic balance traced in ω by pseudo-arclength: one or more pieces, each a
+    curve from one end of the range to an end (``pieces``: the index of each piece's first
+    point; consecutive points of different pieces are not neighbours on the curve)."""
 
     omega: np.ndarray
     x: np.ndarray  # (points, 2N): a_1, a_3, …, b_1, b_3, …
     folds: list[float]  # where dω/ds changes sign, refined
+    pieces: tuple[int, ...] = (0,)
+    complete: bool = True  # every one-harmonic root at both ends lies on a traced piece
+
+    def piece_slices(self) -> list[slice]:
+        """The points of each piece."""
+        ends = [*self.pieces[1:], len(self.omega)]
+        return [slice(a, b) for a, b in zip(self.pieces, ends, strict=True)]
 
 
 MAX_POINTS = 20000
@@ -233,8 +244,13 @@ def response_range(eps: float, force: float, Q: float) -> tuple[float, float]:
 def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_start: float,
                      omega_stop: float, step: float = 0.02, max_points: int = MAX_POINTS,
                      max_seconds: float = CONTINUATION_SECONDS) -> Continuation:
-    """Trace the harmonic-balance solution from ``omega_start`` (largest one-harmonic branch)
-    until ω leaves ``[min, max]`` of the two ends, through any number of folds.
+    """Trace the harmonic-balance curve on ``[lo, hi]`` (the two ends) through any number of
+    folds: first from the smallest one-harmonic root at ``omega_start`` (the in-well branch
+    of a softening spring, the only one below the resonance of a hardening one), until ω leaves
+    the range; then from every root at either end that no traced piece has reached, each until
+    it leaves the range.  A softening spring's curve is two pieces: the small-amplitude branch
+    up to its fold and back down the middle branch, and the resonant branch, which leaves the
+    range at its low end over the barrier.
 
     Refuses (:class:`InputError`) a curve too long to trace: its length in (a, b, ω) is about
     ``(hi − lo) + π r_max`` (up the resonant branch to its peak r_max and back down while the
@@ -257,51 +273,99 @@ def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_s
         raise InputError(f"harmonics {harmonics}: about {seconds:.0f} s of continuation "
                          f"({estimate:.0f} points × {1e3 * point_seconds(harmonics):.0f} ms) for "
                          f"{where}; the limit is {max_seconds:.0f} s, ask for fewer")
-    branches = first_order_branches(d)
-    if not branches:
+    if not first_order_branches(d):
         raise InputError(f"{where}: no one-harmonic branch at ω = {omega_start:g} to start from")
-    br = branches[0]
     limit = min(max_points, int(2 * max(seconds, CONTINUATION_SECONDS) / point_seconds(harmonics)))
+    allowed = 2 * max(seconds, CONTINUATION_SECONDS)
+    deadline = time.monotonic() + allowed
+    points: list[np.ndarray] = []
+    starts: list[int] = []
+    folds: list[float] = []
     y = None
     try:
         with np.errstate(over="ignore", invalid="ignore"):
-            x = np.zeros(2 * harmonics)
-            x[0], x[harmonics] = br.A1 * np.cos(br.delta0), br.A1 * np.sin(br.delta0)
-            x = _newton_fixed_omega(sysm, x, omega_start)
-            y = np.append(x, omega_start)
-            direction = 1.0 if omega_stop > omega_start else -1.0
-            t = _tangent(sysm, y, None)
-            if t[-1] * direction < 0:
-                t = -t
-            points, folds = [y], []
-            allowed = 2 * max(seconds, CONTINUATION_SECONDS)
-            deadline = time.monotonic() + allowed
-            for _ in range(limit):
-                if time.monotonic() > deadline:
-                    raise InputError(f"{where}: the continuation gave up after "
-                                     f"{allowed:.0f} s at ω = {y[-1]:.6g}, "
-                                     f"{len(points)} points in (its estimate: {estimate:.0f}): "
-                                     "the corrector does not converge there")
-                y_new = _corrector(sysm, y + step * t, t)
-                t_new = _tangent(sysm, y_new, t)
-                if not (np.all(np.isfinite(y_new)) and np.all(np.isfinite(t_new))):
-                    raise np.linalg.LinAlgError("the balance overflowed")
-                if t_new[-1] * t[-1] < 0:
-                    folds.append(_refine_fold(sysm, y, t, step))
-                y, t = y_new, t_new
+            ends, complete = _end_solutions(sysm, d, omega_start, omega_stop)
+            visited = [False] * len(ends)
+            while not all(visited):
+                k = visited.index(False)
+                visited[k] = True
+                omega0, x0, direction = ends[k]
+                y = np.append(x0, omega0)
+                t = _tangent(sysm, y, None)
+                if t[-1] * direction < 0:
+                    t = -t
+                starts.append(len(points))
                 points.append(y)
-                if not lo <= y[-1] <= hi:
-                    break
-            else:
-                raise InputError(f"{where}: the continuation did not leave ω in [{lo:.3g}, "
-                                 f"{hi:.3g}] within {limit} steps of {step:g} (the estimate was "
-                                 f"{estimate:.0f}); the curve is longer than it looks")
+                y_old = None
+                while y_old is None or lo <= y[-1] <= hi:
+                    if len(points) - len(starts) >= limit:
+                        raise InputError(f"{where}: the continuation did not leave ω in "
+                                         f"[{lo:.3g}, {hi:.3g}] within {limit} steps of "
+                                         f"{step:g} (the estimate was {estimate:.0f}); the "
+                                         "curve is longer than it looks")
+                    if time.monotonic() > deadline:
+                        raise InputError(f"{where}: the continuation gave up after "
+                                         f"{allowed:.0f} s at ω = {y[-1]:.6g}, "
+                                         f"{len(points)} points in (its estimate: "
+                                         f"{estimate:.0f}): the corrector does not converge "
+                                         "there")
+                    y_new = _corrector(sysm, y + step * t, t)
+                    t_new = _tangent(sysm, y_new, t)
+                    if not (np.all(np.isfinite(y_new)) and np.all(np.isfinite(t_new))):
+                        raise np.linalg.LinAlgError("the balance overflowed")
+                    if t_new[-1] * t[-1] < 0:
+                        folds.append(_refine_fold(sysm, y, t, step))
+                    y_old, y, t = y, y_new, t_new
+                    points.append(y)
+                # the end it left by: the nearest solution there is reached
+                edge = lo if y[-1] < lo else hi
+                s_edge = (edge - y_old[-1]) / (y[-1] - y_old[-1])
+                x_edge = y_old[:-1] + s_edge * (y[:-1] - y_old[:-1])
+                at_edge = [j for j, e in enumerate(ends) if e[0] == edge]
+                if at_edge:
+                    nearest = min(at_edge, key=lambda j: np.linalg.norm(ends[j][1] - x_edge))
+                    if np.linalg.norm(ends[nearest][1] - x_edge) \
+                            <= 1e-2 * (1 + np.linalg.norm(x_edge)):
+                        visited[nearest] = True
     except np.linalg.LinAlgError as exc:
         at = "" if y is None else f" at ω = {y[-1]:.4g}"
         raise InputError(f"{where}: the harmonic-balance continuation failed{at} ({exc}): "
                          "its Jacobian is singular or the balance overflowed") from None
     arr = np.array(points)
-    return Continuation(arr[:, -1], arr[:, :-1], sorted(folds))
+    return Continuation(arr[:, -1], arr[:, :-1], sorted(folds), tuple(starts), complete)
+
+
+def _end_solutions(sysm: BalanceSystem, d: Drive, omega_start: float, omega_stop: float
+                   ) -> tuple[list[tuple[float, np.ndarray, float]], bool]:
+    """The balance solutions from every one-harmonic root at both ends, as ``(ω, x, the
+    direction into the range)``: the smallest root at ``omega_start`` first, then the others
+    there and those at ``omega_stop``, each by amplitude (distinct solutions only); and
+    whether every root's balance converged."""
+    out: list[tuple[float, np.ndarray, float]] = []
+    complete = True
+    h = sysm.harmonics
+    for omega, direction in ((omega_start, np.sign(omega_stop - omega_start)),
+                             (omega_stop, np.sign(omega_start - omega_stop))):
+        roots = first_order_branches(Drive(d.eps, d.force, omega, d.Q))
+        for br in sorted(roots, key=lambda b: abs(b.A1)):
+            x = np.zeros(2 * h)
+            x[0], x[h] = br.A1 * np.cos(br.delta0), br.A1 * np.sin(br.delta0)
+            try:
+                x = _newton_fixed_omega(sysm, x, omega)
+            except np.linalg.LinAlgError:
+                x = np.full(2 * h, np.nan)
+            size = np.max(np.abs(x))
+            residual = np.max(np.abs(sysm.residual(x, omega)))
+            if not residual <= 1e-9 * (abs(d.force) + (1 + omega**2) * size
+                                       + abs(d.eps) * size**3):
+                complete = False
+                continue
+            if all(e[0] != omega or np.linalg.norm(e[1] - x) > 1e-6 * (1 + np.linalg.norm(x))
+                   for e in out):
+                out.append((omega, x, float(direction)))
+    if not out or out[0][0] != omega_start:
+        raise np.linalg.LinAlgError(f"no balance converged at ω = {omega_start:.4g}")
+    return out, complete
 
 
 def _newton_fixed_omega(sysm: BalanceSystem, x: np.ndarray, omega: float) -> np.ndarray:
@@ -636,6 +700,11 @@ BALANCE_NEAR = 1e-3
 CONTINUATION_HARMONICS = 8
 # NOTE: the continuation that seeds the orbits carries at most 8 harmonics (2 ms a point; its
 # crossings are then polished at the harmonics asked): a seed, not an answer.
+REFINED_HARMONICS = 32
+# NOTE: where shooting from a balance fails, the balance is solved again with 32 harmonics and
+# shot once more: an orbit near the barrier of a softening spring can be so unstable (Floquet
+# multiplier 7.7e7 at ε −0.1, f 0.3, Q 20, ω 0.3) that the 8-harmonic balance's 1e-5 error
+# carries its trajectory out of the well within the period; 32 harmonics bring it to ~1e-16.
 CONTINUATION_BUDGET = 15.0
 # NOTE: seconds the seeding continuation may take (its own estimate, checked before it starts);
 # above, the seeds are the one-harmonic roots only and the result says it may be incomplete.
@@ -659,6 +728,7 @@ class Orbit:
     branch: Branch | None
     seed: str
     paired: str | None  # "shot" (its shooting reached it), "rank", "balance", None (no root)
+    failure: ShootingFailure | None = None  # orbit None: why shooting from the balance failed
 
     @property
     def r(self) -> float:
@@ -675,6 +745,7 @@ class Orbits:
     roots: tuple[tuple[Branch, int | None], ...]  # each root, the index of the orbit it stands for
     complete: bool  # whether the seeds cover the whole response curve (balance_crossings)
     note: str  # how the seeds were found
+    failures: tuple[ShootingFailure | None, ...] = ()  # per root: why its shooting found none
 
 
 def _guess(hb: HarmonicBalance, omega: float) -> np.ndarray:
@@ -708,11 +779,22 @@ def _amplitude(found: dict) -> float:
     return math.hypot(found["orbit"].A[1], found["orbit"].B[1])
 
 
-def _balance(d: Drive, start: Branch | np.ndarray, harmonics: int) -> HarmonicBalance | None:
+def try_balance(d: Drive, start: Branch | np.ndarray, harmonics: int,
+                converged: bool = False) -> HarmonicBalance | None:
+    """:func:`driven.harmonic_balance` from ``start``, or ``None`` where its Newton meets a
+    singular Jacobian (exactly at a fold) — and, with ``converged``, where it does not
+    converge."""
     try:
-        return harmonic_balance(d, start, harmonics)
+        hb = harmonic_balance(d, start, harmonics)
     except np.linalg.LinAlgError:
         return None
+    return hb if hb.converged or not converged else None
+
+
+def _balance_vector(hb: HarmonicBalance) -> np.ndarray:
+    """``x = (a_1, a_3, …, b_1, b_3, …)`` of a balance solution."""
+    A, B = amplitudes(hb.coefficients, 0.0, 2 * hb.harmonics - 1)
+    return np.array([*A.values(), *B.values()])
 
 
 @functools.lru_cache(maxsize=16)
@@ -733,9 +815,10 @@ def balance_crossings(d: Drive, harmonics: int = CONTINUATION_HARMONICS
     balance vectors ``x`` with ``harmonics`` harmonics, interpolated between continuation
     points (linearly; quadratically around each turn of ω, where both crossings near a fold
     may lie between two points): seeds, not solutions.  With how they were found, and whether
-    they are complete: the curve traced across the whole range, or none needed (linear, one
-    orbit; ω above the range, where ``response`` has one branch too).  ``False``: undamped
-    (no continuation), refused, or the curve left the range where it began."""
+    they are complete: every piece of the curve that reaches an end of the range traced (a
+    softening spring's two, see :func:`continue_balance`), or none needed (linear, one orbit;
+    ω above the range, where ``response`` has one branch too).  ``False``: undamped (no
+    continuation), refused, or a root at an end whose balance did not converge."""
     if d.damping == 0:
         return [], "undamped: no continuation (the response curve needs damping)", False
     if d.eps == 0:  # linear: one orbit, the root's (and the curve, up to r = fQ, is long)
@@ -748,7 +831,19 @@ def balance_crossings(d: Drive, harmonics: int = CONTINUATION_HARMONICS
     cont, why = _traced(d.eps, d.force, d.Q, harmonics, lo, hi)
     if cont is None:
         return [], f"continuation refused ({why})", False
-    w, x = cont.omega - d.omega, cont.x
+    seeds = []
+    for piece in cont.piece_slices():
+        seeds += _crossings(cont.omega[piece] - d.omega, cont.x[piece])
+    note = f"continued harmonic balance (N = {harmonics}) on [{lo:.6g}, {hi:.6g}]"
+    if not cont.complete:  # a root at an end whose balance did not converge: not traced
+        return seeds, (f"{note}: the balance from a one-harmonic root at an end of the range "
+                       "did not converge, its piece of the curve is missing"), False
+    return seeds, note, True
+
+
+def _crossings(w: np.ndarray, x: np.ndarray) -> list[np.ndarray]:
+    """Where one piece of the continued curve meets ``w = 0`` (``w``: its ω minus the drive's),
+    interpolated (see :func:`balance_crossings`)."""
     seeds = []
     for i in range(len(w) - 1):
         if w[i] * w[i + 1] <= 0 and w[i] != w[i + 1]:
@@ -766,11 +861,7 @@ def balance_crossings(d: Drive, harmonics: int = CONTINUATION_HARMONICS
             if abs(s) <= 1:
                 seeds.append(x[i] + s * (x[i + 1] - x[i - 1]) / 2
                              + s * s * (x[i + 1] - 2 * x[i] + x[i - 1]) / 2)
-    note = f"continued harmonic balance (N = {harmonics}) on [{lo:.6g}, {hi:.6g}]"
-    if not cont.omega[-1] > hi:  # it turned back and left below lo: part of the curve only
-        return seeds, (f"{note}: the curve left the range at omega {cont.omega[-1]:.6g} "
-                       "without crossing it"), False
-    return seeds, note, True
+    return seeds
 
 
 def periodic_orbits(d: Drive, harmonics: int = 8, shoot_harmonics: int = 9) -> Orbits:
@@ -788,27 +879,25 @@ def periodic_orbits(d: Drive, harmonics: int = 8, shoot_harmonics: int = 9) -> O
     roots = first_order_branches(d)
     seeds: list[tuple[int | None, list[np.ndarray], HarmonicBalance | None]] = []
     for k, br in enumerate(roots):
-        hb = _balance(d, br, harmonics)
+        hb = try_balance(d, br, harmonics)
         first = br.A1 * np.array([math.cos(br.delta0), d.omega * math.sin(br.delta0)])
         guesses = [_guess(hb, d.omega), first] if hb is not None and hb.converged else [first]
         seeds.append((k, guesses, hb))
     crossings, note, complete = balance_crossings(d, min(harmonics, CONTINUATION_HARMONICS))
     for x in crossings:
-        hb = _balance(d, x, harmonics)
+        hb = try_balance(d, x, harmonics)
         h = len(x) // 2
         raw = np.array([x[:h].sum(), d.omega * np.sum(np.arange(1, 2 * h, 2) * x[h:])])
         seeds.append((None, [_guess(hb, d.omega), raw] if hb is not None and hb.converged
                       else [raw], hb))
     found: list[dict] = []  # orbit, balance, whether that balance is the orbit's, seed
     reached: dict[int, int] = {}  # root index -> orbit index
+    failures: dict[int, ShootingFailure] = {}  # root index -> why its shooting found none
     for k, guesses, hb in seeds:
-        orbit = None
-        for tol, guess in itertools.product(SHOOTING_TOLERANCES, guesses):
-            orbit = shoot(d.eps, d.force, d.omega, d.damping, guess,
-                          harmonics=shoot_harmonics, tol=tol)
-            if orbit is not None:
-                break
+        orbit, failure = _shoot_seed(d, guesses, hb, shoot_harmonics)
         if orbit is None:
+            if k is not None:
+                failures[k] = failure
             continue
         j = next((j for j, f in enumerate(found) if _state_distance(
             f["orbit"].initial, orbit.initial, d.omega) <= SAME_ORBIT), None)
@@ -833,7 +922,8 @@ def periodic_orbits(d: Drive, harmonics: int = 8, shoot_harmonics: int = 9) -> O
                                else _guess(f["balance"], d.omega), d.omega)
                > (BALANCE_NEAR if f["orbit"] is not None else SAME_ORBIT) for f in found):
             reached[k] = len(found)
-            found.append({"orbit": None, "balance": hb, "own": True, "seed": "one_harmonic"})
+            found.append({"orbit": None, "balance": hb, "own": True, "seed": "one_harmonic",
+                          "failure": failures.get(k)})
     rank = sorted(range(len(found)), key=lambda j: -_amplitude(found[j]))
     found = [found[j] for j in rank]
     new_index = {old: new for new, old in enumerate(rank)}
@@ -854,6 +944,31 @@ def periodic_orbits(d: Drive, harmonics: int = 8, shoot_harmonics: int = 9) -> O
         paired.update(dict.fromkeys(free_orbits, "rank"))
     stands = {k: j for j, k in owner.items()}
     orbits = tuple(Orbit(f["orbit"], f["balance"], roots[owner[j]] if j in owner else None,
-                         f["seed"], paired.get(j)) for j, f in enumerate(found))
+                         f["seed"], paired.get(j), f.get("failure"))
+                   for j, f in enumerate(found))
     return Orbits(orbits, tuple((br, stands.get(k)) for k, br in enumerate(roots)),
-                  complete, note)
+                  complete, note, tuple(failures.get(k) for k in range(len(roots))))
+
+
+def _shoot_seed(d: Drive, guesses: list[np.ndarray], hb: HarmonicBalance | None,
+                shoot_harmonics: int) -> tuple[PeriodicOrbit | None, ShootingFailure | None]:
+    """Shooting from each guess at each of SHOOTING_TOLERANCES, then (a converged balance)
+    from the balance solved again with REFINED_HARMONICS; the orbit, or why the first guess
+    found none."""
+    first = None
+    for tol, guess in itertools.product(SHOOTING_TOLERANCES, guesses):
+        found = shoot_explained(d.eps, d.force, d.omega, d.damping, guess,
+                                harmonics=shoot_harmonics, tol=tol)
+        if isinstance(found, PeriodicOrbit):
+            return found, None
+        first = first or found
+    if hb is not None and hb.converged and hb.harmonics < REFINED_HARMONICS:
+        fine = try_balance(d, _balance_vector(hb), REFINED_HARMONICS, converged=True)
+        if fine is not None:
+            for tol in SHOOTING_TOLERANCES:
+                found = shoot_explained(d.eps, d.force, d.omega, d.damping,
+                                        _guess(fine, d.omega), harmonics=shoot_harmonics,
+                                        tol=tol)
+                if isinstance(found, PeriodicOrbit):
+                    return found, None
+    return None, first

@@ -7,8 +7,10 @@ what it stores:
 * ``response``: the steady amplitude ``r = √(A₁² + B₁²)`` of every 1:1 branch (harmonic
   balance with 10 harmonics from each first-order root), its one-harmonic stability
   (``∂G/∂u > 0``), and the largest and smallest stable amplitude;
-* ``stability``: shooting from each branch's balance solution: the distinct periodic orbits,
-  how many are Floquet-stable, their largest Floquet modulus;
+* ``stability``: every distinct periodic orbit (:func:`response.periodic_orbits`: shooting
+  from each branch's balance solution and from the crossings of the continued balance, which
+  find the orbits the one-harmonic roots miss near a fold), how many are Floquet-stable, their
+  largest Floquet modulus, and the orbit each first-order branch stands for;
 * ``subharmonic``: the 1/3 subharmonic (eq. 10.87, undamped; ``omega`` is its frequency, the
   drive is at ``3ω``): whether it exists, both roots, Hill and true-orbit stability;
 * ``validity``: the μ-expansion's and low-order harmonic balance's error in ``A₁`` against
@@ -57,10 +59,16 @@ if TYPE_CHECKING:
 # NOTE: xarray and zarr are imported where the client uses them: every worker imports this
 # module to run its blocks and needs neither (~1.3 s of each worker's start-up, measured).
 
-from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
+from .driven import Drive, amplitudes, first_order_branches, mu_expansion
 from .errors import InputError
-from .numerics import shoot
-from .response import SAME_ORBIT, amplitude_slope, subharmonic
+from .response import (
+    CONTINUATION_HARMONICS,
+    SAME_ORBIT,
+    amplitude_slope,
+    periodic_orbits,
+    subharmonic,
+    try_balance,
+)
 
 # --- what one point computes -------------------------------------------------------------------
 
@@ -69,23 +77,12 @@ BRANCHES = 3
 RESPONSE_HARMONICS = 10
 # NOTE: harmonic balance with 10 odd harmonics equals the true orbit to ~1e-10 at the notes'
 # parameters (the judge of the validity chart), at ~1 ms a branch.
-GUESS_HARMONICS = 10
-# NOTE: shooting starts from the balance solution; from 10 harmonics Newton needs one flow
-# fewer than from 5 and the stability map is fastest (14.5 against 16.6 ms a point, measured).
+ORBIT_HARMONICS = 8
+# NOTE: the balance each orbit is shot from (response.periodic_orbits' default).
 MU_ORDERS = (1, 2, 4, 6, 10)
 BALANCE_HARMONICS = (2, 4)
 JUDGE_HARMONICS = 10
 # NOTE: the methods and the judge of charts.driven_validity_figure (its VALIDITY_METHODS).
-
-
-def _balance(d: Drive, branch: object, harmonics: int) -> object | None:
-    """Harmonic balance from a first-order root, or ``None`` where it refuses (does not
-    converge, or meets a singular Jacobian exactly at a fold)."""
-    try:
-        hb = harmonic_balance(d, branch, harmonics)
-    except np.linalg.LinAlgError:
-        return None
-    return hb if hb.converged else None
 
 
 def _response(omega: float, force: float, eps: float, Q: float) -> dict:
@@ -94,7 +91,7 @@ def _response(omega: float, force: float, eps: float, Q: float) -> dict:
     r, stable = [math.nan] * BRANCHES, [-1] * BRANCHES
     for k, br in enumerate(branches):
         stable[k] = int(amplitude_slope(br.A1**2, omega, d) > 0)
-        hb = _balance(d, br, RESPONSE_HARMONICS)
+        hb = try_balance(d, br, RESPONSE_HARMONICS, converged=True)
         if hb is not None:
             A, B = amplitudes(hb.coefficients, 0.0, 1)
             r[k] = math.hypot(A[1], B[1])
@@ -105,29 +102,21 @@ def _response(omega: float, force: float, eps: float, Q: float) -> dict:
 
 
 def _stability(omega: float, force: float, eps: float, Q: float) -> dict:
-    d = Drive(eps, force, omega, Q)
-    branches = first_order_branches(d)[:BRANCHES]
+    """Every distinct 1:1 orbit (:func:`response.periodic_orbits`: the one-harmonic roots and,
+    damped, the crossings of the continued balance, shot and deduplicated); per first-order
+    branch, the orbit it stands for (NaN / −1 where it stands for none)."""
+    found = periodic_orbits(Drive(eps, force, omega, Q), ORBIT_HARMONICS, shoot_harmonics=1)
+    shot = [o.orbit for o in found.orbits if o.orbit is not None]
     r, floquet, stable = [math.nan] * BRANCHES, [math.nan] * BRANCHES, [-1] * BRANCHES
-    distinct: list = []
-    for k, br in enumerate(branches):
-        hb = _balance(d, br, GUESS_HARMONICS)
-        if hb is not None:  # the start of cli.driven_json: q(0) = ΣA_n, q̇(0) = ω Σ n B_n
-            A, B = amplitudes(hb.coefficients, 0.0, 2 * GUESS_HARMONICS - 1)
-            guess = np.array([sum(A.values()), omega * sum(n * b for n, b in B.items())])
-        else:  # the first-order root itself (choose.driven_tradeoffs' start)
-            guess = br.A1 * np.array([math.cos(br.delta0), omega * math.sin(br.delta0)])
-        orbit = shoot(eps, force, omega, d.damping, guess, harmonics=1)
-        if orbit is None:
-            continue
-        r[k] = math.hypot(orbit.A[1], orbit.B[1])
-        floquet[k] = float(np.max(np.abs(orbit.multipliers)))
-        stable[k] = int(orbit.stable)
-        scale = 1 + float(np.max(np.abs(orbit.initial)))
-        if all(np.max(np.abs(orbit.initial - o.initial)) > SAME_ORBIT * scale for o in distinct):
-            distinct.append(orbit)
-    return {"branches": len(branches), "orbits": len(distinct),
-            "stable_orbits": sum(o.stable for o in distinct),
-            "max_floquet": max((float(np.max(np.abs(o.multipliers))) for o in distinct),
+    for k, (_, j) in enumerate(found.roots[:BRANCHES]):
+        orbit = None if j is None else found.orbits[j].orbit
+        if orbit is not None:
+            r[k] = math.hypot(orbit.A[1], orbit.B[1])
+            floquet[k] = float(np.max(np.abs(orbit.multipliers)))
+            stable[k] = int(orbit.stable)
+    return {"branches": min(len(found.roots), BRANCHES), "orbits": len(shot),
+            "stable_orbits": sum(o.stable for o in shot),
+            "max_floquet": max((float(np.max(np.abs(o.multipliers))) for o in shot),
                                default=math.nan),
             "r": r, "floquet": floquet, "orbit_stable": stable}
 
@@ -159,7 +148,7 @@ def validity_errors(d: Drive) -> tuple[np.ndarray, np.ndarray, int]:
     mu_err = np.full(len(MU_ORDERS), np.nan)
     hb_err = np.full(len(BALANCE_HARMONICS), np.nan)
     branches = first_order_branches(d)
-    judge = _balance(d, branches[0], JUDGE_HARMONICS) if branches else None
+    judge = try_balance(d, branches[0], JUDGE_HARMONICS, converged=True) if branches else None
     if judge is None:
         return mu_err, hb_err, len(branches)
     truth = amplitudes(judge.coefficients, 0.0, 1)[0][1]
@@ -168,7 +157,7 @@ def validity_errors(d: Drive) -> tuple[np.ndarray, np.ndarray, int]:
         if len(mu.coefficients) > order and mu.converged:
             mu_err[k] = abs(amplitudes(*mu.partial(order), 1)[0][1] - truth)
     for k, harmonics in enumerate(BALANCE_HARMONICS):
-        hb = _balance(d, branches[0], harmonics)
+        hb = try_balance(d, branches[0], harmonics, converged=True)
         if hb is not None:
             hb_err[k] = abs(amplitudes(hb.coefficients, 0.0, 1)[0][1] - truth)
     return mu_err, hb_err, len(branches)
@@ -248,20 +237,22 @@ RESPONSE = Kind(
 # NOTE: 256 points: ~3 ms a point (balance on up to three branches), ~1 s a task.
 
 STABILITY = Kind(
-    "stability", "Floquet stability of the 1:1 orbits found by shooting from every branch",
+    "stability", "Floquet stability of every distinct 1:1 orbit (shooting from every branch "
+    "and from the continued harmonic balance)",
     AXES, (BRANCH,),
     (Field("branches", "number of first-order 1:1 branches", "int8"),
      Field("orbits", "distinct periodic orbits found by shooting", "int8"),
      Field("stable_orbits", "distinct Floquet-stable orbits", "int8"),
      Field("max_floquet", "largest Floquet modulus over the orbits"),
-     Field("r", "r = sqrt(A1^2 + B1^2) of the orbit shot from the branch", dims=("branch",)),
-     Field("floquet", "largest Floquet modulus of the orbit shot from the branch",
+     Field("r", "r = sqrt(A1^2 + B1^2) of the orbit the branch stands for", dims=("branch",)),
+     Field("floquet", "largest Floquet modulus of the orbit the branch stands for",
            dims=("branch",)),
-     Field("orbit_stable", "Floquet stability of the orbit shot from the branch", "int8",
+     Field("orbit_stable", "Floquet stability of the orbit the branch stands for", "int8",
            ("branch",), flag=True)),
     _stability, (("omega", 1.2), ("force", 0.3), ("eps", 0.1), ("Q", 20.0)),
     64, "stable_orbits",
-    (("guess_harmonics", GUESS_HARMONICS), ("same_orbit", SAME_ORBIT)))
+    (("orbit_harmonics", ORBIT_HARMONICS), ("continuation_harmonics", CONTINUATION_HARMONICS),
+     ("same_orbit", SAME_ORBIT)))
 # NOTE: 64 points: ~15 ms a point (two RK4 passes per Newton step per branch), ~1 s a task.
 
 SUBHARMONIC = Kind(
