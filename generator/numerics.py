@@ -237,7 +237,9 @@ def shoot_explained(eps: float, force: float, omega: float, damping: float, gues
         return ShootingFailure(
             f"{where} (q, q') = ({y[0]:.6g}, {y[1]:.6g}) escapes the well at t = {at:.4g} "
             f"(of a period {T:.4g}): |q| passes {bound:.6g} moving outward, past which no "
-            "trajectory returns and no periodic orbit reaches", k == 0, bound)
+            "trajectory returns and no periodic orbit reaches"
+            + ("; an orbit near this state, if any, is too unstable for single shooting"
+               if k == 0 else ""), k == 0, bound)
 
     step = np.full(2, np.nan)
     for k in range(max_iter):

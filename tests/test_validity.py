@@ -146,3 +146,143 @@ def test_the_unstable_subharmonic_near_its_existence_boundary_is_found():
     assert minus["numerical"] is not None, "the unstable orbit is missed"
     assert abs(minus["numerical"]["a1"] - a1) < 1e-6 and minus["numerical"]["stable"] is False
     assert abs(plus["numerical"]["a1"] - minus["numerical"]["a1"]) > 0.05  # two orbits
+
+
+# --- escape from a softening spring's well, in shooting and in `driven` -------------------------
+
+def _segment(y, t0, t1, eps, force, omega, damping, t_eval=None):
+    """DOP853 (rtol 1e-12) on the equation and its variational equation from ``t0`` to ``t1``:
+    the end state, the monodromy of the arc, the solution."""
+    def rhs(t, z):
+        k = -1.0 - 3.0 * eps * z[0] ** 2
+        return [z[1], force * np.cos(omega * t) - damping * z[1] - z[0] - eps * z[0] ** 3,
+                z[3], k * z[2] - damping * z[3], z[5], k * z[4] - damping * z[5]]
+
+    sol = solve_ivp(rhs, (t0, t1), [y[0], y[1], 1.0, 0.0, 0.0, 1.0], method="DOP853",
+                    rtol=1e-12, atol=1e-12, t_eval=t_eval)
+    end = sol.y[:, -1]
+    return end[:2], np.array([[end[2], end[4]], [end[3], end[5]]]), sol
+
+
+def multiple_shooting(y0, eps, force, omega, damping, segments=8):
+    """A periodic orbit too unstable for single shooting (a Floquet multiplier ~1e8 turns the
+    integrator's 1e-12 into 1e-4 over one period): Newton on the continuity of ``segments``
+    DOP853 arcs, each amplifying errors by only the segments-th root.  ``(state, r,
+    multipliers)``."""
+    T = 2 * np.pi / omega
+    ts = np.linspace(0, T, segments + 1)
+    Y = [np.array(y0, float)]
+    for i in range(segments - 1):
+        Y.append(_segment(Y[-1], ts[i], ts[i + 1], eps, force, omega, damping)[0])
+    Y = np.array(Y)
+    for _ in range(30):
+        F = np.zeros(2 * segments)
+        J = np.zeros((2 * segments, 2 * segments))
+        for i in range(segments):
+            end, M, _ = _segment(Y[i], ts[i], ts[i + 1], eps, force, omega, damping)
+            j = (i + 1) % segments
+            F[2 * i:2 * i + 2] = end - Y[j]
+            J[2 * i:2 * i + 2, 2 * i:2 * i + 2] += M
+            J[2 * i:2 * i + 2, 2 * j:2 * j + 2] -= np.eye(2)
+        step = np.linalg.solve(J, -F).reshape(segments, 2)
+        Y = Y + step
+        if np.max(np.abs(step)) < 1e-12 * (1 + np.max(np.abs(Y))):
+            break
+    else:
+        raise AssertionError("multiple shooting did not converge")
+    mono, c1, n = np.eye(2), 0j, 64
+    for i in range(segments):
+        t = ts[i] + (ts[i + 1] - ts[i]) * np.arange(n) / n
+        _, M, sol = _segment(Y[i], ts[i], ts[i + 1], eps, force, omega, damping,
+                             t_eval=np.append(t, ts[i + 1]))
+        mono = M @ mono
+        c1 += np.sum(sol.y[0, :-1] * np.exp(-1j * omega * t)) / (n * segments)
+    return Y[0], float(2 * abs(c1)), np.linalg.eigvals(mono)
+
+
+def escapes(y0, eps, force, omega, damping, t0=0.0, periods=1.0, far=1e3):
+    """Whether DOP853 from ``y0`` at ``t0`` reaches ``|q| = far`` within ``periods`` drive
+    periods (the softening spring's cubic force then runs it off to infinity)."""
+    def rhs(t, z):
+        return [z[1], force * np.cos(omega * t) - damping * z[1] - z[0] - eps * z[0] ** 3]
+
+    def out(t, z):
+        return abs(z[0]) - far
+    out.terminal = True
+    sol = solve_ivp(rhs, (t0, t0 + periods * 2 * np.pi / omega), list(y0), method="DOP853",
+                    rtol=1e-12, atol=1e-12, events=out)
+    return sol.status == 1
+
+
+def test_shooting_reports_a_trajectory_past_the_escape_bound_as_escaping():
+    """Every periodic orbit of the softening spring stays within |q| ≤ x, the root of
+    |ε|x³ − x − |f| = 0 (numpy.roots here); from beyond it, moving outward, DOP853 runs off
+    to infinity whatever the drive's phase — and shooting from there says it escapes, where it
+    used to return nothing without a reason."""
+    from lindstedt.numerics import escape_bound, shoot, shoot_explained
+
+    eps, f, Q, w = -0.1, 0.3, 20.0, 0.8
+    roots = np.roots([-eps, 0.0, -1.0, -f])
+    x = max(r.real for r in roots if abs(r.imag) < 1e-12)
+    assert abs(escape_bound(eps, f) - x) < 1e-14 * x and abs(escape_bound(eps, -f) - x) < 1e-14
+    assert escape_bound(0.1, f) == np.inf
+    start = np.array([1.001 * x, 0.0])
+    for t0 in np.arange(4) * np.pi / (2 * w):
+        assert escapes(start, eps, f, w, 1 / Q, t0)
+        assert escapes(-start, eps, f, w, 1 / Q, t0)
+    failure = shoot_explained(eps, f, w, 1 / Q, start)
+    assert failure.escaped and "escapes the well" in failure.reason
+    assert abs(failure.bound - x) < 1e-14 * x
+    assert shoot(eps, f, w, 1 / Q, start) is None
+    # a hardening spring has no well to leave: never an escape
+    far = shoot_explained(0.1, f, w, 1 / Q, np.array([1e30, 0.0]))
+    assert not getattr(far, "escaped", False)
+
+
+def test_an_orbit_too_unstable_for_the_coarse_balance_guess_is_found():
+    """ε = −0.1, f = 0.3, Q = 20, ω = 0.3: the orbit hugging the barrier has a Floquet
+    multiplier 7.7e7; from the 8-harmonic balance (1e-5 off) its trajectory escapes within the
+    period, and `driven` had it as a balance without an orbit. Against multiple shooting."""
+    from lindstedt.driven import Drive
+    from lindstedt.response import periodic_orbits
+
+    eps, f, Q, w = -0.1, 0.3, 20.0, 0.3
+    top = periodic_orbits(Drive(eps, f, w, Q)).orbits[0]
+    assert top.orbit is not None and not top.orbit.stable and top.paired == "shot"
+    state, r, lam = multiple_shooting(top.orbit.initial, eps, f, w, 1 / Q)
+    assert np.max(np.abs(top.orbit.initial - state)) < 1e-8 * np.max(np.abs(state))
+    assert abs(top.r - r) < 1e-8 * r
+    got, ref = max(abs(top.orbit.multipliers)), max(abs(lam))
+    assert ref > 1e7 and abs(got / ref - 1) < 1e-5
+
+
+def test_driven_says_the_branch_escapes_the_well():
+    """ε = −0.1, f = 0.3, Q = 20, ω = 0.2: the resonant branch leans over the barrier; the
+    state of its harmonic balance runs off to infinity within a period (DOP853), and `driven`
+    says it escapes the well (reason in `shooting_note`) instead of "no orbit found"; the
+    in-well orbit beside it against DOP853 + Newton."""
+    from test_branches import reference_orbit
+
+    eps, f, Q, w = -0.1, 0.3, 20.0, 0.2
+    args = ["driven", "--eps", str(eps), "--force", str(f), "--Q", str(Q), "--omega", str(w)]
+    run = [sys.executable, "-m", "lindstedt", *args]
+    data = json.loads(subprocess.run([*run, "--json"], capture_output=True, text=True,
+                                     check=True).stdout)
+    big, small = data["branches"]
+    assert big["numerical"] is None and big["escapes"] is True
+    assert "escapes the well" in big["shooting_note"]
+    hb = big["harmonic_balance"]
+    y0 = (sum(hb["A"].values()), w * sum(int(n) * b for n, b in hb["B"].items()))
+    assert escapes(y0, eps, f, w, 1 / Q)
+    assert small["escapes"] is False and small["shooting_note"] is None
+    ref = reference_orbit(small["numerical"]["initial"], eps, f, w, 1 / Q)
+    assert ref is not None and abs(ref[1] - small["numerical"]["r"]) < 1e-8
+    assert ref[3] is small["numerical"]["stable"] is True
+    for key in ("A1", "r", "delta0", "mu_expansion", "mu_converged", "mu_note",
+                "harmonic_balance", "numerical", "seed", "first_order"):
+        assert key in big
+    # the second root's balance converged onto the first's: it stands for no orbit, and says why
+    lone = [root for root in data["one_harmonic_roots"] if root["branch"] is None]
+    assert lone and all(root["escapes"] for root in lone)
+    text = subprocess.run(run, capture_output=True, text=True, check=True).stdout
+    assert "(escapes the well)" in text and "no orbit found" not in text
