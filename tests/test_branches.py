@@ -158,6 +158,10 @@ SWEEPS = [
                  id="lower-fold-eps1"),
     pytest.param(1.0, 0.5, 10.0, (2.2, 0), "below",
                  (2.2, 2.204, 2.206, 2.21, 2.2119, 2.2125), id="upper-fold-eps1"),
+    # a softening spring: the small in-well branch folds onto the middle one at 0.8044965 (the
+    # cubic's: 0.80390); between the two the continued balance alone finds the two orbits
+    pytest.param(-0.1, 0.3, 20.0, (0.8, -1), "below",
+                 (0.795, 0.8, 0.803, 0.804, 0.8044, 0.8046, 0.806), id="softening-fold"),
 ]
 
 
@@ -229,3 +233,26 @@ def test_omega_1489_no_orbit_twice_and_the_middle_one_found():
     assert [br["first_order"] for br in data["branches"]] == ["shot", "rank", "shot"]
     assert [br["r"] for br in data["branches"]] == sorted(
         (br["r"] for br in data["branches"]), reverse=True)
+
+
+def test_softening_folds_and_seeding_against_the_reference():
+    """ε = −0.1, f = 0.3, Q = 20: the balance continuation starts on the small (in-well) branch
+    and traces the whole curve, so `response` reports the fold of the in-well branch (it
+    reported none: the continuation began on the resonant branch over the barrier and left the
+    range without meeting it) and `driven`'s seeding is complete; the fold against the
+    reference fold, and its side of the one-harmonic fold (numpy.roots' branch count)."""
+    from lindstedt.cli import response_json
+
+    eps, force, Q = -0.1, 0.3, 20.0
+    fold = reference_fold(eps, force, Q, 0.8, -1)
+    data = response_json(eps, force, Q, 8)
+    (balance,) = data["harmonic_balance"]["folds"]
+    (true,) = data["numerical"]["folds"]
+    assert abs(true - fold) < 1e-8 and abs(balance - fold) < 1e-8
+    (cubic,) = data["one_harmonic"]["folds"]
+    assert cubic < fold
+    for w, count in ((cubic - 1e-6, 3), (cubic + 1e-6, 1)):
+        assert len(_cubic_seeds(eps, force, w, 1 / Q)) == count
+    for w in (0.5, 0.8, 0.804, 1.0):
+        found = periodic_orbits(Drive(eps, force, w, Q))
+        assert found.complete, (w, found.note)

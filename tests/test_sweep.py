@@ -329,3 +329,32 @@ def test_cli_sweep_killed_then_resumed_equals_serial(tmp_path):
         np.testing.assert_array_equal(resumed[name].values, serial[name].values)
     for name in ("max_floquet", "r"):  # the workers' single-threaded LAPACK: rounding apart
         np.testing.assert_allclose(resumed[name].values, serial[name].values, rtol=1e-12)
+
+
+def test_stability_counts_every_distinct_orbit_against_dop853():
+    """The stability map counts the orbits the one-harmonic roots miss: at ω = 1.491 (ε 0.1,
+    f 0.3, Q 20) the cubic has one root and the true system three orbits (two stable), and
+    inside the softening spring's fold window at ω = 0.804 (ε −0.1) likewise. Each count,
+    the largest Floquet modulus and the small branch's r against DOP853 + Newton on the period
+    map (test_branches), started from every orbit's state and from the one-harmonic root."""
+    from lindstedt.response import periodic_orbits
+    from test_branches import _cubic_seeds, _distance, reference_orbit
+
+    for eps, w in ((EPS, 1.491), (-0.1, 0.804)):
+        axes = {"omega": [w], "force": [FORCE], "eps": [eps], "Q": [Q]}
+        point = serial_sweep("stability", axes).isel(omega=0, force=0, eps=0, Q=0)
+        starts = [o.orbit.initial for o in periodic_orbits(Drive(eps, FORCE, w, Q)).orbits]
+        refs = []
+        for y0 in [*starts, *_cubic_seeds(eps, FORCE, w, 1 / Q)]:
+            ref = reference_orbit(y0, eps, FORCE, w, 1 / Q)
+            if ref is not None and all(_distance(ref[0], o[0], w) > 1e-7 for o in refs):
+                refs.append(ref)
+        assert len(refs) == 3 and int(point.branches) == 1
+        assert int(point.orbits) == 3 and int(point.stable_orbits) == 2
+        assert sum(ref[3] for ref in refs) == 2
+        top = max(m for ref in refs for m in ref[2])
+        assert abs(float(point.max_floquet) - top) < 1e-6
+        (seed,) = _cubic_seeds(eps, FORCE, w, 1 / Q)  # the one root, and its orbit
+        own = reference_orbit(seed, eps, FORCE, w, 1 / Q)
+        assert abs(float(point.r[0]) - own[1]) < 1e-8 and int(point.orbit_stable[0]) == 1
+        assert np.isnan(point.r[1:]).all()
