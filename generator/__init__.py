@@ -2,8 +2,10 @@
 
 The pipeline, one module per stage (input -> output); a stage imports only stages above it::
 
-    models     oscillator definitions (frozen dataclasses)              -> Model
-    series     exact Fourier algebra in the monomial basis of cos s     (the fast kernel)
+    equation   user text through a whitelist walker over ``ast``         str -> Equation
+    models     the oscillator registry, a user's Oscillator, its L–P Model  Equation, K -> Model
+    series     exact Fourier algebra in the monomial basis of cos s     (QQ: FLINT fmpq_poly;
+               QQ[params]: FLINT fmpq_mpoly)
     lindstedt  L–P series, order-by-order equations, naive expansion    Model, K -> SeriesSolution
     numerics   references: elliptic periods, Jacobi cn, shooting + Floquet, sweeps, true folds
     driven     μ-expansion with phase, harmonic balance                 Drive, order -> branches

@@ -23,8 +23,11 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 # twice as fast on one BLAS thread as on OpenBLAS's pool on a busy machine (`response
 # --harmonics 40`: 8.7 s against 17.3 s), and the cost estimates assume one thread.
 
-FREE_MODELS = ("duffing", "pendulum")
+FREE_MODELS = ("duffing", "pendulum", "helmholtz_duffing", "quintic", "cubic_quintic",
+               "velocity_squared", "sinh_spring")
 # NOTE: models.MODELS, restated so that parsing arguments needs no SymPy (a test keeps them equal).
+EMITTED = ("driven", "balance", "fourier")
+# NOTE: generate's names for the driven oscillator's modules (not free oscillators).
 SCENE_NAMES = ("clock", "hard-spring", "notes-driven")
 # NOTE: choose.SCENES's keys, likewise.
 DRIVEN_QUANTITIES = ("amplitudes", "response")
@@ -78,18 +81,41 @@ def _rational(c: object) -> str:
     return f"{int(c.p)}/{int(c.q)}"
 
 
+def _coefficient(sol, c: object) -> str | dict:
+    """``"p/q"``, or for coefficients in ``QQ[A, params]`` an object mapping each monomial
+    (SymPy's ``str``: ``"A**2*alpha"``, ``"1"``) to its exact ``"p/q"``."""
+    if sol.ground.is_rational:
+        return _rational(c)
+    import sympy as sp
+
+    expr = sp.expand(sol.ground.to_sympy(c))
+    terms = sp.Poly(expr, *sorted(expr.free_symbols, key=str)).terms() if expr.free_symbols \
+        else ([((), expr)] if expr != 0 else [])
+    gens = sorted(expr.free_symbols, key=str)
+    out = {}
+    for powers, value in terms:
+        key = sp.Mul(*(g**e for g, e in zip(gens, powers, strict=True)))
+        out[str(key)] = _rational(value)
+    return dict(sorted(out.items()))
+
+
 def series_json(sol) -> dict:
     """The contract of ``lindstedt series MODEL --order K --json`` (keys are stable)."""
-    return {
-        "model": sol.model.name,
+    m = sol.model
+    data = {
+        "model": m.name,
         "order": sol.order,
-        "variable": sol.model.variable,
-        "omega": [_rational(c) for c in sol.omega],
-        "period": [_rational(c) for c in sol.period],
-        "q": [{str(n): _rational(c) for n, c in sorted(qj.items())} for qj in sol.q],
+        "variable": m.variable,
+        "omega": [_coefficient(sol, c) for c in sol.omega],
+        "period": [_coefficient(sol, c) for c in sol.period],
+        "q": [{str(n): _coefficient(sol, c) for n, c in sorted(qj.items())} for qj in sol.q],
         "convention": sol.convention,
-        "radius": str(sol.model.radius),
+        "radius": str(m.radius),
     }
+    if m.source:
+        data.update(equation=m.source, omega0=str(m.frequency),
+                    units="omega in units of omega0, period in units of 2*pi/omega0")
+    return data
 
 
 def series_table(sol) -> str:
@@ -98,30 +124,75 @@ def series_table(sol) -> str:
     lines = [
         f"{m.name}: {m.title}, expansion variable {m.variable}, order {sol.order}",
         f"convention: {sol.convention}",
-        f"{'j':>3}  {'omega_j':>24}  {'(T/2pi)_j':>24}  q_j: harmonic n -> coefficient",
     ]
-    for j in range(sol.order + 1):
-        harmonics = ", ".join(f"{n}: {_rational(c)}" for n, c in sorted(sol.q[j].items()))
-        lines.append(
-            f"{j:>3}  {_rational(sol.omega[j]):>24}  {_rational(sol.period[j]):>24}  {harmonics}"
-        )
+    if m.frequency != 1:
+        lines.append(f"omega in units of omega0 = {m.frequency}, T in units of 2*pi/omega0")
+    if sol.ground.is_rational:
+        lines.append(f"{'j':>3}  {'omega_j':>24}  {'(T/2pi)_j':>24}  "
+                     "q_j: harmonic n -> coefficient")
+        for j in range(sol.order + 1):
+            harmonics = ", ".join(f"{n}: {_rational(c)}" for n, c in sorted(sol.q[j].items()))
+            lines.append(f"{j:>3}  {_rational(sol.omega[j]):>24}  "
+                         f"{_rational(sol.period[j]):>24}  {harmonics}")
+        return "\n".join(lines)
+    g = sol.ground.to_sympy
+    for j in range(sol.order + 1):  # symbolic coefficients: one block an order
+        lines.append(f"j = {j}: omega_j = {g(sol.omega[j])}")
+        lines.append(f"       (T/2pi)_j = {g(sol.period[j])}")
+        for n, c in sorted(sol.q[j].items()):
+            lines.append(f"       q_j[cos {n}s] = {g(c)}")
     return "\n".join(lines)
+
+
+def _params(pairs: Sequence[str] | None) -> dict[str, str]:
+    """``--param NAME=VALUE`` pairs, each name once."""
+    values: dict[str, str] = {}
+    for pair in pairs or ():
+        name, sep, value = pair.partition("=")
+        name = name.strip()
+        if not sep or not name or not value.strip():
+            raise InputError(f"--param {pair!r}: write NAME=VALUE, e.g. alpha=1/3")
+        if name in values:
+            raise InputError(f"--param {name}: given twice")
+        values[name] = value.strip()
+    return values
+
+
+def _free_model(args: argparse.Namespace, order: int):
+    from .models import model_from_text
+
+    return model_from_text(args.model, order, _params(args.param), args.name)
 
 
 def _cmd_series(args: argparse.Namespace) -> int:
     from .lindstedt import derive
-    from .models import model_by_name
 
-    progress = Progress(f"deriving {args.model} to order {args.order}", not args.json)
-    sol = derive(model_by_name(args.model, args.order), args.order, progress)
+    model = _free_model(args, args.order)
+    progress = Progress(f"deriving {model.name} to order {args.order}", not args.json)
+    sol = derive(model, args.order, progress)
     progress.close()
     print(json.dumps(series_json(sol)) if args.json else series_table(sol))
     return 0
 
 
+def _cmd_models(args: argparse.Namespace) -> int:
+    from .models import REGISTRY
+
+    if args.json:
+        print(json.dumps([{"name": e.name, "equation": e.equation, "about": e.about}
+                          for e in REGISTRY.values()]))
+        return 0
+    width = max(len(name) for name in REGISTRY)
+    for e in REGISTRY.values():
+        print(f"{e.name:<{width}}  {e.equation:<44}  {e.about}")
+    return 0
+
+
 def _cmd_generate(args: argparse.Namespace) -> int:
     order = args.order
-    if args.model in ("driven", "balance", "fourier") and args.allow_divergent:
+    if args.model in EMITTED and (args.param or args.name):
+        raise InputError(f"--param/--name: the {args.model} modules take neither")
+    if args.model in EMITTED and args.allow_divergent:
         raise InputError(f"--allow-divergent: the {args.model} evaluators have no radius to lift")
     from . import emit
 
@@ -133,8 +204,9 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     elif args.model == "fourier":
         paths = emit.generate_fourier(args.harmonics, out, overwrite_edited=args.overwrite_edited)
     else:
-        progress = Progress(f"deriving {args.model} to order {order + 2}")
-        paths = emit.generate(args.model, order, out, args.allow_divergent, progress,
+        model = _free_model(args, order + 2)
+        progress = Progress(f"deriving {model.name} to order {order + 2}")
+        paths = emit.generate(model, order, out, args.allow_divergent, progress,
                               overwrite_edited=args.overwrite_edited)
         progress.close()
     for path in paths:
@@ -910,6 +982,21 @@ class _DeprecatedForce(argparse.Action):
 # One definition per flag: the same name means the same thing, with one help text and one
 # default, in every command.
 
+def _flag_oscillator(p: argparse.ArgumentParser, emitted: bool = False) -> None:
+    """The oscillator: a name of `lindstedt models` or an equation, with --param and --name."""
+    extra = ("; or driven: μ-expansion A_n(ω), balance: harmonic-balance Newton solver, "
+             "fourier: exact Fourier series of Duffing") if emitted else ""
+    p.add_argument("model", metavar="EQUATION|NAME",
+                   help="an equation such as \"q'' + q + eps*(alpha*q**2 + q**3) = 0\" (q' and "
+                   "q'' are the derivatives, eps the small parameter, other names parameters) "
+                   f"or a name: {', '.join(FREE_MODELS)}{extra}")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="give a parameter an exact value, e.g. alpha=1/3 (repeatable; "
+                   "default: parameters stay symbolic)")
+    p.add_argument("--name", metavar="NAME",
+                   help="the oscillator's name in output and file names (default: oscillator)")
+
+
 def _flag_order(p: argparse.ArgumentParser, what: str) -> None:
     p.add_argument("--order", type=_order, default=DEFAULT_ORDER, metavar="K",
                    help=f"{what}, an integer ≥ 0 (default {DEFAULT_ORDER})")
@@ -981,19 +1068,23 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("series", help="derive the L–P series of a free oscillator",
                        description="Derive ω_j, (T/2π)_j and q_j of the L–P series exactly.")
-    p.add_argument("model", choices=FREE_MODELS, help="the oscillator")
+    _flag_oscillator(p)
     _flag_order(p, "highest order K of the series")
     _flag_json(p)
     _flag_allow_slow(p)
     p.set_defaults(func=_cmd_series)
 
+    p = sub.add_parser("models", help="list the named oscillators",
+                       description="The named oscillators: each is an equation (any equation "
+                       "of the family can be given instead of a name).")
+    _flag_json(p, "the list as JSON")
+    p.set_defaults(func=_cmd_models)
+
     p = sub.add_parser(
         "generate", help="write a numba evaluator module and LaTeX tables and derivation",
         description="Write a numba evaluator module (and for duffing, pendulum, driven its "
         "LaTeX tables and derivation) into --out.")
-    p.add_argument("model", choices=(*FREE_MODELS, "driven", "balance", "fourier"),
-                   help="duffing, pendulum: L–P series; driven: μ-expansion A_n(ω); balance: "
-                   "harmonic-balance Newton solver; fourier: exact Fourier series of Duffing")
+    _flag_oscillator(p, emitted=True)
     _flag_order(p, f"highest order K (duffing, pendulum; driven up to {DRIVEN_MAX_ORDER})")
     p.add_argument("--out", default="out", metavar="DIR",
                    help="output folder, created if missing (default out/)")

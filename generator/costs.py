@@ -61,6 +61,7 @@ def power_law(fixed: float, at_reference: float, reference: float, growth: float
 SERIES_COSTS = {
     "duffing": (0.9, 13.6, 300, 3.5),
     "pendulum": (0.9, 22.0, 100, 4.6),
+    "oscillator": (0.9, 22.0, 100, 4.6),
 }
 # NOTE: `lindstedt series MODEL --order K` (start-up, then derive): Duffing grows like K^3.5
 # (13.6 s at K = 300); the pendulum, which needs every power u^(2k+1) up to k = K, like K^4.6.
@@ -69,6 +70,7 @@ GENERATE_COSTS = {
     # model: (fixed s, s at the reference size, reference size, growth: power, or "exp" base)
     "duffing": (2.5, 80.0, 100, 2.2),
     "pendulum": (2.5, 76.0, 80, 4.0),
+    "oscillator": (2.5, 76.0, 80, 4.0),
     "balance": (3.0, 59.0, 12, 4.0),
     "fourier": (3.5, 0.0, 60, 1.0),
     "driven": (12.0, 29.0, 5, "6"),
@@ -82,6 +84,7 @@ DRIVEN_COSTS = (3.0, 13.3, 100, 3.5)
 # μ-expansion to order K on every branch: 16 s at K = 100, 57 s at 150, undamped or not.
 
 FIXED_COSTS = {
+    "models": 1.0,
     "subharmonic": 6.0,
     "mixing": 12.0,
     "clock": 5.0,
@@ -104,14 +107,20 @@ SWEEP_START = 15.0
 # grids on the loaded machine), on top of the points' work.
 
 
+def _fit(table: dict, model: str) -> tuple:
+    """A named model's own fit, else the one for a user's oscillator."""
+    return table.get(model, table["oscillator"])
+
+
 def series_cost(args: argparse.Namespace) -> Cost:
-    return Cost(power_law(*SERIES_COSTS[args.model], args.order), f"order {args.order}",
-                f"derivation for {args.model}")
+    name = args.model if args.model in SERIES_COSTS else "the oscillator"
+    return Cost(power_law(*_fit(SERIES_COSTS, args.model), args.order), f"order {args.order}",
+                f"derivation for {name}")
 
 
 def generate_seconds(model: str, size: int) -> float:
     """Estimated wall time of ``lindstedt generate MODEL`` at ``size`` (GENERATE_COSTS)."""
-    return power_law(*GENERATE_COSTS[model], size)
+    return power_law(*_fit(GENERATE_COSTS, model), size)
 
 
 def generate_cost(args: argparse.Namespace) -> Cost:
@@ -119,14 +128,14 @@ def generate_cost(args: argparse.Namespace) -> Cost:
     if args.model == "driven" and args.order > DRIVEN_MAX_ORDER:
         raise InputError(f"order {args.order}: the exact μ-expansion is emitted up to order "
                          f"{DRIVEN_MAX_ORDER} (its rational functions grow fast)")
-    if args.model in SERIES_COSTS and args.order > GENERATE_MAX_ORDER:
+    if args.model not in ("driven", "balance", "fourier") and args.order > GENERATE_MAX_ORDER:
         raise InputError(f"order {args.order}: generate stops at order {GENERATE_MAX_ORDER} (the "
                          "code printer's nesting limit); `lindstedt series` derives higher orders")
     harmonic = args.model in ("balance", "fourier")
     size = args.harmonics if harmonic else args.order
     return Cost(generate_seconds(args.model, size),
                 f"--harmonics {size}" if harmonic else f"order {size}",
-                f"generating {args.model}")
+                f"generating {args.model if args.model in GENERATE_COSTS else 'the oscillator'}")
 
 
 def driven_cost(args: argparse.Namespace) -> Cost:
@@ -213,6 +222,7 @@ COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "sweep": sweep_cost,
     "clock": fixed_cost("clock"),
     "scene": fixed_cost("scene"),
+    "models": fixed_cost("models"),
 }
 # NOTE: one estimator per command; `demo` has none: its work is the fixed built-in job
 # (`make demo`), which nothing on its command line scales.

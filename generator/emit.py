@@ -46,9 +46,9 @@ from .lower import (
     lower_fourier,
     lower_free,
 )
-from .models import check_order, model_by_name
+from .models import Model, check_order, model_by_name
 from .numerics import shoot
-from .printers import latex_expr, latex_rational, pycode
+from .printers import latex_coefficient, latex_expr, latex_rational, pycode
 
 
 def template_folder() -> Path:
@@ -162,6 +162,8 @@ def render_module(module: Module) -> str:
 
 def _signed(c: sp.Expr, factor: str, first: bool) -> str:
     """``+ \\frac{p}{q} factor`` with the sign pulled out (LaTeX)."""
+    if not c.is_Rational:  # a polynomial in the symbolic parameters: bracketed, as it is
+        return f"{'' if first else '+'} \\left({latex_expr(c)}\\right)\\,{factor}".strip()
     c = sp.Rational(c)
     sign = "-" if c < 0 else ("" if first else "+")
     mag = abs(c)
@@ -187,12 +189,12 @@ def latex_context(solution: SeriesSolution, order: int) -> dict:
     y = variable.split("=")[0].strip()
     qs = sp.latex(m.coordinate)
     rows = [
-        {"j": j, "omega": latex_rational(g.to_sympy(solution.omega[j])),
-         "tau": latex_rational(g.to_sympy(solution.period[j]))}
+        {"j": j, "omega": latex_coefficient(g.to_sympy(solution.omega[j])),
+         "tau": latex_coefficient(g.to_sympy(solution.period[j]))}
         for j in range(order + 1)
     ]
     fourier = [
-        {"j": j, "n": n, "c": latex_rational(g.to_sympy(c))}
+        {"j": j, "n": n, "c": latex_coefficient(g.to_sympy(c))}
         for j in range(order + 1) for n, c in sorted(solution.q[j].items())
     ]
     period_terms = [
@@ -403,23 +405,28 @@ def write_files(out: Path, files: Mapping[str, str | bytes], flag: str = "--out"
             tmp.unlink(missing_ok=True)
 
 
-def generate(model: str, order: int, out: Path, allow_divergent: bool = False,
+def generate(model: str | Model, order: int, out: Path, allow_divergent: bool = False,
              progress: Callable[[int, int], None] | None = None, *,
              overwrite_edited: bool = False, flag: str = "--out") -> list[Path]:
     """``lindstedt generate``: the numba module and the LaTeX of ``model`` at ``order``.
 
-    The series is derived to ``order + 2`` so the module can estimate its truncation error
-    (``progress`` follows the derivation, as in :func:`lindstedt.derive`).  Every target is
-    checked before the derivation starts (here and in every ``generate_*``).
+    ``model`` is a registry name or a :class:`Model` built for ``order + 2``: the series is
+    derived two orders further so the module can estimate its truncation error (``progress``
+    follows the derivation, as in :func:`lindstedt.derive`).  Every target is checked before
+    the derivation starts (here and in every ``generate_*``).
     """
     order = check_order(order)
-    check_writable(out, [f"{model}.py", f"{model}_tables.tex", f"{model}_derivation.tex"],
+    m = model_by_name(model, order + 2) if isinstance(model, str) else model
+    name = m.name
+    check_writable(out, [f"{name}.py", f"{name}_tables.tex", f"{name}_derivation.tex"],
                    flag, overwrite_edited)
-    command = f"lindstedt generate {model} --order {order}" + (
+    source = name if not m.source else f'"{m.source}" --name {name}' + "".join(
+        f" --param {k}={v}" for k, v in m.given)
+    command = f"lindstedt generate {source} --order {order}" + (
         " --allow-divergent" if allow_divergent else "")
-    solution = derive(model_by_name(model, order + 2), order + 2, progress)
+    solution = derive(m, order + 2, progress)
     module = lower_free(solution, command, allow_divergent)
-    files = {f"{model}.py": render_module(module)}
+    files = {f"{name}.py": render_module(module)}
     files.update(render_latex(solution, order, module.provenance))
     return write_files(out, files, flag, overwrite_edited)
 

@@ -95,14 +95,21 @@ def derive(model: Model, order: int,
     r = basis.resonant
     P = [ground.poly([zero] * r + [one])]
     DP = [P[0] * ground.scalar(-1)]  # u_0'' = -u_0
-    powers = _Powers(P, basis, sorted({n for terms in forcing for n, _ in terms}))
+    velocity = [[(a, b, ground.scalar(c)) for a, b, c in terms]
+                for terms in model.velocity_forcing]
+    powers = _Powers(P, basis, sorted({n for terms in forcing for n, _ in terms}
+                                      | {a for terms in velocity for a, _, _ in terms if a}))
     omega, W, rests = [one], [one], []
+    slopes = _Slopes(P, basis, ground, sorted({b for terms in velocity for _, b, _ in terms}))
     for j in range(1, order + 1):
         powers.extend(j - 1)
         G = ground.poly([])
         for k, terms in enumerate(forcing[:j], start=1):
             for n, c in terms:
                 G = G - powers.term(n, j - k) * c
+        for k, terms in enumerate(velocity[:j], start=1):
+            for a, b, c in terms:
+                G = G - slopes.term(powers, W, a, b, j - k) * c
         for a in range(1, j):
             G = G - DP[j - a] * W[a]
         g = G.coeffs()
@@ -174,6 +181,69 @@ class _Powers:
         return value.left_shift(shift) if shift else value
 
 
+class _Slopes:
+    """``[y^m] ω^b u^a u'^b`` for time-reversible velocity terms (b even), in the kernel's basis.
+
+    ``u'(s) = -sin s · du/dC``, so ``u'² = (1 - C²)(du/dC)²`` is a cosine sum: with
+    ``R = du/dC`` (even in C for odd u, kept in ``v = C²`` then) the term is
+    ``ω^b (1 - C²)^(b/2) R^b u^a``, and ``ω² = Σ W_i y^i`` is known below the current order.
+    """
+
+    def __init__(self, P: list, basis: Basis, ground: Ground, exponents: list[int]) -> None:
+        self.P, self.basis, self.ground = P, basis, ground
+        self.R: list = []
+        self.tables: dict[int, list] = {b: [] for b in range(2, max(exponents, default=0) + 1)}
+        self.products: dict[tuple[int, int], list] = {}
+        zero, one = ground.scalar(0), ground.scalar(1)
+        # (1 - C²) in the basis: 1 - v (odd: even functions live in v) or 1 - C²
+        self.sine2 = ground.poly([one, -one] if basis.odd else [one, zero, -one])
+
+    def _series(self, b: int) -> list:
+        return self.R if b == 1 else self.tables[b]
+
+    def _extend(self, m: int) -> None:
+        while len(self.R) <= m:
+            cs = self.P[len(self.R)].coeffs()
+            if self.basis.odd:  # d/dC Σ p_k C^(2k+1) = Σ (2k+1) p_k v^k
+                self.R.append(self.ground.poly([c * (2 * k + 1) for k, c in enumerate(cs)]))
+            else:  # d/dC Σ p_k C^k = Σ k p_k C^(k-1)
+                self.R.append(self.ground.poly([c * k for k, c in enumerate(cs)][1:]))
+        for b, table in self.tables.items():  # [y^i] R^b = Σ_a [y^a] R^(b-1) · R_(i-a)
+            prev = self._series(b - 1)
+            while len(table) <= m:
+                i = len(table)
+                acc = prev[0] * self.R[i]
+                for x in range(1, i + 1):
+                    acc = acc + prev[x] * self.R[i - x]
+                table.append(acc)
+
+    def term(self, powers: _Powers, W: list, a: int, b: int, m: int) -> Any:
+        """``[y^m] ω^b u^a u'^b / C^parity`` (``W`` holds ``ω²`` to at least ``y^m``)."""
+        self._extend(m)
+        product = self.products.setdefault((a, b), [])
+        rb = self._series(b)
+        while len(product) <= m:  # [y^i] (u^a · R^b), each index once
+            i = len(product)
+            if a == 0:
+                product.append(rb[i])
+                continue
+            acc = powers.term(a, 0) * rb[i]
+            for x in range(1, i + 1):
+                acc = acc + powers.term(a, x) * rb[i - x]
+            product.append(acc)
+        zero = self.ground.scalar(0)
+        w = [self.ground.scalar(1)] + [zero] * m  # [y^i] (ω²)^(b/2), scalars
+        for _ in range(b // 2):
+            w = [sum((w[x] * W[i - x] for x in range(i + 1)), zero) for i in range(m + 1)]
+        acc = product[m]
+        for i in range(1, m + 1):
+            if w[i]:
+                acc = acc + product[m - i] * w[i]
+        for _ in range(b // 2):
+            acc = acc * self.sine2
+        return acc
+
+
 def _square_coefficient(P: list, m: int) -> Any:
     """``[y^m] P²`` with half the products (symmetry of the convolution)."""
     acc = None
@@ -188,15 +258,16 @@ def _square_coefficient(P: list, m: int) -> Any:
 
 
 def omega_coefficients(solution: SeriesSolution) -> list[sp.Expr]:
-    """Physical ``ω_j`` (coefficient of ``coupling^j``): ``ω_j^scaled · order_factor^j``."""
+    """Physical ``ω_j`` (coefficient of ``coupling^j``): ``ω₀ ω_j^scaled · order_factor^j``."""
     m = solution.model
-    return [solution.ground.to_sympy(w) * m.order_factor**j for j, w in enumerate(solution.omega)]
+    return [m.frequency * solution.ground.to_sympy(w) * m.order_factor**j
+            for j, w in enumerate(solution.omega)]
 
 
 def period_series(solution: SeriesSolution) -> sp.Expr:
     """``T(A) = 2π Σ τ_j y^j`` (notes: ``T ≅ 2π(1 - 3εA²/8 + 57(εA²)²/256)``)."""
     y = solution.model.y
-    return 2 * sp.pi * sum(
+    return 2 * sp.pi / solution.model.frequency * sum(
         solution.ground.to_sympy(c) * y**j for j, c in enumerate(solution.period)
     )
 

@@ -174,8 +174,9 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     x, w, s, total = sp.symbols("x w s T")
     y = m.y.xreplace(to_args)
     amplitude = m.amplitude.xreplace(to_args)
-    omega = [g.to_sympy(c) for c in solution.omega[: order + 1]]
-    tau = [g.to_sympy(c) for c in solution.period[: order + 1]]
+    # ω₀ = 1 but for a user's linear frequency: ω = ω₀ Σ ω_j y^j, T = (2π/ω₀) Σ τ_j y^j
+    omega = [m.frequency * g.to_sympy(c) for c in solution.omega[: order + 1]]
+    tau = [g.to_sympy(c) / m.frequency for c in solution.period[: order + 1]]
     guard = m.orbit_condition.xreplace({sp.Symbol("Y"): x})
     radius = m.radius
     if radius is not None and not allow_divergent:
@@ -196,7 +197,7 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     domain = "NaN where no periodic orbit exists" + (
         "" if allow_divergent or radius is None else " or beyond the radius of convergence"
     )
-    tail = abs(g.to_sympy(solution.period[order + 1]))
+    tail = abs(g.to_sympy(solution.period[order + 1]) / m.frequency)
     estimate = tail * sp.Abs(x) ** (order + 1) / sp.Abs(total)
     if radius is not None:  # inf at and beyond the radius (--allow-divergent): never negative
         estimate = sp.Piecewise((estimate / (1 - sp.Abs(x) / radius), sp.Abs(x) < radius),
@@ -226,10 +227,14 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
             params, prelude, guard, ((total, horner(tau, x)),), estimate,
         ),
     )
-    Q = tuple(
-        tuple(float(g.to_sympy(solution.q[j].get(n, g.scalar(0)))) for n in range(top + 1))
-        for j in range(order + 1)
-    )
+    numeric = ()  # the coefficients as floats, where they are numbers (no symbolic parameter)
+    if g.is_rational:
+        Q = tuple(
+            tuple(float(g.to_sympy(solution.q[j].get(n, g.scalar(0)))) for n in range(top + 1))
+            for j in range(order + 1)
+        )
+        numeric = (("OMEGA", tuple(float(c) for c in omega)),
+                   ("PERIOD", tuple(float(c) for c in tau)), ("Q", Q))
     constants = (
         ("ORDER", order),
         ("MODEL", m.name),
@@ -237,9 +242,7 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
         ("CONVENTION", solution.convention),
         ("RADIUS", float(radius) if radius is not None else float("nan")),
         ("ALLOW_DIVERGENT", allow_divergent),
-        ("OMEGA", tuple(float(c) for c in omega)),
-        ("PERIOD", tuple(float(c) for c in tau)),
-        ("Q", Q),
+        *numeric,
         ("OMEGA_EXACT", tuple(str(c) for c in omega)),
         ("PERIOD_EXACT", tuple(str(c) for c in tau)),
     )
@@ -251,6 +254,10 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
         provenance=provenance(
             m.name, order, command, allow_divergent=allow_divergent,
             forcing=[[(n, str(c)) for n, c in terms] for terms in m.forcing[: order + 2]],
+            **({"equation": m.source, "frequency": str(m.frequency), "given": m.given,
+                "velocity_forcing": [[(a, b, str(c)) for a, b, c in terms]
+                                     for terms in m.velocity_forcing[: order + 2]]}
+               if m.source else {}),
         ),
     )
 

@@ -12,14 +12,18 @@ with ``y = coupling · order_factor`` the expansion variable (``x = εA²`` for 
 from __future__ import annotations
 
 import math
+import re
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import sympy as sp
 
+from .equation import Equation, parse_equation, parse_expression
 from .errors import InputError
 
 t, eps, A, theta0 = sp.symbols("t epsilon A theta_0")
 Y = sp.Symbol("Y")  # stands for the expansion variable y in conditions
+ONE = sp.Integer(1)
 
 
 @dataclass(frozen=True)
@@ -40,18 +44,26 @@ class Model:
     parameters: tuple[tuple[str, sp.Symbol], ...] = ()  # argument name -> symbol, in order
     orbit_condition: sp.Basic = sp.true  # in the symbol Y = y: a periodic orbit exists
     exact_to: int | None = None  # the highest order its forcing is complete for (None: all)
+    velocity_forcing: tuple[tuple[tuple[int, int, sp.Expr], ...], ...] = ()
+    # NOTE: time-reversible terms ``y^k c ω^b u^a u'^b`` (b even), ``((a, b, c), ...)`` per order
+    # k; ω^b comes from ``q̇ = A ω u'(s)`` (the frequency ω in units of ``frequency``).
+    frequency: sp.Expr = ONE  # ω₀, the linear frequency: time is scaled by it
+    source: str = ""  # the equation as the user wrote it ("" for the built-in constructors)
+    given: tuple[tuple[str, str], ...] = ()  # parameter values given with it (--param)
 
     @property
     def odd(self) -> bool:
         """All forcing powers odd: the solution holds odd harmonics only."""
-        return all(n % 2 == 1 for terms in self.forcing for n, _ in terms)
+        return (all(n % 2 == 1 for terms in self.forcing for n, _ in terms)
+                and all(a % 2 == 1 for terms in self.velocity_forcing for a, _, _ in terms))
 
     @property
     def y(self) -> sp.Expr:
         return self.coupling * self.order_factor
 
     def coefficients(self) -> list[sp.Expr]:
-        return [c for terms in self.forcing for _, c in terms]
+        return ([c for terms in self.forcing for _, c in terms]
+                + [c for terms in self.velocity_forcing for _, _, c in terms])
 
 
 def duffing() -> Model:
@@ -149,16 +161,277 @@ def polynomial(coefficients: dict[int, object]) -> Model:
     )
 
 
-MODELS = ("duffing", "pendulum")
+@dataclass(frozen=True)
+class Oscillator:
+    """A user's equation of motion, solved for the acceleration and sorted by what each term is.
+
+    ``q̈ = -(force(q, q̇) + parametric(q, q̇, t)) + drive(t)``: ``force`` is autonomous (its
+    linear part included), ``drive`` depends on t alone, ``parametric`` on both.  Given
+    parameter values are substituted; the others stay symbols.
+    """
+
+    name: str
+    equation: Equation
+    values: tuple[tuple[sp.Symbol, sp.Rational], ...]
+    force: sp.Expr
+    drive: sp.Expr
+    parametric: sp.Expr
+
+    @property
+    def coordinate(self) -> sp.Symbol:
+        return self.equation.coordinate
+
+    @property
+    def velocity(self) -> sp.Symbol:
+        return self.equation.derivatives[1]
+
+    @property
+    def parameters(self) -> tuple[sp.Symbol, ...]:
+        """The parameters left symbolic."""
+        given = {s for s, _ in self.values}
+        return tuple(p for p in self.equation.parameters if p not in given)
+
+    def refuse(self, method: str, why: str) -> InputError:
+        return InputError(f"{self.name} ({self.equation.text}): {method} does not apply: {why}")
+
+
+def oscillator(text: str, values: dict[str, str] | None = None, name: str = "oscillator"
+               ) -> Oscillator:
+    """Parse ``text`` (see :mod:`lindstedt.equation`) with parameter ``values`` (exact text such
+    as ``"1/3"``) into an :class:`Oscillator`; every value must name a parameter of the text."""
+    if not NAME.fullmatch(name or ""):
+        raise InputError(f"name {name!r}: letters, digits and '_' only, starting with a letter")
+    eq = parse_equation(text)
+    known = {str(p): p for p in eq.parameters}
+    subs = {}
+    for key, value in (values or {}).items():
+        if key not in known:
+            used = ", ".join(known) or "none"
+            raise InputError(f"--param {key}: not a parameter of {text!r} (its parameters: "
+                             f"{used})")
+        number = parse_expression(str(value), f"--param {key}")
+        if not number.is_Rational:
+            raise InputError(f"--param {key}={value}: not a rational number")
+        subs[known[key]] = number
+    q, v, a = eq.derivatives
+    expr = sp.expand(eq.expression.xreplace(subs))
+    mass = expr.coeff(a)
+    if mass == 0 or (expr.has(a) and (mass.has(q, v, a, eq.time)
+                                     or sp.expand(expr - mass * a).has(a))):
+        raise InputError(f"equation {text!r}: {a} must enter linearly with a constant "
+                         "coefficient")
+    if mass.free_symbols:
+        raise InputError(f"equation {text!r}: the coefficient of {a} is {mass}; give its "
+                         "parameters values (--param) or divide them out")
+    rest = sp.expand(sp.expand(expr - mass * a) / mass)
+    drive = parametric = force = sp.Integer(0)
+    for term in sp.Add.make_args(rest):
+        if not term.has(eq.time):
+            force += term
+        elif term.has(q, v):
+            parametric += term
+        else:
+            drive -= term
+    return Oscillator(name=name, equation=eq, values=tuple(sorted(subs.items(), key=str)),
+                      force=force, drive=drive, parametric=parametric)
+
+
+NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,31}")
+LP = "free L–P"
+
+
+def free_model(osc: Oscillator, order: int) -> Model:
+    """The L–P model of a free, time-reversible oscillator ``q̈ + g(q, q̇²) = 0``, sized for
+    ``order``; a one-line :class:`InputError` says why when L–P does not apply.
+
+    ``q = A u(s)``, ``s = ω₀ Ω t`` turns each term ``c ε^e q^a q̇^b`` into
+    ``c ε^e A^(a+b-1) ω₀^(b-2) Ω^b u^a u'^b``.  Every nonlinear term with ε: ``y = εA^p`` when
+    they share one ``p = a + b - 1`` and ``e = 1`` (exact rationals), else ``y = ε`` with
+    coefficients in ``QQ[A, params]``.  No ε: ``y = A^g``, the amplitude itself is small (the
+    pendulum); a non-polynomial force is Taylor-expanded to exactly the degree order K needs.
+    """
+    order = check_order(order)
+    if osc.drive != 0:
+        raise osc.refuse(LP, f"it is driven by {sp.sstr(osc.drive)} (use `lindstedt driven`)")
+    if osc.parametric != 0:
+        raise osc.refuse(LP, f"{sp.sstr(osc.parametric)} excites it parametrically")
+    q, v = osc.coordinate, osc.velocity
+    small = osc.equation.small
+    g = osc.force
+    _check_analytic(osc, g)
+    if small is not None and g.has(small) and not g.is_polynomial(q, v):
+        raise osc.refuse(LP, "eps times a non-polynomial force has infinitely many terms at "
+                         "each order of eps; drop eps (the amplitude is then the small "
+                         "quantity) or give a polynomial")
+    odd_joint = sp.expand(g.xreplace({q: -q, v: -v}) + g) == 0
+    degree = (2 if odd_joint else 1) * order + 1  # highest q^a q̇^b an order-K series needs
+    polynomial_force = g.is_polynomial(q, v)
+    if not polynomial_force:
+        lam = sp.Dummy("lam")
+        g = sp.series(g.xreplace({q: lam * q, v: lam * v}), lam, 0, degree + 1).removeO()
+        g = sp.expand(g.subs(lam, 1))
+    poly = sp.Poly(g, q, v)
+    terms = {}
+    for (a, b), c in zip(poly.monoms(), poly.coeffs(), strict=True):
+        terms[(a, b)] = sp.expand(c)
+    if terms.get((0, 0), 0) != 0:
+        raise osc.refuse(LP, f"q = 0 is no equilibrium (the force there is {terms[(0, 0)]})")
+    if any(b % 2 for a, b in terms):
+        raise osc.refuse(LP, f"a term odd in {v} dissipates or feeds energy, so there is no "
+                         "family of periodic orbits")
+    w2 = terms.pop((1, 0), sp.Integer(0))
+    if w2.free_symbols:
+        raise osc.refuse(LP, f"the linear frequency squared {w2} must be a number; give its "
+                         "parameters values (--param)")
+    if w2 <= 0:
+        raise osc.refuse(LP, f"the linear term {w2}*{q} does not restore (q = 0 is unstable "
+                         "or neutral): no oscillation about it")
+    frequency = sp.sqrt(w2)
+    nonlinear = {}
+    for (a, b), c in terms.items():
+        for e, ce in (sp.Poly(c, small).terms() if small is not None and c.has(small)
+                      else [((0,), c)]):
+            nonlinear[(a, b, e[0])] = sp.expand(ce * w2 ** sp.Rational(b - 2, 2))
+    if not nonlinear:
+        raise osc.refuse(LP, "the force is linear (a harmonic oscillator): ω = ω₀ exactly")
+    with_small = {e for _, _, e in nonlinear}
+    if small is not None and 0 in with_small and len(with_small) > 1:
+        raise osc.refuse(LP, "some nonlinear terms carry eps and some do not; put eps on every "
+                         "nonlinear term or on none")
+    p_values = {a + b - 1 for a, b, _ in nonlinear}
+    if small is None or with_small == {0}:
+        step = 2 if not polynomial_force and odd_joint else math.gcd(*p_values)
+        orders = {key: (key[0] + key[1] - 1) // step for key in nonlinear}
+        factor, coupling = A**step, sp.Integer(1)
+        variable = "A" if step == 1 else f"A**{step}"
+        scale = {key: sp.Integer(1) for key in nonlinear}
+    elif with_small == {1} and len(p_values) == 1:
+        (p,) = p_values
+        orders = {key: 1 for key in nonlinear}
+        factor, coupling = A**p, small
+        variable = f"x = eps*A**{p}" if p > 1 else "x = eps*A"
+        scale = {key: sp.Integer(1) for key in nonlinear}
+    else:
+        orders = {key: key[2] for key in nonlinear}
+        factor, coupling, variable = sp.Integer(1), small, "eps"
+        scale = {key: A ** (key[0] + key[1] - 1) for key in nonlinear}
+    top = max(orders.values())
+    by_order = [[[], []] for _ in range(max(top, order))]
+    for key in sorted(nonlinear):
+        a, b, _ = key
+        k = orders[key]
+        if k > len(by_order):
+            continue
+        c = nonlinear[key] * scale[key]
+        if b == 0:
+            by_order[k - 1][0].append((a, c))
+        else:
+            by_order[k - 1][1].append((a, b, c))
+    eq = osc.equation
+    return Model(
+        name=osc.name,
+        title=_title(osc),
+        latex=_latex(osc),
+        equation=sp.Eq(sp.Derivative(q, t, 2) + osc.force, 0),
+        coordinate=q,
+        amplitude=A,
+        coupling=coupling,
+        order_factor=factor,
+        variable=variable,
+        forcing=tuple(tuple(f) for f, _ in by_order),
+        radius=None,
+        parameters=(("A", A), *((("eps", small),) if coupling == small else ()),
+                    *((str(p), p) for p in osc.parameters)),
+        exact_to=None if polynomial_force else order,
+        velocity_forcing=tuple(tuple(vf) for _, vf in by_order),
+        frequency=frequency,
+        source=eq.text,
+        given=tuple((str(p), str(v)) for p, v in osc.values),
+    )
+
+
+def _check_analytic(osc: Oscillator, g: sp.Expr) -> None:
+    """A force analytic at the equilibrium: finite there, log and sqrt of positive values."""
+    q, v = osc.coordinate, osc.velocity
+    at_rest = {q: sp.Integer(0), v: sp.Integer(0)}
+    for f in g.atoms(sp.log, sp.Pow):
+        if isinstance(f, sp.Pow) and not ((f.exp.is_Rational and not f.exp.is_Integer)
+                                          or f.exp.is_negative):
+            continue
+        inner = f.args[0] if isinstance(f, sp.log) else f.base
+        if not inner.has(q, v):
+            continue
+        value = inner.xreplace(at_rest)
+        if value.free_symbols:
+            raise osc.refuse(LP, f"cannot tell whether {sp.sstr(f)} is analytic at {q} = 0 "
+                             "(give its parameters values)")
+        if not (value > 0 if isinstance(f, sp.log) or not f.exp.is_Integer else value != 0):
+            raise osc.refuse(LP, f"{sp.sstr(f)} is not analytic at {q} = 0")
+
+
+def _title(osc: Oscillator) -> str:
+    q = osc.coordinate
+    return f"{q}'' + {sp.sstr(osc.force)} = 0"
+
+
+def _latex(osc: Oscillator) -> str:
+    q, v = osc.coordinate, osc.velocity
+    name = sp.latex(q)
+    shown = osc.force.xreplace({v: sp.Symbol(rf"\dot{{{name}}}")})
+    return rf"\ddot{{{name}}} + {sp.latex(shown)} = 0"
+
+
+@dataclass(frozen=True)
+class Entry:
+    """A named oscillator of the registry: its equation, and how to build its model."""
+
+    name: str
+    equation: str
+    about: str
+    build: Callable[[int], Model] | None = None  # a hand-made model (radius, orbit condition)
+
+    def model(self, order: int) -> Model:
+        if self.build is not None:
+            return self.build(order)
+        return free_model(oscillator(self.equation, name=self.name), order)
+
+
+REGISTRY = {e.name: e for e in (
+    Entry("duffing", "q'' + q + eps*q**3 = 0", "hardening (eps > 0) or softening cubic spring, "
+          "notes §10.3", lambda order: duffing()),
+    Entry("pendulum", "theta'' + sin(theta) = 0", "the plane pendulum, App. 4.1", pendulum),
+    Entry("helmholtz_duffing", "q'' + q + eps*(alpha*q**2 + beta*q**3) = 0",
+          "asymmetric spring: quadratic and cubic terms (parameters stay symbolic)"),
+    Entry("quintic", "q'' + q + eps*q**5 = 0", "quintic spring"),
+    Entry("cubic_quintic", "q'' + q + eps*(q**3 + q**5) = 0", "cubic and quintic spring"),
+    Entry("velocity_squared", "q'' + q + eps*q*q'**2 = 0",
+          "position-dependent mass, time-reversible (q q̇² term)"),
+    Entry("sinh_spring", "q'' + sinh(q) = 0", "exponentially hardening spring"),
+)}
+MODELS = tuple(REGISTRY)
 
 
 def model_by_name(name: str, order: int) -> Model:
     """The named model, sized for ``order`` (the pendulum takes exactly what it needs)."""
-    if name == "duffing":
-        return duffing()
-    if name == "pendulum":
-        return pendulum(order)
-    raise InputError(f"model {name!r}: unknown; choose one of {', '.join(MODELS)}")
+    entry = REGISTRY.get(name)
+    if entry is None:
+        raise InputError(f"model {name!r}: unknown; choose one of {', '.join(MODELS)}")
+    return entry.model(order)
+
+
+def model_from_text(text: str, order: int, values: dict[str, str] | None = None,
+                    name: str | None = None) -> Model:
+    """A registry name or an equation (anything with a prime), sized for ``order``."""
+    if "'" not in text:
+        if values:
+            entry = REGISTRY.get(text)
+            if entry is not None and entry.build is None:
+                return free_model(oscillator(entry.equation, values, name or text), order)
+            raise InputError(f"--param: model {text!r} takes no parameters")
+        if name is not None and name != text:
+            raise InputError(f"--name {name}: a built-in model keeps its name {text!r}")
+        return model_by_name(text, order)
+    return free_model(oscillator(text, values, name or "oscillator"), order)
 
 
 MAX_ORDER = 100_000

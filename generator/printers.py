@@ -102,6 +102,11 @@ def latex_rational(r: sp.Rational) -> str:
     return sign + (p if q == "1" else rf"\frac{{{p}}}{{{q}}}")
 
 
+def latex_coefficient(c: sp.Expr) -> str:
+    """:func:`latex_rational` for a number, SymPy's LaTeX for a polynomial in parameters."""
+    return latex_rational(c) if c.is_Rational else sp.latex(c)
+
+
 def latex_expr(expr: sp.Basic) -> str:
     """SymPy's LaTeX for short symbolic factors (powers of A, ε, θ₀)."""
     return sp.latex(expr)

@@ -1,0 +1,276 @@
+"""User text -> SymPy, through a whitelist walker over Python's ``ast`` (nothing is evaluated).
+
+An equation of motion reads like ``q'' + q + eps*(alpha*q**2 + q**3) = 0``: the coordinate is
+the one name written with primes (``q'`` and ``q''`` are its derivatives in ``t``), ``t`` is
+time, ``eps`` the small parameter, and every other name a parameter.  The walker accepts
+numbers, names, ``+ - * / **`` with integer exponents, and calls of the analytic functions in
+:data:`FUNCTIONS` on one argument; anything else (attributes, subscripts, lambdas, strings,
+comprehensions, keywords, non-integer or huge powers) is refused with its column.  Numbers stay
+exact: ``0.1`` is ``1/10``.
+
+    >>> parse_equation("q'' + q + eps*q**3 = 0").expression
+    eps*q**3 + q + q''
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from dataclasses import dataclass
+
+import sympy as sp
+
+from .errors import InputError
+
+FUNCTIONS = {
+    "sin": sp.sin, "cos": sp.cos, "exp": sp.exp, "sinh": sp.sinh, "cosh": sp.cosh,
+    "tanh": sp.tanh, "log": sp.log, "sqrt": sp.sqrt,
+}
+# NOTE: analytic at the equilibrium as long as log's and sqrt's argument is positive there
+# (``log(1 + q)``, ``sqrt(1 + q**2)``); :mod:`models` checks that before expanding.
+TIME, SMALL = "t", "eps"
+RESERVED = frozenset(FUNCTIONS) | {"pi", "E", "I", "oo", "nan", "zoo"}
+# NOTE: names SymPy users read as constants are refused rather than taken as parameters.
+MAX_TEXT = 2000
+MAX_DEPTH = 60
+MAX_POWER = 64
+MAX_DIGITS = 40
+MAX_NAME = 32
+# NOTE: bounds that keep a hostile text from costing time or memory before any algebra
+# (``q**10**10``, ``9**9**9``, 10⁵ nested brackets); far above any oscillator's needs.
+ALLOWED = frozenset("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_+-*/().'= ")
+# NOTE: nothing else can reach a parse, so no comment (#), quote, brace or backslash of the
+# user's ever reaches a banner, a docstring or a LaTeX file.
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_PRIMED = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)('+)")
+
+
+@dataclass(frozen=True)
+class Equation:
+    """A parsed equation of motion ``expression = 0`` (left side minus right side).
+
+    ``derivatives[k]`` is the symbol standing for the k-th time derivative of the coordinate
+    (``derivatives[0]`` is the coordinate itself); ``parameters`` are the other names, sorted.
+    """
+
+    text: str
+    expression: sp.Expr
+    derivatives: tuple[sp.Symbol, ...]
+    time: sp.Symbol
+    small: sp.Symbol | None
+    parameters: tuple[sp.Symbol, ...]
+
+    @property
+    def coordinate(self) -> sp.Symbol:
+        return self.derivatives[0]
+
+
+def _fail(text: str, column: int, what: str) -> InputError:
+    return InputError(f"equation {text!r}, column {column + 1}: {what}")
+
+
+def _check_characters(text: str, what: str) -> None:
+    if len(text) > MAX_TEXT:
+        raise InputError(f"{what}: {len(text)} characters, above the limit {MAX_TEXT}")
+    for i, ch in enumerate(text):
+        if ch not in ALLOWED:
+            raise InputError(f"{what} {text!r}, column {i + 1}: character {ch!r} is not allowed "
+                             "(ASCII letters, digits, + - * / ( ) . ' = and spaces)")
+
+
+def _check_names(text: str, source: str, what: str) -> None:
+    for match in _NAME.finditer(source):
+        name, col = match.group(), match.start()
+        if col and (source[col - 1].isdigit() or source[col - 1] == "."):
+            continue  # part of a number such as 1e3
+        if name.startswith("_") or name.endswith("_"):
+            raise InputError(f"{what} {text!r}, column {col + 1}: name {name!r} may not start "
+                             "or end with '_'")
+        if len(name) > MAX_NAME:
+            raise InputError(f"{what} {text!r}, column {col + 1}: name {name[:12]}… is longer "
+                             f"than {MAX_NAME} characters")
+
+
+class _Walker:
+    """Turns a whitelisted ``ast`` expression into SymPy, or raises naming the column."""
+
+    def __init__(self, text: str, offset: int, what: str) -> None:
+        self.text, self.offset, self.what = text, offset, what
+        self.names: dict[str, int] = {}  # name -> first column
+
+    def fail(self, node: ast.AST, why: str) -> InputError:
+        col = self.offset + getattr(node, "col_offset", 0)
+        return InputError(f"{self.what} {self.text!r}, column {col + 1}: {why}")
+
+    def walk(self, node: ast.AST, depth: int = 0) -> sp.Expr:
+        if depth > MAX_DEPTH:
+            raise self.fail(node, f"nested deeper than {MAX_DEPTH} levels")
+        handler = getattr(self, f"_{type(node).__name__}", None)
+        if handler is None:
+            raise self.fail(node, f"{_describe(node)} is not allowed here")
+        return handler(node, depth + 1)
+
+    def _Expression(self, node: ast.Expression, depth: int) -> sp.Expr:
+        return self.walk(node.body, depth)
+
+    def _Constant(self, node: ast.Constant, depth: int) -> sp.Expr:
+        value = node.value
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.fail(node, f"{_describe(node)} is not allowed here")
+        segment = ast.get_source_segment(self.source, node) or repr(value)
+        digits = sum(ch.isdigit() for ch in segment)
+        if digits > MAX_DIGITS or "_" in segment:
+            raise self.fail(node, f"number {segment[:16]!r}: more than {MAX_DIGITS} digits")
+        if isinstance(value, int):
+            return sp.Integer(value)
+        mantissa, _, exponent = segment.lower().partition("e")
+        if exponent and abs(int(exponent)) > MAX_DIGITS:
+            raise self.fail(node, f"number {segment!r}: exponent beyond ±{MAX_DIGITS}")
+        # exact: the decimal text, never the binary float
+        return sp.Rational(mantissa) * sp.Integer(10) ** int(exponent or 0)
+
+    def _Name(self, node: ast.Name, depth: int) -> sp.Expr:
+        name = node.id
+        if name in RESERVED:
+            raise self.fail(node, f"{name!r} is a reserved name here"
+                            + (" (a function: call it, e.g. sin(q))" if name in FUNCTIONS
+                               else ""))
+        self.names.setdefault(name, self.offset + node.col_offset)
+        return sp.Symbol(name)
+
+    def _UnaryOp(self, node: ast.UnaryOp, depth: int) -> sp.Expr:
+        operand = self.walk(node.operand, depth)
+        if isinstance(node.op, ast.USub):
+            return -operand
+        if isinstance(node.op, ast.UAdd):
+            return operand
+        raise self.fail(node, f"operator {type(node.op).__name__} is not allowed")
+
+    def _BinOp(self, node: ast.BinOp, depth: int) -> sp.Expr:
+        if isinstance(node.op, ast.Pow):
+            return self.walk(node.left, depth) ** self._exponent(node.right)
+        ops = {ast.Add: sp.Add, ast.Sub: lambda a, b: a - b, ast.Mult: sp.Mul,
+               ast.Div: lambda a, b: a / b}
+        op = ops.get(type(node.op))
+        if op is None:
+            raise self.fail(node, f"operator {type(node.op).__name__} is not allowed "
+                            "(only + - * / **)")
+        left, right = self.walk(node.left, depth), self.walk(node.right, depth)
+        if op is ops[ast.Div] and right == 0:
+            raise self.fail(node, "division by zero")
+        return op(left, right)
+
+    def _exponent(self, node: ast.AST) -> int:
+        sign, inner = 1, node
+        if isinstance(inner, ast.UnaryOp) and isinstance(inner.op, ast.USub | ast.UAdd):
+            sign = -1 if isinstance(inner.op, ast.USub) else 1
+            inner = inner.operand
+        if not (isinstance(inner, ast.Constant) and type(inner.value) is int):
+            raise self.fail(node, "powers must be integers (write sqrt(...) for a square root)")
+        if inner.value > MAX_POWER:
+            raise self.fail(node, f"power {inner.value} is above the limit {MAX_POWER}")
+        return sign * inner.value
+
+    def _Call(self, node: ast.Call, depth: int) -> sp.Expr:
+        if not isinstance(node.func, ast.Name) or node.func.id not in FUNCTIONS:
+            name = node.func.id if isinstance(node.func, ast.Name) else _describe(node.func)
+            raise self.fail(node, f"function {name!r} is not allowed (allowed: "
+                            f"{', '.join(sorted(FUNCTIONS))})")
+        if node.keywords or len(node.args) != 1 or isinstance(node.args[0], ast.Starred):
+            raise self.fail(node, f"{node.func.id}() takes exactly one argument")
+        return FUNCTIONS[node.func.id](self.walk(node.args[0], depth))
+
+    def parse(self, source: str) -> sp.Expr:
+        if not source.strip():
+            raise InputError(f"{self.what} {self.text!r}, column {self.offset + 1}: empty side")
+        self.offset += len(source) - len(source.lstrip())  # ast counts from the first token
+        self.source = source.strip()
+        try:
+            tree = ast.parse(self.source, mode="eval")
+        except SyntaxError as exc:
+            col = self.offset + max((exc.offset or 1) - 1, 0)
+            raise InputError(f"{self.what} {self.text!r}, column {col + 1}: does not parse "
+                             f"({exc.msg})") from None
+        except (RecursionError, MemoryError, ValueError):
+            raise InputError(f"{self.what} {self.text!r}: too deeply nested to parse") from None
+        return self.walk(tree)
+
+
+def _describe(node: ast.AST) -> str:
+    kinds = {ast.Attribute: "attribute access", ast.Subscript: "indexing",
+             ast.Lambda: "a lambda", ast.JoinedStr: "an f-string", ast.Compare: "a comparison",
+             ast.ListComp: "a comprehension", ast.GeneratorExp: "a comprehension",
+             ast.SetComp: "a comprehension", ast.DictComp: "a comprehension",
+             ast.BoolOp: "a boolean operator", ast.IfExp: "a conditional",
+             ast.NamedExpr: "an assignment", ast.Await: "await", ast.Starred: "unpacking"}
+    if isinstance(node, ast.Constant):
+        return f"constant {node.value!r}"[:40]
+    return kinds.get(type(node), type(node).__name__)
+
+
+def parse_expression(text: str, what: str = "expression") -> sp.Expr:
+    """A formula without primes (a parameter value such as ``1/3``) through the walker."""
+    if not isinstance(text, str):
+        raise InputError(f"{what} {text!r}: not text")
+    _check_characters(text, what)
+    _check_names(text, text, what)
+    if "'" in text or "=" in text:
+        col = min(i for i in (text.find("'"), text.find("=")) if i >= 0)
+        raise InputError(f"{what} {text!r}, column {col + 1}: {text[col]!r} is not allowed here")
+    return _Walker(text, 0, what).parse(text)
+
+
+def parse_equation(text: str) -> Equation:
+    """Parse an equation of motion (see the module docstring); ``= 0`` may be left out."""
+    what = "equation"
+    if not isinstance(text, str):
+        raise InputError(f"equation {text!r}: not text")
+    _check_characters(text, what)
+    if text.count("=") > 1 or "==" in text:
+        raise _fail(text, text.find("="), "one '=' at most (left side = right side)")
+    # primes -> trailing underscores of the same length: the columns stay the user's
+    orders: dict[str, int] = {}
+    source = text
+    for match in _PRIMED.finditer(text):
+        name, primes = match.groups()
+        orders[name] = max(orders.get(name, 0), len(primes))
+        source = source[: match.start(2)] + "_" * len(primes) + source[match.end(2):]
+    stray = source.find("'")
+    if stray >= 0:
+        raise _fail(text, stray, "a prime belongs right after the coordinate's name (q'')")
+    _check_names(text, text.replace("'", " "), what)
+    left, _, right = source.partition("=")
+    walker = _Walker(text, 0, what)
+    lhs = walker.parse(left)
+    names = dict(walker.names)
+    rhs = sp.Integer(0)
+    if "=" in source:
+        right_walker = _Walker(text, len(left) + 1, what)
+        rhs = right_walker.parse(right)
+        for name, col in right_walker.names.items():
+            names.setdefault(name, col)
+    if len(orders) != 1:
+        if not orders:
+            raise InputError(f"equation {text!r}: no coordinate — write its acceleration with "
+                             "primes, e.g. q''")
+        raise InputError(f"equation {text!r}: primes on {', '.join(sorted(orders))}; "
+                         "one coordinate only")
+    (coordinate, top), = orders.items()
+    if coordinate in (TIME, SMALL) or coordinate in RESERVED:
+        raise InputError(f"equation {text!r}: {coordinate!r} cannot be the coordinate")
+    if top != 2:
+        raise InputError(f"equation {text!r}: the highest derivative is {coordinate}"
+                         f"{chr(39) * top}; an oscillator's equation is of second order")
+    derivatives = tuple(sp.Symbol(coordinate + "'" * k) for k in range(3))
+    rename = {sp.Symbol(coordinate + "_" * k): derivatives[k] for k in range(3)}
+    expression = (lhs - rhs).xreplace(rename)
+    others = sorted(n for n in names if n.rstrip("_") != coordinate and n not in (TIME, SMALL))
+    small = sp.Symbol(SMALL) if SMALL in names else None
+    return Equation(
+        text=text,
+        expression=expression,
+        derivatives=derivatives,
+        time=sp.Symbol(TIME),
+        small=small,
+        parameters=tuple(sp.Symbol(n) for n in others),
+    )
