@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from .equation import Equation, parse_equation, parse_expression
+from .equation import SMALL, Equation, parse_equation, parse_expression
 from .errors import InputError
 
 t, eps, A, theta0 = sp.symbols("t epsilon A theta_0")
@@ -203,6 +203,8 @@ def oscillator(text: str, values: dict[str, str] | None = None, name: str = "osc
         raise InputError(f"name {name!r}: letters, digits and '_' only, starting with a letter")
     eq = parse_equation(text)
     known = {str(p): p for p in eq.parameters}
+    if eq.small is not None:  # a value for eps too: the amplitude is then the small quantity
+        known[SMALL] = eq.small
     subs = {}
     for key, value in (values or {}).items():
         if key not in known:
