@@ -308,3 +308,127 @@ def from_fourier(coeffs: dict[int, Any], basis: Basis, ground: Ground) -> Any:
             if t:
                 mono[i] = mono[i] + a * t
     return ground.poly(mono[basis.parity :: basis.stride])
+
+
+@dataclass(frozen=True)
+class Trig:
+    """A Fourier sum with sines, ``Σ a_n cos ns + Σ b_n sin ns = P(C) + S·R(C)``.
+
+    ``C = cos s``, ``S = sin s`` (``cos ns = T_n(C)``, ``sin ns = S·U_{n-1}(C)``) and
+    ``S² = 1 − C²`` close the algebra on pairs of polynomials over the ground ring: a product
+    is four polynomial products, ``d/ds`` stays in the basis, and ``u'' + u = F`` is triangular
+    in both halves (:func:`solve_trig`).  ``docs/benchmarks.md`` measures it against the
+    Laurent form in ``z = e^{is}``.
+    """
+
+    cos_part: Any  # P(C)
+    sin_part: Any  # R(C)
+    ground: Ground
+
+    @classmethod
+    def from_fourier(cls, cosines: dict[int, Any], sines: dict[int, Any], ground: Ground
+                     ) -> Trig:
+        """From ``{n: a_n}`` and ``{n: b_n}`` (``n ≥ 1`` for sines)."""
+        if any(n < 1 for n in sines):
+            raise ValueError(f"sine harmonics {sorted(sines)}: n must be ≥ 1")
+        P = from_fourier(cosines, Basis(False), ground)
+        top = max(sines, default=0)
+        mono = [ground.scalar(0)] * max(top, 1)
+        cheb = [[1], [0, 2]]  # U_0 = 1, U_1 = 2C, U_{n+1} = 2C U_n − U_{n−1}
+        for _ in range(2, top):
+            a, b = cheb[-1], cheb[-2]
+            nxt = [0] + [2 * x for x in a]
+            for i, x in enumerate(b):
+                nxt[i] -= x
+            cheb.append(nxt)
+        for n, b in sines.items():
+            for i, u in enumerate(cheb[n - 1]):
+                if u:
+                    mono[i] = mono[i] + b * u
+        return cls(P, ground.poly(mono), ground)
+
+    def to_fourier(self) -> tuple[dict[int, Any], dict[int, Any]]:
+        """``({n: a_n}, {n: b_n})``, zero coefficients left out."""
+        g = self.ground
+        cosines = to_fourier(self.cos_part, Basis(False), g)
+        rs = self.sin_part.coeffs()
+        sines: dict[int, Any] = {}
+        half = g.scalar(Fraction(1, 2))
+        for r in reversed(rs):  # Horner: (sin ns)·C = (sin(n+1)s + sin(n−1)s)/2, then + r·S
+            shifted: dict[int, Any] = {}
+            for n, b in sines.items():
+                for m in (n + 1, n - 1):
+                    if m:
+                        shifted[m] = shifted.get(m, g.scalar(0)) + b * half
+            shifted[1] = shifted.get(1, g.scalar(0)) + r
+            sines = shifted
+        return cosines, {n: b for n, b in sorted(sines.items()) if b}
+
+    def __add__(self, other: Trig) -> Trig:
+        return Trig(self.cos_part + other.cos_part, self.sin_part + other.sin_part, self.ground)
+
+    def __sub__(self, other: Trig) -> Trig:
+        return Trig(self.cos_part - other.cos_part, self.sin_part - other.sin_part, self.ground)
+
+    def __mul__(self, other: Trig | Any) -> Trig:
+        if not isinstance(other, Trig):
+            return Trig(self.cos_part * other, self.sin_part * other, self.ground)
+        one_minus_c2 = self._one_minus_c2()
+        cos_part = self.cos_part * other.cos_part + one_minus_c2 * (self.sin_part
+                                                                    * other.sin_part)
+        sin_part = self.cos_part * other.sin_part + self.sin_part * other.cos_part
+        return Trig(cos_part, sin_part, self.ground)
+
+    def _one_minus_c2(self) -> Any:
+        g = self.ground
+        return g.poly([g.scalar(1), g.scalar(0), g.scalar(-1)])
+
+    def derivative(self) -> Trig:
+        """``d/ds``: ``d P(C) = −S P'(C)``, ``d(S R(C)) = C R − (1 − C²) R'``."""
+        g = self.ground
+        dP, dR = _dC(self.cos_part, g), _dC(self.sin_part, g)
+        C = g.poly([g.scalar(0), g.scalar(1)])
+        return Trig(C * self.sin_part - self._one_minus_c2() * dR, dP * g.scalar(-1), g)
+
+
+def _dC(poly: Any, ground: Ground) -> Any:
+    cs = poly.coeffs()
+    return ground.poly([c * k for k, c in enumerate(cs)][1:])
+
+
+@dataclass(frozen=True)
+class TrigSolved:
+    """``u'' + u = F`` in the sine-capable basis: a particular solution and the secular parts."""
+
+    particular: Trig  # up to the homogeneous a cos s + b sin s (the caller's convention)
+    secular_cos: Any  # Fourier coefficient of cos s in F
+    secular_sin: Any  # Fourier coefficient of sin s in F
+
+
+def solve_trig(F: Trig) -> TrigSolved:
+    """Particular periodic solution of ``u'' + u = F`` and the resonant (secular) parts of F.
+
+    The cosine half is :func:`solve_oscillator`'s back-substitution; in the sine half
+    ``(d²/ds² + 1)(S C^n) = S[(1 − (n+1)²) C^n + n(n−1) C^(n−2)]`` is triangular too, with a
+    zero pivot at ``S C⁰ = sin s``, whose remainder is the Fourier coefficient of ``sin s``.
+    """
+    g = F.ground
+    zero = g.scalar(0)
+    c = F.cos_part.coeffs()
+    c = c + [zero] * (2 - len(c))
+    cos_solved = solve_oscillator(c, Basis(False), g)
+    r = F.sin_part.coeffs() or [zero]
+    top = len(r) - 1
+    p = [zero] * (top + 1)
+    secular_sin = zero
+    for n in range(top, -1, -1):
+        rhs = r[n]
+        if n + 2 <= top:
+            rhs = rhs - p[n + 2] * ((n + 2) * (n + 1))
+        if n == 0:
+            secular_sin = rhs
+            continue
+        p[n] = rhs * g.scalar(Fraction(1, 1 - (n + 1) ** 2))
+    cos_particular = list(cos_solved.particular)
+    return TrigSolved(Trig(g.poly(cos_particular), g.poly(p), g), cos_solved.secular,
+                      secular_sin)

@@ -6,7 +6,15 @@ from fractions import Fraction
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from lindstedt.series import Basis, Ground, from_fourier, solve_oscillator, to_fourier
+from lindstedt.series import (
+    Basis,
+    Ground,
+    Trig,
+    from_fourier,
+    solve_oscillator,
+    solve_trig,
+    to_fourier,
+)
 
 QQ = Ground.for_coefficients([])
 rationals = st.builds(Fraction, st.integers(-99, 99).filter(bool), st.integers(1, 50))
@@ -74,3 +82,94 @@ def test_even_harmonic_in_odd_basis_is_refused():
 
     with pytest.raises(ValueError, match="odd harmonics"):
         from_fourier({2: QQ.scalar(1)}, Basis(True), QQ)
+
+
+# The sine-capable kernel (P(C) + S·R(C)) against the textbook product-to-sum rules.
+
+def sine_series():
+    return st.dictionaries(st.integers(1, 9), rationals, max_size=5)
+
+
+def trig_product(a: tuple[dict, dict], b: tuple[dict, dict]) -> tuple[dict, dict]:
+    """cos·cos, cos·sin, sin·sin by product-to-sum on Fraction dicts (sin(-n) = -sin n)."""
+    cos: dict[int, Fraction] = {}
+    sin: dict[int, Fraction] = {}
+
+    def put(table, n, v, odd):
+        if odd and n < 0:
+            n, v = -n, -v
+        n = abs(n)
+        if odd and n == 0:
+            return
+        table[n] = table.get(n, Fraction(0)) + v
+
+    (ac, as_), (bc, bs) = a, b
+    for m, x in ac.items():
+        for n, y in bc.items():
+            put(cos, m + n, x * y / 2, False)
+            put(cos, m - n, x * y / 2, False)
+        for n, y in bs.items():  # cos m · sin n = (sin(n+m) + sin(n-m))/2
+            put(sin, n + m, x * y / 2, True)
+            put(sin, n - m, x * y / 2, True)
+    for m, x in as_.items():
+        for n, y in bc.items():
+            put(sin, m + n, x * y / 2, True)
+            put(sin, m - n, x * y / 2, True)
+        for n, y in bs.items():  # sin m · sin n = (cos(m-n) - cos(m+n))/2
+            put(cos, m - n, x * y / 2, False)
+            put(cos, m + n, -x * y / 2, False)
+    return ({k: v for k, v in cos.items() if v}, {k: v for k, v in sin.items() if v})
+
+
+def trig(cos: dict, sin: dict) -> Trig:
+    return Trig.from_fourier({n: QQ.scalar(c) for n, c in cos.items()},
+                             {n: QQ.scalar(c) for n, c in sin.items()}, QQ)
+
+
+def fractions_of(t: Trig) -> tuple[dict, dict]:
+    c, s = t.to_fourier()
+    return as_fractions(c), as_fractions(s)
+
+
+@settings(max_examples=60, deadline=None)
+@given(cos_series(False), sine_series(), cos_series(False), sine_series())
+def test_trig_roundtrip_and_product(ac, as_, bc, bs):
+    assert fractions_of(trig(ac, as_)) == (ac, as_)
+    assert fractions_of(trig(ac, as_) * trig(bc, bs)) == trig_product((ac, as_), (bc, bs))
+
+
+@settings(max_examples=60, deadline=None)
+@given(cos_series(False), sine_series())
+def test_trig_derivative(ac, as_):
+    """d/ds: a_n cos ns -> -n a_n sin ns, b_n sin ns -> n b_n cos ns."""
+    cos = {n: n * b for n, b in as_.items()}
+    sin = {n: -n * a for n, a in ac.items() if n}
+    assert fractions_of(trig(ac, as_).derivative()) == (
+        {n: c for n, c in cos.items() if c}, {n: c for n, c in sin.items() if c})
+
+
+@settings(max_examples=60, deadline=None)
+@given(cos_series(False), sine_series())
+def test_trig_particular_solution_and_both_secular_parts(fc, fs):
+    """u'' + u = F: u_n = F_n/(1 - n²) for n ≠ 1 in both halves; secular parts F_1."""
+    solved = solve_trig(trig(fc, fs))
+    assert QQ.to_fraction(solved.secular_cos) == fc.get(1, 0)
+    assert QQ.to_fraction(solved.secular_sin) == fs.get(1, 0)
+    uc, us = fractions_of(solved.particular)
+    uc.pop(1, None)  # defined up to the homogeneous a cos s + b sin s
+    us.pop(1, None)
+    assert uc == {n: c / (1 - n * n) for n, c in fc.items() if n != 1}
+    assert us == {n: c / (1 - n * n) for n, c in fs.items() if n != 1}
+
+
+def test_trig_over_symbolic_parameters():
+    """QQ[a, b]: (a cos s + b sin s)² = (a² + b²)/2 + (a² − b²)/2 cos 2s + ab sin 2s."""
+    import sympy as sp
+
+    a, b = sp.symbols("a b")
+    g = Ground.for_coefficients([a, b])
+    x = Trig.from_fourier({1: g.scalar(a)}, {1: g.scalar(b)}, g)
+    cos, sin = (x * x).to_fourier()
+    assert {n: sp.expand(g.to_sympy(c)) for n, c in cos.items()} == {
+        0: sp.expand((a**2 + b**2) / 2), 2: sp.expand((a**2 - b**2) / 2)}
+    assert {n: g.to_sympy(c) for n, c in sin.items()} == {2: a * b}
