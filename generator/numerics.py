@@ -46,28 +46,122 @@ def pendulum_period_exact(theta0: ArrayLike) -> np.ndarray:
 
 # --- periodic orbits of the driven oscillator: shooting and Floquet multipliers ---------------
 
+@dataclass(frozen=True)
+class ForceTable:
+    """A polynomial force ``g(q, q̇) = Σ c_i q^(a_i) q̇^(b_i)`` of ``q̈ + g(q, q̇) = f cos ωt``
+    (its linear part included), as the arrays the compiled integrator reads."""
+
+    q_powers: np.ndarray  # a_i (int64)
+    v_powers: np.ndarray  # b_i (int64)
+    coefficients: np.ndarray  # c_i (float64)
+
+    @staticmethod
+    def of(terms: dict[tuple[int, int], float]) -> ForceTable:
+        """From ``{(a, b): c}``; zero coefficients are dropped."""
+        items = sorted((key, float(c)) for key, c in terms.items() if c != 0)
+        return ForceTable(np.array([a for (a, _), _ in items], dtype=np.int64),
+                          np.array([b for (_, b), _ in items], dtype=np.int64),
+                          np.array([c for _, c in items], dtype=np.float64))
+
+    @property
+    def terms(self) -> dict[tuple[int, int], float]:
+        return {(int(a), int(b)): float(c) for a, b, c in
+                zip(self.q_powers, self.v_powers, self.coefficients, strict=True)}
+
+    @property
+    def odd(self) -> bool:
+        """``g(−q, −q̇) = −g(q, q̇)``: a periodic response to ``cos ωt`` holds odd harmonics."""
+        return bool(np.all((self.q_powers + self.v_powers) % 2 == 1))
+
+    @property
+    def dissipative(self) -> bool:
+        """A term odd in ``q̇``: the flow does not keep area (``det M ≠ 1`` in general), so
+        stability asks every Floquet multiplier inside the unit circle."""
+        return bool(np.any(self.v_powers % 2 == 1))
+
+    @property
+    def cubic(self) -> np.ndarray | None:
+        """``(k₁, k₃, γ)`` when the force is ``k₁q + k₃q³ + γq̇`` (eq. 10.60's form, any of
+        them zero): the integrator's unrolled fast path; else ``None``."""
+        terms = self.terms
+        if not set(terms) <= {(1, 0), (3, 0), (0, 1)}:
+            return None
+        return np.array([terms.get((1, 0), 0.0), terms.get((3, 0), 0.0),
+                         terms.get((0, 1), 0.0)])
+
+    @property
+    def degree(self) -> int:
+        return int(np.max(self.q_powers + self.v_powers, initial=1))
+
+
+def duffing_table(eps: float, damping: float) -> ForceTable:
+    """Eq. 10.60's force ``q + εq³ + q̇/Q`` as a :class:`ForceTable`."""
+    return ForceTable.of({(1, 0): 1.0, (3, 0): eps, (0, 1): damping})
+
+
 @njit(cache=True)
-def _rhs(t: float, y: np.ndarray, eps: float, force: float, omega: float, damping: float,
-         out: np.ndarray) -> None:
-    """Eq. 10.60 and its variational equation: y = (q, p, M11, M21, M12, M22)."""
+def _power(x: float, n: int) -> float:
+    """``x**n`` for an integer ``n ≥ 0`` by multiplication (the low powers unrolled)."""
+    if n == 0:
+        return 1.0
+    if n == 1:
+        return x
+    if n == 2:
+        return x * x
+    if n == 3:
+        return x * x * x
+    out = x * x * x
+    for _ in range(n - 3):
+        out *= x
+    return out
+
+
+@njit(cache=True)
+def _table_force(q: float, p: float, qp: np.ndarray, vp: np.ndarray,
+                 cs: np.ndarray) -> tuple[float, float, float]:
+    """``g = Σ c q^a p^b`` and its partial derivatives ``∂g/∂q``, ``∂g/∂p``."""
+    g, gq, gp = 0.0, 0.0, 0.0
+    for i in range(cs.size):
+        a, b, c = qp[i], vp[i], cs[i]
+        qa, pb = _power(q, a), _power(p, b)
+        g += c * qa * pb
+        if a > 0:
+            gq += c * a * _power(q, a - 1) * pb
+        if b > 0:
+            gp += c * b * qa * _power(p, b - 1)
+    return g, gq, gp
+
+
+@njit(cache=True)
+def _rhs(t: float, y: np.ndarray, qp: np.ndarray, vp: np.ndarray, cs: np.ndarray,
+         cubic: np.ndarray | None, force: float, omega: float, out: np.ndarray) -> None:
+    """``q̈ = f cos ωt − Σ c q^a q̇^b`` and its variational equation:
+    y = (q, p, M11, M21, M12, M22).  ``cubic``: ``None``, or ``(k₁, k₃, γ)`` when the table
+    is ``k₁q + k₃q³ + γq̇`` (:attr:`ForceTable.cubic`): then the force is evaluated unrolled
+    (numba compiles the kernel once for each case and drops the branch not taken)."""
     q, p = y[0], y[1]
+    if cubic is not None:  # the fast path (eq. 10.60)
+        g = cubic[0] * q + cubic[1] * q * q * q + cubic[2] * p
+        gq, gp = cubic[0] + 3.0 * cubic[1] * q * q, cubic[2]
+    else:
+        g, gq, gp = _table_force(q, p, qp, vp, cs)
     out[0] = p
-    out[1] = force * np.cos(omega * t) - damping * p - q - eps * q**3
-    k = -1.0 - 3.0 * eps * q * q
+    out[1] = force * np.cos(omega * t) - g
     for col in range(2):
-        a, b = y[2 + 2 * col], y[3 + 2 * col]
-        out[2 + 2 * col] = b
-        out[3 + 2 * col] = k * a - damping * b
+        u, w = y[2 + 2 * col], y[3 + 2 * col]
+        out[2 + 2 * col] = w
+        out[3 + 2 * col] = -gq * u - gp * w
 
 
 @njit(cache=True)
-def _rk4(y0: np.ndarray, t0: float, t1: float, steps: int, eps: float, force: float,
-         omega: float, damping: float, samples: int,
+def _rk4(y0: np.ndarray, t0: float, t1: float, steps: int, qp: np.ndarray, vp: np.ndarray,
+         cs: np.ndarray, cubic: np.ndarray | None, force: float, omega: float, samples: int,
          bound: float) -> tuple[np.ndarray, np.ndarray, float]:
-    """Classical RK4 with ``steps`` steps; returns the end state, ``samples`` equispaced
-    values of q on [t0, t1) (``steps`` must be a multiple of ``samples``) and the time the
-    trajectory escaped (−1 if it did not): ``|q| > bound`` moving outward (``q q̇ ≥ 0``), where
-    it stops, the state and the samples not reached NaN."""
+    """Classical RK4 with ``steps`` steps on ``q̈ + Σ c q^a q̇^b = f cos ωt`` (the table
+    ``qp, vp, cs``); returns the end state, ``samples`` equispaced values of q on [t0, t1)
+    (``steps`` must be a multiple of ``samples``) and the time the trajectory escaped (−1 if
+    it did not): ``|q| > bound`` moving outward (``q q̇ ≥ 0``), where it stops, the state and
+    the samples not reached NaN."""
     h = (t1 - t0) / steps
     y = y0.copy()
     k1, k2, k3, k4 = np.empty(6), np.empty(6), np.empty(6), np.empty(6)
@@ -79,14 +173,18 @@ def _rk4(y0: np.ndarray, t0: float, t1: float, steps: int, eps: float, force: fl
         if i % every == 0:
             qs[i // every] = y[0]
         t = t0 + i * h
-        _rhs(t, y, eps, force, omega, damping, k1)
-        tmp[:] = y + 0.5 * h * k1
-        _rhs(t + 0.5 * h, tmp, eps, force, omega, damping, k2)
-        tmp[:] = y + 0.5 * h * k2
-        _rhs(t + 0.5 * h, tmp, eps, force, omega, damping, k3)
-        tmp[:] = y + h * k3
-        _rhs(t + h, tmp, eps, force, omega, damping, k4)
-        y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        _rhs(t, y, qp, vp, cs, cubic, force, omega, k1)
+        for j in range(6):  # elementwise: no temporary arrays in the loop
+            tmp[j] = y[j] + 0.5 * h * k1[j]
+        _rhs(t + 0.5 * h, tmp, qp, vp, cs, cubic, force, omega, k2)
+        for j in range(6):
+            tmp[j] = y[j] + 0.5 * h * k2[j]
+        _rhs(t + 0.5 * h, tmp, qp, vp, cs, cubic, force, omega, k3)
+        for j in range(6):
+            tmp[j] = y[j] + h * k3[j]
+        _rhs(t + h, tmp, qp, vp, cs, cubic, force, omega, k4)
+        for j in range(6):
+            y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
         if abs(y[0]) > bound and y[0] * y[1] >= 0.0:
             escaped = t + h
             for j in range(i // every + 1, samples):
@@ -121,21 +219,32 @@ def escape_bound(eps: float, force: float) -> float:
     return x
 
 
+def flow_table(table: ForceTable, force: float, omega: float, y0: np.ndarray, period: float,
+               samples: int = 64, steps: int | None = None,
+               bound: float = math.inf) -> tuple[np.ndarray, np.ndarray, float]:
+    """One period of ``q̈ + g(q, q̇) = f cos ωt`` (``g`` the table) from ``y0`` with its
+    monodromy columns, ``samples`` values of q over it and the time the trajectory escaped
+    past ``bound`` (−1 if it did not; the state and the samples from there are NaN):
+    Richardson-extrapolated from two RK4 step sizes, or plain RK4 with ``steps`` steps."""
+    state = np.concatenate([np.asarray(y0, dtype=float), [1.0, 0.0, 0.0, 1.0]])
+    bound = float(bound)
+    args = (table.q_powers, table.v_powers, table.coefficients, table.cubic, float(force),
+            float(omega))
+    if steps is not None:
+        return _rk4(state, 0.0, period, steps, *args, samples, bound)
+    coarse, qc, tc = _rk4(state, 0.0, period, STEPS_PER_PERIOD, *args, samples, bound)
+    fine, qf, tf = _rk4(state, 0.0, period, 2 * STEPS_PER_PERIOD, *args, samples, bound)
+    escaped = min((t for t in (tc, tf) if t >= 0), default=-1.0)
+    return fine + (fine - coarse) / 15, qf + (qf - qc) / 15, escaped
+
+
 def flow_escape(y0: np.ndarray, period: float, eps: float, force: float, omega: float,
                 damping: float, samples: int = 64, steps: int | None = None,
                 bound: float = math.inf) -> tuple[np.ndarray, np.ndarray, float]:
     """:func:`flow` and the time the trajectory escaped past ``bound`` (−1 if it did not; the
     state and the samples from there are NaN)."""
-    state = np.concatenate([y0, [1.0, 0.0, 0.0, 1.0]])
-    bound = float(bound)
-    if steps is not None:
-        return _rk4(state, 0.0, period, steps, eps, force, omega, damping, samples, bound)
-    coarse, qc, tc = _rk4(state, 0.0, period, STEPS_PER_PERIOD, eps, force, omega, damping,
-                          samples, bound)
-    fine, qf, tf = _rk4(state, 0.0, period, 2 * STEPS_PER_PERIOD, eps, force, omega, damping,
-                        samples, bound)
-    escaped = min((t for t in (tc, tf) if t >= 0), default=-1.0)
-    return fine + (fine - coarse) / 15, qf + (qf - qc) / 15, escaped
+    return flow_table(duffing_table(eps, damping), force, omega, y0, period, samples, steps,
+                      bound)
 
 
 def flow(y0: np.ndarray, period: float, eps: float, force: float, omega: float,
@@ -214,21 +323,34 @@ def shoot_explained(eps: float, force: float, omega: float, damping: float, gues
                     harmonics: int = 9, tol: float = 1e-12, max_iter: int = 30,
                     periods: int = 1, steps: int | None = None
                     ) -> PeriodicOrbit | ShootingFailure:
-    """Newton's method on ``φ_T(y₀) − y₀ = 0`` (the monodromy matrix is its Jacobian + I).
+    """:func:`shoot_table` on eq. 10.60 (``q + εq³ + q̇/Q``), with the escape bound of a
+    softening spring's well (:func:`escape_bound`)."""
+    return shoot_table(duffing_table(eps, damping), force, omega, guess, harmonics, tol,
+                       max_iter, periods, steps, escape_bound(eps, force))
 
-    Stability from the Floquet multipliers: damped, stable when all ``|λ| < 1``; undamped
-    (Hamiltonian, ``det M = 1``), linearly stable when the pair lies on the unit circle,
-    i.e. ``|tr M| < 2`` (a real pair ``λ, 1/λ`` with ``|tr M| > 2`` is unstable).
+
+def shoot_table(table: ForceTable, force: float, omega: float, guess: np.ndarray,
+                harmonics: int = 9, tol: float = 1e-12, max_iter: int = 30,
+                periods: int = 1, steps: int | None = None, bound: float = math.inf
+                ) -> PeriodicOrbit | ShootingFailure:
+    """Newton's method on ``φ_T(y₀) − y₀ = 0`` for ``q̈ + g(q, q̇) = f cos ωt`` (``g`` the
+    polynomial ``table``); the monodromy matrix is its Jacobian + I.
+
+    Stability from the Floquet multipliers: dissipative (a term odd in q̇, e.g. q̇/Q), stable
+    when all ``|λ| < 1``; otherwise (area-preserving, ``det M = 1``), linearly stable when the
+    pair lies on the unit circle, i.e. ``|tr M| < 2`` (a real pair ``λ, 1/λ`` with
+    ``|tr M| > 2`` is unstable).  ``A``, ``B``: the odd harmonics for an odd force, else every
+    harmonic up to ``harmonics`` with the mean as ``A[0]``.
     ``periods = p`` looks for an orbit of p drive periods; its ``A``, ``B`` are then the
     coefficients of ``cos(nωt/p)``, ``sin(nωt/p)``.  ``steps``: plain RK4 with that many
     steps per orbit instead of the Richardson pair (cheaper, less accurate).  Where Newton's
-    method finds no orbit, a :class:`ShootingFailure` says why: a trajectory that escapes the
-    well (a softening spring: ``|q|`` past :func:`escape_bound` moving outward, from the guess
-    or from a Newton iterate), RK4 overflowing, a singular ``M − I``, or no convergence.
+    method finds no orbit, a :class:`ShootingFailure` says why: a trajectory that escapes
+    past ``bound`` (a softening spring's well: ``|q|`` past :func:`escape_bound` moving
+    outward, from the guess or from a Newton iterate), RK4 overflowing, a singular ``M − I``,
+    or no convergence.
     """
     T = periods * 2 * np.pi / omega  # periods = 3: the 1/3 subharmonic (eq. 10.83)
     samples = _samples(harmonics, STEPS_PER_PERIOD if steps is None else steps)
-    bound = escape_bound(eps, force)
     y = np.array(guess, dtype=float)
 
     def escape(k: int | None, y: np.ndarray, at: float) -> ShootingFailure:
@@ -243,7 +365,7 @@ def shoot_explained(eps: float, force: float, omega: float, damping: float, gues
 
     step = np.full(2, np.nan)
     for k in range(max_iter):
-        end, _, at = flow_escape(y, T, eps, force, omega, damping, steps=steps, bound=bound)
+        end, _, at = flow_table(table, force, omega, y, T, steps=steps, bound=bound)
         if at >= 0:
             return escape(k, y, at)
         if not np.all(np.isfinite(end)):  # RK4 overflowed: h is too big for the amplitude
@@ -265,18 +387,22 @@ def shoot_explained(eps: float, force: float, omega: float, damping: float, gues
         return ShootingFailure(f"Newton's method did not converge in {max_iter} iterations "
                                f"(last step {np.max(np.abs(step)):.1e}, tolerance {tol:g})",
                                False, bound)
-    end, qs, at = flow_escape(y, T, eps, force, omega, damping, samples=samples, steps=steps,
-                              bound=bound)
+    end, qs, at = flow_table(table, force, omega, y, T, samples=samples, steps=steps,
+                           bound=bound)
     if at >= 0:
         return escape(None, y, at)
     if not (np.all(np.isfinite(end)) and np.all(np.isfinite(qs))):
         return ShootingFailure("RK4 overflowed on the converged orbit", False, bound)
     Mono = end[2:].reshape(2, 2).T
     lam = np.linalg.eigvals(Mono)
-    stable = bool(np.all(np.abs(lam) < 1) if damping > 0 else abs(np.trace(Mono)) < 2)
+    stable = bool(np.all(np.abs(lam) < 1) if table.dissipative
+                  else abs(np.trace(Mono)) < 2)
     c = np.fft.rfft(qs) / len(qs)
-    A = {n: float(2 * c[n].real) for n in range(1, harmonics + 1, 2)}
-    B = {n: float(-2 * c[n].imag) for n in range(1, harmonics + 1, 2)}
+    odd = table.odd
+    A = {n: float(2 * c[n].real) for n in range(1, harmonics + 1, 2 if odd else 1)}
+    B = {n: float(-2 * c[n].imag) for n in range(1, harmonics + 1, 2 if odd else 1)}
+    if not odd:
+        A = {0: float(c[0].real), **A}
     return PeriodicOrbit(y, A, B, lam, stable, float(np.max(np.abs(end[:2] - y))))
 
 
