@@ -254,6 +254,8 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
         provenance=provenance(
             m.name, order, command, allow_divergent=allow_divergent,
             forcing=[[(n, str(c)) for n, c in terms] for terms in m.forcing[: order + 2]],
+            **({"elementary": [(n, str(a), str(w)) for n, a, w in m.elementary]}
+               if m.elementary else {}),
             **({"equation": m.source, "frequency": str(m.frequency), "given": m.given,
                 "velocity_forcing": [[(a, b, str(c)) for a, b, c in terms]
                                      for terms in m.velocity_forcing[: order + 2]]}

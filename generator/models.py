@@ -50,6 +50,9 @@ class Model:
     frequency: sp.Expr = ONE  # ω₀, the linear frequency: time is scaled by it
     source: str = ""  # the equation as the user wrote it ("" for the built-in constructors)
     given: tuple[tuple[str, str], ...] = ()  # parameter values given with it (--param)
+    elementary: tuple[tuple[str, sp.Expr, sp.Expr], ...] = ()
+    # NOTE: forces ``w (F(λAu) − λAu)/A`` with F = sin or sinh, ``(name, λ, w)``, every order of
+    # y = A² (odd): summed by recurrence, not Taylor term by term (the pendulum: ("sin", 1, 1))
 
     @property
     def odd(self) -> bool:
@@ -63,7 +66,8 @@ class Model:
 
     def coefficients(self) -> list[sp.Expr]:
         return ([c for terms in self.forcing for _, c in terms]
-                + [c for terms in self.velocity_forcing for _, _, c in terms])
+                + [c for terms in self.velocity_forcing for _, _, c in terms]
+                + [c for _, lam, w in self.elementary for c in (lam, w)])
 
 
 def duffing() -> Model:
@@ -89,16 +93,13 @@ def duffing() -> Model:
 def pendulum(order: int) -> Model:
     """``θ̈ + sin θ = 0`` (notes App. 4.1), expanded in ``θ₀²``.
 
-    ``sin(θ₀u)/θ₀ = u + Σ_k (-1)^k θ₀^(2k) u^(2k+1)/(2k+1)!``: order K needs exactly the
-    terms ``k = 1..K`` of the Taylor series of sin, and the model holds no more.
-    The period ``4K(sin²(θ₀/2))`` is singular at the separatrix ``θ₀ = π``: radius ``π²``.
+    ``sin(θ₀u)/θ₀ − u`` enters every order of ``θ₀²``; the kernel sums it by the recurrence of
+    sine and cosine of a series (``elementary``), so the model is exact at every order
+    (``order`` only checks the argument: it once sized a Taylor polynomial).  The period
+    ``4K(sin²(θ₀/2))`` is singular at the separatrix ``θ₀ = π``: radius ``π²``.
     """
-    order = check_order(order)
+    check_order(order)
     th = sp.Symbol("theta")
-    forcing = tuple(
-        ((2 * k + 1, sp.Rational((-1) ** k, math.factorial(2 * k + 1))),)
-        for k in range(1, order + 1)
-    )
     return Model(
         name="pendulum",
         title="theta'' + sin(theta) = 0",
@@ -109,11 +110,11 @@ def pendulum(order: int) -> Model:
         coupling=sp.Integer(1),
         order_factor=theta0**2,
         variable="theta0**2",
-        forcing=forcing,
+        forcing=(),
         radius=sp.pi**2,
         parameters=(("theta0", theta0),),
         orbit_condition=sp.Lt(Y, sp.pi**2),  # |θ₀| ≥ π: over the top, no libration
-        exact_to=order,
+        elementary=(("sin", sp.Integer(1), sp.Integer(1)),),
     )
 
 
@@ -267,6 +268,20 @@ def free_model(osc: Oscillator, order: int) -> Model:
                          "quantity) or give a polynomial")
     odd_joint = sp.expand(g.xreplace({q: -q, v: -v}) + g) == 0
     degree = (2 if odd_joint else 1) * order + 1  # highest q^a q̇^b an order-K series needs
+    elementary, linear = [], sp.Integer(0)
+    if small is None and odd_joint and not g.has(v):  # c sin(λq), c sinh(λq): by recurrence
+        rest = sp.Integer(0)
+        for term in sp.Add.make_args(sp.expand(g)):
+            found = _elementary_term(term, q)
+            if found is None:
+                rest += term
+            else:
+                elementary.append(found)
+                linear += found[2] * found[1]
+        if elementary and rest.is_polynomial(q, v):
+            g = rest
+        else:
+            elementary, linear = [], sp.Integer(0)
     polynomial_force = g.is_polynomial(q, v)
     if not polynomial_force:
         lam = sp.Dummy("lam")
@@ -275,13 +290,14 @@ def free_model(osc: Oscillator, order: int) -> Model:
     poly = sp.Poly(g, q, v)
     terms = {}
     for (a, b), c in zip(poly.monoms(), poly.coeffs(), strict=True):
-        terms[(a, b)] = sp.expand(c)
+        if sp.expand(c) != 0:
+            terms[(a, b)] = sp.expand(c)
     if terms.get((0, 0), 0) != 0:
         raise osc.refuse(LP, f"q = 0 is no equilibrium (the force there is {terms[(0, 0)]})")
     if any(b % 2 for a, b in terms):
         raise osc.refuse(LP, f"a term odd in {v} dissipates or feeds energy, so there is no "
                          "family of periodic orbits")
-    w2 = terms.pop((1, 0), sp.Integer(0))
+    w2 = terms.pop((1, 0), sp.Integer(0)) + linear
     if w2.free_symbols:
         raise osc.refuse(LP, f"the linear frequency squared {w2} must be a number; give its "
                          "parameters values (--param)")
@@ -294,7 +310,7 @@ def free_model(osc: Oscillator, order: int) -> Model:
         for e, ce in (sp.Poly(c, small).terms() if small is not None and c.has(small)
                       else [((0,), c)]):
             nonlinear[(a, b, e[0])] = sp.expand(ce * w2 ** sp.Rational(b - 2, 2))
-    if not nonlinear:
+    if not nonlinear and not elementary:
         raise osc.refuse(LP, "the force is linear (a harmonic oscillator): ω = ω₀ exactly")
     with_small = {e for _, _, e in nonlinear}
     if small is not None and 0 in with_small and len(with_small) > 1:
@@ -302,7 +318,7 @@ def free_model(osc: Oscillator, order: int) -> Model:
                          "nonlinear term or on none")
     p_values = {a + b - 1 for a, b, _ in nonlinear}
     if small is None or with_small == {0}:
-        step = 2 if not polynomial_force and odd_joint else math.gcd(*p_values)
+        step = 2 if (elementary or not polynomial_force) and odd_joint else math.gcd(*p_values)
         orders = {key: (key[0] + key[1] - 1) // step for key in nonlinear}
         factor, coupling = A**step, sp.Integer(1)
         variable = "A" if step == 1 else f"A**{step}"
@@ -317,7 +333,7 @@ def free_model(osc: Oscillator, order: int) -> Model:
         orders = {key: key[2] for key in nonlinear}
         factor, coupling, variable = sp.Integer(1), small, "eps"
         scale = {key: A ** (key[0] + key[1] - 1) for key in nonlinear}
-    top = max(orders.values())
+    top = max(orders.values(), default=0)
     by_order = [[[], []] for _ in range(max(top, order))]
     for key in sorted(nonlinear):
         a, b, _ = key
@@ -345,11 +361,29 @@ def free_model(osc: Oscillator, order: int) -> Model:
         parameters=(("A", A), *((("eps", small),) if coupling == small else ()),
                     *((str(p), p) for p in osc.parameters)),
         exact_to=None if polynomial_force else order,
+        elementary=tuple((name, lam, c / w2) for name, lam, c in elementary),
         velocity_forcing=tuple(tuple(vf) for _, vf in by_order),
         frequency=frequency,
         source=eq.text,
         given=tuple((str(p), str(v)) for p, v in osc.values),
     )
+
+
+def _elementary_term(term: sp.Expr, q: sp.Symbol) -> tuple[str, sp.Expr, sp.Expr] | None:
+    """``c·sin(λq)`` or ``c·sinh(λq)`` with constant c and λ as ``(name, λ, c)``, else None."""
+    coefficient, functions = sp.S.One, []
+    for factor in sp.Mul.make_args(term):
+        if factor.has(q):
+            functions.append(factor)
+        else:
+            coefficient *= factor
+    if len(functions) != 1 or not isinstance(functions[0], sp.sin | sp.sinh):
+        return None
+    argument = sp.expand(functions[0].args[0])
+    lam = argument.coeff(q)
+    if lam == 0 or sp.expand(argument - lam * q) != 0 or lam.has(q):
+        return None
+    return (type(functions[0]).__name__, lam, coefficient)
 
 
 def _check_analytic(osc: Oscillator, g: sp.Expr) -> None:

@@ -56,7 +56,13 @@ def test_notes_first_and_second_order(duffing40):
                                        + sp.Rational(57, 256) * eps**2 * A**4)) == T
 
 
-def _residual_polynomial(model, order):
+def _taylor_sin(order):
+    """sin(θ₀u)/θ₀ − u = Σ_k (−1)^k θ₀^(2k) u^(2k+1)/(2k+1)!, term k at order k of θ₀²."""
+    return tuple(((2 * k + 1, sp.Rational((-1) ** k, sp.factorial(2 * k + 1))),)
+                 for k in range(1, order + 1))
+
+
+def _residual_polynomial(model, order, forcing=None):
     """ω² u'' + u + Σ y^k P_k(u) as a polynomial in (y, C = cos s), by SymPy's Poly alone.
 
     ``cos ns`` is Chebyshev's ``T_n(C)`` and ``(cos ns)'' = -n² cos ns``.
@@ -75,14 +81,15 @@ def _residual_polynomial(model, order):
     upp = sum((poly(y**j) * cheb[n] * (-n * n * g(c)) for j, qj in enumerate(sol.q)
                for n, c in qj.items()), zero)
     omega = sum((poly(y**j) * g(w) for j, w in enumerate(sol.omega)), zero)
-    force = sum((poly(y**k) * (u**n) * c for k, terms in enumerate(model.forcing, 1)
+    force = sum((poly(y**k) * (u**n) * c for k, terms in enumerate(forcing or model.forcing, 1)
                  for n, c in terms), zero)
     return omega**2 * upp + u + force, y
 
 
-@pytest.mark.parametrize("model,order", [(duffing(), 6), (pendulum(5), 5)])
-def test_residual_is_exactly_of_next_order(model, order):
-    poly, _y = _residual_polynomial(model, order)
+@pytest.mark.parametrize("model,order,forcing", [(duffing(), 6, None),
+                                                 (pendulum(5), 5, _taylor_sin(5))])
+def test_residual_is_exactly_of_next_order(model, order, forcing):
+    poly, _y = _residual_polynomial(model, order, forcing)
     by_power: dict[int, list] = {}
     for (py, _), c in poly.terms():
         by_power.setdefault(py, []).append(c)
@@ -174,11 +181,15 @@ def test_order_zero():
 
 
 def test_a_model_too_small_for_the_order_is_refused():
-    """pendulum(4) holds sin's Taylor terms to θ₀⁸ only: its order-8 series would be wrong
-    from j = 5 on, so derive refuses; pendulum(8) gives the elliptic-integral coefficients."""
-    with pytest.raises(InputError, match=r"order 8: the pendulum model holds .* to order 4"):
-        derive(pendulum(4), 8)
+    """A Taylor-expanded force built for order 4 holds its terms to q⁹ only: its order-8 series
+    would be wrong from j = 5 on, so derive refuses.  The pendulum's sin is summed by
+    recurrence, exact at every order: pendulum(4) to order 8 gives the elliptic-integral
+    coefficients."""
+    from lindstedt.models import model_from_text
+
+    with pytest.raises(InputError, match=r"order 8: the oscillator model holds .* to order 4"):
+        derive(model_from_text("q'' + q*exp(-q**2) = 0", 4), 8)
     exact = pendulum_period(8)
-    got = derive(pendulum(8), 8)
-    assert [got.ground.to_fraction(c) for c in got.period] == exact
-    assert [got.ground.to_fraction(c) for c in derive(pendulum(4), 4).period] == exact[:5]
+    for model in (pendulum(8), pendulum(4), model_from_text("theta'' + sin(theta) = 0", 8)):
+        got = derive(model, 8)
+        assert [got.ground.to_fraction(c) for c in got.period] == exact
