@@ -90,30 +90,22 @@ def derive(model: Model, order: int,
     basis = Basis(model.odd)
     ground = Ground.for_coefficients(model.coefficients())
     zero, one = ground.scalar(0), ground.scalar(1)
-    forcing = [[(n, ground.scalar(c)) for n, c in terms] for terms in model.forcing]
     # u_0 = cos s: one monomial at the resonant index.
     r = basis.resonant
     P = [ground.poly([zero] * r + [one])]
     DP = [P[0] * ground.scalar(-1)]  # u_0'' = -u_0
-    velocity = [[(a, b, ground.scalar(c)) for a, b, c in terms]
-                for terms in model.velocity_forcing]
-    powers = _Powers(P, basis, sorted({n for terms in forcing for n, _ in terms}
-                                      | {a for terms in velocity for a, _, _ in terms if a}))
     omega, W, rests = [one], [one], []
-    slopes = _Slopes(P, basis, ground, sorted({b for terms in velocity for _, b, _ in terms}))
+    forces = _Forces(model, P, W, basis, ground)
     elementary = [_Elementary(P, ground, name, lam, weight)
                   for name, lam, weight in model.elementary]
     for j in range(1, order + 1):
-        powers.extend(j - 1)
         G = ground.poly([])
         for e in elementary:
             G = G - e.forcing(j)
-        for k, terms in enumerate(forcing[:j], start=1):
-            for n, c in terms:
-                G = G - powers.term(n, j - k) * c
-        for k, terms in enumerate(velocity[:j], start=1):
-            for a, b, c in terms:
-                G = G - slopes.term(powers, W, a, b, j - k) * c
+        for k in range(1, j + 1):
+            term = forces.term(k, j - k)
+            if term is not None:
+                G = G - term
         for a in range(1, j):
             G = G - DP[j - a] * W[a]
         g = G.coeffs()
@@ -146,45 +138,6 @@ def derive(model: Model, order: int,
         q=tuple(to_fourier(Pj, basis, ground) for Pj in P),
         forcing=tuple(rests),
     )
-
-
-class _Powers:
-    """``[y^m] P^n`` for the forcing powers, built order by order from ``P^(n-s)·P^s``."""
-
-    def __init__(self, P: list, basis: Basis, needed: list[int]) -> None:
-        self.P, self.basis = P, basis
-        step = basis.stride  # odd models: only odd powers (and P² as the step)
-        chain = set()
-        for n in needed:
-            while n > 1:
-                chain.add(n)
-                n -= step
-        chain.add(step)
-        self.tables = {n: [] for n in sorted(chain) if n > 1}
-        self.step = step
-
-    def series(self, n: int) -> list:
-        return self.P if n == 1 else self.tables[n]
-
-    def extend(self, m: int) -> None:
-        """Make ``[y^m] P^n`` available for every tracked ``n`` (needs ``P_0..P_m``)."""
-        for n, table in self.tables.items():
-            if len(table) > m:
-                continue
-            if n == 2:
-                acc = _square_coefficient(self.P, m)
-            else:
-                a_series, b_series = self.series(n - self.step), self.series(self.step)
-                acc = a_series[0] * b_series[m]
-                for a in range(1, m + 1):
-                    acc = acc + a_series[a] * b_series[m - a]
-            table.append(acc)
-
-    def term(self, n: int, m: int) -> Any:
-        """``[y^m] u^n / C^parity`` in the kernel's basis."""
-        shift = self.basis.power_shift(n)
-        value = self.series(n)[m]
-        return value.left_shift(shift) if shift else value
 
 
 class _Elementary:
@@ -237,80 +190,212 @@ class _Elementary:
         self.c[m] = acc.left_shift(1) * scale  # (C·P)(C·s) = v·(P s)
 
 
-class _Slopes:
-    """``[y^m] ω^b u^a u'^b`` for time-reversible velocity terms (b even), in the kernel's basis.
+class _Series:
+    """A power series in y whose coefficients are polynomials in the kernel's basis, computed
+    one coefficient at a time (order j needs index j − k of an order-k force, all from
+    ``u_0..u_(j-1)``).  ``odd``: in the odd basis, stored over C (``C·P(v)``); else even,
+    plain in ``v`` (in the full basis every node is plain in C)."""
 
-    ``u'(s) = -sin s · du/dC``, so ``u'² = (1 - C²)(du/dC)²`` is a cosine sum: with
-    ``R = du/dC`` (even in C for odd u, kept in ``v = C²`` then) the term is
-    ``ω^b (1 - C²)^(b/2) R^b u^a``, and ``ω² = Σ W_i y^i`` is known below the current order.
-    """
+    odd: bool
 
-    def __init__(self, P: list, basis: Basis, ground: Ground, exponents: list[int]) -> None:
-        self.P, self.basis, self.ground = P, basis, ground
-        self.R: list = []
-        self.tables: dict[int, list] = {b: [] for b in range(2, max(exponents, default=0) + 1)}
-        self.products: dict[tuple[int, int], list] = {}
-        zero, one = ground.scalar(0), ground.scalar(1)
-        # (1 - C²) in the basis: 1 - v (odd: even functions live in v) or 1 - C²
-        self.sine2 = ground.poly([one, -one] if basis.odd else [one, zero, -one])
+    def __init__(self) -> None:
+        self.cache: list = []
 
-    def _series(self, b: int) -> list:
-        return self.R if b == 1 else self.tables[b]
+    def coeff(self, i: int) -> Any:
+        while len(self.cache) <= i:
+            self.cache.append(self.compute(len(self.cache)))
+        return self.cache[i]
 
-    def _extend(self, m: int) -> None:
-        while len(self.R) <= m:
-            cs = self.P[len(self.R)].coeffs()
-            if self.basis.odd:  # d/dC Σ p_k C^(2k+1) = Σ (2k+1) p_k v^k
-                self.R.append(self.ground.poly([c * (2 * k + 1) for k, c in enumerate(cs)]))
-            else:  # d/dC Σ p_k C^k = Σ k p_k C^(k-1)
-                self.R.append(self.ground.poly([c * k for k, c in enumerate(cs)][1:]))
-        for b, table in self.tables.items():  # [y^i] R^b = Σ_a [y^a] R^(b-1) · R_(i-a)
-            prev = self._series(b - 1)
-            while len(table) <= m:
-                i = len(table)
-                acc = prev[0] * self.R[i]
-                for x in range(1, i + 1):
-                    acc = acc + prev[x] * self.R[i - x]
-                table.append(acc)
+    def compute(self, i: int) -> Any:
+        raise NotImplementedError
 
-    def term(self, powers: _Powers, W: list, a: int, b: int, m: int) -> Any:
-        """``[y^m] ω^b u^a u'^b / C^parity`` (``W`` holds ``ω²`` to at least ``y^m``)."""
-        self._extend(m)
-        product = self.products.setdefault((a, b), [])
-        rb = self._series(b)
-        while len(product) <= m:  # [y^i] (u^a · R^b), each index once
-            i = len(product)
-            if a == 0:
-                product.append(rb[i])
-                continue
-            acc = powers.term(a, 0) * rb[i]
+
+class _Solution(_Series):
+    """``u`` itself: ``P_i``, appended by :func:`derive` as each order is solved."""
+
+    def __init__(self, P: list, odd: bool) -> None:
+        super().__init__()
+        self.P, self.odd = P, odd
+
+    def coeff(self, i: int) -> Any:
+        return self.P[i]
+
+
+class _Product(_Series):
+    """``[y^i] a·b = Σ a_x b_(i−x)`` (half the products for a square); two odd factors give
+    ``C²·(…) = v·(…)``, a shift in the odd basis."""
+
+    def __init__(self, a: _Series, b: _Series, basis: Basis) -> None:
+        super().__init__()
+        self.a, self.b = a, b
+        self.odd = a.odd != b.odd
+        self.shift = 1 if basis.odd and a.odd and b.odd else 0
+
+    def compute(self, i: int) -> Any:
+        a, b = self.a, self.b
+        if a is b:
+            acc = None
+            for x in range((i + 1) // 2):
+                term = a.coeff(x) * a.coeff(i - x)
+                acc = term if acc is None else acc + term
+            acc = acc * 2 if acc is not None else None
+            if i % 2 == 0:
+                sq = a.coeff(i // 2) * a.coeff(i // 2)
+                acc = sq if acc is None else acc + sq
+        else:
+            acc = a.coeff(0) * b.coeff(i)
             for x in range(1, i + 1):
-                acc = acc + powers.term(a, x) * rb[i - x]
-            product.append(acc)
-        zero = self.ground.scalar(0)
-        w = [self.ground.scalar(1)] + [zero] * m  # [y^i] (ω²)^(b/2), scalars
-        for _ in range(b // 2):
-            w = [sum((w[x] * W[i - x] for x in range(i + 1)), zero) for i in range(m + 1)]
-        acc = product[m]
-        for i in range(1, m + 1):
-            if w[i]:
-                acc = acc + product[m - i] * w[i]
-        for _ in range(b // 2):
-            acc = acc * self.sine2
+                acc = acc + a.coeff(x) * b.coeff(i - x)
+        return acc.left_shift(self.shift) if self.shift else acc
+
+
+class _Sum(_Series):
+    """``c₀ + Σ c_k·node_k`` with exact scalars (every node of one parity)."""
+
+    def __init__(self, constant: Any, terms: list[tuple[Any, _Series]], ground: Ground,
+                 odd: bool) -> None:
+        super().__init__()
+        self.constant, self.terms, self.ground, self.odd = constant, terms, ground, odd
+
+    def compute(self, i: int) -> Any:
+        acc = self.ground.poly([self.constant] if i == 0 and self.constant else [])
+        for c, node in self.terms:
+            acc = acc + node.coeff(i) * c
         return acc
 
 
-def _square_coefficient(P: list, m: int) -> Any:
-    """``[y^m] P²`` with half the products (symmetry of the convolution)."""
-    acc = None
-    for a in range((m + 1) // 2):
-        term = P[a] * P[m - a]
-        acc = term if acc is None else acc + term
-    acc = acc * 2 if acc is not None else None
-    if m % 2 == 0:
-        sq = P[m // 2] * P[m // 2]
-        acc = sq if acc is None else acc + sq
-    return acc
+class _Slope2(_Series):
+    """``Y = ω² u'²``: ``u' = −sin s·du/dC`` gives ``u'² = (1 − C²)(du/dC)²``, a cosine sum
+    (even), and ``ω² = Σ W_i y^i`` is known below the order being solved."""
+
+    def __init__(self, P: list, W: list, basis: Basis, ground: Ground) -> None:
+        super().__init__()
+        self.odd = False
+        self.P, self.W, self.basis, self.ground = P, W, basis, ground
+        one, zero = ground.scalar(1), ground.scalar(0)
+        # (1 − C²) in the basis: 1 − v (odd: even functions live in v) or 1 − C²
+        self.sine2 = ground.poly([one, -one] if basis.odd else [one, zero, -one])
+        self.R = _Derivative(P, basis, ground)
+        self.R2 = _Product(self.R, self.R, Basis(False))  # R is even in the odd basis
+
+    def compute(self, i: int) -> Any:
+        acc = self.R2.coeff(i)
+        for x in range(1, i + 1):
+            if self.W[x]:
+                acc = acc + self.R2.coeff(i - x) * self.W[x]
+        return acc * self.sine2
+
+
+class _Derivative(_Series):
+    """``R = du/dC``: in the odd basis ``d/dC Σ p_k C^(2k+1) = Σ (2k+1) p_k v^k`` (even)."""
+
+    def __init__(self, P: list, basis: Basis, ground: Ground) -> None:
+        super().__init__()
+        self.P, self.basis, self.ground, self.odd = P, basis, ground, False
+
+    def compute(self, i: int) -> Any:
+        cs = self.P[i].coeffs()
+        if self.basis.odd:
+            return self.ground.poly([c * (2 * k + 1) for k, c in enumerate(cs)])
+        return self.ground.poly([c * k for k, c in enumerate(cs)][1:])
+
+
+class _Forces:
+    """Every polynomial force ``Σ c u^a (ω u')^b`` of the model as series nodes, in Horner
+    form with shared subexpressions: ``u·H(u², Y)`` for odd forces (``u⁵ + 2u³Y + uY²/3``
+    costs three and a half convolutions an order, not seven and a half by power tables),
+    ``H(u, Y)`` otherwise, ``Y = ω²u'²``."""
+
+    def __init__(self, model: Model, P: list, W: list, basis: Basis, ground: Ground) -> None:
+        self.basis, self.ground = basis, ground
+        self.u = _Solution(P, basis.odd)
+        self.memo: dict = {}
+        self.Y: _Slope2 | None = None
+        self.P, self.W = P, W
+        z, y = sp.symbols("z y")
+        self.z, self.y = z, y
+        self.by_order: list[_Series | None] = []
+        for k in range(max(len(model.forcing), len(model.velocity_forcing))):
+            poly = sp.Integer(0)
+            for n, c in (model.forcing[k] if k < len(model.forcing) else ()):
+                poly += self._monomial(n, 0) * c
+            for a, b, c in (model.velocity_forcing[k] if k < len(model.velocity_forcing)
+                            else ()):
+                poly += self._monomial(a, b) * c
+            self.by_order.append(self._compile(sp.expand(poly)) if poly != 0 else None)
+
+    def _monomial(self, a: int, b: int) -> sp.Expr:
+        """``u^a Y^(b/2)`` in the Horner variables (``z = u²`` over the factored u if odd)."""
+        if self.basis.odd:
+            return self.z ** ((a - 1) // 2) * self.y ** (b // 2)
+        return self.z**a * self.y ** (b // 2)
+
+    def _compile(self, poly: sp.Expr) -> _Series:
+        if not poly.free_symbols & {self.z, self.y}:  # c·u (odd basis, a = 1)
+            return _Sum(None, [(self.ground.scalar(poly), self.u)], self.ground, self.u.odd)
+        node = self._node(sp.horner(poly, self.z, self.y))
+        return self._product(self.u, node) if self.basis.odd else node
+
+    def _product(self, a: _Series, b: _Series) -> _Series:
+        key = ("*", *sorted((id(a), id(b))))
+        if key not in self.memo:
+            self.memo[key] = _Product(a, b, self.basis)
+        return self.memo[key]
+
+    def _leaf(self, symbol: sp.Symbol) -> _Series:
+        if symbol == self.y:
+            if self.Y is None:
+                self.Y = _Slope2(self.P, self.W, self.basis, self.ground)
+            return self.Y
+        if self.basis.odd:  # z = u²: even
+            return self._product(self.u, self.u)
+        return self.u
+
+    def _node(self, expr: sp.Expr) -> _Series:
+        """A series node for a polynomial expression in z, y (memoised by expression)."""
+        if expr in self.memo:
+            return self.memo[expr]
+        if expr.is_Symbol:
+            node = self._leaf(expr)
+        elif expr.is_Pow:
+            base, n = self._node(expr.base), int(expr.exp)
+            node = base
+            for _ in range(n - 1):
+                node = self._product(node, base)
+        elif expr.is_Mul:
+            scalar = sp.Integer(1)
+            nodes = []
+            for f in expr.args:
+                if f.free_symbols & {self.z, self.y}:
+                    nodes.append(self._node(f))
+                else:
+                    scalar *= f
+            node = nodes[0]
+            for other in nodes[1:]:
+                node = self._product(node, other)
+            if scalar != 1:
+                node = _Sum(None, [(self.ground.scalar(scalar), node)], self.ground, node.odd)
+        elif expr.is_Add:
+            constant, terms = None, []
+            for f in expr.args:
+                if f.free_symbols & {self.z, self.y}:
+                    inner = self._node(f)
+                    if isinstance(inner, _Sum) and inner.constant is None:
+                        terms.extend(inner.terms)
+                    else:
+                        terms.append((self.ground.scalar(1), inner))
+                else:
+                    constant = self.ground.scalar(f)
+            node = _Sum(constant, terms, self.ground, terms[0][1].odd)
+        else:
+            raise ValueError(f"force {expr}: not a polynomial in u and u'²")
+        self.memo[expr] = node
+        return node
+
+    def term(self, k: int, m: int) -> Any:
+        """``[y^m]`` of the order-k force (over C^parity), or None when it has none."""
+        node = self.by_order[k - 1] if k <= len(self.by_order) else None
+        return None if node is None else node.coeff(m)
 
 
 def omega_coefficients(solution: SeriesSolution) -> list[sp.Expr]:
