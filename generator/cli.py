@@ -194,20 +194,22 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         raise InputError(f"--param/--name: the {args.model} modules take neither")
     if args.model in EMITTED and args.allow_divergent:
         raise InputError(f"--allow-divergent: the {args.model} evaluators have no radius to lift")
-    from . import emit
+    from . import compiler
 
     out = _out_folder(args.out)
     if args.model == "driven":
-        paths = emit.generate_driven(order, out, overwrite_edited=args.overwrite_edited)
+        paths = compiler.generate_driven(order, out, overwrite_edited=args.overwrite_edited)
     elif args.model == "balance":
-        paths = emit.generate_balance(args.harmonics, out, overwrite_edited=args.overwrite_edited)
+        paths = compiler.generate_balance(args.harmonics, out,
+                                          overwrite_edited=args.overwrite_edited)
     elif args.model == "fourier":
-        paths = emit.generate_fourier(args.harmonics, out, overwrite_edited=args.overwrite_edited)
+        paths = compiler.generate_fourier(args.harmonics, out,
+                                          overwrite_edited=args.overwrite_edited)
     else:
         model = _free_model(args, order + 2)
         progress = Progress(f"deriving {model.name} to order {order + 2}")
-        paths = emit.generate(model, order, out, args.allow_divergent, progress,
-                              overwrite_edited=args.overwrite_edited)
+        paths = compiler.generate(model, order, out, args.allow_divergent, progress,
+                                  overwrite_edited=args.overwrite_edited)
         progress.close()
     for path in paths:
         print(path)
@@ -246,7 +248,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         gallery,
         speed_accuracy_figure,
     )
-    from .emit import check_writable, generate, generate_balance, generate_driven, load_generated
+    from .compiler import generate, generate_balance, generate_driven
+    from .emit import check_writable, load_generated
     from .lindstedt import derive
     from .models import model_by_name
     from .numerics import duffing_period_exact, pendulum_period_exact
@@ -454,10 +457,108 @@ def driven_table(data: dict) -> str:
     return "\n".join(lines)
 
 
+def driven_equation_json(text: str, values: dict[str, str], omega: float, harmonics: int,
+                         name: str = "oscillator") -> dict:
+    """The contract of ``lindstedt driven EQUATION … --json``: every distinct 1:1 orbit found
+    (:func:`response.equation_orbits`), largest first, each by its harmonic balance (``A``
+    holds the constant ``"0"`` and even harmonics unless the force is odd) and, checked by
+    shooting, the true orbit with its Floquet moduli and verdict."""
+    from .driven import driven_equation
+    from .response import equation_orbits
+
+    de = driven_equation(text, values, omega, name)
+    found = equation_orbits(de, harmonics)
+    branches = []
+    for orb in found.orbits:
+        hb_json = {"harmonics": harmonics, "A": {}, "B": {}, "residual": orb.residual,
+                   "converged": orb.converged, "r": None}
+        if orb.balance is not None:
+            A, B = found.system.amplitudes(orb.balance)
+            hb_json.update(A=_keyed(A), B=_keyed(B), r=_first_harmonic(A, B))
+        numerical = None
+        if orb.orbit is not None:
+            o = orb.orbit
+            numerical = {"A": _keyed(o.A), "B": _keyed(o.B), "floquet_moduli": sorted(
+                float(abs(m)) for m in o.multipliers), "stable": o.stable,
+                "r": _first_harmonic(o.A, o.B), "initial": [float(v) for v in o.initial],
+                "residual": o.residual}
+        branches.append({
+            "r": None if numerical is None else numerical["r"],
+            "stable": None if numerical is None else numerical["stable"],
+            "harmonic_balance": hb_json, "numerical": numerical,
+            **_shooting_json(orb.failure),
+        })
+    return {
+        "equation": text,
+        "name": name,
+        "parameters": {"omega": omega, "harmonics": harmonics, "values": dict(de.values),
+                       "drive": {"amplitude": de.force, "frequency": de.frequency}},
+        "force": [{"q": a, "dq": b, "c": c} for (a, b), c in sorted(de.terms.items())],
+        "odd": de.odd,
+        "branches": branches,
+        "seeding": {"complete": found.complete, "note": found.note},
+    }
+
+
+def driven_equation_table(data: dict) -> str:
+    p = data["parameters"]
+    given = ", ".join(f"{k} = {v}" for k, v in p["values"].items())
+    lines = [f"{data['equation']}: {given}{', ' if given else ''}{p['drive']['frequency']} = "
+             f"{p['omega']}"]
+    orders = ([1, 3, 5] if data["odd"] else [0, 1, 2, 3])
+    columns = ["r", *(f"A{k}" for k in orders), *(f"B{k}" for k in orders if k)]
+    for i, br in enumerate(data["branches"], 1):
+        num = br["numerical"]
+        verdict = (("escapes" if br.get("escapes") else "no orbit found") if num is None
+                   else "stable" if num["stable"] else "unstable")
+        moduli = "" if num is None else ", Floquet |lambda| = " + ", ".join(
+            f"{m:.6f}" for m in num["floquet_moduli"])
+        lines.append(f"\nbranch {i}: r = {br['r'] if br['r'] is None else round(br['r'], 6)}"
+                     f" ({verdict}{moduli})")
+        lines.append(f"{'':>22} " + " ".join(f"{c:>11}" for c in columns))
+        hb = br["harmonic_balance"]
+        rows = [(f"harmonic balance N={hb['harmonics']}", hb)]
+        if num is not None:
+            rows.append(("numerical (shooting)", num))
+        for label, row in rows:
+            if row is hb and not hb["converged"]:
+                lines.append(f"{label:>22} (did not converge)")
+                continue
+            values = {"r": row["r"], **{f"A{k}": v for k, v in row["A"].items()},
+                      **{f"B{k}": v for k, v in row["B"].items()}}
+            lines.append(f"{label:>22} " + " ".join(
+                f"{values[c]:>11.6f}" if c in values else f"{'':>11}" for c in columns))
+        if num is None and br.get("shooting_note"):
+            lines.append(f"  shooting: {br['shooting_note']}")
+    seeding = data["seeding"]
+    if not seeding["complete"]:
+        lines.append(f"\nwarning: {seeding['note']}; orbits beyond it may be missing")
+    return "\n".join(lines)
+
+
+DRIVE_FLAGS = ("eps", "force", "Q")
+
+
 def _cmd_driven(args: argparse.Namespace) -> int:
     from .driven import Drive, check_steady_state
 
-    d = Drive(args.eps, args.force, args.omega, args.Q)
+    if args.model is not None:
+        given = [f"--{k}" for k in DRIVE_FLAGS if getattr(args, k) is not None]
+        if given:
+            raise InputError(f"{', '.join(given)}: with an equation give its parameters with "
+                             "--param (e.g. --param eps=1/10) and the drive in the equation")
+        if args.omega is None:
+            raise InputError("--omega: the drive frequency is required")
+        data = driven_equation_json(args.model, _params(args.param), args.omega,
+                                    args.harmonics, args.name or "oscillator")
+        print(json.dumps(data) if args.json else driven_equation_table(data))
+        return 0
+    if args.param or args.name:
+        raise InputError("--param/--name: give an equation (EQUATION) to take them")
+    missing = [f"--{k}" for k in ("eps", "force", "omega") if getattr(args, k) is None]
+    if missing:
+        raise InputError(f"the following arguments are required: {', '.join(missing)}")
+    d = Drive(args.eps, args.force, args.omega, math.inf if args.Q is None else args.Q)
     check_steady_state(d.eps, d.Q, d.omega)
     data = driven_json(d, args.order, args.harmonics)
     print(json.dumps(data) if args.json else driven_table(data))
@@ -675,8 +776,9 @@ def _cmd_choose(args: argparse.Namespace) -> int:
     for name in ("tol", "x_min", "x_max"):
         if getattr(args, name) is None:
             raise InputError(f"choose period needs --{name.replace('_', '-')}")
-    from .choose import candidates, choose_period, modelled_ns
-    from .emit import check_writable, generate_choice
+    from .choose import choose_period, modelled_ns
+    from .compiler import generate_choice
+    from .emit import check_writable
 
     if args.emit:
         check_writable(_out_folder(args.emit, "--emit"), ["chosen_period.py"], "--emit",
@@ -684,19 +786,18 @@ def _cmd_choose(args: argparse.Namespace) -> int:
     progress = Progress("timing the verified methods", not args.json)
     choice = choose_period(args.tol, args.x_min, args.x_max, progress)
     progress.close()
-    data = {"method": choice.method, "order": choice.order, "max_error": choice.max_error,
+    data = {"method": choice.method.name, "order": choice.order,
+            "max_error": choice.max_error,
             "ns_per_point": choice.ns_per_point, "verified_on": choice.verified_on,
             "modelled_ns_per_point": modelled_ns("period", choice.method, choice.order),
             "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
             "quantity": "period", "variable": "x = eps*A**2",
             "considered": _considered(choice.considered)}
     if args.emit:
-        cand = next(c for c in candidates() if (c.method, c.order) == (choice.method,
-                                                                         choice.order))
         command = (f"lindstedt choose period --tol {args.tol!r} --x-min {args.x_min!r} "
                    f"--x-max {args.x_max!r}")
         data["emitted"] = [str(p) for p in generate_choice(
-            cand, command, Path(args.emit), (args.x_min, args.x_max),
+            choice.candidate, command, Path(args.emit), (args.x_min, args.x_max),
             overwrite_edited=args.overwrite_edited)]
     if args.json:
         print(json.dumps(data))
@@ -753,7 +854,8 @@ def _choose_q(args: argparse.Namespace) -> int:
         if getattr(args, name) is None:
             raise InputError(f"choose q needs --{name.replace('_', '-')}")
     from .choose import choose_solution, modelled_ns
-    from .emit import check_writable, generate, generate_fourier
+    from .compiler import generate_method
+    from .emit import check_writable
 
     if args.emit:
         check_writable(_out_folder(args.emit, "--emit"), ["duffing.py", "duffing_tables.tex",
@@ -762,17 +864,15 @@ def _choose_q(args: argparse.Namespace) -> int:
     c = choose_solution(args.tol, args.x_min, args.x_max, args.t_max,
                         emittable=bool(args.emit), progress=progress)
     progress.close()
-    data = {"quantity": "q", "method": c.method, "order": c.order, "max_error": c.max_error,
+    data = {"quantity": "q", "method": c.method.name, "order": c.order,
+            "max_error": c.max_error,
             "ns_per_point": c.ns_per_point, "verified_on": c.verified_on,
             "modelled_ns_per_point": modelled_ns("q", c.method, c.order),
             "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
             "considered": _considered(c.considered)}
     if args.emit:
-        options = {"flag": "--emit", "overwrite_edited": args.overwrite_edited}
-        paths = (generate("duffing", c.order, Path(args.emit), **options)
-                 if c.method == "lindstedt" else
-                 generate_fourier(c.order, Path(args.emit), **options))
-        data["emitted"] = [str(p) for p in paths]
+        data["emitted"] = [str(p) for p in generate_method(
+            c.method, c.order, Path(args.emit), overwrite_edited=args.overwrite_edited)]
     if args.json:
         print(json.dumps(data))
         return 0
@@ -801,7 +901,8 @@ def _choose_driven(args: argparse.Namespace) -> int:
 
     check_steady_state(args.eps, args.Q, lo, hi)
     from .choose import DRIVEN_MAX, choose_driven
-    from .emit import check_writable, generate_balance, generate_driven
+    from .compiler import generate_method
+    from .emit import check_writable
 
     if args.emit:
         check_writable(_out_folder(args.emit, "--emit"),
@@ -812,7 +913,7 @@ def _choose_driven(args: argparse.Namespace) -> int:
                             if args.emit else None),
                       progress=progress)
     progress.close()
-    data = {"quantity": args.quantity, "method": c.method, "order": c.order,
+    data = {"quantity": args.quantity, "method": c.method.name, "order": c.order,
             "max_error": c.max_error, "ns_per_point": c.ns_per_point,
             "verified_on": c.verified_on, "seconds": c.ns_per_point * 1e-9,
             "modelled_ns_per_point": c.modelled_ns_per_point,
@@ -826,9 +927,8 @@ def _choose_driven(args: argparse.Namespace) -> int:
     if args.omega is not None:
         data["truth"] = c.truth.A[0].tolist()
     if args.emit:
-        emit = generate_balance if c.method == "harmonic_balance" else generate_driven
-        data["emitted"] = [str(p) for p in emit(c.order, Path(args.emit), flag="--emit",
-                                                overwrite_edited=args.overwrite_edited)]
+        data["emitted"] = [str(p) for p in generate_method(
+            c.method, c.order, Path(args.emit), overwrite_edited=args.overwrite_edited)]
     if args.json:
         print(json.dumps(data))
         return 0
@@ -1096,10 +1196,24 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_overwrite_edited(p)
     p.set_defaults(func=_cmd_generate)
 
-    p = sub.add_parser("driven", help="steady 1:1 response of the driven Duffing oscillator",
-                       description="q'' + q'/Q + q + eps q^3 = f cos(w t): every 1:1 branch by "
-                       "the μ-expansion, harmonic balance and shooting.")
-    _flag_drive(p, required=True, omega="ω, the drive frequency")
+    p = sub.add_parser("driven", help="steady 1:1 response of a driven oscillator",
+                       description="q'' + q'/Q + q + eps q^3 = f cos(w t) (--eps, --force, --Q): "
+                       "every 1:1 branch by the μ-expansion, harmonic balance and shooting; or "
+                       "your own equation q'' + g(q, q') = f*cos(w*t), g a polynomial, with "
+                       "--param for its parameters: every 1:1 orbit by harmonic balance and "
+                       "shooting.")
+    p.add_argument("model", metavar="EQUATION", nargs="?", default=None,
+                   help="an equation such as \"q'' + q + eps*q**3 + gamma*q'**3 = f*cos(w*t)\" "
+                   "(a polynomial force, one drive f*cos(w*t) whose w is --omega; default: "
+                   "eq. 10.60 with --eps, --force, --Q)")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="with EQUATION: an exact value for each of its parameters, e.g. "
+                   "eps=1/10 (repeatable; every parameter but w needs one)")
+    p.add_argument("--name", metavar="NAME",
+                   help="with EQUATION: the oscillator's name in messages (default: oscillator)")
+    _flag_drive(p, required=False, omega="ω, the drive frequency (required)", Q="none")
+    p.add_argument("--Q", type=_quality, default=None, metavar="Q",
+                   help="quality factor Q > 0 of the damping q'/Q (default: inf, undamped)")
     _flag_order(p, "μ-expansion order K")
     _flag_harmonics(p, "odd harmonics N of harmonic balance")
     _flag_json(p)

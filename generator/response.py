@@ -22,7 +22,10 @@ from .driven import (
     BalanceSystem,
     Branch,
     Drive,
+    DrivenEquation,
     HarmonicBalance,
+    PolynomialBalance,
+    amplitude_bound,
     amplitudes,
     check_harmonics,
     first_order_branches,
@@ -31,12 +34,14 @@ from .driven import (
 )
 from .errors import InputError
 from .numerics import (
+    ForceTable,
     PeriodicOrbit,
     ShootingFailure,
     ToneFit,
     hill_multipliers,
     shoot,
     shoot_explained,
+    shoot_table,
     steady_state_amplitudes,
     steady_state_fit,
 )
@@ -972,3 +977,215 @@ def _shoot_seed(d: Drive, guesses: list[np.ndarray], hb: HarmonicBalance | None,
                 if isinstance(found, PeriodicOrbit):
                     return found, None
     return None, first
+
+
+# --- a user's driven oscillator: every orbit at one ω, from a continuation in the drive -------
+
+class _DriveFamily:
+    """A :class:`driven.PolynomialBalance` at fixed ω as a family in the drive amplitude f:
+    the interface :func:`_tangent` and :func:`_corrector` take, with f in ω's place."""
+
+    def __init__(self, system: PolynomialBalance, omega: float) -> None:
+        self.system, self.omega = system, omega
+
+    def residual(self, x: np.ndarray, f: float) -> np.ndarray:
+        return self.system.residual(x, self.omega, force=f)
+
+    def jacobian(self, x: np.ndarray, f: float) -> np.ndarray:
+        return self.system.jacobian(x, self.omega)
+
+    def d_omega(self, x: np.ndarray, f: float) -> np.ndarray:
+        return -self.system.drive
+
+
+@dataclass(frozen=True)
+class DriveContinuation:
+    """The balance traced in the drive amplitude from rest (``f = 0``, ``q = 0``) at one ω."""
+
+    force: np.ndarray  # f at each point
+    x: np.ndarray  # (points, unknowns)
+    complete: bool  # it reached the amplitude bound, past which no orbit lies
+    note: str
+
+
+MAX_DRIVE_POINTS = 4000
+# NOTE: the continuation in f stops after 4000 points (~5 s at 31 unknowns) and says its seeds
+# may be incomplete; a curve up to an amplitude bound of a few hundred takes far fewer.
+
+
+def continue_in_drive(system: PolynomialBalance, omega: float, bound: float | None,
+                      max_points: int = MAX_DRIVE_POINTS,
+                      max_seconds: float = CONTINUATION_BUDGET) -> DriveContinuation:
+    """Trace the balance from ``f = 0``, ``x = 0`` by pseudo-arclength in ``(x, f)`` until the
+    first harmonic exceeds ``bound`` (:func:`driven.amplitude_bound`; then every orbit at the
+    drive lies on the traced part, up to isolated branches the curve does not pass) or the
+    budget ends.  The step adapts: halved where the corrector fails or the tangent turns by
+    more than ~25°, grown by 1.5 where it does not, up to 1 % of the curve's scale and, near
+    ``±f``, to half the distance from it (down to 1e-4 of the scale)."""
+    fam = _DriveFamily(system, omega)
+    m = system.size
+    k1 = int(np.nonzero(system.orders == 1)[0][0])
+    sin1 = system.n_cos + int(np.nonzero(system.orders[system.orders > 0] == 1)[0][0])
+    scale = abs(system.force) + (bound if bound is not None else 10.0)
+    h_max, h_floor, h_min = scale / 100, scale * 1e-4, scale * 1e-9
+    h = h_max / 4
+    y = np.zeros(m + 1)
+    deadline = time.monotonic() + max_seconds
+    with np.errstate(over="ignore", invalid="ignore"):
+        t = _tangent(fam, y, None)
+        if t[-1] < 0:
+            t = -t
+        if abs(t[-1]) < 1e-8:  # ω at a linear resonance, undamped: q = 0 is degenerate
+            t = _first_direction(fam, y, h, k1, sin1)
+        points = [y]
+        while True:
+            r = math.hypot(y[k1], y[sin1])
+            if bound is not None and r > bound:
+                return _drive_curve(points, True, f"continued in the drive amplitude from 0 "
+                                    f"up to the amplitude bound r = {bound:.4g}")
+            if len(points) >= max_points or time.monotonic() > deadline:
+                return _drive_curve(points, False, f"the continuation in the drive stopped at "
+                                    f"r = {r:.4g} after {len(points)} points"
+                                    + ("" if bound is None else f" (bound {bound:.4g})"))
+            try:
+                y_new = _corrector(fam, y + h * t, t)
+                t_new = _tangent(fam, y_new, t)
+            except np.linalg.LinAlgError:
+                y_new = t_new = None
+            good = (y_new is not None and np.all(np.isfinite(y_new))
+                    and np.all(np.isfinite(t_new))
+                    and np.max(np.abs(fam.residual(y_new[:-1], y_new[-1])))
+                    <= 1e-9 * (1 + np.max(np.abs(y_new)))
+                    and np.linalg.norm(y_new - y) <= 2 * h and t_new @ t > 0.9)
+            if not good:
+                h /= 2
+                if h < h_min:
+                    return _drive_curve(points, False, f"the continuation in the drive failed "
+                                        f"at r = {r:.4g}, f = {y[-1]:.4g} (no step converges)")
+                continue
+            y, t = y_new, t_new
+            points.append(y)
+            # near ±f the steps shrink with the distance to it, so that a fold of the curve
+            # just beyond ±f (two crossings close together) leaves points on both sides
+            near = min(abs(y[-1] - system.force), abs(y[-1] + system.force))
+            h = min(1.5 * h, h_max, max(h_floor, 0.5 * near))
+
+
+def _first_direction(fam: _DriveFamily, y: np.ndarray, h: float, k1: int,
+                     sin1: int) -> np.ndarray:
+    """Where ``[J | −e₁]`` is singular at rest (an undamped harmonic at its linear resonance,
+    the response growing like ``f^(1/3)``), the curve's first direction: the first of ±cos ωt,
+    ±sin ωt whose pseudo-arclength step converges; its tangent there, pointing away from rest.
+    """
+    for k, sign in itertools.product((k1, sin1), (1.0, -1.0)):
+        t = np.zeros_like(y)
+        t[k] = sign
+        try:
+            z = _corrector(fam, y + h * t, t)
+            if np.max(np.abs(fam.residual(z[:-1], z[-1]))) <= 1e-9 * (1 + np.max(np.abs(z))):
+                t = _tangent(fam, z, z - y)
+                return t
+        except np.linalg.LinAlgError:
+            continue
+    raise InputError("the balance at rest is singular (a harmonic at its linear resonance) and "
+                     "no first step from it converges")
+
+
+def _drive_curve(points: list[np.ndarray], complete: bool, note: str) -> DriveContinuation:
+    arr = np.array(points)
+    return DriveContinuation(arr[:, -1], arr[:, :-1], complete, note)
+
+
+@dataclass(frozen=True)
+class EquationOrbit:
+    """One distinct periodic orbit of a user's driven oscillator: its balance and, where
+    shooting found it, the true orbit with its Floquet multipliers."""
+
+    orbit: PeriodicOrbit | None
+    balance: np.ndarray | None  # x of the balance solution that led to it
+    converged: bool  # that balance's Newton converged
+    residual: float | None
+    failure: ShootingFailure | None = None
+
+    @property
+    def r(self) -> float:
+        """The first-harmonic amplitude of the true orbit (of the balance where none)."""
+        if self.orbit is not None:
+            return math.hypot(self.orbit.A.get(1, 0.0), self.orbit.B.get(1, 0.0))
+        return float("nan")
+
+
+@dataclass(frozen=True)
+class EquationOrbits:
+    orbits: tuple[EquationOrbit, ...]
+    system: PolynomialBalance
+    complete: bool
+    note: str
+    seeds: int
+
+
+def _half_period(system: PolynomialBalance, x: np.ndarray) -> np.ndarray:
+    """``q(t + T/2)``: harmonic k times ``(−1)^k``; it answers ``−f cos ωt`` where ``q`` answers
+    ``f cos ωt`` (the force is autonomous)."""
+    sign = (-1.0) ** np.concatenate([system.orders, system.orders[system.orders > 0]])
+    return sign * x
+
+
+def equation_orbits(de: DrivenEquation, harmonics: int = 8,
+                    shoot_harmonics: int | None = None) -> EquationOrbits:
+    """Every distinct periodic orbit of period ``2π/ω`` of a :class:`driven.DrivenEquation`
+    that the seeds reach, largest ``r`` first, each once, checked by shooting with its Floquet
+    multipliers (:func:`numerics.shoot_table`).
+
+    Seeds: where the balance (at most CONTINUATION_HARMONICS harmonics), continued in the drive
+    amplitude from rest (:func:`continue_in_drive`), crosses ``f`` — and ``−f``, shifted by half
+    a period — (:func:`_crossings`, quadratic around the folds); each is polished by Newton's
+    method at ``harmonics`` and shot from; orbits within SAME_ORBIT are one."""
+    check_harmonics(harmonics)
+    top = 2 * harmonics - 1
+    shoot_harmonics = top if shoot_harmonics is None else shoot_harmonics
+    omega, f = de.omega, de.force
+    coarse = PolynomialBalance(de.terms, f, min(harmonics, CONTINUATION_HARMONICS), de.odd)
+    fine = PolynomialBalance(de.terms, f, harmonics, de.odd)
+    bound = amplitude_bound(de.terms, omega, abs(f))
+    curve = continue_in_drive(coarse, omega, bound)
+    seeds = _crossings(curve.force - f, curve.x)
+    seeds += [_half_period(coarse, x) for x in _crossings(curve.force + f, curve.x)]
+    table = ForceTable.of(de.terms)
+    found: list[EquationOrbit] = []
+    for x in seeds:
+        A, B = coarse.amplitudes(x)
+        start = fine.vector(A, B)
+        xb, converged, residual = fine.solve(start, omega)
+        guesses = [fine.state(xb, omega)] if converged else []
+        guesses.append(coarse.state(x, omega))
+        orbit, failure = None, None
+        for tol, guess in itertools.product(SHOOTING_TOLERANCES, guesses):
+            shot = shoot_table(table, f, omega, guess, harmonics=shoot_harmonics, tol=tol)
+            if isinstance(shot, PeriodicOrbit):
+                orbit, failure = shot, None
+                break
+            failure = failure or shot
+        if orbit is None:
+            if converged and all(o.orbit is not None or _state_distance(
+                    fine.state(o.balance, omega), fine.state(xb, omega), omega) > SAME_ORBIT
+                    for o in found):
+                found.append(EquationOrbit(None, xb, converged, residual, failure))
+            continue
+        j = next((j for j, o in enumerate(found) if o.orbit is not None and _state_distance(
+            o.orbit.initial, orbit.initial, omega) <= SAME_ORBIT), None)
+        own = converged and _state_distance(fine.state(xb, omega), orbit.initial,
+                                            omega) <= BALANCE_NEAR
+        if j is None:
+            found.append(EquationOrbit(orbit, xb if converged else None, converged and own,
+                                       residual if converged else None))
+        elif own and not found[j].converged:
+            found[j] = EquationOrbit(orbit, xb, True, residual)
+    found.sort(key=lambda o: -(o.r if o.orbit is not None else _balance_r(fine, o.balance)))
+    note = curve.note + f"; {len(seeds)} crossings of the drive amplitude"
+    return EquationOrbits(tuple(found), fine, curve.complete, note, len(seeds))
+
+
+def _balance_r(system: PolynomialBalance, x: np.ndarray) -> float:
+    A, B = system.amplitudes(x)
+    return math.hypot(A.get(1, 0.0), B.get(1, 0.0))
