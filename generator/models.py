@@ -414,7 +414,8 @@ def _latex(osc: Oscillator) -> str:
     q, v = osc.coordinate, osc.velocity
     name = sp.latex(q)
     shown = osc.force.xreplace({v: sp.Symbol(rf"\dot{{{name}}}")})
-    return rf"\ddot{{{name}}} + {sp.latex(shown)} = 0"
+    names = {osc.equation.small: r"\varepsilon"} if osc.equation.small is not None else {}
+    return rf"\ddot{{{name}}} + {sp.latex(shown, symbol_names=names)} = 0"
 
 
 @dataclass(frozen=True)

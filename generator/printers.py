@@ -107,6 +107,10 @@ def latex_coefficient(c: sp.Expr) -> str:
     return latex_rational(c) if c.is_Rational else sp.latex(c)
 
 
+EPS = sp.Symbol("eps")
+# NOTE: a user's small parameter, named eps in the equation, is ε in LaTeX.
+
+
 def latex_expr(expr: sp.Basic) -> str:
     """SymPy's LaTeX for short symbolic factors (powers of A, ε, θ₀)."""
-    return sp.latex(expr)
+    return sp.latex(expr, symbol_names={EPS: r"\varepsilon"})
