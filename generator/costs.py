@@ -139,7 +139,27 @@ def generate_cost(args: argparse.Namespace) -> Cost:
                 f"generating {args.model if args.model in GENERATE_COSTS else 'the oscillator'}")
 
 
+DRIVEN_EQUATION_FIXED = 4.0
+DRIVEN_EQUATION_CONTINUATION = 15.0
+# NOTE: `lindstedt driven EQUATION`: start-up with SymPy's parse and the numba kernels from
+# cache (~2.5 s), then the continuation in the drive amplitude, which stops itself at 15 s
+# (response.CONTINUATION_BUDGET; 0.1–2 s measured on the issue's equations), then Newton at N
+# harmonics and shooting (0.05–0.5 s) on every crossing.
+
+
+def driven_equation_seconds(harmonics: int) -> float:
+    """An upper bound of ``driven EQUATION``: the fixed part, the continuation's own deadline,
+    and three crossings' Newton solves at N harmonics (up to 4N − 1 unknowns, 50 dense steps
+    at ~1 GFlop/s) with their shooting (0.5 s each at most: 4 tries of up to 30 periods)."""
+    unknowns = 4 * harmonics - 1
+    return (DRIVEN_EQUATION_FIXED + DRIVEN_EQUATION_CONTINUATION
+            + 3 * (50 * unknowns**3 / 1e9 + 0.5))
+
+
 def driven_cost(args: argparse.Namespace) -> Cost:
+    if getattr(args, "model", None) is not None:
+        return Cost(driven_equation_seconds(args.harmonics), f"--harmonics {args.harmonics}",
+                    "the continuation, balance and shooting of the equation")
     return Cost(power_law(*DRIVEN_COSTS, args.order), f"order {args.order}",
                 "the μ-expansion on every branch")
 
