@@ -10,8 +10,9 @@ import time
 from pathlib import Path
 
 import numpy as np
+from lindstedt.compiler import generate_balance
 from lindstedt.driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
-from lindstedt.emit import generate_balance, load_generated
+from lindstedt.emit import load_generated
 from lindstedt.numerics import shoot, sweep
 from lindstedt.response import continue_balance, one_harmonic_curve
 from timing import best

@@ -24,7 +24,8 @@ from pathlib import Path
 
 import numpy as np
 import sympy as sp
-from lindstedt.emit import generate, load_generated
+from lindstedt.compiler import generate
+from lindstedt.emit import load_generated
 from lindstedt.lindstedt import derive, period_series, solution_expression
 from lindstedt.lower import Evaluator, lower_free
 from lindstedt.models import A, duffing, eps, t

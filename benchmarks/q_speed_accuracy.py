@@ -21,8 +21,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-from lindstedt.choose import cn_fourier
-from lindstedt.emit import generate, load_generated
+from lindstedt.compiler import generate
+from lindstedt.emit import load_generated
+from lindstedt.methods import cn_fourier
 from scipy.integrate import solve_ivp
 from scipy.special import ellipj
 from timing import best

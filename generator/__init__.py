@@ -11,8 +11,12 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
     driven     μ-expansion with phase, harmonic balance                 Drive, order -> branches
     response   one-harmonic curves and folds, balance continuation      Drive, ω range -> folds
     printers   NumbaPrinter(PythonCodePrinter), LaTeX rationals         Expr -> str
-    lower      solutions -> IR records (Evaluator, Module)              Horner, Chebyshev recurrence
-    emit       strict Jinja2 environments, provenance, one-unit writes  IR -> files
+    lower      solutions -> IR records (Module, Evaluator, Derivation,  solution -> Unit
+               PeriodFormula); Horner, Chebyshev recurrence, AGM steps
+    emit       strict Jinja2 environments, provenance, one-unit writes  Unit -> files
+    methods    the method registry: per method what it applies to (and  Model | Drive -> Method
+               why not), how it derives, evaluates, lowers, its reference
+    compiler   derive -> lower -> render -> write, each once, in order  Target, Request -> files
     choose     methods × orders, verified error, recorded cost model    tol, range -> Choice
     sweep      driven maps over grids on dask.distributed, into Zarr    kind, axes -> Dataset
     charts     matplotlib figures                                       results -> PNG/SVG/PDF

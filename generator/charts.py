@@ -19,16 +19,15 @@ import numpy as np
 from .choose import (
     DRIVEN_QUANTITIES,
     DrivenTradeoff,
-    candidates,
     driven_tradeoffs,
     driven_truth,
     pareto_front,
-    reference_period,
     tradeoffs,
 )
 from .driven import Drive
 from .emit import check_folder, check_target, write_files
 from .errors import InputError
+from .methods import candidates, reference_period
 from .numerics import steady_state_amplitudes, sweep
 from .response import (
     CONTINUATION_SECONDS,

@@ -7,51 +7,51 @@ against an independent reference and timed; the cheapest within the tolerance wi
   μ-expansion orders, harmonic balance, shooting; with ``emit``, the emitted modules;
 * named scenes (:data:`SCENES`) and the appendix's pendulum claims.
 
-Candidates for ``T/2π`` as a function of ``x = εA²``:
-
-* ``lindstedt``: the L–P series ``Σ τ_j x^j`` truncated at order k (radius |x| < 1, set by the
-  separatrix at x = −1);
-* ``resummed``: the same series re-expanded in ``m = x/(2(1+x))``:
-  ``T/2π = √(1 − 2m) Σ c_n m^n`` — analytic for ``|m| < 1``, i.e. ``x > −2/3``, and
-  ``m < 1/2`` for every ``x ≥ 0``, so it converges out to ``εA² → ∞``;
-* ``pade``: the diagonal Padé approximant ``[k/k]`` of the L–P series;
-* ``modified``: the modified L–P of Cheung, Chen & Lau, re-expanded from the exact series;
-* ``agm``: the exact period through Gauss's arithmetic–geometric mean,
-  ``T/2π = 1/AGM(√(1+x), √(1+x/2))`` (``K(m) = π/(2 AGM(1, √(1−m)))``, scaled), stopped after
-  n steps — the order; each step squares the relative error, so 2–3 steps are exact to
-  double precision everywhere except next to the separatrix;
-* ``exact``: ``4K(m)/√(1+x)`` (SciPy's ``ellipk``), the baseline any method must beat.
-
-:func:`choose_period` verifies every candidate against the exact period on N points of the
-requested range, measures its compiled cost, and returns the cheapest within the tolerance.
+The methods themselves — what each applies to, how it derives, evaluates and lowers, and its
+reference — are the records of :mod:`methods`; this module verifies them on a range, times
+them, and picks by the recorded :data:`COST_MODEL`.  With ``--emit`` the choice goes through
+:mod:`compiler`.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 import sys
 import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from fractions import Fraction
 from pathlib import Path
 from typing import TypeVar
 
 import mpmath
 import numpy as np
-from numba import njit
-from scipy.integrate import solve_ivp
 from scipy.special import ellipj, ellipk
 
+from .compiler import generate, generate_method
 from .display import html_table
-from .driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
-from .emit import generate, generate_balance, generate_driven, load_generated
+from .driven import Drive, amplitudes, first_order_branches, harmonic_balance
+from .emit import load_generated
 from .errors import InputError
 from .lindstedt import derive
+from .methods import (
+    DRIVEN_MAX,
+    INTEGRATION_RTOLS,
+    SHOOTING_STEPS,
+    SIMPLEST_FIRST,
+    Candidate,
+    Method,
+    candidates,
+    cn_fourier,
+    integrated_period,
+    method,
+    methods_for,
+    one_harmonic_amplitudes,
+    reference_period,
+    reference_q,
+)
 from .models import duffing, pendulum
-from .numerics import duffing_period_exact, shoot
+from .numerics import shoot
 
 Progress = Callable[[int, int], None]
 # NOTE: ``progress(done, total)`` lets the command line draw a bar over the long loops.
@@ -61,179 +61,9 @@ def quiet(done: int, total: int) -> None:
     """The default progress report: none."""
 
 
-MAX_ORDER = 60
-# NOTE: order 60 of the exact series takes ~0.1 s and reaches 1e-16 wherever |x| ≤ 0.5.
-AGM_STEPS = 8
-# NOTE: each AGM step squares the relative gap of a and b: 3 steps reach 1e-16 for all
-# x ∈ [−0.5, 10³]; 6 reach it down to x = −1 + 1e-12, next to the separatrix.
 VERIFY_POINTS = 2001
 # NOTE: points (Chebyshev-spaced, ends included) on which every candidate is verified.
 
-
-BLOCK = 1024
-# NOTE: Horner runs coefficient-outer, point-inner over blocks of three 8 KB arrays that stay in
-# L1 (256 and 4096 measured slower): no dependency between points, so LLVM vectorises the inner
-# loop (point-outer Horner cannot be).
-
-
-FASTMATH = {"contract", "arcp", "nsz", "reassoc"}
-# NOTE: error_model="numpy" below: Python's model checks every division for zero, which keeps
-# LLVM from vectorising any loop that divides (9 ns/point instead of 1.2 for the AGM).
-
-
-@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
-def _horner_block(c: np.ndarray, t: np.ndarray, acc: np.ndarray) -> None:
-    acc[:] = c[c.size - 1]
-    for j in range(c.size - 2, -1, -1):
-        cj = c[j]
-        for i in range(t.size):
-            acc[i] = acc[i] * t[i] + cj
-
-
-@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
-def _agm_block(x: np.ndarray, steps: int, a: np.ndarray, b: np.ndarray) -> None:
-    """``a ← (a + b)/2, b ← √(ab)`` from ``a = √(1+x), b = √(1+x/2)``, ``steps`` times."""
-    for i in range(x.size):
-        a[i] = np.sqrt(1.0 + x[i])
-        b[i] = np.sqrt(1.0 + 0.5 * x[i])
-    for _ in range(steps):
-        for i in range(x.size):
-            a[i], b[i] = 0.5 * (a[i] + b[i]), np.sqrt(a[i] * b[i])
-
-
-@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
-def _evaluate(kind: int, num: np.ndarray, den: np.ndarray, steps: int, x: np.ndarray,
-              out: np.ndarray) -> None:
-    """Blocked evaluation of a candidate; kind 0: Σ num_j x^j, 1: in m with √(1 − 2m),
-    2: Padé num(x)/den(x), 3: modified L–P 1/√((1 + 3x/4) g(α)), 4: ``steps`` AGM steps.
-    NaN outside the candidate's domain."""
-    t = np.empty(BLOCK)
-    p = np.empty(BLOCK)
-    q = np.empty(BLOCK)
-    for start in range(0, x.size, BLOCK):
-        n = min(BLOCK, x.size - start)
-        xs = x[start : start + n]
-        tv, pv, qv = t[:n], p[:n], q[:n]
-        if kind == 4:
-            _agm_block(xs, steps, pv, qv)
-        else:
-            if kind == 1:
-                for i in range(n):
-                    tv[i] = xs[i] / (2.0 + 2.0 * xs[i])
-            elif kind == 3:
-                for i in range(n):
-                    tv[i] = 3.0 * xs[i] / (4.0 + 3.0 * xs[i])
-            else:
-                tv[:] = xs
-            _horner_block(num, tv, pv)
-            if kind == 2:
-                _horner_block(den, tv, qv)
-        o = out[start : start + n]
-        if kind == 0:
-            for i in range(n):
-                o[i] = pv[i] if abs(xs[i]) < 1.0 else np.nan
-        elif kind == 1:
-            for i in range(n):
-                o[i] = pv[i] * np.sqrt(1.0 - 2.0 * tv[i]) if xs[i] > -2.0 / 3.0 else np.nan
-        elif kind == 2:
-            for i in range(n):
-                o[i] = pv[i] / qv[i] if xs[i] > -1.0 else np.nan
-        elif kind == 3:
-            for i in range(n):
-                o[i] = 1.0 / np.sqrt((1.0 + 0.75 * xs[i]) * pv[i]) if xs[i] > -1.0 else np.nan
-        else:
-            for i in range(n):
-                o[i] = 2.0 / (pv[i] + qv[i]) if xs[i] > -1.0 else np.nan
-
-
-KINDS = {"lindstedt": 0, "resummed": 1, "pade": 2, "modified": 3, "agm": 4}
-
-
-@dataclass(frozen=True)
-class Candidate:
-    method: str
-    order: int
-    num: np.ndarray
-    den: np.ndarray
-
-    def __call__(self, x: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-        if self.method == "exact":
-            return duffing_period_exact(1.0, x) / (2 * np.pi)
-        out = np.empty_like(x) if out is None else out
-        _evaluate(KINDS[self.method], self.num, self.den, self.order, x, out)
-        return out
-
-
-def _mul(a: list[Fraction], b: list[Fraction]) -> list[Fraction]:
-    """Product of power series truncated to ``len(a)`` terms."""
-    return [sum(a[i] * b[n - i] for i in range(n + 1)) for n in range(len(a))]
-
-
-def _compose(outer: list[Fraction], inner: list[Fraction]) -> list[Fraction]:
-    """``outer(inner(t))`` truncated to ``len(outer)`` terms (``inner`` has no constant)."""
-    total = [Fraction(0)] * len(outer)
-    power = [Fraction(1)] + [Fraction(0)] * (len(outer) - 1)
-    for c in outer:
-        total = [s + c * p for s, p in zip(total, power, strict=True)]
-        power = _mul(power, inner)
-    return total
-
-
-def resummed_coefficients(tau: list[Fraction]) -> list[Fraction]:
-    """``c_n`` of ``(T/2π)(x(m)) / √(1 − 2m)``, ``x(m) = 2m/(1 − 2m) = Σ_{n≥1} 2^n m^n``,
-    exactly; the first k + 1 terms use ``τ_0..τ_k``."""
-    k = len(tau) - 1
-    inv_sqrt = [Fraction(1)]
-    for n in range(1, k + 1):  # (1 − 2m)^(−1/2) = Σ binom(2n, n) (m/2)^n·2^n
-        inv_sqrt.append(inv_sqrt[-1] * Fraction(2 * n - 1, n))
-    xm = [Fraction(0)] + [Fraction(2**n) for n in range(1, k + 1)]
-    return _mul(_compose(tau, xm), inv_sqrt)
-
-
-def modified_coefficients(omega: list[Fraction]) -> list[Fraction]:
-    """The modified L–P of Cheung, Chen & Lau: ``ω² = (1 + 3x/4)·g(α)`` with
-    ``α = (3x/4)/(1 + 3x/4)``, which stays below 1 for every ``x > 0``; returns ``g``'s
-    coefficients exactly (``x(α) = (4/3) Σ_{n≥1} α^n``)."""
-    k = len(omega) - 1
-    w2 = _mul(omega, omega)
-    h = _mul(w2, [Fraction(-3, 4) ** n for n in range(k + 1)])  # ω² / (1 + 3x/4)
-    return _compose(h, [Fraction(0)] + [Fraction(4, 3)] * k)
-
-
-def _pade(tau: list[Fraction], k: int) -> tuple[np.ndarray, np.ndarray]:
-    with mpmath.workdps(60):
-        p, q = mpmath.pade([mpmath.mpf(t.numerator) / t.denominator for t in tau[: 2 * k + 1]],
-                           k, k)
-        return np.array([float(c) for c in p]), np.array([float(c) for c in q])
-
-
-@functools.cache
-def candidates(max_order: int = MAX_ORDER) -> tuple[Candidate, ...]:
-    """Every method at every order up to ``max_order`` (Padé up to [12/12]), derived once."""
-    sol = derive(duffing(), max_order)
-    tau = [sol.ground.to_fraction(c) for c in sol.period]
-    res = resummed_coefficients(tau)
-    mod = modified_coefficients([sol.ground.to_fraction(c) for c in sol.omega])
-    out = [Candidate("exact", 0, np.zeros(1), np.ones(1))]
-    out += [Candidate("agm", n, np.zeros(1), np.ones(1)) for n in range(AGM_STEPS + 1)]
-    for k in range(1, max_order + 1):
-        out.append(Candidate("lindstedt", k, np.array([float(t) for t in tau[: k + 1]]),
-                             np.ones(1)))
-        out.append(Candidate("resummed", k, np.array([float(c) for c in res[: k + 1]]),
-                             np.ones(1)))
-        out.append(Candidate("modified", k, np.array([float(c) for c in mod[: k + 1]]),
-                             np.ones(1)))
-        if 2 * k <= max_order and k <= 12:
-            out.append(Candidate("pade", k, *_pade(tau, k)))
-    return tuple(out)
-
-
-def reference_period(x: np.ndarray) -> np.ndarray:
-    """``T/2π = (2/π) K(m)/√(1+x)`` in 30-digit arithmetic (mpmath): the judge of every
-    candidate, SciPy's ``ellipk`` included."""
-    with mpmath.workdps(30):
-        return np.array([float(2 / mpmath.pi * mpmath.ellipk(mpmath.mpf(v) / (2 * (1 + v)))
-                               / mpmath.sqrt(1 + mpmath.mpf(v))) for v in x])
 
 
 def verification_points(x_min: float, x_max: float, n: int = VERIFY_POINTS) -> np.ndarray:
@@ -274,9 +104,6 @@ TIE = 0.15
 # NOTE: costs within 15 % of the cheapest count as a tie, broken by a fixed order of methods
 # (the simplest formula first). Every choice compares the recorded COST_MODEL, so it never
 # depends on this run's timings (and what --emit writes is the same on every run).
-SIMPLEST_FIRST = ("lindstedt", "one_harmonic", "pade", "resummed", "modified", "agm",
-                  "mu_expansion", "harmonic_balance", "fourier", "shooting", "exact")
-
 
 COST_MODEL = {
     "period": {
@@ -310,26 +137,28 @@ COST_MODEL = {
 # timings are reported beside.
 
 
-def modelled_ns(quantity: str, method: str, order: int) -> float:
+def modelled_ns(quantity: str, method: str | Method, order: int) -> float:
     """The recorded cost of ``method`` at ``order`` for ``quantity`` (ns per point)."""
-    return sum(c * order**i for i, c in enumerate(COST_MODEL[quantity][method]))
+    return sum(c * order**i for i, c in enumerate(COST_MODEL[quantity][str(method)]))
 
 
-def cheapest(items: list[T], cost: Callable[[T], float], method: Callable[[T], str]) -> T:
+def cheapest(items: list[T], cost: Callable[[T], float],
+             method: Callable[[T], str | Method]) -> T:
     """The cheapest item, ties (within ``TIE``) going to the simplest method."""
     floor = min(cost(i) for i in items)
     tied = [i for i in items if cost(i) <= (1 + TIE) * floor]
-    return min(tied, key=lambda i: SIMPLEST_FIRST.index(method(i).removesuffix(", emitted")))
+    return min(tied, key=lambda i: SIMPLEST_FIRST.index(str(method(i)).removesuffix(", emitted")))
 
 
 @dataclass(frozen=True)
 class Choice:
-    method: str
+    method: Method
     order: int
     max_error: float
     ns_per_point: float
     verified_on: int
     considered: tuple[tuple[str, int, float, float], ...]  # per method: order, error, ns
+    candidate: Candidate | None = None  # what was verified: what --emit lowers
 
     def _repr_html_(self) -> str:
         return choice_table(self, "choose_period: T/2π, max relative error")
@@ -363,7 +192,7 @@ def choose_period(tol: float, x_min: float, x_max: float,
                          "(the separatrix is at x = -1)")
     x = verification_points(x_min, x_max)
     exact = reference_period(x)
-    best_per_method: dict[str, tuple[Candidate, float]] = {}
+    best_per_method: dict[Method, tuple[Candidate, float]] = {}
     best_error = np.inf
     for c in candidates():
         if c.method in best_per_method:
@@ -385,7 +214,7 @@ def choose_period(tol: float, x_min: float, x_max: float,
     c, err, ns = cheapest(timed, lambda t: modelled_ns("period", t[0].method, t[0].order),
                           lambda t: t[0].method)
     return Choice(c.method, c.order, err, ns, len(x),
-                  tuple((t[0].method, t[0].order, t[1], t[2]) for t in timed))
+                  tuple((t[0].method.name, t[0].order, t[1], t[2]) for t in timed), c)
 
 
 # --- the grandfather's clock: the notes' appendix claims --------------------------------------
@@ -450,25 +279,6 @@ class Tradeoff:
     errors: np.ndarray  # at the chart's x values (NaN: outside the candidate's domain)
 
 
-INTEGRATION_RTOLS = (1e-4, 1e-7, 1e-10, 1e-13)
-# NOTE: DOP853 tolerances for the "numerical" method: from plotting accuracy to nearly exact.
-
-
-def integrated_period(x: float, rtol: float) -> float:
-    """``T/2π`` by integrating ``u'' + u + x u³ = 0`` from ``u = 1`` to the half period
-    (``u'`` back to zero), SciPy's DOP853 at ``rtol``."""
-    def rhs(_t: float, y: np.ndarray) -> list[float]:
-        return [y[1], -y[0] - x * y[0] ** 3]
-
-    def half(_t: float, y: np.ndarray) -> float:
-        return y[1]
-
-    half.terminal, half.direction = True, 1.0
-    sol = solve_ivp(rhs, (0.0, 100.0 / np.sqrt(1 + max(x, 0.0)) + 100.0), [1.0, 0.0],
-                    method="DOP853", rtol=rtol, atol=rtol * 1e-3, events=half)
-    return float(2 * sol.t_events[0][0] / (2 * np.pi))
-
-
 def tradeoffs(xs: np.ndarray, points: int = 200_000) -> list[Tradeoff]:
     """Every candidate: measured ns/point (on [0, 0.5]) and its error at each ``x``; plus
     numerical integration at several tolerances (timed per call)."""
@@ -478,7 +288,7 @@ def tradeoffs(xs: np.ndarray, points: int = 200_000) -> list[Tradeoff]:
     for c in candidates():
         with np.errstate(invalid="ignore"):
             err = np.abs(c(xs) / ref - 1)
-        out.append(Tradeoff(c.method, c.order, ns_per_point(c, points=points), err))
+        out.append(Tradeoff(c.method.name, c.order, ns_per_point(c, points=points), err))
     for k, rtol in enumerate(INTEGRATION_RTOLS):
         t0 = time.perf_counter()
         values = np.array([integrated_period(x, rtol) for x in xs])
@@ -521,7 +331,7 @@ def clock_scene(swing_deg: float = 10.0, seconds_per_day: float = 0.1) -> SceneR
         sol = derive(pendulum(k), k)
         coeffs = np.array([float(sol.ground.to_fraction(c)) * np.pi ** (2 * j)
                            for j, c in enumerate(sol.period)])
-        cand = Candidate("lindstedt", k, coeffs, np.ones(1))
+        cand = Candidate(method("period", "lindstedt"), k, coeffs, np.ones(1))
         err = float(np.max(np.abs(cand(t) / exact - 1)))
         if err <= tol:
             return SceneResult(
@@ -538,20 +348,14 @@ def hard_spring_scene(x: float = 50.0, tol: float = 1e-8) -> SceneResult:
     c = choose_period(tol, x, x * (1 + 1e-12))
     return SceneResult("hard-spring", f"Duffing period to {tol:g} at εA² = {x:g}",
                        f"{c.method} order {c.order}",
-                       {"method": c.method, "order": c.order, "max_error": c.max_error,
+                       {"method": c.method.name, "order": c.order, "max_error": c.max_error,
                         "ns_per_point": c.ns_per_point})
 
 
 # --- the driven amplitudes A_n(ω) and the response r(ω): methods side by side ---------------
 
-DRIVEN_MAX = 12
-# NOTE: μ-orders 0..12 and 1..12 odd harmonics: at the notes' parameters both reach 1e-12
-# well before that; more only costs.
 DRIVEN_POINTS = 21
 # NOTE: ω points (Chebyshev-spaced) on which a range is verified; each costs one shooting.
-SHOOTING_STEPS = (64, 128, 256, 512, 1024)
-# NOTE: the "numerical" method: shooting from the one-harmonic guess with plain RK4 at these
-# steps per period (the truth uses 4096 and 8192, Richardson-combined).
 DRIVEN_QUANTITIES = ("amplitudes", "response")
 # NOTE: amplitudes: max |error| of A_n, B_n for n = 1, 3, 5; response: |r − r_true| with
 # r = √(A₁² + B₁²), the amplitude of the fundamental (eq. 10.79's r).
@@ -601,19 +405,6 @@ class DrivenTradeoff:
     errors: dict[str, np.ndarray]  # quantity -> error per ω
 
 
-def one_harmonic_amplitudes(eps: float, force: float, Q: float,
-                            omegas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``A₁ = r cos δ₀``, ``B₁ = r sin δ₀`` of the largest one-harmonic branch, vectorised
-    (closed-form cubic; ``f sin δ₀ = rω/Q``, ``f cos δ₀ = ¾εr³ − (ω² − 1)r``)."""
-    from .response import one_harmonic_curve
-
-    w = np.asarray(omegas, dtype=float)
-    r = one_harmonic_curve(eps, force, Q, w).r[:, 0]
-    delta = np.arctan2(r * w * Drive(eps, force, 1.0, Q).damping,
-                       0.75 * eps * r**3 - (w**2 - 1) * r)
-    return r * np.cos(delta), r * np.sin(delta)
-
-
 def driven_errors(truth: DrivenTruth, A: np.ndarray, B: np.ndarray) -> dict[str, np.ndarray]:
     """Both error measures per ω for ``(n, 3)`` arrays of ``A_n``, ``B_n`` (n = 1, 3, 5; a
     NaN row — a refused ω — stays NaN)."""
@@ -642,79 +433,44 @@ def driven_tradeoffs(truth: DrivenTruth, eps: float, force: float,
     out = [DrivenTradeoff("one_harmonic", 1, ns,
                           driven_errors(truth, np.column_stack([a1, zeros]),
                                         np.column_stack([b1, zeros])))]
-    for method, orders in (("mu_expansion", range(DRIVEN_MAX + 1)),
-                           ("harmonic_balance", range(1, DRIVEN_MAX + 1)),
-                           ("shooting", SHOOTING_STEPS)):
-        for order in orders:
+    for m in methods_for("driven"):
+        if m.solve is None:
+            continue  # the one-harmonic closed form, vectorised above
+        for order in m.driven_orders:
             A, B = np.full((n, 3), np.nan), np.full((n, 3), np.nan)
             seconds = 0.0
             for i, w in enumerate(truth.omega):
                 d = Drive(eps, force, float(w), Q)
                 t0 = time.perf_counter()
-                branch = first_order_branches(d)[0]
-                if method == "mu_expansion":
-                    mu = mu_expansion(d, branch, order)
-                    ok = len(mu.coefficients) > order and mu.converged
-                    values = amplitudes(*mu.partial(min(order, len(mu.coefficients) - 1)), 5)
-                elif method == "harmonic_balance":
-                    hb = harmonic_balance(d, branch, order)
-                    ok = hb.converged
-                    values = amplitudes(hb.coefficients, 0.0, 5)
-                else:
-                    guess = branch.A1 * np.array([np.cos(branch.delta0),
-                                                  w * np.sin(branch.delta0)])
-                    orbit = shoot(eps, force, float(w), d.damping, guess, steps=order)
-                    ok = orbit is not None
-                    values = (orbit.A, orbit.B) if ok else ({}, {})
+                ok, values = m.solve(d, first_order_branches(d)[0], order)
                 seconds += time.perf_counter() - t0
                 if ok:
                     A[i], B[i] = _harmonics_135(values)
-            out.append(DrivenTradeoff(method, order, seconds / n * 1e9,
+            out.append(DrivenTradeoff(m.name, order, seconds / n * 1e9,
                                       driven_errors(truth, A, B)))
     return out
 
 
-def emitted_driven(method: str, order: int, truth: DrivenTruth, eps: float, force: float,
+def emitted_driven(name: str, order: int, truth: DrivenTruth, eps: float, force: float,
                    Q: float) -> DrivenTradeoff:
-    """The emitted module of ``method`` at ``order`` (``generate driven``: undamped μ-expansion
-    as compiled ufuncs, timed on 10⁵ ω through the ``_into`` twins; ``generate balance``:
-    compiled Newton, one solve per ω from the one-harmonic root), generated into a temporary
-    folder, timed and judged at every ω of ``truth``."""
-    n = truth.omega.size
-    A, B = np.zeros((n, 3)), np.zeros((n, 3))  # harmonics the module lacks are zero
+    """The emitted module of method ``name`` at ``order`` (``generate driven``: the undamped
+    μ-expansion as compiled ufuncs; ``generate balance``: compiled Newton), generated into a
+    temporary folder through the compiler, run by the record's ``run_emitted``, timed and
+    judged at every ω of ``truth``."""
+    m = method("driven", name)
+    why = m.emittable(Drive(eps, force, 1.0, Q)) if m.target is not None else "no module"
+    if why:
+        raise InputError(why)
     with tempfile.TemporaryDirectory(prefix="lindstedt-emitted-") as tmp:
-        if method == "mu_expansion":
-            if not np.isinf(Q):
-                raise InputError("the damped μ-expansion has no emitted module (only the "
-                                 "undamped one is derived exactly)")
-            generate_driven(order, Path(tmp))
-            mod = load_generated(Path(tmp) / "driven.py")
-            fns = {k: getattr(mod, f"A_{h}_into") for k, h in enumerate((1, 3, 5))
-                   if hasattr(mod, f"A_{h}_into")}  # the order's harmonics; the rest stay 0
-            for k, f in fns.items():
-                A[:, k] = f(np.empty(n), truth.omega, eps, force, 0.0)
-            dense = np.resize(truth.omega, 100_000)
-            buf = np.empty_like(dense)
-            ns = best_seconds(lambda: [f(buf, dense, eps, force, 0.0) for f in fns.values()],
-                              1) / dense.size * 1e9
-            sys.modules.pop("driven", None)
-        else:
-            generate_balance(order, Path(tmp))
-            mod = load_generated(Path(tmp) / "balance.py")
-            a1, b1 = one_harmonic_amplitudes(eps, force, Q, truth.omega)
-            x0 = np.zeros((n, 2 * order))
-            x0[:, 0], x0[:, order] = a1, b1
-            damping = Drive(eps, force, 1.0, Q).damping
-            xs = [mod.newton(x, w, eps, force, damping)[0]
-                  for x, w in zip(x0, truth.omega, strict=True)]
-            ns = best_seconds(lambda: [mod.newton(x, w, eps, force, damping)
-                                       for x, w in zip(x0, truth.omega, strict=True)],
-                              1) / n * 1e9
-            for k in range(min(order, 3)):
-                A[:, k] = [x[k] for x in xs]
-                B[:, k] = [x[order + k] for x in xs]
-            sys.modules.pop("balance", None)
-    return DrivenTradeoff(f"{method}, emitted", order, ns, driven_errors(truth, A, B))
+        paths = generate_method(m, order, Path(tmp), flag="--out")
+        module = next(p for p in paths if p.suffix == ".py")
+        mod = load_generated(module)
+        try:
+            A, B, run, points = m.run_emitted(mod, truth.omega, eps, force, Q, order)
+            ns = best_seconds(run, 1) / points * 1e9
+        finally:
+            sys.modules.pop(module.stem, None)
+    return DrivenTradeoff(f"{name}, emitted", order, ns, driven_errors(truth, A, B))
 
 
 @dataclass(frozen=True)
@@ -722,7 +478,7 @@ class DrivenChoice:
     """The cheapest verified method for a driven quantity over ω points."""
 
     quantity: str
-    method: str
+    method: Method
     order: int
     max_error: float
     ns_per_point: float  # measured wall time per ω
@@ -756,7 +512,7 @@ def choose_driven(quantity: str, tol: float, eps: float, force: float, Q: float,
             raise InputError(f"{name} {v}: not finite")
     if tol <= 0:
         raise InputError(f"tol {tol}: must be > 0")
-    Drive(eps, force, omega_min, Q)  # validates the parameters
+    drive = Drive(eps, force, omega_min, Q)  # validates the parameters
     if omega_max is None:
         omegas = np.array([omega_min])
     elif omega_min < omega_max:
@@ -770,9 +526,9 @@ def choose_driven(quantity: str, tol: float, eps: float, force: float, Q: float,
         err = float(np.max(t.errors[quantity]))  # NaN anywhere: refused somewhere
         if np.isnan(err) or (t.method in best and best[t.method][0].order <= t.order):
             continue  # each method at its smallest sufficient order, whatever the list's order
+        m = method("driven", t.method)
         if emit is not None and not (  # only what has an emitted module competes
-                (t.method == "harmonic_balance" and t.order <= emit[1])
-                or (t.method == "mu_expansion" and np.isinf(Q) and t.order <= emit[0])):
+                m.bound >= 0 and t.order <= emit[m.bound] and m.emittable(drive) is None):
             continue
         reachable = min(reachable, err)
         if err <= tol:
@@ -804,7 +560,8 @@ def choose_driven(quantity: str, tol: float, eps: float, force: float, Q: float,
         else:
             raise InputError(f"tol {tol:g}: the emitted modules miss it where the interpreted "
                              "methods met it (rounding in the compiled formulas); loosen tol")
-    return DrivenChoice(quantity, t.method.removesuffix(", emitted"), t.order, err,
+    return DrivenChoice(quantity, method("driven", t.method.removesuffix(", emitted")), t.order,
+                        err,
                         t.ns_per_point, omegas.size, tuple(considered), truth,
                         modelled_ns("driven", t.method, t.order))
 
@@ -833,7 +590,7 @@ FOURIER_MAX = 40
 
 @dataclass(frozen=True)
 class SolutionChoice:
-    method: str  # "lindstedt", "fourier" (exact nome series, N harmonics) or "exact" (ellipj)
+    method: Method  # "lindstedt", "fourier" (exact nome series, N harmonics) or "exact" (ellipj)
     order: int  # L–P order, or number of odd harmonics
     max_error: float  # max |q − A cn| / A over the grid
     ns_per_point: float
@@ -842,75 +599,6 @@ class SolutionChoice:
 
     def _repr_html_(self) -> str:
         return choice_table(self, "choose_solution: q(t)/A, max error")
-
-
-def _exact_q(t: np.ndarray, x: float) -> np.ndarray:
-    """``q/A = cn(√(1+x) t | m)``, ``m = x/(2(1+x))``: SciPy for m ≥ 0, mpmath below."""
-    m = x / (2 * (1 + x))
-    if m >= 0:
-        return ellipj(np.sqrt(1 + x) * t, m)[1]
-    with mpmath.workdps(20):
-        return np.array([float(mpmath.re(mpmath.ellipfun("cn", np.sqrt(1 + x) * v, m)))
-                         for v in t])
-
-
-@njit(cache=True, error_model="numpy")
-def _agm(a: float, b: float) -> float:
-    """The arithmetic–geometric mean, to double precision."""
-    for _ in range(60):
-        if abs(a - b) <= 1e-16 * a:
-            break
-        a, b = 0.5 * (a + b), np.sqrt(a * b)
-    return 0.5 * (a + b)
-
-
-@njit(cache=True, error_model="numpy")
-def cn_fourier(t: np.ndarray, x: np.ndarray, harmonics: int, out: np.ndarray) -> np.ndarray:
-    """``q/A`` of the free Duffing oscillator, ``x = εA² > −1``, as the exact Fourier series
-    of the elliptic function in the nome ``q = exp(−πK′/K)``, truncated to ``harmonics``
-    odd harmonics of ``Ω = 2π/T``: ``cn(u|m) = (2π/(kK)) Σ qⁿ⁺¹ᐟ²/(1 + q²ⁿ⁺¹) cos((2n+1)v)``
-    for ``m ≥ 0``, and for ``m < 0`` the imaginary-modulus transform ``cn(u|−μ) =
-    cd(√(1+μ) u | μ/(1+μ))`` with ``cd``'s series (signs ``(−1)ⁿ``, denominators
-    ``1 − q²ⁿ⁺¹``).  The L–P series in x is its expansion; this one converges for every
-    ``x > −1``.  NaN for ``x ≤ −1``.  The coefficients (two AGMs and an exp) are recomputed
-    only where x changes, so a run of points at one amplitude costs a cos and a recurrence."""
-    b = np.zeros(max(harmonics, 1))
-    last, omega = np.nan, 1.0  # the coefficients are recomputed only when x changes
-    for i in range(t.size):
-        xi = x[i]
-        if not xi > -1.0:
-            out[i] = np.nan
-            continue
-        if xi != last:
-            last = xi
-            m = xi / (2.0 + 2.0 * xi)
-            if m == 0.0:
-                b[:] = 0.0
-                b[0], omega = 1.0, 1.0
-            else:
-                if m > 0.0:
-                    mm, scale, alt = m, np.sqrt(1.0 + xi), 1.0
-                else:
-                    mm = -m / (1.0 - m)
-                    scale, alt = np.sqrt((1.0 + xi) * (1.0 - m)), -1.0
-                K = 0.5 * np.pi / _agm(1.0, np.sqrt(1.0 - mm))
-                nome = np.exp(-np.pi * (0.5 * np.pi / _agm(1.0, np.sqrt(mm))) / K)
-                omega = 0.5 * np.pi * scale / K
-                qn, q2n1, sign = np.sqrt(nome), nome, 2.0 * np.pi / (np.sqrt(mm) * K)
-                for n in range(harmonics):
-                    b[n] = sign * qn / (1.0 + alt * q2n1)
-                    qn *= nome
-                    q2n1 *= nome * nome
-                    sign *= alt
-        c1 = np.cos(omega * t[i])
-        w = 4.0 * c1 * c1 - 2.0
-        prev, cur = c1, c1  # cos((2n+1)v) by the recurrence c_{n+2} = w c_n − c_{n−2}
-        total = 0.0
-        for n in range(harmonics):
-            total += b[n] * cur
-            prev, cur = cur, w * cur - prev
-        out[i] = total
-    return out
 
 
 def _fourier_cost(harmonics: int, x_min: float, x_max: float) -> float:
@@ -940,7 +628,7 @@ def choose_solution(tol: float, x_min: float, x_max: float, t_max: float = 20.0,
         raise InputError(f"range [{x_min}, {x_max}] reaches x = εA² ≤ -1: no periodic orbit")
     xs = verification_points(x_min, x_max, 9)
     t = np.linspace(0.0, t_max, 401)
-    exact = {x: _exact_q(t, x) for x in xs}
+    exact = {x: reference_q(t, x) for x in xs}
     found: dict[str, tuple[int, float]] = {}
     reachable = np.inf
     if np.max(np.abs(xs)) < 1:  # beyond the radius the truncated series is no answer
@@ -970,19 +658,18 @@ def choose_solution(tol: float, x_min: float, x_max: float, t_max: float = 20.0,
         raise InputError(f"tol {tol:g}: no L–P order nor exact Fourier series reaches it on "
                          f"[{x_min}, {x_max}]; the best reachable is {reachable:.1e}")
     timed = []
-    for method, (order, err) in found.items():
-        ns = (_generated_q_cost(order, x_min, x_max) if method == "lindstedt"
-              else _fourier_cost(order, x_min, x_max))
-        timed.append((method, order, err, ns))
+    q_costs = {"lindstedt": _generated_q_cost, "fourier": _fourier_cost}
+    for name, (order, err) in found.items():
+        timed.append((name, order, err, q_costs[name](order, x_min, x_max)))
     if x_min >= 0 and not emittable:
         x = np.random.default_rng(0).uniform(x_min, x_max, 200_000)
         tt = np.random.default_rng(1).uniform(0, t_max, x.size)
         t0 = time.perf_counter()
         ellipj(np.sqrt(1 + x) * tt, x / (2 * (1 + x)))
         timed.append(("exact", 0, 0.0, (time.perf_counter() - t0) / x.size * 1e9))
-    method, order, err, ns = cheapest(timed, lambda v: modelled_ns("q", v[0], v[1]),
-                                      lambda v: v[0])
-    return SolutionChoice(method, order, err, ns, xs.size * t.size, tuple(timed))
+    name, order, err, ns = cheapest(timed, lambda v: modelled_ns("q", v[0], v[1]),
+                                    lambda v: v[0])
+    return SolutionChoice(method("q", name), order, err, ns, xs.size * t.size, tuple(timed))
 
 
 def _generated_q_cost(order: int, x_min: float, x_max: float) -> float:

@@ -21,33 +21,18 @@ from pathlib import Path
 from types import ModuleType
 
 import jinja2
-import numpy as np
 import sympy as sp
 
-from .driven import (
-    Drive,
-    amplitudes,
-    balance_equations,
-    first_order_branches,
-    harmonic_balance,
-    mu_expansion,
-    mu_expansion_exact,
-)
 from .errors import InputError
-from .lindstedt import SeriesSolution, derive, order_terms
 from .lower import (
     ArrayKernel,
+    Derivation,
     Evaluator,
     Module,
+    MuDerivation,
     Provenance,
-    lower_balance,
-    lower_choice,
-    lower_driven,
-    lower_fourier,
-    lower_free,
+    Unit,
 )
-from .models import Model, check_order, model_by_name
-from .numerics import shoot
 from .printers import latex_coefficient, latex_expr, latex_rational, pycode
 
 
@@ -180,51 +165,46 @@ def _harmonic_terms(coeffs: Mapping[int, sp.Expr], scale: str, leading: bool) ->
     return terms
 
 
-def latex_context(solution: SeriesSolution, order: int) -> dict:
-    """Everything the two LaTeX templates use, as strings (order ``K ≤ solution.order``)."""
-    m, g = solution.model, solution.ground
+def latex_context(d: Derivation) -> dict:
+    """Everything the two LaTeX templates use, as strings."""
     variable = {"duffing": r"x = \varepsilon A^2", "pendulum": r"y = \theta_0^2"}.get(
-        m.name, sp.latex(m.y)
+        d.model, latex_expr(d.y) if d.y.is_Symbol else f"y = {latex_expr(d.y)}"
     )
-    y = variable.split("=")[0].strip()
-    qs = sp.latex(m.coordinate)
+    y = variable.split("=")[0].strip()  # a symbol: powers y^{j} of it are valid TeX
+    qs = sp.latex(d.coordinate)
     rows = [
-        {"j": j, "omega": latex_coefficient(g.to_sympy(solution.omega[j])),
-         "tau": latex_coefficient(g.to_sympy(solution.period[j]))}
-        for j in range(order + 1)
+        {"j": j, "omega": latex_coefficient(w), "tau": latex_coefficient(tau)}
+        for j, (w, tau) in enumerate(zip(d.omega, d.period, strict=True))
     ]
-    fourier = [
-        {"j": j, "n": n, "c": latex_coefficient(g.to_sympy(c))}
-        for j in range(order + 1) for n, c in sorted(solution.q[j].items())
-    ]
+    fourier = [{"j": j, "n": n, "c": latex_coefficient(c)}
+               for j, qj in enumerate(d.q) for n, c in qj]
     period_terms = [
-        _signed(g.to_sympy(solution.period[j]), f"{y}^{{{j}}}" if j > 1 else y, first=False)
-        for j in range(1, order + 1) if solution.period[j]
+        _signed(d.period[j], f"{y}^{{{j}}}" if j > 1 else y, first=False)
+        for j in range(1, d.order + 1) if d.period[j] != 0
     ]
+    amp = latex_expr(d.amplitude)
     orders = []
-    for j in range(1, order + 1):
-        t = order_terms(solution, j)
-        scale = latex_expr(m.amplitude * m.order_factor**j)
-        amp = latex_expr(m.amplitude)
-        secular = _signed(t.resonant, scale, first=True) + f" + 2{amp}\\,\\omega_{{{j}}}"
+    for t in d.orders:
+        scale = latex_expr(d.amplitude * d.order_factor**t.j)
+        secular = _signed(t.resonant, scale, first=True) + f" + 2{amp}\\,\\omega_{{{t.j}}}"
         orders.append({
-            "j": j,
+            "j": t.j,
             # \left(: the resonant coefficient can be a fraction of many stacked lines
             "forcing": [f"\\left({secular}\\right)\\cos s",
-                        *_harmonic_terms(t.forcing, scale, leading=False)],
+                        *_harmonic_terms(dict(t.forcing), scale, leading=False)],
             "secular": secular,
-            "omega": _signed(t.omega, latex_expr(m.order_factor**j), first=True),
-            "solution": _harmonic_terms(t.q, scale, leading=True),
+            "omega": _signed(t.omega, latex_expr(d.order_factor**t.j), first=True),
+            "solution": _harmonic_terms(dict(t.q), scale, leading=True),
         })
     return {
-        "title": f"{m.name.capitalize()}: ${m.latex}$",
+        "title": f"{d.model.capitalize()}: ${d.latex}$",
         "q": qs,
         "variable": variable,
         "y": y,
-        "order": order,
-        "convention": (f"${qs}(0) = {latex_expr(m.amplitude)}$, $\\dot {qs}(0) = 0$, "
+        "order": d.order,
+        "convention": (f"${qs}(0) = {amp}$, $\\dot {qs}(0) = 0$, "
                        f"so ${qs}_j(0) = 0$ for $j \\ge 1$"),
-        "coupling": "" if m.coupling == 1 else r"\varepsilon^j",
+        "coupling": "" if d.coupling == 1 else r"\varepsilon^j",
         "rows": rows,
         "fourier": fourier,
         "period_terms": period_terms,
@@ -232,16 +212,61 @@ def latex_context(solution: SeriesSolution, order: int) -> dict:
     }
 
 
-def render_latex(solution: SeriesSolution, order: int, p: Provenance) -> dict[str, str]:
+def render_latex(d: Derivation, p: Provenance) -> dict[str, str]:
     """``{file name: text}`` of the tables and the derivation document."""
     env = environment(latex=True)
-    ctx = latex_context(solution, order)
+    ctx = latex_context(d)
     head = banner(p, "%")
     return {
         f"{p.model}_tables.tex": env.get_template("tables.tex.j2").render(banner=head, **ctx),
         f"{p.model}_derivation.tex": env.get_template("derivation.tex.j2").render(
             banner=head, **ctx),
     }
+
+
+DMATH_INLINE = 90
+# NOTE: longer rational functions are typeset as 1/D·(N), N expanded: breqn can break a sum
+# inside \Bigl(…\Bigr) but never inside a \frac.
+
+
+def _dmath(expr: sp.Expr) -> str:
+    r"""LaTeX for a breqn ``dmath*``: short expressions as SymPy prints them, long ones
+    as ``\frac{1}{D}\Bigl(N\Bigr)``."""
+    text = sp.latex(expr)
+    if len(text) > DMATH_INLINE:
+        num, den = sp.fraction(sp.together(expr))
+        num = sp.expand(num)
+        if den != 1 and isinstance(num, sp.Add):
+            text = rf"\frac{{1}}{{{sp.latex(den)}}}\Bigl({sp.latex(num)}\Bigr)"
+    return text.replace("A_{1}", "A_1")
+
+
+def render_mu_derivation(d: MuDerivation, p: Provenance) -> dict[str, str]:
+    """``{"driven_derivation.tex": text}``: the μ-expansion order by order and the notes'
+    table."""
+    orders = [{
+        "j": o.order,
+        "forcing": [(n, _dmath(c)) for n, c in sorted(o.forcing.items())],
+        "secular": _dmath(o.secular),
+        "unknown": _dmath(o.unknown),
+        "value": _dmath(o.value) if o.value is not None else "",
+        "solution": [(n, _dmath(c)) for n, c in sorted(o.q.items())],
+    } for o in d.orders]
+    rows = [{"label": label, **{f"a{n}": v if isinstance(v, str) else f"{v:.6f}"
+                                for n, v in cells}} for label, cells in d.table.rows]
+    table = {"eps": d.table.eps, "force": d.table.force, "omega": d.table.omega, "rows": rows}
+    tex = environment(latex=True).get_template("mu_derivation.tex.j2").render(
+        banner=banner(p, "%"), order=d.order, orders=orders, table=table)
+    return {f"{p.model}_derivation.tex": tex}
+
+
+def render(unit: Unit) -> dict[str, str]:
+    """``{file name: text}`` of a unit: its module, then each document beside it."""
+    files = {f"{unit.module.name}.py": render_module(unit.module)}
+    for doc in unit.documents:
+        render_doc = render_latex if isinstance(doc, Derivation) else render_mu_derivation
+        files.update(render_doc(doc, unit.module.provenance))
+    return files
 
 
 NAME_MAX = 255
@@ -405,32 +430,6 @@ def write_files(out: Path, files: Mapping[str, str | bytes], flag: str = "--out"
             tmp.unlink(missing_ok=True)
 
 
-def generate(model: str | Model, order: int, out: Path, allow_divergent: bool = False,
-             progress: Callable[[int, int], None] | None = None, *,
-             overwrite_edited: bool = False, flag: str = "--out") -> list[Path]:
-    """``lindstedt generate``: the numba module and the LaTeX of ``model`` at ``order``.
-
-    ``model`` is a registry name or a :class:`Model` built for ``order + 2``: the series is
-    derived two orders further so the module can estimate its truncation error (``progress``
-    follows the derivation, as in :func:`lindstedt.derive`).  Every target is checked before
-    the derivation starts (here and in every ``generate_*``).
-    """
-    order = check_order(order)
-    m = model_by_name(model, order + 2) if isinstance(model, str) else model
-    name = m.name
-    check_writable(out, [f"{name}.py", f"{name}_tables.tex", f"{name}_derivation.tex"],
-                   flag, overwrite_edited)
-    source = name if not m.source else f'"{m.source}" --name {name}' + "".join(
-        f" --param {k}={v}" for k, v in m.given)
-    command = f"lindstedt generate {source} --order {order}" + (
-        " --allow-divergent" if allow_divergent else "")
-    solution = derive(m, order + 2, progress)
-    module = lower_free(solution, command, allow_divergent)
-    files = {f"{name}.py": render_module(module)}
-    files.update(render_latex(solution, order, module.provenance))
-    return write_files(out, files, flag, overwrite_edited)
-
-
 def load_generated(path: Path) -> ModuleType:
     """Import a generated module from its file under its own name (``duffing.py`` -> ``duffing``).
 
@@ -444,98 +443,3 @@ def load_generated(path: Path) -> ModuleType:
     sys.modules[name] = module
     spec.loader.exec_module(module)
     return module
-
-
-NOTES_DRIVE = (0.1, 1.0, 1.0)
-# NOTE: ε, f, ω of the notes' table (§10.4, undamped), reproduced in every driven derivation.
-NOTES_TABLE_ORDERS = 6
-
-
-def notes_table() -> dict:
-    """The notes' table (A₁, A₃, A₅ by μ-order, harmonic balance, shooting) as strings."""
-    eps, force, omega = NOTES_DRIVE
-    d = Drive(eps, force, omega)
-    (branch,) = first_order_branches(d)
-    mu = mu_expansion(d, branch, NOTES_TABLE_ORDERS)
-    rows = []
-
-    def row(label: str, A: dict) -> dict:
-        cells = {f"a{n}": f"{A[n]:.6f}" if A.get(n) else "" for n in (1, 3, 5)}
-        return {"label": label, **cells}
-
-    for j in range(NOTES_TABLE_ORDERS + 1):
-        rows.append(row(f"$\\mu$-expansion, order {j}", amplitudes(*mu.partial(j), 2 * j + 1)[0]))
-    hb = harmonic_balance(d, branch, 8)
-    A, _ = amplitudes(hb.coefficients, 0.0, 15)
-    rows.append(row("harmonic balance, $N = 8$", A))
-    orbit = shoot(eps, force, omega, 0.0, np.array([sum(A.values()), 0.0]))
-    rows.append(row("numerical (shooting)", orbit.A))
-    rows.append({"label": "notes: numerical", "a1": "2.356", "a3": "0.0456", "a5": "0.0008"})
-    return {"eps": eps, "force": force, "omega": omega, "rows": rows}
-
-
-DMATH_INLINE = 90
-# NOTE: longer rational functions are typeset as 1/D·(N), N expanded: breqn can break a sum
-# inside \Bigl(…\Bigr) but never inside a \frac.
-
-
-def _dmath(expr: sp.Expr) -> str:
-    r"""LaTeX for a breqn ``dmath*``: short expressions as SymPy prints them, long ones
-    as ``\frac{1}{D}\Bigl(N\Bigr)``."""
-    text = sp.latex(expr)
-    if len(text) > DMATH_INLINE:
-        num, den = sp.fraction(sp.together(expr))
-        num = sp.expand(num)
-        if den != 1 and isinstance(num, sp.Add):
-            text = rf"\frac{{1}}{{{sp.latex(den)}}}\Bigl({sp.latex(num)}\Bigr)"
-    return text.replace("A_{1}", "A_1")
-
-
-def generate_driven(order: int, out: Path, *, overwrite_edited: bool = False,
-                    flag: str = "--out") -> list[Path]:
-    """``lindstedt generate driven``: A_n(ω) evaluators and the μ-expansion's derivation."""
-    names = ["driven.py", "driven_derivation.tex"]
-    check_writable(out, names, flag, overwrite_edited)
-    command = f"lindstedt generate driven --order {order}"
-    orders = mu_expansion_exact(order)
-    module = lower_driven(orders, command)
-    ctx_orders = [{
-        "j": o.order,
-        "forcing": [(n, _dmath(c)) for n, c in sorted(o.forcing.items())],
-        "secular": _dmath(o.secular),
-        "unknown": _dmath(o.unknown),
-        "value": _dmath(o.value) if o.value is not None else "",
-        "solution": [(n, _dmath(c)) for n, c in sorted(o.q.items())],
-    } for o in orders]
-    tex = environment(latex=True).get_template("mu_derivation.tex.j2").render(
-        banner=banner(module.provenance, "%"), order=order, orders=ctx_orders,
-        table=notes_table())
-    return write_files(out, dict(zip(names, (render_module(module), tex), strict=True)), flag,
-                       overwrite_edited)
-
-
-def generate_balance(harmonics: int, out: Path, *, overwrite_edited: bool = False,
-                     flag: str = "--out") -> list[Path]:
-    """``lindstedt generate balance``: compiled harmonic-balance residual, Jacobian, Newton."""
-    check_writable(out, ["balance.py"], flag, overwrite_edited)
-    module = lower_balance(balance_equations(harmonics),
-                           f"lindstedt generate balance --harmonics {harmonics}")
-    return write_files(out, {"balance.py": render_module(module)}, flag, overwrite_edited)
-
-
-def generate_fourier(harmonics: int, out: Path, *, overwrite_edited: bool = False,
-                     flag: str = "--out") -> list[Path]:
-    """``lindstedt generate fourier``: the exact Fourier series of the free Duffing solution."""
-    check_writable(out, ["fourier.py"], flag, overwrite_edited)
-    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 60:
-        raise InputError(f"harmonics {harmonics!r}: must be an integer in 1..60")
-    module = lower_fourier(harmonics, f"lindstedt generate fourier --harmonics {harmonics}")
-    return write_files(out, {"fourier.py": render_module(module)}, flag, overwrite_edited)
-
-
-def generate_choice(candidate: object, command: str, out: Path, verified: tuple[float, float],
-                    *, overwrite_edited: bool = False, flag: str = "--emit") -> list[Path]:
-    """``lindstedt choose period … --emit DIR``: just the chosen evaluator, NaN outside the
-    range ``verified`` of x = εA² it was verified on."""
-    module = lower_choice(candidate, command, verified)
-    return write_files(out, {"chosen_period.py": render_module(module)}, flag, overwrite_edited)

@@ -18,8 +18,7 @@ import sympy as sp
 
 from . import __version__
 from .driven import A1_, BalanceEquations, MuOrder, eps_, omega_
-from .errors import InputError
-from .lindstedt import SeriesSolution
+from .lindstedt import SeriesSolution, order_terms
 from .printers import identifier
 
 Assign = tuple[sp.Symbol, sp.Expr]
@@ -390,7 +389,7 @@ def lower_fourier(terms: int, command: str) -> Module:
     """``q(t, A, eps)`` and ``omega(A, eps)`` of the free Duffing oscillator from the exact
     Fourier series of its elliptic-function solution in the nome ``q = exp(−πK′/K)``,
     truncated to ``terms`` odd harmonics; ``K``, ``K′`` by the AGM (see
-    ``choose.cn_fourier``, which the chooser verifies; same formulas)."""
+    ``methods.cn_fourier``, which the chooser verifies; same formulas and AGM steps)."""
     t, A, eps, x, m, mm, scale, alt, K, Kp, nome, w = sp.symbols(
         "t A eps x m mm scale alt K K_prime nome w")
     hardening = m >= 0
@@ -423,50 +422,122 @@ def lower_fourier(terms: int, command: str) -> Module:
     )
 
 
-def lower_choice(candidate, command: str, verified: tuple[float, float]) -> Module:
+x_ = sp.Symbol("x")
+# NOTE: x = εA², the variable of every period formula (:class:`PeriodFormula`).
+
+
+@dataclass(frozen=True)
+class PeriodFormula:
+    """``T/2π`` of one verified period candidate in ``x = εA²``: assignments, then the value,
+    inside the method's domain; its coefficients as the verified doubles (provenance)."""
+
+    method: str
+    order: int
+    domain: sp.Basic  # SymPy boolean in x_
+    body: tuple[Assign, ...]
+    value: sp.Expr
+    num: tuple[float, ...]
+    den: tuple[float, ...]
+
+
+def lower_choice(formula: PeriodFormula, command: str, verified: tuple[float, float]) -> Module:
     """The period evaluator ``choose period`` picked, as one numba ufunc ``period(A, eps)``,
     NaN outside the range ``verified = (x_min, x_max)`` of ``x = εA²`` it was verified on (as
     well as outside the method's domain).
 
     Coefficients and bounds enter as the exact binary values of the verified doubles (so the
     emitted evaluator computes what was verified, up to FMA contraction)."""
-    if candidate.method == "exact":
-        raise InputError("the exact period (SciPy's ellipk) has no compiled evaluator to emit; "
-                         "loosen the tolerance or narrow the range")
-    A, eps, x, m = sp.symbols("A eps x m")
-
-    def coeffs(values) -> list[sp.Expr]:
-        return [sp.Rational(float(v)) for v in values]
-
-    domain = {"lindstedt": sp.And(x > -1, sp.Abs(x) < 1), "resummed": x > sp.Rational(-2, 3),
-              "pade": x > -1, "modified": x > -1, "agm": x > -1}[candidate.method]
+    A, eps = sp.symbols("A eps")
     lo, hi = (sp.Rational(float(v)) for v in verified)
-    guard = sp.And(domain, x >= lo, x <= hi)
-    body: tuple = ()
-    if candidate.method == "agm":
-        lines, mean = agm_steps(sp.sqrt(1 + x), sp.sqrt(1 + x / 2), candidate.order, "")
-        body, out = tuple(lines), 1 / mean
-    elif candidate.method == "lindstedt":
-        out = horner(coeffs(candidate.num), x)
-    elif candidate.method == "resummed":
-        body = ((m, x / (2 + 2 * x)),)
-        out = sp.sqrt(1 - 2 * m) * horner(coeffs(candidate.num), m)
-    elif candidate.method == "modified":
-        body = ((m, 3 * x / (4 + 3 * x)),)
-        out = 1 / sp.sqrt((1 + sp.Rational(3, 4) * x) * horner(coeffs(candidate.num), m))
-    else:
-        out = horner(coeffs(candidate.num), x) / horner(coeffs(candidate.den), x)
-    ev = Evaluator("period", f"Duffing period T(A, eps): {candidate.method} order "
-                   f"{candidate.order}, the method `lindstedt choose` verified for x = eps*A**2 "
+    guard = sp.And(formula.domain, x_ >= lo, x_ <= hi)
+    ev = Evaluator("period", f"Duffing period T(A, eps): {formula.method} order "
+                   f"{formula.order}, the method `lindstedt choose` verified for x = eps*A**2 "
                    f"in [{float(lo)!r}, {float(hi)!r}]; NaN outside that range.", (A, eps),
-                   ((x, eps * A**2),), guard, body, 2 * sp.pi * out)
+                   ((x_, eps * A**2),), guard, formula.body, 2 * sp.pi * formula.value)
     return Module(
         name="chosen_period",
         doc=f"The period evaluator chosen by `{command}`.",
-        constants=(("METHOD", candidate.method), ("ORDER", candidate.order),
+        constants=(("METHOD", formula.method), ("ORDER", formula.order),
                    ("VERIFIED_X", (float(lo), float(hi)))),
         evaluators=(ev,),
-        provenance=provenance("duffing", candidate.order, command, method=candidate.method,
-                              num=[float(v) for v in candidate.num],
-                              den=[float(v) for v in candidate.den]),
+        provenance=provenance("duffing", formula.order, command, method=formula.method,
+                              num=list(formula.num), den=list(formula.den)),
     )
+
+
+# --- documents: the LaTeX beside a module, as SymPy objects (printed by emit) ---------------
+
+@dataclass(frozen=True)
+class OrderPieces:
+    """The ``y^j`` equation of a free oscillator: its forcing, resonant part, ω_j, q_j."""
+
+    j: int
+    resonant: sp.Expr
+    omega: sp.Expr
+    forcing: tuple[tuple[int, sp.Expr], ...]
+    q: tuple[tuple[int, sp.Expr], ...]
+
+
+@dataclass(frozen=True)
+class Derivation:
+    """The tables and the order-by-order derivation of a free oscillator's series to
+    ``order`` (templates ``tables.tex.j2``, ``derivation.tex.j2``)."""
+
+    model: str
+    latex: str  # the equation of motion, as the model typesets it
+    y: sp.Expr
+    coordinate: sp.Symbol
+    amplitude: sp.Expr
+    order_factor: sp.Expr
+    coupling: sp.Expr
+    order: int
+    omega: tuple[sp.Expr, ...]
+    period: tuple[sp.Expr, ...]
+    q: tuple[tuple[tuple[int, sp.Expr], ...], ...]
+    orders: tuple[OrderPieces, ...]
+
+
+def lower_derivation(solution: SeriesSolution, order: int) -> Derivation:
+    """The document of ``solution`` at order ``K ≤ solution.order``."""
+    m, g = solution.model, solution.ground
+    pieces = []
+    for j in range(1, order + 1):
+        t = order_terms(solution, j)
+        pieces.append(OrderPieces(j, t.resonant, t.omega, tuple(sorted(t.forcing.items())),
+                                  tuple(sorted(t.q.items()))))
+    return Derivation(
+        model=m.name, latex=m.latex, y=m.y, coordinate=m.coordinate, amplitude=m.amplitude,
+        order_factor=m.order_factor, coupling=m.coupling, order=order,
+        omega=tuple(g.to_sympy(c) for c in solution.omega[: order + 1]),
+        period=tuple(g.to_sympy(c) for c in solution.period[: order + 1]),
+        q=tuple(tuple((n, g.to_sympy(c)) for n, c in sorted(solution.q[j].items()))
+                for j in range(order + 1)),
+        orders=tuple(pieces))
+
+
+@dataclass(frozen=True)
+class NotesTable:
+    """The notes' driven table: A₁, A₃, A₅ by μ-order, harmonic balance and shooting at
+    ``(eps, force, omega)``; a cell is a number, or the notes' own printed digits."""
+
+    eps: float
+    force: float
+    omega: float
+    rows: tuple[tuple[str, tuple[tuple[int, float | str], ...]], ...]
+
+
+@dataclass(frozen=True)
+class MuDerivation:
+    """The μ-expansion's derivation to ``order`` and the notes' table (``mu_derivation.tex.j2``)."""
+
+    order: int
+    orders: tuple[MuOrder, ...]
+    table: NotesTable
+
+
+@dataclass(frozen=True)
+class Unit:
+    """What one command writes: a module and the documents beside it."""
+
+    module: Module
+    documents: tuple[Derivation | MuDerivation, ...] = ()

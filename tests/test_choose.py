@@ -10,8 +10,9 @@ from fractions import Fraction
 import mpmath
 import numpy as np
 import pytest
-from lindstedt.choose import candidates, choose_period, resummed_coefficients
+from lindstedt.choose import choose_period
 from lindstedt.errors import InputError
+from lindstedt.methods import candidates, resummed_coefficients
 from reference import duffing_period
 
 
@@ -177,7 +178,8 @@ def test_every_method_emits_its_period(tmp_path, method, order, lo, hi, tol):
     """Each branch of lower_choice, not only the one the timings pick: the emitted module's
     period(A, eps) against T = 4K(m)/√(1+x) (mpmath) on the verified range, its ends
     included, and NaN just outside it (and beyond the separatrix)."""
-    from lindstedt.emit import generate_choice, load_generated
+    from lindstedt.compiler import generate_choice
+    from lindstedt.emit import load_generated
 
     cand = next(c for c in candidates() if (c.method, c.order) == (method, order))
     generate_choice(cand, "test", tmp_path, (lo, hi))
@@ -198,7 +200,7 @@ def test_every_method_emits_its_period(tmp_path, method, order, lo, hi, tol):
 
 
 def test_integrated_period_reaches_its_tolerance():
-    from lindstedt.choose import integrated_period, reference_period
+    from lindstedt.methods import integrated_period, reference_period
 
     for x in (0.1, 5.0, -0.5):
         ref = reference_period(np.array([x]))[0]
@@ -209,8 +211,8 @@ def test_integrated_period_reaches_its_tolerance():
 def test_modified_lindstedt_of_cheung_chen_lau():
     """ω² = (1 + 3x/4) g(α), α = 3x/(4 + 3x): by construction g = 1 + O(α²) (CCL's choice of α
     absorbs the first-order term), and the series holds out to x = 10³ and down to x = −0.9."""
-    from lindstedt.choose import modified_coefficients, reference_period
     from lindstedt.lindstedt import derive
+    from lindstedt.methods import modified_coefficients, reference_period
     from lindstedt.models import duffing
 
     sol = derive(duffing(), 40)
@@ -241,8 +243,8 @@ def test_one_harmonic_closed_form_is_mu_order_zero():
     for q = A₁ cos ωt + B₁ sin ωt (cos: (1 − ω²)A₁ + ωB₁/Q + ¾εr²A₁ = f, sin: (1 − ω²)B₁ −
     ωA₁/Q + ¾εr²B₁ = 0, r² = A₁² + B₁²: signs included) on the largest branch (numpy.roots of
     the cubic in r²), damped and undamped; and it is the μ-expansion's order 0."""
-    from lindstedt.choose import one_harmonic_amplitudes
     from lindstedt.driven import Drive, amplitudes, first_order_branches, mu_expansion
+    from lindstedt.methods import one_harmonic_amplitudes
 
     eps, f = 0.1, 0.7
     for Q in (np.inf, 20.0):
@@ -328,7 +330,7 @@ def test_choose_q_against_jacobi_cn():
 def test_exact_fourier_series_of_the_solution(x):
     """The nome series against mpmath's cn (any m < 1): double precision with enough
     harmonics, on a softening spring next to the separatrix too."""
-    from lindstedt.choose import cn_fourier
+    from lindstedt.methods import cn_fourier
 
     t = np.linspace(0.0, 15.0, 61)
     m = x / (2 * (1 + x))
@@ -343,7 +345,8 @@ def test_exact_fourier_series_of_the_solution(x):
 def test_choose_q_for_a_softening_spring_beyond_the_series():
     """On [−0.95, 0] the L–P series cannot reach 1e-10 and SciPy's cn does not take m < 0:
     the exact Fourier series does, and the choice holds off the verification grid."""
-    from lindstedt.choose import choose_solution, cn_fourier
+    from lindstedt.choose import choose_solution
+    from lindstedt.methods import cn_fourier
 
     c = choose_solution(1e-10, -0.95, 0.0)
     assert c.method == "fourier" and c.max_error <= 1e-10

@@ -16,11 +16,12 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from lindstedt import emit
-from lindstedt.emit import check_writable, generate, load_generated, render_latex, render_module
+from lindstedt import emit, methods
+from lindstedt.compiler import generate
+from lindstedt.emit import check_writable, load_generated, render_latex, render_module
 from lindstedt.errors import InputError
 from lindstedt.lindstedt import derive
-from lindstedt.lower import lower_free
+from lindstedt.lower import lower_derivation, lower_free
 from lindstedt.models import duffing
 
 SET = ("duffing.py", "duffing_tables.tex", "duffing_derivation.tex")
@@ -40,7 +41,7 @@ def no_derivation(monkeypatch):
     """Any derivation fails the test: what is refused must be refused before the work."""
     def forbidden(*args, **kwargs):
         raise AssertionError("derive ran before the paths were checked")
-    monkeypatch.setattr(emit, "derive", forbidden)
+    monkeypatch.setattr(methods, "derive", forbidden)
 
 
 def test_banner_must_match_in_full(tmp_path, no_derivation):
@@ -177,7 +178,7 @@ def _check_text(command: str) -> str:
                               ast.Expr)) for n in tree.body)
     head = text.splitlines()[:4]  # the fifth, the body hash, is added when written
     assert all(line.startswith("# ") for line in head) and head[2].startswith("# command: ")
-    for tex in render_latex(SOLUTION, 3, module.provenance).values():
+    for tex in render_latex(lower_derivation(SOLUTION, 3), module.provenance).values():
         assert all(line.startswith("% ") for line in tex.splitlines()[:4])
     return text
 

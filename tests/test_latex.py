@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 import sympy as sp
-from lindstedt.emit import generate, generate_driven
+from lindstedt.compiler import generate, generate_driven
 from lindstedt.printers import LATEX_LINE_DIGITS, latex_digits, latex_rational
 
 GENERATED = Path(__file__).resolve().parents[1] / "generated"

@@ -1,0 +1,107 @@
+"""The driver: derive -> lower -> render -> write, each stage called once, in order.
+
+Every command that writes files comes through :func:`compile_target`: ``generate`` (a free
+oscillator, ``driven``, ``balance``, ``fourier``), ``choose … --emit`` and ``demo``.  A
+:class:`methods.Target` says what its method derives and how it lowers; :mod:`emit` renders
+the :class:`lower.Unit` and writes it.  Every target file is checked before the derivation
+starts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from functools import partial
+from pathlib import Path
+
+from .emit import check_writable, render, write_files
+from .errors import InputError
+from .methods import (
+    BALANCE,
+    CHOSEN_PERIOD,
+    FOURIER,
+    FREE,
+    MU,
+    Candidate,
+    Method,
+    Request,
+    Target,
+)
+from .models import Model, check_order, model_by_name
+
+Progress = Callable[[int, int], None]
+
+
+def compile_target(target: Target, request: Request, out: Path,
+                   progress: Progress | None = None, *, overwrite_edited: bool = False,
+                   flag: str = "--out") -> list[Path]:
+    """Check the targets, derive, lower, render, write: the files written."""
+    names = target.files(request)
+    check_writable(out, list(names), flag, overwrite_edited)
+    derived = target.derive(request, progress)
+    unit = target.lower(derived, request)
+    files = render(unit)
+    if set(files) != set(names):
+        raise RuntimeError(f"rendered {sorted(files)}, announced {sorted(names)}")
+    return write_files(out, files, flag, overwrite_edited)
+
+
+def generate(model: str | Model, order: int, out: Path, allow_divergent: bool = False,
+             progress: Progress | None = None, *,
+             overwrite_edited: bool = False, flag: str = "--out") -> list[Path]:
+    """``lindstedt generate``: the numba module and the LaTeX of ``model`` at ``order``.
+
+    ``model`` is a registry name or a :class:`Model` built for ``order + 2``: the series is
+    derived two orders further so the module can estimate its truncation error (``progress``
+    follows the derivation, as in :func:`lindstedt.derive`).
+    """
+    order = check_order(order)
+    m = model_by_name(model, order + 2) if isinstance(model, str) else model
+    source = m.name if not m.source else f'"{m.source}" --name {m.name}' + "".join(
+        f" --param {k}={v}" for k, v in m.given)
+    command = f"lindstedt generate {source} --order {order}" + (
+        " --allow-divergent" if allow_divergent else "")
+    return compile_target(FREE, Request(order, command, m, allow_divergent), out, progress,
+                          overwrite_edited=overwrite_edited, flag=flag)
+
+
+def generate_driven(order: int, out: Path, *, overwrite_edited: bool = False,
+                    flag: str = "--out") -> list[Path]:
+    """``lindstedt generate driven``: A_n(ω) evaluators and the μ-expansion's derivation."""
+    return compile_target(MU, Request(order, f"lindstedt generate driven --order {order}"),
+                          out, overwrite_edited=overwrite_edited, flag=flag)
+
+
+def generate_balance(harmonics: int, out: Path, *, overwrite_edited: bool = False,
+                     flag: str = "--out") -> list[Path]:
+    """``lindstedt generate balance``: compiled harmonic-balance residual, Jacobian, Newton."""
+    command = f"lindstedt generate balance --harmonics {harmonics}"
+    return compile_target(BALANCE, Request(harmonics, command), out,
+                          overwrite_edited=overwrite_edited, flag=flag)
+
+
+def generate_fourier(harmonics: int, out: Path, *, overwrite_edited: bool = False,
+                     flag: str = "--out") -> list[Path]:
+    """``lindstedt generate fourier``: the exact Fourier series of the free Duffing solution."""
+    command = f"lindstedt generate fourier --harmonics {harmonics}"
+    return compile_target(FOURIER, Request(harmonics, command), out,
+                          overwrite_edited=overwrite_edited, flag=flag)
+
+
+def generate_choice(candidate: Candidate, command: str, out: Path,
+                    verified: tuple[float, float], *, overwrite_edited: bool = False,
+                    flag: str = "--emit") -> list[Path]:
+    """``lindstedt choose period … --emit DIR``: just the chosen evaluator, NaN outside the
+    range ``verified`` of x = εA² it was verified on."""
+    request = Request(candidate.order, command, candidate=candidate, verified=verified)
+    return compile_target(CHOSEN_PERIOD, request, out, overwrite_edited=overwrite_edited,
+                          flag=flag)
+
+
+def generate_method(m: Method, order: int, out: Path, *, overwrite_edited: bool = False,
+                    flag: str = "--emit") -> list[Path]:
+    """The module of a method ``choose … --emit`` picked, as ``generate`` writes it."""
+    if m.target is None:
+        raise InputError(f"{m.name}: no emitted module")
+    writer = {FREE: partial(generate, "duffing"), MU: generate_driven,
+              BALANCE: generate_balance, FOURIER: generate_fourier}[m.target]
+    return writer(order, out, overwrite_edited=overwrite_edited, flag=flag)

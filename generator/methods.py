@@ -1,0 +1,767 @@
+"""The methods, one record each: what it answers and for which oscillators (and why not), how it
+derives, evaluates and lowers, and what it is checked against.
+
+``choose`` loops over :data:`METHODS`; the compiler asks a record's :class:`Target` what to
+derive and lower for ``generate`` and ``choose --emit``.  Adding a method is adding a record.
+
+The free Duffing period ``T/2π`` as a function of ``x = εA²`` (``choose period``):
+
+* ``lindstedt``: the L–P series ``Σ τ_j x^j`` truncated at order k (radius |x| < 1, set by the
+  separatrix at x = −1);
+* ``resummed``: the same series re-expanded in ``m = x/(2(1+x))``:
+  ``T/2π = √(1 − 2m) Σ c_n m^n`` — analytic for ``|m| < 1``, i.e. ``x > −2/3``, and
+  ``m < 1/2`` for every ``x ≥ 0``, so it converges out to ``εA² → ∞``;
+* ``pade``: the diagonal Padé approximant ``[k/k]`` of the L–P series;
+* ``modified``: the modified L–P of Cheung, Chen & Lau, re-expanded from the exact series;
+* ``agm``: the exact period through Gauss's arithmetic–geometric mean,
+  ``T/2π = 1/AGM(√(1+x), √(1+x/2))`` (``K(m) = π/(2 AGM(1, √(1−m)))``, scaled), stopped after
+  n steps — the order; each step squares the relative error, so 2–3 steps are exact to
+  double precision everywhere except next to the separatrix;
+* ``exact``: ``4K(m)/√(1+x)`` (SciPy's ``ellipk``), the baseline any method must beat.
+
+Each is checked against :func:`reference_period` (mpmath, 30 digits).  The solution q(t)
+(``choose q``): the L–P series, the exact Fourier series in the nome (:func:`cn_fourier`) and
+SciPy's cn, checked against cn.  The driven amplitudes (``choose amplitudes|response``): one
+harmonic, the μ-expansion, harmonic balance and shooting, checked against shooting with
+Richardson-combined RK4.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from dataclasses import dataclass
+from fractions import Fraction
+from types import ModuleType
+
+import mpmath
+import numpy as np
+import sympy as sp
+from numba import njit
+from scipy.integrate import solve_ivp
+from scipy.special import ellipj
+
+from .driven import (
+    Branch,
+    Drive,
+    amplitudes,
+    balance_equations,
+    first_order_branches,
+    harmonic_balance,
+    mu_expansion,
+    mu_expansion_exact,
+)
+from .errors import InputError
+from .lindstedt import derive
+from .lower import (
+    FOURIER_AGM_STEPS,
+    MuDerivation,
+    NotesTable,
+    PeriodFormula,
+    Unit,
+    agm_steps,
+    horner,
+    lower_balance,
+    lower_choice,
+    lower_derivation,
+    lower_driven,
+    lower_fourier,
+    lower_free,
+    x_,
+)
+from .models import Model, check_order, duffing
+from .numerics import duffing_period_exact, shoot
+
+Progress = Callable[[int, int], None]
+
+MAX_ORDER = 60
+# NOTE: order 60 of the exact series takes ~0.1 s and reaches 1e-16 wherever |x| ≤ 0.5.
+AGM_STEPS = 8
+# NOTE: each AGM step squares the relative gap of a and b: 3 steps reach 1e-16 for all
+# x ∈ [−0.5, 10³]; 6 reach it down to x = −1 + 1e-12, next to the separatrix.
+PADE_MAX = 12
+# NOTE: Padé [k/k] up to [12/12] (2k ≤ the series' order).
+
+
+# --- evaluation: compiled kernels --------------------------------------------------------------
+
+BLOCK = 1024
+# NOTE: Horner runs coefficient-outer, point-inner over blocks of three 8 KB arrays that stay in
+# L1 (256 and 4096 measured slower): no dependency between points, so LLVM vectorises the inner
+# loop (point-outer Horner cannot be).
+
+FASTMATH = {"contract", "arcp", "nsz", "reassoc"}
+# NOTE: error_model="numpy" below: Python's model checks every division for zero, which keeps
+# LLVM from vectorising any loop that divides (9 ns/point instead of 1.2 for the AGM).
+
+
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
+def _horner_block(c: np.ndarray, t: np.ndarray, acc: np.ndarray) -> None:
+    acc[:] = c[c.size - 1]
+    for j in range(c.size - 2, -1, -1):
+        cj = c[j]
+        for i in range(t.size):
+            acc[i] = acc[i] * t[i] + cj
+
+
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
+def agm(a: np.ndarray, b: np.ndarray, steps: int) -> None:
+    """Gauss's arithmetic–geometric mean in place, elementwise: ``a ← (a + b)/2, b ← √(ab)``,
+    ``steps`` times (a converged pair stays put, so a fixed count serves every argument);
+    the mean is then ``(a + b)/2``.  The one numeric AGM (:func:`lower.agm_steps` is its
+    lowering for emitted modules)."""
+    for _ in range(steps):
+        for i in range(a.size):
+            a[i], b[i] = 0.5 * (a[i] + b[i]), np.sqrt(a[i] * b[i])
+
+
+@njit(cache=True, fastmath=FASTMATH, error_model="numpy")
+def _evaluate(kind: int, num: np.ndarray, den: np.ndarray, steps: int, x: np.ndarray,
+              out: np.ndarray) -> None:
+    """Blocked evaluation of a candidate; kind 0: Σ num_j x^j, 1: in m with √(1 − 2m),
+    2: Padé num(x)/den(x), 3: modified L–P 1/√((1 + 3x/4) g(α)), 4: ``steps`` AGM steps.
+    NaN outside the candidate's domain."""
+    t = np.empty(BLOCK)
+    p = np.empty(BLOCK)
+    q = np.empty(BLOCK)
+    for start in range(0, x.size, BLOCK):
+        n = min(BLOCK, x.size - start)
+        xs = x[start : start + n]
+        tv, pv, qv = t[:n], p[:n], q[:n]
+        if kind == 4:
+            for i in range(n):
+                pv[i] = np.sqrt(1.0 + xs[i])
+                qv[i] = np.sqrt(1.0 + 0.5 * xs[i])
+            agm(pv, qv, steps)
+        else:
+            if kind == 1:
+                for i in range(n):
+                    tv[i] = xs[i] / (2.0 + 2.0 * xs[i])
+            elif kind == 3:
+                for i in range(n):
+                    tv[i] = 3.0 * xs[i] / (4.0 + 3.0 * xs[i])
+            else:
+                tv[:] = xs
+            _horner_block(num, tv, pv)
+            if kind == 2:
+                _horner_block(den, tv, qv)
+        o = out[start : start + n]
+        if kind == 0:
+            for i in range(n):
+                o[i] = pv[i] if abs(xs[i]) < 1.0 else np.nan
+        elif kind == 1:
+            for i in range(n):
+                o[i] = pv[i] * np.sqrt(1.0 - 2.0 * tv[i]) if xs[i] > -2.0 / 3.0 else np.nan
+        elif kind == 2:
+            for i in range(n):
+                o[i] = pv[i] / qv[i] if xs[i] > -1.0 else np.nan
+        elif kind == 3:
+            for i in range(n):
+                o[i] = 1.0 / np.sqrt((1.0 + 0.75 * xs[i]) * pv[i]) if xs[i] > -1.0 else np.nan
+        else:
+            for i in range(n):
+                o[i] = 2.0 / (pv[i] + qv[i]) if xs[i] > -1.0 else np.nan
+
+
+@njit(cache=True, error_model="numpy")
+def cn_fourier(t: np.ndarray, x: np.ndarray, harmonics: int, out: np.ndarray) -> np.ndarray:
+    """``q/A`` of the free Duffing oscillator, ``x = εA² > −1``, as the exact Fourier series
+    of the elliptic function in the nome ``q = exp(−πK′/K)``, truncated to ``harmonics``
+    odd harmonics of ``Ω = 2π/T``: ``cn(u|m) = (2π/(kK)) Σ qⁿ⁺¹ᐟ²/(1 + q²ⁿ⁺¹) cos((2n+1)v)``
+    for ``m ≥ 0``, and for ``m < 0`` the imaginary-modulus transform ``cn(u|−μ) =
+    cd(√(1+μ) u | μ/(1+μ))`` with ``cd``'s series (signs ``(−1)ⁿ``, denominators
+    ``1 − q²ⁿ⁺¹``).  The L–P series in x is its expansion; this one converges for every
+    ``x > −1``.  NaN for ``x ≤ −1``.  The coefficients (two AGMs and an exp) are recomputed
+    only where x changes, so a run of points at one amplitude costs a cos and a recurrence.
+    :func:`lower.lower_fourier` lowers the same formulas for an emitted module."""
+    b = np.zeros(max(harmonics, 1))
+    a2, b2 = np.empty(2), np.empty(2)  # K's and K′'s AGMs side by side
+    last, omega = np.nan, 1.0  # the coefficients are recomputed only when x changes
+    for i in range(t.size):
+        xi = x[i]
+        if not xi > -1.0:
+            out[i] = np.nan
+            continue
+        if xi != last:
+            last = xi
+            m = xi / (2.0 + 2.0 * xi)
+            if m == 0.0:
+                b[:] = 0.0
+                b[0], omega = 1.0, 1.0
+            else:
+                if m > 0.0:
+                    mm, scale, alt = m, np.sqrt(1.0 + xi), 1.0
+                else:
+                    mm = -m / (1.0 - m)
+                    scale, alt = np.sqrt((1.0 + xi) * (1.0 - m)), -1.0
+                a2[:] = 1.0
+                b2[0], b2[1] = np.sqrt(1.0 - mm), np.sqrt(mm)
+                agm(a2, b2, FOURIER_AGM_STEPS)
+                K = np.pi / (a2[0] + b2[0])
+                nome = np.exp(-np.pi * (np.pi / (a2[1] + b2[1])) / K)
+                omega = 0.5 * np.pi * scale / K
+                qn, q2n1, sign = np.sqrt(nome), nome, 2.0 * np.pi / (np.sqrt(mm) * K)
+                for n in range(harmonics):
+                    b[n] = sign * qn / (1.0 + alt * q2n1)
+                    qn *= nome
+                    q2n1 *= nome * nome
+                    sign *= alt
+        c1 = np.cos(omega * t[i])
+        w = 4.0 * c1 * c1 - 2.0
+        prev, cur = c1, c1  # cos((2n+1)v) by the recurrence c_{n+2} = w c_n − c_{n−2}
+        total = 0.0
+        for n in range(harmonics):
+            total += b[n] * cur
+            prev, cur = cur, w * cur - prev
+        out[i] = total
+    return out
+
+
+# --- derivation: the period series re-expanded --------------------------------------------------
+
+def _mul(a: list[Fraction], b: list[Fraction]) -> list[Fraction]:
+    """Product of power series truncated to ``len(a)`` terms."""
+    return [sum(a[i] * b[n - i] for i in range(n + 1)) for n in range(len(a))]
+
+
+def _compose(outer: list[Fraction], inner: list[Fraction]) -> list[Fraction]:
+    """``outer(inner(t))`` truncated to ``len(outer)`` terms (``inner`` has no constant)."""
+    total = [Fraction(0)] * len(outer)
+    power = [Fraction(1)] + [Fraction(0)] * (len(outer) - 1)
+    for c in outer:
+        total = [s + c * p for s, p in zip(total, power, strict=True)]
+        power = _mul(power, inner)
+    return total
+
+
+def resummed_coefficients(tau: list[Fraction]) -> list[Fraction]:
+    """``c_n`` of ``(T/2π)(x(m)) / √(1 − 2m)``, ``x(m) = 2m/(1 − 2m) = Σ_{n≥1} 2^n m^n``,
+    exactly; the first k + 1 terms use ``τ_0..τ_k``."""
+    k = len(tau) - 1
+    inv_sqrt = [Fraction(1)]
+    for n in range(1, k + 1):  # (1 − 2m)^(−1/2) = Σ binom(2n, n) (m/2)^n·2^n
+        inv_sqrt.append(inv_sqrt[-1] * Fraction(2 * n - 1, n))
+    xm = [Fraction(0)] + [Fraction(2**n) for n in range(1, k + 1)]
+    return _mul(_compose(tau, xm), inv_sqrt)
+
+
+def modified_coefficients(omega: list[Fraction]) -> list[Fraction]:
+    """The modified L–P of Cheung, Chen & Lau: ``ω² = (1 + 3x/4)·g(α)`` with
+    ``α = (3x/4)/(1 + 3x/4)``, which stays below 1 for every ``x > 0``; returns ``g``'s
+    coefficients exactly (``x(α) = (4/3) Σ_{n≥1} α^n``)."""
+    k = len(omega) - 1
+    w2 = _mul(omega, omega)
+    h = _mul(w2, [Fraction(-3, 4) ** n for n in range(k + 1)])  # ω² / (1 + 3x/4)
+    return _compose(h, [Fraction(0)] + [Fraction(4, 3)] * k)
+
+
+def _pade(tau: list[Fraction], k: int) -> tuple[np.ndarray, np.ndarray]:
+    with mpmath.workdps(60):
+        p, q = mpmath.pade([mpmath.mpf(t.numerator) / t.denominator for t in tau[: 2 * k + 1]],
+                           k, k)
+        return np.array([float(c) for c in p]), np.array([float(c) for c in q])
+
+
+@dataclass(frozen=True)
+class PeriodSeries:
+    """The exact L–P series of the free Duffing oscillator: ``τ_j`` and ``ω_j``."""
+
+    tau: list[Fraction]
+    omega: list[Fraction]
+
+
+Coefficients = tuple[np.ndarray, np.ndarray]
+ONE = np.ones(1)
+NONE = np.zeros(1)
+
+
+def _floats(values: list[Fraction]) -> np.ndarray:
+    return np.array([float(v) for v in values])
+
+
+def _lp_orders(s: PeriodSeries, top: int) -> list[tuple[int, Coefficients]]:
+    return [(k, (_floats(s.tau[: k + 1]), ONE)) for k in range(1, top + 1)]
+
+
+def _resummed_orders(s: PeriodSeries, top: int) -> list[tuple[int, Coefficients]]:
+    res = resummed_coefficients(s.tau)
+    return [(k, (_floats(res[: k + 1]), ONE)) for k in range(1, top + 1)]
+
+
+def _modified_orders(s: PeriodSeries, top: int) -> list[tuple[int, Coefficients]]:
+    mod = modified_coefficients(s.omega)
+    return [(k, (_floats(mod[: k + 1]), ONE)) for k in range(1, top + 1)]
+
+
+def _pade_orders(s: PeriodSeries, top: int) -> list[tuple[int, Coefficients]]:
+    return [(k, _pade(s.tau, k)) for k in range(1, min(top // 2, PADE_MAX) + 1)]
+
+
+def _agm_orders(s: PeriodSeries, top: int) -> list[tuple[int, Coefficients]]:
+    return [(n, (NONE, ONE)) for n in range(AGM_STEPS + 1)]
+
+
+def _exact_orders(s: PeriodSeries, top: int) -> list[tuple[int, Coefficients]]:
+    return [(0, (NONE, ONE))]
+
+
+# --- lowering: a period candidate as x-expressions ---------------------------------------------
+
+_m = sp.Symbol("m")
+
+
+def _rationals(values: np.ndarray) -> list[sp.Expr]:
+    """The verified doubles as exact binary rationals."""
+    return [sp.Rational(float(v)) for v in values]
+
+
+def _lower_lp(c: Candidate) -> tuple[tuple, sp.Expr]:
+    return (), horner(_rationals(c.num), x_)
+
+
+def _lower_resummed(c: Candidate) -> tuple[tuple, sp.Expr]:
+    return ((_m, x_ / (2 + 2 * x_)),), sp.sqrt(1 - 2 * _m) * horner(_rationals(c.num), _m)
+
+
+def _lower_modified(c: Candidate) -> tuple[tuple, sp.Expr]:
+    return (((_m, 3 * x_ / (4 + 3 * x_)),),
+            1 / sp.sqrt((1 + sp.Rational(3, 4) * x_) * horner(_rationals(c.num), _m)))
+
+
+def _lower_pade(c: Candidate) -> tuple[tuple, sp.Expr]:
+    return (), horner(_rationals(c.num), x_) / horner(_rationals(c.den), x_)
+
+
+def _lower_agm(c: Candidate) -> tuple[tuple, sp.Expr]:
+    lines, mean = agm_steps(sp.sqrt(1 + x_), sp.sqrt(1 + x_ / 2), c.order, "")
+    return tuple(lines), 1 / mean
+
+
+def _not_lowered(c: Candidate) -> tuple[tuple, sp.Expr]:
+    raise InputError("the exact period (SciPy's ellipk) has no compiled evaluator to emit; "
+                     "loosen the tolerance or narrow the range")
+
+
+# --- what a method applies to ------------------------------------------------------------------
+
+def _free(subject: object) -> str | None:
+    if not isinstance(subject, Model):
+        return "a free oscillator's series: give an equation without a drive"
+    return None
+
+
+def _free_duffing(subject: object) -> str | None:
+    if not isinstance(subject, Model) or subject.name != "duffing" or subject.source:
+        return ("its closed form is the free Duffing oscillator's (x = εA², the separatrix "
+                "at x = -1)")
+    return None
+
+
+def _driven(subject: object) -> str | None:
+    if not isinstance(subject, Drive):
+        return "a driven oscillator's steady state: give a drive f cos(ωt)"
+    return None
+
+
+def _undamped(subject: object) -> str | None:
+    if _driven(subject):
+        return _driven(subject)
+    if subject.damping != 0:
+        return "the damped μ-expansion has no emitted module (only the undamped one is " \
+               "derived exactly)"
+    return None
+
+
+def _always(subject: object) -> str | None:
+    return None
+
+
+# --- emission: what `generate` derives and lowers ------------------------------------------------
+
+@dataclass(frozen=True)
+class Request:
+    """One emission asked for: its order (or harmonics), the command that asked, and what the
+    target needs besides (the free oscillator, the verified candidate and range)."""
+
+    order: int
+    command: str
+    model: Model | None = None
+    allow_divergent: bool = False
+    candidate: Candidate | None = None
+    verified: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Target:
+    """What a method emits: its files, and its derive and lower stages (the compiler calls
+    each once, in order, then renders and writes)."""
+
+    files: Callable[[Request], tuple[str, ...]]
+    derive: Callable[[Request, Progress | None], object]
+    lower: Callable[[object, Request], Unit]
+
+
+def _free_files(r: Request) -> tuple[str, ...]:
+    name = r.model.name
+    return (f"{name}.py", f"{name}_tables.tex", f"{name}_derivation.tex")
+
+
+def _free_derive(r: Request, progress: Progress | None) -> object:
+    return derive(r.model, r.order + 2, progress)
+
+
+def _free_lower(solution: object, r: Request) -> Unit:
+    module = lower_free(solution, r.command, r.allow_divergent)
+    return Unit(module, (lower_derivation(solution, r.order),))
+
+
+NOTES_DRIVE = (0.1, 1.0, 1.0)
+# NOTE: ε, f, ω of the notes' table (§10.4, undamped), reproduced in every driven derivation.
+NOTES_TABLE_ORDERS = 6
+
+
+def notes_table() -> NotesTable:
+    """The notes' table: A₁, A₃, A₅ by μ-order, harmonic balance and shooting."""
+    eps, force, omega = NOTES_DRIVE
+    d = Drive(eps, force, omega)
+    (branch,) = first_order_branches(d)
+    mu = mu_expansion(d, branch, NOTES_TABLE_ORDERS)
+
+    def cells(A: dict) -> tuple[tuple[int, float | str], ...]:
+        return tuple((n, A[n] if A.get(n) else "") for n in (1, 3, 5))
+
+    rows = [(f"$\\mu$-expansion, order {j}", cells(amplitudes(*mu.partial(j), 2 * j + 1)[0]))
+            for j in range(NOTES_TABLE_ORDERS + 1)]
+    hb = harmonic_balance(d, branch, 8)
+    A, _ = amplitudes(hb.coefficients, 0.0, 15)
+    rows.append(("harmonic balance, $N = 8$", cells(A)))
+    orbit = shoot(eps, force, omega, 0.0, np.array([sum(A.values()), 0.0]))
+    rows.append(("numerical (shooting)", cells(orbit.A)))
+    rows.append(("notes: numerical", ((1, "2.356"), (3, "0.0456"), (5, "0.0008"))))
+    return NotesTable(eps, force, omega, tuple(rows))
+
+
+def _mu_derive(r: Request, progress: Progress | None) -> object:
+    return mu_expansion_exact(r.order), notes_table()
+
+
+def _mu_lower(derived: object, r: Request) -> Unit:
+    orders, table = derived
+    return Unit(lower_driven(orders, r.command), (MuDerivation(r.order, orders, table),))
+
+
+def _balance_derive(r: Request, progress: Progress | None) -> object:
+    return balance_equations(r.order)
+
+
+def _balance_lower(eqs: object, r: Request) -> Unit:
+    return Unit(lower_balance(eqs, r.command))
+
+
+def _fourier_derive(r: Request, progress: Progress | None) -> object:
+    harmonics = r.order
+    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 60:
+        raise InputError(f"harmonics {harmonics!r}: must be an integer in 1..60")
+    return harmonics  # closed form: nothing to derive but the count
+
+
+def _fourier_lower(harmonics: object, r: Request) -> Unit:
+    return Unit(lower_fourier(harmonics, r.command))
+
+
+def _choice_derive(r: Request, progress: Progress | None) -> object:
+    return r.candidate  # derived and verified by choose
+
+
+def _choice_lower(c: object, r: Request) -> Unit:
+    return Unit(lower_choice(c.method.formula(c), r.command, r.verified))
+
+
+FREE = Target(_free_files, _free_derive, _free_lower)
+MU = Target(lambda r: ("driven.py", "driven_derivation.tex"), _mu_derive, _mu_lower)
+BALANCE = Target(lambda r: ("balance.py",), _balance_derive, _balance_lower)
+FOURIER = Target(lambda r: ("fourier.py",), _fourier_derive, _fourier_lower)
+CHOSEN_PERIOD = Target(lambda r: ("chosen_period.py",), _choice_derive, _choice_lower)
+
+
+# --- driven: one method at one order at one ω ---------------------------------------------------
+
+Solved = tuple[bool, tuple[dict, dict]]
+
+
+def _solve_mu(d: Drive, branch: Branch, order: int) -> Solved:
+    mu = mu_expansion(d, branch, order)
+    ok = len(mu.coefficients) > order and mu.converged
+    return ok, amplitudes(*mu.partial(min(order, len(mu.coefficients) - 1)), 5)
+
+
+def _solve_balance(d: Drive, branch: Branch, order: int) -> Solved:
+    hb = harmonic_balance(d, branch, order)
+    return hb.converged, amplitudes(hb.coefficients, 0.0, 5)
+
+
+def _solve_shooting(d: Drive, branch: Branch, order: int) -> Solved:
+    guess = branch.A1 * np.array([np.cos(branch.delta0), d.omega * np.sin(branch.delta0)])
+    orbit = shoot(d.eps, d.force, d.omega, d.damping, guess, steps=order)
+    return (True, (orbit.A, orbit.B)) if orbit is not None else (False, ({}, {}))
+
+
+Emitted = tuple[np.ndarray, np.ndarray, Callable[[], object], int]
+
+
+def _run_mu_module(mod: ModuleType, omega: np.ndarray, eps: float, force: float, Q: float,
+                   order: int) -> Emitted:
+    """A_1, A_3, A_5 of an emitted μ-expansion module at ``omega`` (B_n = 0: undamped), and a
+    run over 10⁵ ω through the ``_into`` twins to time."""
+    n = omega.size
+    A, B = np.zeros((n, 3)), np.zeros((n, 3))  # harmonics the module lacks are zero
+    fns = {k: getattr(mod, f"A_{h}_into") for k, h in enumerate((1, 3, 5))
+           if hasattr(mod, f"A_{h}_into")}  # the order's harmonics; the rest stay 0
+    for k, f in fns.items():
+        A[:, k] = f(np.empty(n), omega, eps, force, 0.0)
+    dense = np.resize(omega, 100_000)
+    buf = np.empty_like(dense)
+    return A, B, lambda: [f(buf, dense, eps, force, 0.0) for f in fns.values()], dense.size
+
+
+def _run_balance_module(mod: ModuleType, omega: np.ndarray, eps: float, force: float, Q: float,
+                        order: int) -> Emitted:
+    """A_n, B_n of an emitted balance module: its compiled Newton, one solve per ω from the
+    one-harmonic root; and a run over every ω to time."""
+    n = omega.size
+    A, B = np.zeros((n, 3)), np.zeros((n, 3))
+    a1, b1 = one_harmonic_amplitudes(eps, force, Q, omega)
+    x0 = np.zeros((n, 2 * order))
+    x0[:, 0], x0[:, order] = a1, b1
+    damping = Drive(eps, force, 1.0, Q).damping
+    xs = [mod.newton(x, w, eps, force, damping)[0] for x, w in zip(x0, omega, strict=True)]
+    for k in range(min(order, 3)):
+        A[:, k] = [x[k] for x in xs]
+        B[:, k] = [x[order + k] for x in xs]
+    return A, B, lambda: [mod.newton(x, w, eps, force, damping)
+                          for x, w in zip(x0, omega, strict=True)], n
+
+
+def one_harmonic_amplitudes(eps: float, force: float, Q: float,
+                            omegas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``A₁ = r cos δ₀``, ``B₁ = r sin δ₀`` of the largest one-harmonic branch, vectorised
+    (``r`` from :func:`response.one_harmonic_curve`; ``f sin δ₀ = rω/Q``,
+    ``f cos δ₀ = ¾εr³ − (ω² − 1)r``)."""
+    from .response import one_harmonic_curve
+
+    w = np.asarray(omegas, dtype=float)
+    r = one_harmonic_curve(eps, force, Q, w).r[:, 0]
+    delta = np.arctan2(r * w * Drive(eps, force, 1.0, Q).damping,
+                       0.75 * eps * r**3 - (w**2 - 1) * r)
+    return r * np.cos(delta), r * np.sin(delta)
+
+
+DRIVEN_MAX = 12
+# NOTE: μ-orders 0..12 and 1..12 odd harmonics: at the notes' parameters both reach 1e-12
+# well before that; more only costs.
+SHOOTING_STEPS = (64, 128, 256, 512, 1024)
+# NOTE: the "numerical" method: shooting from the one-harmonic guess with plain RK4 at these
+# steps per period (the truth uses 4096 and 8192, Richardson-combined).
+
+
+# --- references ----------------------------------------------------------------------------------
+
+def reference_period(x: np.ndarray) -> np.ndarray:
+    """``T/2π = (2/π) K(m)/√(1+x)`` in 30-digit arithmetic (mpmath): the judge of every
+    candidate, SciPy's ``ellipk`` included."""
+    with mpmath.workdps(30):
+        return np.array([float(2 / mpmath.pi * mpmath.ellipk(mpmath.mpf(v) / (2 * (1 + v)))
+                               / mpmath.sqrt(1 + mpmath.mpf(v))) for v in x])
+
+
+def reference_q(t: np.ndarray, x: float) -> np.ndarray:
+    """``q/A = cn(√(1+x) t | m)``, ``m = x/(2(1+x))``: SciPy for m ≥ 0, mpmath below."""
+    m = x / (2 * (1 + x))
+    if m >= 0:
+        return ellipj(np.sqrt(1 + x) * t, m)[1]
+    with mpmath.workdps(20):
+        return np.array([float(mpmath.re(mpmath.ellipfun("cn", np.sqrt(1 + x) * v, m)))
+                         for v in t])
+
+
+INTEGRATION_RTOLS = (1e-4, 1e-7, 1e-10, 1e-13)
+# NOTE: DOP853 tolerances for the "numerical" method: from plotting accuracy to nearly exact.
+
+
+def integrated_period(x: float, rtol: float) -> float:
+    """``T/2π`` by integrating ``u'' + u + x u³ = 0`` from ``u = 1`` to the half period
+    (``u'`` back to zero), SciPy's DOP853 at ``rtol``."""
+    def rhs(_t: float, y: np.ndarray) -> list[float]:
+        return [y[1], -y[0] - x * y[0] ** 3]
+
+    def half(_t: float, y: np.ndarray) -> float:
+        return y[1]
+
+    half.terminal, half.direction = True, 1.0
+    sol = solve_ivp(rhs, (0.0, 100.0 / np.sqrt(1 + max(x, 0.0)) + 100.0), [1.0, 0.0],
+                    method="DOP853", rtol=rtol, atol=rtol * 1e-3, events=half)
+    return float(2 * sol.t_events[0][0] / (2 * np.pi))
+
+
+# --- the records ---------------------------------------------------------------------------------
+
+Lowered = tuple[tuple, sp.Expr]
+
+
+@dataclass(frozen=True, eq=False)
+class Method:
+    """One method for one quantity.  A method is known by its name: it compares equal to it
+    (``choice.method == "agm"``) and prints as it, so tables and JSON show the name."""
+
+    name: str
+    quantity: str  # "period", "q" or "driven"
+    about: str
+    reference: str  # what its answers are checked against
+    applies: Callable[[object], str | None] = _always  # why not, for a Model or a Drive
+    kind: int = -1  # period: the compiled kernel's branch (-1: SciPy's ellipk)
+    steps: bool = False  # period: the order counts steps, not terms (listed first)
+    domain: sp.Basic = sp.true  # period: where the formula holds, in x_
+    orders: Callable[[PeriodSeries, int], list[tuple[int, Coefficients]]] | None = None
+    lowered: Callable[[Candidate], Lowered] = _not_lowered
+    solve: Callable[[Drive, Branch, int], Solved] | None = None  # driven: one ω, one order
+    driven_orders: tuple[int, ...] = ()
+    target: Target | None = None  # what `generate` / `--emit` writes for it
+    bound: int = -1  # driven: which of ``choose``'s emit bounds caps its order (-1: none)
+    run_emitted: Callable[..., Emitted] | None = None  # driven: read its emitted module
+    emittable: Callable[[object], str | None] = _always  # why its module cannot be emitted
+
+    def why_not(self, subject: object) -> str | None:
+        """None when the method applies to ``subject`` (a Model or a Drive), else why not."""
+        return self.applies(subject)
+
+    def evaluate(self, c: Candidate, x: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """``T/2π`` of candidate ``c`` at ``x`` (period methods)."""
+        if self.kind < 0:
+            return duffing_period_exact(1.0, x) / (2 * np.pi)
+        out = np.empty_like(x) if out is None else out
+        _evaluate(self.kind, c.num, c.den, c.order, x, out)
+        return out
+
+    def formula(self, c: Candidate) -> PeriodFormula:
+        """Candidate ``c`` lowered: its assignments and value in x_, inside the domain."""
+        body, value = self.lowered(c)
+        return PeriodFormula(self.name, c.order, self.domain, body, value,
+                             tuple(float(v) for v in c.num), tuple(float(v) for v in c.den))
+
+    @property
+    def rank(self) -> int:
+        """Ties of cost go to the simplest formula: its place in :data:`SIMPLEST_FIRST`."""
+        return SIMPLEST_FIRST.index(self.name)
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Method):
+            return (self.name, self.quantity) == (other.name, other.quantity)
+        return isinstance(other, str) and self.name == other
+
+    def __hash__(self) -> int:
+        return hash(self.name)
+
+    def __str__(self) -> str:
+        return self.name
+
+    def __format__(self, spec: str) -> str:
+        return format(self.name, spec)
+
+
+SIMPLEST_FIRST = ("lindstedt", "one_harmonic", "pade", "resummed", "modified", "agm",
+                  "mu_expansion", "harmonic_balance", "fourier", "shooting", "exact")
+# NOTE: the tie order of methods (the simplest formula first).
+
+_PERIOD = "free Duffing T/2π against mpmath's K(m) at 30 digits"
+_Q = "free Duffing q(t)/A against cn (SciPy's ellipj for m ≥ 0, mpmath below)"
+_DRIVEN = "A₁, A₃, A₅ and B_n against shooting (RK4, Richardson-combined, Floquet-checked)"
+
+METHODS: tuple[Method, ...] = (
+    # the period, in the order its candidates are listed
+    Method("exact", "period", "4K(m)/√(1+x), SciPy's ellipk", _PERIOD, _free_duffing,
+           steps=True, orders=_exact_orders),
+    Method("agm", "period", "1/AGM(√(1+x), √(1+x/2)), n steps", _PERIOD, _free_duffing,
+           kind=4, steps=True, domain=x_ > -1, orders=_agm_orders, lowered=_lower_agm,
+           target=CHOSEN_PERIOD),
+    Method("lindstedt", "period", "the L–P series Σ τ_j x^j", _PERIOD, _free_duffing,
+           kind=0, domain=sp.And(x_ > -1, sp.Abs(x_) < 1), orders=_lp_orders,
+           lowered=_lower_lp, target=CHOSEN_PERIOD),
+    Method("resummed", "period", "the series in m = x/(2(1+x)) times √(1 − 2m)", _PERIOD,
+           _free_duffing, kind=1, domain=x_ > sp.Rational(-2, 3), orders=_resummed_orders,
+           lowered=_lower_resummed, target=CHOSEN_PERIOD),
+    Method("modified", "period", "modified L–P (Cheung, Chen & Lau)", _PERIOD, _free_duffing,
+           kind=3, domain=x_ > -1, orders=_modified_orders, lowered=_lower_modified,
+           target=CHOSEN_PERIOD),
+    Method("pade", "period", "diagonal Padé [k/k] of the L–P series", _PERIOD, _free_duffing,
+           kind=2, domain=x_ > -1, orders=_pade_orders, lowered=_lower_pade,
+           target=CHOSEN_PERIOD),
+    # q(t)
+    Method("lindstedt", "q", "the L–P series of q(t) (generate NAME)",
+           "q(t) against cn; any free oscillator's period against quadrature", _free,
+           target=FREE),
+    Method("fourier", "q", "the exact Fourier series of cn in the nome, N odd harmonics", _Q,
+           _free_duffing, target=FOURIER),
+    Method("exact", "q", "cn by SciPy's ellipj (x ≥ 0; no emitted evaluator)", _Q,
+           _free_duffing),
+    # the driven amplitudes A_n(ω) and the response r(ω)
+    Method("one_harmonic", "driven", "the one-harmonic cubic in closed form", _DRIVEN,
+           _driven, driven_orders=(1,)),
+    Method("mu_expansion", "driven", "the μ-expansion with phase, order K", _DRIVEN, _driven,
+           solve=_solve_mu, driven_orders=tuple(range(DRIVEN_MAX + 1)), target=MU,
+           bound=0, run_emitted=_run_mu_module, emittable=_undamped),
+    Method("harmonic_balance", "driven", "Galerkin harmonic balance, N odd harmonics", _DRIVEN,
+           _driven, solve=_solve_balance, driven_orders=tuple(range(1, DRIVEN_MAX + 1)),
+           target=BALANCE, bound=1, run_emitted=_run_balance_module),
+    Method("shooting", "driven", "shooting with plain RK4, N steps a period", _DRIVEN, _driven,
+           solve=_solve_shooting, driven_orders=SHOOTING_STEPS),
+)
+
+
+def method(quantity: str, name: str) -> Method:
+    """The record of ``name`` for ``quantity``."""
+    for m in METHODS:
+        if m.quantity == quantity and m.name == name:
+            return m
+    raise KeyError(f"no method {name!r} for {quantity}")
+
+
+def methods_for(quantity: str, subject: object | None = None) -> tuple[Method, ...]:
+    """The methods of ``quantity`` (that apply to ``subject``, when given), in registry order."""
+    return tuple(m for m in METHODS if m.quantity == quantity
+                 and (subject is None or m.why_not(subject) is None))
+
+
+# --- period candidates: every method at every order ----------------------------------------------
+
+@dataclass(frozen=True)
+class Candidate:
+    """One period method at one order with its coefficients (as verified doubles)."""
+
+    method: Method
+    order: int
+    num: np.ndarray
+    den: np.ndarray
+
+    def __call__(self, x: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        return self.method.evaluate(self, x, out)
+
+
+def period_series(max_order: int) -> PeriodSeries:
+    """The exact τ_j and ω_j of the free Duffing oscillator to ``max_order``."""
+    sol = derive(duffing(), check_order(max_order))
+    return PeriodSeries([sol.ground.to_fraction(c) for c in sol.period],
+                        [sol.ground.to_fraction(c) for c in sol.omega])
+
+
+@functools.cache
+def candidates(max_order: int = MAX_ORDER) -> tuple[Candidate, ...]:
+    """Every period method at every order up to ``max_order`` (Padé up to [12/12]), derived
+    once: the fixed-order ones (exact, the AGM's steps) first, then order by order."""
+    series = period_series(max_order)
+    found = []
+    for rank, m in enumerate(methods_for("period", duffing())):
+        for order, (num, den) in m.orders(series, max_order):
+            found.append(((not m.steps, 0 if m.steps else order, rank),
+                          Candidate(m, order, num, den)))
+    found.sort(key=lambda item: item[0])
+    return tuple(c for _, c in found)
