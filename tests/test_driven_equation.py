@@ -202,8 +202,27 @@ def test_duffing_as_text_reproduces_the_built_in(Q, omega):
     (["q'' + q + eps*q**3 = 0", "--param", "eps=1/10"], "no drive"),
     (["q'' + q = f*cos(w*t)", "--param", "f=1/10", "--param", "w=2"], "--omega"),
     (["q'' + q = f*cos(w*t)", "--param", "f=1/10", "--eps", "0.1"], "--eps"),
+    (["--eps", "0.1"], "required: --force"),  # eq. 10.60 as before
 ])
 def test_refusals(argv, says, capsys):
     assert main(["driven", *argv, "--omega", "1.2"]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and says in err, err
+
+
+def test_cost_bounds_the_equation_path():
+    """The estimate covers `driven EQUATION` (the μ-expansion's --order plays no part) and
+    bounds its measured wall time."""
+    import time
+
+    from lindstedt.cli import build_parser
+    from lindstedt.costs import COSTS
+
+    argv = ["driven", ASYMMETRIC, "--omega", "1.2", "--order", "200", "--harmonics", "20"]
+    for pair in VALUES.items():
+        argv += ["--param", "=".join(pair)]
+    cost = COSTS["driven"](build_parser().parse_args(argv))
+    assert "harmonics 20" in cost.subject and cost.seconds < 60
+    start = time.perf_counter()
+    equation_orbits(driven_equation(ASYMMETRIC, VALUES, 1.2), 20)
+    assert time.perf_counter() - start < cost.seconds
