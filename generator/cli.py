@@ -206,7 +206,10 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         paths = compiler.generate_fourier(args.harmonics, out,
                                           overwrite_edited=args.overwrite_edited)
     else:
+        from .lower import check_emitted_names
+
         model = _free_model(args, order + 2)
+        check_emitted_names(model)  # before the derivation: a clash is known at once
         progress = Progress(f"deriving {model.name} to order {order + 2}")
         paths = compiler.generate(model, order, out, args.allow_divergent, progress,
                                   overwrite_edited=args.overwrite_edited)

@@ -15,6 +15,7 @@ exact: ``0.1`` is ``1/10``.
 from __future__ import annotations
 
 import ast
+import math
 import re
 from dataclasses import dataclass
 
@@ -36,8 +37,11 @@ MAX_DEPTH = 60
 MAX_POWER = 64
 MAX_DIGITS = 40
 MAX_NAME = 32
+MAX_MAGNITUDE = 300
 # NOTE: bounds that keep a hostile text from costing time or memory before any algebra
-# (``q**10**10``, ``9**9**9``, 10⁵ nested brackets); far above any oscillator's needs.
+# (``q**10**10``, ``9**9**9``, ``((2**64)**64)**64``, ``(q**64)**64``, 10⁵ nested brackets):
+# powers, degrees (a bound carried up the tree) and numbers (|log10| ≤ MAX_MAGNITUDE) are
+# checked before they are built; far above any oscillator's needs.
 ALLOWED = frozenset("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_+-*/().'= ")
 # NOTE: nothing else can reach a parse, so no comment (#), quote, brace or backslash of the
 # user's ever reaches a banner, a docstring or a LaTeX file.
@@ -102,63 +106,83 @@ class _Walker:
         col = self.offset + getattr(node, "col_offset", 0)
         return InputError(f"{self.what} {self.text!r}, column {col + 1}: {why}")
 
-    def walk(self, node: ast.AST, depth: int = 0) -> sp.Expr:
+    def walk(self, node: ast.AST, depth: int = 0) -> tuple[sp.Expr, int]:
+        """The node's expression and a bound on its degree in the names (0 for a number)."""
         if depth > MAX_DEPTH:
             raise self.fail(node, f"nested deeper than {MAX_DEPTH} levels")
         handler = getattr(self, f"_{type(node).__name__}", None)
         if handler is None:
             raise self.fail(node, f"{_describe(node)} is not allowed here")
-        return handler(node, depth + 1)
+        expr, degree = handler(node, depth + 1)
+        if degree > MAX_POWER:
+            raise self.fail(node, f"degree {degree} is above the limit {MAX_POWER}")
+        return expr, degree
 
-    def _Expression(self, node: ast.Expression, depth: int) -> sp.Expr:
+    def _Expression(self, node: ast.Expression, depth: int) -> tuple[sp.Expr, int]:
         return self.walk(node.body, depth)
 
-    def _Constant(self, node: ast.Constant, depth: int) -> sp.Expr:
+    def _Constant(self, node: ast.Constant, depth: int) -> tuple[sp.Expr, int]:
         value = node.value
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.fail(node, f"{_describe(node)} is not allowed here")
         segment = ast.get_source_segment(self.source, node) or repr(value)
+        if "_" in segment:
+            raise self.fail(node, f"number {segment[:16]!r}: write it without '_'")
         digits = sum(ch.isdigit() for ch in segment)
-        if digits > MAX_DIGITS or "_" in segment:
+        if digits > MAX_DIGITS:
             raise self.fail(node, f"number {segment[:16]!r}: more than {MAX_DIGITS} digits")
         if isinstance(value, int):
-            return sp.Integer(value)
+            return sp.Integer(value), 0
         mantissa, _, exponent = segment.lower().partition("e")
         if exponent and abs(int(exponent)) > MAX_DIGITS:
             raise self.fail(node, f"number {segment!r}: exponent beyond ±{MAX_DIGITS}")
         # exact: the decimal text, never the binary float
-        return sp.Rational(mantissa) * sp.Integer(10) ** int(exponent or 0)
+        return sp.Rational(mantissa) * sp.Integer(10) ** int(exponent or 0), 0
 
-    def _Name(self, node: ast.Name, depth: int) -> sp.Expr:
+    def _Name(self, node: ast.Name, depth: int) -> tuple[sp.Expr, int]:
         name = node.id
         if name in RESERVED:
             raise self.fail(node, f"{name!r} is a reserved name here"
                             + (" (a function: call it, e.g. sin(q))" if name in FUNCTIONS
                                else ""))
         self.names.setdefault(name, self.offset + node.col_offset)
-        return sp.Symbol(name)
+        return sp.Symbol(name), 1
 
-    def _UnaryOp(self, node: ast.UnaryOp, depth: int) -> sp.Expr:
-        operand = self.walk(node.operand, depth)
+    def _UnaryOp(self, node: ast.UnaryOp, depth: int) -> tuple[sp.Expr, int]:
+        operand, degree = self.walk(node.operand, depth)
         if isinstance(node.op, ast.USub):
-            return -operand
+            return -operand, degree
         if isinstance(node.op, ast.UAdd):
-            return operand
+            return operand, degree
         raise self.fail(node, f"operator {type(node.op).__name__} is not allowed")
 
-    def _BinOp(self, node: ast.BinOp, depth: int) -> sp.Expr:
+    def _BinOp(self, node: ast.BinOp, depth: int) -> tuple[sp.Expr, int]:
         if isinstance(node.op, ast.Pow):
-            return self.walk(node.left, depth) ** self._exponent(node.right)
+            base, degree = self.walk(node.left, depth)
+            n = self._exponent(node.right)
+            if base.is_number:
+                if base == 0 and n < 0:
+                    raise self.fail(node, "division by zero (0 to a negative power)")
+                size = abs(n) * _magnitude(base)
+                if size > MAX_MAGNITUDE:
+                    raise self.fail(node, f"a number of about 10^{size:.0f}: beyond "
+                                    f"10^{MAX_MAGNITUDE}")
+            return base**n, degree * abs(n)
         ops = {ast.Add: sp.Add, ast.Sub: lambda a, b: a - b, ast.Mult: sp.Mul,
                ast.Div: lambda a, b: a / b}
         op = ops.get(type(node.op))
         if op is None:
             raise self.fail(node, f"operator {type(node.op).__name__} is not allowed "
                             "(only + - * / **)")
-        left, right = self.walk(node.left, depth), self.walk(node.right, depth)
+        (left, dl), (right, dr) = self.walk(node.left, depth), self.walk(node.right, depth)
         if op is ops[ast.Div] and right == 0:
             raise self.fail(node, "division by zero")
-        return op(left, right)
+        if isinstance(node.op, ast.Mult | ast.Div):
+            result = op(left, right)
+            if result.is_number and _magnitude(result) > MAX_MAGNITUDE:  # products too
+                raise self.fail(node, f"a number beyond 10^{MAX_MAGNITUDE}")
+            return result, dl + dr
+        return op(left, right), max(dl, dr)
 
     def _exponent(self, node: ast.AST) -> int:
         sign, inner = 1, node
@@ -171,14 +195,15 @@ class _Walker:
             raise self.fail(node, f"power {inner.value} is above the limit {MAX_POWER}")
         return sign * inner.value
 
-    def _Call(self, node: ast.Call, depth: int) -> sp.Expr:
+    def _Call(self, node: ast.Call, depth: int) -> tuple[sp.Expr, int]:
         if not isinstance(node.func, ast.Name) or node.func.id not in FUNCTIONS:
             name = node.func.id if isinstance(node.func, ast.Name) else _describe(node.func)
             raise self.fail(node, f"function {name!r} is not allowed (allowed: "
                             f"{', '.join(sorted(FUNCTIONS))})")
         if node.keywords or len(node.args) != 1 or isinstance(node.args[0], ast.Starred):
             raise self.fail(node, f"{node.func.id}() takes exactly one argument")
-        return FUNCTIONS[node.func.id](self.walk(node.args[0], depth))
+        argument, degree = self.walk(node.args[0], depth)
+        return FUNCTIONS[node.func.id](argument), degree
 
     def parse(self, source: str) -> sp.Expr:
         if not source.strip():
@@ -193,7 +218,20 @@ class _Walker:
                              f"({exc.msg})") from None
         except (RecursionError, MemoryError, ValueError):
             raise InputError(f"{self.what} {self.text!r}: too deeply nested to parse") from None
-        return self.walk(tree)
+        return self.walk(tree)[0]
+
+
+def _magnitude(x: sp.Expr) -> float:
+    """``|log10 |x||`` of a nonzero number (0 for zero), from the digits of a rational."""
+    if x == 0:
+        return 0.0
+    if x.is_Rational:
+        return max(abs(x.p).bit_length(), abs(x.q).bit_length()) * math.log10(2)
+    try:
+        value = abs(complex(x))
+    except (TypeError, OverflowError, ValueError):
+        return math.inf
+    return abs(math.log10(value)) if 0 < value < math.inf else math.inf
 
 
 def _describe(node: ast.AST) -> str:

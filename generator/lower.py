@@ -9,8 +9,11 @@ Chebyshev recurrence ``c_{n+2} = 2cos(2s)·c_n - c_{n-2}`` (odd harmonics) or
 
 from __future__ import annotations
 
+import builtins
 import hashlib
 import json
+import keyword
+import re
 import unicodedata
 from dataclasses import dataclass
 
@@ -18,7 +21,9 @@ import sympy as sp
 
 from . import __version__
 from .driven import A1_, BalanceEquations, MuOrder, eps_, omega_
+from .errors import InputError
 from .lindstedt import SeriesSolution, order_terms
+from .models import Model
 from .printers import identifier
 
 Assign = tuple[sp.Symbol, sp.Expr]
@@ -156,6 +161,36 @@ def harmonics(top: int, odd: bool, s: sp.Expr, sines: bool) -> tuple[list[Assign
     return lines, cos_of, sin_of
 
 
+MODULE_NAMES = frozenset({
+    "math", "np", "numba", "njit", "vectorize", "overload", "types", "TRIG_LIMIT", "SIN_KERNEL",
+    "COS_KERNEL", "ORDER", "MODEL", "VARIABLE", "CONVENTION", "RADIUS", "ALLOW_DIVERGENT",
+    "OMEGA", "PERIOD", "Q", "OMEGA_EXACT", "PERIOD_EXACT", "omega", "period", "error_estimate",
+})
+LOCAL_NAMES = frozenset({"out", "i", "t"})
+# NOTE: the names an emitted free module defines at its top and uses inside its functions
+# (templates/module.py.j2 and :func:`lower_free`); `_`-names need no entry, since a user's
+# names never start with '_', and lower_free renames its x, w, s, T away from a user's.
+_LOCAL = re.compile(r"[csw]_\d+|.*_in|.*_into")
+
+
+def check_emitted_names(model: Model) -> None:
+    """A user's parameter or coordinate that would clash with a name of the emitted module is
+    refused (a parameter named ``x`` would be overwritten by the expansion variable)."""
+    coordinate = str(model.coordinate)
+    taken = MODULE_NAMES | LOCAL_NAMES | frozenset(dir(builtins)) | frozenset(keyword.kwlist)
+    for name, _ in model.parameters:
+        if name in ("A", "eps", "theta0"):
+            continue
+        if name in taken or _LOCAL.fullmatch(name) or name in (coordinate,
+                                                                coordinate + "dot"):
+            raise InputError(f"parameter {name!r}: the emitted module uses this name; rename "
+                             "the parameter")
+    for name in (coordinate, coordinate + "dot"):
+        if name in taken or _LOCAL.fullmatch(name):
+            raise InputError(f"coordinate {coordinate!r}: the emitted module would define "
+                             f"{name!r}, which it uses already; rename the coordinate")
+
+
 def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = False) -> Module:
     """Evaluators ω, T, q, q̇ and the truncation-error estimate of a free oscillator.
 
@@ -167,10 +202,14 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     order = solution.order - 2
     if order < 0:
         raise ValueError("lower_free needs a solution derived to order K + 2")
+    check_emitted_names(m)
     g = solution.ground
     args = {name: sp.Symbol(identifier(name)) for name, _ in m.parameters}
     to_args = {sym: args[name] for name, sym in m.parameters}
-    x, w, s, total = sp.symbols("x w s T")
+    user = {str(m.coordinate), str(m.coordinate) + "dot", *args}
+    # a user's name keeps its meaning: an internal name it would shadow takes a leading '_'
+    # (which no user name has); the built-in models keep x, w, s, T, byte for byte
+    x, w, s, total = (sp.Symbol(n if n not in user else "_" + n) for n in ("x", "w", "s", "T"))
     y = m.y.xreplace(to_args)
     amplitude = m.amplitude.xreplace(to_args)
     # ω₀ = 1 but for a user's linear frequency: ω = ω₀ Σ ω_j y^j, T = (2π/ω₀) Σ τ_j y^j

@@ -17,6 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import sympy as sp
+from sympy.polys.domains import QQ
 
 from .equation import SMALL, Equation, parse_equation, parse_expression
 from .errors import InputError
@@ -260,6 +261,8 @@ def free_model(osc: Oscillator, order: int) -> Model:
         raise osc.refuse(LP, f"{sp.sstr(osc.parametric)} excites it parametrically")
     q, v = osc.coordinate, osc.velocity
     small = osc.equation.small
+    if A in osc.parameters:
+        raise osc.refuse(LP, "A is the amplitude (q(0) = A): give the parameter another name")
     g = osc.force
     _check_analytic(osc, g)
     if small is not None and g.has(small) and not g.is_polynomial(q, v):
@@ -301,24 +304,38 @@ def free_model(osc: Oscillator, order: int) -> Model:
     if w2.free_symbols:
         raise osc.refuse(LP, f"the linear frequency squared {w2} must be a number; give its "
                          "parameters values (--param)")
+    if not w2.is_Rational:
+        raise osc.refuse(LP, f"the linear frequency squared {w2} must be a rational number "
+                         "(exact algebra)")
     if w2 <= 0:
         raise osc.refuse(LP, f"the linear term {w2}*{q} does not restore (q = 0 is unstable "
                          "or neutral): no oscillation about it")
     frequency = sp.sqrt(w2)
     nonlinear = {}
+    params = osc.parameters
     for (a, b), c in terms.items():
+        if small is not None and c.has(small) and not c.is_polynomial(small):
+            raise osc.refuse(LP, f"eps enters the coefficient {c} of {q**a * v**b} other than "
+                             "as a polynomial")
         for e, ce in (sp.Poly(c, small).terms() if small is not None and c.has(small)
                       else [((0,), c)]):
+            _check_exact(osc, ce, params, f"the coefficient of {q**a * v**b}")
             nonlinear[(a, b, e[0])] = sp.expand(ce * w2 ** sp.Rational(b - 2, 2))
-    if not nonlinear and not elementary:
+    for _, lam, c in elementary:
+        _check_exact(osc, lam, (), "the argument's factor of sin or sinh")
+        _check_exact(osc, c, (), "the factor of sin or sinh")
+    if not nonlinear and not elementary and polynomial_force:
         raise osc.refuse(LP, "the force is linear (a harmonic oscillator): ω = ω₀ exactly")
     with_small = {e for _, _, e in nonlinear}
     if small is not None and 0 in with_small and len(with_small) > 1:
         raise osc.refuse(LP, "some nonlinear terms carry eps and some do not; put eps on every "
                          "nonlinear term or on none")
     p_values = {a + b - 1 for a, b, _ in nonlinear}
-    if small is None or with_small == {0}:
-        step = 2 if (elementary or not polynomial_force) and odd_joint else math.gcd(*p_values)
+    if small is None or with_small <= {0}:
+        # a Taylor-expanded force was cut at the degree of a step fixed by its symmetry (2 for
+        # an odd force, else 1), whatever step its first terms happen to share
+        step = (2 if odd_joint else 1) if elementary or not polynomial_force else \
+            math.gcd(*p_values)
         orders = {key: (key[0] + key[1] - 1) // step for key in nonlinear}
         factor, coupling = A**step, sp.Integer(1)
         variable = "A" if step == 1 else f"A**{step}"
@@ -384,6 +401,22 @@ def _elementary_term(term: sp.Expr, q: sp.Symbol) -> tuple[str, sp.Expr, sp.Expr
     if lam == 0 or sp.expand(argument - lam * q) != 0 or lam.has(q):
         return None
     return (type(functions[0]).__name__, lam, coefficient)
+
+
+def _check_exact(osc: Oscillator, c: sp.Expr, params: tuple[sp.Symbol, ...], what: str
+                 ) -> None:
+    """A coefficient the exact algebra can hold: a polynomial in the symbolic parameters with
+    rational numbers (``QQ[params]``), not ``1/alpha``, ``sin(1)`` or ``sqrt(2)``."""
+    try:
+        sp.Poly(c, *params, domain=QQ) if params else QQ.from_sympy(c)
+        ok = c.free_symbols <= set(params)
+    except (sp.PolynomialError, sp.CoercionFailed, sp.GeneratorsNeeded, ValueError,
+            TypeError):
+        ok = False
+    if not ok:
+        raise osc.refuse(LP, f"{what} is {sp.sstr(c)}: exact algebra needs rational numbers "
+                         "and polynomials in the parameters (give values with --param, write "
+                         "rationals)")
 
 
 def _check_analytic(osc: Oscillator, g: sp.Expr) -> None:
