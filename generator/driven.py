@@ -12,7 +12,8 @@ Two perturbative routes to its steady 1:1 response:
   one-harmonic equation.
 
 Both work on Fourier sums stored as complex coefficients ``c_n`` of ``e^{inτ}``
-(``q = Σ c_n e^{inτ}``, ``c_{−n} = c̄_n``), where products are exact convolutions.
+(``q = Σ c_n e^{inτ}``, ``c_{−n} = c̄_n``), where products are exact convolutions: the float
+kernel of :mod:`series` (``laurent_*``).
 """
 
 from __future__ import annotations
@@ -28,7 +29,21 @@ from sympy.polys.domains import QQ
 
 from .display import SHOWN_ROWS, harmonics_table, html_table
 from .errors import InputError
-from .series import Basis, Ground, solve_oscillator, to_fourier
+from .series import (
+    Basis,
+    Ground,
+    laurent_cos,
+    laurent_derivative,
+    laurent_from_fourier,
+    laurent_harmonics,
+    laurent_product,
+    laurent_secular,
+    laurent_solve,
+    laurent_to_fourier,
+    solve_oscillator,
+    to_fourier,
+    trig_power,
+)
 
 if TYPE_CHECKING:  # numerics (numba) is imported where an orbit is shot
     pass
@@ -87,41 +102,12 @@ def check_steady_state(eps: float, Q: float, omega_min: float,
                          "resonance has no steady state (its amplitude grows like f t/2)")
 
 
-# --- Fourier sums as complex coefficient arrays, index n + M --------------------------------
-
-def _product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Coefficients of the product, truncated to the same harmonics ``|n| ≤ M``."""
-    M = (len(a) - 1) // 2
-    return np.convolve(a, b)[M : 3 * M + 1]
-
-
-def _harmonics(M: int) -> np.ndarray:
-    return np.arange(-M, M + 1)
-
-
-def _cos_tau(M: int, amplitude: complex = 1.0) -> np.ndarray:
-    """``amplitude · e^{iτ}/2 + c.c.``: ``A cos τ`` for real A."""
-    out = np.zeros(2 * M + 1, dtype=complex)
-    out[M + 1] = amplitude / 2
-    out[M - 1] = np.conj(amplitude) / 2
-    return out
-
-
-def _secular(F: np.ndarray) -> np.ndarray:
-    """``(cos τ, sin τ)`` coefficients of ``F``: ``2 Re c₁``, ``−2 Im c₁``."""
-    M = (len(F) - 1) // 2
-    return np.array([2 * F[M + 1].real, -2 * F[M + 1].imag])
-
-
 def amplitudes(c: np.ndarray, phase: float, harmonics: int) -> tuple[dict, dict]:
     """``A_n``, ``B_n`` of ``q(t) = Σ A_n cos nωt + B_n sin nωt`` from ``c_n`` of ``e^{inτ}``,
     ``τ = ωt − phase``, for odd ``n ≤ harmonics``."""
-    M = (len(c) - 1) // 2
-    A, B = {}, {}
-    for n in range(1, min(harmonics, M) + 1, 2):
-        z = c[M + n] * np.exp(-1j * n * phase)
-        A[n], B[n] = 2 * z.real, -2 * z.imag
-    return A, B
+    orders = np.arange(1, min(harmonics, (len(c) - 1) // 2) + 1, 2)
+    a, b = laurent_to_fourier(c, orders, phase)
+    return dict(zip(orders.tolist(), a, strict=True)), dict(zip(orders.tolist(), b, strict=True))
 
 
 # --- first order: the branches --------------------------------------------------------------
@@ -228,18 +214,18 @@ class MuExpansion:
 def _forcing(d: Drive, q: list, cubes: list, E: list, delta0: float, j: int) -> np.ndarray:
     """``F_j`` of eq. 10.68: needs ``q_{j−1}``, ``[μ^{j−1}] q³`` and ``E_{j−1}``."""
     M = (len(q[0]) - 1) // 2
-    n = _harmonics(M)
     w2 = d.omega**2
     prev = q[j - 1]
-    F = (1 - 1 / w2) * prev - d.damping / d.omega * (1j * n * prev) - d.eps / w2 * cubes[j - 1]
+    F = (1 - 1 / w2) * prev - d.damping / d.omega * laurent_derivative(prev) \
+        - d.eps / w2 * cubes[j - 1]
     # [μ^{j−1}] cos(τ + δ) = Re(e^{i(τ+δ₀)} E_{j−1}),  E = exp(i Σ_{k≥1} δ_k μ^k)
-    return F + d.force / w2 * _cos_tau(M, np.exp(1j * delta0) * E[j - 1])
+    return F + d.force / w2 * laurent_cos(M, np.exp(1j * delta0) * E[j - 1])
 
 
 def _extend(q: list, squares: list, cubes: list, E: list, deltas: list, m: int) -> None:
     """Append ``[μ^m]`` of ``q²``, ``q³`` and ``E`` (``m E_m = i Σ k δ_k E_{m−k}``)."""
-    squares.append(sum(_product(q[a], q[m - a]) for a in range(m + 1)))
-    cubes.append(sum(_product(q[a], squares[m - a]) for a in range(m + 1)))
+    squares.append(sum(laurent_product(q[a], q[m - a]) for a in range(m + 1)))
+    cubes.append(sum(laurent_product(q[a], squares[m - a]) for a in range(m + 1)))
     E.append(1j * sum(k * deltas[k] * E[m - k] for k in range(1, m + 1)) / m)
 
 
@@ -255,14 +241,12 @@ def mu_expansion(d: Drive, branch: Branch, order: int) -> MuExpansion:
         raise InputError(f"order {order!r}: must be an integer in 0..200")
     top = max(order, JUDGED_FROM)
     M = 2 * top + 5
-    n = _harmonics(M)
-    q = [_cos_tau(M, branch.A1)]
+    q = [laurent_cos(M, branch.A1)]
     deltas = [branch.delta0]
-    squares = [_product(q[0], q[0])]
-    cubes = [_product(q[0], squares[0])]
+    squares = [laurent_product(q[0], q[0])]
+    cubes = [laurent_product(q[0], squares[0])]
     E = [1.0 + 0j]
     dets: list[float] = []
-    resonant = np.abs(n) == 1
 
     def stop(j: int, reason: str) -> MuExpansion:
         """The orders found before order ``j`` failed, not converged, with the reason."""
@@ -272,15 +256,15 @@ def mu_expansion(d: Drive, branch: Branch, order: int) -> MuExpansion:
     for j in range(1, top + 1):
         with np.errstate(over="ignore", invalid="ignore"):
             F = _forcing(d, q, cubes, E, branch.delta0, j)
-            p = np.where(resonant, 0, F / np.where(resonant, 1, 1 - n * n))
+            p = laurent_solve(F).particular
 
             def secular_next(b: float, delta: float, p: np.ndarray = p,
                              j: int = j) -> np.ndarray:
                 """Secular part of F_{j+1} for trial b_j, δ_j (it is affine in both)."""
-                qs, ds = [*q, p + _cos_tau(M, b)], [*deltas, delta]
+                qs, ds = [*q, p + laurent_cos(M, b)], [*deltas, delta]
                 sq, cb, Es = list(squares), list(cubes), list(E)
                 _extend(qs, sq, cb, Es, ds, j)
-                return _secular(_forcing(d, qs, cb, Es, branch.delta0, j + 1))
+                return laurent_secular(_forcing(d, qs, cb, Es, branch.delta0, j + 1))
 
             s0 = secular_next(0.0, 0.0)
             J = np.column_stack([secular_next(1.0, 0.0) - s0, secular_next(0.0, 1.0) - s0])
@@ -291,7 +275,7 @@ def mu_expansion(d: Drive, branch: Branch, order: int) -> MuExpansion:
         if abs(det) < 1e-12 * (1 + abs(d.force) + abs(d.eps) * branch.A1**2):
             return stop(j, "singular secular system (a fold: branches merge)")
         b, delta = np.linalg.solve(J, -s0)
-        q.append(p + _cos_tau(M, b))
+        q.append(p + laurent_cos(M, b))
         deltas.append(float(delta))
         with np.errstate(over="ignore", invalid="ignore"):
             _extend(q, squares, cubes, E, deltas, j)
@@ -355,30 +339,27 @@ class BalanceSystem:
 
     def coefficients(self, x: np.ndarray) -> np.ndarray:
         """``c_n`` of ``e^{inωt}`` for ``q = Σ a_k cos kωt + b_k sin kωt``."""
-        odd, M, h = self.odd, self.M, self.harmonics
-        c = np.zeros(2 * M + 1, dtype=complex)
-        z = (x[:h] - 1j * x[h:]) / 2
-        c[M + odd] = z
-        c[M - odd] = np.conj(z)
-        return c
+        h = self.harmonics
+        return laurent_from_fourier(self.M, self.odd, x[:h], x[h:])
 
     def _project(self, R: np.ndarray) -> np.ndarray:
-        return np.concatenate([2 * R[self.M + self.odd].real, -2 * R[self.M + self.odd].imag])
+        return np.concatenate(laurent_to_fourier(R, self.odd))
 
     def _linear(self, omega: float) -> np.ndarray:
-        n = _harmonics(self.M)
+        n = laurent_harmonics(self.M)
         return -(n * omega) ** 2 + 1j * n * omega * self.damping + 1
 
     def residual(self, x: np.ndarray, omega: float) -> np.ndarray:
         c = self.coefficients(x)
-        return self._project(self._linear(omega) * c + self.eps * _product(c, _product(c, c))
-                             - _cos_tau(self.M, self.force))
+        return self._project(self._linear(omega) * c
+                             + self.eps * laurent_product(c, laurent_product(c, c))
+                             - laurent_cos(self.M, self.force))
 
     def jacobian(self, x: np.ndarray, omega: float) -> np.ndarray:
         """``∂R/∂x``: ``dR_n/dc_m = lin_n δ_nm + 3ε (q²)_{n−m}``, ``c_{±m} = (a_m ∓ i b_m)/2``."""
         odd, M = self.odd, self.M
         c = self.coefficients(x)
-        q2 = _product(c, c)
+        q2 = laurent_product(c, c)
         K_plus = np.diag(self._linear(omega)[M + odd]) + 3 * self.eps * q2[M + odd[:, None]
                                                                            - odd[None, :]]
         K_minus = 3 * self.eps * q2[M + odd[:, None] + odd[None, :]]
@@ -387,7 +368,7 @@ class BalanceSystem:
 
     def d_omega(self, x: np.ndarray, omega: float) -> np.ndarray:
         """``∂R/∂ω``: only the linear part depends on ω."""
-        n = _harmonics(self.M)
+        n = laurent_harmonics(self.M)
         return self._project((-2 * n * n * omega + 1j * n * self.damping)
                              * self.coefficients(x))
 
@@ -533,31 +514,6 @@ def mu_expansion_exact(order: int) -> tuple[MuOrder, ...]:
 
 # --- harmonic balance, symbolically (emitted as compiled residual and Jacobian) --------------
 
-def trig_product(x: dict, y: dict) -> dict:
-    """Product of real Fourier sums ``{(n, "c"|"s"): coeff}`` by product-to-sum."""
-    out: dict = {}
-
-    def add(n: int, kind: str, value: sp.Expr) -> None:
-        if n < 0:
-            n, value = -n, (value if kind == "c" else -value)
-        if n == 0 and kind == "s":
-            return
-        out[(n, kind)] = out.get((n, kind), 0) + value
-
-    for (m, p), u in x.items():
-        for (n, r), v in y.items():
-            h = u * v / 2
-            if p == "c" and r == "c":
-                add(m - n, "c", h), add(m + n, "c", h)
-            elif p == "s" and r == "s":
-                add(m - n, "c", h), add(m + n, "c", -h)
-            elif p == "s":  # sin m cos n
-                add(m + n, "s", h), add(m - n, "s", h)
-            else:  # cos m sin n
-                add(m + n, "s", h), add(n - m, "s", h)
-    return out
-
-
 @dataclass(frozen=True)
 class BalanceEquations:
     """Galerkin residual of eq. 10.60 for ``q = Σ a_k cos kωt + b_k sin kωt``, k odd ≤ 2N − 1."""
@@ -576,16 +532,15 @@ def balance_equations(harmonics: int) -> BalanceEquations:
     a = [sp.Symbol(f"a_{k}") for k in odd]
     b = [sp.Symbol(f"b_{k}") for k in odd]
     w, eps, f, g = sp.symbols("omega eps force damping")
-    q = {**{(k, "c"): ak for k, ak in zip(odd, a, strict=True)},
-         **{(k, "s"): bk for k, bk in zip(odd, b, strict=True)}}
-    cube = trig_product(trig_product(q, q), q)
+    cube_cos, cube_sin = trig_power(dict(zip(odd, a, strict=True)),
+                                    dict(zip(odd, b, strict=True)), 3)
     cos_res, sin_res = [], []
     for k, ak, bk in zip(odd, a, b, strict=True):
         # q̇ contributes kω(b_k cos − a_k sin), q̈ contributes −(kω)² q
         cos_res.append(sp.expand((1 - (k * w) ** 2) * ak + g * k * w * bk
-                                 + eps * cube.get((k, "c"), 0) - (f if k == 1 else 0)))
+                                 + eps * cube_cos.get(k, 0) - (f if k == 1 else 0)))
         sin_res.append(sp.expand((1 - (k * w) ** 2) * bk - g * k * w * ak
-                                 + eps * cube.get((k, "s"), 0)))
+                                 + eps * cube_sin.get(k, 0)))
     return BalanceEquations(harmonics, (*a, *b), (w, eps, f, g), (*cos_res, *sin_res))
 
 

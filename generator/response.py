@@ -30,7 +30,6 @@ from .driven import (
     check_harmonics,
     first_order_branches,
     harmonic_balance,
-    trig_product,
 )
 from .errors import InputError
 from .numerics import (
@@ -45,6 +44,7 @@ from .numerics import (
     steady_state_amplitudes,
     steady_state_fit,
 )
+from .series import trig_power
 
 _u, _w, _e, _f, _g = sp.symbols("u w e f g")  # u = r², w = ω², g = 1/Q
 _G = _u * ((1 - _w + sp.Rational(3, 4) * _e * _u) ** 2 + _w * _g**2) - _f**2
@@ -437,12 +437,11 @@ _a, _b, _F, _w1, _eps1 = sp.symbols("a b F omega epsilon")
 
 def subharmonic_secular() -> tuple[sp.Expr, sp.Expr]:
     """The cos τ and sin τ coefficients of ``ω²q₀'' + q₀ + εq₀³ − f cos 3τ`` divided by ε,
-    ``q₀ = a cos τ + b sin τ + F cos 3τ``, ``F = f/(1 − 9ω²)`` (eq. 10.85, 10.86), by
-    product-to-sum."""
-    q = {(1, "c"): _a, (1, "s"): _b, (3, "c"): _F}
-    cube = trig_product(trig_product(q, q), q)
-    cos_eq = sp.expand(((1 - _w1**2) * _a + _eps1 * cube[(1, "c")]) / _eps1)
-    sin_eq = sp.expand(((1 - _w1**2) * _b + _eps1 * cube[(1, "s")]) / _eps1)
+    ``q₀ = a cos τ + b sin τ + F cos 3τ``, ``F = f/(1 − 9ω²)`` (eq. 10.85, 10.86), by the
+    exact Fourier kernel (:func:`series.trig_power`)."""
+    cube_cos, cube_sin = trig_power({1: _a, 3: _F}, {1: _b}, 3)
+    cos_eq = sp.expand(((1 - _w1**2) * _a + _eps1 * cube_cos[1]) / _eps1)
+    sin_eq = sp.expand(((1 - _w1**2) * _b + _eps1 * cube_sin[1]) / _eps1)
     return cos_eq, sin_eq
 
 

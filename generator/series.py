@@ -20,6 +20,7 @@ from fractions import Fraction
 from functools import cache
 from typing import Any
 
+import numpy as np
 import sympy as sp
 from flint import fmpq, fmpq_mpoly_ctx, fmpq_poly
 from sympy.polys.densearith import dup_add, dup_mul, dup_mul_ground, dup_neg, dup_sub
@@ -432,3 +433,100 @@ def solve_trig(F: Trig) -> TrigSolved:
     cos_particular = list(cos_solved.particular)
     return TrigSolved(Trig(g.poly(cos_particular), g.poly(p), g), cos_solved.secular,
                       secular_sin)
+
+
+
+def trig_power(cosines: dict[int, sp.Expr], sines: dict[int, sp.Expr], power: int
+               ) -> tuple[dict[int, sp.Expr], dict[int, sp.Expr]]:
+    """Fourier coefficients ``({n: a_n}, {n: b_n})`` of ``(Σ a_k cos ks + Σ b_k sin ks)^power``
+    for SymPy coefficients (polynomials over QQ in their symbols): the :class:`Trig` kernel
+    over ``QQ[symbols]``, back in SymPy."""
+    ground = Ground.for_coefficients([*cosines.values(), *sines.values()])
+    base = Trig.from_fourier({n: ground.scalar(c) for n, c in cosines.items()},
+                             {n: ground.scalar(c) for n, c in sines.items()}, ground)
+    out = base
+    for _ in range(power - 1):
+        out = out * base
+    cos, sin = out.to_fourier()
+    return ({n: ground.to_sympy(c) for n, c in cos.items()},
+            {n: ground.to_sympy(c) for n, c in sin.items()})
+
+# --- the float kernel: the same algebra in the Laurent form, for the numeric methods ---------
+# A real Fourier sum is held as the complex coefficients ``c_n`` of ``z^n = e^{ins}`` for
+# ``|n| ≤ M`` (``c_{−n} = c̄_n``), a complex128 array indexed ``n + M``: products are
+# convolutions (numpy's, in C), ``d/ds`` is ``i n``, and ``u'' + u = F`` is ``F_n/(1 − n²)``.
+# In floating point the Laurent form is the natural one (no exact cancellation to keep);
+# ``docs/benchmarks.md`` ("One Fourier kernel") records what moved onto it.
+
+
+def laurent_harmonics(M: int) -> np.ndarray:
+    """``n = −M … M``, the index of each coefficient."""
+    return np.arange(-M, M + 1)
+
+
+def laurent_cos(M: int, amplitude: complex = 1.0) -> np.ndarray:
+    """``amplitude · e^{is}/2 + c.c.``: ``A cos s`` for real ``A`` (``Re(A e^{is})`` else)."""
+    out = np.zeros(2 * M + 1, dtype=complex)
+    out[M + 1] = amplitude / 2
+    out[M - 1] = np.conj(amplitude) / 2
+    return out
+
+
+def laurent_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The product, truncated to the same harmonics ``|n| ≤ M``."""
+    M = (len(a) - 1) // 2
+    return np.convolve(a, b)[M : 3 * M + 1]
+
+
+def laurent_derivative(c: np.ndarray) -> np.ndarray:
+    """``d/ds``: ``c_n → i n c_n``."""
+    return 1j * laurent_harmonics((len(c) - 1) // 2) * c
+
+
+def laurent_secular(F: np.ndarray) -> np.ndarray:
+    """``(cos s, sin s)`` coefficients of ``F``: ``2 Re c₁``, ``−2 Im c₁``."""
+    M = (len(F) - 1) // 2
+    return np.array([2 * F[M + 1].real, -2 * F[M + 1].imag])
+
+
+@dataclass(frozen=True)
+class LaurentSolved:
+    """``u'' + u = F`` in the Laurent form: :class:`TrigSolved`'s fields in floating point."""
+
+    particular: np.ndarray  # c_n of u, the resonant n = ±1 left at zero
+    secular_cos: float  # Fourier coefficient of cos s in F
+    secular_sin: float  # Fourier coefficient of sin s in F
+
+
+def laurent_solve(F: np.ndarray) -> LaurentSolved:
+    """Particular periodic solution of ``u'' + u = F`` and the resonant (secular) parts of F:
+    ``u_n = F_n/(1 − n²)`` for ``|n| ≠ 1`` (the exact kernel's :func:`solve_trig`)."""
+    n = laurent_harmonics((len(F) - 1) // 2)
+    resonant = np.abs(n) == 1
+    particular = np.where(resonant, 0, F / np.where(resonant, 1, 1 - n * n))
+    cos1, sin1 = laurent_secular(F)
+    return LaurentSolved(particular, float(cos1), float(sin1))
+
+
+def laurent_from_fourier(M: int, orders: np.ndarray, cosines: np.ndarray,
+                         sines: np.ndarray | None = None) -> np.ndarray:
+    """``c_n`` of ``Σ a_k cos ks + b_k sin ks`` over ``orders`` (``k ≥ 1``, distinct, ``≤ M``;
+    ``sines`` all zero when None)."""
+    orders = np.asarray(orders)
+    c = np.zeros(2 * M + 1, dtype=complex)
+    z = (np.asarray(cosines) - 1j * (0 if sines is None else np.asarray(sines))) / 2
+    c[M + orders] = z
+    c[M - orders] = np.conj(z)
+    return c
+
+
+def laurent_to_fourier(c: np.ndarray, orders: np.ndarray,
+                       phase: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """``(a_k, b_k)`` of the sum ``Σ c_n e^{in(s − phase)}`` over ``orders`` (``k ≥ 1``):
+    ``2 Re``, ``−2 Im`` of ``c_k e^{−ik·phase}`` (the inverse of :func:`laurent_from_fourier`
+    at ``phase = 0``)."""
+    orders = np.asarray(orders)
+    z = c[(len(c) - 1) // 2 + orders]
+    if phase:
+        z = z * np.exp(-1j * orders * phase)
+    return 2 * z.real, -2 * z.imag
