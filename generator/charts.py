@@ -124,6 +124,51 @@ def response_figure(eps: float, force: float, Q: float, harmonics: int, path: Pa
     return _save(fig, path)
 
 
+def response_equation_figure(text: str, values: dict[str, str], harmonics: int, path: Path,
+                             name: str = "oscillator", omega_min: float | None = None,
+                             omega_max: float | None = None,
+                             max_seconds: float = CONTINUATION_SECONDS) -> Path:
+    """Response r(ω) of a user's damped driven oscillator: the one-harmonic amplitudes, the
+    continued N-harmonic balance (first-harmonic amplitude), the simulated sweeps up and down
+    (max |q|), its folds."""
+    from .driven import PolynomialBalance
+    from .numerics import ForceTable, sweep_table
+    from .response import ESCAPE_FACTOR, continue_equation, equation_range, response_equation
+
+    check_plot_path(path)
+    de = response_equation(text, values, name)
+    er = equation_range(de.terms, de.force, omega_min, omega_max)
+    lo, hi = er.omega_range
+    cont = continue_equation(de, harmonics, lo, hi, max_seconds=max_seconds)
+    fine = PolynomialBalance(de.terms, de.force, harmonics, de.odd)
+    table = ForceTable.of(de.terms)
+    bound = ESCAPE_FACTOR * float(np.max(np.sum(np.abs(cont.x), axis=1)))
+    up = sweep_table(table, de.force, lo, hi, barrier=bound, bound=bound)
+    down = sweep_table(table, de.force, hi, lo, barrier=bound, bound=bound)
+    fig, ax = plt.subplots(figsize=(8, 4.2))
+    omega = np.linspace(lo, hi, 600)
+    one = [(w, r) for w in omega for r in er.one_harmonic.amplitudes(float(w))]
+    if one:
+        ax.plot(*np.array(one).T, "C0.", ms=1.5, label="one harmonic")
+    amp = np.array([_first(fine, x) for x in cont.x])
+    for k, piece in enumerate(cont.piece_slices()):
+        ax.plot(cont.omega[piece], amp[piece], "k-", lw=0.7,
+                label=f"harmonic balance N = {harmonics}" if k == 0 else None)
+    ax.plot(up.omega, up.amplitude, "C3.", ms=1.5, label="sweep up (max |q|)")
+    ax.plot(down.omega, down.amplitude, "C2.", ms=1.5, label="sweep down (max |q|)")
+    for w in cont.folds:
+        ax.axvline(w, color="grey", ls=":", lw=1)
+    ax.set(xlabel=f"drive frequency {de.frequency}", ylabel="amplitude", title=text)
+    ax.legend(fontsize=8, loc="upper left")
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def _first(system: object, x: np.ndarray) -> float:
+    A, B = system.amplitudes(x)
+    return float(np.hypot(A.get(1, 0.0), B.get(1, 0.0)))
+
+
 def subharmonic_figure(eps: float, force: float, path: Path) -> Path:
     """Amplitude a(ω) of both roots of eq. 10.87 where they exist; Hill verdict as line
     style, the true orbit's verdict as markers."""

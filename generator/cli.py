@@ -624,7 +624,94 @@ def _charts():
     return charts
 
 
+def response_equation_json(text: str, values: dict[str, str], harmonics: int,
+                           name: str = "oscillator", omega_min: float | None = None,
+                           omega_max: float | None = None,
+                           max_seconds: float = COST_LIMIT_SECONDS) -> dict:
+    """The contract of ``lindstedt response EQUATION … --json``: the keys of
+    :func:`response_json` (``parameters`` as ``driven EQUATION``'s, with ``omega_range``),
+    with the folds of the general one-harmonic balance, of the continued N-harmonic balance,
+    and of the true orbit (each with its Floquet moduli), the sweeps' jumps and escapes."""
+    import numpy as np
+
+    from .driven import PolynomialBalance
+    from .numerics import ForceTable, sweep_table
+    from .response import (
+        ESCAPE_FACTOR,
+        continue_equation,
+        equation_range,
+        orbit_fold_table,
+        response_equation,
+    )
+
+    de = response_equation(text, values, name)
+    er = equation_range(de.terms, de.force, omega_min, omega_max)
+    lo, hi = er.omega_range
+    cont = continue_equation(de, harmonics, lo, hi, max_seconds=max_seconds)
+    fine = PolynomialBalance(de.terms, de.force, harmonics, de.odd)
+    table = ForceTable.of(de.terms)
+    true_folds = []
+    for w in cont.folds:
+        x = cont.x[int(np.argmin(np.abs(cont.omega - w)))]
+        found = orbit_fold_table(table, de.force, w, fine.state(x, w))
+        if found is not None:
+            true_folds.append((found[0], sorted(float(abs(m)) for m in found[2])))
+    true_folds.sort()
+    bound = ESCAPE_FACTOR * float(np.max(np.sum(np.abs(cont.x), axis=1)))
+    up = sweep_table(table, de.force, lo, hi, barrier=bound, bound=bound)
+    down = sweep_table(table, de.force, hi, lo, barrier=bound, bound=bound)
+    return {
+        "equation": text,
+        "name": name,
+        "parameters": {"harmonics": harmonics, "omega_range": [lo, hi],
+                       "values": dict(de.values), "linear_frequency": er.linear_frequency,
+                       "drive": {"amplitude": de.force, "frequency": de.frequency}},
+        "force": [{"q": a, "dq": b, "c": c} for (a, b), c in sorted(de.terms.items())],
+        "odd": de.odd,
+        "one_harmonic": {"folds": [float(w) for w in er.one_harmonic_folds]},
+        "harmonic_balance": {"harmonics": harmonics, "folds": [float(w) for w in cont.folds],
+                             "complete": cont.complete},
+        "numerical": {"folds": [w for w, _ in true_folds],
+                      "fold_floquet_moduli": [m for _, m in true_folds],
+                      "sweep_up_jump": up.jump, "sweep_down_jump": down.jump,
+                      "sweep_resolution": up.resolution, "sweep_up_escape": up.escape,
+                      "sweep_down_escape": down.escape, "escape_bound": bound},
+    }
+
+
+RESPONSE_EQUATION_ONLY = ("omega_min", "omega_max")
+
+
+def _response_args(args: argparse.Namespace) -> None:
+    """The flags of ``response`` with and without EQUATION, each refused in one line where it
+    does not belong."""
+    if args.model is not None:
+        given = [f"--{k}" for k in DRIVE_FLAGS if getattr(args, k) is not None]
+        if given:
+            raise InputError(f"{', '.join(given)}: with an equation give its parameters with "
+                             "--param (e.g. --param eps=1/10) and the drive in the equation")
+        return
+    if args.param or args.name or any(getattr(args, k) is not None
+                                      for k in RESPONSE_EQUATION_ONLY):
+        raise InputError("--param/--name/--omega-min/--omega-max: give an equation (EQUATION) "
+                         "to take them")
+    missing = [f"--{k}" for k in DRIVE_FLAGS if getattr(args, k) is None]
+    if missing:
+        raise InputError(f"the following arguments are required: {', '.join(missing)}")
+
+
 def _cmd_response(args: argparse.Namespace) -> int:
+    _response_args(args)
+    limit = math.inf if args.allow_slow else COST_LIMIT_SECONDS
+    if args.model is not None:
+        values, name = _params(args.param), args.name or "oscillator"
+        return _report(
+            args, lambda: response_equation_json(args.model, values, args.harmonics, name,
+                                                 args.omega_min, args.omega_max, limit),
+            lambda path: _charts().response_equation_figure(
+                args.model, values, args.harmonics, path, name, args.omega_min,
+                args.omega_max, limit),
+            _response_equation_table)
     return _report(
         args, lambda: response_json(args.eps, args.force, args.Q, args.harmonics,
                                     math.inf if args.allow_slow else COST_LIMIT_SECONDS),
@@ -655,6 +742,34 @@ def _response_table(data: dict) -> list[str]:
         else:
             text = "no jump"
         lines.append(f"{'sweep ' + way:>26}: {text}")
+    return lines
+
+
+def _response_equation_table(data: dict) -> list[str]:
+    p = data["parameters"]
+    given = ", ".join(f"{k} = {v}" for k, v in p["values"].items())
+    harmonics = data["harmonic_balance"]["harmonics"]
+    lo, hi = p["omega_range"]
+    lines = [f"{data['equation']}: {given}{'; ' if given else ''}{p['drive']['frequency']} in "
+             f"[{lo:.4g}, {hi:.4g}] (omega0 = {p['linear_frequency']:.6g})"]
+    num = data["numerical"]
+    for label, folds in (("one harmonic", data["one_harmonic"]["folds"]),
+                         (f"harmonic balance N={harmonics}", data["harmonic_balance"]["folds"]),
+                         ("true orbit (Floquet +1)", num["folds"])):
+        lines.append(f"{label:>26}: folds " + (", ".join(f"{w:.12f}" for w in folds) or "none"))
+    for way in ("up", "down"):
+        value, escape = num[f"sweep_{way}_jump"], num[f"sweep_{way}_escape"]
+        if escape is not None:
+            text = (f"escapes at {escape:.4f} (|q| past {num['escape_bound']:.3g}, 10 times "
+                    "every balance solution's: no steady state beyond)")
+        elif value is not None:
+            text = f"jumps at {value:.4f} (sweep step {num['sweep_resolution']:.1e} per period)"
+        else:
+            text = "no jump"
+        lines.append(f"{'sweep ' + way:>26}: {text}")
+    if not data["harmonic_balance"]["complete"]:
+        lines.append("warning: a balance at an end of the range did not converge from its "
+                     "one-harmonic root: pieces of the curve may be missing")
     return lines
 
 
@@ -1224,9 +1339,31 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_driven)
 
     p = sub.add_parser("response", help="folds and hysteresis of the damped driven oscillator",
-                       description="Response curve over ω: folds three ways, sweep jumps.")
-    _flag_drive(p, required=True, omega=None, Q="required")
-    _flag_harmonics(p, "odd harmonics N of the continued balance")
+                       description="Response curve over ω: folds three ways, sweep jumps. "
+                       "q'' + q'/Q + q + eps q^3 = f cos(w t) (--eps, --force, --Q), or your "
+                       "own damped equation q'' + g(q, q') = f*cos(w*t), g a polynomial, with "
+                       "--param for every parameter but w.")
+    p.add_argument("model", metavar="EQUATION", nargs="?", default=None,
+                   help="an equation such as \"q'' + 0.05*q' + q + eps*(q**2 + q**3) = "
+                   "f*cos(w*t)\" (a polynomial force with damping, one drive f*cos(w*t) whose w "
+                   "the curve varies; default: eq. 10.60 with --eps, --force, --Q)")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="with EQUATION: an exact value for each of its parameters, e.g. "
+                   "eps=1/10 (repeatable; every parameter but w needs one)")
+    p.add_argument("--name", metavar="NAME",
+                   help="with EQUATION: the oscillator's name in messages (default: oscillator)")
+    _flag_drive(p, required=False, omega=None, Q=None)
+    p.add_argument("--Q", type=_quality, default=None, metavar="Q",
+                   help="quality factor Q > 0 of the damping q'/Q (finite; required without "
+                   "EQUATION)")
+    p.add_argument("--omega-min", type=_real, metavar="W",
+                   help="with EQUATION: the lowest ω of the curve (default: half the lowest of "
+                   "the linear frequency ω0 and the one-harmonic folds)")
+    p.add_argument("--omega-max", type=_real, metavar="W",
+                   help="with EQUATION: the highest ω of the curve (default: 1.25 × the highest "
+                   "of ω0 and the one-harmonic folds)")
+    _flag_harmonics(p, "odd harmonics N of the continued balance (with EQUATION: harmonics "
+                    "1..2N-1, with the constant and even ones unless the force is odd)")
     _flag_json(p)
     _flag_plot(p)
     _flag_allow_slow(p, deprecated_force=False)

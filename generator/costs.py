@@ -164,9 +164,53 @@ def driven_cost(args: argparse.Namespace) -> Cost:
                 "the μ-expansion on every branch")
 
 
+RESPONSE_EQUATION_FIXED = 10.0
+# NOTE: `lindstedt response EQUATION`, on top of its continuation's estimate: start-up with
+# SymPy's parse twice (~2.5 s), the one-harmonic folds (~0.3 s), the ends' Newton solves, each
+# fold refined on the true orbit (~0.1–0.5 s each) and the two sweeps on the table's integrator
+# (0.1–1 s each; a force of degree 7 with velocity terms 2 s), bounded from measured 3–6 s.
+RESPONSE_EQUATION_ENDS = 2 * 15.0
+# NOTE: where a balance at an end of the range does not converge from its one-harmonic root, its
+# seeds come from the continuation in the drive amplitude, which stops itself at 15 s
+# (response.CONTINUATION_BUDGET): counted only when the estimate meets an end whose balance
+# does not converge (see response_equation_cost).
+
+
+def response_equation_cost(args: argparse.Namespace) -> Cost:
+    """``response EQUATION``: the equation lowered (refused in one line before anything runs),
+    its range and continuation estimated as the command will run them."""
+    from .driven import PolynomialBalance
+    from .response import equation_continuation_seconds, equation_range, response_equation
+
+    values: dict[str, str] = {}
+    for pair in args.param or ():
+        key, _, value = pair.partition("=")
+        values[key.strip()] = value.strip()
+    de = response_equation(args.model, values, args.name or "oscillator")
+    er = equation_range(de.terms, de.force, args.omega_min, args.omega_max)
+    lo, hi = er.omega_range
+    _, seconds = equation_continuation_seconds(de.terms, de.force, args.harmonics, de.odd, lo,
+                                               hi)
+    fine = PolynomialBalance(de.terms, de.force, args.harmonics, de.odd)
+    ends = 0.0
+    for w in (lo, hi):
+        for r in er.one_harmonic.amplitudes(w):
+            x = fine.vector({1: r * math.cos(er.one_harmonic.phase(r, w))},
+                            {1: r * math.sin(er.one_harmonic.phase(r, w))})
+            if not fine.solve(x, w)[1]:
+                ends += RESPONSE_EQUATION_ENDS / 2
+                break
+    return Cost(RESPONSE_EQUATION_FIXED + ends + seconds, f"--harmonics {args.harmonics}",
+                "continuation, fold refinement and simulated sweeps of the equation")
+
+
 def response_cost(args: argparse.Namespace) -> Cost:
     from .response import continuation_seconds, response_range
 
+    if getattr(args, "model", None) is not None:
+        return response_equation_cost(args)
+    if any(getattr(args, k, None) is None for k in ("eps", "force", "Q")):
+        return Cost(RESPONSE_FIXED, "response", "response")  # the command says what is missing
     lo, hi = response_range(args.eps, args.force, args.Q)
     return Cost(RESPONSE_FIXED + continuation_seconds(args.eps, args.force, args.Q,
                                                       args.harmonics, lo, hi),

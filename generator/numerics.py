@@ -407,17 +407,14 @@ def shoot_table(table: ForceTable, force: float, omega: float, guess: np.ndarray
 
 
 @njit(cache=True)
-def _swept_force(t: float, q: float, p: float, eps: float, force: float, damping: float,
-                 omega0: float, beta: float) -> float:
-    """q̈ of eq. 10.60 under the drive f cos(ω₀t + βt²/2)."""
-    return force * np.cos(omega0 * t + 0.5 * beta * t * t) - damping * p - q - eps * q**3
-
-
-@njit(cache=True)
-def _sweep(eps: float, force: float, damping: float, omega0: float, omega1: float,
-           periods: int, steps: int) -> tuple[np.ndarray, np.ndarray]:
-    """RK4 through a linear frequency sweep ``ω(t) = ω₀ + βt`` of ``periods`` drive periods;
-    per period: the mean ω and max |q|."""
+def _sweep(qp: np.ndarray, vp: np.ndarray, cs: np.ndarray, cubic: np.ndarray | None,
+           force: float, omega0: float, omega1: float, periods: int, steps: int,
+           bound: float) -> tuple[np.ndarray, np.ndarray]:
+    """RK4 on ``q̈ + Σ c q^a q̇^b = f cos(ω₀t + βt²/2)`` (the table ``qp, vp, cs``; ``cubic``
+    as in :func:`_rhs`) through a linear frequency sweep ``ω(t) = ω₀ + βt`` of ``periods``
+    drive periods; per period: the mean ω and max |q|.  Where ``|q|`` passes ``bound`` moving
+    outward (``q q̇ ≥ 0``) the trajectory has escaped: it stops at the end of that period,
+    the later ones' max |q| NaN."""
     mean = 0.5 * (omega0 + omega1)
     duration = periods * 2 * np.pi / mean
     beta = (omega1 - omega0) / duration
@@ -428,23 +425,37 @@ def _sweep(eps: float, force: float, damping: float, omega0: float, omega1: floa
     omegas = np.zeros(periods)
     amps = np.zeros(periods)
     counts = np.zeros(periods)
+    y, tmp = np.zeros(6), np.zeros(6)  # (q, p) and a zero variational part
+    k1, k2, k3, k4 = np.empty(6), np.empty(6), np.empty(6), np.empty(6)
+    escaped = periods
     for _ in range(n):
         phase = omega0 * t + 0.5 * beta * t * t
         k = min(int(phase / (2 * np.pi)), periods - 1)
+        if k > escaped:  # the period of the escape is complete: stop
+            for j in range(k, periods):  # ω at the middle of the periods not reached
+                amps[j] = np.nan
+                omegas[j] = np.sqrt(max(omega0**2 + 4 * np.pi * beta * (j + 0.5), 0.0))
+                counts[j] = 1
+            break
         amps[k] = max(amps[k], abs(q))
         omegas[k] += omega0 + beta * t
         counts[k] += 1
-        args = (eps, force, damping, omega0, beta)
-        k1q, k1p = p, _swept_force(t, q, p, *args)
-        k2q = p + 0.5 * h * k1p
-        k2p = _swept_force(t + 0.5 * h, q + 0.5 * h * k1q, k2q, *args)
-        k3q = p + 0.5 * h * k2p
-        k3p = _swept_force(t + 0.5 * h, q + 0.5 * h * k2q, k3q, *args)
-        k4q = p + h * k3p
-        k4p = _swept_force(t + h, q + h * k3q, k4q, *args)
-        q += h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q)
-        p += h / 6 * (k1p + 2 * k2p + 2 * k3p + k4p)
+        # the chirp's phase ω₀t + βt²/2 is (ω₀ + βt/2)·t: _rhs's cos(ωt) at that ω
+        y[0], y[1] = q, p
+        _rhs(t, y, qp, vp, cs, cubic, force, omega0 + 0.5 * beta * t, k1)
+        th = t + 0.5 * h
+        tmp[0], tmp[1] = q + 0.5 * h * k1[0], p + 0.5 * h * k1[1]
+        _rhs(th, tmp, qp, vp, cs, cubic, force, omega0 + 0.5 * beta * th, k2)
+        tmp[0], tmp[1] = q + 0.5 * h * k2[0], p + 0.5 * h * k2[1]
+        _rhs(th, tmp, qp, vp, cs, cubic, force, omega0 + 0.5 * beta * th, k3)
+        tmp[0], tmp[1] = q + h * k3[0], p + h * k3[1]
+        _rhs(t + h, tmp, qp, vp, cs, cubic, force, omega0 + 0.5 * beta * (t + h), k4)
+        q += h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
+        p += h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
         t += h
+        if escaped == periods and abs(q) > bound and q * p >= 0.0:
+            escaped = k
+            amps[k] = max(amps[k], abs(q))
     return omegas / np.maximum(counts, 1), amps
 
 
@@ -473,10 +484,23 @@ def sweep(eps: float, force: float, damping: float, omega_from: float, omega_to:
     amplitude per drive period, the jump between branches if any, or — a softening spring
     driven over its barrier ``|q| = 1/√−ε`` — the ω where it escapes (amplitudes NaN from there,
     no jump reported)."""
-    omegas, amps = _sweep(eps, force, damping, omega_from, omega_to, periods, SWEEP_STEPS)
-    step = abs(omega_to - omega_from) / periods
     barrier = 1 / np.sqrt(-eps) if eps < 0 else np.inf  # the potential's maxima, |q| = 1/√−ε
-    out = ~np.isfinite(amps) | (amps > barrier)
+    return sweep_table(duffing_table(eps, damping), force, omega_from, omega_to, periods,
+                       barrier, escape_bound(eps, force))
+
+
+def sweep_table(table: ForceTable, force: float, omega_from: float, omega_to: float,
+                periods: int = 10_000, barrier: float = math.inf,
+                bound: float = math.inf) -> Sweep:
+    """:func:`sweep` of ``q̈ + g(q, q̇) = f cos ωt`` (``g`` the polynomial ``table``): an
+    amplitude past ``barrier``, or a trajectory past ``bound`` moving outward (where the
+    integration stops), or one that overflows, is an escape."""
+    omegas, amps = _sweep(table.q_powers, table.v_powers, table.coefficients, table.cubic,
+                          float(force), float(omega_from), float(omega_to), periods,
+                          SWEEP_STEPS, float(bound))
+    step = abs(omega_to - omega_from) / periods
+    with np.errstate(invalid="ignore"):
+        out = ~np.isfinite(amps) | (amps > barrier)
     if out.any():  # over the barrier the orbit runs off to infinity: no branch to jump to
         first = int(np.argmax(out))
         amps = np.where(np.arange(amps.size) < first, amps, np.nan)

@@ -37,6 +37,7 @@ from .numerics import (
     PeriodicOrbit,
     ShootingFailure,
     ToneFit,
+    flow_table,
     hill_multipliers,
     shoot,
     shoot_explained,
@@ -280,7 +281,21 @@ def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_s
                          f"{where}; the limit is {max_seconds:.0f} s, ask for fewer")
     if not first_order_branches(d):
         raise InputError(f"{where}: no one-harmonic branch at ω = {omega_start:g} to start from")
-    limit = min(max_points, int(2 * max(seconds, CONTINUATION_SECONDS) / point_seconds(harmonics)))
+    return _continue(sysm, lambda: _end_solutions(sysm, d, omega_start, omega_stop),
+                     omega_start, omega_stop, step, estimate, seconds,
+                     point_seconds(harmonics), max_points, where)
+
+
+def _continue(sysm: BalanceSystem | PolynomialBalance, end_solutions, omega_start: float,
+              omega_stop: float, step: float, estimate: float, seconds: float,
+              per_point: float, max_points: int, where: str) -> Continuation:
+    """The pseudo-arclength loop of :func:`continue_balance` on any balance with ``residual``,
+    ``jacobian`` and ``d_omega`` in ``(x, ω)``: from each of ``end_solutions()`` (``(ω, x,
+    direction into the range)`` at the two ends, the first at ``omega_start``, and whether
+    they are complete) not reached yet, until ω leaves the range; ``estimate`` points of
+    ``per_point`` seconds, ``seconds`` in all, bound its steps and its time."""
+    lo, hi = sorted((omega_start, omega_stop))
+    limit = min(max_points, int(2 * max(seconds, CONTINUATION_SECONDS) / per_point))
     allowed = 2 * max(seconds, CONTINUATION_SECONDS)
     deadline = time.monotonic() + allowed
     points: list[np.ndarray] = []
@@ -289,7 +304,7 @@ def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_s
     y = None
     try:
         with np.errstate(over="ignore", invalid="ignore"):
-            ends, complete = _end_solutions(sysm, d, omega_start, omega_stop)
+            ends, complete = end_solutions()
             visited = [False] * len(ends)
             while not all(visited):
                 k = visited.index(False)
@@ -1188,3 +1203,331 @@ def equation_orbits(de: DrivenEquation, harmonics: int = 8,
 def _balance_r(system: PolynomialBalance, x: np.ndarray) -> float:
     A, B = system.amplitudes(x)
     return math.hypot(A.get(1, 0.0), B.get(1, 0.0))
+
+
+# --- a user's driven oscillator: the response curve in ω -------------------------------------
+
+_poly = np.polynomial.polynomial
+
+@dataclass(frozen=True)
+class OneHarmonic:
+    """``q = r cos(ωt − φ)`` in ``q̈ + g(q, q̇) = f cos ωt`` (a polynomial ``g``, its table
+    ``terms``): the first harmonic of ``q̈ + g`` is ``(P_c(r), P_s(r))`` with
+    ``P_c = −ω²r + Σ c ω^b C_ab r^(a+b)``, ``P_s = Σ c ω^b S_ab r^(a+b)`` (``C_ab``, ``S_ab``
+    the cos θ, sin θ coefficients of ``cos^a θ (−sin θ)^b``), and ``H(r) = P_c² + P_s² − f²``
+    vanishes at the amplitudes: for eq. 10.60 exactly the cubic ``G`` of the module's header
+    (in ``r``), so the same folds."""
+
+    terms: dict[tuple[int, int], float]
+    force: float
+
+    @functools.cached_property
+    def _harmonics(self) -> list[tuple[int, int, float, float, float]]:
+        theta = 2 * np.pi * np.arange(64) / 64
+        out = []
+        for (a, b), c in sorted(self.terms.items()):
+            wave = np.cos(theta) ** a * (-np.sin(theta)) ** b
+            out.append((a, b, c, 2 * float(np.mean(wave * np.cos(theta))),
+                        2 * float(np.mean(wave * np.sin(theta)))))
+        return out
+
+    def polynomial(self, omega: float) -> np.ndarray:
+        """``H(r)`` at ``omega``: its coefficients, lowest power first, trimmed."""
+        d = max(a + b for a, b, *_ in self._harmonics)
+        pc, ps = np.zeros(d + 1), np.zeros(d + 1)
+        pc[1] = -omega**2
+        for a, b, c, cos, sin in self._harmonics:
+            pc[a + b] += c * omega**b * cos
+            ps[a + b] += c * omega**b * sin
+        H = _poly.polyadd(_poly.polymul(pc, pc), _poly.polymul(ps, ps))
+        H[0] -= self.force**2
+        return _poly.polytrim(H, 0)
+
+    def amplitudes(self, omega: float) -> np.ndarray:
+        """The positive real roots r of ``H``, ascending (each polished by Newton's method)."""
+        H = self.polynomial(omega)
+        dH = _poly.polyder(H)
+        roots = _poly.polyroots(H)
+        scale = 1 + np.abs(roots)
+        rs = roots.real[(np.abs(roots.imag) <= 1e-7 * scale) & (roots.real > 0)]
+        for _ in range(3):
+            d = _poly.polyval(rs, dH)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                rs = rs - np.where(d != 0, _poly.polyval(rs, H) / d, 0.0)
+        return np.sort(rs[rs > 0])
+
+    def phase(self, r: float, omega: float) -> float:
+        """φ of the root ``r``: ``(P_c, P_s) = f (cos φ, −sin φ)``."""
+        pc = -omega**2 * r + sum(c * omega**b * cos * r ** (a + b)
+                                 for a, b, c, cos, _ in self._harmonics)
+        ps = sum(c * omega**b * sin * r ** (a + b) for a, b, c, _, sin in self._harmonics)
+        return math.atan2(-ps, pc)
+
+    def folds(self, lo: float, hi: float, points: int = 1500) -> list[float]:
+        """The ω in ``[lo, hi]`` where two amplitudes meet (``H = ∂H/∂r = 0``): where the
+        number of roots changes on a geometric grid, each polished by Newton's method in
+        ``(r, ω)``."""
+        grid = np.geomspace(lo, hi, points)
+        counts = [len(self.amplitudes(w)) for w in grid]
+        out = []
+        for i in range(points - 1):
+            if counts[i] == counts[i + 1]:
+                continue
+            j = i if counts[i] > counts[i + 1] else i + 1  # the side with the pair
+            rs = self.amplitudes(grid[j])
+            if len(rs) < 2:
+                continue
+            k = int(np.argmin(np.diff(rs)))
+            z = np.array([0.5 * (rs[k] + rs[k + 1]), 0.5 * (grid[i] + grid[i + 1])])
+            fold = self._polish_fold(z)
+            if fold is not None and grid[i] - 1e-3 * grid[i] <= fold <= grid[i + 1] * 1.001:
+                out.append(fold)
+        return sorted(out)
+
+    def _polish_fold(self, z: np.ndarray) -> float | None:
+        def F(z: np.ndarray) -> np.ndarray:
+            H = self.polynomial(z[1])
+            return np.array([_poly.polyval(z[0], H), _poly.polyval(z[0], _poly.polyder(H))])
+
+        for _ in range(40):
+            f0 = F(z)
+            J = np.empty((2, 2))
+            for k in range(2):
+                e = np.zeros(2)
+                e[k] = 1e-7 * (1 + abs(z[k]))
+                J[:, k] = (F(z + e) - F(z - e)) / (2 * e[k])
+            try:
+                dz = np.linalg.solve(J, -f0)
+            except np.linalg.LinAlgError:
+                return None
+            z = z + dz
+            if not (np.all(np.isfinite(z)) and z[0] > 0 and z[1] > 0):
+                return None
+            if np.max(np.abs(dz)) < 1e-15 * (1 + np.max(np.abs(z))):
+                break
+        return float(z[1])
+
+    def extent(self, lo: float, hi: float, folds: list[float]) -> float:
+        """The largest amplitude on ``[lo, hi]`` (a grid and the folds)."""
+        grid = np.concatenate([np.linspace(lo, hi, 400), folds])
+        return float(max((r for w in grid for r in self.amplitudes(w)), default=0.0))
+
+
+EQUATION_POINT_SECONDS = (2e-3, 1e-6)
+# NOTE: seconds per continuation point of a user's equation, fixed + per unknown²: the
+# alternating frequency/time Jacobian (S samples × m unknowns, S ≈ 2(d + 1)·2N) and the SVD;
+# measured 2.5 ms at m = 31 (N = 8, a force with even terms), 16 ms at m = 127 (N = 32).
+
+
+def equation_point_seconds(unknowns: int) -> float:
+    return EQUATION_POINT_SECONDS[0] + EQUATION_POINT_SECONDS[1] * unknowns**2
+
+
+@dataclass(frozen=True)
+class EquationResponse:
+    """What ``lindstedt response EQUATION`` computes before its sweeps."""
+
+    one_harmonic: OneHarmonic
+    omega_range: tuple[float, float]
+    one_harmonic_folds: list[float]
+    linear_frequency: float
+
+
+def linear_frequency(terms: dict[tuple[int, int], float]) -> float:
+    """``ω₀ = √c`` of the linear term ``c q``; :class:`InputError` where ``c ≤ 0``."""
+    c = terms.get((1, 0), 0.0)
+    if not c > 0:
+        raise InputError(f"the linear term {c:g}*q: no oscillation about q = 0 (ω0² must be "
+                         "> 0) to draw a response curve around")
+    return math.sqrt(c)
+
+
+def equation_range(terms: dict[tuple[int, int], float], force: float,
+                   omega_min: float | None = None,
+                   omega_max: float | None = None) -> EquationResponse:
+    """The ω range of a response curve: as for eq. 10.60, half the lowest to 1.25 × the highest
+    of ω₀ and the one-harmonic folds (looked for in ``[ω₀/10, 10ω₀]``), each end replaced by
+    ``omega_min``/``omega_max`` where given."""
+    w0 = linear_frequency(terms)
+    one = OneHarmonic(dict(terms), float(force))
+    folds = one.folds(0.1 * w0, 10 * w0)
+    lo = 0.5 * min([w0, *folds]) if omega_min is None else omega_min
+    hi = 1.25 * max([w0, *folds]) if omega_max is None else omega_max
+    for flag, value in (("--omega-min", lo), ("--omega-max", hi)):
+        if not (math.isfinite(value) and value > 0):
+            raise InputError(f"{flag} {value!r}: must be finite and > 0")
+    if not lo < hi:
+        raise InputError(f"--omega-min {lo:g} must lie below --omega-max {hi:g}")
+    return EquationResponse(one, (lo, hi), [w for w in folds if lo <= w <= hi], w0)
+
+
+def equation_continuation_seconds(terms: dict[tuple[int, int], float], force: float,
+                                  harmonics: int, odd: bool, lo: float, hi: float,
+                                  step: float = 0.02, max_points: int = MAX_POINTS
+                                  ) -> tuple[float, float]:
+    """``(points, seconds)`` the continuation of :func:`continue_equation` is estimated at (its
+    length ``(hi − lo) + π r_max`` over ``step``, r_max from the one-harmonic amplitudes), or
+    :class:`InputError` above ``max_points``."""
+    one = OneHarmonic(dict(terms), float(force))
+    r_max = one.extent(lo, hi, one.folds(lo, hi, 400))
+    estimate = ((hi - lo) + np.pi * r_max) / step
+    if not estimate <= max_points:
+        raise InputError(f"force {force:g}: the response curve spans ω in [{lo:.3g}, {hi:.3g}] "
+                         f"with one-harmonic amplitudes up to {r_max:.3g}, about "
+                         f"{estimate:.2g} continuation steps of {step:g}; the limit is "
+                         f"{max_points}")
+    unknowns = 2 * harmonics if odd else 4 * harmonics - 1
+    # the ends: two continuations in the drive amplitude, each within its own deadline
+    return estimate, estimate * equation_point_seconds(unknowns)
+
+
+def continue_equation(de: DrivenEquation, harmonics: int, omega_start: float,
+                      omega_stop: float, step: float = 0.02, max_points: int = MAX_POINTS,
+                      max_seconds: float = CONTINUATION_SECONDS) -> Continuation:
+    """:func:`continue_balance` for a user's :class:`driven.DrivenEquation` (its ω ignored):
+    the :class:`driven.PolynomialBalance` with ``harmonics`` traced in ω through its folds,
+    starting from every balance solution at the two ends that the continuation in the drive
+    amplitude from rest reaches (:func:`continue_in_drive`, as ``driven EQUATION`` seeds),
+    the smallest at ``omega_start`` first."""
+    check_harmonics(harmonics)
+    fine = PolynomialBalance(de.terms, de.force, harmonics, de.odd)
+    lo, hi = sorted((omega_start, omega_stop))
+    where = f"{de.name} ({de.text})"
+    estimate, seconds = equation_continuation_seconds(de.terms, de.force, harmonics, de.odd,
+                                                      lo, hi, step, max_points)
+    if seconds > max_seconds:
+        raise InputError(f"harmonics {harmonics}: about {seconds:.0f} s of continuation "
+                         f"({estimate:.0f} points) for {where}; the limit is "
+                         f"{max_seconds:.0f} s, ask for fewer")
+    return _continue(fine, lambda: _equation_ends(de, fine, omega_start, omega_stop),
+                     omega_start, omega_stop, step, estimate, seconds,
+                     equation_point_seconds(fine.size), max_points, where)
+
+
+def equation_solutions(de: DrivenEquation, fine: PolynomialBalance, omega: float
+                       ) -> tuple[list[np.ndarray], bool]:
+    """Every balance solution at ``omega`` that the continuation in the drive amplitude from
+    rest crosses (at most CONTINUATION_HARMONICS harmonics, then Newton at ``fine``'s), distinct,
+    by amplitude; and whether that continuation was complete and every crossing converged."""
+    coarse = PolynomialBalance(de.terms, de.force, min(fine.harmonics, CONTINUATION_HARMONICS),
+                               de.odd)
+    curve = continue_in_drive(coarse, omega, amplitude_bound(de.terms, omega, abs(de.force)))
+    seeds = _crossings(curve.force - de.force, curve.x)
+    seeds += [_half_period(coarse, x) for x in _crossings(curve.force + de.force, curve.x)]
+    out: list[np.ndarray] = []
+    complete = curve.complete
+    for x in seeds:
+        A, B = coarse.amplitudes(x)
+        xb, converged, _ = fine.solve(fine.vector(A, B), omega)
+        if not converged:
+            complete = False
+            continue
+        if all(np.linalg.norm(y - xb) > 1e-6 * (1 + np.linalg.norm(xb)) for y in out):
+            out.append(xb)
+    out.sort(key=lambda x: _balance_r(fine, x))
+    return out, complete
+
+
+def _equation_ends(de: DrivenEquation, fine: PolynomialBalance, omega_start: float,
+                   omega_stop: float) -> tuple[list[tuple[float, np.ndarray, float]], bool]:
+    """:func:`_end_solutions` for a user's equation: Newton's method on the balance from every
+    one-harmonic root (:class:`OneHarmonic`) at each end; where one of them does not converge,
+    the solutions the continuation in the drive amplitude crosses there
+    (:func:`equation_solutions`)."""
+    out: list[tuple[float, np.ndarray, float]] = []
+    complete = True
+    one = OneHarmonic(dict(de.terms), de.force)
+    k1 = int(np.nonzero(fine.orders == 1)[0][0])
+    s1 = fine.n_cos + int(np.nonzero(fine.orders[fine.orders > 0] == 1)[0][0])
+    for omega, direction in ((omega_start, np.sign(omega_stop - omega_start)),
+                             (omega_stop, np.sign(omega_start - omega_stop))):
+        found: list[np.ndarray] = []
+        for r in one.amplitudes(omega):
+            x = np.zeros(fine.size)
+            phi = one.phase(r, omega)
+            x[k1], x[s1] = r * math.cos(phi), r * math.sin(phi)
+            x, converged, _ = fine.solve(x, omega)
+            if not converged:
+                found, whole = equation_solutions(de, fine, omega)
+                complete = complete and whole
+                break
+            if all(np.linalg.norm(y - x) > 1e-6 * (1 + np.linalg.norm(x)) for y in found):
+                found.append(x)
+        found.sort(key=lambda x: _balance_r(fine, x))
+        out.extend((omega, x, float(direction)) for x in found)
+    if not out or out[0][0] != omega_start:
+        raise np.linalg.LinAlgError(f"no balance converged at ω = {omega_start:.4g}")
+    return out, complete
+
+
+def orbit_fold_table(table: ForceTable, force: float, omega: float, y0: np.ndarray,
+                     tol: float = 1e-11) -> tuple[float, np.ndarray, np.ndarray] | None:
+    """:func:`numerics.orbit_fold` for ``q̈ + g(q, q̇) = f cos ωt`` (``g`` the table): the true
+    orbit with a Floquet multiplier ``+1`` by Newton's method in ``(y₀, ω)`` on
+    ``(φ_T(y₀) − y₀, det(M − I))``; ``(ω, y₀, multipliers)`` or ``None``."""
+    def F(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        end, _, _ = flow_table(table, force, z[2], z[:2], 2 * np.pi / z[2], samples=1)
+        mono = end[2:].reshape(2, 2).T
+        return np.array([*(end[:2] - z[:2]), np.linalg.det(mono - np.eye(2))]), mono
+
+    z = np.array([*y0, omega], dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        for _ in range(30):
+            if not z[2] > 0:
+                return None
+            f0, _ = F(z)
+            J = np.empty((3, 3))
+            for k in range(3):
+                e = np.zeros(3)
+                e[k] = 1e-7 * (1 + abs(z[k]))
+                J[:, k] = (F(z + e)[0] - F(z - e)[0]) / (2 * e[k])
+            if not (np.all(np.isfinite(J)) and np.all(np.isfinite(f0))):
+                return None
+            try:
+                dz = np.linalg.solve(J, -f0)
+            except np.linalg.LinAlgError:
+                return None
+            z = z + dz
+            if np.max(np.abs(dz)) < tol * (1 + np.max(np.abs(z))):
+                _, mono = F(z)
+                return float(z[2]), z[:2], np.linalg.eigvals(mono)
+    return None
+
+
+ESCAPE_FACTOR = 10.0
+# NOTE: a user's equation has no barrier in closed form: a sweep whose |q| passes 10× the largest
+# |q| of any balance solution on the range (Σ|a_k| + |b_k| over the continued curve), moving
+# outward, has left every steady state there: an escape (a softening spring over its barrier
+# runs off to infinity within a period or two after that).
+
+RESPONSE = "response"
+
+
+def response_equation(text: str, values: dict[str, str], name: str = "oscillator",
+                      method: str = RESPONSE) -> DrivenEquation:
+    """A user's damped driven oscillator for a response curve in its drive frequency: the
+    :class:`driven.DrivenEquation` of ``text`` (ω left free: every parameter but the drive
+    frequency needs a value), refused in one line where the force depends on the drive
+    frequency or has no damping (a term odd in q')."""
+    from .driven import driven_equation
+
+    def lowered(omega: float) -> DrivenEquation:
+        try:
+            return driven_equation(text, values, omega, name)
+        except InputError as exc:
+            message = str(exc).replace(": driven does not apply: ", f": {method} does not apply: ")
+            message = message.replace("(its value is --omega)", f"(the {method} curve's ω)")
+            if " is the drive frequency; give it with --omega" in message:
+                message = message.split(";")[0] + f"; {method} varies it (drop this --param)"
+            raise InputError(message) from None
+
+    de, other = lowered(1.0), lowered(2.0)
+    if de.terms != other.terms or de.force != other.force:
+        raise InputError(f"{name} ({text}): {method} does not apply: the force or the drive's "
+                         f"amplitude depends on the drive frequency {de.frequency}, which the "
+                         "curve varies")
+    if not de.dissipative:
+        raise InputError(f"{name} ({text}): {method} does not apply: no damping (a term odd in "
+                         "the velocity, e.g. q'/Q): no steady state to draw a response curve of")
+    linear_frequency(de.terms)
+    return de
