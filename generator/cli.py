@@ -796,7 +796,46 @@ def subharmonic_json(eps: float, force: float, omega: float) -> dict:
     }
 
 
+def _equation_args(args: argparse.Namespace, flags: Sequence[str],
+                   required: Sequence[str]) -> bool:
+    """Whether an EQUATION was given; refuses in one line the flags it replaces beside it, its
+    own flags without it, and a missing required flag without it."""
+    if args.model is not None:
+        given = [f"--{k}" for k in flags if getattr(args, k) is not None]
+        if given:
+            raise InputError(f"{', '.join(given)}: with an equation give its parameters with "
+                             "--param (e.g. --param eps=1/10) and the drive in the equation")
+        return True
+    if args.param or args.name:
+        raise InputError("--param/--name: give an equation (EQUATION) to take them")
+    missing = [f"--{k}" for k in required if getattr(args, k) is None]
+    if missing:
+        raise InputError(f"the following arguments are required: {', '.join(missing)}")
+    return False
+
+
+def subharmonic_equation_json(text: str, values: dict[str, str], omega: float | None,
+                              name: str = "oscillator") -> dict:
+    """:func:`subharmonic_json` of an equation of eq. 10.83's form, with ``equation``,
+    ``name`` and the ``parameters.values`` given."""
+    from .response import subharmonic_equation
+
+    eps, force, omega, form = subharmonic_equation(text, values, omega, name)
+    data = subharmonic_json(eps, force, omega)
+    data["parameters"]["values"] = dict(form.values)
+    return {"equation": text, "name": name, **data}
+
+
 def _cmd_subharmonic(args: argparse.Namespace) -> int:
+    if _equation_args(args, ("eps", "force"), ("eps", "force", "omega")):
+        from .response import subharmonic_equation
+
+        values, name = _params(args.param), args.name or "oscillator"
+        eps, force, _, _ = subharmonic_equation(args.model, values, args.omega, name)
+        return _report(args, lambda: subharmonic_equation_json(args.model, values, args.omega,
+                                                               name),
+                       lambda path: _charts().subharmonic_figure(eps, force, path),
+                       _subharmonic_table)
     return _report(args, lambda: subharmonic_json(args.eps, args.force, args.omega),
                    lambda path: _charts().subharmonic_figure(args.eps, args.force, path),
                    _subharmonic_table)
@@ -846,7 +885,26 @@ def _drive(text: str) -> tuple[float, float]:
         raise argparse.ArgumentTypeError(f"drive {text!r}: expected F@W, e.g. 0.3@1.3") from None
 
 
+def mixing_equation_json(text: str, values: dict[str, str], name: str = "oscillator") -> dict:
+    """:func:`mixing_json` of an equation of the mixing series' form (drives by ascending
+    frequency), with ``equation``, ``name`` and the ``parameters.values`` given."""
+    from .response import mixing_equation
+
+    eps, Q, drives, form = mixing_equation(text, values, name)
+    data = mixing_json(eps, Q, drives)
+    data["parameters"]["values"] = dict(form.values)
+    return {"equation": text, "name": name, **data}
+
+
 def _cmd_mixing(args: argparse.Namespace) -> int:
+    if _equation_args(args, ("eps", "Q", "drive"), ("eps", "Q", "drive")):
+        from .response import mixing_equation
+
+        values, name = _params(args.param), args.name or "oscillator"
+        eps, Q, drives, _ = mixing_equation(args.model, values, name)
+        return _report(args, lambda: mixing_equation_json(args.model, values, name),
+                       lambda path: _charts().mixing_figure(eps, Q, drives, path),
+                       _mixing_table)
     return _report(args, lambda: mixing_json(args.eps, args.Q, args.drive),
                    lambda path: _charts().mixing_figure(args.eps, args.Q, args.drive, path),
                    _mixing_table)
@@ -1215,6 +1273,18 @@ def _flag_oscillator(p: argparse.ArgumentParser, emitted: bool = False) -> None:
                    help="the oscillator's name in output and file names (default: oscillator)")
 
 
+def _flag_equation(p: argparse.ArgumentParser, example: str) -> None:
+    """An optional EQUATION of the command's own form, with --param and --name."""
+    p.add_argument("model", metavar="EQUATION", nargs="?", default=None,
+                   help=f"an equation such as {example}; default: the notes' equation with "
+                   "the flags")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="with EQUATION: an exact value for each of its parameters, e.g. "
+                   "eps=1/10 (repeatable; every parameter needs one)")
+    p.add_argument("--name", metavar="NAME",
+                   help="with EQUATION: the oscillator's name in messages (default: oscillator)")
+
+
 def _flag_order(p: argparse.ArgumentParser, what: str) -> None:
     p.add_argument("--order", type=_order, default=DEFAULT_ORDER, metavar="K",
                    help=f"{what}, an integer ≥ 0 (default {DEFAULT_ORDER})")
@@ -1370,20 +1440,34 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_response)
 
     p = sub.add_parser("subharmonic", help="the 1/3 subharmonic of eq. 10.83 and its stability",
-                       description="omega^2 q'' + q + eps q^3 = f cos 3τ: the 1/3 subharmonic.")
-    _flag_drive(p, required=True, omega="ω of eq. 10.83, the subharmonic's frequency: the "
-                "drive is at 3ω", Q=None)
+                       description="omega^2 q'' + q + eps q^3 = f cos 3τ: the 1/3 subharmonic "
+                       "(--eps, --force, --omega), or your own equation when it is of that form: "
+                       "q'' + q + eps*q**3 = f*cos(3*w*t) in any coordinate, with --param.")
+    _flag_equation(p, "\"x'' + x + eps*x**3 = f*cos(3*w*t)\" (exactly q + eps*q**3, undamped, "
+                   "omega0 = 1; the drive at 3*omega: w = --omega here, w = 3*omega in "
+                   "f*cos(w*t), or a number 3*omega without --omega)")
+    _flag_drive(p, required=False, omega="ω of eq. 10.83, the subharmonic's frequency: the "
+                "drive is at 3ω (required, unless the equation's drive frequency is a number)",
+                Q=None)
     _flag_json(p)
     _flag_plot(p)
     p.set_defaults(func=_cmd_subharmonic)
 
     p = sub.add_parser("mixing", help="combination tones of a two-tone drive",
                        description="q'' + q'/Q + q + eps q^3 = Σ f_i cos(w_i t): "
-                       "predicted and simulated combination tones.")
-    _flag_drive(p, required=True, omega=None, Q="required", force=False)
-    p.add_argument("--drive", type=_drive, action="append", required=True, metavar="F@W",
+                       "predicted and simulated combination tones (--eps, --Q, --drive), or "
+                       "your own equation of that form with --param.")
+    _flag_equation(p, "\"x'' + x'/Q + x + eps*x**3 = f1*cos(w1*t) + f2*cos(w2*t)\" (exactly "
+                   "q + eps*q**3 + q'/Q, omega0 = 1; every frequency a number: the tones are "
+                   "numbered by ascending frequency)")
+    _flag_drive(p, required=False, omega=None, Q=None, force=False)
+    p.add_argument("--Q", type=_quality, default=None, metavar="Q",
+                   help="quality factor Q > 0 of the damping q'/Q (finite; required without "
+                   "EQUATION)")
+    p.add_argument("--drive", type=_drive, action="append", metavar="F@W",
                    help="a drive f cos(w t): amplitude F at frequency W (units of the linear "
-                   "natural frequency), e.g. 0.3@1.3; repeat for each tone (required)")
+                   "natural frequency), e.g. 0.3@1.3; repeat for each tone (required without "
+                   "EQUATION)")
     _flag_json(p)
     _flag_plot(p)
     p.set_defaults(func=_cmd_mixing)

@@ -1531,3 +1531,128 @@ def response_equation(text: str, values: dict[str, str], name: str = "oscillator
                          "the velocity, e.g. q'/Q): no steady state to draw a response curve of")
     linear_frequency(de.terms)
     return de
+
+
+# --- the notes' εq³ ansatz from a user's equation: subharmonic, mixing -------------------------
+
+@dataclass(frozen=True)
+class CubicForm:
+    """A user's equation that IS ``q̈ + γq̇ + q + εq³ = Σ f_i cos(ν_i t)`` once its values are
+    given: ε, γ (0: undamped) and the drives, each ``(f, ν)`` with ``ν = c·w`` where ``c`` is a
+    number and ``w`` a name left free (``None``: ``ν = c``)."""
+
+    eps: float
+    damping: sp.Rational
+    drives: tuple[tuple[float, sp.Rational, sp.Symbol | None], ...]
+    values: tuple[tuple[str, str], ...]
+
+
+def cubic_form(text: str, values: dict[str, str], name: str, method: str, why: str,
+               free_frequency: bool) -> CubicForm:
+    """Map ``text`` onto eq. 10.60's form or refuse in one line, naming what ``method``'s ansatz
+    (``why``) needs: the force exactly ``q + εq³`` (+ ``γq̇``) in any coordinate, with rational
+    coefficients and ω₀ = 1; the drive a sum of ``f cos(ν t)``; every parameter given, except,
+    with ``free_frequency``, one name in the drives' frequencies."""
+    from .models import oscillator
+
+    osc = oscillator(text, values, name)
+    q, v, t = osc.coordinate, osc.velocity, osc.equation.time
+    if osc.parametric != 0:
+        raise osc.refuse(method, f"{sp.sstr(osc.parametric)} depends on both t and {q}: {why}")
+    force = sp.expand(osc.force)
+    missing = sorted(str(s) for s in force.free_symbols - {q, v})
+    if missing:
+        raise osc.refuse(method, "give " + ", ".join(missing) + " a value (--param "
+                         + " --param ".join(f"{m}=..." for m in missing) + ")")
+    wanted = f"{q} + eps*{q}**3" + (f" + {v}/Q" if method == "mixing" else "")
+    if not force.is_polynomial(q, v):
+        raise osc.refuse(method, f"the force {sp.sstr(force)} is not {wanted}: {why}")
+    terms = dict(zip(sp.Poly(force, q, v).monoms(), sp.Poly(force, q, v).coeffs(), strict=True))
+    other = sorted(sp.sstr(q**a * v**b) for a, b in terms if (a, b) not in
+                   {(1, 0), (3, 0), (0, 1)})
+    if other:
+        raise osc.refuse(method, f"the force {sp.sstr(force)} has {', '.join(other)}; {why} "
+                         f"needs exactly {wanted}")
+    if terms.get((1, 0), 0) != 1:
+        raise osc.refuse(method, f"the linear term is {sp.sstr(terms.get((1, 0), 0) * q)}; "
+                         f"{why} needs {q} (omega0 = 1: rescale time so that it is)")
+    drive = sp.expand(osc.drive)
+    if drive == 0:
+        raise osc.refuse(method, f"no drive: write it on the right, e.g. {q}'' + ... = "
+                         "f*cos(w*t)")
+    drives = []
+    frequencies: set[sp.Symbol] = set()
+    for term in sp.Add.make_args(drive):
+        amplitude, wave = term.as_independent(t, as_Add=False)
+        if not isinstance(wave, sp.cos):
+            raise osc.refuse(method, f"the drive term {sp.sstr(term)} is not f*cos(w*t) (a "
+                             "sine or another function of t: shift t or rewrite it)")
+        c, rest = wave.args[0].as_independent(t, as_Add=False)
+        if rest != t:
+            raise osc.refuse(method, f"the drive's argument {sp.sstr(wave.args[0])} is not "
+                             "w*t")
+        number, symbols = c.as_coeff_Mul()
+        symbol = None
+        if symbols != 1:
+            if not (free_frequency and isinstance(symbols, sp.Symbol)):
+                need = ", ".join(sorted(str(s) for s in c.free_symbols))
+                raise osc.refuse(method, f"give {need} a value (--param {need}=...): the "
+                                 "drive frequencies must be numbers")
+            symbol = symbols
+            frequencies.add(symbol)
+        missing = sorted(str(s) for s in amplitude.free_symbols)
+        if missing:
+            raise osc.refuse(method, "give " + ", ".join(missing) + " a value (--param "
+                             + " --param ".join(f"{m}=..." for m in missing) + ")")
+        if not (number.is_Rational and amplitude.is_Rational):
+            raise osc.refuse(method, f"the drive term {sp.sstr(term)}: its amplitude and "
+                             "frequency must be rational numbers")
+        drives.append((float(amplitude), number, symbol))
+    if len(frequencies) > 1:
+        raise osc.refuse(method, "the drives' frequencies name "
+                         + ", ".join(sorted(map(str, frequencies))) + "; give them values")
+    return CubicForm(float(terms.get((3, 0), 0)), sp.Rational(terms.get((0, 1), 0)),
+                     tuple(drives), tuple((str(k), str(val)) for k, val in osc.values))
+
+
+SUBHARMONIC_ANSATZ = "the 1/3 subharmonic of eq. 10.83 (omega^2 q'' + q + eps q^3 = f cos 3tau)"
+MIXING_ANSATZ = "the mixing series (q'' + q'/Q + q + eps q^3 = sum f_i cos(w_i t))"
+
+
+def subharmonic_equation(text: str, values: dict[str, str], omega: float | None,
+                         name: str = "oscillator") -> tuple[float, float, float, CubicForm]:
+    """``(eps, force, omega)`` of eq. 10.83 for ``text`` (:func:`cubic_form`, undamped, one
+    drive): its frequency ``c·w`` is the drive at ``3ω``, so ``w = 3ω/c`` (``f*cos(3*w*t)``:
+    ``w = ω``); a numeric frequency ``c`` is ``3ω`` itself (then no ``omega``)."""
+    form = cubic_form(text, values, name, "subharmonic", SUBHARMONIC_ANSATZ, True)
+    where = f"{name} ({text}): subharmonic does not apply: "
+    if form.damping != 0:
+        raise InputError(where + f"the damping term {sp.sstr(form.damping)}*q'; "
+                         f"{SUBHARMONIC_ANSATZ} is undamped")
+    if len(form.drives) != 1:
+        raise InputError(where + f"{len(form.drives)} drive terms; {SUBHARMONIC_ANSATZ} takes "
+                         "one, f*cos(3*w*t)")
+    force, c, symbol = form.drives[0]
+    if symbol is None:
+        if omega is not None:
+            raise InputError(f"--omega: the drive's frequency {c} is given in the equation "
+                             f"(omega = {c}/3); drop --omega or write the drive as "
+                             "f*cos(3*w*t)")
+        omega = float(c / 3)
+    elif omega is None:
+        raise InputError("--omega: the subharmonic's frequency is required (the drive "
+                         f"{c}*{symbol} is at 3*omega)")
+    if not omega > 0 or not float(c) > 0:
+        raise InputError(where + "the drive frequency must be > 0")
+    return form.eps, force, float(omega), form
+
+
+def mixing_equation(text: str, values: dict[str, str], name: str = "oscillator"
+                    ) -> tuple[float, float, list[tuple[float, float]], CubicForm]:
+    """``(eps, Q, drives)`` of :func:`mixing_series` for ``text`` (:func:`cubic_form`, every
+    drive frequency a number), the drives by ascending frequency; ``Q = 1/γ`` (inf undamped,
+    which the mixing series refuses)."""
+    form = cubic_form(text, values, name, "mixing", MIXING_ANSATZ, False)
+    Q = math.inf if form.damping == 0 else float(1 / form.damping)
+    drives = sorted(((f, float(c)) for f, c, _ in form.drives), key=lambda d: (d[1], d[0]))
+    return form.eps, Q, drives, form
