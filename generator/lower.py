@@ -306,14 +306,18 @@ def cubic_branches(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol) -> tuple[
     """Real roots of ``(ω² − 1)A − ¾εA³ + f = 0``, largest first, as SymPy expressions.
 
     ``A³ + pA + q = 0`` with ``p = −4(ω² − 1)/(3ε)``, ``q = −4f/(3ε)``: three real roots by the
-    trigonometric formula when ``4p³ + 27q² < 0`` (NaN for the missing ones otherwise), else
-    Cardano's single root in its stable form.
+    trigonometric formula when ``4p³ + 27q² < 0`` (the middle one from the product of the roots;
+    NaN for the missing ones otherwise), else Cardano's single root in its stable form.
     """
     p = -4 * (omega**2 - 1) / (3 * eps)
     q = -4 * force / (3 * eps)
     three = 4 * p**3 + 27 * q**2 < 0
     arg = sp.Min(sp.Max(3 * q / (2 * p) * sp.sqrt(-3 / p), -1), 1)
     trig = [2 * sp.sqrt(-p / 3) * sp.cos(sp.acos(arg) / 3 - 2 * sp.pi * k / 3) for k in range(3)]
+    # the middle root's cosine passes through zero (|cos| ≤ 1/2 there, the others ≥ 1/2): from
+    # the product of the roots, −q, instead, or it keeps only the digits 1/√(−p) leaves it —
+    # A₁ was 1e-5 off at ε = 1e-20, differently in the ufunc and in its SIMD loop
+    trig[1] = -q / (trig[0] * trig[2])
     delta = q**2 / 4 + p**3 / 27
 
     def cbrt(z: sp.Expr) -> sp.Expr:

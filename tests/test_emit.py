@@ -322,6 +322,26 @@ def test_driven_module_at_the_linear_resonance():
     assert abs(drv.A_1(w, eps_, f, 0) - A[1]) <= 1e-8
 
 
+@pytest.mark.parametrize("w", [1.5, 3.0, 10.0])
+@pytest.mark.parametrize("eps_", [1e-20, 1e-12, 1e-4])
+def test_driven_module_middle_root_at_a_tiny_eps(w, eps_):
+    """The middle root of (ω² − 1)A − ¾εA³ + f = 0 tends to f/(1 − ω²) as ε → 0 while the
+    others run off like 1/√ε: the trigonometric formula's cosine passes through zero there and
+    kept only ~√ε of the digits (1e-5 off at ε = 1e-20, differently in the ufunc and in its
+    SIMD loop).  Against mpmath's root at 40 digits, in the ufunc and in A_1_into."""
+    drv = load(GENERATED / "driven.py")
+    f = 2.0
+    with mpmath.workdps(40):
+        root = mpmath.findroot(lambda a: (w * w - 1) * a - 0.75 * mpmath.mpf(eps_) * a**3 + f,
+                               f / (1 - w * w))
+    assert drv.first_order(w, eps_, f, 1) == pytest.approx(float(root), rel=1e-13)
+    # the μ-expansion's corrections are O(ε): A_1 is the root to that
+    omegas = np.full(7, w)
+    got = drv.A_1_into(np.empty(7), omegas, eps_, f, 1.0)
+    assert np.all(np.abs(got / float(root) - 1) <= max(1e-13, 10 * eps_))
+    assert drv.A_1(w, eps_, f, 1) == pytest.approx(float(root), rel=max(1e-13, 10 * eps_))
+
+
 def test_balance_module_newton_equals_convolution_balance():
     """The emitted residual/Jacobian (SymPy product-to-sum) against the convolution route."""
     bal = load(GENERATED / "balance.py")
