@@ -479,18 +479,9 @@ def _sweep(qp: np.ndarray, vp: np.ndarray, cs: np.ndarray, cubic: np.ndarray | N
         amps[k] = max(amps[k], abs(q))
         omegas[k] += omega0 + beta * t
         counts[k] += 1
-        # the chirp's phase ω₀t + βt²/2 is (ω₀ + βt/2)·t: _rhs's cos(ωt) at that ω
-        y[0], y[1] = q, p
-        _rhs(t, y, qp, vp, cs, cubic, force, omega0 + 0.5 * beta * t, k1)
-        th = t + 0.5 * h
-        tmp[0], tmp[1] = q + 0.5 * h * k1[0], p + 0.5 * h * k1[1]
-        _rhs(th, tmp, qp, vp, cs, cubic, force, omega0 + 0.5 * beta * th, k2)
-        tmp[0], tmp[1] = q + 0.5 * h * k2[0], p + 0.5 * h * k2[1]
-        _rhs(th, tmp, qp, vp, cs, cubic, force, omega0 + 0.5 * beta * th, k3)
-        tmp[0], tmp[1] = q + h * k3[0], p + h * k3[1]
-        _rhs(t + h, tmp, qp, vp, cs, cubic, force, omega0 + 0.5 * beta * (t + h), k4)
-        q += h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
-        p += h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+        _rk4_step(t, h, y, qp, vp, cs, cubic, force, omega0, beta, NO_TERMS, k1, k2, k3, k4,
+                  tmp)
+        q, p = y[0], y[1]
         t += h
         if escaped == periods and abs(q) > bound and q * p >= 0.0:
             escaped = k
