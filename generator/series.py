@@ -510,23 +510,27 @@ def laurent_solve(F: np.ndarray) -> LaurentSolved:
 
 def laurent_from_fourier(M: int, orders: np.ndarray, cosines: np.ndarray,
                          sines: np.ndarray | None = None) -> np.ndarray:
-    """``c_n`` of ``Σ a_k cos ks + b_k sin ks`` over ``orders`` (``k ≥ 1``, distinct, ``≤ M``;
-    ``sines`` all zero when None)."""
+    """``c_n`` of ``Σ a_k cos ks + b_k sin ks`` over ``orders`` (distinct, ``0 ≤ k ≤ M``, the
+    mean ``a_0`` at ``k = 0``; ``sines`` all zero when None)."""
     orders = np.asarray(orders)
     c = np.zeros(2 * M + 1, dtype=complex)
     z = (np.asarray(cosines) - 1j * (0 if sines is None else np.asarray(sines))) / 2
     c[M + orders] = z
     c[M - orders] = np.conj(z)
+    if np.any(orders == 0):
+        c[M] = 2 * c[M].real
     return c
 
 
 def laurent_to_fourier(c: np.ndarray, orders: np.ndarray,
                        phase: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """``(a_k, b_k)`` of the sum ``Σ c_n e^{in(s − phase)}`` over ``orders`` (``k ≥ 1``):
-    ``2 Re``, ``−2 Im`` of ``c_k e^{−ik·phase}`` (the inverse of :func:`laurent_from_fourier`
-    at ``phase = 0``)."""
+    """``(a_k, b_k)`` of the sum ``Σ c_n e^{in(s − phase)}`` over ``orders`` (``k ≥ 0``):
+    ``2 Re``, ``−2 Im`` of ``c_k e^{−ik·phase}``, the mean ``a_0 = c_0`` (the inverse of
+    :func:`laurent_from_fourier` at ``phase = 0``)."""
     orders = np.asarray(orders)
     z = c[(len(c) - 1) // 2 + orders]
     if phase:
         z = z * np.exp(-1j * orders * phase)
+    if np.any(orders == 0):
+        z = np.where(orders == 0, z.real / 2, z)
     return 2 * z.real, -2 * z.imag

@@ -173,3 +173,66 @@ def test_trig_over_symbolic_parameters():
     assert {n: sp.expand(g.to_sympy(c)) for n, c in cos.items()} == {
         0: sp.expand((a**2 + b**2) / 2), 2: sp.expand((a**2 - b**2) / 2)}
     assert {n: g.to_sympy(c) for n, c in sin.items()} == {2: a * b}
+
+
+# The float kernel (Laurent form, complex128) against the exact one on random rational sums.
+
+import numpy as np  # noqa: E402
+from lindstedt.series import (  # noqa: E402
+    laurent_derivative,
+    laurent_from_fourier,
+    laurent_product,
+    laurent_solve,
+    laurent_to_fourier,
+)
+
+LAURENT_M = 40  # holds every product below (harmonics ≤ 18) untruncated
+
+
+def laurent(cos: dict, sin: dict) -> np.ndarray:
+    orders = sorted(set(cos) | set(sin))
+    return laurent_from_fourier(LAURENT_M, np.array(orders, dtype=int),
+                                np.array([float(cos.get(n, 0)) for n in orders]),
+                                np.array([float(sin.get(n, 0)) for n in orders]))
+
+
+def close(c: np.ndarray, exact: tuple[dict, dict]) -> bool:
+    """Every cos/sin coefficient of ``c`` within rounding of the exact ``({n: a}, {n: b})``."""
+    a, b = laurent_to_fourier(c, np.arange(LAURENT_M + 1))
+    cos, sin = exact
+    want_a = np.array([float(cos.get(n, 0)) for n in range(LAURENT_M + 1)])
+    want_b = np.array([float(sin.get(n, 0)) for n in range(LAURENT_M + 1)])
+    scale = 1 + max(np.abs(want_a).max(), np.abs(want_b).max())
+    return bool(np.allclose(a, want_a, rtol=0, atol=1e-13 * scale)
+                and np.allclose(b, want_b, rtol=0, atol=1e-13 * scale))
+
+
+@settings(max_examples=60, deadline=None)
+@given(cos_series(False), sine_series(), cos_series(False), sine_series())
+def test_laurent_roundtrip_and_product_against_trig(ac, as_, bc, bs):
+    assert close(laurent(ac, as_), fractions_of(trig(ac, as_)))
+    assert close(laurent_product(laurent(ac, as_), laurent(bc, bs)),
+                 fractions_of(trig(ac, as_) * trig(bc, bs)))
+
+
+@settings(max_examples=60, deadline=None)
+@given(cos_series(False), sine_series())
+def test_laurent_derivative_against_trig(ac, as_):
+    assert close(laurent_derivative(laurent(ac, as_)), fractions_of(trig(ac, as_).derivative()))
+
+
+@settings(max_examples=60, deadline=None)
+@given(cos_series(False), sine_series())
+def test_laurent_solve_and_secular_parts_against_trig(fc, fs):
+    """u'' + u = F: the particular solution (resonant harmonic aside) and both secular parts."""
+    exact = solve_trig(trig(fc, fs))
+    solved = laurent_solve(laurent(fc, fs))
+    assert abs(solved.secular_cos - float(QQ.to_fraction(exact.secular_cos))) <= 1e-13 * (
+        1 + abs(solved.secular_cos))
+    assert abs(solved.secular_sin - float(QQ.to_fraction(exact.secular_sin))) <= 1e-13 * (
+        1 + abs(solved.secular_sin))
+    cos, sin = fractions_of(exact.particular)
+    cos.pop(1, None)  # the homogeneous a cos s + b sin s: each kernel's own convention
+    sin.pop(1, None)
+    assert close(solved.particular, (cos, sin))
+    assert solved.particular[LAURENT_M + 1] == 0 == solved.particular[LAURENT_M - 1]
