@@ -47,10 +47,11 @@ from .methods import (
     method,
     methods_for,
     one_harmonic_amplitudes,
+    quadrature_period,
     reference_period,
     reference_q,
 )
-from .models import duffing, pendulum
+from .models import Model, duffing, pendulum
 from .numerics import shoot
 
 Progress = Callable[[int, int], None]
@@ -176,10 +177,17 @@ def choice_table(c: Choice | DrivenChoice | SolutionChoice, what: str) -> str:
         [(m, o, f"{e:.1e}", f"{ns:.3g}") for m, o, e, ns in c.considered], marked=chosen)
 
 
+USER_VERIFY_POINTS = 401
+# NOTE: a user's oscillator is judged by quadrature (methods.quadrature_period, ~1.6 ms a
+# point): 401 Chebyshev points of the range, ends included, where truncation errors peak.
+
+
 def choose_period(tol: float, x_min: float, x_max: float,
-                  progress: Progress = quiet) -> Choice:
+                  progress: Progress = quiet, model: Model | None = None) -> Choice:
     """The cheapest method whose verified relative error on ``[x_min, x_max]`` is ≤ ``tol``
-    (``progress(done, total)`` follows the timing of the candidates)."""
+    (``progress(done, total)`` follows the timing of the candidates).  ``model``: another free
+    polynomial oscillator, judged by quadrature, in its own variable (the free Duffing one, in
+    x = εA², by default); only the methods that apply to it compete."""
     for name, v in (("tol", tol), ("x-min", x_min), ("x-max", x_max)):
         if not np.isfinite(v):
             raise InputError(f"{name} {v}: not finite")
@@ -187,14 +195,27 @@ def choose_period(tol: float, x_min: float, x_max: float,
         raise InputError(f"tol {tol}: must be > 0")
     if not x_min < x_max:
         raise InputError(f"range [{x_min}, {x_max}]: empty or reversed")
-    if x_min <= -1:
-        raise InputError(f"range [{x_min}, {x_max}] reaches x = εA² ≤ -1: no periodic orbit "
-                         "(the separatrix is at x = -1)")
-    x = verification_points(x_min, x_max)
-    exact = reference_period(x)
+    if model is not None:
+        why = method("period", "lindstedt").why_not(model)
+        if why is not None:
+            raise InputError(f"{model.name} ({model.source or model.title}): choose period "
+                             f"does not apply: {why}")
+        x = verification_points(x_min, x_max, USER_VERIFY_POINTS)
+        exact = quadrature_period(model, x)
+        if np.any(np.isnan(exact)):
+            bad = x[np.isnan(exact)]
+            raise InputError(f"range [{x_min}, {x_max}]: no bounded periodic swing from "
+                             f"q(0) = A at {model.variable} = {bad[0]:g} (of "
+                             f"{len(bad)} verification points)")
+    else:
+        if x_min <= -1:
+            raise InputError(f"range [{x_min}, {x_max}] reaches x = εA² ≤ -1: no periodic "
+                             "orbit (the separatrix is at x = -1)")
+        x = verification_points(x_min, x_max)
+        exact = reference_period(x)
     best_per_method: dict[Method, tuple[Candidate, float]] = {}
     best_error = np.inf
-    for c in candidates():
+    for c in candidates(model=model) if model is not None else candidates():
         if c.method in best_per_method:
             continue
         with np.errstate(invalid="ignore"):

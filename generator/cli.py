@@ -945,6 +945,12 @@ def _print_choice(header: str, chosen: tuple[str, int, float, float],
 
 
 def _cmd_choose(args: argparse.Namespace) -> int:
+    if args.model is None and (args.param or args.name):
+        raise InputError("--param/--name: give an EQUATION (choose period EQUATION …)")
+    if args.model is not None and args.quantity != "period":
+        raise InputError(f"choose {args.quantity} EQUATION: only the period is chosen for an "
+                         "equation (q, amplitudes and response are the notes' Duffing "
+                         "oscillator's)")
     if args.quantity in DRIVEN_QUANTITIES:
         return _choose_driven(args)
     if args.quantity == "q":
@@ -952,6 +958,15 @@ def _cmd_choose(args: argparse.Namespace) -> int:
     for name in ("tol", "x_min", "x_max"):
         if getattr(args, name) is None:
             raise InputError(f"choose period needs --{name.replace('_', '-')}")
+    model = None
+    if args.model is not None:
+        if args.emit:
+            raise InputError("--emit: the chosen period module is the Duffing oscillator's; "
+                             "`lindstedt generate EQUATION` emits an equation's evaluators")
+        from .methods import MAX_ORDER
+        from .models import model_from_text
+
+        model = model_from_text(args.model, MAX_ORDER, _params(args.param), args.name)
     from .choose import choose_period, modelled_ns
     from .compiler import generate_choice
     from .emit import check_writable
@@ -960,15 +975,19 @@ def _cmd_choose(args: argparse.Namespace) -> int:
         check_writable(_out_folder(args.emit, "--emit"), ["chosen_period.py"], "--emit",
                        args.overwrite_edited)
     progress = Progress("timing the verified methods", not args.json)
-    choice = choose_period(args.tol, args.x_min, args.x_max, progress)
+    choice = choose_period(args.tol, args.x_min, args.x_max, progress, model=model)
     progress.close()
+    variable = "x = eps*A**2" if model is None else model.variable
     data = {"method": choice.method.name, "order": choice.order,
             "max_error": choice.max_error,
             "ns_per_point": choice.ns_per_point, "verified_on": choice.verified_on,
             "modelled_ns_per_point": modelled_ns("period", choice.method, choice.order),
             "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
-            "quantity": "period", "variable": "x = eps*A**2",
+            "quantity": "period", "variable": variable,
             "considered": _considered(choice.considered)}
+    if model is not None:
+        data.update(equation=model.source or model.title, omega0=str(model.frequency),
+                    reference="quadrature of the scaled potential (Gauss–Legendre, 256 nodes)")
     if args.emit:
         command = (f"lindstedt choose period --tol {args.tol!r} --x-min {args.x_min!r} "
                    f"--x-max {args.x_max!r}")
@@ -978,7 +997,7 @@ def _cmd_choose(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(data))
         return 0
-    _print_choice(f"period T(x), x = eps*A**2 in [{args.x_min:g}, {args.x_max:g}], tolerance "
+    _print_choice(f"period T(x), {variable} in [{args.x_min:g}, {args.x_max:g}], tolerance "
                   f"{args.tol:g} (relative, verified on {choice.verified_on} points):",
                   (choice.method, choice.order, choice.max_error, choice.ns_per_point),
                   choice.considered)
@@ -1477,6 +1496,8 @@ def build_parser() -> argparse.ArgumentParser:
                        "meets the tolerance on the range.")
     p.add_argument("quantity", choices=("period", "q", *DRIVEN_QUANTITIES),
                    help="period T(x); q(t); amplitudes A_n, B_n; response r(ω)")
+    _flag_equation(p, "\"q'' + q + eps*q**5 = 0\" (period only: a free oscillator with a "
+                   "polynomial force, judged by quadrature; x is then its expansion variable)")
     p.add_argument("--tol", type=_real, metavar="TOL",
                    help="tolerance > 0 (period, q: relative, required; amplitudes, response: "
                    "absolute, default 1e-4)")

@@ -117,10 +117,11 @@ def agm(a: np.ndarray, b: np.ndarray, steps: int) -> None:
 
 @njit(cache=True, fastmath=FASTMATH, error_model="numpy")
 def _evaluate(kind: int, num: np.ndarray, den: np.ndarray, steps: int, x: np.ndarray,
-              out: np.ndarray) -> None:
+              out: np.ndarray, masked: bool = True) -> None:
     """Blocked evaluation of a candidate; kind 0: Σ num_j x^j, 1: in m with √(1 − 2m),
     2: Padé num(x)/den(x), 3: modified L–P 1/√((1 + 3x/4) g(α)), 4: ``steps`` AGM steps.
-    NaN outside the candidate's domain."""
+    NaN outside the candidate's domain (the free Duffing oscillator's; ``masked=False`` for
+    another oscillator, whose range the chooser checks against its own reference)."""
     t = np.empty(BLOCK)
     p = np.empty(BLOCK)
     q = np.empty(BLOCK)
@@ -146,7 +147,10 @@ def _evaluate(kind: int, num: np.ndarray, den: np.ndarray, steps: int, x: np.nda
             if kind == 2:
                 _horner_block(den, tv, qv)
         o = out[start : start + n]
-        if kind == 0:
+        if not masked:
+            for i in range(n):
+                o[i] = pv[i] / qv[i] if kind == 2 else pv[i]
+        elif kind == 0:
             for i in range(n):
                 o[i] = pv[i] if abs(xs[i]) < 1.0 else np.nan
         elif kind == 1:
@@ -294,7 +298,13 @@ def _modified_orders(s: PeriodSeries, top: int) -> list[tuple[int, Coefficients]
 
 
 def _pade_orders(s: PeriodSeries, top: int) -> list[tuple[int, Coefficients]]:
-    return [(k, _pade(s.tau, k)) for k in range(1, min(top // 2, PADE_MAX) + 1)]
+    found = []
+    for k in range(1, min(top // 2, PADE_MAX) + 1):
+        try:
+            found.append((k, _pade(s.tau, k)))
+        except ZeroDivisionError:  # no [k/k] approximant (e.g. a series in A with gaps)
+            continue
+    return found
 
 
 def _agm_orders(s: PeriodSeries, top: int) -> list[tuple[int, Coefficients]]:
@@ -347,6 +357,27 @@ def _not_lowered(c: Candidate) -> tuple[tuple, sp.Expr]:
 def _free(subject: object) -> str | None:
     if not isinstance(subject, Model):
         return "a free oscillator's series: give an equation without a drive"
+    return None
+
+
+def _series_period(subject: object) -> str | None:
+    """The L–P series and its Padé: the free Duffing oscillator, or a free polynomial one
+    whose period is one exact rational series in one variable (every parameter given)."""
+    if _free_duffing(subject) is None:
+        return None
+    return _polynomial_free(subject)
+
+
+def _polynomial_free(subject: object) -> str | None:
+    if not isinstance(subject, Model):
+        return "a free oscillator's series: give an equation without a drive"
+    if any(subject.velocity_forcing) or subject.elementary or subject.exact_to is not None:
+        return ("its period is checked by quadrature of a polynomial potential: no velocity "
+                "terms, no sin/sinh or Taylor-expanded force")
+    values = [c for terms in subject.forcing for _, c in terms]
+    if not all(sp.sympify(c).is_Rational for c in values):
+        return ("its series must be one rational series in one variable: give every "
+                "parameter a value (--param) and one power p = a + b - 1 or no eps")
     return None
 
 
@@ -574,6 +605,58 @@ def reference_period(x: np.ndarray) -> np.ndarray:
                                / mpmath.sqrt(1 + mpmath.mpf(v))) for v in x])
 
 
+QUADRATURE_NODES = 256
+# NOTE: Gauss–Legendre nodes in θ (u = m + h sin θ between the turning points): the integrand
+# is analytic there for simple turning points, and 256 nodes meet the Duffing oscillator's
+# elliptic period to 1e-15 for |x| ≤ 0.9 (tests/test_choose.py).
+
+
+def quadrature_period(model: Model, x: np.ndarray) -> np.ndarray:
+    """``T/2π`` of a free polynomial oscillator at ``y = x`` by quadrature, independent of the
+    series: its scaled form ``u'' + u + Σ_k x^k Σ_n c_kn u^n = 0`` (time in units of 1/ω₀,
+    ``u(0) = 1``) has the potential ``V(u) = u²/2 + Σ x^k c_kn u^(n+1)/(n+1)``, and
+    ``T = 2∫ du/√(2(V(1) − V(u)))`` from the turning point below 1 (the largest root of
+    ``V(u) = V(1)`` under 1) up to 1.  NaN where the motion from u = 1 is unbounded (no
+    turning point below) or 1 is no turning point."""
+    theta, weights = np.polynomial.legendre.leggauss(QUADRATURE_NODES)
+    theta, weights = theta * np.pi / 2, weights * np.pi / 2
+    out = np.full(x.shape, np.nan)
+    for i, xv in enumerate(np.asarray(x, dtype=float)):
+        V = np.zeros(2)  # V(u) low to high
+        V = np.polynomial.polynomial.polyadd(V, [0.0, 0.0, 0.5])
+        for k, terms in enumerate(model.forcing, start=1):
+            for n, c in terms:
+                coeff = np.zeros(n + 2)
+                coeff[n + 1] = float(c) * xv**k / (n + 1)
+                V = np.polynomial.polynomial.polyadd(V, coeff)
+        dV = np.polynomial.polynomial.polyder(V)
+        if np.polynomial.polynomial.polyval(1.0, dV) <= 0:
+            continue  # u = 1 is no turning point of a bounded swing
+        level = np.polynomial.polynomial.polyval(1.0, V)
+        shifted = np.polynomial.polynomial.polysub(V, [level])
+        roots = np.polynomial.polynomial.polyroots(shifted)
+        below = sorted(r.real for r in roots if abs(r.imag) < 1e-9 and r.real < 1 - 1e-9)
+        if not below:
+            continue
+        u_min = below[-1]
+        if np.polynomial.polynomial.polyval(u_min, dV) >= 0:
+            continue  # the swing does not turn there: it escapes
+        for _ in range(3):  # Newton polish of the turning point
+            u_min -= (np.polynomial.polynomial.polyval(u_min, shifted)
+                      / np.polynomial.polynomial.polyval(u_min, dV))
+        # V(1) − V(u) = (1 − u)(u − u_min) S(u), and with u = m + h sin θ the product
+        # (1 − u)(u − u_min) = h² cos²θ cancels du = h cos θ dθ: T = 2∫ dθ/√(2 S(u)),
+        # smooth, with no difference of nearly equal numbers near the turning points
+        S, _ = np.polynomial.polynomial.polydiv(
+            shifted, np.polynomial.polynomial.polyfromroots([1.0, u_min]))
+        u = (1 + u_min) / 2 + (1 - u_min) / 2 * np.sin(theta)
+        s_u = np.polynomial.polynomial.polyval(u, S)
+        if np.any(s_u <= 0):
+            continue  # another turning point between: no swing between these two
+        out[i] = 2 * float(np.sum(weights / np.sqrt(2 * s_u))) / (2 * np.pi)
+    return out
+
+
 def reference_q(t: np.ndarray, x: float) -> np.ndarray:
     """``q/A = cn(√(1+x) t | m)``, ``m = x/(2(1+x))``: SciPy for m ≥ 0, mpmath below."""
     m = x / (2 * (1 + x))
@@ -639,7 +722,7 @@ class Method:
         if self.kind < 0:
             return duffing_period_exact(1.0, x) / (2 * np.pi)
         out = np.empty_like(x) if out is None else out
-        _evaluate(self.kind, c.num, c.den, c.order, x, out)
+        _evaluate(self.kind, c.num, c.den, c.order, x, out, c.masked)
         return out
 
     def formula(self, c: Candidate) -> PeriodFormula:
@@ -683,7 +766,7 @@ METHODS: tuple[Method, ...] = (
     Method("agm", "period", "1/AGM(√(1+x), √(1+x/2)), n steps", _PERIOD, _free_duffing,
            kind=4, steps=True, domain=x_ > -1, orders=_agm_orders, lowered=_lower_agm,
            target=CHOSEN_PERIOD),
-    Method("lindstedt", "period", "the L–P series Σ τ_j x^j", _PERIOD, _free_duffing,
+    Method("lindstedt", "period", "the L–P series Σ τ_j x^j", _PERIOD, _series_period,
            kind=0, domain=sp.And(x_ > -1, sp.Abs(x_) < 1), orders=_lp_orders,
            lowered=_lower_lp, target=CHOSEN_PERIOD),
     Method("resummed", "period", "the series in m = x/(2(1+x)) times √(1 − 2m)", _PERIOD,
@@ -692,7 +775,7 @@ METHODS: tuple[Method, ...] = (
     Method("modified", "period", "modified L–P (Cheung, Chen & Lau)", _PERIOD, _free_duffing,
            kind=3, domain=x_ > -1, orders=_modified_orders, lowered=_lower_modified,
            target=CHOSEN_PERIOD),
-    Method("pade", "period", "diagonal Padé [k/k] of the L–P series", _PERIOD, _free_duffing,
+    Method("pade", "period", "diagonal Padé [k/k] of the L–P series", _PERIOD, _series_period,
            kind=2, domain=x_ > -1, orders=_pade_orders, lowered=_lower_pade,
            target=CHOSEN_PERIOD),
     # q(t)
@@ -741,27 +824,32 @@ class Candidate:
     order: int
     num: np.ndarray
     den: np.ndarray
+    masked: bool = True  # NaN outside the free Duffing oscillator's domain (see _evaluate)
 
     def __call__(self, x: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         return self.method.evaluate(self, x, out)
 
 
-def period_series(max_order: int) -> PeriodSeries:
-    """The exact τ_j and ω_j of the free Duffing oscillator to ``max_order``."""
-    sol = derive(duffing(), check_order(max_order))
+def period_series(max_order: int, model: Model | None = None) -> PeriodSeries:
+    """The exact τ_j and ω_j of ``model`` (the free Duffing oscillator by default)."""
+    sol = derive(model or duffing(), check_order(max_order))
     return PeriodSeries([sol.ground.to_fraction(c) for c in sol.period],
                         [sol.ground.to_fraction(c) for c in sol.omega])
 
 
 @functools.cache
-def candidates(max_order: int = MAX_ORDER) -> tuple[Candidate, ...]:
-    """Every period method at every order up to ``max_order`` (Padé up to [12/12]), derived
-    once: the fixed-order ones (exact, the AGM's steps) first, then order by order."""
-    series = period_series(max_order)
+def candidates(max_order: int = MAX_ORDER, model: Model | None = None
+               ) -> tuple[Candidate, ...]:
+    """Every period method at every order up to ``max_order`` (Padé up to [12/12]) for
+    ``model`` (the free Duffing oscillator by default), derived once: the fixed-order ones
+    (exact, the AGM's steps) first, then order by order."""
+    subject = model or duffing()
+    series = period_series(max_order, subject)
+    masked = model is None or _free_duffing(model) is None
     found = []
-    for rank, m in enumerate(methods_for("period", duffing())):
+    for rank, m in enumerate(methods_for("period", subject)):
         for order, (num, den) in m.orders(series, max_order):
             found.append(((not m.steps, 0 if m.steps else order, rank),
-                          Candidate(m, order, num, den)))
+                          Candidate(m, order, num, den, masked)))
     found.sort(key=lambda item: item[0])
     return tuple(c for _, c in found)

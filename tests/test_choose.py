@@ -423,3 +423,62 @@ def test_period_choice_ignores_the_runs_timings(monkeypatch):
     method, order = picks.pop()
     floor = min(choose.modelled_ns("period", m, o) for m, o, _, _ in c.considered)
     assert choose.modelled_ns("period", method, order) <= (1 + choose.TIE) * floor
+
+
+# --- choose period for a user's oscillator ----------------------------------------------------
+
+def _mp_period(potential, level_at=1):
+    """T/2π of u'' + V'(u) = 0 from u(0) = 1 by mpmath's tanh-sinh quadrature at 30 digits:
+    the other turning point by findroot, T = 2∫ du/√(2(V(1) − V(u)))."""
+    with mpmath.workdps(30):
+        top = potential(mpmath.mpf(level_at))
+        low = mpmath.findroot(lambda u: potential(u) - top, -mpmath.mpf(level_at))
+        # tanh-sinh puts nodes within 1e-30 of the ends, where rounding can make the gap < 0
+        integral = mpmath.quad(lambda u: 1 / mpmath.sqrt(abs(2 * (top - potential(u)))),
+                               [low, 0, level_at])
+        return float(2 * integral / (2 * mpmath.pi))
+
+
+def test_quadrature_period_is_the_elliptic_period():
+    """The Gauss–Legendre quadrature of the scaled potential, against mpmath's K(m)."""
+    from lindstedt.methods import quadrature_period
+    from lindstedt.models import duffing
+
+    x = np.array([-0.9, -0.5, -0.1, 0.0, 0.3, 0.9, 5.0, 100.0])
+    with mpmath.workdps(30):
+        exact = np.array([float(2 / mpmath.pi * mpmath.ellipk(mpmath.mpf(v) / (2 * (1 + v)))
+                                / mpmath.sqrt(1 + mpmath.mpf(v))) for v in x])
+    np.testing.assert_allclose(quadrature_period(duffing(), x), exact, rtol=5e-15, atol=0)
+
+
+def test_choose_period_for_an_equation_against_mpmath():
+    """q'' + q + εq⁵ = 0 in x = εA⁴: the chosen candidate meets the tolerance at points the
+    chooser never saw, against mpmath's tanh-sinh quadrature (another rule, 30 digits)."""
+    from lindstedt.models import model_from_text
+
+    model = model_from_text("q'' + q + eps*q**5 = 0", 60)
+    tol = 1e-8
+    c = choose_period(tol, -0.3, 0.5, model=model)
+    assert c.method in ("lindstedt", "pade") and c.max_error <= tol
+    xs = np.array([-0.29, -0.123, 0.0371, 0.2468, 0.4999])
+    got = c.candidate(xs)
+    for x, value in zip(xs, got, strict=True):
+        exact = _mp_period(lambda u, x=x: u**2 / 2 + mpmath.mpf(x) * u**6 / 6)
+        assert abs(value / exact - 1) <= tol, (x, value, exact)
+
+
+def test_choose_period_for_an_equation_refuses_with_a_reason():
+    from lindstedt.models import model_from_text
+
+    with pytest.raises(InputError, match="no bounded periodic swing"):
+        choose_period(1e-8, -3.0, 0.5, model=model_from_text("q'' + q + eps*q**5 = 0", 60))
+    with pytest.raises(InputError, match="no velocity terms"):
+        choose_period(1e-8, 0.0, 0.5, model=model_from_text("q'' + q + eps*q*q'**2 = 0", 60))
+    with pytest.raises(InputError, match="give every parameter a value"):
+        choose_period(1e-8, 0.0, 0.5,
+                      model=model_from_text("q'' + q + eps*(alpha*q**2 + q**3) = 0", 60))
+    cmd = [sys.executable, "-m", "lindstedt", "choose", "q", "q'' + q + eps*q**5 = 0",
+           "--tol", "1e-8", "--x-min", "0", "--x-max", "0.5"]
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr.count("\n") == 1 and "only the period" in done.stderr
