@@ -4,12 +4,16 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
 
     equation   user text through a whitelist walker over ``ast``         str -> Equation
     models     the oscillator registry, a user's Oscillator, its L–P Model  Equation, K -> Model
-    series     exact Fourier algebra in the monomial basis of cos s     (QQ: FLINT fmpq_poly;
-               QQ[params]: FLINT fmpq_mpoly)
+    series     the one Fourier kernel: exact P(C) + S·R(C) over QQ       (FLINT fmpq_poly) and
+               QQ[params] (fmpq_mpoly), the odd-cosine fast path, and the Laurent form in e^{is}
+               over complex128 for the numeric methods
     lindstedt  L–P series, order-by-order equations, naive expansion    Model, K -> SeriesSolution
-    numerics   references: elliptic periods, Jacobi cn, shooting + Floquet, sweeps, true folds
-    driven     μ-expansion with phase, harmonic balance                 Drive, order -> branches
-    response   one-harmonic curves and folds, balance continuation      Drive, ω range -> folds
+    numerics   references: elliptic periods, Jacobi cn; one RK4 step for any polynomial force
+               table: shooting + Floquet, sweeps, true folds, simulations
+    driven     μ-expansion with phase, harmonic balance (Duffing; and a  Drive | equation ->
+               user's polynomial force by alternating frequency/time)   branches
+    response   one-harmonic curves and folds, balance continuation in   Drive | equation,
+               ω or in the drive; periodic orbits, subharmonic, mixing  ω range -> folds
     printers   NumbaPrinter(PythonCodePrinter), LaTeX rationals         Expr -> str
     lower      solutions -> IR records (Module, Evaluator, Derivation,  solution -> Unit
                PeriodFormula); Horner, Chebyshev recurrence, AGM steps
