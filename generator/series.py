@@ -258,8 +258,9 @@ def solve_oscillator(g: Sequence[Any], basis: Basis, ground: Ground) -> Solved:
 def to_fourier(poly: Any, basis: Basis, ground: Ground) -> dict[int, Any]:
     """Fourier cosine coefficients ``{n: a_n}`` of ``C^parity · P(v)``.
 
-    Horner's rule in ``z = e^{is}`` with ``z·C = (z² + 1)/2``: ``z^D · u`` is a polynomial in
-    ``z`` whose coefficient of ``z^(D+n)`` is ``a_n / 2`` (``a_0`` itself for ``n = 0``).
+    ``z = e^{is}`` with ``z·C = (z² + 1)/2``: ``z^D · u`` is a polynomial in ``z`` whose
+    coefficient of ``z^(D+n)`` is ``a_n / 2`` (``a_0`` itself for ``n = 0``), built by halves
+    (:func:`_in_z`).
     """
     cs = poly.coeffs()
     if not cs:
@@ -268,9 +269,7 @@ def to_fourier(poly: Any, basis: Basis, ground: Ground) -> dict[int, Any]:
     zc = ground.poly([half, ground.scalar(0), half])
     w = zc if basis.stride == 1 else zc * zc
     top = len(cs) - 1
-    acc = ground.poly([cs[top]])
-    for k in range(top - 1, -1, -1):
-        acc = acc * w + ground.poly([cs[k]]).left_shift(basis.stride * (top - k))
+    acc = _in_z(cs, 0, len(cs), w, basis.stride, ground, {1: w})
     if basis.parity:
         acc = acc * zc
     degree = basis.harmonic(top)
@@ -283,6 +282,40 @@ def to_fourier(poly: Any, basis: Basis, ground: Ground) -> dict[int, Any]:
         if c:
             out[n] = c
     return out
+
+
+HORNER_BELOW = 16
+# NOTE: pieces shorter than this go by Horner's rule; longer ones split in halves, so the
+# conversion costs a few large products (FLINT's fast multiplication) instead of n small ones:
+# Duffing's q_j at order 300 convert 2–3× faster (benchmarks: 16 measured best of 8…96).
+
+
+def _in_z(cs: list, lo: int, hi: int, w: Any, stride: int, ground: Ground, powers: dict
+          ) -> Any:
+    """``F = Σ_{k<n} c_(lo+k) w^k z^(stride·(n−1−k))`` for ``n = hi − lo`` (``w = (zC)^stride``):
+    with ``P = L + v^h H``, ``F(P) = z^(stride(n−h))·F(L) + w^h·F(H)``."""
+    n = hi - lo
+    if n <= HORNER_BELOW:
+        acc = ground.poly([cs[hi - 1]])
+        for k in range(hi - 2, lo - 1, -1):
+            acc = acc * w + ground.poly([cs[k]]).left_shift(stride * (hi - 1 - k))
+        return acc
+    h = n // 2
+    if h not in powers:
+        powers[h] = _power(w, h, powers)
+    left = _in_z(cs, lo, lo + h, w, stride, ground, powers)
+    right = _in_z(cs, lo + h, hi, w, stride, ground, powers)
+    return left.left_shift(stride * (n - h)) + powers[h] * right
+
+
+def _power(w: Any, h: int, powers: dict) -> Any:
+    """``w^h`` from the cached powers (halving)."""
+    if h in powers:
+        return powers[h]
+    half = _power(w, h // 2, powers)
+    result = half * half if h % 2 == 0 else half * half * w
+    powers[h] = result
+    return result
 
 
 def from_fourier(coeffs: dict[int, Any], basis: Basis, ground: Ground) -> Any:
