@@ -467,3 +467,34 @@ def test_parameter_named_like_the_amplitude():
     """A is the amplitude q(0) = A: a parameter of that name is refused, not merged."""
     with pytest.raises(InputError, match="A is the amplitude"):
         model_from_text("q'' + q + eps*A*q**3 = 0", 3)
+
+
+def test_series_json_at_order_20_matches_the_quadrature_period(capsys):
+    """``lindstedt series "q'' + q + eps*(q**2 + q**3) = 0" --order 20 --json``: its period,
+    summed from the JSON's monomial → "p/q" objects at (A, ε), is the quadrature period to the
+    size of its first omitted terms, at three amplitudes."""
+    import json
+
+    text = "q'' + q + eps*(q**2 + q**3) = 0"
+    assert main(["series", text, "--order", "20", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["variable"] == "eps" and data["order"] == 20
+
+    def value(coefficient: dict, A: mp.mpf) -> mp.mpf:
+        """Σ p/q A^k over the object's monomials "1", "A", "A**k"."""
+        total = mp.mpf(0)
+        for monomial, rational in coefficient.items():
+            p, q = rational.split("/")
+            k = {"1": 0, "A": 1}.get(monomial) or int(monomial.removeprefix("A**"))
+            total += mp.mpf(int(p)) / int(q) * A**k
+        return total
+
+    for a, e in (("0.5", "0.1"), ("1", "0.05"), ("0.3", "-0.2")):
+        with mp.workdps(DPS):
+            A, eps = mp.mpf(a), mp.mpf(e)
+            T, _ = potential_period(lambda q, eps=eps: q**2 / 2 + eps * (q**3 / 3 + q**4 / 4), A)
+            terms = [value(c, A) * eps**j for j, c in enumerate(data["period"])]
+            partial = 2 * mp.pi * sum(terms)
+            tail = 2 * mp.pi * (abs(terms[-1]) + abs(terms[-2]))  # the series' last steps
+            assert abs(partial - T) <= 10 * tail + mp.mpf(10) ** -25, (a, e, partial - T, tail)
+            assert abs(partial / T - 1) < 1e-12
