@@ -110,7 +110,7 @@ def series_json(sol) -> dict:
         "period": [_coefficient(sol, c) for c in sol.period],
         "q": [{str(n): _coefficient(sol, c) for n, c in sorted(qj.items())} for qj in sol.q],
         "convention": sol.convention,
-        "radius": str(m.radius),
+        "radius": None if m.radius is None else str(m.radius),
     }
     if m.source:
         data.update(equation=m.source, omega0=str(m.frequency),
@@ -1259,7 +1259,9 @@ class _Parser(argparse.ArgumentParser):
         self._negative_number_matcher = re.compile(r"^-\.?\d")
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        # one prefix for every error, a subcommand's argparse ones included
+        self.exit(2, f"lindstedt: error: {self.prog.removeprefix('lindstedt ')}: {message}\n"
+                  if self.prog != "lindstedt" else f"lindstedt: error: {message}\n")
 
 
 class _DeprecatedForce(argparse.Action):

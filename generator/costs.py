@@ -37,7 +37,8 @@ class Cost:
     what: str  # e.g. "the μ-expansion", "generating duffing"
 
     def refusal(self) -> str:
-        about = (f"about {self.seconds:,.0f} s" if math.isfinite(self.seconds)
+        about = (f"about {self.seconds:,.0f} s" if self.seconds < 1e7
+                 else f"about {self.seconds:.1e} s" if math.isfinite(self.seconds)
                  else "more than 1e300 s")
         return (f"{self.subject}: {about} of {self.what} on this machine; pass --allow-slow "
                 "to run it")
@@ -113,10 +114,56 @@ def _fit(table: dict, model: str) -> tuple:
     return table.get(model, table["oscillator"])
 
 
+SYMBOLIC_FIT = (0.0, 1.7, 30, 4.0)
+# NOTE: a series in ε with coefficients in QQ[A, α] (Helmholtz–Duffing, α symbolic): 0.29 s at
+# order 20, 1.7 at 30, 4.8 at 40 under load; each further symbol 1.5× (α, β: 2.0 s at 30).
+
+
+def oscillator_seconds(text: str, pairs: list[str] | None, order: int) -> float:
+    """Estimated derivation time of a user's equation at ``order``: the Duffing fit scaled by
+    its force's degree d (polynomials ~(d−1)/2 times longer, ~((d−1)/2)³ dearer: ``eps*q**63``
+    to order 40, 4.4 min, is estimated at 6.5), the symbolic fit when coefficients stay
+    polynomials in A or parameters, the Taylor route's fit for a non-polynomial force.  The
+    equation is parsed here (its errors come first, as the command's own)."""
+    import sympy as sp
+
+    from .equation import SMALL, parse_equation
+
+    eq = parse_equation(text)
+    q, v, a = eq.derivatives
+    force = sp.expand(eq.expression.xreplace({a: 0}))
+    if not force.is_polynomial(q, v):
+        if force.has(sp.sin, sp.sinh) and not force.has(sp.exp, sp.log, sp.sqrt, sp.cos,
+                                                        sp.cosh, sp.tanh):
+            return power_law(*SERIES_COSTS["pendulum"], order)
+        return power_law(*SERIES_COSTS["oscillator"], order)
+    poly = sp.Poly(force, q, v)
+    degree = max(1, poly.total_degree())
+    scale = max(1.0, ((degree - 1) / 2) ** 3)
+    given = {pair.partition("=")[0].strip() for pair in pairs or ()}
+    free = [p for p in eq.parameters if str(p) not in given]
+    small = [] if eq.small is None or SMALL in given else [eq.small]
+    powers = {sum(m) - 1 for m in poly.monoms() if sum(m) > 1}
+    symbols = len(free) + (1 if small and len(powers) > 1 else 0)
+    if symbols:
+        return 0.9 + power_law(*SYMBOLIC_FIT, order) * 1.5 ** (symbols - 1) * scale
+    fixed, *fit = SERIES_COSTS["duffing"]
+    return fixed + power_law(0.0, *fit, order) * scale
+
+
 def series_cost(args: argparse.Namespace) -> Cost:
+    if args.model in SERIES_COSTS:
+        seconds = power_law(*SERIES_COSTS[args.model], args.order)
+    elif args.model.isidentifier():  # another registry name: its equation is known
+        from .models import REGISTRY
+
+        entry = REGISTRY.get(args.model)
+        seconds = (oscillator_seconds(entry.equation, args.param, args.order) if entry
+                   else power_law(*SERIES_COSTS["oscillator"], args.order))
+    else:
+        seconds = oscillator_seconds(args.model, args.param, args.order)
     name = args.model if args.model in SERIES_COSTS else "the oscillator"
-    return Cost(power_law(*_fit(SERIES_COSTS, args.model), args.order), f"order {args.order}",
-                f"derivation for {name}")
+    return Cost(seconds, f"order {args.order}", f"derivation for {name}")
 
 
 def generate_seconds(model: str, size: int) -> float:
@@ -134,6 +181,11 @@ def generate_cost(args: argparse.Namespace) -> Cost:
                          "code printer's nesting limit); `lindstedt series` derives higher orders")
     harmonic = args.model in ("balance", "fourier")
     size = args.harmonics if harmonic else args.order
+    if args.model not in GENERATE_COSTS:  # a user's: its derivation, then Duffing's emission
+        derivation = series_cost(argparse.Namespace(model=args.model, param=args.param,
+                                                    order=size + 2)).seconds
+        return Cost(derivation + generate_seconds("duffing", size), f"order {size}",
+                    "generating the oscillator")
     return Cost(generate_seconds(args.model, size),
                 f"--harmonics {size}" if harmonic else f"order {size}",
                 f"generating {args.model if args.model in GENERATE_COSTS else 'the oscillator'}")

@@ -275,7 +275,8 @@ def parse_equation(text: str) -> Equation:
         source = source[: match.start(2)] + "_" * len(primes) + source[match.end(2):]
     stray = source.find("'")
     if stray >= 0:
-        raise _fail(text, stray, "a prime belongs right after the coordinate's name (q'')")
+        raise _fail(text, stray, "a ' that is no prime after a name (quotes and strings are "
+                    "not allowed; the derivatives are written q' and q'')")
     _check_names(text, text.replace("'", " "), what)
     left, _, right = source.partition("=")
     walker = _Walker(text, 0, what)

@@ -11,6 +11,7 @@ with ``y = coupling · order_factor`` the expansion variable (``x = εA²`` for 
 
 from __future__ import annotations
 
+import keyword
 import math
 import re
 from collections.abc import Callable
@@ -201,8 +202,9 @@ def oscillator(text: str, values: dict[str, str] | None = None, name: str = "osc
                ) -> Oscillator:
     """Parse ``text`` (see :mod:`lindstedt.equation`) with parameter ``values`` (exact text such
     as ``"1/3"``) into an :class:`Oscillator`; every value must name a parameter of the text."""
-    if not NAME.fullmatch(name or ""):
-        raise InputError(f"name {name!r}: letters, digits and '_' only, starting with a letter")
+    if not NAME.fullmatch(name or "") or keyword.iskeyword(name):
+        raise InputError(f"name {name!r}: letters, digits and '_' only, starting with a letter, "
+                         "and no Python keyword (the module is imported by that name)")
     eq = parse_equation(text)
     known = {str(p): p for p in eq.parameters}
     if eq.small is not None:  # a value for eps too: the amplitude is then the small quantity
@@ -492,7 +494,7 @@ def model_by_name(name: str, order: int) -> Model:
 def model_from_text(text: str, order: int, values: dict[str, str] | None = None,
                     name: str | None = None) -> Model:
     """A registry name or an equation (anything with a prime), sized for ``order``."""
-    if "'" not in text:
+    if NAME.fullmatch(text):  # a name (of the registry or not); anything else is an equation
         if values:
             entry = REGISTRY.get(text)
             if entry is not None and entry.build is None:

@@ -138,3 +138,20 @@ def test_emit_bounds_keep_choose_emit_within_the_limit():
     assert costs.FIXED_COSTS["choose amplitudes"] < cost.seconds <= costs.COST_LIMIT_SECONDS
     slow = costs.COSTS["choose"](build_parser().parse_args([*argv, "--allow-slow"]))
     assert slow.seconds > costs.COST_LIMIT_SECONDS
+
+
+def test_a_users_equation_is_estimated_by_its_degree_and_symbols():
+    """A high-degree force is dearer than Duffing at the same order, symbolic coefficients
+    dearer than numbers; `eps*q**63` to order 40 (4.4 minutes measured) is refused at once."""
+    from lindstedt.costs import series_cost
+
+    def cost(text, order, *pairs):
+        return series_cost(argparse.Namespace(model=text, order=order,
+                                              param=list(pairs) or None)).seconds
+
+    duffing = cost("q'' + q + eps*q**3 = 0", 60)
+    assert cost("q'' + q + eps*q**9 = 0", 60) > 2 * duffing
+    assert cost("q'' + q + eps*(alpha*q**2 + q**3) = 0", 30) > cost(
+        "q'' + q + eps*(alpha*q**2 + q**3) = 0", 30, "alpha=1/3")
+    done = run("series", "q'' + q + eps*q**63 = 0", "--order", "40")
+    assert done.returncode == 2 and "--allow-slow" in done.stderr and done.stdout == ""

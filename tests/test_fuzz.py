@@ -155,7 +155,10 @@ def command_line(draw, opts: tuple[Opt, ...], switches: tuple[str, ...] = ("--js
 
 
 SERIES = command_line((
-    Opt(None, st.sampled_from(["duffing", "pendulum"]), st.just("nosuch"), number=False),
+    Opt(None, st.sampled_from(["duffing", "pendulum", "q'' + q + eps*q**5 = 0",
+                               "theta'' + sinh(theta) = 0"]),
+        st.sampled_from(["nosuch", "q'' + q + eps*q'", "q'' + __import__('os')", "q'' + q",
+                         "q'' + q + eps*q**999", "x''"]), number=False),
     Opt("--order", maybe(whole(0, 6)), INTEGER)), valid_switches=("--allow-slow",))
 # NOTE: --allow-slow only with a small order (a large one would run for hours, as asked).
 
@@ -215,6 +218,8 @@ CHOOSE = command_line((
 
 CLOCK = st.sampled_from([[], ["--json"], ["--bogus"], ["extra"], ["--json", "--json"]])
 
+MODELS = st.sampled_from([[], ["--json"], ["--bogus"], ["extra"], ["--json", "--json"]])
+
 SCENE = command_line((Opt(None, st.just("clock"), st.sampled_from(["nosuch", "CLOCK", ""]),
                           number=False),))
 # NOTE: hard-spring (14 s) and notes-driven (9 s) are valid but slow; `choose` covers them.
@@ -226,7 +231,7 @@ DEMO = st.tuples(st.sampled_from(BAD_FOLDERS), st.sampled_from([[], ["--bogus"]]
 BUDGET = {"series": (SERIES, 2), "generate": (GENERATE, 2), "driven": (DRIVEN, 4),
           "response": (RESPONSE, 3), "subharmonic": (SUBHARMONIC, 2),
           "mixing": (mixing(), 3), "choose": (CHOOSE, 2), "clock": (CLOCK, 1),
-          "scene": (SCENE, 1), "demo": (DEMO, 1)}
+          "scene": (SCENE, 1), "demo": (DEMO, 1), "models": (MODELS, 1)}
 # NOTE: examples (pairs of runs side by side) per command: 42 runs, the file ~60 s on the
 # 2-core machine with other work loading it (a refusal takes 0.1–3 s, a valid run 2–8 s).
 
@@ -255,6 +260,7 @@ test_fuzz_choose = _fuzz("choose")
 test_fuzz_clock = _fuzz("clock")
 test_fuzz_scene = _fuzz("scene")
 test_fuzz_demo = _fuzz("demo")
+test_fuzz_models = _fuzz("models")
 
 
 NOT_FUZZED = {"sweep": "new (generator/sweep.py, being written): a dask cluster per run"}
