@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -110,6 +111,190 @@ def amplitudes(c: np.ndarray, phase: float, harmonics: int) -> tuple[dict, dict]
     return dict(zip(orders.tolist(), a, strict=True)), dict(zip(orders.tolist(), b, strict=True))
 
 
+# --- one harmonic: the cubic in u = r² -------------------------------------------------------
+
+def _cubic(u: np.ndarray, a: np.ndarray, wg2: np.ndarray, eps: float,
+           f2: float) -> tuple[np.ndarray, np.ndarray]:
+    """``G`` and ``∂G/∂u`` at ``u`` from ``a = 1 − ω²``, ``wg2 = ω²/Q²`` and ``f2 = f²``."""
+    s = a + 0.75 * eps * u
+    s2 = s * s + wg2
+    return u * s2 - f2, s2 + 1.5 * eps * u * s
+
+
+def amplitude_residual(u: np.ndarray, omega: np.ndarray, d: Drive) -> np.ndarray:
+    """``G(u) = u[(1 − ω² + ¾εu)² + ω²/Q²] − f²`` (``d.omega`` unused: ``omega`` is given)."""
+    return _cubic(u, (1 - omega) * (1 + omega), (omega * d.damping) ** 2, d.eps, d.force**2)[0]
+
+
+def amplitude_slope(u: np.ndarray, omega: np.ndarray, d: Drive) -> np.ndarray:
+    """``∂G/∂u``: positive on stable one-harmonic branches."""
+    return _cubic(u, (1 - omega) * (1 + omega), (omega * d.damping) ** 2, d.eps, d.force**2)[1]
+
+
+def _two_sum(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    s = x + y
+    z = s - x
+    return s, (x - (s - z)) + (y - z)
+
+
+def _two_product(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def split(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        c = 134217729.0 * v  # 2²⁷ + 1: Veltkamp's split into two 26-bit halves
+        h = c - (c - v)
+        return h, v - h
+
+    p = x * y
+    (xh, xl), (yh, yl) = split(x), split(y)
+    return p, ((xh * yh - p) + xh * yl + xl * yh) + xl * yl
+
+
+def _dd_mul(x: tuple, y: tuple) -> tuple[np.ndarray, np.ndarray]:
+    p, e = _two_product(x[0], y[0])
+    return _two_sum(p, e + (x[0] * y[1] + x[1] * y[0]))
+
+
+def _dd_add(x: tuple, y: tuple) -> tuple[np.ndarray, np.ndarray]:
+    s, e = _two_sum(x[0], y[0])
+    return _two_sum(s, e + (x[1] + y[1]))
+
+
+def _exact_residual(u: np.ndarray, omega: np.ndarray, eps: float, force: float,
+                    damping: float) -> np.ndarray:
+    """``G(u)`` in double-double arithmetic: right where the plain sum is only rounding (at a
+    fold ``G`` is flat, and its roots there need ``G`` to twice the digits)."""
+    zero = np.zeros_like(u)
+    a = _dd_mul(_two_sum(1.0, -omega), _two_sum(1.0, omega))
+    s = _dd_add(a, _dd_mul(_two_product(0.75 + zero, eps + zero), (u, zero)))
+    wg = _two_product(omega, damping + zero)
+    t = _dd_add(_dd_mul(s, s), _dd_mul(wg, wg))
+    f2 = _two_product(force + zero, force + zero)
+    G = _dd_add(_dd_mul(t, (u, zero)), (-f2[0], -f2[1]))
+    return G[0] + G[1]
+
+
+FLAT = 1e-6
+# NOTE: a root whose |∂G/∂u|·u is below FLAT·f² (beside a fold) is polished on the
+# double-double G, as is the sign of G at a zero of ∂G/∂u within FLAT·f² of zero.
+ROOT_STEPS = 200
+# NOTE: at most this many Newton steps per root; from inside a piece of one curvature Newton
+# converges monotonically, and from the starts below in 2–6 steps (≈50 beside a fold).
+
+
+def one_harmonic_roots(eps: float, force: float, Q: float, omega: np.ndarray) -> np.ndarray:
+    """Every positive root ``u = r²`` of the one-harmonic cubic ``G`` (:func:`amplitude_residual`)
+    at each ``omega``: shape ``(n, 3)``, largest first, NaN where a branch does not exist.
+
+    ``G(0) = −f² < 0`` and ``G`` grows without end.  Cut ``u > 0`` at the zeros of
+    ``∂G/∂u`` (a pair, positive where ``ε(1 − ω²) < 0`` and ``(1 − ω²)² > 3ω²/Q²``), of
+    ``∂²G/∂u² `` (``u = −8(1 − ω²)/(9ε)``) and at a bound above every root: on each piece
+    ``G`` is monotone and of one curvature, so a piece whose ends differ in sign holds exactly
+    one root — no root is lost, however far apart the roots — and Newton's method kept inside
+    the piece converges to it monotonically (after at most one step).  Each piece starts from
+    the quadratic model of ``G`` at its zero of ``∂G/∂u`` (near a fold that is the root to a
+    few digits) or else from its end where ``G`` and ``∂²G/∂u²`` agree in sign."""
+    d = Drive(eps, force, 1.0, Q)
+    w = np.atleast_1d(np.asarray(omega, dtype=float))
+    a = (1 - w) * (1 + w)
+    wg = w * d.damping
+    wg2 = wg * wg
+    f2 = force * force
+    roots = np.full((w.size, 3), np.nan)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        k = a * a + wg2  # ∂G/∂u at u = 0
+        linear = np.where(k > 0, f2 / k, np.nan)  # Newton's first step from u = 0
+        if eps == 0:
+            roots[:, 0] = linear
+            return roots
+        bent = -8 * a / (9 * eps)  # ∂²G/∂u² = 0
+        D = (np.abs(a) - math.sqrt(3) * wg) * (np.abs(a) + math.sqrt(3) * wg)
+        turns = (bent > 0) & (D > 0)
+        far = 8 / (9 * abs(eps)) * (np.abs(a) + 0.5 * np.sqrt(np.maximum(D, 0)))
+        mid = np.maximum(bent, 0)
+        c1 = np.where(turns, 16 * k / (27 * eps * eps) / far, mid)  # the pair's product
+        c2 = np.where(turns, far, mid)
+        # above every root: u(1 − ω² + ¾εu)² ≤ f² bounds |¾εu + (1 − ω²)| by f/√u
+        top = np.where(bent > 0, (np.abs(a) + np.sqrt(f2 / bent)) * 4 / (3 * abs(eps)),
+                       2 * np.fmin(linear, np.cbrt(16 * f2 / (9 * eps * eps))))
+        top = np.maximum(top, c2)
+        ends = (np.zeros_like(w), c1, mid, c2, top)
+        G = [np.full_like(w, -f2)] + [_cubic(e, a, wg2, eps, f2)[0] for e in ends[1:]]
+        for p in (1, 3):  # beside a fold: whether two roots or none, on the double-double G
+            i = np.flatnonzero(turns & (np.abs(G[p]) < FLAT * f2))
+            G[p][i] = _exact_residual(ends[p][i], w[i], eps, force, d.damping)
+        # the quadratic model of G at c1 and c2: G(c ± h) ≈ G(c) + ∂²G/∂u² h²/2
+        h1 = np.sqrt(np.abs(2 * G[1] / (27 / 8 * eps * eps * c1 + 3 * eps * a)))
+        h2 = np.sqrt(np.abs(2 * G[3] / (27 / 8 * eps * eps * c2 + 3 * eps * a)))
+        starts = (np.where(turns, np.fmax(linear, c1 - h1), linear), c1 + h1, c2 - h2,
+                  np.where(turns, np.fmin(top, c2 + h2), top))
+    found = [((G[p] < 0) & (G[p + 1] >= 0)) | ((G[p] > 0) & (G[p + 1] <= 0)) for p in range(4)]
+    rows = [np.flatnonzero(found[p]) for p in range(4)]
+    above = [sum(found[q].astype(int) for q in range(p + 1, 4)) for p in range(3)] + [0 * w]
+    pieces = [[v[rows[p]] for v in (ends[p], ends[p + 1], starts[p], a, wg2)] for p in range(4)]
+    lo, hi, x, a, wg2 = (np.concatenate(v) for v in zip(*pieces, strict=True))
+    r = np.concatenate(rows)
+
+    def plain(i: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return _cubic(x, a[i], wg2[i], eps, f2)
+
+    x = _newton(np.clip(x, lo, hi), lo, hi, plain)
+    flat = np.flatnonzero(np.abs(plain(slice(None), x)[1]) * x < FLAT * f2)
+    if flat.size:  # beside a fold: polish on the double-double G
+
+        def exact(i: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            j = flat[i]
+            return (_exact_residual(x, w[r[j]], eps, force, d.damping),
+                    _cubic(x, a[j], wg2[j], eps, f2)[1])
+
+        x[flat] = _newton(x[flat], lo[flat], hi[flat], exact)
+    rank = np.concatenate([above[p][rows[p]] for p in range(4)]).astype(int)
+    roots[r, rank] = x  # the pieces ascend in u: largest first, NaN last
+    return roots
+
+
+def _newton(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, G: Callable) -> np.ndarray:
+    """Newton's method on each root ``x`` kept inside its piece ``[lo, hi]``, until its moves stop
+    shrinking or reach rounding; ``G(i, x)`` gives ``G`` and ``∂G/∂u`` of the roots ``i`` at
+    ``x``."""
+    x = x.copy()
+    todo = np.arange(x.size)  # the roots still moving
+    moved = np.full(x.shape, np.inf)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        for _ in range(ROOT_STEPS):
+            if not todo.size:
+                break
+            xt = x[todo]
+            value, slope = G(todo, xt)
+            new = np.clip(xt - np.where(slope != 0, value / slope, 0.0), lo[todo], hi[todo])
+            move = np.abs(new - xt)
+            x[todo] = new
+            going = (move > 2.0**-52 * new) & (move < moved[todo])
+            moved[todo] = move
+            todo = todo[going]
+    return x
+
+
+def one_harmonic_phase(eps: float, force: float, Q: float, omega: np.ndarray,
+                       r: np.ndarray) -> np.ndarray:
+    """``δ₀`` of the one-harmonic root ``r``: ``f sin δ₀ = rω/Q``,
+    ``f cos δ₀ = ¾εr³ − (ω² − 1)r`` (0 or π undamped)."""
+    damping = 0.0 if math.isinf(Q) else 1.0 / Q
+    sign = math.copysign(1.0, force)
+    return np.arctan2(sign * r * omega * damping, sign * (0.75 * eps * r**3 - (omega**2 - 1) * r))
+
+
+def one_harmonic(eps: float, force: float, Q: float,
+                 omega: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``A₁`` and ``δ₀`` of every one-harmonic branch, each ``(n, 3)``, largest ``r`` first (NaN
+    where none): damped ``A₁ = r``; undamped ``δ₀ = 0`` and ``A₁ = ±r``, the sign of
+    ``cos δ₀`` (``A₁ < 0``: in antiphase)."""
+    w = np.atleast_1d(np.asarray(omega, dtype=float))
+    r = np.sqrt(one_harmonic_roots(eps, force, Q, w))
+    delta = one_harmonic_phase(eps, force, Q, w[:, None], r)
+    if math.isinf(Q):
+        return np.copysign(r, np.cos(delta)), np.where(np.isfinite(r), 0.0, np.nan)
+    return r, delta
+
+
 # --- first order: the branches --------------------------------------------------------------
 
 @dataclass(frozen=True)
@@ -129,52 +314,11 @@ def first_order_branches(d: Drive) -> list[Branch]:
 
     Undamped: ``(ω² − 1)A₁ − ¾εA₁³ + f = 0`` with ``δ₀ = 0`` (``A₁ < 0`` is the branch in
     antiphase).  Damped: ``r²[(1 − ω² + ¾εr²)² + ω²/Q²] = f²`` (cubic in ``r²``) with
-    ``f sin δ₀ = rω/Q`` and ``f cos δ₀ = ¾εr³ − (ω² − 1)r``.
+    ``f sin δ₀ = rω/Q`` and ``f cos δ₀ = ¾εr³ − (ω² − 1)r``: :func:`one_harmonic`.
     """
-    w2 = d.omega**2
-    if d.damping == 0:
-        roots = np.roots([-0.75 * d.eps, 0.0, w2 - 1, d.force])
-        real = sorted({float(r.real) for r in roots if abs(r.imag) <= 1e-9 * (1 + abs(r))},
-                      reverse=True)
-        return [Branch(_polish_cubic(d, r), 0.0) for r in real]
-    # u = r²: (9/16)ε² u³ + (3/2)ε(1 − ω²) u² + ((1 − ω²)² + ω²/Q²) u − f² = 0
-    a = 1 - w2
-    roots = np.roots([9 / 16 * d.eps**2, 1.5 * d.eps * a, a * a + w2 * d.damping**2,
-                      -d.force**2])
-    found = [root.real for root in roots
-             if abs(root.imag) <= 1e-9 * (1 + abs(root)) and root.real > 0]
-    steps = 3  # Newton on the cubic: np.roots loses digits near a fold
-    if not found:
-        # G(0) = −f² < 0 < G(∞): a positive root exists, but np.roots lost it among roots
-        # many decades larger (Q ≪ 1, ω ≫ 1): start from the linear response instead
-        found, steps = [d.force**2 / (a * a + w2 * d.damping**2)], 60
-    out = []
-    for u in found:
-        for _ in range(steps):
-            s = a + 0.75 * d.eps * u
-            slope = s * s + w2 * d.damping**2 + 1.5 * d.eps * u * s
-            if slope != 0:
-                u -= (u * (s * s + w2 * d.damping**2) - d.force**2) / slope
-        if not u > 0:
-            continue
-        if steps > 3 and not abs(u * ((a + 0.75 * d.eps * u) ** 2 + w2 * d.damping**2)
-                                 - d.force**2) <= 1e-9 * d.force**2:
-            continue
-        r = math.sqrt(u)
-        delta = math.atan2(r * d.omega * d.damping, 0.75 * d.eps * r**3 - (w2 - 1) * r)
-        out.append(Branch(r, delta))
-    return sorted(out, key=lambda b: -b.A1)
-
-
-def _polish_cubic(d: Drive, A: float) -> float:
-    """Two Newton steps on the undamped cubic: roots to full double precision."""
-    for _ in range(3):
-        g = (d.omega**2 - 1) * A - 0.75 * d.eps * A**3 + d.force
-        dg = (d.omega**2 - 1) - 2.25 * d.eps * A**2
-        if dg == 0:
-            break
-        A -= g / dg
-    return A
+    A, delta = one_harmonic(d.eps, d.force, d.Q, np.array([d.omega]))
+    return sorted((Branch(float(a), float(dl)) for a, dl in zip(A[0], delta[0], strict=True)
+                   if math.isfinite(a)), key=lambda b: -b.A1)
 
 
 # --- the μ-expansion -------------------------------------------------------------------------

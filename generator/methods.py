@@ -50,6 +50,7 @@ from .driven import (
     harmonic_balance,
     mu_expansion,
     mu_expansion_exact,
+    one_harmonic,
 )
 from .errors import InputError
 from .lindstedt import derive
@@ -576,15 +577,9 @@ def _run_balance_module(mod: ModuleType, omega: np.ndarray, eps: float, force: f
 def one_harmonic_amplitudes(eps: float, force: float, Q: float,
                             omegas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``A₁ = r cos δ₀``, ``B₁ = r sin δ₀`` of the largest one-harmonic branch, vectorised
-    (``r`` from :func:`response.one_harmonic_curve`; ``f sin δ₀ = rω/Q``,
-    ``f cos δ₀ = ¾εr³ − (ω² − 1)r``)."""
-    from .response import one_harmonic_curve
-
-    w = np.asarray(omegas, dtype=float)
-    r = one_harmonic_curve(eps, force, Q, w).r[:, 0]
-    delta = np.arctan2(r * w * Drive(eps, force, 1.0, Q).damping,
-                       0.75 * eps * r**3 - (w**2 - 1) * r)
-    return r * np.cos(delta), r * np.sin(delta)
+    (:func:`driven.one_harmonic`)."""
+    A, delta = one_harmonic(eps, force, Q, omegas)
+    return A[:, 0] * np.cos(delta[:, 0]), A[:, 0] * np.sin(delta[:, 0])
 
 
 DRIVEN_MAX = 12

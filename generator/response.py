@@ -26,10 +26,13 @@ from .driven import (
     HarmonicBalance,
     PolynomialBalance,
     amplitude_bound,
+    amplitude_residual,
+    amplitude_slope,
     amplitudes,
     check_harmonics,
     first_order_branches,
     harmonic_balance,
+    one_harmonic_roots,
 )
 from .errors import InputError
 from .numerics import (
@@ -58,17 +61,6 @@ def _fold_polynomial() -> sp.Poly:
     return sp.Poly(sp.resultant(_G, sp.diff(_G, _u), _u), _w)
 
 
-def amplitude_residual(u: np.ndarray, omega: np.ndarray, d: Drive) -> np.ndarray:
-    """``G(u) = u[(1 − ω² + ¾εu)² + ω²/Q²] − f²``."""
-    return u * ((1 - omega**2 + 0.75 * d.eps * u) ** 2 + omega**2 * d.damping**2) - d.force**2
-
-
-def amplitude_slope(u: np.ndarray, omega: np.ndarray, d: Drive) -> np.ndarray:
-    """``∂G/∂u``: positive on stable one-harmonic branches."""
-    a = 1 - omega**2 + 0.75 * d.eps * u
-    return a * a + omega**2 * d.damping**2 + 1.5 * d.eps * u * a
-
-
 @dataclass(frozen=True)
 class ResponseCurve:
     """One-harmonic amplitudes ``r`` (NaN where a branch does not exist), largest first."""
@@ -79,44 +71,13 @@ class ResponseCurve:
 
 
 def one_harmonic_curve(eps: float, force: float, Q: float, omega: np.ndarray) -> ResponseCurve:
-    """All real branches of the amplitude equation over ``omega``, vectorised.
-
-    The cubic in ``u`` is solved in closed form (trigonometric for three real roots, Cardano
-    for one), then each root is polished by two Newton steps on ``G``.
-    """
+    """All real branches of the amplitude equation over ``omega``, vectorised
+    (:func:`driven.one_harmonic_roots`)."""
     d = Drive(eps, force, 1.0, Q)
     w = np.asarray(omega, dtype=float)
     if np.any(~np.isfinite(w)) or np.any(w <= 0):
         raise InputError("omega: every frequency must be finite and > 0")
-    if eps == 0:
-        u = force**2 / ((1 - w**2) ** 2 + w**2 * d.damping**2)
-        roots = np.stack([u, np.full_like(w, np.nan), np.full_like(w, np.nan)], axis=1)
-    else:
-        # (9/16)ε² u³ + (3/2)ε a u² + (a² + ω²g²) u − f² = 0, a = 1 − ω²
-        a = 1 - w**2
-        c3, c2, c1, c0 = 9 / 16 * eps**2, 1.5 * eps * a, a * a + w**2 * d.damping**2, -force**2
-        b, c, e = c2 / c3, c1 / c3, c0 / c3
-        p = c - b * b / 3
-        q = 2 * b**3 / 27 - b * c / 3 + e
-        disc = (q / 2) ** 2 + (p / 3) ** 3
-        with np.errstate(invalid="ignore", divide="ignore"):
-            m = 2 * np.sqrt(np.maximum(-p / 3, 0))
-            theta = np.arccos(np.clip(3 * q / (p * m), -1, 1)) / 3
-            trig = np.stack([m * np.cos(theta - 2 * np.pi * k / 3) for k in range(3)], axis=1)
-            s = np.sqrt(np.maximum(disc, 0))
-            cardano = np.cbrt(-q / 2 + s) + np.cbrt(-q / 2 - s)
-        one = disc > 0
-        roots = np.where(one[:, None], np.stack([cardano, np.full_like(w, np.nan),
-                                                 np.full_like(w, np.nan)], axis=1), trig)
-        roots = roots - (b / 3)[:, None]
-        for _ in range(2):
-            W = w[:, None]
-            G = amplitude_residual(roots, W, d)
-            dG = amplitude_slope(roots, W, d)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                roots = np.where(dG != 0, roots - G / dG, roots)
-    roots = np.where(roots > 0, roots, np.nan)
-    roots = -np.sort(-roots, axis=1)  # NaN last, largest first
+    roots = one_harmonic_roots(eps, force, Q, w)
     r = np.sqrt(roots)
     with np.errstate(invalid="ignore"):
         stable = amplitude_slope(roots, w[:, None], d) > 0

@@ -122,11 +122,13 @@ def test_fold_is_reported_not_summed():
     assert not mu.converged
     where, reason = mu.reason.split(": ", 1)
     assert reason == "singular secular system (a fold: branches merge)", mu.reason
-    j = int(where.removeprefix("order "))  # 1 or 2: A₁ is a double root only to ~1e-8
+    # ω rounded to a double splits the double root into two real roots 6e-8 apart, each found
+    # to rounding: the determinants are that small, and order 1..3 reports the fold
+    j = int(where.removeprefix("order "))
     assert 1 <= j <= 4 and len(mu.coefficients) == j and len(mu.determinants) == j
     # the secular determinant is D = 1 − 1/ω² − 9εA₁²/(4ω²) up to a factor, and D = 0 here
     assert abs(1 - 1 / w**2 - 2.25 * eps * A**2 / w**2) < 1e-15
-    assert all(abs(det) < 1e-7 for det in mu.determinants)
+    assert all(abs(det) < 1e-6 for det in mu.determinants)
     near = Drive(eps, f, w * (1 + 1e-3))
     br = min(first_order_branches(near), key=lambda b: abs(b.A1 - A))
     assert mu_expansion(near, br, 4).converged
