@@ -499,3 +499,21 @@ def test_series_json_at_order_20_matches_the_quadrature_period(capsys):
             tail = 2 * mp.pi * (abs(terms[-1]) + abs(terms[-2]))  # the series' last steps
             assert abs(partial - T) <= 10 * tail + mp.mpf(10) ** -25, (a, e, partial - T, tail)
             assert abs(partial / T - 1) < 1e-12
+
+
+def test_emitted_user_module_is_nan_beyond_its_estimated_radius(tmp_path):
+    """No silent divergent numbers: a user's module guards |y| < R with R estimated from its
+    own coefficients.  The quintic's period is singular at the separatrix x = εA⁴ = −1 (where
+    u = 1 is the top of the potential u²/2 + x u⁶/6): Domb–Sykes puts R within 2 % below it;
+    beyond, NaN.  Symbolic coefficients (series in ε, A free): the guard is evaluated at A."""
+    emit("q'' + q + eps*q**5 = 0", 8, tmp_path, "quintic_guard")
+    mod = load_generated(tmp_path / "quintic_guard.py")
+    assert 0.98 <= mod.RADIUS <= 1.0
+    assert math.isnan(mod.period(1.0, -1.2)) and math.isnan(mod.period(1.0, 3.0))
+    with mp.workdps(DPS):
+        T, _ = potential_period(lambda q: q**2 / 2 + mp.mpf("0.3") * q**6 / 6, 1)
+    assert mod.period(1.0, 0.3) == pytest.approx(float(T), rel=1e-5)
+    emit("q'' + q + eps*(q**2 + q**3) = 0", 6, tmp_path, "asym_guard")
+    asym = load_generated(tmp_path / "asym_guard.py")
+    assert math.isnan(asym.period(3.0, 1.0))  # εA ~ 3: far outside any convergence
+    assert math.isfinite(asym.period(0.5, 0.1))
