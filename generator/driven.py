@@ -159,22 +159,26 @@ def _dd_add(x: tuple, y: tuple) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _exact_residual(u: np.ndarray, omega: np.ndarray, eps: float, force: float,
-                    damping: float) -> np.ndarray:
-    """``G(u)`` in double-double arithmetic: right where the plain sum is only rounding (at a
-    fold ``G`` is flat, and its roots there need ``G`` to twice the digits)."""
+                    Q: float) -> np.ndarray:
+    """``G(u)`` in double-double arithmetic, on the exact values of the doubles ``omega``, ε,
+    f, Q: right where the plain sum is only rounding (at a fold ``G`` is flat, and its roots
+    there need ``G`` to twice the digits)."""
     zero = np.zeros_like(u)
     a = _dd_mul(_two_sum(1.0, -omega), _two_sum(1.0, omega))
     s = _dd_add(a, _dd_mul(_two_product(0.75 + zero, eps + zero), (u, zero)))
-    wg = _two_product(omega, damping + zero)
+    wg = (zero, zero)
+    if not math.isinf(Q):  # ω/Q and the rest of the division, (ω − (ω/Q)Q)/Q
+        p, e = _two_product(omega / Q, Q + zero)
+        wg = _two_sum(omega / Q, ((omega - p) - e) / Q)
     t = _dd_add(_dd_mul(s, s), _dd_mul(wg, wg))
     f2 = _two_product(force + zero, force + zero)
     G = _dd_add(_dd_mul(t, (u, zero)), (-f2[0], -f2[1]))
     return G[0] + G[1]
 
 
-FLAT = 1e-6
-# NOTE: a root whose |∂G/∂u|·u is below FLAT·f² (beside a fold) is polished on the
-# double-double G, as is the sign of G at a zero of ∂G/∂u within FLAT·f² of zero.
+FLAT = 1e-4
+# NOTE: where G is within FLAT·f² of zero at a zero of ∂G/∂u (beside a fold), its sign there
+# and the roots of the two pieces beside it are found on the double-double G.
 ROOT_STEPS = 200
 # NOTE: at most this many Newton steps per root; from inside a piece of one curvature Newton
 # converges monotonically, and from the starts below in 2–6 steps (≈50 beside a fold).
@@ -218,9 +222,9 @@ def one_harmonic_roots(eps: float, force: float, Q: float, omega: np.ndarray) ->
         top = np.maximum(top, c2)
         ends = (np.zeros_like(w), c1, mid, c2, top)
         G = [np.full_like(w, -f2)] + [_cubic(e, a, wg2, eps, f2)[0] for e in ends[1:]]
-        for p in (1, 3):  # beside a fold: whether two roots or none, on the double-double G
-            i = np.flatnonzero(turns & (np.abs(G[p]) < FLAT * f2))
-            G[p][i] = _exact_residual(ends[p][i], w[i], eps, force, d.damping)
+        flat = {p: turns & (np.abs(G[p]) < FLAT * f2) for p in (1, 3)}  # beside a fold
+        for p, i in flat.items():  # whether two roots there or none: on the double-double G
+            G[p][i] = _exact_residual(ends[p][i], w[i], eps, force, Q)
         # the quadratic model of G at c1 and c2: G(c ± h) ≈ G(c) + ∂²G/∂u² h²/2
         h1 = np.sqrt(np.abs(2 * G[1] / (27 / 8 * eps * eps * c1 + 3 * eps * a)))
         h2 = np.sqrt(np.abs(2 * G[3] / (27 / 8 * eps * eps * c2 + 3 * eps * a)))
@@ -232,20 +236,16 @@ def one_harmonic_roots(eps: float, force: float, Q: float, omega: np.ndarray) ->
     pieces = [[v[rows[p]] for v in (ends[p], ends[p + 1], starts[p], a, wg2)] for p in range(4)]
     lo, hi, x, a, wg2 = (np.concatenate(v) for v in zip(*pieces, strict=True))
     r = np.concatenate(rows)
+    fine = np.concatenate([flat[p // 2 * 2 + 1][rows[p]] for p in range(4)])
 
-    def plain(i: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return _cubic(x, a[i], wg2[i], eps, f2)
+    def residual(i: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        value, slope = _cubic(x, a[i], wg2[i], eps, f2)
+        k = fine[i]
+        if k.any():  # beside a fold G is flat: its roots need G to twice the digits
+            value[k] = _exact_residual(x[k], w[r[i[k]]], eps, force, Q)
+        return value, slope
 
-    x = _newton(np.clip(x, lo, hi), lo, hi, plain)
-    flat = np.flatnonzero(np.abs(plain(slice(None), x)[1]) * x < FLAT * f2)
-    if flat.size:  # beside a fold: polish on the double-double G
-
-        def exact(i: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            j = flat[i]
-            return (_exact_residual(x, w[r[j]], eps, force, d.damping),
-                    _cubic(x, a[j], wg2[j], eps, f2)[1])
-
-        x[flat] = _newton(x[flat], lo[flat], hi[flat], exact)
+    x = _newton(np.clip(x, lo, hi), lo, hi, residual)
     rank = np.concatenate([above[p][rows[p]] for p in range(4)]).astype(int)
     roots[r, rank] = x  # the pieces ascend in u: largest first, NaN last
     return roots

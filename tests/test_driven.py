@@ -237,3 +237,86 @@ def test_damped_output_shows_r_and_both_phases_parts():
     assert abs(float(shooting[0]) - r_true) < 1e-6
     assert abs(float(shooting[1]) - orbit.A[1]) < 1e-6
     assert abs(float(shooting[2]) - orbit.B[1]) < 1e-6
+
+
+# --- the one-harmonic solver against 30-digit roots -------------------------------------------
+
+def reference_branches(eps: float, force: float, Q: float, omega: float) -> list[tuple]:
+    """``(r, A₁, δ₀)`` of every real branch, largest r first, from mpmath's ``polyroots`` at 30
+    digits on the exact values of the doubles: the cubic in ``u = r²`` (``A₁`` from the
+    undamped cubic in ``A`` itself), the phase from ``f sin δ₀ = rω/Q``,
+    ``f cos δ₀ = ¾εr³ − (ω² − 1)r``."""
+    import mpmath
+
+    with mpmath.workdps(30):
+        e, f, w = mpmath.mpf(eps), mpmath.mpf(force), mpmath.mpf(omega)
+        g = 0 if math.isinf(Q) else 1 / mpmath.mpf(Q)
+        a = 1 - w**2
+        if eps == 0:
+            us = [f**2 / (a**2 + (w * g) ** 2)]
+        else:
+            us = mpmath.polyroots([9 * e**2 / 16, 3 * e * a / 2, a**2 + (w * g) ** 2, -f**2],
+                                  maxsteps=500, extraprec=300)
+        us = [mpmath.re(u) for u in us if abs(mpmath.im(u)) <= 1e-25 * abs(u) and
+              mpmath.re(u) > 0]
+        if math.isinf(Q):
+            As = ([f / (1 - w**2)] if eps == 0 else
+                  mpmath.polyroots([-3 * e / 4, 0, w**2 - 1, f], maxsteps=500, extraprec=300))
+            As = sorted((mpmath.re(A) for A in As if abs(mpmath.im(A)) <= 1e-25 * abs(A)),
+                        key=abs, reverse=True)
+            assert len(As) == len(us)
+            return [(float(abs(A)), float(A), 0.0) for A in As]
+        out = []
+        for u in sorted(us, reverse=True):
+            r = mpmath.sqrt(u)
+            delta = mpmath.atan2(r * w * g / f, (3 * e * r**3 / 4 - (w**2 - 1) * r) / f)
+            out.append((float(r), float(r), float(delta)))
+        return out
+
+
+def reference_grid() -> list[tuple[float, float, float, np.ndarray]]:
+    """Hardening and softening, damped and not, ε down to 1e-12 and 0, the force across three
+    decades; ω on a grid through ω = 1 and at 1e-3, 1e-5 and 1e-7 (relative) on both sides of
+    every fold."""
+    from lindstedt.response import one_harmonic_folds
+
+    base = np.concatenate([np.geomspace(0.2, 5, 41), [1.0, 1 - 1e-9, 1 + 1e-9]])
+    grid = []
+    for eps, force, Q in itertools.product([0.1, -0.1, 2.0, 1e-12, 0.0], [0.3, -1.0, 30.0],
+                                           [math.inf, 20.0, 3.0, 0.05]):
+        omega = base
+        if eps:
+            folds = np.array(one_harmonic_folds(eps, force, Q))
+            if len(folds):
+                near = np.array([-1e-3, -1e-5, -1e-7, 0.0, 1e-7, 1e-5, 1e-3])
+                omega = np.concatenate([omega, (folds[:, None] * (1 + near)).ravel()])
+        else:
+            omega = omega[np.abs(omega - 1) > 1e-6] if math.isinf(Q) else omega
+        grid.append((eps, force, Q, omega))
+    return grid
+
+
+def test_one_harmonic_solver_finds_every_root_to_1e12():
+    """Every real branch r (A₁ signed, undamped) and δ₀ of :func:`driven.one_harmonic`, the
+    count right, each to 1e-12 relative (δ₀ absolute) of 30-digit roots, over both fold
+    windows; and :func:`first_order_branches` the same roots."""
+    from lindstedt.driven import one_harmonic
+
+    checked = folds = 0
+    for eps, force, Q, omega in reference_grid():
+        A, delta = one_harmonic(eps, force, Q, omega)
+        for i, w in enumerate(omega):
+            ref = reference_branches(eps, force, Q, float(w))
+            got = [(abs(A[i, k]), A[i, k], delta[i, k]) for k in range(3)
+                   if np.isfinite(A[i, k])]
+            where = f"eps {eps}, f {force}, Q {Q}, omega {w!r}: {got} against {ref}"
+            assert len(got) == len(ref), where
+            for (r, a1, d0), (r_ref, a1_ref, d0_ref) in zip(got, ref, strict=True):
+                assert abs(r - r_ref) <= 1e-12 * r_ref, where
+                assert abs(a1 - a1_ref) <= 1e-12 * r_ref, where
+                assert abs(d0 - d0_ref) <= 1e-12, where
+            branches = first_order_branches(Drive(eps, force, float(w), Q))
+            assert sorted(b.A1 for b in branches) == sorted(a for _, a, _ in got), where
+            checked += len(ref)
+            folds += len(ref) == 3
+    assert checked > 2000 and folds > 200  # three branches: inside a fold window
