@@ -190,7 +190,7 @@ def one_harmonic_roots(eps: float, force: float, Q: float, omega: np.ndarray) ->
 
     ``G(0) = −f² < 0`` and ``G`` grows without end.  Cut ``u > 0`` at the zeros of
     ``∂G/∂u`` (a pair, positive where ``ε(1 − ω²) < 0`` and ``(1 − ω²)² > 3ω²/Q²``), of
-    ``∂²G/∂u² `` (``u = −8(1 − ω²)/(9ε)``) and at a bound above every root: on each piece
+    ``∂²G/∂u²`` (``u = −8(1 − ω²)/(9ε)``) and at a bound above every root: on each piece
     ``G`` is monotone and of one curvature, so a piece whose ends differ in sign holds exactly
     one root — no root is lost, however far apart the roots — and Newton's method kept inside
     the piece converges to it monotonically (after at most one step).  Each piece starts from
