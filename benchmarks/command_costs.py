@@ -30,6 +30,11 @@ CASES = [
     *[["generate", "driven", "--order", str(k)] for k in (3, 4, 5)],
     *[["series", "duffing", "--order", str(k), "--json"] for k in (100, 200, 300)],
     *[["series", "pendulum", "--order", str(k), "--json"] for k in (40, 70, 100)],
+    *[["series", "q'' + q + eps*q**5 = 0", "--order", str(k), "--json"] for k in (50, 100)],
+    ["series", "q'' + q + eps*q**9 = 0", "--order", "60", "--json"],
+    ["series", "q'' + q + eps*(alpha*q**2 + q**3) = 0", "--order", "30", "--json"],
+    ["series", "q'' + q + eps*(q**5 + 2*q**3*q'**2 + q*q'**4/3) = 0", "--order", "100", "--json"],
+    ["generate", "q'' + q + eps*(q**2 + q**3) = 0", "--name", "hd", "--order", "8"],
     *[["driven", *DRIVE, "--omega", "1.3", "--order", str(k), "--json"] for k in (4, 64, 100,
                                                                                150, 200)],
     *[["driven", *DRIVE, "--omega", "1.3", "--Q", "20", "--order", str(k), "--json"]

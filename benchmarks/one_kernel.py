@@ -5,21 +5,16 @@
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
+import timing
 from lindstedt.driven import Drive, first_order_branches, harmonic_balance, mu_expansion
 from lindstedt.numerics import flow, hill_multipliers, steady_state_amplitudes, sweep
 
 
 def best(f, n: int) -> float:
+    """The compiled kernels warm up (compile) on a first call, then the timing rule."""
     f()
-    times = []
-    for _ in range(n):
-        t = time.perf_counter()
-        f()
-        times.append(time.perf_counter() - t)
-    return min(times)
+    return timing.best(f, n)
 
 
 def main() -> None:

@@ -131,20 +131,13 @@ def response_equation_figure(text: str, values: dict[str, str], harmonics: int, 
     """Response r(ω) of a user's damped driven oscillator: the one-harmonic amplitudes, the
     continued N-harmonic balance (first-harmonic amplitude), the simulated sweeps up and down
     (max |q|), its folds."""
-    from .driven import PolynomialBalance
-    from .numerics import ForceTable, sweep_table
-    from .response import ESCAPE_FACTOR, continue_equation, equation_range, response_equation
+    from .response import equation_response
 
     check_plot_path(path)
-    de = response_equation(text, values, name)
-    er = equation_range(de.terms, de.force, omega_min, omega_max)
+    curve = equation_response(text, values, harmonics, name, omega_min, omega_max, max_seconds)
+    de, er, cont, fine, up, down = (curve.de, curve.er, curve.cont, curve.fine, curve.up,
+                                    curve.down)
     lo, hi = er.omega_range
-    cont = continue_equation(de, harmonics, lo, hi, max_seconds=max_seconds)
-    fine = PolynomialBalance(de.terms, de.force, harmonics, de.odd)
-    table = ForceTable.of(de.terms)
-    bound = ESCAPE_FACTOR * float(np.max(np.sum(np.abs(cont.x), axis=1)))
-    up = sweep_table(table, de.force, lo, hi, barrier=bound, bound=bound)
-    down = sweep_table(table, de.force, hi, lo, barrier=bound, bound=bound)
     fig, ax = plt.subplots(figsize=(8, 4.2))
     omega = np.linspace(lo, hi, 600)
     one = [(w, r) for w in omega for r in er.one_harmonic.amplitudes(float(w))]

@@ -634,32 +634,19 @@ def response_equation_json(text: str, values: dict[str, str], harmonics: int,
     and of the true orbit (each with its Floquet moduli), the sweeps' jumps and escapes."""
     import numpy as np
 
-    from .driven import PolynomialBalance
-    from .numerics import ForceTable, sweep_table
-    from .response import (
-        ESCAPE_FACTOR,
-        continue_equation,
-        equation_range,
-        orbit_fold_table,
-        response_equation,
-    )
+    from .response import equation_response, orbit_fold_table
 
-    de = response_equation(text, values, name)
-    er = equation_range(de.terms, de.force, omega_min, omega_max)
+    curve = equation_response(text, values, harmonics, name, omega_min, omega_max, max_seconds)
+    de, er, cont, up, down = curve.de, curve.er, curve.cont, curve.up, curve.down
     lo, hi = er.omega_range
-    cont = continue_equation(de, harmonics, lo, hi, max_seconds=max_seconds)
-    fine = PolynomialBalance(de.terms, de.force, harmonics, de.odd)
-    table = ForceTable.of(de.terms)
     true_folds = []
     for w in cont.folds:
         x = cont.x[int(np.argmin(np.abs(cont.omega - w)))]
-        found = orbit_fold_table(table, de.force, w, fine.state(x, w))
+        found = orbit_fold_table(curve.table, de.force, w, curve.fine.state(x, w))
         if found is not None:
             true_folds.append((found[0], sorted(float(abs(m)) for m in found[2])))
     true_folds.sort()
-    bound = ESCAPE_FACTOR * float(np.max(np.sum(np.abs(cont.x), axis=1)))
-    up = sweep_table(table, de.force, lo, hi, barrier=bound, bound=bound)
-    down = sweep_table(table, de.force, hi, lo, barrier=bound, bound=bound)
+    bound = curve.bound
     return {
         "equation": text,
         "name": name,
@@ -1294,14 +1281,15 @@ def _flag_oscillator(p: argparse.ArgumentParser, emitted: bool = False) -> None:
                    help="the oscillator's name in output and file names (default: oscillator)")
 
 
-def _flag_equation(p: argparse.ArgumentParser, example: str) -> None:
+def _flag_equation(p: argparse.ArgumentParser, example: str,
+                   default: str = "the notes' equation with the flags",
+                   which: str = "every parameter needs one") -> None:
     """An optional EQUATION of the command's own form, with --param and --name."""
     p.add_argument("model", metavar="EQUATION", nargs="?", default=None,
-                   help=f"an equation such as {example}; default: the notes' equation with "
-                   "the flags")
+                   help=f"an equation such as {example}; default: {default}")
     p.add_argument("--param", action="append", metavar="NAME=VALUE",
                    help="with EQUATION: an exact value for each of its parameters, e.g. "
-                   "eps=1/10 (repeatable; every parameter needs one)")
+                   f"eps=1/10 (repeatable; {which})")
     p.add_argument("--name", metavar="NAME",
                    help="with EQUATION: the oscillator's name in messages (default: oscillator)")
 
@@ -1411,15 +1399,9 @@ def build_parser() -> argparse.ArgumentParser:
                        "your own equation q'' + g(q, q') = f*cos(w*t), g a polynomial, with "
                        "--param for its parameters: every 1:1 orbit by harmonic balance and "
                        "shooting.")
-    p.add_argument("model", metavar="EQUATION", nargs="?", default=None,
-                   help="an equation such as \"q'' + q + eps*q**3 + gamma*q'**3 = f*cos(w*t)\" "
-                   "(a polynomial force, one drive f*cos(w*t) whose w is --omega; default: "
-                   "eq. 10.60 with --eps, --force, --Q)")
-    p.add_argument("--param", action="append", metavar="NAME=VALUE",
-                   help="with EQUATION: an exact value for each of its parameters, e.g. "
-                   "eps=1/10 (repeatable; every parameter but w needs one)")
-    p.add_argument("--name", metavar="NAME",
-                   help="with EQUATION: the oscillator's name in messages (default: oscillator)")
+    _flag_equation(p, "\"q'' + q + eps*q**3 + gamma*q'**3 = f*cos(w*t)\" (a polynomial "
+                   "force, one drive f*cos(w*t) whose w is --omega)",
+                   "eq. 10.60 with --eps, --force, --Q", "every parameter but w needs one")
     _flag_drive(p, required=False, omega="ω, the drive frequency (required)", Q="none")
     p.add_argument("--Q", type=_quality, default=None, metavar="Q",
                    help="quality factor Q > 0 of the damping q'/Q (default: inf, undamped)")
@@ -1434,15 +1416,10 @@ def build_parser() -> argparse.ArgumentParser:
                        "q'' + q'/Q + q + eps q^3 = f cos(w t) (--eps, --force, --Q), or your "
                        "own damped equation q'' + g(q, q') = f*cos(w*t), g a polynomial, with "
                        "--param for every parameter but w.")
-    p.add_argument("model", metavar="EQUATION", nargs="?", default=None,
-                   help="an equation such as \"q'' + 0.05*q' + q + eps*(q**2 + q**3) = "
-                   "f*cos(w*t)\" (a polynomial force with damping, one drive f*cos(w*t) whose w "
-                   "the curve varies; default: eq. 10.60 with --eps, --force, --Q)")
-    p.add_argument("--param", action="append", metavar="NAME=VALUE",
-                   help="with EQUATION: an exact value for each of its parameters, e.g. "
-                   "eps=1/10 (repeatable; every parameter but w needs one)")
-    p.add_argument("--name", metavar="NAME",
-                   help="with EQUATION: the oscillator's name in messages (default: oscillator)")
+    _flag_equation(p, "\"q'' + 0.05*q' + q + eps*(q**2 + q**3) = f*cos(w*t)\" (a "
+                   "polynomial force with damping, one drive f*cos(w*t) whose w the curve "
+                   "varies)", "eq. 10.60 with --eps, --force, --Q", "every parameter but w "
+                   "needs one")
     _flag_drive(p, required=False, omega=None, Q=None)
     p.add_argument("--Q", type=_quality, default=None, metavar="Q",
                    help="quality factor Q > 0 of the damping q'/Q (finite; required without "

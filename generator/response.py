@@ -39,6 +39,7 @@ from .numerics import (
     ForceTable,
     PeriodicOrbit,
     ShootingFailure,
+    Sweep,
     ToneFit,
     flow_table,
     hill_multipliers,
@@ -47,6 +48,7 @@ from .numerics import (
     shoot_table,
     steady_state_amplitudes,
     steady_state_fit,
+    sweep_table,
 )
 from .series import trig_power
 
@@ -1492,6 +1494,42 @@ def response_equation(text: str, values: dict[str, str], name: str = "oscillator
                          "the velocity, e.g. q'/Q): no steady state to draw a response curve of")
     linear_frequency(de.terms)
     return de
+
+
+@dataclass(frozen=True)
+class EquationCurve:
+    """A user's response curve, computed once for the JSON, the table and the figure: the
+    equation, its range, the continued balance, the sweeps up and down and their escape
+    bound."""
+
+    de: DrivenEquation
+    er: EquationResponse
+    cont: Continuation
+    fine: PolynomialBalance
+    table: ForceTable
+    bound: float
+    up: Sweep
+    down: Sweep
+
+
+def equation_response(text: str, values: dict[str, str], harmonics: int,
+                      name: str = "oscillator", omega_min: float | None = None,
+                      omega_max: float | None = None,
+                      max_seconds: float = CONTINUATION_SECONDS) -> EquationCurve:
+    """``response EQUATION``'s curve: the continuation over the range, then the simulated
+    sweeps both ways, escapes detected past :data:`ESCAPE_FACTOR` × the largest balance."""
+    from .driven import PolynomialBalance
+
+    de = response_equation(text, values, name)
+    er = equation_range(de.terms, de.force, omega_min, omega_max)
+    lo, hi = er.omega_range
+    cont = continue_equation(de, harmonics, lo, hi, max_seconds=max_seconds)
+    table = ForceTable.of(de.terms)
+    bound = ESCAPE_FACTOR * float(np.max(np.sum(np.abs(cont.x), axis=1)))
+    return EquationCurve(
+        de, er, cont, PolynomialBalance(de.terms, de.force, harmonics, de.odd), table, bound,
+        sweep_table(table, de.force, lo, hi, barrier=bound, bound=bound),
+        sweep_table(table, de.force, hi, lo, barrier=bound, bound=bound))
 
 
 # --- the notes' εq³ ansatz from a user's equation: subharmonic, mixing -------------------------
