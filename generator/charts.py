@@ -333,7 +333,9 @@ def validity_figure(path: Path) -> Path:
     for xv, text in ((-1, "separatrix x = −1"), (1, "L–P radius |x| = 1"),
                      (-2 / 3, "m = −1: resummed limit")):
         ax.axvline(xv, color="grey", lw=0.8, ls="-.")
-        ax.annotate(text, (xv, 1e-15), rotation=90, fontsize=7, va="bottom", ha="right")
+        # on a white box: the curves crowd these lines at every height
+        ax.annotate(text, (xv, 1e-15), rotation=90, fontsize=7, va="bottom", ha="right",
+                    bbox={"fc": "white", "ec": "none", "alpha": 0.85, "pad": 1.0})
     ax.set(xscale="symlog", yscale="log", ylim=(FLOOR / 2, 10), xlim=(-1.05, 1000),
            xlabel="x = εA² (symlog)",
            ylabel="relative error of T", title="where each method holds (NaN = refused)")
