@@ -24,7 +24,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 # --harmonics 40`: 8.7 s against 17.3 s), and the cost estimates assume one thread.
 
 FREE_MODELS = ("duffing", "pendulum", "helmholtz_duffing", "quintic", "cubic_quintic",
-               "velocity_squared", "sinh_spring")
+               "velocity_squared", "sinh_spring", "van_der_pol", "rayleigh")
 # NOTE: models.MODELS, restated so that parsing arguments needs no SymPy (a test keeps them equal).
 EMITTED = ("driven", "balance", "fourier")
 # NOTE: generate's names for the driven oscillator's modules (not free oscillators).
@@ -164,9 +164,48 @@ def _free_model(args: argparse.Namespace, order: int):
     return model_from_text(args.model, order, _params(args.param), args.name)
 
 
-def _cmd_series(args: argparse.Namespace) -> int:
-    from .lindstedt import derive
+def limit_cycle_json(lc) -> dict:
+    """``lindstedt series`` of a self-excited oscillator: ω, T/2π and q(0) as exact "p/q" in
+    ε, each q_j's cos and sin coefficients, the first-order amplitude slope and the verdict."""
+    m = lc.model
+    frac = _fraction_text
+    return {
+        "model": m.name, "order": lc.order, "variable": "eps",
+        "omega": [frac(c) for c in lc.omega], "period": [frac(c) for c in lc.period],
+        "amplitude": [frac(c) for c in lc.amplitude],
+        "q": [{"cos": {str(n): frac(c) for n, c in sorted(cos.items())},
+               "sin": {str(n): frac(c) for n, c in sorted(sin.items())}} for cos, sin in lc.q],
+        "convention": "q'(0) = 0; q(0) = sum_j amplitude[j] eps^j, s = omega t",
+        "equation": m.source, "slope": frac(lc.slope),
+        "stable_for": "eps > 0" if lc.slope > 0 else "eps < 0",
+    }
 
+
+def _fraction_text(c) -> str:
+    return f"{c.numerator}/{c.denominator}"
+
+
+def limit_cycle_table(lc) -> str:
+    m = lc.model
+    lines = [f"{m.name}: {m.title}, a limit cycle, expansion variable eps, order {lc.order}",
+             "convention: q'(0) = 0, q(0) = sum_j amplitude_j eps^j; attracting for "
+             + ("eps > 0" if lc.slope > 0 else "eps < 0"),
+             f"{'j':>3}  {'omega_j':>22}  {'(T/2pi)_j':>22}  {'amplitude_j':>22}"]
+    for j in range(lc.order + 1):
+        lines.append(f"{j:>3}  {_fraction_text(lc.omega[j]):>22}  "
+                     f"{_fraction_text(lc.period[j]):>22}  {_fraction_text(lc.amplitude[j]):>22}")
+    return "\n".join(lines)
+
+
+def _cmd_series(args: argparse.Namespace) -> int:
+    from .lindstedt import derive, derive_limit_cycle
+    from .models import SelfExcited, series_model
+
+    found = series_model(args.model, args.order, _params(args.param), args.name)
+    if isinstance(found, SelfExcited):
+        lc = derive_limit_cycle(found, args.order)
+        print(json.dumps(limit_cycle_json(lc)) if args.json else limit_cycle_table(lc))
+        return 0
     model = _free_model(args, args.order)
     progress = Progress(f"deriving {model.name} to order {args.order}", not args.json)
     sol = derive(model, args.order, progress)

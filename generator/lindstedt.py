@@ -24,7 +24,7 @@ import sympy as sp
 from .display import SHOWN_ORDERS, latex_aligned, latex_sum, latex_text, more
 from .errors import InputError
 from .models import Model, check_order, t
-from .series import Basis, Ground, solve_oscillator, to_fourier
+from .series import Basis, Ground, Trig, solve_oscillator, solve_trig, to_fourier
 
 CONVENTION = "q(0) = A, q'(0) = 0, so q_j(0) = 0 for j >= 1"
 s = sp.Symbol("s")
@@ -559,3 +559,189 @@ def naive_expression(naive: NaiveSolution, j: int) -> sp.Expr:
     return (m.amplitude * m.order_factor**j) * sum(
         c * t**mp * trig[f](n * t) for (mp, n, f), c in naive.terms[j].items()
     )
+
+
+@dataclass(frozen=True)
+class LimitCycle:
+    """The L–P series of a limit cycle of ``q̈ + q = ε f(q, q̇)``, exact, in powers of ε.
+
+    Phase: ``q̇(0) = 0``.  ``omega[j]``, ``period[j]``: coefficients of ``ε^j`` in ω and T/2π;
+    ``amplitude[j]``: of ``q(0)``; ``q[j] = ({n: a_n}, {n: b_n})``, the cos and sin
+    coefficients of ``q_j(s)``, ``s = ωt``.  ``slope``: ``S'(a₀)`` of the first-order amplitude
+    function ``S(a) = [sin s] f(a cos s, −a sin s)``; the cycle attracts for ``ε S'(a₀) > 0``.
+    """
+
+    model: Any
+    order: int
+    omega: tuple[Fraction, ...]
+    period: tuple[Fraction, ...]
+    amplitude: tuple[Fraction, ...]
+    q: tuple[tuple[dict[int, Fraction], dict[int, Fraction]], ...]
+    slope: Fraction
+
+
+def limit_cycle_amplitudes(model: Any) -> list[tuple[Fraction, Fraction]]:
+    """The positive roots ``a₀`` of ``S(a) = [sin s] f(a cos s, −a sin s)`` (the first-order
+    secular condition) with ``S'(a₀)``, smallest first; an irrational root is refused (the
+    series are exact rationals)."""
+    a = sp.Symbol("a")
+    g = Ground.for_coefficients([a])
+    x = Trig.from_fourier({1: g.scalar(a)}, {}, g)
+    f = _force_of(model.terms, x, x.derivative(), g)
+    _, sines = f.to_fourier()
+    S = sp.expand(g.to_sympy(sines.get(1, g.scalar(0))))
+    found = []
+    for root in sp.Poly(S, a).real_roots() if S.has(a) else []:
+        if root <= 0 or any(r == root for r, _ in found):
+            continue
+        if not root.is_Rational:
+            raise InputError(f"{model.name}: the limit cycle's amplitude {root} is irrational; "
+                             "the exact series need a rational one")
+        found.append((Fraction(int(root.p), int(root.q)),
+                      _fraction(sp.diff(S, a).subs(a, root))))
+    if not found:
+        raise InputError(f"{model.name} ({model.source}): no limit cycle: the first-order "
+                         f"amplitude function S(a) = {S} has no positive root (the terms odd "
+                         "in q' only dissipate or only feed energy)")
+    return found
+
+
+def _fraction(r: sp.Expr) -> Fraction:
+    r = sp.Rational(r)
+    return Fraction(int(r.p), int(r.q))
+
+
+def _force_of(terms: Any, x: Trig, v: Trig, g: Ground) -> Trig:
+    """``Σ c x^a v^b`` of Trig sums (the first order's force, any ground)."""
+    total = Trig(g.poly([]), g.poly([]), g)
+    for a, b, c in terms:
+        term = Trig(g.poly([g.scalar(c)]), g.poly([]), g)
+        for _ in range(a):
+            term = term * x
+        for _ in range(b):
+            term = term * v
+        total = total + term
+    return total
+
+
+def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
+    """ω, T/2π, q(0) and q_j of limit cycle ``cycle`` (by amplitude, smallest first) to order
+    K.  At order j, ``q_j'' + q_j = F_j`` holds ``a_(j−1)`` (the unknown cos s of ``q_(j−1)``)
+    and ``W_j`` (from ω²) linearly: the sin s condition fixes ``a_(j−1)``, the cos s one
+    ``W_j``; ``q_j'(0) = 0`` fixes its sin s."""
+    order = check_order(order)
+    top = order + 1  # q_K's cos s (so q(0)'s ε^K) is fixed by the secular condition of K + 1
+    cycles = limit_cycle_amplitudes(model)
+    if not 0 <= cycle < len(cycles):
+        raise InputError(f"cycle {cycle}: {model.name} has {len(cycles)} limit cycle(s)")
+    a0, slope = cycles[cycle]
+    g = Ground.for_coefficients([])
+    zero = g.scalar(0)
+
+    def trig(cos: dict, sin: dict) -> Trig:
+        return Trig.from_fourier({n: g.scalar(c) for n, c in cos.items() if c},
+                                 {n: g.scalar(c) for n, c in sin.items() if c}, g)
+
+    cos_s = trig({1: 1}, {})
+    one = Trig(g.poly([g.scalar(1)]), g.poly([]), g)
+    qs = [trig({1: a0}, {})]
+    W, omega = [g.scalar(1)], [g.scalar(1)]
+    powers: dict[tuple[str, int], list] = {}
+
+    def velocity(i: int) -> Trig:  # [ε^i] ω q'
+        acc = qs[i].derivative()
+        for k in range(1, i + 1):
+            acc = acc + qs[i - k].derivative() * omega[k]
+        return acc
+
+    def series(kind: str, n: int, i: int) -> Trig | None:
+        """[ε^i] q^n or (ω q')^n (None for n = 0 beyond i = 0), cached by index; an index is
+        recomputed once its q gains its cos s."""
+        if n == 0:
+            return one if i == 0 else None
+        table = powers.setdefault((kind, n), [])
+        while len(table) <= i:
+            m = len(table)
+            if n == 1:
+                table.append(qs[m] if kind == "q" else velocity(m))
+                continue
+            base = [series(kind, 1, k) for k in range(m + 1)]
+            acc = series(kind, n - 1, 0) * base[m]
+            for k in range(1, m + 1):
+                acc = acc + series(kind, n - 1, k) * base[m - k]
+            table.append(acc)
+        return table[i]
+
+    def force(i: int) -> Trig:  # [ε^i] f(q, ω q')
+        total = Trig(g.poly([]), g.poly([]), g)
+        for a, b, c in model.terms:
+            for k in range(i + 1):
+                left, right = series("q", a, k), series("v", b, i - k)
+                if left is not None and right is not None:
+                    total = total + left * right * g.scalar(c)
+        return total
+
+    lin = None  # the a_(j−1) cos s part's image in F_j: f's linearisation at q_0, + W_1 cos s
+    for j in range(1, top + 1):
+        known = force(j - 1)
+        for i in range(1, j):
+            known = known - qs[j - i].derivative().derivative() * W[i]
+        if j >= 2:
+            if lin is None:
+                x = Trig.from_fourier({1: g.scalar(1)}, {}, g)
+                q0, v0 = qs[0], qs[0].derivative()
+                lin = Trig(g.poly([]), g.poly([]), g)
+                for a, b, c in model.terms:  # d/dλ (q0 + λx)^a (v0 + λx')^b at λ = 0
+                    if a:
+                        lin = lin + _power(q0, a - 1, g) * _power(v0, b, g) * x * g.scalar(c * a)
+                    if b:
+                        lin = lin + _power(q0, a, g) * _power(v0, b - 1, g) * x.derivative() \
+                            * g.scalar(c * b)
+                lin = lin + cos_s * W[1]
+            _, ks = _secular_parts(known, g)
+            _, ls = _secular_parts(lin, g)
+            a_prev = -ks / ls if ls else zero  # the sin s condition
+            qs[j - 1] = qs[j - 1] + cos_s * a_prev
+            for key in powers:  # index j−1 was cached without a_(j−1): recompute it
+                del powers[key][j - 1:]
+            known = force(j - 1)
+            for i in range(1, j):
+                known = known - qs[j - i].derivative().derivative() * W[i]
+        kc, _ = _secular_parts(known, g)
+        Wj = -kc / g.scalar(a0)  # the cos s condition, kc + W_j a0 = 0 (−W_j q_0'' = W_j a0 cos s)
+        W.append(Wj)
+        S = sum((omega[a] * omega[j - a] for a in range(1, j)), zero)
+        omega.append((Wj - S) * g.scalar(Fraction(1, 2)))
+        F = known + cos_s * (Wj * g.scalar(a0))
+        solved = solve_trig(F)
+        cos, sin = solved.particular.to_fourier()
+        cos.pop(1, None)  # its cos s: a_j, fixed at the next order
+        sin.pop(1, None)
+        b1 = -sum((c * n for n, c in sin.items()), zero)  # q_j'(0) = Σ n b_n = 0
+        sin[1] = b1
+        qs.append(trig({n: g.to_fraction(c) for n, c in cos.items()},
+                       {n: g.to_fraction(c) for n, c in sin.items()}))
+    period = [g.scalar(1)]
+    for j in range(1, order + 1):
+        period.append(-sum((omega[a] * period[j - a] for a in range(1, j + 1)), zero))
+    fourier = [tuple({n: g.to_fraction(c) for n, c in part.items() if c}
+                     for part in qj.to_fourier()) for qj in qs[: order + 1]]
+    return LimitCycle(
+        model=model, order=order,
+        omega=tuple(g.to_fraction(w) for w in omega[: order + 1]),
+        period=tuple(g.to_fraction(p) for p in period),
+        amplitude=tuple(sum(cos.values(), Fraction(0)) for cos, _ in fourier),
+        q=tuple(fourier), slope=slope)
+
+
+def _power(x: Trig, n: int, g: Ground) -> Trig:
+    out = Trig(g.poly([g.scalar(1)]), g.poly([]), g)
+    for _ in range(n):
+        out = out * x
+    return out
+
+
+def _secular_parts(F: Trig, g: Ground) -> tuple[Any, Any]:
+    """The Fourier coefficients of cos s and sin s in ``F``."""
+    solved = solve_trig(F)
+    return solved.secular_cos, solved.secular_sin

@@ -301,7 +301,8 @@ def free_model(osc: Oscillator, order: int) -> Model:
         raise osc.refuse(LP, f"q = 0 is no equilibrium (the force there is {terms[(0, 0)]})")
     if any(b % 2 for a, b in terms):
         raise osc.refuse(LP, f"a term odd in {v} dissipates or feeds energy, so there is no "
-                         "family of periodic orbits")
+                         "family of periodic orbits (the limit cycles of q'' + q = eps*f(q, "
+                         "q'): lindstedt series)")
     w2 = terms.pop((1, 0), sp.Integer(0)) + linear
     if w2.free_symbols:
         raise osc.refuse(LP, f"the linear frequency squared {w2} must be a number; give its "
@@ -405,6 +406,51 @@ def _elementary_term(term: sp.Expr, q: sp.Symbol) -> tuple[str, sp.Expr, sp.Expr
     return (type(functions[0]).__name__, lam, coefficient)
 
 
+@dataclass(frozen=True)
+class SelfExcited:
+    """``q̈ + q = ε f(q, q̇)`` with ``f`` polynomial and odd in ``q̇`` somewhere (van der Pol,
+    Rayleigh, Liénard): no family of orbits but isolated limit cycles, whose amplitude the
+    L–P series fixes order by order.  ``terms``: ``(a, b, c)`` of ``c q^a q̇^b`` in ``f``."""
+
+    name: str
+    title: str
+    source: str
+    terms: tuple[tuple[int, int, sp.Rational], ...]
+
+
+def self_excited_model(osc: Oscillator) -> SelfExcited:
+    """The :class:`SelfExcited` record of ``q'' + q - eps*f(q, q') = 0``, or a one-line
+    :class:`InputError` naming what does not fit (every parameter needs a value)."""
+    method = "the limit-cycle series"
+    if osc.drive != 0 or osc.parametric != 0:
+        raise osc.refuse(method, "it is driven or parametrically excited (terms in t)")
+    q, v, small = osc.coordinate, osc.velocity, osc.equation.small
+    if small is None:
+        raise osc.refuse(method, "write the small parameter: q'' + q = eps*f(q, q')")
+    g = sp.expand(osc.force)
+    if not g.is_polynomial(q, v, small):
+        raise osc.refuse(method, "f(q, q') must be a polynomial")
+    poly = sp.Poly(g, q, v, small)
+    f_terms, linear = [], sp.Integer(0)
+    for (a, b, e), c in zip(poly.monoms(), poly.coeffs(), strict=True):
+        if (a, b, e) == (1, 0, 0):
+            linear = c
+        elif e == 1:
+            _check_exact(osc, c, (), f"the coefficient of eps*{q**a * v**b}")
+            f_terms.append((a, b, -sp.Rational(c)))
+        else:
+            raise osc.refuse(method, f"the term {c * q**a * v**b * small**e} is not of the form "
+                             "q'' + q = eps*f(q, q') (ω₀ = 1, eps to the first power)")
+    if linear != 1:
+        raise osc.refuse(method, f"the linear term is {linear}*{q}: write it as q (ω₀ = 1)")
+    if not any(b % 2 for _, b, _ in f_terms):
+        raise osc.refuse(method, "f is even in q': a conservative oscillator (use series, "
+                         "which finds its family of orbits)")
+    f = sum(c * q**a * v**b for a, b, c in f_terms)
+    return SelfExcited(name=osc.name, title=f"{q}'' + {q} = eps*({sp.sstr(f)})",
+                       source=osc.equation.text, terms=tuple(sorted(f_terms)))
+
+
 def _check_exact(osc: Oscillator, c: sp.Expr, params: tuple[sp.Symbol, ...], what: str
                  ) -> None:
     """A coefficient the exact algebra can hold: a polynomial in the symbolic parameters with
@@ -479,6 +525,10 @@ REGISTRY = {e.name: e for e in (
     Entry("velocity_squared", "q'' + q + eps*q*q'**2 = 0",
           "position-dependent mass, time-reversible (q q̇² term)"),
     Entry("sinh_spring", "q'' + sinh(q) = 0", "exponentially hardening spring"),
+    Entry("van_der_pol", "q'' + q = eps*(1 - q**2)*q'", "self-excited: one limit cycle "
+          "(series: its L–P series, amplitude fixed order by order)"),
+    Entry("rayleigh", "q'' + q = eps*(q' - q'**3/3)", "self-excited (Rayleigh): one limit "
+          "cycle"),
 )}
 MODELS = tuple(REGISTRY)
 
@@ -489,6 +539,24 @@ def model_by_name(name: str, order: int) -> Model:
     if entry is None:
         raise InputError(f"model {name!r}: unknown; choose one of {', '.join(MODELS)}")
     return entry.model(order)
+
+
+def series_model(text: str, order: int, values: dict[str, str] | None = None,
+                 name: str | None = None) -> Model | SelfExcited:
+    """What ``lindstedt series`` derives for ``text``: the family of orbits of a conservative
+    oscillator (:func:`model_from_text`), or the limit cycles of a self-excited one (a force
+    odd in q', ``q'' + q = eps*f(q, q')``: :func:`self_excited_model`)."""
+    entry = REGISTRY.get(text) if NAME.fullmatch(text) else None
+    equation = entry.equation if entry is not None and entry.build is None else None
+    if not NAME.fullmatch(text):
+        equation = text
+    if equation is not None:
+        osc = oscillator(equation, values, name or (text if entry else "oscillator"))
+        q, v = osc.coordinate, osc.velocity
+        if osc.drive == 0 and osc.parametric == 0 and osc.force.is_polynomial(q, v) and \
+                sp.expand(osc.force.xreplace({v: -v}) - osc.force) != 0:
+            return self_excited_model(osc)
+    return model_from_text(text, order, values, name)
 
 
 def model_from_text(text: str, order: int, values: dict[str, str] | None = None,

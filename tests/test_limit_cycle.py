@@ -1,0 +1,120 @@
+"""Limit cycles of q'' + q = ε f(q, q'): the exact L–P series (amplitude fixed order by order)
+against the published van der Pol coefficients and against the cycle found numerically
+(DOP853, rtol 1e-12: the period between two turns and q there)."""
+
+from __future__ import annotations
+
+import json
+from fractions import Fraction as F
+
+import numpy as np
+import pytest
+from lindstedt.cli import main
+from lindstedt.errors import InputError
+from lindstedt.lindstedt import derive_limit_cycle, limit_cycle_amplitudes
+from lindstedt.models import oscillator, self_excited_model
+from scipy.integrate import solve_ivp
+
+VDP = "q'' + q = eps*(1 - q**2)*q'"
+LIENARD = "q'' + q = eps*(1 - 5*q**2/4 + q**4/8)*q'"
+# NOTE: S(a) = −a(1 − 5a²/16 + a⁴/64): two cycles, a = 2 and a = 4, of opposite stability
+
+
+def model(text: str):
+    return self_excited_model(oscillator(text, name="cycle"))
+
+
+def numerical_cycle(f, eps: float, q0: float, backwards: bool = False,
+                    settle_time: float = 200.0) -> tuple[float, float]:
+    """(period, q at the turn q' = 0, q > 0) of the cycle reached from (q0, 0): time to settle
+    (the offset decays like exp(−ε S'(a₀) t/2); backwards in time for a repelling cycle), then
+    the time between two turns."""
+    sign = -1.0 if backwards else 1.0
+
+    def rhs(_t, y):
+        q, p = y
+        return [sign * p, sign * (-q + eps * f(q, p))]
+
+    settle = solve_ivp(rhs, (0, settle_time), [q0, 0.0], method="DOP853", rtol=1e-12,
+                       atol=1e-14)
+    start = settle.y[:, -1]
+
+    def turn(_t, y):
+        return y[1]
+    turn.direction = 1.0 if backwards else -1.0  # q' through zero at a maximum of q
+
+    run = solve_ivp(rhs, (0, 40), start, method="DOP853", rtol=1e-12, atol=1e-14,
+                    events=turn, dense_output=True)
+    t = run.t_events[0]
+    q = run.y_events[0][:, 0]
+    assert len(t) >= 3
+    return float(t[2] - t[1]), float(q[2])
+
+
+def test_van_der_pol_against_the_published_coefficients():
+    """ω = 1 − ε²/16 + 17ε⁴/3072 + 35ε⁶/884736 − 678899ε⁸/5096079360 …, the amplitude
+    2 + ε²/96 − 1033ε⁴/552960 … (Andersen & Geer 1982; the classical values)."""
+    lc = derive_limit_cycle(model(VDP), 8)
+    assert list(lc.omega) == [1, 0, F(-1, 16), 0, F(17, 3072), 0, F(35, 884736), 0,
+                              F(-678899, 5096079360)]
+    assert list(lc.amplitude[:5]) == [2, 0, F(1, 96), 0, F(-1033, 552960)]
+    assert lc.q[1] == ({}, {1: F(3, 4), 3: F(-1, 4)})  # q₁ = (3 sin s − sin 3s)/4
+    assert lc.slope == 2  # S'(2) > 0: attracting for ε > 0
+
+
+@pytest.mark.parametrize("eps", [0.1, 0.3])
+def test_van_der_pol_period_and_amplitude_against_the_numerical_cycle(eps):
+    lc = derive_limit_cycle(model(VDP), 24)
+    T, q_max = numerical_cycle(lambda q, p: (1 - q * q) * p, eps, 1.0)
+    series_T = 2 * np.pi * sum(float(c) * eps**j for j, c in enumerate(lc.period))
+    series_q = sum(float(c) * eps**j for j, c in enumerate(lc.amplitude))
+    assert series_T == pytest.approx(T, rel=1e-10)
+    assert series_q == pytest.approx(q_max, rel=1e-9)
+
+
+def test_a_quartic_lienard_term_has_two_cycles_of_opposite_stability():
+    cycles = limit_cycle_amplitudes(model(LIENARD))
+    assert [a for a, _ in cycles] == [2, 4]
+    (_, s_inner), (_, s_outer) = cycles
+    assert s_inner * s_outer < 0
+    eps = 0.05
+    f = lambda q, p: (1 - 1.25 * q * q + q**4 / 8) * p  # noqa: E731
+    for k, (_, slope) in enumerate(cycles):
+        lc = derive_limit_cycle(model(LIENARD), 12, cycle=k)
+        # an attracting cycle is reached forwards in time, a repelling one backwards
+        rate = eps * abs(float(slope)) / 2  # the offset decays like exp(−rate t)
+        T, q_max = numerical_cycle(f, eps, [1.9, 4.1][k], backwards=slope < 0,
+                                   settle_time=40 / rate)
+        assert 2 * np.pi * sum(float(c) * eps**j for j, c in enumerate(lc.period)) == \
+            pytest.approx(T, rel=1e-9)
+        assert sum(float(c) * eps**j for j, c in enumerate(lc.amplitude)) == \
+            pytest.approx(q_max, rel=1e-8)
+
+
+def test_rayleigh_has_van_der_pols_frequency():
+    """q̈ + q = ε(q̇ − q̇³/3) is van der Pol's equation for q̇ (differentiate): the same ω."""
+    assert derive_limit_cycle(model("q'' + q = eps*(q' - q'**3/3)"), 8).omega == \
+        derive_limit_cycle(model(VDP), 8).omega
+
+
+def test_refusals_name_what_is_wrong():
+    with pytest.raises(InputError, match="no limit cycle"):
+        derive_limit_cycle(model("q'' + q = -eps*q'"), 4)
+    with pytest.raises(InputError, match="irrational"):
+        derive_limit_cycle(model("q'' + q = eps*(1 - 2*q**2)*q'"), 4)  # a = √2
+    with pytest.raises(InputError, match="conservative"):
+        model("q'' + q = eps*q**3")
+    with pytest.raises(InputError, match="cycle 1"):
+        derive_limit_cycle(model(VDP), 2, cycle=1)
+
+
+def test_series_json_of_a_limit_cycle(capsys):
+    assert main(["series", "van_der_pol", "--order", "4", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["omega"] == ["1/1", "0/1", "-1/16", "0/1", "17/3072"]
+    assert data["amplitude"][:3] == ["2/1", "0/1", "1/96"]
+    assert data["q"][1] == {"cos": {}, "sin": {"1": "3/4", "3": "-1/4"}}
+    assert data["stable_for"] == "eps > 0"
+    assert main(["series", "q'' + q + eps*q' = 0", "--order", "2"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "no limit cycle" in err
