@@ -8,6 +8,7 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
                QQ[params] (fmpq_mpoly), the odd-cosine fast path, and the Laurent form in e^{is}
                over complex128 for the numeric methods
     lindstedt  L–P series, order-by-order equations, naive expansion    Model, K -> SeriesSolution
+               and the limit cycles of q'' + q = ε f(q, q')             SelfExcited, K -> LimitCycle
     numerics   references: elliptic periods, Jacobi cn; one RK4 step for any polynomial force
                table: shooting + Floquet, sweeps, true folds, simulations
     driven     μ-expansion with phase, harmonic balance (Duffing; and a  Drive | equation ->
