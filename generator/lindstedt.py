@@ -648,10 +648,23 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
     W, omega = [g.scalar(1)], [g.scalar(1)]
     powers: dict[tuple[str, int], list] = {}
 
+    slopes: dict[int, Trig] = {}  # q_i' and q_i'', each made once (index j − 1 remade when
+    curvatures: dict[int, Trig] = {}  # its cos s arrives)
+
+    def slope_of(i: int) -> Trig:
+        if i not in slopes:
+            slopes[i] = qs[i].derivative()
+        return slopes[i]
+
+    def curvature_of(i: int) -> Trig:
+        if i not in curvatures:
+            curvatures[i] = slope_of(i).derivative()
+        return curvatures[i]
+
     def velocity(i: int) -> Trig:  # [ε^i] ω q'
-        acc = qs[i].derivative()
+        acc = slope_of(i)
         for k in range(1, i + 1):
-            acc = acc + qs[i - k].derivative() * omega[k]
+            acc = acc + slope_of(i - k) * omega[k]
         return acc
 
     def series(kind: str, n: int, i: int) -> Trig | None:
@@ -685,7 +698,7 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
     for j in range(1, top + 1):
         known = force(j - 1)
         for i in range(1, j):
-            known = known - qs[j - i].derivative().derivative() * W[i]
+            known = known - curvature_of(j - i) * W[i]
         if j >= 2:
             if lin is None:
                 x = Trig.from_fourier({1: g.scalar(1)}, {}, g)
@@ -704,23 +717,23 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
             qs[j - 1] = qs[j - 1] + cos_s * a_prev
             for key in powers:  # index j−1 was cached without a_(j−1): recompute it
                 del powers[key][j - 1:]
+            slopes.pop(j - 1, None)
+            curvatures.pop(j - 1, None)
             known = force(j - 1)
             for i in range(1, j):
-                known = known - qs[j - i].derivative().derivative() * W[i]
+                known = known - curvature_of(j - i) * W[i]
         kc, _ = _secular_parts(known, g)
         Wj = -kc / g.scalar(a0)  # the cos s condition, kc + W_j a0 = 0 (−W_j q_0'' = W_j a0 cos s)
         W.append(Wj)
         S = sum((omega[a] * omega[j - a] for a in range(1, j)), zero)
         omega.append((Wj - S) * g.scalar(Fraction(1, 2)))
         F = known + cos_s * (Wj * g.scalar(a0))
-        solved = solve_trig(F)
-        cos, sin = solved.particular.to_fourier()
-        cos.pop(1, None)  # its cos s: a_j, fixed at the next order
-        sin.pop(1, None)
-        b1 = -sum((c * n for n, c in sin.items()), zero)  # q_j'(0) = Σ n b_n = 0
-        sin[1] = b1
-        qs.append(trig({n: g.to_fraction(c) for n, c in cos.items()},
-                       {n: g.to_fraction(c) for n, c in sin.items()}))
+        p = solve_trig(F).particular
+        # its cos s (a_j) waits for the next order's sin s condition; its sin s makes
+        # q_j'(0) = R(1) = 0 (d/ds of S·R(C) at s = 0 is R(1); of P(C), 0): R's constant term
+        r = p.sin_part.coeffs()
+        r_at_one = sum(r, zero)
+        qs.append(Trig(p.cos_part, p.sin_part - g.poly([r_at_one]), g))
     period = [g.scalar(1)]
     for j in range(1, order + 1):
         period.append(-sum((omega[a] * period[j - a] for a in range(1, j + 1)), zero))

@@ -174,6 +174,10 @@ class Ground:
     def scalar(self, value: Any) -> Any:
         """An exact ring element from an int, Fraction, SymPy number or expression."""
         if self.is_rational:
+            if type(value) is int:  # the common case, without SymPy
+                return fmpq(value)
+            if isinstance(value, Fraction):
+                return fmpq(value.numerator, value.denominator)
             r = sp.Rational(value)
             return fmpq(int(r.p), int(r.q))
         ctx = self._flint_ring
@@ -384,18 +388,18 @@ class Trig:
     def to_fourier(self) -> tuple[dict[int, Any], dict[int, Any]]:
         """``({n: a_n}, {n: b_n})``, zero coefficients left out."""
         g = self.ground
-        cosines = to_fourier(self.cos_part, Basis(False), g)
-        rs = self.sin_part.coeffs()
-        sines: dict[int, Any] = {}
+        basis = Basis(False)
+        cosines = to_fourier(self.cos_part, basis, g)
+        # S·R(C) with R(C) = Σ ρ_n cos ns: cos ns · sin s = (sin(n+1)s − sin(n−1)s)/2
         half = g.scalar(Fraction(1, 2))
-        for r in reversed(rs):  # Horner: (sin ns)·C = (sin(n+1)s + sin(n−1)s)/2, then + r·S
-            shifted: dict[int, Any] = {}
-            for n, b in sines.items():
-                for m in (n + 1, n - 1):
-                    if m:
-                        shifted[m] = shifted.get(m, g.scalar(0)) + b * half
-            shifted[1] = shifted.get(1, g.scalar(0)) + r
-            sines = shifted
+        sines: dict[int, Any] = {}
+        for n, rho in to_fourier(self.sin_part, basis, g).items():
+            if n == 0:
+                sines[1] = sines.get(1, g.scalar(0)) + rho
+                continue
+            sines[n + 1] = sines.get(n + 1, g.scalar(0)) + rho * half
+            if n > 1:
+                sines[n - 1] = sines.get(n - 1, g.scalar(0)) - rho * half
         return cosines, {n: b for n, b in sorted(sines.items()) if b}
 
     def __add__(self, other: Trig) -> Trig:
@@ -414,18 +418,26 @@ class Trig:
         return Trig(cos_part, sin_part, self.ground)
 
     def _one_minus_c2(self) -> Any:
-        g = self.ground
-        return g.poly([g.scalar(1), g.scalar(0), g.scalar(-1)])
+        return _constants(self.ground)[1]
 
     def derivative(self) -> Trig:
         """``d/ds``: ``d P(C) = −S P'(C)``, ``d(S R(C)) = C R − (1 − C²) R'``."""
         g = self.ground
         dP, dR = _dC(self.cos_part, g), _dC(self.sin_part, g)
-        C = g.poly([g.scalar(0), g.scalar(1)])
-        return Trig(C * self.sin_part - self._one_minus_c2() * dR, dP * g.scalar(-1), g)
+        C, one_minus_c2, minus_one = _constants(g)
+        return Trig(C * self.sin_part - one_minus_c2 * dR, dP * minus_one, g)
+
+
+@cache
+def _constants(ground: Ground) -> tuple[Any, Any, Any]:
+    """``C``, ``1 − C²`` and −1 of a ground, made once."""
+    zero, one = ground.scalar(0), ground.scalar(1)
+    return (ground.poly([zero, one]), ground.poly([one, zero, -one]), ground.scalar(-1))
 
 
 def _dC(poly: Any, ground: Ground) -> Any:
+    if ground.is_rational:  # FLINT's own derivative
+        return poly.derivative()
     cs = poly.coeffs()
     return ground.poly([c * k for k, c in enumerate(cs)][1:])
 
