@@ -204,14 +204,38 @@ def _cmd_series(args: argparse.Namespace) -> int:
     found = series_model(args.model, args.order, _params(args.param), args.name)
     if isinstance(found, SelfExcited):
         lc = derive_limit_cycle(found, args.order)
-        print(json.dumps(limit_cycle_json(lc)) if args.json else limit_cycle_table(lc))
-        return 0
-    model = _free_model(args, args.order)
-    progress = Progress(f"deriving {model.name} to order {args.order}", not args.json)
-    sol = derive(model, args.order, progress)
-    progress.close()
-    print(json.dumps(series_json(sol)) if args.json else series_table(sol))
+        data, text = limit_cycle_json(lc), limit_cycle_table(lc)
+        omega = lc.omega
+    else:
+        model = _free_model(args, args.order)
+        progress = Progress(f"deriving {model.name} to order {args.order}", not args.json)
+        sol = derive(model, args.order, progress)
+        progress.close()
+        data, text = series_json(sol), series_table(sol)
+        omega = [sol.ground.to_fraction(c) for c in sol.omega] if sol.ground.is_rational \
+            else None
+    if args.singularities:
+        data["singularities"], line = _singularities(omega, data["variable"])
+        text += "\n" + line
+    print(json.dumps(data) if args.json else text)
     return 0
+
+
+def _singularities(omega, variable: str) -> tuple[list[dict], str]:
+    """``--singularities``: the nearest singularity of ω estimated from its exact series."""
+    from .lindstedt import nearest_singularity
+
+    if omega is None:
+        raise InputError("--singularities: the coefficients stay symbolic; give every "
+                         "parameter a value (--param)")
+    name = variable.partition("=")[0].strip() or variable
+    est = nearest_singularity(omega, name)
+    if est is None:
+        return [], "singularities: too few nonzero coefficients for an estimate (raise --order)"
+    row = {"variable": est.variable, "radius": est.radius, "angle": est.angle,
+           "spread": est.spread, "method": est.method}
+    return [row], (f"nearest singularity of omega ({est.method}): |{est.variable}| = "
+                   f"{est.radius:.6g}, angle ±{est.angle:.6g} rad, spread {est.spread:.2g}")
 
 
 def _cmd_models(args: argparse.Namespace) -> int:
@@ -1406,6 +1430,10 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Derive ω_j, (T/2π)_j and q_j of the L–P series exactly.")
     _flag_oscillator(p)
     _flag_order(p, "highest order K of the series")
+    p.add_argument("--singularities", action="store_true",
+                   help="also estimate the nearest singularities of ω from the exact series "
+                   "(Domb–Sykes or Mercer–Roberts, extrapolated in 1/n; their spread over the "
+                   "last orders); with --json a key 'singularities'")
     _flag_json(p)
     _flag_allow_slow(p)
     p.set_defaults(func=_cmd_series)

@@ -13,7 +13,8 @@ it; the first-harmonic convention would give other coefficients).
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
 from math import factorial
@@ -758,3 +759,78 @@ def _secular_parts(F: Trig, g: Ground) -> tuple[Any, Any]:
     """The Fourier coefficients of cos s and sin s in ``F``."""
     solved = solve_trig(F)
     return solved.secular_cos, solved.secular_sin
+
+
+@dataclass(frozen=True)
+class Singularity:
+    """The nearest singularities of a series, estimated from its coefficients: at ``radius``
+    and ``±angle`` (radians) in the plane of ``variable``; ``spread``: how far the estimates
+    from the last orders (extrapolated in 1/n) lie apart — the estimate's own uncertainty."""
+
+    variable: str
+    radius: float
+    angle: float
+    spread: float
+    method: str
+
+
+def nearest_singularity(coefficients: Sequence[Fraction], variable: str = "eps"
+                        ) -> Singularity | None:
+    """Domb–Sykes (ratios c_n/c_(n−1), for one real singularity: a tail of one sign or of
+    alternating signs) or Mercer–Roberts (a complex-conjugate pair: B_n² = (c_(n+1)c_(n−1) −
+    c_n²)/(c_n c_(n−2) − c_(n−1)²) → 1/R², cos θ from the same), each estimate extrapolated
+    linearly in 1/n over the last orders.  A series with zero odd terms is read in the square
+    of ``variable``.  None with fewer than 12 usable coefficients."""
+    import mpmath
+
+    c = list(coefficients)
+    if len(c) > 2 and all(x == 0 for x in c[1::2]):
+        c, variable = c[::2], f"{variable}**2"
+    c = [mpmath.mpf(x.numerator) / x.denominator for x in c]
+    while c and c[-1] == 0:
+        c.pop()
+    if len(c) < 12:
+        return None
+    tail = c[len(c) // 2:]
+    signs = [mpmath.sign(x) for x in tail]
+    real = all(s == signs[0] for s in signs) or all(
+        signs[k] == -signs[k + 1] for k in range(len(signs) - 1))
+    ns, radii, angles = [], [], []
+    for n in range(max(3, len(c) // 2), len(c) - 1):
+        if real:
+            if c[n - 1] == 0:
+                continue
+            ratio = abs(c[n] / c[n - 1])
+            radii.append(1 / ratio)
+            angles.append(0.0 if signs[0] == signs[-1] and all(
+                s == signs[0] for s in signs) else math.pi)
+        else:
+            den = c[n] * c[n - 2] - c[n - 1] ** 2
+            if den == 0 or c[n] == 0:
+                continue
+            b2 = (c[n + 1] * c[n - 1] - c[n] ** 2) / den
+            if b2 <= 0:
+                continue
+            b = mpmath.sqrt(b2)
+            cos_t = (c[n - 1] * b / c[n] + c[n + 1] / (b * c[n])) / 2
+            radii.append(1 / b)
+            angles.append(float(mpmath.acos(max(-1, min(1, cos_t)))))
+        ns.append(n)
+    if len(ns) < 4:
+        return None
+
+    def extrapolate(values: list, lo: int) -> float:
+        x = [1 / mpmath.mpf(n) for n in ns[lo:]]
+        y = [mpmath.mpf(v) for v in values[lo:]]
+        mx, my = sum(x) / len(x), sum(y) / len(y)
+        sxx = sum((a - mx) ** 2 for a in x)
+        slope = sum((a - mx) * (b - my) for a, b in zip(x, y, strict=True)) / sxx
+        return float(my - slope * mx)
+
+    half = len(ns) // 2
+    fits = [extrapolate(radii, lo) for lo in range(0, half + 1)]
+    angle_fits = [extrapolate(angles, lo) for lo in range(0, half + 1)]
+    radius, angle = fits[-1], angle_fits[-1] if not real else angles[-1]
+    spread = max(fits) - min(fits)
+    return Singularity(variable, radius, float(angle), float(spread),
+                       "Domb–Sykes" if real else "Mercer–Roberts")
