@@ -721,3 +721,59 @@ def steady_state_fit(eps: float, damping: float, forces: list[float],
         var = np.where(amp > 0, (c * c * var_c + s * s * var_s + 2 * c * s * cov_cs)
                        / np.where(amp > 0, amp * amp, 1.0), (var_c + var_s) / 2)
     return ToneFit(amp, np.sqrt(np.maximum(var, 0.0)), math.sqrt(sigma2))
+
+
+@dataclass(frozen=True)
+class LimitCycleOrbit:
+    """A limit cycle of the autonomous ``q̈ + g(q, q̇) = 0`` found by shooting: ``q(0)`` at the
+    turn ``q̇(0) = 0``, its period, and its Floquet multipliers (one is 1, the phase; the other
+    ``det M``) with the exponent ``ln|det M| / T`` (< 0: the cycle attracts)."""
+
+    q0: float
+    period: float
+    multipliers: tuple[complex, complex]
+    exponent: float
+
+
+def limit_cycle_orbit(table: ForceTable, q0: float, period: float, tol: float = 1e-12,
+                      max_iter: int = 30) -> LimitCycleOrbit | None:
+    """Newton's method on ``φ_T(q₀, 0) − (q₀, 0) = 0`` in ``(q₀, T)`` (the phase fixed by
+    ``q̇(0) = 0``): the Jacobian is ``[M e₁ − e₁, ẏ(T)]`` with the monodromy ``M`` from the one
+    compiled RK4 step (Richardson pair).  None when Newton does not converge."""
+    q, T = float(q0), float(period)
+    for _ in range(max_iter):
+        if not (np.isfinite(q) and np.isfinite(T) and T > 0):
+            return None
+        end, _, escaped = flow_table(table, 0.0, 2 * np.pi / T, np.array([q, 0.0]), T)
+        if escaped >= 0 or not np.all(np.isfinite(end)):
+            return None
+        residual = end[:2] - np.array([q, 0.0])
+        M = end[2:].reshape(2, 2, order="F")
+        g, _, _ = _table_force(end[0], end[1], table.q_powers, table.v_powers,
+                               table.coefficients)
+        jacobian = np.column_stack([M[:, 0] - np.array([1.0, 0.0]), [end[1], -g]])
+        try:
+            step = np.linalg.solve(jacobian, -residual)
+        except np.linalg.LinAlgError:
+            return None
+        q, T = q + step[0], T + step[1]
+        if np.max(np.abs(step)) < tol * max(1.0, abs(q), T):
+            end, _, _ = flow_table(table, 0.0, 2 * np.pi / T, np.array([q, 0.0]), T)
+            M = end[2:].reshape(2, 2, order="F")
+            mu = np.linalg.eigvals(M)
+            mu = tuple(sorted((complex(m) for m in mu), key=lambda m: abs(abs(m) - 1)))
+            return LimitCycleOrbit(q, T, mu, float(np.log(abs(np.linalg.det(M))) / T))
+    return None
+
+
+def true_limit_cycle(model: object, eps: float, cycle: int = 0, order: int = 12
+                     ) -> LimitCycleOrbit | None:
+    """The true orbit of limit cycle ``cycle`` of a :class:`models.SelfExcited` oscillator at
+    ``eps``, shot from its L–P series at ``order`` (q(0) and T as the seed)."""
+    from .lindstedt import derive_limit_cycle
+
+    lc = derive_limit_cycle(model, order, cycle)
+    table = ForceTable.of({(1, 0): 1.0, **{(a, b): -eps * float(c) for a, b, c in model.terms}})
+    q0 = sum(float(c) * eps**j for j, c in enumerate(lc.amplitude))
+    T = 2 * np.pi * sum(float(c) * eps**j for j, c in enumerate(lc.period))
+    return limit_cycle_orbit(table, q0, T)

@@ -138,3 +138,30 @@ def test_nearest_singularities_from_the_exact_series():
         est = nearest_singularity([sol.ground.to_fraction(c) for c in sol.period], "y")
         assert est.method == "Domb–Sykes" and est.angle == angle
         assert abs(est.radius / where - 1) < 0.01
+
+
+def test_true_cycle_and_its_floquet_exponent():
+    """Shooting in (q(0), T) from the series' seed: van der Pol's period at ε = 1 is the
+    classical 6.6632868593…; the exponent ln|det M|/T equals Liouville's ∮ ε ∂f/∂q̇ dt / T
+    integrated along DOP853's cycle, and at small ε the averaged −ε S'(a₀)/2 (opposite signs
+    for the Liénard term's two cycles)."""
+    from lindstedt.numerics import true_limit_cycle
+
+    vdp = model(VDP)
+    one = true_limit_cycle(vdp, 1.0)
+    assert one.period == pytest.approx(6.663286859323, rel=1e-10)
+    eps = 0.3
+    orbit = true_limit_cycle(vdp, eps)
+    assert min(abs(m - 1) for m in orbit.multipliers) < 1e-9  # the phase direction
+
+    def rhs(_t, y):
+        q, p, _ = y
+        return [p, -q + eps * (1 - q * q) * p, eps * (1 - q * q)]  # ∂f/∂q̇ = 1 − q²
+
+    run = solve_ivp(rhs, (0, orbit.period), [orbit.q0, 0.0, 0.0], method="DOP853",
+                    rtol=1e-12, atol=1e-14)
+    assert orbit.exponent == pytest.approx(run.y[2, -1] / orbit.period, rel=1e-8)
+    lienard = model(LIENARD)
+    for k, (_, slope) in enumerate(limit_cycle_amplitudes(lienard)):
+        cycle = true_limit_cycle(lienard, 0.01, k)
+        assert cycle.exponent == pytest.approx(-0.01 * float(slope) / 2, rel=0.02)
