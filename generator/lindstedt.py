@@ -716,13 +716,12 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
             _, ls = _secular_parts(lin, g)
             a_prev = -ks / ls if ls else zero  # the sin s condition
             qs[j - 1] = qs[j - 1] + cos_s * a_prev
-            for key in powers:  # index j−1 was cached without a_(j−1): recompute it
+            for key in powers:  # index j−1 was cached without a_(j−1): made again when used
                 del powers[key][j - 1:]
             slopes.pop(j - 1, None)
             curvatures.pop(j - 1, None)
-            known = force(j - 1)
-            for i in range(1, j):
-                known = known - curvature_of(j - i) * W[i]
+            # F_j holds a_(j−1) linearly, through f's linearisation at q_0 and W_1 q_(j−1)''
+            known = known + lin * a_prev
         kc, _ = _secular_parts(known, g)
         Wj = -kc / g.scalar(a0)  # the cos s condition, kc + W_j a0 = 0 (−W_j q_0'' = W_j a0 cos s)
         W.append(Wj)

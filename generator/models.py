@@ -436,7 +436,7 @@ def self_excited_model(osc: Oscillator) -> SelfExcited:
         if (a, b, e) == (1, 0, 0):
             linear = c
         elif e == 1:
-            _check_exact(osc, c, (), f"the coefficient of eps*{q**a * v**b}")
+            _check_exact(osc, c, (), f"the coefficient of eps*{q**a * v**b}", method)
             f_terms.append((a, b, -sp.Rational(c)))
         else:
             raise osc.refuse(method, f"the term {c * q**a * v**b * small**e} is not of the form "
@@ -451,8 +451,8 @@ def self_excited_model(osc: Oscillator) -> SelfExcited:
                        source=osc.equation.text, terms=tuple(sorted(f_terms)))
 
 
-def _check_exact(osc: Oscillator, c: sp.Expr, params: tuple[sp.Symbol, ...], what: str
-                 ) -> None:
+def _check_exact(osc: Oscillator, c: sp.Expr, params: tuple[sp.Symbol, ...], what: str,
+                 method: str = LP) -> None:
     """A coefficient the exact algebra can hold: a polynomial in the symbolic parameters with
     rational numbers (``QQ[params]``), not ``1/alpha``, ``sin(1)`` or ``sqrt(2)``."""
     try:
@@ -462,7 +462,7 @@ def _check_exact(osc: Oscillator, c: sp.Expr, params: tuple[sp.Symbol, ...], wha
             TypeError):
         ok = False
     if not ok:
-        raise osc.refuse(LP, f"{what} is {sp.sstr(c)}: exact algebra needs rational numbers "
+        raise osc.refuse(method, f"{what} is {sp.sstr(c)}: exact algebra needs rational numbers "
                          "and polynomials in the parameters (give values with --param, write "
                          "rationals)")
 
