@@ -270,7 +270,17 @@ def _cmd_generate(args: argparse.Namespace) -> int:
                                           overwrite_edited=args.overwrite_edited)
     else:
         from .lower import check_emitted_names
+        from .models import SelfExcited, series_model
 
+        found = series_model(args.model, order + 2, _params(args.param), args.name)
+        if isinstance(found, SelfExcited):
+            if args.allow_divergent:
+                raise InputError("--allow-divergent: a limit cycle's evaluators stop at their "
+                                 "estimated radius")
+            for path in compiler.generate_limit_cycle(found, order, out,
+                                                      overwrite_edited=args.overwrite_edited):
+                print(path)
+            return 0
         model = _free_model(args, order + 2)
         check_emitted_names(model)  # before the derivation: a clash is known at once
         progress = Progress(f"deriving {model.name} to order {order + 2}")

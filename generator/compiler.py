@@ -20,6 +20,7 @@ from .methods import (
     CHOSEN_PERIOD,
     FOURIER,
     FREE,
+    LIMIT_CYCLE,
     MU,
     Candidate,
     Method,
@@ -61,6 +62,17 @@ def generate(model: str | Model, order: int, out: Path, allow_divergent: bool = 
     command = f"lindstedt generate {source} --order {order}" + (
         " --allow-divergent" if allow_divergent else "")
     return compile_target(FREE, Request(order, command, m, allow_divergent), out, progress,
+                          overwrite_edited=overwrite_edited, flag=flag)
+
+
+def generate_limit_cycle(model: object, order: int, out: Path, *,
+                         overwrite_edited: bool = False, flag: str = "--out") -> list[Path]:
+    """``lindstedt generate`` of a self-excited oscillator: its limit cycle's evaluators."""
+    order = check_order(order)
+    if order < 1:
+        raise InputError(f"order {order}: a limit cycle's evaluators start at order 1")
+    command = f'lindstedt generate "{model.source}" --name {model.name} --order {order}'
+    return compile_target(LIMIT_CYCLE, Request(order, command, model), out,
                           overwrite_edited=overwrite_edited, flag=flag)
 
 

@@ -53,7 +53,7 @@ from .driven import (
     one_harmonic,
 )
 from .errors import InputError
-from .lindstedt import derive
+from .lindstedt import derive, derive_limit_cycle
 from .lower import (
     FOURIER_AGM_STEPS,
     MuDerivation,
@@ -68,9 +68,10 @@ from .lower import (
     lower_driven,
     lower_fourier,
     lower_free,
+    lower_limit_cycle,
     x_,
 )
-from .models import Model, check_order, duffing
+from .models import Model, SelfExcited, check_order, duffing
 from .numerics import duffing_period_exact, shoot
 
 Progress = Callable[[int, int], None]
@@ -417,7 +418,7 @@ class Request:
 
     order: int
     command: str
-    model: Model | None = None
+    model: Model | SelfExcited | None = None
     allow_divergent: bool = False
     candidate: Candidate | None = None
     verified: tuple[float, float] = (0.0, 0.0)
@@ -445,6 +446,23 @@ def _free_derive(r: Request, progress: Progress | None) -> object:
 def _free_lower(solution: object, r: Request) -> Unit:
     module = lower_free(solution, r.command, r.allow_divergent)
     return Unit(module, (lower_derivation(solution, r.order),))
+
+
+def _cycle_files(r: Request) -> tuple[str, ...]:
+    return (f"{r.model.name}.py",)
+
+
+RADIUS_ORDER = 60
+# NOTE: a limit cycle's radius is estimated from ω to at least this order (1 % from order 60
+# for van der Pol), whatever order its evaluators sum.
+
+
+def _cycle_derive(r: Request, progress: Progress | None) -> object:
+    return derive_limit_cycle(r.model, max(r.order + 2, RADIUS_ORDER))
+
+
+def _cycle_lower(cycle: object, r: Request) -> Unit:
+    return Unit(lower_limit_cycle(cycle, r.command, r.order))
 
 
 NOTES_DRIVE = (0.1, 1.0, 1.0)
@@ -510,6 +528,7 @@ def _choice_lower(c: object, r: Request) -> Unit:
 
 
 FREE = Target(_free_files, _free_derive, _free_lower)
+LIMIT_CYCLE = Target(_cycle_files, _cycle_derive, _cycle_lower)
 MU = Target(lambda r: ("driven.py", "driven_derivation.tex"), _mu_derive, _mu_lower)
 BALANCE = Target(lambda r: ("balance.py",), _balance_derive, _balance_lower)
 FOURIER = Target(lambda r: ("fourier.py",), _fourier_derive, _fourier_lower)

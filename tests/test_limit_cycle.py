@@ -165,3 +165,27 @@ def test_true_cycle_and_its_floquet_exponent():
     for k, (_, slope) in enumerate(limit_cycle_amplitudes(lienard)):
         cycle = true_limit_cycle(lienard, 0.01, k)
         assert cycle.exponent == pytest.approx(-0.01 * float(slope) / 2, rel=0.02)
+
+
+def test_emitted_limit_cycle_module_against_the_true_cycle(tmp_path):
+    """`lindstedt generate van_der_pol`: ω, T, q(0) and q(t) against the shot cycle and
+    DOP853 from it, within the module's own error estimate; NaN from 90 % of its estimated
+    radius (√3.42 in ε) on."""
+    from lindstedt.emit import load_generated
+    from lindstedt.numerics import true_limit_cycle
+
+    assert main(["generate", "van_der_pol", "--order", "16", "--out", str(tmp_path)]) == 0
+    mod = load_generated(tmp_path / "van_der_pol.py")
+    assert 0.9 * 3.40**0.5 < mod.RADIUS < 0.9 * 3.44**0.5
+    assert np.isnan(mod.period(2.0)) and np.isnan(mod.q(0.5, -2.0))
+    for eps in (0.1, 0.3, 0.6):
+        cycle = true_limit_cycle(model(VDP), eps)
+        bound = max(1e-11, 3 * mod.error_estimate(eps))
+        assert mod.period(eps) == pytest.approx(cycle.period, rel=bound)
+        assert mod.omega(eps) == pytest.approx(2 * np.pi / cycle.period, rel=bound)
+        assert mod.amplitude(eps) == pytest.approx(cycle.q0, rel=max(1e-10, 30 * bound))
+        t = np.linspace(0.0, cycle.period, 7)
+        run = solve_ivp(lambda _t, y, e=eps: [y[1], -y[0] + e * (1 - y[0] ** 2) * y[1]],
+                        (0, cycle.period), [cycle.q0, 0.0], method="DOP853", rtol=1e-12,
+                        atol=1e-14, t_eval=t)
+        np.testing.assert_allclose(mod.q(t, eps), run.y[0], atol=max(1e-9, 30 * bound))
