@@ -57,7 +57,7 @@ CASES = [
     ["sweep", "validity", "--omega", "0.5:1.5:128", "--force", "0.3", "--eps", "0.1", "--Q",
      "inf", "--json"],
 ]
-SLOW = {"series", "generate", "driven", "response", "choose", "sweep"}
+SLOW = {"series", "generate", "driven", "response", "choose", "sweep", "mathieu"}
 # NOTE: the commands that take --allow-slow (the others never exceed the limit).
 
 

@@ -9,6 +9,8 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
                over complex128 for the numeric methods
     lindstedt  L–P series, order-by-order equations, naive expansion    Model, K -> SeriesSolution
                and the limit cycles of q'' + q = ε f(q, q')             SelfExcited, K -> LimitCycle
+    hill       Mathieu's a_m(q), b_m(q) as exact series (L–P about      kind, m, K -> [c_k]
+               cos mz, sin mz)
     numerics   references: elliptic periods, Jacobi cn; one RK4 step for any polynomial force
                table: shooting + Floquet, sweeps, true folds, simulations
     driven     μ-expansion with phase, harmonic balance (Duffing; and a  Drive | equation ->

@@ -238,6 +238,22 @@ def _singularities(omega, variable: str) -> tuple[list[dict], str]:
                    f"{est.radius:.6g}, angle ±{est.angle:.6g} rad, spread {est.spread:.2g}")
 
 
+def _cmd_mathieu(args: argparse.Namespace) -> int:
+    """``lindstedt mathieu a|b --m M --order K``: DLMF §28.6's series of a_m(q) or b_m(q)."""
+    from .hill import mathieu_series
+
+    series = mathieu_series(args.kind, args.m, args.order)
+    if args.json:
+        print(json.dumps({"kind": args.kind, "m": args.m, "variable": "q",
+                          "series": [_fraction_text(c) for c in series]}))
+        return 0
+    print(f"{args.kind}_{args.m}(q) of y'' + (a - 2q cos 2z) y = 0 (DLMF 28.2.1), order "
+          f"{args.order}: coefficient of q^k")
+    for k, c in enumerate(series):
+        print(f"{k:>4}  {_fraction_text(c)}")
+    return 0
+
+
 def _cmd_models(args: argparse.Namespace) -> int:
     from .models import REGISTRY
 
@@ -1272,6 +1288,16 @@ def _order(text: str) -> int:
     return value
 
 
+def _count_from_zero(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: not an integer") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{value}: must be ≥ 0")
+    return value
+
+
 def _positive(text: str) -> int:
     """A positive integer (workers, points per task)."""
     value = _order(text)
@@ -1447,6 +1473,18 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_json(p)
     _flag_allow_slow(p)
     p.set_defaults(func=_cmd_series)
+
+    p = sub.add_parser("mathieu", help="Mathieu's characteristic values a_m(q), b_m(q) as "
+                       "exact series", description="The series of a_m(q) (even solutions "
+                       "ce_m) or b_m(q) (odd, se_m) of y'' + (a - 2q cos 2z) y = 0 in DLMF's "
+                       "normalisation, exact rationals, by L–P about cos mz or sin mz.")
+    p.add_argument("kind", choices=("a", "b"), help="a: even solutions; b: odd ones")
+    p.add_argument("--m", type=_count_from_zero, default=0, metavar="M",
+                   help="the index m, an integer ≥ 0 (≥ 1 for b; default 0)")
+    _flag_order(p, "highest power K of q")
+    _flag_json(p, "the contract {kind, m, variable, series}")
+    _flag_allow_slow(p, deprecated_force=False)
+    p.set_defaults(func=_cmd_mathieu)
 
     p = sub.add_parser("models", help="list the named oscillators",
                        description="The named oscillators: each is an equation (any equation "

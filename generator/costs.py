@@ -345,6 +345,15 @@ def emit_bounds(allow_slow: bool, max_harmonics: int = EMIT_MAX_HARMONICS,
     return largest("driven", DRIVEN_MAX_ORDER), largest("balance", max_harmonics)
 
 
+MATHIEU_FIT = (0.4, 0.5, 100, 3.0)
+# NOTE: `lindstedt mathieu`: start-up, then K orders of growing exact rationals (0.48 s at 100).
+
+
+def mathieu_cost(args: argparse.Namespace) -> Cost:
+    return Cost(power_law(*MATHIEU_FIT, args.order), f"order {args.order}",
+                "the Mathieu series")
+
+
 COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "series": series_cost,
     "generate": generate_cost,
@@ -357,6 +366,7 @@ COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "clock": fixed_cost("clock"),
     "scene": fixed_cost("scene"),
     "models": fixed_cost("models"),
+    "mathieu": mathieu_cost,
 }
 # NOTE: one estimator per command; `demo` has none: its work is the fixed built-in job
 # (`make demo`), which nothing on its command line scales.

@@ -220,6 +220,10 @@ CLOCK = st.sampled_from([[], ["--json"], ["--bogus"], ["extra"], ["--json", "--j
 
 MODELS = st.sampled_from([[], ["--json"], ["--bogus"], ["extra"], ["--json", "--json"]])
 
+MATHIEU = command_line((
+    Opt(None, st.sampled_from(["a", "b"]), st.sampled_from(["c", "", "A"]), number=False),
+    Opt("--m", maybe(whole(1, 6)), INTEGER), Opt("--order", maybe(whole(0, 30)), INTEGER)))
+
 SCENE = command_line((Opt(None, st.just("clock"), st.sampled_from(["nosuch", "CLOCK", ""]),
                           number=False),))
 # NOTE: hard-spring (14 s) and notes-driven (9 s) are valid but slow; `choose` covers them.
@@ -231,7 +235,8 @@ DEMO = st.tuples(st.sampled_from(BAD_FOLDERS), st.sampled_from([[], ["--bogus"]]
 BUDGET = {"series": (SERIES, 2), "generate": (GENERATE, 2), "driven": (DRIVEN, 4),
           "response": (RESPONSE, 3), "subharmonic": (SUBHARMONIC, 2),
           "mixing": (mixing(), 3), "choose": (CHOOSE, 2), "clock": (CLOCK, 1),
-          "scene": (SCENE, 1), "demo": (DEMO, 1), "models": (MODELS, 1)}
+          "scene": (SCENE, 1), "demo": (DEMO, 1), "models": (MODELS, 1),
+          "mathieu": (MATHIEU, 2)}
 # NOTE: examples (pairs of runs side by side) per command: 42 runs, the file ~60 s on the
 # 2-core machine with other work loading it (a refusal takes 0.1–3 s, a valid run 2–8 s).
 
@@ -261,6 +266,7 @@ test_fuzz_clock = _fuzz("clock")
 test_fuzz_scene = _fuzz("scene")
 test_fuzz_demo = _fuzz("demo")
 test_fuzz_models = _fuzz("models")
+test_fuzz_mathieu = _fuzz("mathieu")
 
 
 NOT_FUZZED = {"sweep": "new (generator/sweep.py, being written): a dask cluster per run"}

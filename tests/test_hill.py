@@ -1,0 +1,77 @@
+"""Mathieu's characteristic values as exact series: DLMF 28.6.1–28.6.6 where they are printed,
+and at any order against the eigenvalues of the truncated Hill matrix (mpmath, 40 digits)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from fractions import Fraction as F
+
+import mpmath as mp
+import pytest
+from lindstedt.cli import main
+from lindstedt.errors import InputError
+from lindstedt.hill import mathieu_series
+
+DLMF = {  # coefficients of q^0 … q^8 (28.6.1–28.6.6); a_1 and b_1 to q^6 here
+    ("a", 0): [0, 0, F(-1, 2), 0, F(7, 128), 0, F(-29, 2304), 0, F(68687, 18874368)],
+    ("a", 1): [1, 1, F(-1, 8), F(-1, 64), F(-1, 1536), F(11, 36864), F(49, 589824)],
+    ("b", 1): [1, -1, F(-1, 8), F(1, 64), F(-1, 1536), F(-11, 36864), F(49, 589824)],
+    ("a", 2): [4, 0, F(5, 12), 0, F(-763, 13824), 0, F(1002401, 79626240), 0,
+               F(-1669068401, 458647142400)],
+    ("b", 2): [4, 0, F(-1, 12), 0, F(5, 13824), 0, F(-289, 79626240), 0,
+               F(21391, 458647142400)],
+}
+
+
+@pytest.mark.parametrize(("kind", "m"), sorted(DLMF))
+def test_dlmf_series(kind, m):
+    expected = DLMF[(kind, m)]
+    assert mathieu_series(kind, m, len(expected) - 1) == expected
+
+
+def hill_eigenvalue(kind: str, m: int, q: mp.mpf, size: int = 60) -> mp.mpf:
+    """a_m(q) or b_m(q) as the eigenvalue of the truncated recurrence of the Fourier
+    coefficients (DLMF 28.4): cos 2kz, cos (2k+1)z, sin (2k+1)z or sin (2k+2)z."""
+    start = {("a", 0): 0, ("a", 1): 1, ("b", 1): 1, ("b", 0): 2}[(kind, m % 2)]
+    harmonics = [start + 2 * k for k in range(size)]
+    M = mp.matrix(size, size)
+    for i, n in enumerate(harmonics):
+        M[i, i] = n * n
+        if i + 1 < size:
+            M[i, i + 1] = M[i + 1, i] = q
+    if start == 0:  # y = A_0 + Σ A_2k cos 2kz: the coupling to A_0 is 2q (symmetrised: √2 q)
+        M[0, 1] = M[1, 0] = mp.sqrt(2) * q
+    elif start == 1:  # cos z · 2q cos 2z holds cos z again: ±q on the first diagonal
+        M[0, 0] = 1 + (q if kind == "a" else -q)
+    values = sorted(mp.re(v) for v in mp.eig(M)[0])
+    return values[(m - start) // 2]
+
+
+@pytest.mark.parametrize("m", range(7))
+@pytest.mark.parametrize("kind", ["a", "b"])
+def test_series_against_the_hill_matrix(kind, m):
+    if kind == "b" and m == 0:
+        pytest.skip("b_0 does not exist")
+    with mp.workdps(40):
+        for q in (mp.mpf("0.1"), mp.mpf("0.4")):
+            series = mathieu_series(kind, m, 40)
+            value = sum(mp.mpf(c.numerator) / c.denominator * q**k for k, c in enumerate(series))
+            assert abs(value - hill_eigenvalue(kind, m, q)) < mp.mpf(10) ** -20, (kind, m, q)
+
+
+def test_the_contract_and_bad_input(capsys):
+    assert main(["mathieu", "a", "--m", "0", "--order", "40", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert set(data) == {"kind", "m", "variable", "series"} and data["variable"] == "q"
+    assert data["series"][:5] == ["0/1", "0/1", "-1/2", "0/1", "7/128"]
+    assert len(data["series"]) == 41
+    with pytest.raises(InputError, match="b_0 does not exist"):
+        mathieu_series("b", 0, 4)
+    for args in (["mathieu", "b", "--m", "0"], ["mathieu", "c"], ["mathieu", "a", "--m", "x"],
+                 ["mathieu", "a", "--order", "-1"]):
+        done = subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
+                              text=True, check=False)
+        assert done.returncode == 2 and done.stdout == "", args
+        assert done.stderr.count("\n") == 1 and done.stderr.startswith("lindstedt: error:")
