@@ -707,10 +707,11 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
                 lin = Trig(g.poly([]), g.poly([]), g)
                 for a, b, c in model.terms:  # d/dλ (q0 + λx)^a (v0 + λx')^b at λ = 0
                     if a:
-                        lin = lin + _power(q0, a - 1, g) * _power(v0, b, g) * x * g.scalar(c * a)
+                        lin = lin + (_trig_power(q0, a - 1, g) * _trig_power(v0, b, g) * x
+                                     * g.scalar(c * a))
                     if b:
-                        lin = lin + _power(q0, a, g) * _power(v0, b - 1, g) * x.derivative() \
-                            * g.scalar(c * b)
+                        lin = lin + (_trig_power(q0, a, g) * _trig_power(v0, b - 1, g)
+                                     * x.derivative() * g.scalar(c * b))
                 lin = lin + cos_s * W[1]
             _, ks = _secular_parts(known, g)
             _, ls = _secular_parts(lin, g)
@@ -747,7 +748,7 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
         q=tuple(fourier), slope=slope)
 
 
-def _power(x: Trig, n: int, g: Ground) -> Trig:
+def _trig_power(x: Trig, n: int, g: Ground) -> Trig:
     out = Trig(g.poly([g.scalar(1)]), g.poly([]), g)
     for _ in range(n):
         out = out * x
