@@ -1462,8 +1462,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"lindstedt {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = sub.add_parser("series", help="derive the L–P series of a free oscillator",
-                       description="Derive ω_j, (T/2π)_j and q_j of the L–P series exactly.")
+    p = sub.add_parser("series", help="the L–P series of a free oscillator, or of its limit "
+                       "cycles", description="Derive ω_j, (T/2π)_j and q_j of the L–P series "
+                       "exactly; for q'' + q = eps*f(q, q') with f odd in q', of its limit "
+                       "cycles (the amplitude fixed order by order).")
     _flag_oscillator(p)
     _flag_order(p, "highest order K of the series")
     p.add_argument("--singularities", action="store_true",
