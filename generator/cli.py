@@ -1278,17 +1278,7 @@ def _axis_values(text: str) -> list[float]:
 
 
 def _order(text: str) -> int:
-    """An order K: a non-negative integer."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: not an integer") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{value}: must be ≥ 0")
-    return value
-
-
-def _count_from_zero(text: str) -> int:
+    """An order K (or an index such as mathieu's m): a non-negative integer."""
     try:
         value = int(text)
     except ValueError:
@@ -1481,7 +1471,7 @@ def build_parser() -> argparse.ArgumentParser:
                        "ce_m) or b_m(q) (odd, se_m) of y'' + (a - 2q cos 2z) y = 0 in DLMF's "
                        "normalisation, exact rationals, by L–P about cos mz or sin mz.")
     p.add_argument("kind", choices=("a", "b"), help="a: even solutions; b: odd ones")
-    p.add_argument("--m", type=_count_from_zero, default=0, metavar="M",
+    p.add_argument("--m", type=_order, default=0, metavar="M",
                    help="the index m, an integer ≥ 0 (≥ 1 for b; default 0)")
     _flag_order(p, "highest power K of q")
     _flag_json(p, "the contract {kind, m, variable, series}")
