@@ -158,12 +158,6 @@ def _params(pairs: Sequence[str] | None) -> dict[str, str]:
     return values
 
 
-def _free_model(args: argparse.Namespace, order: int):
-    from .models import model_from_text
-
-    return model_from_text(args.model, order, _params(args.param), args.name)
-
-
 def limit_cycle_json(lc) -> dict:
     """``lindstedt series`` of a self-excited oscillator: ω, T/2π and q(0) as exact "p/q" in
     ε, each q_j's cos and sin coefficients, the first-order amplitude slope and the verdict."""
@@ -207,7 +201,7 @@ def _cmd_series(args: argparse.Namespace) -> int:
         data, text = limit_cycle_json(lc), limit_cycle_table(lc)
         omega = lc.omega
     else:
-        model = _free_model(args, args.order)
+        model = found  # series_model built it (model_from_text): parse and expand once
         progress = Progress(f"deriving {model.name} to order {args.order}", not args.json)
         sol = derive(model, args.order, progress)
         progress.close()
@@ -297,7 +291,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
                                                       overwrite_edited=args.overwrite_edited):
                 print(path)
             return 0
-        model = _free_model(args, order + 2)
+        model = found
         check_emitted_names(model)  # before the derivation: a clash is known at once
         progress = Progress(f"deriving {model.name} to order {order + 2}")
         paths = compiler.generate(model, order, out, args.allow_divergent, progress,

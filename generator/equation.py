@@ -213,7 +213,8 @@ class _Walker:
         try:
             tree = ast.parse(self.source, mode="eval")
         except SyntaxError as exc:
-            col = self.offset + max((exc.offset or 1) - 1, 0)
+            # Python reports offset 0 for a text that ends too early: point at its end
+            col = self.offset + (exc.offset - 1 if exc.offset else len(self.source))
             raise InputError(f"{self.what} {self.text!r}, column {col + 1}: does not parse "
                              f"({exc.msg})") from None
         except (RecursionError, MemoryError, ValueError):

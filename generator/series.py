@@ -411,14 +411,11 @@ class Trig:
     def __mul__(self, other: Trig | Any) -> Trig:
         if not isinstance(other, Trig):
             return Trig(self.cos_part * other, self.sin_part * other, self.ground)
-        one_minus_c2 = self._one_minus_c2()
+        one_minus_c2 = _constants(self.ground)[1]
         cos_part = self.cos_part * other.cos_part + one_minus_c2 * (self.sin_part
                                                                     * other.sin_part)
         sin_part = self.cos_part * other.sin_part + self.sin_part * other.cos_part
         return Trig(cos_part, sin_part, self.ground)
-
-    def _one_minus_c2(self) -> Any:
-        return _constants(self.ground)[1]
 
     def derivative(self) -> Trig:
         """``d/ds``: ``d P(C) = −S P'(C)``, ``d(S R(C)) = C R − (1 − C²) R'``."""

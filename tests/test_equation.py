@@ -455,3 +455,9 @@ def test_generate_refusal_leaves_an_existing_folder_empty(capsys, tmp_path):
 def test_coefficients_outside_the_ring_are_refused(text, capsys):
     assert main(["series", text, "--order", "3"]) == 2
     assert len(capsys.readouterr().err.splitlines()) == 1
+
+
+def test_a_text_that_ends_too_early_is_pointed_at_its_end():
+    """Python reports no column for an unfinished expression: the error names the end."""
+    with pytest.raises(InputError, match=r"column 10: does not parse"):
+        parse_equation("q'' + q +")
