@@ -385,6 +385,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     # (benchmarks/*speed_accuracy.py refresh the committed copies the README shows).
     print(f"  {speed_accuracy_figure(figures / 'speed_accuracy.png')}")
     print(f"  {driven_speed_accuracy_figure(figures / 'driven_speed_accuracy.png')}")
+    _demo_parametric(figures)
     if shutil.which("pdflatex"):
         for tex in sorted(out.glob("*.tex")):
             for _ in range(2):  # longtable settles its column widths on the second pass
@@ -395,6 +396,23 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     else:
         print("\npdflatex not found: `make demo` installs it; LaTeX sources are in", out)
     return 0
+
+
+DEMO_SUBHARMONIC = (0.1, 0.5, 1.3)
+# NOTE: (ε, f, ω) where the notes' q₀ Hill test calls the "−" root stable and it is not.
+
+
+def _demo_parametric(figures: Path) -> None:
+    """The demo's parametric block: the response figure under ``figures``, the tongue and
+    onsets, and one subharmonic where the full Hill equation corrects the notes' verdict."""
+    from .charts import PARAMETRIC_FIGURE, parametric_figure
+
+    data = parametric_json(*PARAMETRIC_FIGURE, points=2)
+    print(f"  {parametric_figure(*PARAMETRIC_FIGURE, figures / 'parametric.png')}")
+    print()
+    for line in [*_parametric_table(data)[:5], *_subharmonic_table(subharmonic_json(
+            *DEMO_SUBHARMONIC))]:
+        print(line)
 
 
 def driven_json(d, order: int, harmonics: int) -> dict:
@@ -862,6 +880,9 @@ def subharmonic_json(eps: float, force: float, omega: float) -> dict:
                 "a1": s.orbit.A[1], "a3": s.orbit.A[3], "stable": s.orbit.stable,
                 "simulation_locks": s.locked,
                 "floquet_moduli": sorted(float(abs(m)) for m in s.orbit.multipliers)},
+            "full_hill": None if s.balance is None else {
+                "a1": s.balance[0][1], "a3": s.balance[0][3], "stable": s.full_hill_stable,
+                "floquet_moduli": sorted(float(abs(m)) for m in s.full_hill_multipliers)},
         } for s in solutions],
     }
 
@@ -921,9 +942,100 @@ def _subharmonic_table(data: dict) -> list[str]:
         true = "no orbit found" if num is None else (
             f"true orbit a1 = {num['a1']:.6f}, {'stable' if num['stable'] else 'unstable'}, "
             f"a simulation 1% off it {'locks on' if num['simulation_locks'] else 'drifts away'}")
+        full = s["full_hill"]
         lines.append(f"  root {s['root']}: a = {s['a']:.6f}, Hill: "
-                     f"{'stable' if s['hill_stable'] else 'unstable'}; {true}")
+                     f"{'stable' if s['hill_stable'] else 'unstable'}; full Hill: "
+                     + ("no balance" if full is None else
+                        f"{'stable' if full['stable'] else 'unstable'} (a1 = {full['a1']:.6f})")
+                     + f"; {true}")
     return lines
+
+
+MAX_PARAMETRIC_POINTS = 401
+# NOTE: each ω costs a balance and a full Hill pass per branch (~5 ms): 401 points stay within
+# the command's fixed estimate (costs.FIXED_COSTS["parametric"]).
+PARAMETRIC_SHOTS = 10
+# NOTE: shooting at about ten ω of the range, every branch there: the numerical truth.
+
+
+def parametric_json(eps: float, zeta: float, gamma: float, omega_from: float, omega_to: float,
+                    points: int = 41, harmonics: int = 6) -> dict:
+    """The contract of ``lindstedt parametric … --json``: the tongue, the onsets, the fold and
+    every branch point (one harmonic, balance with its full-Hill verdict, shooting)."""
+    import numpy as np
+
+    from .parametric import Pump, check_omega, fold, onsets, response, tongue_edges
+
+    p = Pump(eps, zeta, gamma)
+    lo, hi = check_omega(omega_from, "--omega-from"), check_omega(omega_to, "--omega-to")
+    if not lo < hi:
+        raise InputError(f"--omega-from {lo:g} --omega-to {hi:g}: the range must increase")
+    if not 2 <= points <= MAX_PARAMETRIC_POINTS:
+        raise InputError(f"--points {points}: must be in 2..{MAX_PARAMETRIC_POINTS}")
+    if not 1 <= harmonics <= 16:
+        raise InputError(f"--harmonics {harmonics}: must be in 1..16")
+    rows = response(p, np.linspace(lo, hi, points), harmonics,
+                    shoot_every=max(1, (points - 1) // PARAMETRIC_SHOTS))
+    edges, top = tongue_edges(p), fold(p)
+
+    def moduli(lam) -> list[float]:
+        return sorted(float(abs(m)) for m in lam)
+
+    return {
+        "equation": "q'' + 2 zeta q' + (1 + eps cos 2wt) q + gamma q^3 = 0",
+        "parameters": {"eps": eps, "zeta": zeta, "gamma": gamma, "omega_from": lo,
+                       "omega_to": hi, "points": points, "harmonics": harmonics},
+        "tongue": None if edges is None else {"lower": edges[0], "upper": edges[1]},
+        "onsets": [{"omega": o.omega, "branch": o.branch, "supercritical": o.supercritical}
+                   for o in onsets(p)],
+        "fold": None if top is None else {"omega": top[0], "r": top[1]},
+        "branches": [{
+            "branch": r.one.branch, "omega": r.one.omega,
+            "one_harmonic": {"a": r.one.a, "b": r.one.b, "r": r.one.r, "stable": r.one.stable},
+            "balance": None if r.balance is None else {
+                "r": r.balance.r, "residual": r.balance.residual,
+                "full_hill_stable": r.balance.stable,
+                "floquet_moduli": moduli(r.balance.multipliers)},
+            "shooting": None if r.orbit is None else {
+                "r": math.hypot(r.orbit.A[1], r.orbit.B[1]), "stable": r.orbit.stable,
+                "floquet_moduli": moduli(r.orbit.multipliers)},
+        } for r in rows],
+    }
+
+
+def _parametric_table(data: dict) -> list[str]:
+    p, t = data["parameters"], data["tongue"]
+    lines = [f"{data['equation']}: eps = {p['eps']}, zeta = {p['zeta']}, gamma = {p['gamma']}",
+             "tongue (one harmonic): " + ("closed by the damping" if t is None else
+                                          f"{t['lower']:.6f} < omega < {t['upper']:.6f}")]
+    for o in data["onsets"]:
+        lines.append(f"onset of branch {o['branch']} at omega = {o['omega']:.6f}: "
+                     + ("supercritical" if o["supercritical"] else "subcritical"))
+    if data["fold"] is not None:
+        lines.append(f"fold (branches + and - meet): omega = {data['fold']['omega']:.6g}, "
+                     f"r = {data['fold']['r']:.6g}")
+    lines.append(f"{'omega':>9} {'branch':>6} {'r (1 harm.)':>12} {'stable':>7} "
+                 f"{'r (balance)':>12} {'full Hill':>9} {'r (shot)':>12} {'shot':>8}")
+    for b in data["branches"]:
+        one, bal, shot = b["one_harmonic"], b["balance"], b["shooting"]
+        lines.append(
+            f"{b['omega']:>9.5f} {b['branch']:>6} {one['r']:>12.8f} "
+            f"{'yes' if one['stable'] else 'no':>7} "
+            + (f"{'':>12} {'':>9}" if bal is None else
+               f"{bal['r']:>12.8f} {'yes' if bal['full_hill_stable'] else 'no':>9}")
+            + ("" if shot is None else
+               f" {shot['r']:>12.8f} {'stable' if shot['stable'] else 'unstable':>8}"))
+    return lines
+
+
+def _cmd_parametric(args: argparse.Namespace) -> int:
+    return _report(args, lambda: parametric_json(args.eps, args.zeta, args.gamma,
+                                                 args.omega_from, args.omega_to, args.points,
+                                                 args.harmonics),
+                   lambda path: _charts().parametric_figure(args.eps, args.zeta, args.gamma,
+                                                            args.omega_from, args.omega_to,
+                                                            path),
+                   _parametric_table)
 
 
 def mixing_json(eps: float, Q: float, drives: list[tuple[float, float]]) -> dict:
@@ -1551,6 +1663,30 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_json(p)
     _flag_plot(p)
     p.set_defaults(func=_cmd_subharmonic)
+
+    p = sub.add_parser("parametric", help="the parametrically driven oscillator's response "
+                       "in its first tongue",
+                       description="q'' + 2 zeta q' + (1 + eps cos 2wt) q + gamma q^3 = 0: the "
+                       "1:1 response at w (the pump at 2w), every branch with its stability "
+                       "(one harmonic, harmonic balance with the full Hill equation, shooting), "
+                       "the tongue's edges, the onsets and the fold.")
+    p.add_argument("--eps", type=_real, required=True, metavar="EPS",
+                   help="ε, the pump depth, 0 < ε < 2 (required)")
+    p.add_argument("--zeta", type=_real, default=0.0, metavar="ZETA",
+                   help="ζ ≥ 0, the damping ratio of 2ζq' (default 0: undamped)")
+    p.add_argument("--gamma", type=_real, default=1.0, metavar="GAMMA",
+                   help="γ, the cubic stiffness (> 0 hardens, < 0 softens; default 1)")
+    p.add_argument("--omega-from", type=_real, required=True, metavar="W",
+                   help="the lowest ω, half the pump frequency (required)")
+    p.add_argument("--omega-to", type=_real, required=True, metavar="W",
+                   help="the highest ω (required)")
+    p.add_argument("--points", type=_positive, default=41, metavar="N",
+                   help=f"ω points in the range, 2..{MAX_PARAMETRIC_POINTS} (default 41)")
+    p.add_argument("--harmonics", type=_positive, default=6, metavar="N",
+                   help="odd harmonics of the balance, 1..16 (default 6: 1, 3, …, 11)")
+    _flag_json(p)
+    _flag_plot(p)
+    p.set_defaults(func=_cmd_parametric)
 
     p = sub.add_parser("mixing", help="combination tones of a two-tone drive",
                        description="q'' + q'/Q + q + eps q^3 = Σ f_i cos(w_i t): "

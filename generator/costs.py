@@ -88,6 +88,7 @@ DRIVEN_COSTS = (3.0, 13.3, 100, 3.5)
 FIXED_COSTS = {
     "models": 1.0,
     "subharmonic": 6.0,
+    "parametric": 8.0,
     "mixing": 12.0,
     "clock": 5.0,
     "scene": 12.0,
@@ -360,6 +361,7 @@ COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "driven": driven_cost,
     "response": response_cost,
     "subharmonic": fixed_cost("subharmonic"),
+    "parametric": fixed_cost("parametric"),
     "mixing": fixed_cost("mixing"),
     "choose": choose_cost,
     "sweep": sweep_cost,
