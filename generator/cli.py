@@ -424,6 +424,7 @@ def driven_json(d, order: int, harmonics: int) -> dict:
     stands for (found by continuing the balance through a fold the cubic does not have) has
     ``A1``, ``r``, ``delta0`` null and no μ-expansion, with ``mu_note`` saying why."""
     from .driven import amplitudes, mu_expansion
+    from .numerics import multipliers_stable, orbit_hill_multipliers
     from .response import periodic_orbits
 
     damped = d.damping > 0
@@ -454,6 +455,11 @@ def driven_json(d, order: int, harmonics: int) -> dict:
                        "converged": hb.converged, "r": _first_harmonic(A, B)}
             if damped:
                 hb_json["B"] = _keyed(B)
+            # the full Hill equation about this balance orbit (no shooting)
+            lam = orbit_hill_multipliers({(1, 0): 1.0, (3, 0): d.eps, (0, 1): d.damping}, A,
+                                         B, d.omega)
+            hb_json["full_hill_stable"] = multipliers_stable(lam, damped)
+            hb_json["full_hill_moduli"] = sorted(float(abs(m)) for m in lam)
         else:
             hb_json = {"harmonics": harmonics, "A": {}, "residual": None, "converged": False,
                        "r": None}
@@ -536,6 +542,10 @@ def driven_table(data: dict) -> str:
             cells = " ".join(f"{values[c]:>12.6f}" if c in values else f"{'':>12}"
                              for c in columns)
             lines.append(f"{label:>22} {cells}")
+        if "full_hill_stable" in hb:
+            lines.append("  full Hill equation about the balance: "
+                         f"{'stable' if hb['full_hill_stable'] else 'unstable'} (|multipliers| "
+                         + ", ".join(f"{m:.6g}" for m in hb["full_hill_moduli"]) + ")")
         if br.get("first_order") == "rank":
             lines.append("  note: the first-order root of the same rank in amplitude (shooting "
                          "from it reached another orbit)")
