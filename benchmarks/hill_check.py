@@ -5,7 +5,9 @@
 For every (ε, ω, f) of the grid where eq. 10.87 has real roots, compare the Hill-equation
 verdict (linearised about q₀) and the full Hill equation's (linearised about the whole orbit
 q(t) of the harmonic balance, no shooting) with the Floquet multipliers of the true orbit found
-by shooting.
+by shooting.  Then the driven Duffing branches (eq. 10.60 with damping): the Hill equation about
+the balance orbit cut to its first harmonic (the notes' q₀), about the whole balance orbit, and
+shooting, on a grid of (ε, f, Q, ω).
 """
 
 from __future__ import annotations
@@ -13,11 +15,44 @@ from __future__ import annotations
 from collections import Counter
 
 import numpy as np
-from lindstedt.response import subharmonic
+from lindstedt.driven import Drive, amplitudes
+from lindstedt.numerics import multipliers_stable, orbit_hill_multipliers
+from lindstedt.response import periodic_orbits, subharmonic
 
 
 def _verdict(stable: bool | None, name: str, missing: str) -> str:
     return missing if stable is None else f"{name} {'stable' if stable else 'unstable'}"
+
+
+def driven() -> None:
+    """The driven branches' verdicts: q₀ (first harmonic) Hill, full Hill, shooting."""
+    counts: Counter = Counter()
+    wrong = []
+    for eps in (0.1, 0.3, -0.05):
+        for force in (0.3, 1.0):
+            for Q in (10.0, 50.0):
+                for omega in np.linspace(0.6, 2.0, 8):
+                    d = Drive(eps, force, float(omega), Q)
+                    terms = {(1, 0): 1.0, (3, 0): eps, (0, 1): d.damping}
+                    for o in periodic_orbits(d, 8).orbits:
+                        if o.orbit is None or o.balance is None:
+                            counts["no balance or no true orbit"] += 1
+                            continue
+                        A, B = amplitudes(o.balance.coefficients, 0.0, 15)
+                        full = multipliers_stable(orbit_hill_multipliers(terms, A, B, d.omega),
+                                                  True)
+                        cut = multipliers_stable(orbit_hill_multipliers(
+                            terms, {1: A[1]}, {1: B[1]}, d.omega), True)
+                        counts[", ".join(_verdict(v, n, "") for v, n in (
+                            (cut, "q0 Hill"), (full, "full"), (o.orbit.stable, "true")))] += 1
+                        if cut != o.orbit.stable:
+                            wrong.append(f"eps {eps}, f {force}, Q {Q:g}, omega {omega:.2f}, "
+                                         f"r {o.r:.3f}")
+    print(f"\ndriven Duffing branches\n{'verdicts (q0 Hill, full Hill, shooting)':<56} "
+          f"{'cases':>6}")
+    for verdict, n in sorted(counts.items()):
+        print(f"{verdict:<56} {n:>6}")
+    print("q0 Hill wrong at: " + "; ".join(wrong))
 
 
 def main() -> None:
@@ -43,6 +78,7 @@ def main() -> None:
         print(f"{root:<5} {verdict:<50} {n:>6}")
     print(f"\nfull Hill vs shooting: largest multiplier difference {gap:.1e}; the closest "
           f"shot orbit to the stability boundary has ||tr M| - 2| = {margin:.1e}")
+    driven()
 
 
 if __name__ == "__main__":
