@@ -962,14 +962,14 @@ def _subharmonic_table(data: dict) -> list[str]:
 
 
 MAX_PARAMETRIC_POINTS = 401
-# NOTE: each ω costs a balance and a full Hill pass per branch (~5 ms): 401 points stay within
-# the command's fixed estimate (costs.FIXED_COSTS["parametric"]).
+# NOTE: ω points of the range: 401 draw a smooth curve; their cost with --harmonics is
+# costs.parametric_cost's.
 PARAMETRIC_SHOTS = 10
 # NOTE: shooting at about ten ω of the range, every branch there: the numerical truth.
 
 
 def parametric_json(eps: float, zeta: float, gamma: float, omega_from: float, omega_to: float,
-                    points: int = 41, harmonics: int = 6) -> dict:
+                    points: int = 41, harmonics: int = 8) -> dict:
     """The contract of ``lindstedt parametric … --json``: the tongue, the onsets, the fold and
     every branch point (one harmonic, balance with its full-Hill verdict, shooting)."""
     import numpy as np
@@ -982,8 +982,8 @@ def parametric_json(eps: float, zeta: float, gamma: float, omega_from: float, om
         raise InputError(f"--omega-from {lo:g} --omega-to {hi:g}: the range must increase")
     if not 2 <= points <= MAX_PARAMETRIC_POINTS:
         raise InputError(f"--points {points}: must be in 2..{MAX_PARAMETRIC_POINTS}")
-    if not 1 <= harmonics <= 16:
-        raise InputError(f"--harmonics {harmonics}: must be in 1..16")
+    if isinstance(harmonics, bool) or not 1 <= harmonics <= MAX_HARMONICS:
+        raise InputError(f"--harmonics {harmonics}: must be in 1..{MAX_HARMONICS}")
     rows = response(p, np.linspace(lo, hi, points), harmonics,
                     shoot_every=max(1, (points - 1) // PARAMETRIC_SHOTS))
     edges, top = tongue_edges(p), fold(p)
@@ -1694,8 +1694,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the highest ω (required)")
     p.add_argument("--points", type=_positive, default=41, metavar="N",
                    help=f"ω points in the range, 2..{MAX_PARAMETRIC_POINTS} (default 41)")
-    p.add_argument("--harmonics", type=_positive, default=6, metavar="N",
-                   help="odd harmonics of the balance, 1..16 (default 6: 1, 3, …, 11)")
+    _flag_harmonics(p, "odd harmonics of the balance (1, 3, …, 2N − 1)")
     _flag_json(p)
     _flag_plot(p)
     p.set_defaults(func=_cmd_parametric)

@@ -88,7 +88,6 @@ DRIVEN_COSTS = (3.0, 13.3, 100, 3.5)
 FIXED_COSTS = {
     "models": 1.0,
     "subharmonic": 6.0,
-    "parametric": 8.0,
     "mixing": 12.0,
     "clock": 5.0,
     "scene": 12.0,
@@ -355,13 +354,31 @@ def mathieu_cost(args: argparse.Namespace) -> Cost:
                 "the Mathieu series")
 
 
+PARAMETRIC_FIT = (2.0, 1.5e-3)
+# NOTE: `lindstedt parametric`: start-up and ten shot ω, then per ω and nontrivial branch a
+# balance and a full Hill pass, ~1.5 ms per odd harmonic (measured at load 5: 401 points
+# 10.5 s at 8 harmonics, 116 s at 100).
+
+
+def parametric_cost(args: argparse.Namespace) -> Cost:
+    """Two branches at each of ``--points`` ω, each ``--harmonics`` deep; above the limit a
+    bound (the command has no --allow-slow: fewer points or harmonics answer the same)."""
+    points, harmonics = max(args.points, 1), max(args.harmonics, 8)
+    seconds = PARAMETRIC_FIT[0] + 2 * points * PARAMETRIC_FIT[1] * harmonics
+    if seconds > COST_LIMIT_SECONDS:
+        raise InputError(f"--points {args.points} --harmonics {args.harmonics}: about "
+                         f"{seconds:,.0f} s of balances; the limit is {COST_LIMIT_SECONDS:.0f} "
+                         "s: give fewer points or harmonics")
+    return Cost(seconds, f"--points {args.points}", "the parametric response")
+
+
 COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "series": series_cost,
     "generate": generate_cost,
     "driven": driven_cost,
     "response": response_cost,
     "subharmonic": fixed_cost("subharmonic"),
-    "parametric": fixed_cost("parametric"),
+    "parametric": parametric_cost,
     "mixing": fixed_cost("mixing"),
     "choose": choose_cost,
     "sweep": sweep_cost,

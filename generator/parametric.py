@@ -212,9 +212,9 @@ class ParametricBalance(PolynomialBalance):
                                                                    * self.basis)
 
 
-BALANCE_HARMONICS = 6
-# NOTE: odd harmonics 1 … 11: the balance's first harmonic within ~1e-10 of shooting at
-# ε ≤ 0.5, r ≤ 2 (the harmonics fall ~(γr²/32)^k).
+BALANCE_HARMONICS = 8
+# NOTE: odd harmonics 1 … 15, the command line's default: the balance's first harmonic within
+# ~1e-12 of shooting at ε ≤ 0.2, r ≤ 0.7 (the harmonics fall like (γr²/32)^k).
 
 
 @dataclass(frozen=True)
