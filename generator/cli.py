@@ -1036,7 +1036,8 @@ def _parametric_table(data: dict) -> list[str]:
             + (f"{'' if b['branch'] == '0' else 'none':>12} {'':>9}" if bal is None else
                f"{bal['r']:>12.8f} {'yes' if bal['full_hill_stable'] else 'no':>9}")
             + ("" if shot is None else
-               f" {shot['r']:>12.8f} {'stable' if shot['stable'] else 'unstable':>8}"))
+               f" {shot['r']:>12.8f} {'stable' if shot['stable'] else 'unstable':>8}")
+            .rstrip())
     return lines
 
 

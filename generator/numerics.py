@@ -810,9 +810,12 @@ def orbit_hill_rows(terms: dict[tuple[int, int], float], A: dict[int, float],
         if c:
             stiffness += a * c * power
         power = laurent_product(power, q)
+    # NOTE: a harmonic below 1e-17 of the stiffness's size moves the monodromy by less than a
+    # rounding error: its row is dropped (each row is a cosine per RK4 stage).
+    negligible = 1e-17 * float(np.sum(np.abs(stiffness)))
     rows = [(1.0, -stiffness[M].real, 0.0, 0.0)]
     rows += [(1.0, -2 * abs(c), n * omega, float(np.angle(c)))
-             for n, c in enumerate(stiffness[M + 1:], start=1) if abs(c) > 0]
+             for n, c in enumerate(stiffness[M + 1:], start=1) if abs(c) > negligible]
     return np.array(rows)
 
 
