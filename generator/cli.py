@@ -1030,13 +1030,13 @@ def _parametric_table(data: dict) -> list[str]:
                  "fell onto q = 0: the true tongue is O(eps^2) off the one-harmonic one)")
     for b in data["branches"]:
         one, bal, shot = b["one_harmonic"], b["balance"], b["shooting"]
-        lines.append(
+        lines.append((
             f"{b['omega']:>9.5f} {b['branch']:>6} {one['r']:>12.8f} "
             f"{'yes' if one['stable'] else 'no':>7} "
             + (f"{'' if b['branch'] == '0' else 'none':>12} {'':>9}" if bal is None else
                f"{bal['r']:>12.8f} {'yes' if bal['full_hill_stable'] else 'no':>9}")
             + ("" if shot is None else
-               f" {shot['r']:>12.8f} {'stable' if shot['stable'] else 'unstable':>8}")
+               f" {shot['r']:>12.8f} {'stable' if shot['stable'] else 'unstable':>8}"))
             .rstrip())
     return lines
 
