@@ -196,6 +196,17 @@ def test_full_hill_corrects_the_notes_verdict_on_the_subharmonic():
                                    np.sort_complex(s.orbit.multipliers), atol=1e-9)
 
 
+def test_full_hill_near_the_subharmonic_fold():
+    """ε = 0.1, ω = 1.05, f = 7.8 (the roots meet at f = 7.885): both orbits within 3e-3 of
+    |tr M| = 2, the full Hill verdicts still shooting's; past the true fold no verdict."""
+    _, _, sols = subharmonic(0.1, 7.8, 1.05)
+    for s in sols:
+        assert abs(abs(np.sum(s.orbit.multipliers).real) - 2) < 3e-3
+        assert s.full_hill_stable == s.orbit.stable == (s.root == "+")
+    _, _, sols = subharmonic(0.1, 7.88, 1.05)
+    assert all(s.full_hill_stable is None and s.orbit is None for s in sols)
+
+
 @pytest.mark.parametrize("eps,force,Q,omega", [(0.1, 1.0, 20.0, 1.4), (0.1, 0.3, 20.0, 1.3),
                                                 (-0.05, 0.2, 30.0, 0.9), (0.1, 1.0, 20.0, 0.8)])
 def test_full_hill_on_driven_duffing_branches(eps, force, Q, omega):
