@@ -1684,7 +1684,7 @@ def build_parser() -> argparse.ArgumentParser:
                        "(one harmonic, harmonic balance with the full Hill equation, shooting), "
                        "the tongue's edges, the onsets and the fold.")
     p.add_argument("--eps", type=_real, required=True, metavar="EPS",
-                   help="ε, the pump depth, 0 < ε < 2 (required)")
+                   help="ε, the pump depth, 0 < ε < 1 (required)")
     p.add_argument("--zeta", type=_real, default=0.0, metavar="ZETA",
                    help="ζ ≥ 0, the damping ratio of 2ζq' (default 0: undamped)")
     p.add_argument("--gamma", type=_real, default=1.0, metavar="GAMMA",

@@ -63,7 +63,7 @@ def parametric_secular() -> tuple[sp.Expr, sp.Expr]:
 
 @dataclass(frozen=True)
 class Pump:
-    """``q̈ + 2ζq̇ + (1 + ε cos 2ωt)q + γq³ = 0``: the pump depth ``ε > 0``, damping ``ζ ≥ 0``,
+    """``q̈ + 2ζq̇ + (1 + ε cos 2ωt)q + γq³ = 0``: the pump depth ``0 < ε < 1``, damping ``ζ ≥ 0``,
     cubic stiffness ``γ`` (each finite; checked here, one line per bad input)."""
 
     eps: float
@@ -78,9 +78,9 @@ class Pump:
         if not self.eps > 0:
             raise InputError(f"eps {self.eps!r}: the pump depth must be > 0 (its sign is a "
                              "shift of time by a quarter pump period)")
-        if not self.eps < 2:
-            raise InputError(f"eps {self.eps!r}: must be < 2 (1 + eps cos 2wt keeps the "
-                             "linear stiffness positive)")
+        if not self.eps < 1:
+            raise InputError(f"eps {self.eps!r}: must be < 1 (1 + eps cos 2wt > 0: a spring at "
+                             "every instant; the first tongue's analysis is for a shallow pump)")
         if self.zeta < 0:
             raise InputError(f"zeta {self.zeta!r}: the damping must be >= 0")
 
