@@ -505,7 +505,8 @@ def parametric_figure(eps: float, zeta: float, gamma: float, omega_from: float,
                         label=f"branch {name}, {verdict}" if name != "0" else f"q = 0, {verdict}")
         bal = [(pt.one.omega, pt.balance.r) for pt in pts[::4] if pt.balance is not None]
         if bal:
-            ax.plot(*zip(*bal, strict=True), f"{color}.", ms=3)
+            ax.plot(*zip(*bal, strict=True), f"{color}.", ms=3,
+                    label=f"branch {name}, harmonic balance")
         shot = [(pt.one.omega, math.hypot(pt.orbit.A[1], pt.orbit.B[1]), pt.orbit.stable)
                 for pt in pts if pt.orbit is not None and name != "0"]
         for w, a, s in shot:
