@@ -214,7 +214,8 @@ class ParametricBalance(PolynomialBalance):
 
 BALANCE_HARMONICS = 8
 # NOTE: odd harmonics 1 … 15, the command line's default: the balance's first harmonic within
-# ~1e-12 of shooting at ε ≤ 0.2, r ≤ 0.7 (the harmonics fall like (γr²/32)^k).
+# 4e-14 (relative) of shooting at ε ≤ 0.4 (benchmarks/parametric.py; the harmonics fall like
+# (γr²/32)^k).
 
 
 @dataclass(frozen=True)

@@ -130,11 +130,13 @@ def test_branches_against_shooting_error_shrinks_with_eps():
     assert errors[2] / errors[0] > 2
 
 
+@pytest.mark.parametrize("zeta", [0.01, 0.0])
 @pytest.mark.parametrize("gamma", [1.0, -1.0])
-def test_verdicts_against_floquet_multipliers_of_shot_orbits(gamma):
-    """One harmonic, full Hill about the balance and shooting agree on every branch; the full
-    Hill multipliers are the shot orbit's."""
-    p = Pump(0.2, 0.01, gamma)
+def test_verdicts_against_floquet_multipliers_of_shot_orbits(gamma, zeta):
+    """One harmonic, full Hill about the balance and shooting agree on every branch (undamped:
+    the slow flow's centre is the orbit's pair on the unit circle); the full Hill multipliers
+    are the shot orbit's."""
+    p = Pump(0.2, zeta, gamma)
     seen = set()
     for w in (0.93, 0.96, 1.0, 1.04, 1.07):
         for pt in one_harmonic(p, w)[1:]:
