@@ -829,7 +829,13 @@ def orbit_hill_multipliers(terms: dict[tuple[int, int], float], A: dict[int, flo
     equation itself, e.g. a pump).  Its coefficients are periodic and known: one RK4 pass of
     the monodromy columns over the period (the compiled :func:`_rk4`, Richardson pair), with no
     shooting of the nonlinear orbit.  The notes' test (:func:`hill_multipliers`) is this with
-    ``q`` cut to ``q₀``."""
+    ``q`` cut to ``q₀``.
+
+    Why a pass and not Hill's truncated infinite determinant: the pass gives both multipliers
+    themselves (the verdict and the margin), damping and a pump need nothing new, its error is
+    the integrator's known O(h⁶) after Richardson; the determinant gives ``cos(2πν)`` only after
+    a truncation whose convergence must be checked harmonic by harmonic, and its damped form
+    needs the complex exponent."""
     rows = orbit_hill_rows(terms, A, B, omega)
     extra = np.asarray(extra, dtype=float).reshape(-1, 4)
     if np.any(extra[:, 0] != 1.0):
