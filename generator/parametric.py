@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from .driven import PolynomialBalance
+from .driven import MAGNITUDES, PolynomialBalance
 from .errors import InputError
 from .numerics import (
     ForceTable,
@@ -81,8 +81,16 @@ class Pump:
         if not self.eps < 1:
             raise InputError(f"eps {self.eps!r}: must be < 1 (1 + eps cos 2wt > 0: a spring at "
                              "every instant; the first tongue's analysis is for a shallow pump)")
-        if self.zeta < 0:
-            raise InputError(f"zeta {self.zeta!r}: the damping must be >= 0")
+        if not 0 <= self.zeta <= 1:
+            raise InputError(f"zeta {self.zeta!r}: the damping ratio must be in 0..1 (from "
+                             "eps/4 on the first tongue is closed; above 1 overdamped)")
+        low, high = MAGNITUDES
+        for name, value in (("zeta", self.zeta), ("gamma", self.gamma)):  # nonzero: normal
+            if value != 0 and not low <= abs(value) <= high:
+                raise InputError(f"{name} {value!r}: |{name}| outside {low:g}..{high:g} (or 0); "
+                                 "the balance cubes it, which must stay a normal double")
+        if self.eps < low:
+            raise InputError(f"eps {self.eps!r}: below {low:g}")
 
     @property
     def terms(self) -> dict[tuple[int, int], float]:
@@ -94,11 +102,20 @@ class Pump:
         return np.array([[1.0, -float(self.eps), 2.0 * omega, 0.0]])
 
 
+OMEGA_RANGE = (0.05, 20.0)
+# NOTE: ω of the response (the pump at 2ω): the Floquet pass takes 2048 RK4 steps per period
+# 2π/ω, ≥ 40 per natural period 2π from ω = 0.05; above 20 the pump is far past every tongue
+# (they lie at ω ≈ 1/n).
+
+
 def check_omega(omega: float, name: str = "omega") -> float:
-    """A finite ``ω > 0`` (half the pump's frequency), else :class:`InputError`."""
+    """A finite ``ω`` in :data:`OMEGA_RANGE` (half the pump's frequency), else
+    :class:`InputError`."""
+    lo, hi = OMEGA_RANGE
     if isinstance(omega, bool) or not isinstance(omega, (int, float, np.floating)) \
-            or not math.isfinite(omega) or not omega > 0:
-        raise InputError(f"{name} {omega!r}: must be a finite number > 0")
+            or not lo <= omega <= hi:
+        raise InputError(f"{name} {omega!r}: must be a number in {lo:g}..{hi:g} (the first "
+                         "tongue is at 1)")
     return float(omega)
 
 
