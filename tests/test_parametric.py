@@ -263,3 +263,16 @@ def test_subharmonic_json_gains_the_full_hill_verdict():
     sols = {s["root"]: s for s in json.loads(out.stdout)["solutions"]}
     assert sols["-"]["hill_stable"] and not sols["-"]["full_hill"]["stable"]
     assert sols["-"]["numerical"]["stable"] is False and sols["+"]["full_hill"]["stable"]
+
+
+def test_parametric_figure_is_drawn_and_a_bad_input_draws_nothing(tmp_path, capsys):
+    from lindstedt import cli
+
+    path = tmp_path / "p.png"
+    args = ["parametric", "--eps", "0.2", "--zeta", "0.01", "--omega-from", "0.9",
+            "--omega-to", "1.1", "--points", "2"]
+    assert cli.main([*args, "--zeta", "2", "--plot", str(path)]) == 2
+    assert list(tmp_path.iterdir()) == []
+    assert cli.main([*args, "--plot", str(path)]) == 0
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    capsys.readouterr()
