@@ -518,9 +518,33 @@ ROOT_POLISH = 3
 ROOT_RESOLVED = 1e-9
 # NOTE: the last Newton step must move the root by less than this (relative): beside a fold,
 # where the root is double, it does not, and the evaluators return NaN.
-HARMONICS_EMITTED = 5
+DAMPED_TRUNCATION = 1e-2
+# NOTE: the damped evaluators' verified domain: the first omitted term of the μ-series (its
+# b_{K+1} and δ_{K+1}, which track the error against shooting within a factor 2) at most 1 % of
+# A₁; beyond it, near a fold or at large εA₁², they return NaN rather than a guess.
+DAMPED_HARMONICS = 5
 # NOTE: A_n, B_n for n = 1, 3, 5: the harmonics the tables and charts show (and the first three of
 # the undamped module's).
+
+
+def nested_horner(expr: sp.Expr, gens: tuple[sp.Symbol, ...]) -> sp.Expr:
+    """A polynomial in ``gens`` as Horner's rule in the first, each coefficient in the rest."""
+    if not gens:
+        return expr
+    poly = sp.Poly(expr, gens[0])
+    acc = sp.Integer(0)
+    for c in poly.all_coeffs():
+        acc = acc * gens[0] + nested_horner(sp.expand(c), gens[1:])
+    return acc
+
+
+def _damped_horner(expr: sp.Expr) -> sp.Expr:
+    """``A₁N/(ω^{2j}Δ^m)`` (or ``N/(…)``) with ``N`` by :func:`nested_horner` in x, a, γ."""
+    num, den = sp.fraction(sp.together(expr))
+    if num == 0:
+        return num
+    factor = A1_ if num.has(A1_) else sp.Integer(1)
+    return factor * nested_horner(sp.expand(num / factor), (damped_x, a_, gamma_)) / den
 
 
 def damped_cubic_branches(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol,
@@ -555,12 +579,14 @@ def lower_driven_damped(orders: tuple[MuDampedOrder, ...], command: str) -> Modu
     (:func:`damped_cubic_branches`, polished by ``ROOT_POLISH`` Newton steps); ``δ₀`` is
     :func:`driven.one_harmonic_phase`'s.  With ``τ = ωt − δ`` the sum ``Σ_j q_j(τ)`` has
     coefficients ``α_n`` (cos nτ), ``β_n`` (sin nτ), and ``A_n = α_n cos nδ − β_n sin nδ``,
-    ``B_n = α_n sin nδ + β_n cos nδ``.  NaN (the verified domain): ``ε = 0`` (no cubic), a
-    root Newton does not resolve or ``Δ = 0`` (a fold), and a series whose last term
-    ``|b_K| + A₁|δ_K|`` exceeds the one before (``A₁`` for K = 1): a growing series is no
-    answer.  ``Q = inf`` is the undamped oscillator (``A₁ > 0``, ``δ₀`` = 0 or π).
+    ``B_n = α_n sin nδ + β_n cos nδ``.  ``orders`` holds K + 1 orders: the last one only
+    estimates the truncation error.  NaN (the verified domain): ``ε = 0`` (no cubic), a root
+    Newton does not resolve or ``Δ = 0`` (a fold), and where the first omitted term
+    ``t_{K+1} = |b_{K+1}| + A₁|δ_{K+1}|`` exceeds ``DAMPED_TRUNCATION·A₁`` or the last summed one
+    ``t_K`` (near a fold ``Δ → 0`` and the terms grow).  ``Q = inf`` is the undamped
+    oscillator (``A₁ > 0``, ``δ₀`` = 0 or π).
     """
-    K = len(orders)
+    K = len(orders) - 1
     omega, eps, force, Q, branch = sp.symbols("omega eps force Q branch")
     A1, delta, z, gamma = sp.symbols("A1 delta z gamma")
     x, a, Delta = sp.symbols("x a Delta")
@@ -579,21 +605,25 @@ def lower_driven_damped(orders: tuple[MuDampedOrder, ...], command: str) -> Modu
                 (sp.Symbol("delta0"), sp.atan2(sign * gamma,
                                                sign * (sp.Rational(3, 4) * x - a)))]
     # the phase and the last two terms' sizes, shared subexpressions first
-    named = [sp.Symbol(f"delta{j}") for j in range(1, K + 1)]
-    b = [o.q[0].get(1, sp.Integer(0)).xreplace(to_args) for o in orders]
-    sizes = [sp.Abs(b[j]) + A1 * sp.Abs(named[j]) for j in range(K)]
-    subexprs, reduced = sp.cse([o.delta.xreplace(to_args) for o in orders],
+    named = [sp.Symbol(f"delta{j}") for j in range(1, K + 2)]
+    constants = [sp.Symbol(f"b{j}") for j in (K, K + 1)]
+    sizes = [sp.Abs(b) + A1 * sp.Abs(d) for b, d in zip(constants, named[K - 1:], strict=True)]
+    wanted = [*(o.delta for o in orders), *(o.q[0].get(1, sp.Integer(0))
+                                            for o in orders[K - 1:])]
+    subexprs, reduced = sp.cse([_damped_horner(e).xreplace(to_args) for e in wanted],
                                symbols=sp.numbered_symbols("d_"), order="canonical")
-    prelude += [*subexprs, *zip(named, reduced, strict=True),
-                (delta, sp.Symbol("delta0") + sum(named))]
-    last = sizes[-1]
-    before = A1 if K == 1 else sizes[-2]
-    guard = sp.And(sp.Ne(eps, 0), Q > 0, sp.Ne(Delta, 0), last <= before,
+    prelude += [*subexprs, *zip([*named, *constants], reduced, strict=True),
+                (delta, sp.Symbol("delta0") + sum(named[:K]))]
+    omitted, last = sizes[1], sizes[0]
+    guard = sp.And(sp.Ne(eps, 0), Q > 0, sp.Ne(Delta, 0), omitted <= last,
+                   omitted <= DAMPED_TRUNCATION * A1,
                    sp.Abs(zs[-1] - zs[-2]) <= ROOT_RESOLVED * sp.Abs(z))
+    summed = orders[:K]
     evaluators = []
-    for n in range(1, min(2 * K + 1, HARMONICS_EMITTED) + 1, 2):
-        alpha = (A1 if n == 1 else 0) + sum(o.q[0].get(n, 0) for o in orders)
-        beta = sum(o.q[1].get(n, 0) for o in orders)
+    for n in range(1, min(2 * K + 1, DAMPED_HARMONICS) + 1, 2):
+        alpha = (A1 if n == 1 else 0) + sum(_damped_horner(o.q[0].get(n, sp.Integer(0)))
+                                            for o in summed)
+        beta = sum(_damped_horner(o.q[1].get(n, sp.Integer(0))) for o in summed)
         c, s = sp.cos(n * delta), sp.sin(n * delta)
         for name, out, what in ((f"A_{n}", alpha * c - beta * s, f"cos {n}ωt"),
                                 (f"B_{n}", alpha * s + beta * c, f"sin {n}ωt")):

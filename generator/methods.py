@@ -538,12 +538,14 @@ BALANCE = Target(lambda r: ("balance.py",), _balance_derive, _balance_lower)
 
 
 def _mu_damped_derive(r: Request, progress: Progress | None) -> object:
-    return mu_expansion_damped(r.order)
+    if isinstance(r.order, bool) or not isinstance(r.order, int) or not 1 <= r.order <= 11:
+        raise InputError(f"order {r.order!r}: the damped μ-expansion is emitted at orders 1..11")
+    return mu_expansion_damped(r.order + 1)  # one order more: the truncation error's estimate
 
 
 def _mu_damped_lower(orders: object, r: Request) -> Unit:
     return Unit(lower_driven_damped(orders, r.command),
-                (MuDampedDerivation(r.order, orders, damped_determinant()),))
+                (MuDampedDerivation(r.order, orders[: r.order], damped_determinant()),))
 
 
 MU_DAMPED = Target(lambda r: ("driven_damped.py", "driven_damped_derivation.tex"),

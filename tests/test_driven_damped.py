@@ -31,6 +31,7 @@ from lindstedt.driven import (
     x_,
 )
 from lindstedt.emit import load_generated
+from lindstedt.lower import DAMPED_TRUNCATION
 from lindstedt.numerics import shoot
 
 K = 4
@@ -205,6 +206,35 @@ def test_emitted_is_nan_outside_its_domain(module):
     fold = w[np.flatnonzero(upper)[-1]]
     assert math.isnan(module.A_1(fold, 0.1, 0.3, 20.0, 1))
     assert math.isnan(module.A_1(1.0, 2.0, 20.0, 20.0, 0))  # εA₁² ≫ 1: terms grow
+
+
+def test_emitted_within_its_verified_error_up_to_the_fold(module):
+    """Along the upper branches up to their fold (ε = 0.1, f = 0.3, Q = 20, ω ≈ 1.49):
+    every finite A_n, B_n is within 2·DAMPED_TRUNCATION·A₁ of shooting (the guard's first
+    omitted term tracks the error), and beside the fold, where the branches still exist, the
+    evaluators return NaN."""
+    eps, force, Q = 0.1, 0.3, 20.0
+    dense = np.linspace(1.3, 1.6, 30001)
+    fold = dense[np.flatnonzero(np.isfinite(one_harmonic_roots(eps, force, Q, dense)[:, 1]))[-1]]
+    w = np.concatenate([np.linspace(1.3, fold - 0.01, 10), np.linspace(fold - 0.008, fold, 10)])
+    exists = np.isfinite(one_harmonic_roots(eps, force, Q, w)[:, :2])
+    refused = 0
+    for i, omega in enumerate(w):
+        for k in range(2):
+            A = {n: float(getattr(module, f"A_{n}")(omega, eps, force, Q, k)) for n in (1, 3, 5)}
+            B = {n: float(getattr(module, f"B_{n}")(omega, eps, force, Q, k)) for n in (1, 3, 5)}
+            if not math.isfinite(A[1]):
+                refused += exists[i, k]
+                continue
+            assert all(map(math.isfinite, [*A.values(), *B.values()]))
+            orbit = shoot(eps, force, omega, 1 / Q, np.array([sum(A.values()), omega * sum(
+                n * b for n, b in B.items())]))
+            assert orbit is not None
+            A1 = math.hypot(A[1], B[1])
+            for n in (1, 3, 5):
+                assert abs(A[n] - orbit.A[n]) <= 2 * DAMPED_TRUNCATION * A1, (omega, k, n)
+                assert abs(B[n] - orbit.B[n]) <= 2 * DAMPED_TRUNCATION * A1, (omega, k, n)
+    assert refused >= 2  # the guard acts beside the fold
 
 
 def test_cli_damped(tmp_path):
