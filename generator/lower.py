@@ -540,11 +540,15 @@ def nested_horner(expr: sp.Expr, gens: tuple[sp.Symbol, ...]) -> sp.Expr:
 
 def _damped_horner(expr: sp.Expr) -> sp.Expr:
     """``A₁N/(ω^{2j}Δ^m)`` (or ``N/(…)``) with ``N`` by :func:`nested_horner` in x, a, γ."""
-    num, den = sp.fraction(sp.together(expr))
+    # NOTE: no together(): it would clear the rationals into integers beyond int64
+    num, den = sp.fraction(expr)
     if num == 0:
         return num
     factor = A1_ if num.has(A1_) else sp.Integer(1)
-    return factor * nested_horner(sp.expand(num / factor), (damped_x, a_, gamma_)) / den
+    out = factor * nested_horner(sp.expand(num / factor), (damped_x, a_, gamma_)) / den
+    # an integer literal beyond int64 does not compile: as the nearest double
+    return out.xreplace({n: sp.Float(int(n), 17) for n in out.atoms(sp.Integer)
+                         if abs(n) > 2**53})
 
 
 def damped_cubic_branches(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol,
