@@ -31,7 +31,7 @@ from lindstedt.driven import (
     x_,
 )
 from lindstedt.emit import load_generated
-from lindstedt.lower import DAMPED_TRUNCATION
+from lindstedt.lower import DAMPED_TRUNCATION, lower_driven_damped
 from lindstedt.numerics import shoot
 
 K = 4
@@ -235,6 +235,15 @@ def test_emitted_within_its_verified_error_up_to_the_fold(module):
                 assert abs(A[n] - orbit.A[n]) <= 2 * DAMPED_TRUNCATION * A1, (omega, k, n)
                 assert abs(B[n] - orbit.B[n]) <= 2 * DAMPED_TRUNCATION * A1, (omega, k, n)
     assert refused >= 2  # the guard acts beside the fold
+
+
+def test_emitted_literals_fit_numba_at_order_four():
+    """Every integer literal of the order-4 evaluators fits int64 (numba refuses larger ones):
+    the numerators keep their rational coefficients, which print as doubles."""
+    module = lower_driven_damped(mu_expansion_damped(5), "test")
+    for ev in module.evaluators:
+        for e in (ev.output, ev.guard, *(r for _, r in (*ev.prelude, *ev.body))):
+            assert all(abs(n) < 2**63 for n in e.atoms(sp.Integer)), ev.name
 
 
 def test_cli_damped(tmp_path):
