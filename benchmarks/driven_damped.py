@@ -69,6 +69,9 @@ def emitted() -> None:
                 args = (d.omega, d.eps, d.force, d.Q, k)
                 A = {n: getattr(mod, f"A_{n}")(*args) for n in (1, 3, 5) if hasattr(mod, f"A_{n}")}
                 B = {n: getattr(mod, f"B_{n}")(*args) for n in (1, 3, 5) if hasattr(mod, f"B_{n}")}
+                if not all(np.isfinite([*A.values(), *B.values()])):
+                    worst = np.nan  # outside the verified domain: the evaluators refuse
+                    continue
                 guess = np.array([sum(A.values()), d.omega * sum(n * b for n, b in B.items())])
                 orbit = shoot(d.eps, d.force, d.omega, d.damping, guess)
                 worst = max(worst, *(abs(A[n] - orbit.A[n]) for n in A),
