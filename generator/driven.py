@@ -711,7 +711,7 @@ def _resonant_parts(t: Trig) -> tuple[object, object]:
     return acc_c, acc_s
 
 
-def _power(j: int) -> int:
+def _delta_power(j: int) -> int:
     """``Δ``'s power under order ``j``: each 2×2 solve divides by ``Δ`` once, and order j's
     products reach ``Δ^{2j−2}`` before it (q₁·q₁·q_{j−2}, δ₁δ_{j−1})."""
     return 2 * j - 1 if j else 0
@@ -749,20 +749,21 @@ def mu_expansion_damped(order: int) -> tuple[MuDampedOrder, ...]:
         return value * powers[want - have] if want > have else value
 
     cos1 = Trig.from_fourier({1: one}, {}, ground)
-    q, deltas = [cos1], [zero]  # numerators of q_j/A₁ and δ_j over ω^{2j} Δ^{_power(j)}
+    q, deltas = [cos1], [zero]  # numerators of q_j/A₁ and δ_j over ω^{2j} Δ^{_delta_power(j)}
     sq, cu, X, Y = [cos1 * cos1], [cos1 * cos1 * cos1], [one], [zero]  # q², q³, E = X + iY
 
     def extend(j: int, want: int) -> None:
         """Append ``[μ^j]`` of q², q³ and E (without ``iδ_j``) over ``Δ^want``."""
-        pairs = [(i, j - i) for i in range(1, j)]
-        sq.append(sum((lift(q[i] * q[k], _power(i) + _power(k), want) for i, k in pairs),
-                      lift(q[j] * cos1 * 2, _power(j - 1), want)))
-        cu.append(sum((lift(q[i] * sq[k], _power(i) + _power(k), want) for i, k in pairs),
-                      lift(q[j] * sq[0], _power(j - 1), want) + lift(sq[j] * cos1, want, want)))
-        X.append(sum((lift(deltas[i] * Y[k] * s(Fraction(-i, j)), _power(i) + _power(k), want)
-                      for i, k in pairs), zero))
-        Y.append(sum((lift(deltas[i] * X[k] * s(Fraction(i, j)), _power(i) + _power(k), want)
-                      for i, k in pairs), zero))
+        pairs = [(i, j - i, _delta_power(i) + _delta_power(j - i)) for i in range(1, j)]
+        last = _delta_power(j - 1)  # q[j] is still order j's particular solution
+        sq.append(sum((lift(q[i] * q[k], m, want) for i, k, m in pairs),
+                      lift(q[j] * cos1 * 2, last, want)))
+        cu.append(sum((lift(q[i] * sq[k], m, want) for i, k, m in pairs),
+                      lift(q[j] * sq[0], last, want) + lift(sq[j] * cos1, want, want)))
+        X.append(sum((lift(deltas[i] * Y[k] * s(Fraction(-i, j)), m, want)
+                      for i, k, m in pairs), zero))
+        Y.append(sum((lift(deltas[i] * X[k] * s(Fraction(i, j)), m, want)
+                      for i, k, m in pairs), zero))
 
     def forcing(j: int) -> Trig:
         """``ω² F_{j+1}/A₁`` from order ``j`` (eq. 10.68), over order j's denominator."""
@@ -796,12 +797,12 @@ def mu_expansion_damped(order: int) -> tuple[MuDampedOrder, ...]:
             raise ArithmeticError(f"order {j}: secular terms left in F_{j}")
         c1, s1 = _resonant_parts(solved.particular)
         p = solved.particular - Trig.from_fourier({1: c1}, {1: s1}, ground)
-        forcing_j = fourier(F, j, _power(j - 1), 1)
-        trial = _power(j) - 1  # order j with b_j = δ_j = 0, over Δ^(2j − 2)
+        forcing_j = fourier(F, j, _delta_power(j - 1), 1)
+        trial = _delta_power(j) - 1  # order j with b_j = δ_j = 0, over Δ^(2j − 2)
         q.append(p)
         deltas.append(zero)
         extend(j, trial)
-        q[j] = lift(p, _power(j - 1), trial)
+        q[j] = lift(p, _delta_power(j - 1), trial)
         sc, ss = _resonant_parts(forcing(j))
         b = -(m22 * sc + gamma * ss)  # adj(M)·(−s): the 1/Δ goes into the next power
         delta = gamma * sc - m11 * ss
@@ -810,7 +811,7 @@ def mu_expansion_damped(order: int) -> tuple[MuDampedOrder, ...]:
                    - A1_ * ground.to_sympy(gamma) * dj,
                    real(ss, j, trial) + ground.to_sympy(gamma) * bj
                    + A1_ * ground.to_sympy(m22) * dj)
-        up = _power(j)
+        up = _delta_power(j)
         q[j] = lift(q[j], trial, up) + cos1 * b
         deltas[j] = delta
         sq[j] = lift(sq[j], trial, up) + cos1 * cos1 * (b * 2)
