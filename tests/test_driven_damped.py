@@ -237,6 +237,18 @@ def test_emitted_within_its_verified_error_up_to_the_fold(module):
     assert refused >= 2  # the guard acts beside the fold
 
 
+def test_emitted_into_twin_agrees_with_the_ufunc(module):
+    """``B_3_into`` over an array of ω (other arguments scalars) gives the ufunc's values, NaN
+    where it does, and refuses an out it cannot write."""
+    w = np.linspace(0.6, 1.8, 301)
+    want = module.B_3(w, 0.1, 0.3, 20.0, 0)
+    got = module.B_3_into(np.empty(w.size), w, 0.1, 0.3, 20.0, 0)
+    assert np.array_equal(np.isnan(got), np.isnan(want)) and np.isfinite(want).sum() > 200
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15)
+    with pytest.raises(TypeError):
+        module.B_3_into(np.empty(w.size, np.int64), w, 0.1, 0.3, 20.0, 0)
+
+
 def test_emitted_literals_fit_numba_at_order_four():
     """Every integer literal of the order-4 evaluators fits int64 (numba refuses larger ones):
     the numerators keep their rational coefficients, which print as doubles."""
