@@ -269,9 +269,13 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         raise InputError(f"--allow-divergent: the {args.model} evaluators have no radius to lift")
     from . import compiler
 
+    if args.damped and args.model != "driven":
+        raise InputError(f"--damped: only `generate driven` has a damped variant, not "
+                         f"{args.model}")
     out = _out_folder(args.out)
     if args.model == "driven":
-        paths = compiler.generate_driven(order, out, overwrite_edited=args.overwrite_edited)
+        paths = compiler.generate_driven(order, out, damped=args.damped,
+                                         overwrite_edited=args.overwrite_edited)
     elif args.model == "balance":
         paths = compiler.generate_balance(args.harmonics, out,
                                           overwrite_edited=args.overwrite_edited)
@@ -1615,6 +1619,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--allow-divergent", action="store_true",
                    help="evaluate beyond the radius of convergence instead of returning NaN "
                    "(default: NaN)")
+    p.add_argument("--damped", action="store_true",
+                   help="driven only: the μ-expansion with damping 1/Q, A_n and B_n (n = 1, 3, "
+                   "5) of Q < inf (driven_damped.py, driven_damped_derivation.tex)")
     _flag_allow_slow(p)
     _flag_overwrite_edited(p)
     p.set_defaults(func=_cmd_generate)

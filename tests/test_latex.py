@@ -74,13 +74,15 @@ def written(tmp_path_factory) -> dict[str, Path]:
     for model in ("duffing", "pendulum"):
         generate(model, 40, out)
     generate_driven(3, out)
+    generate_driven(3, out, damped=True)
     texs = {f"order-high/{p.name}": p for p in out.glob("*.tex")}
     texs.update({f"generated/{p.name}": p for p in GENERATED.glob("*.tex")})
     return texs
 
 
 TEX_NAMES = [f"order-high/{m}_{kind}.tex" for m in ("duffing", "pendulum")
-             for kind in ("tables", "derivation")] + ["order-high/driven_derivation.tex"]
+             for kind in ("tables", "derivation")] + ["order-high/driven_derivation.tex",
+                                                      "order-high/driven_damped_derivation.tex"]
 
 
 @pytest.mark.skipif(PDFLATEX is None, reason="pdflatex not installed (`make tex` installs it)")
