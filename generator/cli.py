@@ -248,6 +248,60 @@ def _cmd_mathieu(args: argparse.Namespace) -> int:
     return 0
 
 
+def slow_flow_json(flow) -> dict:
+    """The contract of ``lindstedt slowflow … --json``: ``radial[k-1]`` and ``phase[k-1]`` are
+    R_k and Φ_k of dr/dt = Σ eps^k R_k, dphi/dt = Σ eps^k Φ_k (SymPy text in r, phi and the
+    parameters), for q = r cos(t + phi) (a drive: q = r cos(w t + phi), w = 1 + eps*sigma)."""
+    return {
+        "equation": flow.source, "name": flow.name, "order": flow.order, "variable": "eps",
+        "parameters": [str(p) for p in flow.parameters], "driven": flow.driven,
+        "convention": ("q = r cos(w t + phi), q' = -r w sin(w t + phi) + O(eps), "
+                       "w = 1 + eps*sigma" if flow.driven else
+                       "q = r cos(t + phi), q' = -r sin(t + phi) + O(eps)")
+        + "; mean-free near-identity transformation",
+        "radial": [sp_text(e) for e in flow.radial],
+        "phase": [sp_text(e) for e in flow.phase],
+    }
+
+
+def sp_text(expr) -> str:
+    import sympy as sp
+
+    return sp.sstr(expr, order="lex")
+
+
+def _cmd_slowflow(args: argparse.Namespace) -> int:
+    """``lindstedt slowflow EQUATION|NAME --order K``: the averaged equations, exact."""
+    from .averaging import slow_flow
+    from .models import REGISTRY, oscillator
+
+    text, name = args.model, args.name or "oscillator"
+    if text in REGISTRY:
+        text, name = REGISTRY[text].equation, args.name or text
+    out = _out_folder(args.out) if args.out is not None else None
+    osc = oscillator(text, _params(args.param), name)
+    flow = slow_flow(osc, args.order)
+    if args.json:
+        print(json.dumps(slow_flow_json(flow)))
+    else:
+        frame = "q = r cos(w t + phi), w = 1 + eps*sigma" if flow.driven else \
+            "q = r cos(t + phi)"
+        print(f"{flow.name}: {flow.source}, the slow flow to order {flow.order} ({frame})")
+        print("dr/dt = sum_k eps^k R_k, dphi/dt = sum_k eps^k Phi_k")
+        for k in range(flow.order):
+            print(f"R_{k + 1}   = {sp_text(flow.radial[k])}")
+            print(f"Phi_{k + 1} = {sp_text(flow.phase[k])}")
+    if out is not None:
+        from .compiler import generate_slow_flow
+
+        params = "".join(f" --param {k}={v}" for k, v in sorted(_params(args.param).items()))
+        command = f'lindstedt slowflow "{text}" --name {name} --order {args.order}{params}'
+        for path in generate_slow_flow(osc, args.order, command, out,
+                                       overwrite_edited=args.overwrite_edited):
+            print(f"  {path}", file=sys.stderr if args.json else sys.stdout)
+    return 0
+
+
 def _cmd_models(args: argparse.Namespace) -> int:
     from .models import REGISTRY
 
@@ -1638,6 +1692,22 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("name", choices=SCENE_NAMES, help="the scene")
     _flag_json(p, "JSON")
     p.set_defaults(func=_cmd_scene)
+
+    p = sub.add_parser("slowflow", help="the slow flow (averaging) of q'' + q = eps*f, free, "
+                       "self-excited or driven", description="Average q'' + q = eps*f(q, q') "
+                       "(+ eps*F*cos(w*t), w = 1 + eps*sigma) to order K: dr/dt and dphi/dt "
+                       "exactly, for q = r cos(t + phi); with --out the compiled right sides and "
+                       "the LaTeX of the flow.")
+    _flag_oscillator(p)
+    p.add_argument("--order", type=_order, default=2, metavar="K",
+                   help="the order in eps, 1..6 (default 2)")
+    _flag_json(p, "the contract {equation, name, order, variable, parameters, driven, "
+               "convention, radial, phase}")
+    p.add_argument("--out", metavar="DIR", help="also write <name>_slow_flow.py (numba "
+                   "slow_flow, slow_flow_jacobian, slow_flow_cartesian) and "
+                   "<name>_slow_flow.tex into DIR")
+    _flag_overwrite_edited(p)
+    p.set_defaults(func=_cmd_slowflow)
 
     p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults",
                        description="The main job on the built-in defaults; writes only under "

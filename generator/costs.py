@@ -354,6 +354,19 @@ def mathieu_cost(args: argparse.Namespace) -> Cost:
                 "the Mathieu series")
 
 
+SLOW_FLOW_FIT = (2.0, 0.95, 4, "4")
+# NOTE: `lindstedt slowflow` (start-up, then derive): each order about 4× the one before; the
+# driven Duffing takes 0.95 s at order 4 (van der Pol 0.3 s); --out adds the numba import.
+
+
+def slow_flow_cost(args: argparse.Namespace) -> Cost:
+    from .averaging import MAX_ORDER
+
+    # NOTE: beyond MAX_ORDER the derivation refuses at once (its own one-line message)
+    order = args.order if args.order <= MAX_ORDER else 0
+    return Cost(power_law(*SLOW_FLOW_FIT, order), f"order {args.order}", "the slow flow")
+
+
 COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "series": series_cost,
     "generate": generate_cost,
@@ -367,6 +380,7 @@ COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "scene": fixed_cost("scene"),
     "models": fixed_cost("models"),
     "mathieu": mathieu_cost,
+    "slowflow": slow_flow_cost,
 }
 # NOTE: one estimator per command; `demo` has none: its work is the fixed built-in job
 # (`make demo`), which nothing on its command line scales.
