@@ -232,3 +232,55 @@ def test_bad_input_is_one_line(text, order, match):
     with pytest.raises(InputError, match=match) as info:
         slow_flow(oscillator(text), order)
     assert "\n" not in str(info.value)
+
+
+def test_emitted_right_sides(tmp_path):
+    """The compiled slow_flow against lambdify of the same flow, its Jacobian against central
+    differences, the Cartesian right side against the polar one (u = r cos φ, v = −r sin φ);
+    regenerating gives byte-identical files."""
+    from lindstedt.cli import main
+    from lindstedt.emit import load_generated
+
+    args = ["slowflow", DRIVEN, "--name", "forced", "--param", "k=1/2", "--order", "2",
+            "--out", str(tmp_path)]
+    assert main(args) == 0
+    first = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    assert sorted(first) == ["forced_slow_flow.py", "forced_slow_flow.tex"]
+    assert main(args) == 0
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == first
+    m = load_generated(tmp_path / "forced_slow_flow.py")
+    assert m.PARAMETERS == ("eps", "F", "sigma")
+    flow = slow_flow(oscillator(DRIVEN, {"k": "1/2"}), 2)
+    F, sigma = sp.symbols("F sigma")
+    ref = sp.lambdify((R, PHI, EPS, F, sigma), flow.rates)
+    rng = np.random.default_rng(5)
+    for r, phi, eps, f, s in rng.uniform((0.2, -3, 0.01, -1, -2), (3, 3, 0.3, 1, 2), (20, 5)):
+        x = np.array([r, phi])
+        got = m.slow_flow(x, eps, f, s)
+        assert np.allclose(got, ref(r, phi, eps, f, s), rtol=1e-13, atol=1e-15)
+        h = 1e-6
+        fd = np.column_stack([(m.slow_flow(x + h * e, eps, f, s) - m.slow_flow(x - h * e, eps,
+                                                                              f, s)) / (2 * h)
+                              for e in np.eye(2)])
+        assert np.allclose(m.slow_flow_jacobian(x, eps, f, s), fd, rtol=1e-6, atol=1e-8)
+        u, v = r * math.cos(phi), -r * math.sin(phi)
+        du, dv = m.slow_flow_cartesian(np.array([u, v]), eps, f, s)
+        assert math.isclose((u * du + v * dv) / r, got[0], rel_tol=1e-11, abs_tol=1e-13)
+        assert math.isclose((v * du - u * dv) / r**2, got[1], rel_tol=1e-11, abs_tol=1e-13)
+
+
+def test_cli_json_and_bad_input(capsys):
+    import json
+
+    from lindstedt.cli import main
+
+    assert main(["slowflow", "van_der_pol", "--order", "2", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["order"] == 2 and data["parameters"] == [] and not data["driven"]
+    assert sp.sympify(data["radial"][0], locals={"r": R}) == sp.expand(R / 2 - R**3 / 8)
+    assert sp.sympify(data["phase"][1], locals={"r": R}).subs(R, 2) == sp.Rational(-1, 16)
+    for bad in (["slowflow", "q'' + q**3 = 0"], ["slowflow", "van_der_pol", "--order", "9"],
+                ["slowflow", VDP, "--param", "zz=1"]):
+        assert main(bad) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "Traceback" not in err
