@@ -439,6 +439,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     # (benchmarks/*speed_accuracy.py refresh the committed copies the README shows).
     print(f"  {speed_accuracy_figure(figures / 'speed_accuracy.png')}")
     print(f"  {driven_speed_accuracy_figure(figures / 'driven_speed_accuracy.png')}")
+    _demo_slow_flow(out, figures, args.overwrite_edited)
     if shutil.which("pdflatex"):
         for tex in sorted(out.glob("*.tex")):
             for _ in range(2):  # longtable settles its column widths on the second pass
@@ -449,6 +450,38 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     else:
         print("\npdflatex not found: `make demo` installs it; LaTeX sources are in", out)
     return 0
+
+
+def _demo_slow_flow(out: Path, figures: Path, overwrite_edited: bool) -> None:
+    """The demo's slow flow: van der Pol's to order 2, emitted and typeset, run from r = 0.1
+    against simulation, and its two figures."""
+    import numpy as np
+
+    from .averaging import simulate, slow_flow, transient
+    from .charts import slow_flow_error_figure, slow_flow_transient_figure
+    from .compiler import generate_slow_flow
+    from .emit import load_generated
+    from .models import REGISTRY, oscillator
+
+    text = REGISTRY["van_der_pol"].equation
+    osc = oscillator(text, name="van_der_pol")
+    command = f'lindstedt slowflow "{text}" --name van_der_pol --order 2'
+    print(f"\nthe slow flow of van der Pol to order 2 ({command} --out {out}):")
+    for path in generate_slow_flow(osc, 2, command, out, overwrite_edited=overwrite_edited):
+        print(f"  {path}")
+    emitted = load_generated(out / "van_der_pol_slow_flow.py")
+    rate = emitted.slow_flow(np.array([2.0, 0.0]), 0.1)
+    print(f"  at the cycle r = 2, eps = 0.1: dr/dt = {rate[0]:.3g}, dphi/dt = {rate[1]:.6f} "
+          "(-eps^2/16 = -0.000625)")
+    flow, eps = slow_flow(osc, 2), 0.1
+    t = np.linspace(0.0, 80.0, 9)
+    r_sim = np.hypot(*simulate(osc, eps, 0.1, 0.0, t))
+    r_avg = np.hypot(*transient(flow, eps, 0.1, 0.0, t))
+    print(f"  from r = 0.1 at eps = {eps}:  t  r(simulation)  r(slow flow)")
+    for ti, a, b in zip(t, r_sim, r_avg, strict=True):
+        print(f"  {ti:>24.0f}  {a:>13.6f}  {b:>12.6f}")
+    print(f"  {slow_flow_error_figure(figures / 'slow_flow_error.png')}")
+    print(f"  {slow_flow_transient_figure(figures / 'slow_flow_transient.png')}")
 
 
 def driven_json(d, order: int, harmonics: int) -> dict:
