@@ -46,6 +46,8 @@ U, V = sp.Symbol("_u"), sp.Symbol("_v")  # van der Pol's variables ("_": no user
 R, PHI = sp.Symbol("r", positive=True), sp.Symbol("phi")
 SIGMA = sp.Symbol("sigma")  # the detuning of a drive, ω = 1 + ε σ
 METHOD = "the slow flow"
+RESERVED = frozenset({"r", "phi", "u", "v", "x"})
+# NOTE: the polar and Cartesian variables and the emitted kernels' state vector x.
 
 
 @dataclass(frozen=True)
@@ -123,6 +125,10 @@ def _right_side(osc: Oscillator, order: int
     drive, omega = _drive(osc, c, s)
     params = tuple(sorted(set(osc.parameters) - ({omega} if omega is not None else set())
                           | ({SIGMA} if drive != 0 else set()), key=str))
+    taken = sorted({str(p) for p in params} & RESERVED)
+    if taken:
+        raise osc.refuse(METHOD, f"the parameter name(s) {', '.join(taken)}: r, phi, u, v and "
+                         "x are the slow flow's own variables; rename them")
     if drive != 0 and omega is not None and SIGMA in set(osc.parameters):
         raise osc.refuse(METHOD, "the name sigma is the detuning (w = 1 + eps*sigma); rename "
                          "the parameter")

@@ -281,6 +281,14 @@ def _cmd_slowflow(args: argparse.Namespace) -> int:
     out = _out_folder(args.out) if args.out is not None else None
     osc = oscillator(text, _params(args.param), name)
     flow = slow_flow(osc, args.order)
+    written = []
+    if out is not None:  # written before anything is printed: a refusal prints nothing
+        from .compiler import generate_slow_flow
+
+        params = "".join(f" --param {k}={v}" for k, v in sorted(_params(args.param).items()))
+        command = f'lindstedt slowflow "{text}" --name {name} --order {args.order}{params}'
+        written = generate_slow_flow(osc, args.order, command, out,
+                                     overwrite_edited=args.overwrite_edited)
     if args.json:
         print(json.dumps(slow_flow_json(flow)))
     else:
@@ -291,14 +299,8 @@ def _cmd_slowflow(args: argparse.Namespace) -> int:
         for k in range(flow.order):
             print(f"R_{k + 1}   = {sp_text(flow.radial[k])}")
             print(f"Phi_{k + 1} = {sp_text(flow.phase[k])}")
-    if out is not None:
-        from .compiler import generate_slow_flow
-
-        params = "".join(f" --param {k}={v}" for k, v in sorted(_params(args.param).items()))
-        command = f'lindstedt slowflow "{text}" --name {name} --order {args.order}{params}'
-        for path in generate_slow_flow(osc, args.order, command, out,
-                                       overwrite_edited=args.overwrite_edited):
-            print(f"  {path}", file=sys.stderr if args.json else sys.stdout)
+    for path in written:
+        print(f"  {path}", file=sys.stderr if args.json else sys.stdout)
     return 0
 
 

@@ -731,10 +731,11 @@ def lower_slow_flow(flow: SlowFlow, command: str) -> Unit:
     ``slow_flow_jacobian`` and ``slow_flow_cartesian`` (``x = (u, v)``, ``u = r cos φ``,
     ``v = −r sin φ``: regular through ``r = 0``), all in t, with the LaTeX of the flow."""
     eps = sp.Symbol("eps")
-    names = {str(p) for p in flow.parameters}
-    if "eps" in names or {"r", "phi", "u", "v", "x"} & names:
-        raise InputError(f"parameters {sorted(names)}: eps, r, phi, u, v and x are the slow "
-                         "flow's own names; rename the parameter")
+    taken = MODULE_NAMES | LOCAL_NAMES | frozenset(dir(builtins)) | frozenset(keyword.kwlist)
+    for p in flow.parameters:
+        if str(p) in taken or _LOCAL.fullmatch(str(p)) or re.fullmatch(r"x_\d+", str(p)):
+            raise InputError(f"parameter {str(p)!r}: the emitted module uses this name; "
+                             "rename the parameter")
     params = tuple(sp.Symbol(str(p)) for p in flow.parameters)
     r, phi, u, v = sp.symbols("r phi u v")
     polar = [e.xreplace({R_SLOW: r, PHI_SLOW: phi}) for e in flow.rates]

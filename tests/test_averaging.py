@@ -225,6 +225,7 @@ def test_driven_flow_in_the_rotating_frame():
     ("q'' + q = eps*q'*cos(t)*q", 2, "parametrically"),
     ("q'' + q = eps*q' + cos(w*t)", 2, "of order eps"),
     ("q'' + q = eps*(q' + cos(w*t) + sin(2*w*t))", 2, "one frequency"),
+    ("q'' + q = eps*r*q'", 2, "own variables"),
     (VDP, 0, "orders 1"),
     (VDP, 7, "orders 1"),
 ])
