@@ -20,6 +20,8 @@ VDP = "q'' + q = eps*(1 - q**2)*q'"
 RAYLEIGH = "q'' + q = eps*(q' - q'**3/3)"
 DAMPED_DUFFING = "q'' + 2*eps*zeta*q' + q + eps*q**3 = 0"
 DRIVEN = "q'' + q = eps*(-k*q' - q**3 + F*cos(w*t))"
+LIENARD = "x'' + x = eps*((1/4 - x**2)*x' - x**3 + x*x'**2)"
+# NOTE: a user's Liénard-type equation, conservative terms beside the self-excited one (a0 = 1)
 EPS = sp.Symbol("eps")
 
 
@@ -52,7 +54,7 @@ def _omega_series(flow, a0) -> list[sp.Rational]:
     return [sp.Integer(1)] + [phase.coeff(EPS, k) for k in range(1, N + 1)]
 
 
-@pytest.mark.parametrize("text", [VDP, RAYLEIGH])
+@pytest.mark.parametrize("text", [VDP, RAYLEIGH, LIENARD])
 def test_limit_cycle_frequency_matches_lindstedt_to_the_order(text):
     """The fixed point's phase rate gives ω to ε^N exactly: the L–P series (another derivation,
     the secular conditions at fixed period) holds the same rationals."""
@@ -285,3 +287,19 @@ def test_cli_json_and_bad_input(capsys):
         assert main(bad) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "Traceback" not in err
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_driven_transient(order):
+    """The driven Duffing from rest (k = 1/2, F = 1, σ = 1/2; εt ≤ 4): q(t) of the slow flow
+    (rotating frame, τ = ωt, mapped back) against DOP853 of the equation with w = 1 + εσ."""
+    values = {"k": 0.5, "F": 1.0, "sigma": 0.5}
+    flow = slow_flow(oscillator(DRIVEN), order)
+    errors = []
+    for eps in (0.1, 0.05):
+        times = np.linspace(0, 4 / eps, 2001)
+        sim = _simulate(DRIVEN, {"k": 0.5, "F": 1.0, "w": 1 + 0.5 * eps}, eps, 0.0, 0.0,
+                        times)
+        pred = transient(flow, eps, 0.0, 0.0, times, values)
+        errors.append(np.max(np.abs(sim - pred)))
+    assert 2**order * 0.7 < errors[0] / errors[1] < 2**order * 1.45, errors
