@@ -4,20 +4,24 @@ Van der Pol's variables ``q = u cos τ + v sin τ``, ``q' = −u sin τ + v cos 
 in the standard form of averaging, ``x' = Σ ε^k F_k(x, τ)`` with ``x = (u, v)`` and
 ``F_k = (−g_k sin τ, g_k cos τ)`` (``g_k`` the ε^k part of the right side).  A near-identity
 transformation ``x = y + Σ_{j≥1} ε^j w_j(y, τ)`` with mean-free ``w_j`` (Sanders, Verhulst &
-Murdock, *Averaging Methods*, §2.9 and §3.2; the Krylov–Bogoliubov–Mitropolsky convention)
+Murdock, *Averaging Methods*, §2.9; the Krylov–Bogoliubov–Mitropolsky convention)
 turns it into the autonomous slow flow ``y' = Σ ε^k G_k(y)``: the order-ε^k part of
 ``∂_τ W + G + DW·G = F(y + W, τ)`` reads
 
     ∂_τ w_k + G_k = [F(y + W, τ)]_k − Σ_{i+j=k} Dw_i · G_j,
 
-whose mean over τ is ``G_k`` and whose rest, integrated, is ``w_k`` (eq. 2.9.8 of the book for
-k = 2).  Every average and integral runs in the exact Fourier kernel (:class:`series.Trig` over
-``QQ[u, v, params]``): in these variables ``F`` is a polynomial, free of the ``1/r`` of the polar
-form.  The polar flow (``u = r cos φ``, ``v = −r sin φ``, so ``q = r cos(τ + φ)``)
+whose mean over τ is ``G_k`` and whose rest, integrated, is ``w_k`` (for k = 2 the book's
+second-order averaging, §2.9).  Every average and integral runs in the exact Fourier kernel
+(:class:`series.Trig` over ``QQ[u, v, params]``): in these variables ``F`` is a polynomial, free
+of the ``1/r`` of the polar form.  The polar flow (``u = r cos φ``, ``v = −r sin φ``, so
+``q = r cos(τ + φ)``)
 
     dr/dt = Σ ε^k R_k(r, φ),   dφ/dt = Σ ε^k Φ_k(r, φ)
 
-follows exactly from ``G`` (``r' = (u u' + v v')/r``, ``φ' = (v u' − u v')/r²``).
+follows exactly from ``G`` (``r' = (u u' + v v')/r``, ``φ' = (v u' − u v')/r²``).  Beyond
+the first order the flow depends on the transformation's convention (mean-free here; Nayfeh's
+multiple scales or a stroboscopic choice give other, equivalent flows); what an orbit does does
+not: a cycle's frequency, the transients once mapped back with ``w_j``.
 
 Drive: a term ``ε F cos ωt`` (or ``sin ωt``) is taken near resonance, ``ω = 1 + εσ``, in the
 time ``τ = ωt`` (``ω² q'' + q = ε f(q, ω q') + ε F cos τ``, with ``1/ω²`` expanded in ε), so the
@@ -37,11 +41,11 @@ from sympy.polys.domains import QQ
 
 from .errors import InputError
 from .models import Oscillator
-from .series import MPoly, Trig
+from .series import Ground, MPoly, Trig
 
 MAX_ORDER = 6
-# NOTE: order 6 of van der Pol takes about a second; each order costs ~4× the one before
-# (docs/benchmarks.md, "The slow flow").
+# NOTE: order 6 of van der Pol takes about half a second, the driven Duffing's order 4 one;
+# each order costs 2–4× the one before (docs/benchmarks.md, "The slow flow").
 U, V = sp.Symbol("_u"), sp.Symbol("_v")  # van der Pol's variables ("_": no user name clashes)
 R, PHI = sp.Symbol("r", positive=True), sp.Symbol("phi")
 SIGMA = sp.Symbol("sigma")  # the detuning of a drive, ω = 1 + ε σ
@@ -144,10 +148,7 @@ def _right_side(osc: Oscillator, order: int
     inverse = sp.Add(*((n + 1) * (-sigma_eps) ** n for n in range(order + 1)))  # 1/ω²
     g = sp.expand(q * (1 - inverse) + (h.xreplace({qdot: w * qp}) + drive) * inverse)
     parts = sp.Poly(g, eps).as_dict() if g != 0 else {}
-    out = {}
-    for (k,), gk in sorted(parts.items()):
-        if 1 <= k <= order:
-            out[k] = gk.xreplace({qp: sp.Symbol(str(qp))})
+    out = {k: gk for (k,), gk in sorted(parts.items()) if 1 <= k <= order}
     for k, gk in out.items():
         try:
             sp.Poly(gk, q, qp, c, s, *params, domain=QQ)
@@ -182,9 +183,8 @@ def _drive(osc: Oscillator, c: sp.Symbol, s: sp.Symbol) -> tuple[sp.Expr, sp.Sym
     return out, (omega if omega != 1 else None)
 
 
-def _ground(symbols: tuple[sp.Symbol, ...]):
-    from .series import Ground
-
+def _ground(symbols: tuple[sp.Symbol, ...]) -> Ground:
+    """``QQ[u, v, params]``, the coefficient ring of every Fourier sum of the derivation."""
     return Ground(QQ.poly_ring(*symbols))
 
 
