@@ -541,3 +541,11 @@ def slow_flow_transient_figure(path: Path, eps: float = 0.2) -> Path:
     for a in (ax, low):
         a.grid(True, alpha=0.3)
     return _save(fig, path)
+
+
+def slow_flow_figures(folder: Path) -> list[Path]:
+    """The slow flow's two figures (error against ε, the transient) into ``folder``."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    return [slow_flow_error_figure(folder / "slow_flow_error.png"),
+            slow_flow_transient_figure(folder / "slow_flow_transient.png")]

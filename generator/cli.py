@@ -400,7 +400,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     modules = ["duffing", "pendulum", "driven", "balance"]
     check_writable(out, [*(f"{m}.py" for m in modules), "duffing_tables.tex",
                          "duffing_derivation.tex", "pendulum_tables.tex",
-                         "pendulum_derivation.tex", "driven_derivation.tex"],
+                         "pendulum_derivation.tex", "driven_derivation.tex",
+                         "van_der_pol_slow_flow.py", "van_der_pol_slow_flow.tex"],
                    overwrite_edited=args.overwrite_edited)
     figures.mkdir(parents=True, exist_ok=True)
     check_plot_path(figures / "speed_accuracy.png")
@@ -460,7 +461,7 @@ def _demo_slow_flow(out: Path, figures: Path, overwrite_edited: bool) -> None:
     import numpy as np
 
     from .averaging import simulate, slow_flow, transient
-    from .charts import slow_flow_error_figure, slow_flow_transient_figure
+    from .charts import slow_flow_figures
     from .compiler import generate_slow_flow
     from .emit import load_generated
     from .models import REGISTRY, oscillator
@@ -482,8 +483,8 @@ def _demo_slow_flow(out: Path, figures: Path, overwrite_edited: bool) -> None:
     print(f"  from r = 0.1 at eps = {eps}:  t  r(simulation)  r(slow flow)")
     for ti, a, b in zip(t, r_sim, r_avg, strict=True):
         print(f"  {ti:>24.0f}  {a:>13.6f}  {b:>12.6f}")
-    print(f"  {slow_flow_error_figure(figures / 'slow_flow_error.png')}")
-    print(f"  {slow_flow_transient_figure(figures / 'slow_flow_transient.png')}")
+    for path in slow_flow_figures(figures):
+        print(f"  {path}")
 
 
 def driven_json(d, order: int, harmonics: int) -> dict:
