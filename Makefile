@@ -45,6 +45,8 @@ bench: $(STAMP)
 figures: $(STAMP)
 	$(BIN)/python -c "from lindstedt.charts import gallery; gallery('docs/figures')"
 	$(BIN)/python -c "from lindstedt.charts import slow_flow_figures; slow_flow_figures('docs/figures')"
+	$(BIN)/python -c "from lindstedt.charts import PARAMETRIC_FIGURE, parametric_figure; \
+	parametric_figure(*PARAMETRIC_FIGURE, 'docs/figures/parametric.png')"
 
 generated: $(STAMP)
 	$(BIN)/lindstedt generate duffing --order 12 --out generated

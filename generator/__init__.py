@@ -20,6 +20,8 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
                user's polynomial force by alternating frequency/time)   branches
     response   one-harmonic curves and folds, balance continuation in   Drive | equation,
                ω or in the drive; periodic orbits, subharmonic, mixing  ω range -> folds
+    parametric  q̈ + 2ζq̇ + (1 + ε cos 2ωt)q + γq³ = 0: one-harmonic     Pump, ω range ->
+                branches, tongue, onsets, balance, full-Hill stability branches
     printers   NumbaPrinter(PythonCodePrinter), LaTeX rationals         Expr -> str
     lower      solutions -> IR records (Module, Evaluator, Derivation,  solution -> Unit
                PeriodFormula); Horner, Chebyshev recurrence, AGM steps

@@ -7,6 +7,7 @@ and writes the file atomically (a temporary file in the target folder, then a re
 from __future__ import annotations
 
 import io
+import math
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -549,3 +550,59 @@ def slow_flow_figures(folder: Path) -> list[Path]:
     folder.mkdir(parents=True, exist_ok=True)
     return [slow_flow_error_figure(folder / "slow_flow_error.png"),
             slow_flow_transient_figure(folder / "slow_flow_transient.png")]
+
+
+PARAMETRIC_FIGURE = (0.2, 0.01, 1.0, 0.9, 1.12)
+# NOTE: the README's parametric figure (ε, ζ, γ, ω range): the tongue 0.95 < ω < 1.05, both
+# onsets and the subcritical branch inside the range.
+
+
+def parametric_figure(eps: float, zeta: float, gamma: float, omega_from: float,
+                      omega_to: float, path: Path) -> Path:
+    """Response r(ω) of ``q̈ + 2ζq̇ + (1 + ε cos 2ωt)q + γq³ = 0`` (the pump at 2ω): the
+    one-harmonic branches (stable solid, unstable dashed), the harmonic balance's first harmonic
+    with its full-Hill verdict (dots), shooting (o stable, x unstable), the tongue's edges."""
+    from .parametric import Pump, check_omega, onsets, response, tongue_edges
+
+    check_plot_path(path)
+    p = Pump(eps, zeta, gamma)
+    lo, hi = check_omega(omega_from, "omega-from"), check_omega(omega_to, "omega-to")
+    omega = np.linspace(lo, hi, 221)
+    rows = response(p, omega, shoot_every=20)
+    fig, ax = plt.subplots(figsize=(7.5, 4.4))
+    edges = tongue_edges(p)
+    if edges is not None:
+        ax.axvspan(*edges, color="0.92", label="tongue: q = 0 unstable")
+        for w in edges:
+            ax.axvline(w, color="0.5", lw=0.8, ls=":")
+    colors = {"0": "k", "+": "C0", "-": "C3"}
+    for name, color in colors.items():
+        pts = [r for r in rows if r.one.branch == name]
+        r = np.full(omega.size, np.nan)
+        stable = np.zeros(omega.size, dtype=bool)
+        for pt in pts:
+            k = int(np.argmin(np.abs(omega - pt.one.omega)))
+            r[k], stable[k] = pt.one.r, pt.one.stable
+        for which, style, lw, verdict in ((stable, "-", 2, "stable"),
+                                          (~stable, "--", 1.2, "unstable")):
+            line = np.where(which, r, np.nan)
+            if np.isfinite(line).any():  # no legend entry for a verdict the branch never has
+                ax.plot(omega, line, f"{color}{style}", lw=lw,
+                        label=f"branch {name}, {verdict}" if name != "0" else f"q = 0, {verdict}")
+        bal = [(pt.one.omega, pt.balance.r) for pt in pts[::4] if pt.balance is not None]
+        if bal:
+            ax.plot(*zip(*bal, strict=True), f"{color}.", ms=3,
+                    label=f"branch {name}, harmonic balance")
+        shot = [(pt.one.omega, math.hypot(pt.orbit.A[1], pt.orbit.B[1]), pt.orbit.stable)
+                for pt in pts if pt.orbit is not None and name != "0"]
+        for w, a, s in shot:
+            ax.plot(w, a, f"{color}o" if s else f"{color}x", ms=6, mfc="none")
+    for o in onsets(p):
+        ax.annotate("super" if o.supercritical else "sub", (o.omega, 0), xytext=(0, 8),
+                    textcoords="offset points", ha="center", fontsize=8)
+    ax.set(xlabel="ω (pump at 2ω)", ylabel="r, first harmonic",
+           title=f"parametric resonance (ε = {eps}, ζ = {zeta}, γ = {gamma}); "
+           "o stable, x unstable shot orbit")
+    ax.legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    return _save(fig, path)

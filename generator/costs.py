@@ -367,12 +367,31 @@ def slow_flow_cost(args: argparse.Namespace) -> Cost:
     return Cost(power_law(*SLOW_FLOW_FIT, order), f"order {args.order}", "the slow flow")
 
 
+PARAMETRIC_FIT = (2.0, 1.5e-3)
+# NOTE: `lindstedt parametric`: start-up and ten shot ω, then per ω and nontrivial branch a
+# balance and a full Hill pass, ~1.5 ms per odd harmonic (measured at load 5: 401 points
+# 10.5 s at 8 harmonics, 116 s at 100).
+
+
+def parametric_cost(args: argparse.Namespace) -> Cost:
+    """Two branches at each of ``--points`` ω, each ``--harmonics`` deep; above the limit a
+    bound (the command has no --allow-slow: fewer points or harmonics answer the same)."""
+    points, harmonics = max(args.points, 1), max(args.harmonics, 8)
+    seconds = PARAMETRIC_FIT[0] + 2 * points * PARAMETRIC_FIT[1] * harmonics
+    if seconds > COST_LIMIT_SECONDS:
+        raise InputError(f"--points {args.points} --harmonics {args.harmonics}: about "
+                         f"{seconds:,.0f} s of balances; the limit is {COST_LIMIT_SECONDS:.0f} "
+                         "s: give fewer points or harmonics")
+    return Cost(seconds, f"--points {args.points}", "the parametric response")
+
+
 COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "series": series_cost,
     "generate": generate_cost,
     "driven": driven_cost,
     "response": response_cost,
     "subharmonic": fixed_cost("subharmonic"),
+    "parametric": parametric_cost,
     "mixing": fixed_cost("mixing"),
     "choose": choose_cost,
     "sweep": sweep_cost,
