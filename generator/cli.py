@@ -481,9 +481,10 @@ def _demo_slow_flow(out: Path, figures: Path, overwrite_edited: bool) -> None:
     t = np.linspace(0.0, 80.0, 9)
     r_sim = np.hypot(*simulate(osc, eps, 0.1, 0.0, t))
     r_avg = np.hypot(*transient(flow, eps, 0.1, 0.0, t))
-    print(f"  from r = 0.1 at eps = {eps}:  t  r(simulation)  r(slow flow)")
+    print(f"  from r = 0.1 at eps = {eps}:")
+    print(f"  {'t':>6}  {'r (simulation)':>15}  {'r (slow flow)':>14}")
     for ti, a, b in zip(t, r_sim, r_avg, strict=True):
-        print(f"  {ti:>24.0f}  {a:>13.6f}  {b:>12.6f}")
+        print(f"  {ti:>6.0f}  {a:>15.6f}  {b:>14.6f}")
     for path in slow_flow_figures(figures):
         print(f"  {path}")
 
