@@ -425,3 +425,49 @@ def simulate(osc: Oscillator, eps: float, q0: float, p0: float, times: np.ndarra
     sol = solve_ivp(lambda t, y: (y[1], accel(t, y[0], y[1])), (0.0, float(times[-1])),
                     (q0, p0), method="DOP853", t_eval=times, rtol=rtol, atol=rtol * 1e-2)
     return sol.y
+
+
+@dataclass(frozen=True)
+class CycleSeries:
+    """A limit cycle as a fixed point of an autonomous slow flow: ``r* = Σ ε^j radius[j]``
+    (the root of ``dr/dt``, to ``ε^(order−1)``) and its frequency ``ω = Σ ε^j omega[j]``
+    (``1 + dφ/dt`` there, to ``ε^order``, exact: ω does not depend on the convention)."""
+
+    radius: tuple[sp.Expr, ...]
+    omega: tuple[sp.Expr, ...]
+    slope: sp.Expr  # R_1'(r₀): the cycle attracts for ε·slope < 0
+
+
+def cycle_series(flow: SlowFlow) -> list[CycleSeries]:
+    """Every positive root ``r₀`` of ``R_1`` where ``R_1'(r₀) ≠ 0`` (rational roots; an
+    irrational one is kept as SymPy's exact algebraic number), continued order by order:
+    ``r_i`` from the ε^i part of ``(dr/dt)/ε``, linear in ``r_i`` with slope ``R_1'(r₀)``."""
+    if flow.driven:
+        raise InputError(f"{flow.name}: a driven flow's fixed points depend on the drive; "
+                         "use fixed_points with values")
+    eps = sp.Symbol("eps")
+    N = flow.order
+
+    def truncated(expr: sp.Expr, top: int) -> sp.Expr:
+        expr = sp.expand(expr)
+        return sp.Add(*(expr.coeff(eps, i) * eps**i for i in range(top + 1)))
+
+    out = []
+    R1 = flow.radial[0]
+    if R1 == 0 or R1.free_symbols - {R}:
+        return out
+    for r0 in sp.Poly(R1, R).real_roots():
+        slope = sp.diff(R1, R).subs(R, r0)
+        if r0 <= 0 or slope == 0 or any(c.radius[0] == r0 for c in out):
+            continue
+        rstar = r0
+        for i in range(1, N):
+            radial = truncated(sum(eps**k * flow.radial[k].subs(R, rstar) for k in range(N)), i)
+            rstar = rstar - sp.radsimp(radial.coeff(eps, i) / slope) * eps**i
+        phase = truncated(sum(eps ** (k + 1) * flow.phase[k].subs(R, rstar) for k in range(N)),
+                          N)
+        out.append(CycleSeries(
+            radius=tuple(sp.expand(rstar).coeff(eps, i) if i else r0 for i in range(N)),
+            omega=(sp.Integer(1), *(sp.radsimp(phase.coeff(eps, k)) for k in range(1, N + 1))),
+            slope=slope))
+    return out

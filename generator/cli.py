@@ -251,7 +251,9 @@ def _cmd_mathieu(args: argparse.Namespace) -> int:
 def slow_flow_json(flow) -> dict:
     """The contract of ``lindstedt slowflow … --json``: ``radial[k-1]`` and ``phase[k-1]`` are
     R_k and Φ_k of dr/dt = Σ eps^k R_k, dphi/dt = Σ eps^k Φ_k (SymPy text in r, phi and the
-    parameters), for q = r cos(t + phi) (a drive: q = r cos(w t + phi), w = 1 + eps*sigma)."""
+    parameters), for q = r cos(t + phi) (a drive: q = r cos(w t + phi), w = 1 + eps*sigma);
+    ``cycles``: each limit cycle (a root of dr/dt) of an autonomous flow without symbolic
+    parameters, its radius r* (to eps^(K-1)) and frequency ω (to eps^K) as series in eps."""
     return {
         "equation": flow.source, "name": flow.name, "order": flow.order, "variable": "eps",
         "parameters": [str(p) for p in flow.parameters], "driven": flow.driven,
@@ -261,7 +263,18 @@ def slow_flow_json(flow) -> dict:
         + "; mean-free near-identity transformation",
         "radial": [sp_text(e) for e in flow.radial],
         "phase": [sp_text(e) for e in flow.phase],
+        "cycles": [{"radius": [sp_text(c) for c in cyc.radius],
+                    "omega": [sp_text(c) for c in cyc.omega],
+                    "stable_for": "eps > 0" if cyc.slope < 0 else "eps < 0"}
+                   for cyc in _cycles(flow)],
     }
+
+
+def _cycles(flow) -> list:
+    """The limit cycles of an autonomous flow with numeric coefficients (none otherwise)."""
+    from .averaging import cycle_series
+
+    return [] if flow.driven or flow.parameters else cycle_series(flow)
 
 
 def sp_text(expr) -> str:
@@ -299,6 +312,12 @@ def _cmd_slowflow(args: argparse.Namespace) -> int:
         for k in range(flow.order):
             print(f"R_{k + 1}   = {sp_text(flow.radial[k])}")
             print(f"Phi_{k + 1} = {sp_text(flow.phase[k])}")
+        for cyc in _cycles(flow):
+            print(f"limit cycle (dr/dt = 0, attracting for "
+                  f"{'eps > 0' if cyc.slope < 0 else 'eps < 0'}): r = sum_j eps^j r_j, "
+                  "omega = sum_j eps^j omega_j")
+            print("  r_j:     " + ", ".join(sp_text(c) for c in cyc.radius))
+            print("  omega_j: " + ", ".join(sp_text(c) for c in cyc.omega))
     for path in written:
         print(f"  {path}", file=sys.stderr if args.json else sys.stdout)
     return 0
@@ -1887,7 +1906,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--order", type=_order, default=2, metavar="K",
                    help="the order in eps, 1..6 (default 2)")
     _flag_json(p, "the contract {equation, name, order, variable, parameters, driven, "
-               "convention, radial, phase}")
+               "convention, radial, phase, cycles}")
     p.add_argument("--out", metavar="DIR", help="also write <name>_slow_flow.py (numba "
                    "slow_flow, slow_flow_jacobian, slow_flow_cartesian) and "
                    "<name>_slow_flow.tex into DIR")

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 import sympy as sp
-from lindstedt.averaging import PHI, R, fixed_points, slow_flow, transient
+from lindstedt.averaging import PHI, R, cycle_series, fixed_points, slow_flow, transient
 from lindstedt.driven import Drive, harmonic_balance, one_harmonic_roots
 from lindstedt.errors import InputError
 from lindstedt.lindstedt import derive_limit_cycle
@@ -65,6 +65,9 @@ def test_limit_cycle_frequency_matches_lindstedt_to_the_order(text):
     assert omega == [sp.Rational(w) for w in lc.omega]
     if text == VDP:
         assert omega == [1, 0, sp.Rational(-1, 16), 0, sp.Rational(17, 3072)]
+    (cycle,) = cycle_series(flow)
+    assert list(cycle.omega) == omega and cycle.radius[0] == lc.amplitude[0]
+    assert cycle.slope == -sp.Rational(lc.slope) / 2  # R_1 = −S/2, S of L–P: one stability
 
 
 def _cycle_amplitude(flow, eps: float) -> float:
@@ -282,6 +285,8 @@ def test_cli_json_and_bad_input(capsys):
     assert data["order"] == 2 and data["parameters"] == [] and not data["driven"]
     assert sp.sympify(data["radial"][0], locals={"r": R}) == sp.expand(R / 2 - R**3 / 8)
     assert sp.sympify(data["phase"][1], locals={"r": R}).subs(R, 2) == sp.Rational(-1, 16)
+    assert data["cycles"] == [{"radius": ["2", "0"], "omega": ["1", "0", "-1/16"],
+                               "stable_for": "eps > 0"}]
     for bad in (["slowflow", "q'' + q**3 = 0"], ["slowflow", "van_der_pol", "--order", "9"],
                 ["slowflow", VDP, "--param", "zz=1"]):
         assert main(bad) == 2
