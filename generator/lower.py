@@ -744,13 +744,14 @@ def lower_slow_flow(flow: SlowFlow, command: str) -> Unit:
     args = (eps, *params)
     kernels = []
     for name, doc, unpack, shape, entries in (
-        ("slow_flow", "(dr/dt, dphi/dt) at x = (r, phi); q = r cos(t + phi)"
-         + (", t the drive's phase w t" if flow.driven else ""), (r, phi), (2,),
+        ("slow_flow", "(dr/dt, dphi/dt) at x = (r, phi); q = r cos("
+         + ("w t + phi), w = 1 + eps*sigma" if flow.driven else "t + phi)"), (r, phi), (2,),
          tuple(((i,), e) for i, e in enumerate(polar))),
         ("slow_flow_jacobian", "d(dr/dt, dphi/dt)/d(r, phi)", (r, phi), (2, 2),
          tuple(((i, j), sp.diff(e, x)) for i, e in enumerate(polar)
                for j, x in enumerate((r, phi)))),
-        ("slow_flow_cartesian", "(du/dt, dv/dt) at x = (u, v); q = u cos t + v sin t",
+        ("slow_flow_cartesian", "(du/dt, dv/dt) at x = (u, v); q = u cos "
+         + ("w t + v sin w t" if flow.driven else "t + v sin t"),
          (u, v), (2,), tuple(((i,), e) for i, e in enumerate(cart))),
     ):
         exprs = [e for _, e in entries]
