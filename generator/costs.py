@@ -354,9 +354,10 @@ def mathieu_cost(args: argparse.Namespace) -> Cost:
                 "the Mathieu series")
 
 
-SLOW_FLOW_FIT = (2.0, 0.95, 4, "4")
-# NOTE: `lindstedt slowflow` (start-up, then derive): each order about 4× the one before; the
-# driven Duffing takes 0.95 s at order 4 (van der Pol 0.3 s); --out adds the numba import.
+SLOW_FLOW_FIT = (2.0, 0.95, 4, "2.2")
+# NOTE: `lindstedt slowflow` (start-up, then derive): the driven Duffing, the costliest family,
+# takes 0.95 s to derive at order 4, and the whole command 4.2 s at order 5, 6.1 s at order 6
+# (load 6): about 2.2× per order; van der Pol a third of that.
 
 
 def slow_flow_cost(args: argparse.Namespace) -> Cost:
