@@ -11,6 +11,9 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
                and the limit cycles of q'' + q = ε f(q, q')             SelfExcited, K -> LimitCycle
     hill       Mathieu's a_m(q), b_m(q) as exact series (L–P about      kind, m, K -> [c_k]
                cos mz, sin mz)
+    averaging  the slow flow of q'' + q = ε f (+ ε F cos ωt): near-     Oscillator, K -> SlowFlow
+               identity averaging to any order in van der Pol's
+               variables, exact (R_k, Φ_k of dr/dt, dφ/dt)
     numerics   references: elliptic periods, Jacobi cn; one RK4 step for any polynomial force
                table: shooting + Floquet, sweeps, true folds, simulations
     driven     μ-expansion with phase, harmonic balance (Duffing; and a  Drive | equation ->

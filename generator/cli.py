@@ -248,6 +248,81 @@ def _cmd_mathieu(args: argparse.Namespace) -> int:
     return 0
 
 
+def slow_flow_json(flow) -> dict:
+    """The contract of ``lindstedt slowflow … --json``: ``radial[k-1]`` and ``phase[k-1]`` are
+    R_k and Φ_k of dr/dt = Σ eps^k R_k, dphi/dt = Σ eps^k Φ_k (SymPy text in r, phi and the
+    parameters), for q = r cos(t + phi) (a drive: q = r cos(w t + phi), w = 1 + eps*sigma);
+    ``cycles``: each limit cycle (a root of dr/dt) of an autonomous flow without symbolic
+    parameters, its radius r* (to eps^(K-1)) and frequency ω (to eps^K) as series in eps."""
+    return {
+        "equation": flow.source, "name": flow.name, "order": flow.order, "variable": "eps",
+        "parameters": [str(p) for p in flow.parameters], "driven": flow.driven,
+        "convention": ("q = r cos(w t + phi), q' = -r w sin(w t + phi) + O(eps), "
+                       "w = 1 + eps*sigma" if flow.driven else
+                       "q = r cos(t + phi), q' = -r sin(t + phi) + O(eps)")
+        + "; mean-free near-identity transformation",
+        "radial": [sp_text(e) for e in flow.radial],
+        "phase": [sp_text(e) for e in flow.phase],
+        "cycles": [{"radius": [sp_text(c) for c in cyc.radius],
+                    "omega": [sp_text(c) for c in cyc.omega],
+                    "stable_for": "eps > 0" if cyc.slope < 0 else "eps < 0"}
+                   for cyc in _cycles(flow)],
+    }
+
+
+def _cycles(flow) -> list:
+    """The limit cycles of an autonomous flow with numeric coefficients (none otherwise)."""
+    from .averaging import cycle_series
+
+    return [] if flow.driven or flow.parameters else cycle_series(flow)
+
+
+def sp_text(expr) -> str:
+    import sympy as sp
+
+    return sp.sstr(expr, order="lex")
+
+
+def _cmd_slowflow(args: argparse.Namespace) -> int:
+    """``lindstedt slowflow EQUATION|NAME --order K``: the averaged equations, exact."""
+    from .averaging import slow_flow
+    from .models import REGISTRY, oscillator
+
+    text, name = args.model, args.name or "oscillator"
+    if text in REGISTRY:
+        text, name = REGISTRY[text].equation, args.name or text
+    out = _out_folder(args.out) if args.out is not None else None
+    osc = oscillator(text, _params(args.param), name)
+    flow = slow_flow(osc, args.order)
+    written = []
+    if out is not None:  # written before anything is printed: a refusal prints nothing
+        from .compiler import generate_slow_flow
+
+        params = "".join(f" --param {k}={v}" for k, v in sorted(_params(args.param).items()))
+        command = f'lindstedt slowflow "{text}" --name {name} --order {args.order}{params}'
+        written = generate_slow_flow(osc, args.order, command, out,
+                                     overwrite_edited=args.overwrite_edited)
+    if args.json:
+        print(json.dumps(slow_flow_json(flow)))
+    else:
+        frame = "q = r cos(w t + phi), w = 1 + eps*sigma" if flow.driven else \
+            "q = r cos(t + phi)"
+        print(f"{flow.name}: {flow.source}, the slow flow to order {flow.order} ({frame})")
+        print("dr/dt = sum_k eps^k R_k, dphi/dt = sum_k eps^k Phi_k")
+        for k in range(flow.order):
+            print(f"R_{k + 1}   = {sp_text(flow.radial[k])}")
+            print(f"Phi_{k + 1} = {sp_text(flow.phase[k])}")
+        for cyc in _cycles(flow):
+            print(f"limit cycle (dr/dt = 0, attracting for "
+                  f"{'eps > 0' if cyc.slope < 0 else 'eps < 0'}): r = sum_j eps^j r_j, "
+                  "omega = sum_j eps^j omega_j")
+            print("  r_j:     " + ", ".join(sp_text(c) for c in cyc.radius))
+            print("  omega_j: " + ", ".join(sp_text(c) for c in cyc.omega))
+    for path in written:
+        print(f"  {path}", file=sys.stderr if args.json else sys.stdout)
+    return 0
+
+
 def _cmd_models(args: argparse.Namespace) -> int:
     from .models import REGISTRY
 
@@ -348,7 +423,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     modules = ["duffing", "pendulum", "driven", "balance"]
     check_writable(out, [*(f"{m}.py" for m in modules), "duffing_tables.tex",
                          "duffing_derivation.tex", "pendulum_tables.tex",
-                         "pendulum_derivation.tex", "driven_derivation.tex"],
+                         "pendulum_derivation.tex", "driven_derivation.tex",
+                         "van_der_pol_slow_flow.py", "van_der_pol_slow_flow.tex"],
                    overwrite_edited=args.overwrite_edited)
     figures.mkdir(parents=True, exist_ok=True)
     check_plot_path(figures / "speed_accuracy.png")
@@ -389,6 +465,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     # (benchmarks/*speed_accuracy.py refresh the committed copies the README shows).
     print(f"  {speed_accuracy_figure(figures / 'speed_accuracy.png')}")
     print(f"  {driven_speed_accuracy_figure(figures / 'driven_speed_accuracy.png')}")
+    _demo_slow_flow(out, figures, args.overwrite_edited)
     _demo_parametric(figures)
     if shutil.which("pdflatex"):
         for tex in sorted(out.glob("*.tex")):
@@ -400,6 +477,39 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     else:
         print("\npdflatex not found: `make demo` installs it; LaTeX sources are in", out)
     return 0
+
+
+def _demo_slow_flow(out: Path, figures: Path, overwrite_edited: bool) -> None:
+    """The demo's slow flow: van der Pol's to order 2, emitted and typeset, run from r = 0.1
+    against simulation, and its two figures."""
+    import numpy as np
+
+    from .averaging import simulate, slow_flow, transient
+    from .charts import slow_flow_figures
+    from .compiler import generate_slow_flow
+    from .emit import load_generated
+    from .models import REGISTRY, oscillator
+
+    text = REGISTRY["van_der_pol"].equation
+    osc = oscillator(text, name="van_der_pol")
+    command = f'lindstedt slowflow "{text}" --name van_der_pol --order 2'
+    print(f"\nthe slow flow of van der Pol to order 2 ({command} --out {out}):")
+    for path in generate_slow_flow(osc, 2, command, out, overwrite_edited=overwrite_edited):
+        print(f"  {path}")
+    emitted = load_generated(out / "van_der_pol_slow_flow.py")
+    rate = emitted.slow_flow(np.array([2.0, 0.0]), 0.1)
+    print(f"  at the cycle r = 2, eps = 0.1: dr/dt = {rate[0]:.3g}, dphi/dt = {rate[1]:.6f} "
+          "(-eps^2/16 = -0.000625)")
+    flow, eps = slow_flow(osc, 2), 0.1
+    t = np.linspace(0.0, 80.0, 9)
+    r_sim = np.hypot(*simulate(osc, eps, 0.1, 0.0, t))
+    r_avg = np.hypot(*transient(flow, eps, 0.1, 0.0, t))
+    print(f"  from r = 0.1 at eps = {eps}:")
+    print(f"  {'t':>6}  {'r (simulation)':>15}  {'r (slow flow)':>14}")
+    for ti, a, b in zip(t, r_sim, r_avg, strict=True):
+        print(f"  {ti:>6.0f}  {a:>15.6f}  {b:>14.6f}")
+    for path in slow_flow_figures(figures):
+        print(f"  {path}")
 
 
 DEMO_SUBHARMONIC = (0.1, 0.5, 1.3)
@@ -1793,6 +1903,22 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("name", choices=SCENE_NAMES, help="the scene")
     _flag_json(p, "JSON")
     p.set_defaults(func=_cmd_scene)
+
+    p = sub.add_parser("slowflow", help="the slow flow (averaging) of q'' + q = eps*f, free, "
+                       "self-excited or driven", description="Average q'' + q = eps*f(q, q') "
+                       "(+ eps*F*cos(w*t), w = 1 + eps*sigma) to order K: dr/dt and dphi/dt "
+                       "exactly, for q = r cos(t + phi); with --out the compiled right sides and "
+                       "the LaTeX of the flow.")
+    _flag_oscillator(p)
+    p.add_argument("--order", type=_order, default=2, metavar="K",
+                   help="the order in eps, 1..6 (default 2)")
+    _flag_json(p, "the contract {equation, name, order, variable, parameters, driven, "
+               "convention, radial, phase, cycles}")
+    p.add_argument("--out", metavar="DIR", help="also write <name>_slow_flow.py (numba "
+                   "slow_flow, slow_flow_jacobian, slow_flow_cartesian) and "
+                   "<name>_slow_flow.tex into DIR")
+    _flag_overwrite_edited(p)
+    p.set_defaults(func=_cmd_slowflow)
 
     p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults",
                        description="The main job on the built-in defaults; writes only under "

@@ -23,6 +23,7 @@ from .methods import (
     LIMIT_CYCLE,
     MU,
     MU_DAMPED,
+    SLOW_FLOW,
     Candidate,
     Method,
     Request,
@@ -123,3 +124,11 @@ def generate_method(m: Method, order: int, out: Path, *, overwrite_edited: bool 
     writer = {FREE: partial(generate, "duffing"), MU: generate_driven,
               BALANCE: generate_balance, FOURIER: generate_fourier}[m.target]
     return writer(order, out, overwrite_edited=overwrite_edited, flag=flag)
+
+
+def generate_slow_flow(osc: object, order: int, command: str, out: Path, *,
+                       overwrite_edited: bool = False, flag: str = "--out") -> list[Path]:
+    """``lindstedt slowflow … --out DIR``: the compiled slow-flow right sides of the
+    :class:`models.Oscillator` ``osc`` to ``order`` and the LaTeX of the flow."""
+    return compile_target(SLOW_FLOW, Request(order, command, osc), out,
+                          overwrite_edited=overwrite_edited, flag=flag)

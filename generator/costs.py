@@ -359,6 +359,20 @@ def mathieu_cost(args: argparse.Namespace) -> Cost:
                 "the Mathieu series")
 
 
+SLOW_FLOW_FIT = (2.0, 0.95, 4, "2.2")
+# NOTE: `lindstedt slowflow` (start-up, then derive): the driven Duffing, the costliest family,
+# takes 0.95 s to derive at order 4, and the whole command 4.2 s at order 5, 6.1 s at order 6
+# (load 6): about 2.2× per order; van der Pol a third of that.
+
+
+def slow_flow_cost(args: argparse.Namespace) -> Cost:
+    from .averaging import MAX_ORDER
+
+    # NOTE: beyond MAX_ORDER the derivation refuses at once (its own one-line message)
+    order = args.order if args.order <= MAX_ORDER else 0
+    return Cost(power_law(*SLOW_FLOW_FIT, order), f"order {args.order}", "the slow flow")
+
+
 PARAMETRIC_FIT = (2.0, 1.5e-3)
 # NOTE: `lindstedt parametric`: start-up and ten shot ω, then per ω and nontrivial branch a
 # balance and a full Hill pass, ~1.5 ms per odd harmonic (measured at load 5: 401 points
@@ -391,6 +405,7 @@ COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "scene": fixed_cost("scene"),
     "models": fixed_cost("models"),
     "mathieu": mathieu_cost,
+    "slowflow": slow_flow_cost,
 }
 # NOTE: one estimator per command; `demo` has none: its work is the fixed built-in job
 # (`make demo`), which nothing on its command line scales.

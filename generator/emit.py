@@ -32,6 +32,7 @@ from .lower import (
     MuDampedDerivation,
     MuDerivation,
     Provenance,
+    SlowFlowDocument,
     Unit,
 )
 from .printers import latex_coefficient, latex_expr, latex_rational, pycode
@@ -283,11 +284,25 @@ def render_mu_damped_derivation(d: MuDampedDerivation, p: Provenance) -> dict[st
     return {f"{p.model}_derivation.tex": tex}
 
 
+def render_slow_flow(d: SlowFlowDocument, p: Provenance) -> dict[str, str]:
+    """``{"<name>_slow_flow.tex": text}``: ``R_k`` and ``Φ_k`` order by order."""
+    names = {sp.Symbol("phi"): r"\varphi", sp.Symbol("sigma"): r"\sigma"}
+    orders = [{"k": k + 1, "radial": sp.latex(a, symbol_names=names),
+               "phase": sp.latex(b, symbol_names=names)}
+              for k, (a, b) in enumerate(zip(d.radial, d.phase, strict=True))]
+    tex = environment(latex=True).get_template("slow_flow.tex.j2").render(
+        banner=banner(p, "%"), source=d.source.replace("'", r"\textquotesingle{}")
+        .replace("_", r"\_").replace("**", "\\^{}"), order=d.order, driven=d.driven,
+        orders=orders)
+    return {f"{p.model}.tex": tex}
+
+
 def render(unit: Unit) -> dict[str, str]:
     """``{file name: text}`` of a unit: its module, then each document beside it."""
     files = {f"{unit.module.name}.py": render_module(unit.module)}
     renderers = {Derivation: render_latex, MuDerivation: render_mu_derivation,
-                 MuDampedDerivation: render_mu_damped_derivation}
+                 MuDampedDerivation: render_mu_damped_derivation,
+                 SlowFlowDocument: render_slow_flow}
     for doc in unit.documents:
         files.update(renderers[type(doc)](doc, unit.module.provenance))
     return files

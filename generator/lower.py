@@ -21,6 +21,11 @@ import numpy as np
 import sympy as sp
 
 from . import __version__
+from .averaging import PHI as PHI_SLOW
+from .averaging import R as R_SLOW
+from .averaging import SlowFlow
+from .averaging import U as U_SLOW
+from .averaging import V as V_SLOW
 from .driven import (
     A1_,
     BalanceEquations,
@@ -870,4 +875,71 @@ class Unit:
     """What one command writes: a module and the documents beside it."""
 
     module: Module
-    documents: tuple[Derivation | MuDerivation | MuDampedDerivation, ...] = ()
+    documents: tuple[Derivation | MuDerivation | MuDampedDerivation | SlowFlowDocument, ...] = ()
+
+
+# --- the slow flow (averaging) ---------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SlowFlowDocument:
+    """The slow flow's equations for ``slow_flow.tex.j2``: ``R_k``, ``Φ_k`` by order."""
+
+    name: str
+    source: str  # the equation as the user wrote it
+    order: int
+    driven: bool
+    radial: tuple[sp.Expr, ...]
+    phase: tuple[sp.Expr, ...]
+
+
+def lower_slow_flow(flow: SlowFlow, command: str) -> Unit:
+    """Compiled right sides of the slow flow: ``slow_flow`` (``x = (r, φ)``),
+    ``slow_flow_jacobian`` and ``slow_flow_cartesian`` (``x = (u, v)``, ``u = r cos φ``,
+    ``v = −r sin φ``: regular through ``r = 0``), all in t, with the LaTeX of the flow."""
+    eps = sp.Symbol("eps")
+    taken = MODULE_NAMES | LOCAL_NAMES | frozenset(dir(builtins)) | frozenset(keyword.kwlist)
+    for p in flow.parameters:
+        if str(p) in taken or _LOCAL.fullmatch(str(p)) or re.fullmatch(r"x_\d+", str(p)):
+            raise InputError(f"parameter {str(p)!r}: the emitted module uses this name; "
+                             "rename the parameter")
+    params = tuple(sp.Symbol(str(p)) for p in flow.parameters)
+    r, phi, u, v = sp.symbols("r phi u v")
+    polar = [e.xreplace({R_SLOW: r, PHI_SLOW: phi}) for e in flow.rates]
+    cart = [sp.Add(*(eps ** (k + 1) * G[i] for k, G in enumerate(flow.cartesian)))
+            .xreplace({U_SLOW: u, V_SLOW: v}) for i in range(2)]
+    args = (eps, *params)
+    kernels = []
+    for name, doc, unpack, shape, entries in (
+        ("slow_flow", "(dr/dt, dphi/dt) at x = (r, phi); q = r cos("
+         + ("w t + phi), w = 1 + eps*sigma" if flow.driven else "t + phi)"), (r, phi), (2,),
+         tuple(((i,), e) for i, e in enumerate(polar))),
+        ("slow_flow_jacobian", "d(dr/dt, dphi/dt)/d(r, phi)", (r, phi), (2, 2),
+         tuple(((i, j), sp.diff(e, x)) for i, e in enumerate(polar)
+               for j, x in enumerate((r, phi)))),
+        ("slow_flow_cartesian", "(du/dt, dv/dt) at x = (u, v); q = u cos "
+         + ("w t + v sin w t" if flow.driven else "t + v sin t"),
+         (u, v), (2,), tuple(((i,), e) for i, e in enumerate(cart))),
+    ):
+        exprs = [e for _, e in entries]
+        subexprs, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x_"),
+                                   order="canonical")
+        kernels.append(ArrayKernel(
+            name, doc, unpack, args, shape, tuple(subexprs),
+            tuple((idx, e) for (idx, _), e in zip(entries, reduced, strict=True))))
+    module = Module(
+        name=f"{flow.name}_slow_flow",
+        doc=f"The slow flow of {flow.source} to order {flow.order} in eps (averaging, "
+            "near-identity transformation with mean-free generators)"
+            + (": the drive's frequency is w = 1 + eps*sigma" if flow.driven else "") + ".",
+        constants=(("ORDER", flow.order), ("UNKNOWNS", ("r", "phi")),
+                   ("PARAMETERS", tuple(str(a) for a in args))),
+        evaluators=(),
+        provenance=provenance(f"{flow.name}_slow_flow", flow.order, command,
+                              source=flow.source, parameters=[str(p) for p in params]),
+        kernels=tuple(kernels),
+    )
+    doc = SlowFlowDocument(flow.name, flow.source, flow.order, flow.driven,
+                           tuple(e.xreplace({R_SLOW: r, PHI_SLOW: phi}) for e in flow.radial),
+                           tuple(e.xreplace({R_SLOW: r, PHI_SLOW: phi}) for e in flow.phase))
+    return Unit(module, (doc,))

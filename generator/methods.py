@@ -41,6 +41,7 @@ from numba import njit
 from scipy.integrate import solve_ivp
 from scipy.special import ellipj
 
+from .averaging import slow_flow
 from .driven import (
     Branch,
     Drive,
@@ -73,6 +74,7 @@ from .lower import (
     lower_fourier,
     lower_free,
     lower_limit_cycle,
+    lower_slow_flow,
     x_,
 )
 from .models import Model, SelfExcited, check_order, duffing
@@ -552,6 +554,10 @@ MU_DAMPED = Target(lambda r: ("driven_damped.py", "driven_damped_derivation.tex"
                    _mu_damped_derive, _mu_damped_lower)
 FOURIER = Target(lambda r: ("fourier.py",), _fourier_derive, _fourier_lower)
 CHOSEN_PERIOD = Target(lambda r: ("chosen_period.py",), _choice_derive, _choice_lower)
+SLOW_FLOW = Target(lambda r: (f"{r.model.name}_slow_flow.py", f"{r.model.name}_slow_flow.tex"),
+                   lambda r, progress: slow_flow(r.model, r.order),
+                   lambda flow, r: lower_slow_flow(flow, r.command))
+# NOTE: the slow flow's request carries the user's models.Oscillator as its model.
 
 
 # --- driven: one method at one order at one ω ---------------------------------------------------

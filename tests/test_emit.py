@@ -91,6 +91,10 @@ def test_templates_get_exactly_the_variables_they_use(tmp_path, monkeypatch):
     render_latex(lower_derivation(sol, 3), module.provenance)
     generate_driven(1, tmp_path)  # the driven module and mu_derivation.tex.j2
     generate_driven(1, tmp_path, damped=True)  # and mu_damped_derivation.tex.j2
+    from lindstedt.compiler import generate_slow_flow
+    from lindstedt.models import oscillator
+
+    generate_slow_flow(oscillator("q'' + q = eps*(1 - q**2)*q'"), 2, "cmd", tmp_path)
     folder = template_folder()
     used, includes = {}, {}
     for path in folder.glob("*.j2"):
@@ -102,7 +106,8 @@ def test_templates_get_exactly_the_variables_they_use(tmp_path, monkeypatch):
         reads = used[name].union(*(used[i] for i in includes[name]))
         for ctx in contexts:
             assert reads <= ctx, (name, reads - ctx)  # nothing undefined
-    for name in ("module.py.j2", "mu_derivation.tex.j2", "mu_damped_derivation.tex.j2"):
+    for name in ("module.py.j2", "mu_derivation.tex.j2", "mu_damped_derivation.tex.j2",
+                 "slow_flow.tex.j2"):
         assert passed[name] and all(ctx == used[name] for ctx in passed[name]), name
     latex = passed["tables.tex.j2"] + passed["derivation.tex.j2"]
     assert len(latex) == 2 and latex[0] == latex[1]

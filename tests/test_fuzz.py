@@ -239,12 +239,23 @@ DEMO = st.tuples(st.sampled_from(BAD_FOLDERS), st.sampled_from([[], ["--bogus"]]
     lambda p: ["--out", p[0], *p[1]])
 # NOTE: a valid demo runs for minutes (the `make demo` target); only refusals are fuzzed.
 
+SLOWFLOW = command_line((
+    Opt(None, st.sampled_from(["van_der_pol", "rayleigh",
+                               "q'' + q = eps*(-k*q' - q**3 + F*cos(w*t))"]),
+        st.sampled_from(["nosuch", "q'' + q + q**3 = 0", "2*q'' + q = eps*q'",
+                         "q'' + q = eps*sin(q)", "q'' + q = eps*q'*cos(t)*q",
+                         "q'' + q = eps*r*q'", "q'' + __import__('os')"]), number=False),
+    Opt("--order", maybe(whole(1, 3)), INTEGER),
+    Opt("--out", maybe(st.sampled_from(WRITABLE_FOLDERS)), st.sampled_from(BAD_FOLDERS),
+        number=False)))
+
 BUDGET = {"series": (SERIES, 2), "generate": (GENERATE, 2), "driven": (DRIVEN, 4),
           "response": (RESPONSE, 3), "subharmonic": (SUBHARMONIC, 2),
           "mixing": (mixing(), 3), "choose": (CHOOSE, 2), "clock": (CLOCK, 1),
           "scene": (SCENE, 1), "demo": (DEMO, 1), "models": (MODELS, 1),
-          "mathieu": (MATHIEU, 2), "parametric": (PARAMETRIC, 2)}
-# NOTE: examples (pairs of runs side by side) per command: 46 runs, the file ~60 s on the
+          "mathieu": (MATHIEU, 2), "parametric": (PARAMETRIC, 2),
+          "slowflow": (SLOWFLOW, 2)}
+# NOTE: examples (pairs of runs side by side) per command: 50 runs, the file ~60 s on the
 # 2-core machine with other work loading it (a refusal takes 0.1–3 s, a valid run 2–8 s).
 
 
@@ -274,6 +285,7 @@ test_fuzz_scene = _fuzz("scene")
 test_fuzz_demo = _fuzz("demo")
 test_fuzz_models = _fuzz("models")
 test_fuzz_mathieu = _fuzz("mathieu")
+test_fuzz_slowflow = _fuzz("slowflow")
 test_fuzz_parametric = _fuzz("parametric")
 
 
