@@ -11,6 +11,8 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
                and the limit cycles of q'' + q = ε f(q, q')             SelfExcited, K -> LimitCycle
     hill       Mathieu's a_m(q), b_m(q) as exact series (L–P about      kind, m, K -> [c_k]
                cos mz, sin mz)
+    resum      Padé approximants over QQ, Andersen & Geer's w-variable; [c_k] -> Resummed
+               spurious poles, neighbour spread (past the radius)
     numerics   references: elliptic periods, Jacobi cn; one RK4 step for any polynomial force
                table: shooting + Floquet, sweeps, true folds, simulations
     driven     μ-expansion with phase, harmonic balance (Duffing; and a  Drive | equation ->

@@ -16,6 +16,7 @@ import keyword
 import re
 import unicodedata
 from dataclasses import dataclass
+from fractions import Fraction
 
 import numpy as np
 import sympy as sp
@@ -26,6 +27,7 @@ from .errors import InputError
 from .lindstedt import LimitCycle, SeriesSolution, nearest_singularity, order_terms
 from .models import Model
 from .printers import identifier
+from .resum import Pade, Resummed
 
 Assign = tuple[sp.Symbol, sp.Expr]
 
@@ -347,7 +349,67 @@ LIMIT_CYCLE_MARGIN = sp.Rational(9, 10)
 # the estimate is good to ~1 % from order 60, and near the radius the terms decay slowly.
 
 
-def lower_limit_cycle(lc: LimitCycle, command: str, order: int) -> Module:
+def resummed_expression(r: Resummed, z: sp.Symbol, approximant: Pade | None = None
+                        ) -> tuple[tuple[Assign, ...], sp.Expr]:
+    """The body and output of a :class:`resum.Resummed` at ``z``: ``x = z**power``, Andersen
+    & Geer's ``w`` when the form has one, numerator and denominator in Horner form (exact
+    rationals: the printer rounds each once)."""
+    P = approximant or r.approximant
+    x = sp.Symbol("x")
+    body: list[Assign] = [(x, z**r.power)]
+
+    def rational(c: Fraction) -> sp.Rational:
+        return sp.Rational(c.numerator, c.denominator)
+
+    if r.R is None:
+        return tuple(body), (horner([rational(c) for c in P.numerator], x)
+                             / horner([rational(c) for c in P.denominator], x))
+    w = sp.Symbol("w")
+    body.append((w, x / sp.sqrt(x**2 - 2 * rational(r.p) * x + rational(r.R) ** 2)))
+    ratio = horner([rational(c) for c in P.numerator], w) / horner(
+        [rational(c) for c in P.denominator], w)
+    return tuple(body), sp.sqrt((1 - w) * ratio)
+
+
+@dataclass(frozen=True)
+class ResummedCycle:
+    """A limit cycle's resummed frequency and where it was verified: ``|ε| ≤ limit``, with
+    the largest measured error ``checked`` against the numerical references at ``points``."""
+
+    form: Resummed
+    limit: float
+    tolerance: float
+    points: tuple[float, ...]
+    checked: float
+
+
+def lower_resummed_cycle(r: ResummedCycle) -> tuple[Evaluator, ...]:
+    """``omega_resummed(eps)``, ``period_resummed(eps)`` and ``resummed_error(eps)`` (the
+    relative difference of the neighbouring approximants), NaN beyond the verified |ε|."""
+    eps = sp.Symbol("eps")
+    guard = sp.Abs(eps) <= sp.Rational(repr(r.limit))
+    body, value = resummed_expression(r.form, eps)
+    _, other = resummed_expression(r.form, eps, r.form.neighbour)
+    omega, lower = sp.Symbol("omega"), sp.Symbol("omega_lower")
+    L, M = r.form.approximant.degrees
+    domain = (f"NaN for |eps| > {r.limit:g}, where it was not verified to "
+              f"{r.tolerance:g} against shooting")
+    form = (f"sqrt((1 - w) [{L}/{M}](w)), w = eps²/(eps⁴ - 2 eps² p + R²)^(1/2), R = {r.form.R}"
+            f", p = R cos β = {r.form.p}")
+    return (
+        Evaluator("omega_resummed", f"Frequency ω resummed: {form} ({domain}).", (eps,), (),
+                  guard, body, value),
+        Evaluator("period_resummed", f"Period 2π/ω of omega_resummed ({domain}).", (eps,), (),
+                  guard, (*body, (omega, value)), 2 * sp.pi / omega),
+        Evaluator("resummed_error", "Relative difference of omega_resummed and the next "
+                  f"lower approximant [{L - 1}/{M - 1}] (an error estimate; {domain}).",
+                  (eps,), (), guard, (*body, (omega, value), (lower, other)),
+                  sp.Abs(lower - omega) / omega),
+    )
+
+
+def lower_limit_cycle(lc: LimitCycle, command: str, order: int,
+                      resummed: ResummedCycle | None = None) -> Module:
     """Evaluators ``omega(eps)``, ``period(eps)``, ``amplitude(eps)`` (q(0), at q̇(0) = 0),
     ``q(t, eps)`` and ``error_estimate(eps)`` of a limit cycle's L–P series to ``order``
     (``lc`` derived further: K + 2 for the estimate, and far enough for the radius), NaN where
@@ -412,14 +474,27 @@ def lower_limit_cycle(lc: LimitCycle, command: str, order: int) -> Module:
         ("PERIOD_EXACT", tuple(str(c) for c in tau)),
         ("AMPLITUDE_EXACT", tuple(str(c) for c in amp)),
     )
+    if resummed is not None:
+        evaluators = (*evaluators, *lower_resummed_cycle(resummed))
+        constants = (*constants, *resummed_constants(resummed))
     return Module(
         name=m.name,
         doc=f"{m.title}: its limit cycle's L–P evaluators to order {order} in eps.",
         constants=constants,
         evaluators=evaluators,
         provenance=provenance(m.name, order, command, equation=m.source,
-                              terms=[(a, b, str(c)) for a, b, c in m.terms]),
+                              terms=[(a, b, str(c)) for a, b, c in m.terms],
+                              **({"resummed": resummed_constants(resummed)}
+                                 if resummed is not None else {})),
     )
+
+
+def resummed_constants(r: ResummedCycle) -> tuple[tuple[str, object], ...]:
+    """What the module states about its resummed evaluators: the verified |ε|, the
+    tolerance, the largest error measured at the reference points, the degrees."""
+    return (("RESUMMED_LIMIT", r.limit), ("RESUMMED_TOLERANCE", r.tolerance),
+            ("RESUMMED_CHECKED", tuple(r.points)), ("RESUMMED_ERROR", r.checked),
+            ("RESUMMED_DEGREES", r.form.approximant.degrees))
 
 
 def cubic_branches(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol) -> tuple[sp.Expr, ...]:
