@@ -408,6 +408,62 @@ def lower_resummed_cycle(r: ResummedCycle) -> tuple[Evaluator, ...]:
     )
 
 
+@dataclass(frozen=True)
+class ResummedMathieu:
+    """Mathieu's ``a_m(q)`` or ``b_m(q)`` resummed from its exact series to ``order`` and
+    where it was verified against the eigenvalue reference: ``0 ≤ q ≤ limit`` (``|q|`` when
+    the series is even in q), the largest error ``checked`` there, relative to max(1, |a|)."""
+
+    kind: str
+    m: int
+    order: int
+    form: Resummed
+    limit: float
+    tolerance: float
+    checked: float
+
+
+def lower_mathieu(r: ResummedMathieu, command: str) -> Module:
+    """``{kind}{m}(q)`` (say ``a0``) and ``{kind}{m}_error(q)`` (the relative difference of the
+    neighbouring approximants), NaN outside the verified q."""
+    q = sp.Symbol("q")
+    name = f"{r.kind}{r.m}"
+    bound = sp.Rational(repr(r.limit))
+    guard = sp.Abs(q) <= bound if r.form.power == 2 else sp.And(q >= 0, q <= bound)
+    body, value = resummed_expression(r.form, q)
+    _, other = resummed_expression(r.form, q, r.form.neighbour)
+    here, lower = sp.Symbol("value"), sp.Symbol("value_lower")
+    L, M = r.form.approximant.degrees
+    var = "q²" if r.form.power == 2 else "q"
+    domain = (f"NaN outside {'|q|' if r.form.power == 2 else '0 ≤ q'} ≤ {r.limit:g}, where "
+              f"it was not verified to {r.tolerance:g}·max(1, |{name}|) against the "
+              "eigenvalues of the recurrence's matrix")
+    evaluators = (
+        Evaluator(name, f"Mathieu's {r.kind}_{r.m}(q) (DLMF 28.2), Padé [{L}/{M}] in {var} of "
+                  f"the exact series to order {r.order} ({domain}).", (q,), (), guard, body,
+                  value),
+        Evaluator(f"{name}_error", f"|[{L}/{M}] − [{L - 1}/{M - 1}]| / max(1, |{name}|): the "
+                  f"error estimate ({domain}).", (q,), (), guard,
+                  (*body, (here, value), (lower, other)),
+                  sp.Abs(here - lower) / sp.Max(1, sp.Abs(here))),
+    )
+    constants = (
+        ("ORDER", r.order), ("MODEL", f"mathieu_{name}"), ("VARIABLE", "q"),
+        ("LIMIT", r.limit), ("TOLERANCE", r.tolerance), ("CHECKED_ERROR", r.checked),
+        ("DEGREES", (L, M)), ("SYMMETRIC", r.form.power == 2),
+    )
+    return Module(
+        name=f"mathieu_{name}",
+        doc=f"Mathieu's characteristic value {r.kind}_{r.m}(q) of y'' + (a - 2q cos 2z) y = 0, "
+            "resummed past the radius of its series.",
+        constants=constants, evaluators=evaluators,
+        provenance=provenance(f"mathieu_{name}", r.order, command,
+                              numerator=[str(c) for c in r.form.approximant.numerator],
+                              denominator=[str(c) for c in r.form.approximant.denominator],
+                              limit=r.limit),
+    )
+
+
 def lower_limit_cycle(lc: LimitCycle, command: str, order: int,
                       resummed: ResummedCycle | None = None) -> Module:
     """Evaluators ``omega(eps)``, ``period(eps)``, ``amplitude(eps)`` (q(0), at q̇(0) = 0),

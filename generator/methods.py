@@ -60,6 +60,7 @@ from .lower import (
     NotesTable,
     PeriodFormula,
     ResummedCycle,
+    ResummedMathieu,
     Unit,
     agm_steps,
     horner,
@@ -70,11 +71,12 @@ from .lower import (
     lower_fourier,
     lower_free,
     lower_limit_cycle,
+    lower_mathieu,
     x_,
 )
 from .models import Model, SelfExcited, check_order, duffing
 from .numerics import cycle_reference, duffing_period_exact, shoot
-from .resum import resum_frequency
+from .resum import resum_frequency, resum_series
 
 Progress = Callable[[int, int], None]
 
@@ -424,6 +426,7 @@ class Request:
     allow_divergent: bool = False
     candidate: Candidate | None = None
     verified: tuple[float, float] = (0.0, 0.0)
+    mathieu: tuple[str, int] | None = None  # (kind, m) of a Mathieu characteristic value
 
 
 @dataclass(frozen=True)
@@ -513,6 +516,58 @@ def resum_cycle(lc: object, tolerance: float = RESUM_TOLERANCE) -> ResummedCycle
     return ResummedCycle(form, float(limit), tolerance, tuple(points), worst)
 
 
+MATHIEU_TOLERANCE = 1e-12
+# NOTE: relative to max(1, |a|): the float64 eigenvalue reference agrees with mpmath to
+# ~1e-14 there, SciPy's mathieu_a to 1e-14 … 0.7 (benchmarks/resum.py).
+MATHIEU_RANGE = 50.0
+MATHIEU_GRID = 400
+# NOTE: q ∈ (0, 50] on 400 points: beyond q ≈ 50 no Padé of an order-100 series is within
+# 1e-12 (a_m(q) ~ −2q + 2(2m + 1)√q, a branch at infinity); the eigenvalue solver is the
+# method there.
+
+
+def resum_mathieu(kind: str, m: int, order: int, tolerance: float = MATHIEU_TOLERANCE
+                  ) -> ResummedMathieu:
+    """Padé of Mathieu's exact series (:func:`hill.mathieu_series`, in q², or in q when it
+    has odd powers), verified on a dense grid of ``(0, 50]`` against
+    :func:`numerics.mathieu_reference` (whose float64 values are checked against its mpmath
+    run at the grid's end): ``limit`` is the last grid point before the first failure."""
+    import numpy as np
+
+    from .hill import mathieu_series
+    from .numerics import mathieu_reference
+
+    form = resum_series(mathieu_series(kind, m, order), MATHIEU_RANGE)
+    grid = np.linspace(0.0, MATHIEU_RANGE, MATHIEU_GRID + 1)[1:]
+    ref = np.array([mathieu_reference(kind, m, float(q)) for q in grid])
+    for q in (grid[0], grid[-1]):
+        exact = mathieu_reference(kind, m, float(q), dps=30)
+        if abs(ref[grid == q][0] - exact) > tolerance / 10 * max(1.0, abs(exact)):
+            raise RuntimeError(f"mathieu_reference {kind}_{m}({q}): float64 and mpmath differ")
+    error = np.abs(form(grid) - ref) / np.maximum(1.0, np.abs(ref))
+    ok = error <= tolerance
+    n = int(np.argmin(ok)) if not ok.all() else len(grid)
+    if n == 0:
+        raise InputError(f"{kind}_{m}, order {order}: the resummed series misses "
+                         f"{tolerance:g} already at q = {grid[0]:g}; raise --order")
+    return ResummedMathieu(kind, m, order, form, float(grid[n - 1]), tolerance,
+                           float(error[:n].max()))
+
+
+def _mathieu_files(r: Request) -> tuple[str, ...]:
+    kind, m = r.mathieu
+    return (f"mathieu_{kind}{m}.py",)
+
+
+def _mathieu_derive(r: Request, progress: Progress | None) -> object:
+    kind, m = r.mathieu
+    return resum_mathieu(kind, m, r.order)
+
+
+def _mathieu_lower(derived: object, r: Request) -> Unit:
+    return Unit(lower_mathieu(derived, r.command))
+
+
 NOTES_DRIVE = (0.1, 1.0, 1.0)
 # NOTE: ε, f, ω of the notes' table (§10.4, undamped), reproduced in every driven derivation.
 NOTES_TABLE_ORDERS = 6
@@ -581,6 +636,7 @@ MU = Target(lambda r: ("driven.py", "driven_derivation.tex"), _mu_derive, _mu_lo
 BALANCE = Target(lambda r: ("balance.py",), _balance_derive, _balance_lower)
 FOURIER = Target(lambda r: ("fourier.py",), _fourier_derive, _fourier_lower)
 CHOSEN_PERIOD = Target(lambda r: ("chosen_period.py",), _choice_derive, _choice_lower)
+MATHIEU = Target(_mathieu_files, _mathieu_derive, _mathieu_lower)
 
 
 # --- driven: one method at one order at one ω ---------------------------------------------------
