@@ -28,6 +28,7 @@ import sympy as sp
 from lindstedt.charts import resummed_speed_accuracy_figure
 from lindstedt.compiler import generate_limit_cycle, generate_mathieu
 from lindstedt.emit import load_generated
+from lindstedt.errors import InputError
 from lindstedt.hill import mathieu_series
 from lindstedt.lindstedt import derive_limit_cycle, nearest_singularity
 from lindstedt.methods import RESUM_SPREAD_MARGIN, RESUM_TOLERANCE, resum_mathieu
@@ -87,7 +88,7 @@ def forms_table(omega: list, eps: np.ndarray, truth: np.ndarray) -> None:
         try:
             P, _ = diagonal_pade(coeffs, 0.0, hi)
             rows.append((name, P.degrees, back(P(var))))
-        except Exception as exc:  # noqa: BLE001 — a form without a pole-free approximant
+        except InputError as exc:  # no pole-free near-diagonal approximant
             rows.append((name, str(exc)[:30], np.full_like(eps, np.nan)))
     rows.append(("partial sum in w", (N, 0), horner_float(compose(c, xs, N), w)))
     rows.append(("√((1 − w)·Padé of ω²/(1 − w)), chosen", R.approximant.degrees, R(eps)))
@@ -97,7 +98,7 @@ def forms_table(omega: list, eps: np.ndarray, truth: np.ndarray) -> None:
     print(f"{'form':<42}{'[L/M]':>10}" + "".join(f"{eps[i]:>10g}" for i in cols))
     for name, deg, val in rows:
         err = np.abs(val - truth) / truth
-        print(f"{name:<42}{str(deg):>10}" + "".join(f"{err[i]:>10.1e}" for i in cols))
+        print(f"{name:<42}{deg!s:>10}" + "".join(f"{err[i]:>10.1e}" for i in cols))
 
 
 def cycle_panels(lc, eps: np.ndarray, truth: np.ndarray, shots: dict) -> list:
