@@ -125,3 +125,48 @@ def test_generated_limit_cycle_module_is_byte_identical(emitted, tmp_path):
     assert [p.name for p in again] == [p.name for p in paths]
     for a, b in zip(paths, again, strict=True):
         assert a.read_bytes() == b.read_bytes()
+
+
+def test_mathieu_reference_against_dlmf_and_mpmath():
+    """The eigenvalue reference at q = 1 against Abramowitz & Stegun's Table 20.1 (8 decimals:
+    a_0 = −0.45513860, a_1 = 1.85910807, b_1 = −0.11024882, b_2 = 3.91702477), and float64
+    against mpmath at 30 digits at q = 40."""
+    from lindstedt.numerics import mathieu_reference
+
+    for kind, m, value in (("a", 0, -0.45513860), ("a", 1, 1.85910807),
+                           ("b", 1, -0.11024882), ("b", 2, 3.91702477)):
+        assert mathieu_reference(kind, m, 1.0) == pytest.approx(value, abs=6e-9)
+    for kind, m in (("a", 0), ("a", 3), ("b", 6)):
+        exact = mathieu_reference(kind, m, 40.0, dps=30)
+        assert mathieu_reference(kind, m, 40.0) == pytest.approx(exact, rel=1e-14)
+
+
+@pytest.mark.parametrize(("kind", "m", "past"), [("a", 0, 2.0), ("a", 3, 1.0), ("b", 6, 5.0)])
+def test_emitted_mathieu_against_the_eigenvalue_reference(kind, m, past, tmp_path):
+    """`lindstedt mathieu KIND --m M --order 60 --emit DIR`: the ufunc within 2e-14·max(1,
+    |a|) of the mpmath eigenvalues inside its verified q (1e-14 from the float64 reference it
+    is verified against, which is ≤ 1e-14 from mpmath), past the series' radius (|q| ≈ 1.47
+    for a_0), NaN beyond (and below q = 0 for a series with odd powers)."""
+    from lindstedt.cli import main
+    from lindstedt.emit import load_generated
+    from lindstedt.numerics import mathieu_reference
+
+    assert main(["mathieu", kind, "--m", str(m), "--order", "60", "--emit",
+                 str(tmp_path)]) == 0
+    mod = load_generated(tmp_path / f"mathieu_{kind}{m}.py")
+    f = getattr(mod, f"{kind}{m}")
+    assert past < mod.LIMIT
+    for q in np.linspace(0.1, mod.LIMIT, 6):
+        exact = mathieu_reference(kind, m, float(q), dps=30)
+        assert abs(f(q) - exact) <= 2e-14 * max(1.0, abs(exact))
+    assert np.isnan(f(mod.LIMIT + 0.01)) and np.isnan(f(np.nan))
+    assert np.isnan(f(-0.5)) != mod.SYMMETRIC
+
+
+def test_mathieu_emit_refuses_bad_input(tmp_path, capsys):
+    from lindstedt.cli import main
+
+    assert main(["mathieu", "b", "--m", "0", "--order", "60", "--emit", str(tmp_path)]) == 2
+    assert "b_0 does not exist" in capsys.readouterr().err
+    assert main(["mathieu", "a", "--m", "1", "--order", "2", "--emit", str(tmp_path)]) == 2
+    assert list(tmp_path.iterdir()) == []
