@@ -1029,6 +1029,8 @@ def _cmd_choose(args: argparse.Namespace) -> int:
         raise InputError(f"choose {args.quantity} EQUATION: only the period is chosen for an "
                          "equation (q, amplitudes and response are the notes' Duffing "
                          "oscillator's)")
+    if args.quantity in RESUMMED_QUANTITIES:
+        return _choose_resummed(args)
     if args.quantity in DRIVEN_QUANTITIES:
         return _choose_driven(args)
     if args.quantity == "q":
@@ -1081,6 +1083,45 @@ def _cmd_choose(args: argparse.Namespace) -> int:
                   choice.considered)
     for path in data.get("emitted", []):
         print(f"  emitted {path}")
+    return 0
+
+
+RESUMMED_QUANTITIES = ("cycle", "mathieu")
+# NOTE: choose's quantities past the radius: van der Pol's limit-cycle ω(ε) and Mathieu's
+# a_m(q), b_m(q) (partial sums, resummed evaluator, numerical reference).
+
+
+def _choose_resummed(args: argparse.Namespace) -> int:
+    """``choose cycle`` (ε in [x-min, x-max]) and ``choose mathieu --kind K --m M`` (q)."""
+    for name in ("tol", "x_min", "x_max"):
+        if getattr(args, name) is None:
+            raise InputError(f"choose {args.quantity} needs --{name.replace('_', '-')}")
+    if args.emit:
+        raise InputError(f"--emit: choose {args.quantity} reports; `lindstedt generate "
+                         "van_der_pol` and `lindstedt mathieu … --emit DIR` write the modules")
+    from .choose import choose_limit_cycle, choose_mathieu
+
+    if args.quantity == "cycle":
+        c = choose_limit_cycle(args.tol, args.x_min, args.x_max)
+        what = f"van der Pol's limit-cycle ω(ε), ε in [{args.x_min:g}, {args.x_max:g}]"
+    else:
+        kind, m = args.kind or "a", args.m if args.m is not None else 0
+        c = choose_mathieu(kind, m, args.tol, args.x_min, args.x_max)
+        what = f"Mathieu's {kind}_{m}(q), q in [{args.x_min:g}, {args.x_max:g}]"
+    rows = [{"method": m, "order": o, "max_error": e, "recorded_ns_per_point": r,
+             "ns_per_point": ns} for m, o, e, r, ns in c.considered]
+    if args.json:
+        print(json.dumps({"quantity": args.quantity, "method": c.method, "order": c.order,
+                          "max_error": c.max_error, "ns_per_point": c.ns_per_point,
+                          "verified_on": c.verified_on, "considered": rows,
+                          "decided_by": "recorded costs (lindstedt.choose.RESUMMED_COSTS)"}))
+        return 0
+    print(f"{what}, tolerance {args.tol:g} (relative, {c.verified_on} points): {c.method}"
+          + (f" (order {c.order})" if c.order else ""))
+    for r in rows:
+        print(f"  {r['method']:<10} order {r['order']:>4}  max error {r['max_error']:8.1e}  "
+              f"{r['recorded_ns_per_point']:10.3g} ns/point recorded, "
+              f"{r['ns_per_point']:10.3g} this run")
     return 0
 
 
@@ -1588,8 +1629,15 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("choose", help="the cheapest verified method for a tolerance and a range",
                        description="Time and verify every method, report the cheapest that "
                        "meets the tolerance on the range.")
-    p.add_argument("quantity", choices=("period", "q", *DRIVEN_QUANTITIES),
-                   help="period T(x); q(t); amplitudes A_n, B_n; response r(ω)")
+    p.add_argument("quantity", choices=("period", "q", *DRIVEN_QUANTITIES,
+                                        *RESUMMED_QUANTITIES),
+                   help="period T(x); q(t); amplitudes A_n, B_n; response r(ω); cycle: van der "
+                   "Pol's limit-cycle ω(ε), ε in [x-min, x-max]; mathieu: a_m(q) or b_m(q) "
+                   "(--kind, --m), q in [x-min, x-max]")
+    p.add_argument("--kind", choices=("a", "b"), default=None,
+                   help="mathieu: a (even solutions, default) or b (odd)")
+    p.add_argument("--m", type=_order, default=None, metavar="M",
+                   help="mathieu: the index m (default 0)")
     _flag_equation(p, "\"q'' + q + eps*q**5 = 0\" (period only: a free oscillator with a "
                    "polynomial force, judged by quadrature; x is then its expansion variable)")
     p.add_argument("--tol", type=_real, metavar="TOL",
