@@ -170,3 +170,17 @@ def test_mathieu_emit_refuses_bad_input(tmp_path, capsys):
     assert "b_0 does not exist" in capsys.readouterr().err
     assert main(["mathieu", "a", "--m", "1", "--order", "2", "--emit", str(tmp_path)]) == 2
     assert list(tmp_path.iterdir()) == []
+
+
+def test_choose_mathieu_weighs_series_pade_and_the_solver():
+    """Past the series' radius (q = 2 > 1.47) the partial sums miss; the Padé evaluator meets
+    1e-13 against mpmath and is the cheapest; on (0, 45], where it is NaN, the solver wins."""
+    from lindstedt.choose import choose_mathieu
+
+    near = choose_mathieu("a", 0, 1e-13, 0.0, 2.0, order=60, points=5)
+    rows = {m: e for m, _, e, _, _ in near.considered}
+    assert near.method == "pade" and rows["series"] > 1e-3 and rows["pade"] <= 1e-13
+    far = choose_mathieu("a", 0, 1e-13, 0.0, 45.0, order=60, points=5)
+    assert far.method == "reference" and far.max_error <= 1e-14
+    with pytest.raises(InputError, match="no method meets it"):
+        choose_mathieu("a", 0, 1e-30, 0.0, 2.0, order=60, points=3)
