@@ -374,13 +374,16 @@ def resummed_expression(r: Resummed, z: sp.Symbol, approximant: Pade | None = No
 @dataclass(frozen=True)
 class ResummedCycle:
     """A limit cycle's resummed frequency and where it was verified: ``|ε| ≤ limit``, with
-    the largest measured error ``checked`` against the numerical references at ``points``."""
+    the largest measured error ``checked`` against the numerical references at ``points``;
+    the same for its amplitude q(0) when its Padé form verified anywhere."""
 
     form: Resummed
     limit: float
-    tolerance: float
     points: tuple[float, ...]
     checked: float
+    tolerance: float
+    amplitude: Resummed | None = None  # q(0), Padé in ε², with its (limit, points, checked)
+    amplitude_verified: tuple[float, tuple[float, ...], float] = (0.0, (), float("nan"))
 
 
 def lower_resummed_cycle(r: ResummedCycle) -> tuple[Evaluator, ...]:
@@ -405,7 +408,23 @@ def lower_resummed_cycle(r: ResummedCycle) -> tuple[Evaluator, ...]:
                   f"lower approximant [{L - 1}/{M - 1}] (an error estimate; {domain}).",
                   (eps,), (), guard, (*body, (omega, value), (lower, other)),
                   sp.Abs(lower - omega) / omega),
+        *_lower_resummed_amplitude(r),
     )
+
+
+def _lower_resummed_amplitude(r: ResummedCycle) -> tuple[Evaluator, ...]:
+    """``amplitude_resummed(eps)``: q(0) as the Padé form in ε², NaN beyond its own verified
+    |ε| (none without a verified form)."""
+    if r.amplitude is None:
+        return ()
+    eps = sp.Symbol("eps")
+    limit, _, _ = r.amplitude_verified
+    body, value = resummed_expression(r.amplitude, eps)
+    L, M = r.amplitude.approximant.degrees
+    return (Evaluator(
+        "amplitude_resummed", f"q(0) at q̇(0) = 0, Padé [{L}/{M}] in eps² (NaN for |eps| > "
+        f"{limit:g}, where it was not verified to {r.tolerance:g} against shooting).", (eps,),
+        (), sp.Abs(eps) <= sp.Rational(repr(limit)), body, value),)
 
 
 @dataclass(frozen=True)
@@ -550,7 +569,10 @@ def resummed_constants(r: ResummedCycle) -> tuple[tuple[str, object], ...]:
     tolerance, the largest error measured at the reference points, the degrees."""
     return (("RESUMMED_LIMIT", r.limit), ("RESUMMED_TOLERANCE", r.tolerance),
             ("RESUMMED_CHECKED", tuple(r.points)), ("RESUMMED_ERROR", r.checked),
-            ("RESUMMED_DEGREES", r.form.approximant.degrees))
+            ("RESUMMED_DEGREES", r.form.approximant.degrees),
+            *((("AMPLITUDE_RESUMMED_LIMIT", r.amplitude_verified[0]),
+               ("AMPLITUDE_RESUMMED_ERROR", r.amplitude_verified[2]))
+              if r.amplitude is not None else ()))
 
 
 def cubic_branches(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol) -> tuple[sp.Expr, ...]:

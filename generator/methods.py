@@ -76,7 +76,7 @@ from .lower import (
 )
 from .models import Model, SelfExcited, check_order, duffing
 from .numerics import cycle_reference, duffing_period_exact, shoot
-from .resum import resum_frequency, resum_series
+from .resum import Resummed, resum_frequency, resum_series
 
 Progress = Callable[[int, int], None]
 
@@ -485,11 +485,12 @@ RESUM_CHECKS = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0,
 
 
 def resum_cycle(lc: object, tolerance: float = RESUM_TOLERANCE) -> ResummedCycle | None:
-    """The resummed ω(ε) of a limit cycle (:func:`resum.resum_frequency`) and the |ε| up to
-    which it is verified: the neighbour spread below ``tolerance/10`` on a dense grid of
-    ``(0, 10]``, then DOP853 shooting (:func:`numerics.cycle_reference`) at the check points
-    up to there and at its end, the domain cut at the last one passed when one fails.
-    None for a series with odd powers of ε or without a singularity estimate."""
+    """The resummed ω(ε) of a limit cycle (:func:`resum.resum_frequency`) and its amplitude
+    q(0) (Padé in ε², :func:`resum.resum_series`), each with the |ε| up to which it is
+    verified: the neighbour spread below ``tolerance/10`` on a dense grid of ``(0, 10]``, then
+    DOP853 shooting (:func:`numerics.cycle_reference`) at the check points up to there and at
+    its end, the domain cut at the last one passed when one fails.  None for a series with
+    odd powers of ε or without a singularity estimate (the amplitude alone: None in it)."""
     import numpy as np
 
     est = nearest_singularity(lc.omega)
@@ -499,13 +500,42 @@ def resum_cycle(lc: object, tolerance: float = RESUM_TOLERANCE) -> ResummedCycle
         form = resum_frequency(lc.omega, est.radius, est.angle)
     except InputError:
         return None
+    refs: dict[float, object] = {}
+
+    def reference(e: float) -> object:
+        if e not in refs:
+            refs[e] = cycle_reference(lc.model, e)
+        return refs[e]
+
+    omega = _verified(form, lambda e: 2 * np.pi / reference(e).period, tolerance)
+    if omega is None:
+        return None
+    try:
+        amplitude = resum_series(lc.amplitude, RESUM_RANGE)
+    except InputError:
+        amplitude = None
+    amp = _verified(amplitude, lambda e: reference(e).q0, tolerance) if amplitude else None
+    return ResummedCycle(form, *omega, tolerance=tolerance,
+                         amplitude=amplitude if amp else None,
+                         amplitude_verified=amp if amp else (0.0, (), float("nan")))
+
+
+def _verified(form: Resummed, truth: Callable[[float], float], tolerance: float
+              ) -> tuple[float, tuple[float, ...], float] | None:
+    """``(limit, points, worst)`` of :func:`resum_cycle`'s rule, None if not even its first
+    check point passes."""
+    import numpy as np
+
     grid = np.linspace(0.0, RESUM_RANGE, RESUM_GRID + 1)[1:]
-    bad = grid[~(form.spread(grid) <= tolerance / RESUM_SPREAD_MARGIN)]
-    limit = float(bad[0] - grid[0]) if bad.size else RESUM_RANGE
+    ok = form.spread(grid) <= tolerance / RESUM_SPREAD_MARGIN
+    first_bad = int(np.argmin(ok)) if not ok.all() else len(grid)
+    limit = float(grid[first_bad - 1]) if first_bad else 0.0
     points, worst = [], 0.0
+    if limit == 0.0:
+        return None
     for e in [e for e in RESUM_CHECKS if e < limit] + [limit]:  # and the end itself
-        ref = cycle_reference(lc.model, e)
-        error = abs(float(form(e)) - 2 * np.pi / ref.period) * ref.period / (2 * np.pi)
+        value = truth(e)
+        error = abs(float(form(e)) - value) / abs(value)
         if not error <= tolerance:
             limit = points[-1] if points else 0.0
             break
@@ -513,7 +543,7 @@ def resum_cycle(lc: object, tolerance: float = RESUM_TOLERANCE) -> ResummedCycle
         worst = max(worst, error)
     if not points:
         return None
-    return ResummedCycle(form, float(limit), tolerance, tuple(points), worst)
+    return float(limit), tuple(points), worst
 
 
 MATHIEU_TOLERANCE = 1e-14

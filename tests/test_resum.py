@@ -98,9 +98,9 @@ def emitted(tmp_path_factory):
 
 
 def test_emitted_resummed_frequency_against_shooting(emitted):
-    """omega_resummed and period_resummed within 1e-12 of DOP853 shooting for ε ≤ 1 (the
-    series alone stops at 0.9·√3.42 = 1.66) and within 1e-6 up to the verified limit; NaN
-    beyond it; the error estimate is honest at the references."""
+    """omega_resummed, period_resummed and amplitude_resummed within 1e-12 of DOP853 shooting
+    for ε ≤ 1 (the series alone stops at 0.9·√3.42 = 1.66) and within 1e-6 up to the verified
+    limit; NaN beyond it; the error estimate is below the tolerance there."""
     mod, _ = emitted
     assert 2.5 < mod.RESUMMED_LIMIT < 3.5
     vdp = series_model("van_der_pol", 4)
@@ -109,7 +109,10 @@ def test_emitted_resummed_frequency_against_shooting(emitted):
         assert mod.period_resummed(eps) == pytest.approx(ref.period, rel=tol)
         assert mod.omega_resummed(-eps) == pytest.approx(2 * np.pi / ref.period, rel=tol)
         assert mod.resummed_error(eps) < 1e-6
-    assert np.isnan(mod.omega(1.8))  # the series' own guard
+        if eps <= mod.AMPLITUDE_RESUMMED_LIMIT:
+            assert mod.amplitude_resummed(eps) == pytest.approx(ref.q0, rel=tol)
+    assert np.isnan(mod.omega(1.8)) and np.isnan(mod.amplitude(1.8))  # the series' guard
+    assert mod.AMPLITUDE_RESUMMED_LIMIT > 2.5 and np.isnan(mod.amplitude_resummed(5.0))
     assert np.all(np.isnan(mod.omega_resummed(np.array([mod.RESUMMED_LIMIT + 1e-9, 5.0, 10.0,
                                                           np.nan]))))
 
