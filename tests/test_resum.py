@@ -187,3 +187,12 @@ def test_choose_mathieu_weighs_series_pade_and_the_solver():
     assert far.method == "reference" and far.max_error <= 1e-14
     with pytest.raises(InputError, match="no method meets it"):
         choose_mathieu("a", 0, 1e-30, 0.0, 2.0, order=60, points=3)
+
+
+def test_generated_mathieu_module_is_byte_identical(tmp_path):
+    from lindstedt.compiler import generate_mathieu
+
+    first = generate_mathieu("b", 3, 40, tmp_path / "one")
+    second = generate_mathieu("b", 3, 40, tmp_path / "two")
+    assert [p.name for p in first] == ["mathieu_b3.py"]
+    assert first[0].read_bytes() == second[0].read_bytes()
