@@ -504,7 +504,7 @@ def resum_cycle(lc: object, tolerance: float = RESUM_TOLERANCE) -> ResummedCycle
 
     def reference(e: float) -> object:
         if e not in refs:
-            refs[e] = cycle_reference(lc.model, e)
+            refs[e] = cycle_reference(lc.model, e, guess=float(lc.amplitude[0]))
         return refs[e]
 
     omega = _verified(form, lambda e: 2 * np.pi / reference(e).period, tolerance)
@@ -529,7 +529,7 @@ def _verified(form: Resummed, truth: Callable[[float], float], tolerance: float
     grid = np.linspace(0.0, RESUM_RANGE, RESUM_GRID + 1)[1:]
     ok = form.spread(grid) <= tolerance / RESUM_SPREAD_MARGIN
     first_bad = int(np.argmin(ok)) if not ok.all() else len(grid)
-    limit = float(grid[first_bad - 1]) if first_bad else 0.0
+    limit = round(float(grid[first_bad - 1]), 12) if first_bad else 0.0
     points, worst = [], 0.0
     if limit == 0.0:
         return None
