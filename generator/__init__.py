@@ -14,6 +14,8 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
     averaging  the slow flow of q'' + q = ε f (+ ε F cos ωt): near-     Oscillator, K -> SlowFlow
                identity averaging to any order in van der Pol's
                variables, exact (R_k, Φ_k of dr/dt, dφ/dt)
+    resum      Padé approximants over QQ, Andersen & Geer's w-variable; [c_k] -> Resummed
+               spurious poles, neighbour spread (past the radius)
     numerics   references: elliptic periods, Jacobi cn; one RK4 step for any polynomial force
                table: shooting + Floquet, sweeps, true folds, simulations
     driven     μ-expansion with phase, harmonic balance (Duffing; and a  Drive | equation ->

@@ -604,5 +604,48 @@ def parametric_figure(eps: float, zeta: float, gamma: float, omega_from: float,
            title=f"parametric resonance (ε = {eps}, ζ = {zeta}, γ = {gamma}); "
            "o stable, x unstable shot orbit")
     ax.legend(fontsize=7, loc="upper left")
+    return _save(fig, path)
+
+
+def resummed_speed_accuracy_figure(panels: Sequence[tuple[str, Sequence[tuple[str, str, float,
+                                                                               float]]]],
+                                   mathieu: tuple[np.ndarray, dict[str, np.ndarray]],
+                                   path: Path) -> Path:
+    """Past the radius of convergence.  Top: error against cost, one point per method and
+    order, one panel per range — ``panels`` holds ``(title, [(method, label, ns, error)])``
+    (error inf where a method answers NaN somewhere on the range: drawn at the top).  Bottom:
+    Mathieu's characteristic values, ``mathieu = (q, {label: relative error})`` against q
+    (SciPy's and the resummed evaluators' against the eigenvalue reference)."""
+    check_plot_path(path)
+    fig = plt.figure(figsize=(15, 8))
+    grid = fig.add_gridspec(2, len(panels))
+    colors = {"series": "C0", "resummed": "C1", "shooting": "C4", "lambdify": "C7"}
+    top = 1.0
+    for k, (title, points) in enumerate(panels):
+        ax = fig.add_subplot(grid[0, k])
+        for method, color in colors.items():
+            sel = [p for p in points if p[0] == method]
+            if not sel:
+                continue
+            err = np.array([p[3] for p in sel])
+            ax.plot([p[2] for p in sel], np.where(np.isfinite(err), np.maximum(err, FLOOR), top),
+                    "o", color=color, ms=4, label=method)
+            for _, label, ns, e in sel:
+                ax.annotate(label, (ns, max(e, FLOOR) if np.isfinite(e) else top), fontsize=6,
+                            xytext=(3, 2), textcoords="offset points")
+        ax.set(xscale="log", yscale="log", xlabel="ns / point (recorded)", title=title,
+               ylim=(FLOOR / 3, top * 3))
+        if k == 0:
+            ax.set_ylabel("max relative error of ω (top: NaN somewhere)")
+            ax.legend(fontsize=7)
+    ax = fig.add_subplot(grid[1, :])
+    q, errors = mathieu
+    for label, err in sorted(errors.items()):
+        ax.plot(q, np.maximum(err, FLOOR), "--" if label.startswith("SciPy") else "-", lw=1,
+                label=label)
+    ax.set(yscale="log", xlabel="q", ylabel="|error| / max(1, |a|)",
+           title="Mathieu's a_m(q), b_m(q) against the eigenvalue reference (resummed: NaN "
+                 "beyond the verified q, not drawn)")
+    ax.legend(fontsize=7, ncol=4)
     fig.tight_layout()
     return _save(fig, path)

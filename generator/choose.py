@@ -705,3 +705,127 @@ def _generated_q_cost(order: int, x_min: float, x_max: float) -> float:
         seconds = best_seconds(lambda: mod.q_into(out, t, 1.0, eps))
         sys.modules.pop("duffing", None)
     return seconds / t.size * 1e9
+
+
+RESUMMED_COSTS = {
+    "cycle": {"series": 3.0, "resummed": 5.5, "shooting": 1.5e9},
+    "mathieu": {"series": 60.0, "pade": 3.0, "reference": 1.0e5},
+}
+# NOTE: ns per point, recorded on the 2-core reference machine by benchmarks/resum.py
+# (docs/benchmarks.md): the emitted ufuncs' `_into` loops over a million points (the series
+# and the Padé form), the NumPy Horner sum of Mathieu's series, one DOP853 shooting of the
+# cycle (two tolerances) and one float64 tridiagonal eigenvalue solve.  The choice decides by
+# these, so it does not depend on this run's load; each run's timings are reported beside.
+RESUMMED_ORDER = {"cycle": 60, "mathieu": 100}
+# NOTE: the default orders: the limit cycle's derivation at 60 is ~2 s (its resummed form is
+# then verified to |ε| ≈ 3), Mathieu's at 100 well under a second.
+
+
+@dataclass(frozen=True)
+class ResummedChoice:
+    """The cheapest of a quantity's partial sums, resummed evaluator and numerical reference
+    that meets ``tol`` on the range, by :data:`RESUMMED_COSTS`; ``considered``: per method its
+    order, largest measured error on the range (inf where it returns NaN) and the recorded and
+    this run's ns per point."""
+
+    quantity: str
+    method: str
+    order: int
+    max_error: float
+    ns_per_point: float
+    verified_on: int
+    considered: tuple[tuple[str, int, float, float, float], ...]
+
+    def _repr_html_(self) -> str:
+        return html_table(
+            f"{self.quantity}: {self.method}, error {self.max_error:.1e}, "
+            f"{self.ns_per_point:.3g} ns/point, verified on {self.verified_on} points",
+            ("method", "order", "max error", "recorded ns/point", "this run"),
+            [(m, o, f"{e:.1e}", f"{r:.3g}", f"{ns:.3g}") for m, o, e, r, ns in self.considered])
+
+
+def _relative(value: np.ndarray, reference: np.ndarray, floor: float = 0.0) -> float:
+    err = np.abs(np.asarray(value, float) - reference) / np.maximum(np.abs(reference), floor)
+    return float(np.max(np.where(np.isfinite(err), err, np.inf)))
+
+
+def _pick(quantity: str, kind: str, tol: float, order: int, n: int,
+          rows: list[tuple[str, int, float, float, float]]) -> ResummedChoice:
+    fits = [r for r in rows if r[2] <= tol]
+    if not fits:
+        best = min(rows, key=lambda r: r[2])
+        raise InputError(f"--tol {tol:g}: no method meets it on the range (best: {best[0]}, "
+                         f"{best[2]:.1e}); widen the tolerance or narrow the range")
+    m = min(fits, key=lambda r: RESUMMED_COSTS[kind][r[0]])
+    return ResummedChoice(quantity, m[0], m[1], m[2], m[4], n, tuple(rows))
+
+
+def choose_limit_cycle(tol: float, eps_min: float, eps_max: float, order: int | None = None,
+                       points: int = 7) -> ResummedChoice:
+    """van der Pol's ω on ``[eps_min, eps_max]``: the emitted partial sums (``omega``), the
+    resummed evaluator (``omega_resummed``) and DOP853 shooting, each measured against the
+    shooting references at ``points`` Chebyshev points (shooting's own error: its
+    two-tolerance difference there)."""
+    from .compiler import generate_limit_cycle
+    from .models import series_model
+    from .numerics import cycle_reference
+
+    if not (0 < eps_min <= eps_max) or not (tol > 0):
+        raise InputError(f"--x-min {eps_min}, --x-max {eps_max}, --tol {tol}: need "
+                         "0 < x-min ≤ x-max and tol > 0 (the range of ε)")
+    order = RESUMMED_ORDER["cycle"] if order is None else order
+    vdp = series_model("van_der_pol", order)
+    eps = verification_points(eps_min, eps_max, points)
+    start = time.perf_counter()
+    refs = [cycle_reference(vdp, float(e)) for e in eps]
+    shoot_ns = (time.perf_counter() - start) / len(eps) * 1e9
+    omega = np.array([2 * np.pi / r.period for r in refs])
+    with tempfile.TemporaryDirectory() as out:
+        generate_limit_cycle(vdp, order - 2, Path(out))
+        mod = load_generated(Path(out) / "van_der_pol.py")
+        rows = []
+        for name, ufunc, into in (("series", mod.omega, mod.omega_into),
+                                  ("resummed", mod.omega_resummed, mod.omega_resummed_into)):
+            ns = ns_per_point(lambda x, o, f=into: f(o, x), 1_000_000, eps_min, eps_max)
+            rows.append((name, order - 2, _relative(ufunc(eps), omega),
+                         RESUMMED_COSTS["cycle"][name], ns))
+    rows.append(("shooting", 0, max(r.accuracy for r in refs), RESUMMED_COSTS["cycle"]["shooting"],
+                 shoot_ns))
+    return _pick("limit cycle ω", "cycle", tol, order - 2, len(eps), rows)
+
+
+def choose_mathieu(kind: str, m: int, tol: float, q_min: float, q_max: float,
+                   order: int | None = None, points: int = 41) -> ResummedChoice:
+    """Mathieu's ``a_m(q)`` or ``b_m(q)`` on ``[q_min, q_max]``: the series' partial sum
+    (NumPy Horner), the emitted Padé evaluator and the eigenvalue solver, measured against the
+    eigenvalue solver in mpmath (30 digits) at ``points`` Chebyshev points, relative to
+    max(1, |a|)."""
+    from .compiler import generate_mathieu
+    from .hill import mathieu_series
+    from .numerics import mathieu_reference
+    from .resum import horner_float
+
+    if not (q_min <= q_max) or not (tol > 0):
+        raise InputError(f"--x-min {q_min}, --x-max {q_max}, --tol {tol}: need x-min ≤ x-max "
+                         "and tol > 0 (the range of q)")
+    order = RESUMMED_ORDER["mathieu"] if order is None else order
+    q = verification_points(q_min, q_max, points)
+    truth = np.array([mathieu_reference(kind, m, float(x), dps=30) for x in q])
+    start = time.perf_counter()
+    solver = np.array([mathieu_reference(kind, m, float(x)) for x in q])
+    solver_ns = (time.perf_counter() - start) / len(q) * 1e9
+    coefficients = mathieu_series(kind, m, order)
+    rows = []
+    series_ns = ns_per_point(lambda x, o: horner_float(coefficients, x), 100_000, q_min, q_max)
+    rows.append(("series", order, _relative(horner_float(coefficients, q), truth, 1.0),
+                 RESUMMED_COSTS["mathieu"]["series"], series_ns))
+    with tempfile.TemporaryDirectory() as out:
+        generate_mathieu(kind, m, order, Path(out))
+        mod = load_generated(Path(out) / f"mathieu_{kind}{m}.py")
+        ufunc, into = getattr(mod, f"{kind}{m}"), getattr(mod, f"{kind}{m}_into")
+        ns = ns_per_point(lambda x, o: into(o, x), 1_000_000, q_min, q_max)
+        rows.append(("pade", order, _relative(ufunc(q), truth, 1.0),
+                     RESUMMED_COSTS["mathieu"]["pade"], ns))
+    rows.append(("reference", 0, _relative(solver, truth, 1.0),
+                 RESUMMED_COSTS["mathieu"]["reference"], solver_ns))
+    return _pick(f"mathieu {kind}_{m}", "mathieu", tol, order, len(q), rows)

@@ -236,6 +236,14 @@ def _cmd_mathieu(args: argparse.Namespace) -> int:
     """``lindstedt mathieu a|b --m M --order K``: DLMF §28.6's series of a_m(q) or b_m(q)."""
     from .hill import mathieu_series
 
+    if args.emit is not None:
+        from . import compiler
+
+        for path in compiler.generate_mathieu(args.kind, args.m, args.order,
+                                              _out_folder(args.emit, "--emit"),
+                                              overwrite_edited=args.overwrite_edited):
+            print(path)
+        return 0
     series = mathieu_series(args.kind, args.m, args.order)
     if args.json:
         print(json.dumps({"kind": args.kind, "m": args.m, "variable": "q",
@@ -1260,6 +1268,8 @@ def _cmd_choose(args: argparse.Namespace) -> int:
         raise InputError(f"choose {args.quantity} EQUATION: only the period is chosen for an "
                          "equation (q, amplitudes and response are the notes' Duffing "
                          "oscillator's)")
+    if args.quantity in RESUMMED_QUANTITIES:
+        return _choose_resummed(args)
     if args.quantity in DRIVEN_QUANTITIES:
         return _choose_driven(args)
     if args.quantity == "q":
@@ -1312,6 +1322,45 @@ def _cmd_choose(args: argparse.Namespace) -> int:
                   choice.considered)
     for path in data.get("emitted", []):
         print(f"  emitted {path}")
+    return 0
+
+
+RESUMMED_QUANTITIES = ("cycle", "mathieu")
+# NOTE: choose's quantities past the radius: van der Pol's limit-cycle ω(ε) and Mathieu's
+# a_m(q), b_m(q) (partial sums, resummed evaluator, numerical reference).
+
+
+def _choose_resummed(args: argparse.Namespace) -> int:
+    """``choose cycle`` (ε in [x-min, x-max]) and ``choose mathieu --kind K --m M`` (q)."""
+    for name in ("tol", "x_min", "x_max"):
+        if getattr(args, name) is None:
+            raise InputError(f"choose {args.quantity} needs --{name.replace('_', '-')}")
+    if args.emit:
+        raise InputError(f"--emit: choose {args.quantity} reports; `lindstedt generate "
+                         "van_der_pol` and `lindstedt mathieu … --emit DIR` write the modules")
+    from .choose import choose_limit_cycle, choose_mathieu
+
+    if args.quantity == "cycle":
+        c = choose_limit_cycle(args.tol, args.x_min, args.x_max)
+        what = f"van der Pol's limit-cycle ω(ε), ε in [{args.x_min:g}, {args.x_max:g}]"
+    else:
+        kind, m = args.kind or "a", args.m if args.m is not None else 0
+        c = choose_mathieu(kind, m, args.tol, args.x_min, args.x_max)
+        what = f"Mathieu's {kind}_{m}(q), q in [{args.x_min:g}, {args.x_max:g}]"
+    rows = [{"method": m, "order": o, "max_error": e, "recorded_ns_per_point": r,
+             "ns_per_point": ns} for m, o, e, r, ns in c.considered]
+    if args.json:
+        print(json.dumps({"quantity": args.quantity, "method": c.method, "order": c.order,
+                          "max_error": c.max_error, "ns_per_point": c.ns_per_point,
+                          "verified_on": c.verified_on, "considered": rows,
+                          "decided_by": "recorded costs (lindstedt.choose.RESUMMED_COSTS)"}))
+        return 0
+    print(f"{what}, tolerance {args.tol:g} (relative, {c.verified_on} points): {c.method}"
+          + (f" (order {c.order})" if c.order else ""))
+    for r in rows:
+        print(f"  {r['method']:<10} order {r['order']:>4}  max error {r['max_error']:8.1e}  "
+              f"{r['recorded_ns_per_point']:10.3g} ns/point recorded, "
+              f"{r['ns_per_point']:10.3g} this run")
     return 0
 
 
@@ -1709,6 +1758,12 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_order(p, "highest power K of q")
     _flag_json(p, "the contract {kind, m, variable, series}")
     _flag_allow_slow(p, deprecated_force=False)
+    p.add_argument("--emit", metavar="DIR", default=None,
+                   help="write DIR/mathieu_<kind><m>.py instead: a numba ufunc of the value, "
+                   "Padé-resummed from the series to --order, verified against the eigenvalue "
+                   "reference on a grid of q up to 50 and NaN beyond where it was verified")
+    p.add_argument("--overwrite-edited", action="store_true",
+                   help="with --emit: overwrite a file edited since it was generated")
     p.set_defaults(func=_cmd_mathieu)
 
     p = sub.add_parser("models", help="list the named oscillators",
@@ -1839,8 +1894,15 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("choose", help="the cheapest verified method for a tolerance and a range",
                        description="Time and verify every method, report the cheapest that "
                        "meets the tolerance on the range.")
-    p.add_argument("quantity", choices=("period", "q", *DRIVEN_QUANTITIES),
-                   help="period T(x); q(t); amplitudes A_n, B_n; response r(ω)")
+    p.add_argument("quantity", choices=("period", "q", *DRIVEN_QUANTITIES,
+                                        *RESUMMED_QUANTITIES),
+                   help="period T(x); q(t); amplitudes A_n, B_n; response r(ω); cycle: van der "
+                   "Pol's limit-cycle ω(ε), ε in [x-min, x-max]; mathieu: a_m(q) or b_m(q) "
+                   "(--kind, --m), q in [x-min, x-max]")
+    p.add_argument("--kind", choices=("a", "b"), default=None,
+                   help="mathieu: a (even solutions, default) or b (odd)")
+    p.add_argument("--m", type=_order, default=None, metavar="M",
+                   help="mathieu: the index m (default 0)")
     _flag_equation(p, "\"q'' + q + eps*q**5 = 0\" (period only: a free oscillator with a "
                    "polynomial force, judged by quadrature; x is then its expansion variable)")
     p.add_argument("--tol", type=_real, metavar="TOL",

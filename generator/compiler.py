@@ -21,6 +21,7 @@ from .methods import (
     FOURIER,
     FREE,
     LIMIT_CYCLE,
+    MATHIEU,
     MU,
     MU_DAMPED,
     SLOW_FLOW,
@@ -131,4 +132,18 @@ def generate_slow_flow(osc: object, order: int, command: str, out: Path, *,
     """``lindstedt slowflow … --out DIR``: the compiled slow-flow right sides of the
     :class:`models.Oscillator` ``osc`` to ``order`` and the LaTeX of the flow."""
     return compile_target(SLOW_FLOW, Request(order, command, osc), out,
+                          overwrite_edited=overwrite_edited, flag=flag)
+
+
+def generate_mathieu(kind: str, m: int, order: int, out: Path, *,
+                     overwrite_edited: bool = False, flag: str = "--emit") -> list[Path]:
+    """``lindstedt mathieu a|b --m M --order K --emit DIR``: the resummed a_m(q) or b_m(q)."""
+    from .hill import mathieu_series
+
+    mathieu_series(kind, m, 0)  # the kind and m checked before the derivation
+    order = check_order(order)
+    if order < 4:
+        raise InputError(f"order {order}: a resummed Mathieu evaluator needs order ≥ 4")
+    command = f"lindstedt mathieu {kind} --m {m} --order {order} --emit DIR"
+    return compile_target(MATHIEU, Request(order, command, mathieu=(kind, m)), out,
                           overwrite_edited=overwrite_edited, flag=flag)

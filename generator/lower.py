@@ -16,6 +16,7 @@ import keyword
 import re
 import unicodedata
 from dataclasses import dataclass
+from fractions import Fraction
 
 import numpy as np
 import sympy as sp
@@ -43,6 +44,7 @@ from .errors import InputError
 from .lindstedt import LimitCycle, SeriesSolution, nearest_singularity, order_terms
 from .models import Model
 from .printers import identifier
+from .resum import Pade, Resummed
 
 Assign = tuple[sp.Symbol, sp.Expr]
 
@@ -364,7 +366,142 @@ LIMIT_CYCLE_MARGIN = sp.Rational(9, 10)
 # the estimate is good to ~1 % from order 60, and near the radius the terms decay slowly.
 
 
-def lower_limit_cycle(lc: LimitCycle, command: str, order: int) -> Module:
+def resummed_expression(r: Resummed, z: sp.Symbol, approximant: Pade | None = None
+                        ) -> tuple[tuple[Assign, ...], sp.Expr]:
+    """The body and output of a :class:`resum.Resummed` at ``z``: ``x = z**power``, Andersen
+    & Geer's ``w`` when the form has one, numerator and denominator in Horner form (exact
+    rationals: the printer rounds each once)."""
+    P = approximant or r.approximant
+    x = sp.Symbol("x")
+    body: list[Assign] = [(x, z**r.power)]
+
+    def rational(c: Fraction) -> sp.Rational:
+        return sp.Rational(c.numerator, c.denominator)
+
+    if r.R is None:
+        return tuple(body), (horner([rational(c) for c in P.numerator], x)
+                             / horner([rational(c) for c in P.denominator], x))
+    w = sp.Symbol("w")
+    body.append((w, x / sp.sqrt(x**2 - 2 * rational(r.p) * x + rational(r.R) ** 2)))
+    ratio = horner([rational(c) for c in P.numerator], w) / horner(
+        [rational(c) for c in P.denominator], w)
+    return tuple(body), sp.sqrt((1 - w) * ratio)
+
+
+@dataclass(frozen=True)
+class ResummedCycle:
+    """A limit cycle's resummed frequency and where it was verified: ``|ε| ≤ limit``, with
+    the largest measured error ``checked`` against the numerical references at ``points``;
+    the same for its amplitude q(0) when its Padé form verified anywhere."""
+
+    form: Resummed
+    limit: float
+    points: tuple[float, ...]
+    checked: float
+    tolerance: float
+    amplitude: Resummed | None = None  # q(0), Padé in ε², with its (limit, points, checked)
+    amplitude_verified: tuple[float, tuple[float, ...], float] = (0.0, (), float("nan"))
+
+
+def lower_resummed_cycle(r: ResummedCycle) -> tuple[Evaluator, ...]:
+    """``omega_resummed(eps)``, ``period_resummed(eps)`` and ``resummed_error(eps)`` (the
+    relative difference of the neighbouring approximants), NaN beyond the verified |ε|."""
+    eps = sp.Symbol("eps")
+    guard = sp.Abs(eps) <= sp.Rational(repr(r.limit))
+    body, value = resummed_expression(r.form, eps)
+    _, other = resummed_expression(r.form, eps, r.form.neighbour)
+    omega, lower = sp.Symbol("omega"), sp.Symbol("omega_lower")
+    L, M = r.form.approximant.degrees
+    domain = (f"NaN for |eps| > {r.limit:g}, where it was not verified to "
+              f"{r.tolerance:g} against shooting")
+    form = (f"sqrt((1 - w) [{L}/{M}](w)), w = eps²/(eps⁴ - 2 eps² p + R²)^(1/2), R = {r.form.R}"
+            f", p = R cos β = {r.form.p}")
+    return (
+        Evaluator("omega_resummed", f"Frequency ω resummed: {form} ({domain}).", (eps,), (),
+                  guard, body, value),
+        Evaluator("period_resummed", f"Period 2π/ω of omega_resummed ({domain}).", (eps,), (),
+                  guard, (*body, (omega, value)), 2 * sp.pi / omega),
+        Evaluator("resummed_error", "Relative difference of omega_resummed and the next "
+                  f"lower approximant [{L - 1}/{M - 1}] (an error estimate; {domain}).",
+                  (eps,), (), guard, (*body, (omega, value), (lower, other)),
+                  sp.Abs(lower - omega) / omega),
+        *_lower_resummed_amplitude(r),
+    )
+
+
+def _lower_resummed_amplitude(r: ResummedCycle) -> tuple[Evaluator, ...]:
+    """``amplitude_resummed(eps)``: q(0) as the Padé form in ε², NaN beyond its own verified
+    |ε| (none without a verified form)."""
+    if r.amplitude is None:
+        return ()
+    eps = sp.Symbol("eps")
+    limit, _, _ = r.amplitude_verified
+    body, value = resummed_expression(r.amplitude, eps)
+    L, M = r.amplitude.approximant.degrees
+    return (Evaluator(
+        "amplitude_resummed", f"q(0) at q̇(0) = 0, Padé [{L}/{M}] in eps² (NaN for |eps| > "
+        f"{limit:g}, where it was not verified to {r.tolerance:g} against shooting).", (eps,),
+        (), sp.Abs(eps) <= sp.Rational(repr(limit)), body, value),)
+
+
+@dataclass(frozen=True)
+class ResummedMathieu:
+    """Mathieu's ``a_m(q)`` or ``b_m(q)`` resummed from its exact series to ``order`` and
+    where it was verified against the eigenvalue reference: ``0 ≤ q ≤ limit`` (``|q|`` when
+    the series is even in q), the largest error ``checked`` there, relative to max(1, |a|)."""
+
+    kind: str
+    m: int
+    order: int
+    form: Resummed
+    limit: float
+    tolerance: float
+    checked: float
+
+
+def lower_mathieu(r: ResummedMathieu, command: str) -> Module:
+    """``{kind}{m}(q)`` (say ``a0``) and ``{kind}{m}_error(q)`` (the relative difference of the
+    neighbouring approximants), NaN outside the verified q."""
+    q = sp.Symbol("q")
+    name = f"{r.kind}{r.m}"
+    bound = sp.Rational(repr(r.limit))
+    guard = sp.Abs(q) <= bound if r.form.power == 2 else sp.And(q >= 0, q <= bound)
+    body, value = resummed_expression(r.form, q)
+    _, other = resummed_expression(r.form, q, r.form.neighbour)
+    here, lower = sp.Symbol("value"), sp.Symbol("value_lower")
+    L, M = r.form.approximant.degrees
+    var = "q²" if r.form.power == 2 else "q"
+    domain = (f"NaN outside {'|q|' if r.form.power == 2 else '0 ≤ q'} ≤ {r.limit:g}, where "
+              f"it was not verified to {r.tolerance:g}·max(1, |{name}|) against the "
+              "eigenvalues of the recurrence's matrix")
+    evaluators = (
+        Evaluator(name, f"Mathieu's {r.kind}_{r.m}(q) (DLMF 28.2), Padé [{L}/{M}] in {var} of "
+                  f"the exact series to order {r.order} ({domain}).", (q,), (), guard, body,
+                  value),
+        Evaluator(f"{name}_error", f"|[{L}/{M}] − [{L - 1}/{M - 1}]| / max(1, |{name}|): the "
+                  f"error estimate ({domain}).", (q,), (), guard,
+                  (*body, (here, value), (lower, other)),
+                  sp.Abs(here - lower) / sp.Max(1, sp.Abs(here))),
+    )
+    constants = (
+        ("ORDER", r.order), ("MODEL", f"mathieu_{name}"), ("VARIABLE", "q"),
+        ("LIMIT", r.limit), ("TOLERANCE", r.tolerance), ("CHECKED_ERROR", r.checked),
+        ("DEGREES", (L, M)), ("SYMMETRIC", r.form.power == 2),
+    )
+    return Module(
+        name=f"mathieu_{name}",
+        doc=f"Mathieu's characteristic value {r.kind}_{r.m}(q) of y'' + (a - 2q cos 2z) y = 0, "
+            "resummed past the radius of its series.",
+        constants=constants, evaluators=evaluators,
+        provenance=provenance(f"mathieu_{name}", r.order, command,
+                              numerator=[str(c) for c in r.form.approximant.numerator],
+                              denominator=[str(c) for c in r.form.approximant.denominator],
+                              limit=r.limit),
+    )
+
+
+def lower_limit_cycle(lc: LimitCycle, command: str, order: int,
+                      resummed: ResummedCycle | None = None) -> Module:
     """Evaluators ``omega(eps)``, ``period(eps)``, ``amplitude(eps)`` (q(0), at q̇(0) = 0),
     ``q(t, eps)`` and ``error_estimate(eps)`` of a limit cycle's L–P series to ``order``
     (``lc`` derived further: K + 2 for the estimate, and far enough for the radius), NaN where
@@ -429,14 +566,30 @@ def lower_limit_cycle(lc: LimitCycle, command: str, order: int) -> Module:
         ("PERIOD_EXACT", tuple(str(c) for c in tau)),
         ("AMPLITUDE_EXACT", tuple(str(c) for c in amp)),
     )
+    if resummed is not None:
+        evaluators = (*evaluators, *lower_resummed_cycle(resummed))
+        constants = (*constants, *resummed_constants(resummed))
     return Module(
         name=m.name,
         doc=f"{m.title}: its limit cycle's L–P evaluators to order {order} in eps.",
         constants=constants,
         evaluators=evaluators,
         provenance=provenance(m.name, order, command, equation=m.source,
-                              terms=[(a, b, str(c)) for a, b, c in m.terms]),
+                              terms=[(a, b, str(c)) for a, b, c in m.terms],
+                              **({"resummed": resummed_constants(resummed)}
+                                 if resummed is not None else {})),
     )
+
+
+def resummed_constants(r: ResummedCycle) -> tuple[tuple[str, object], ...]:
+    """What the module states about its resummed evaluators: the verified |ε|, the
+    tolerance, the largest error measured at the reference points, the degrees."""
+    return (("RESUMMED_LIMIT", r.limit), ("RESUMMED_TOLERANCE", r.tolerance),
+            ("RESUMMED_CHECKED", tuple(r.points)), ("RESUMMED_ERROR", r.checked),
+            ("RESUMMED_DEGREES", r.form.approximant.degrees),
+            *((("AMPLITUDE_RESUMMED_LIMIT", r.amplitude_verified[0]),
+               ("AMPLITUDE_RESUMMED_ERROR", r.amplitude_verified[2]))
+              if r.amplitude is not None else ()))
 
 
 def cubic_branches(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol) -> tuple[sp.Expr, ...]:

@@ -1,0 +1,272 @@
+"""Resummation of exact power series past their radius of convergence.
+
+A series ``Σ c_k x^k`` with exact rational ``c_k`` (the limit cycle's ω(ε²), Mathieu's a_m(q))
+becomes a Padé approximant ``[L/M] = P_L(x)/Q_M(x)``, ``Q_M(0) = 1``, computed over QQ (FLINT
+``fmpq_mat`` solve of the ``M`` linear conditions, Baker & Graves-Morris eq. 1.1.6) and rounded
+to floats only at the end; or first re-expanded in Andersen & Geer's variable
+``w = x/(x² − 2xR cos β + R²)^½`` (SIAM J. Appl. Math. 42, 678 (1982)), which maps the two
+conjugate branch points at ``x = R e^(±iβ)`` onto ``|w| = 1`` and ``x = ∞`` onto ``w = 1``.
+
+A Padé approximant is trusted only where its denominator has no real zero (a spurious pole, a
+Froissart doublet, sits on the interval otherwise) and where it agrees with its neighbour
+``[L−1/M−1]``: :func:`check_poles` and :func:`neighbour_spread` measure both; the caller
+compares with its numerical reference and fixes the verified interval.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from fractions import Fraction
+
+import flint
+import numpy as np
+
+from .errors import InputError
+
+
+@dataclass(frozen=True)
+class Pade:
+    """``[L/M](x) = Σ p_i x^i / Σ q_j x^j`` with ``q_0 = 1``, exact; ``variable`` says what
+    ``x`` is in terms of the caller's argument (``"eps**2"``, ``"q"``, ``"w"``)."""
+
+    numerator: tuple[Fraction, ...]
+    denominator: tuple[Fraction, ...]
+    variable: str
+
+    @property
+    def degrees(self) -> tuple[int, int]:
+        return len(self.numerator) - 1, len(self.denominator) - 1
+
+    def __call__(self, x: np.ndarray | float) -> np.ndarray:
+        """The approximant in float64 (Horner on the rounded coefficients)."""
+        x = np.asarray(x, dtype=float)
+        return horner_float(self.numerator, x) / horner_float(self.denominator, x)
+
+    def exact(self, x: Fraction) -> Fraction:
+        """The approximant at a rational ``x``, exactly."""
+        return _horner_exact(self.numerator, x) / _horner_exact(self.denominator, x)
+
+
+def _horner_exact(coeffs: Sequence[Fraction], x: Fraction) -> Fraction:
+    acc = Fraction(0)
+    for c in reversed(coeffs):
+        acc = acc * x + c
+    return acc
+
+
+def horner_float(coeffs: Sequence[Fraction], x: np.ndarray) -> np.ndarray:
+    acc = np.zeros_like(x)
+    for c in reversed(coeffs):
+        acc = acc * x + float(c)
+    return acc
+
+
+def _fmpq(c: Fraction) -> flint.fmpq:
+    return flint.fmpq(c.numerator, c.denominator)
+
+
+def _fraction(c: flint.fmpq) -> Fraction:
+    return Fraction(int(c.p), int(c.q))
+
+
+def pade(coefficients: Sequence[Fraction], L: int, M: int, variable: str = "x") -> Pade:
+    """The exact Padé approximant ``[L/M]`` of ``Σ c_k x^k`` from ``c_0 … c_(L+M)``.
+
+    The denominator solves ``Σ_(j=0..M) q_j c_(L+k−j) = 0`` (k = 1..M, ``q_0 = 1``, ``c_i = 0``
+    for i < 0) over QQ; the numerator is the product's truncation ``p_i = Σ_j q_j c_(i−j)``.
+    A singular system (the block structure of the Padé table) is an :class:`InputError`.
+
+    >>> pade([Fraction(1)] * 3, 0, 1).denominator   # 1/(1 − x)
+    (Fraction(1, 1), Fraction(-1, 1))
+    """
+    if L < 0 or M < 0:
+        raise InputError(f"Padé [{L}/{M}]: degrees must be ≥ 0")
+    c = [Fraction(x) for x in coefficients]
+    if len(c) < L + M + 1:
+        raise InputError(f"Padé [{L}/{M}]: needs {L + M + 1} coefficients, got {len(c)}")
+
+    def at(i: int) -> Fraction:
+        return c[i] if i >= 0 else Fraction(0)
+
+    q = [Fraction(1)]
+    if M:
+        A = flint.fmpq_mat(M, M, [_fmpq(at(L + k - j)) for k in range(1, M + 1)
+                                  for j in range(1, M + 1)])
+        b = flint.fmpq_mat(M, 1, [_fmpq(-at(L + k)) for k in range(1, M + 1)])
+        try:
+            x = A.solve(b)
+        except ZeroDivisionError as exc:
+            raise InputError(f"Padé [{L}/{M}] in {variable}: singular (a block of the Padé "
+                             "table); choose other degrees") from exc
+        q += [_fraction(x[j, 0]) for j in range(M)]
+    p = [sum((q[j] * at(i - j) for j in range(min(i, M) + 1)), Fraction(0))
+         for i in range(L + 1)]
+    return Pade(tuple(p), tuple(q), variable)
+
+
+def real_poles(approximant: Pade, lo: float, hi: float) -> list[float]:
+    """The real zeros of the denominator in ``[lo, hi]`` (FLINT's certified root isolation):
+    an approximant with any is not trusted there (a spurious pole, Froissart doublet)."""
+    den = flint.fmpq_poly([_fmpq(c) for c in approximant.denominator])
+    if den.degree() < 1:
+        return []
+    roots = [float(r.real.mid()) for r, _ in den.complex_roots()
+             if r.imag.contains(0) and abs(float(r.imag.mid())) < 1e-30]
+    return sorted(r for r in roots if lo <= r <= hi)
+
+
+def neighbour_spread(approximant: Pade, neighbour: Pade, x: np.ndarray) -> np.ndarray:
+    """``|[L/M] − [L'/M']| / |[L/M]|`` at ``x``: the error estimate of the pair (the nearer
+    approximant's error is below it wherever the sequence converges)."""
+    a, b = approximant(x), neighbour(x)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.abs(a - b) / np.abs(a)
+
+
+def w_substitution(R: Fraction, p: Fraction, order: int) -> list[Fraction]:
+    """``x(w)`` to ``w^order``, the inverse of ``w = x/(x² − 2px + R²)^½`` (``p = R cos β``),
+    near ``x = w = 0``: ``x = w(R√(1 − (1 − p²/R²)w²) − pw)/(1 − w²)``, exact for rational
+    R and p."""
+    n = order + 1
+    k = 1 - p * p / (R * R)
+    root = [Fraction(0)] * n  # √(1 − k w²) = Σ binom(1/2, i) (−k)^i w^(2i)
+    coeff = Fraction(1)
+    for i in range(0, (n + 1) // 2):
+        if 2 * i < n:
+            root[2 * i] = coeff * (-k) ** i
+        coeff = coeff * (Fraction(1, 2) - i) / (i + 1)
+    num = [Fraction(0)] * n  # w (R √(…) − p w)
+    for i in range(n - 1):
+        num[i + 1] += R * root[i]
+    if n > 2:
+        num[2] -= p
+    x = [Fraction(0)] * n  # / (1 − w²) = × Σ w^(2i)
+    for i in range(n):
+        x[i] = sum((num[i - 2 * j] for j in range(i // 2 + 1)), Fraction(0))
+    return x
+
+
+def compose(coefficients: Sequence[Fraction], inner: Sequence[Fraction], order: int
+            ) -> list[Fraction]:
+    """``Σ c_k inner(w)^k`` to ``w^order`` (``inner(0) = 0``), exactly: Horner in FLINT's
+    truncated products."""
+    if inner and inner[0] != 0:
+        raise ValueError("compose: the inner series must vanish at 0")
+    n = order + 1
+    g = flint.fmpq_poly([_fmpq(Fraction(c)) for c in inner[:n]])
+    acc = flint.fmpq_poly([])
+    for c in reversed(list(coefficients[:n])):
+        acc = acc.mul_low(g, n) + _fmpq(Fraction(c))
+    return [_fraction(acc[i]) for i in range(n)]
+
+
+def w_of(x: np.ndarray, R: float, p: float) -> np.ndarray:
+    """Andersen & Geer's ``w = x/(x² − 2px + R²)^½``."""
+    return x / np.sqrt(x * x - 2 * p * x + R * R)
+
+
+@dataclass(frozen=True)
+class Resummed:
+    """A resummed function of one argument ``z``: ``x = z**power`` (``power`` 2 for a series
+    with even powers only), then either the Padé approximant in ``x`` or — when ``R`` and ``p``
+    are set — ``√((1 − w) [L/M](w))`` with Andersen & Geer's ``w(x)`` (the form of a frequency
+    that falls as ``x^(−1/2)``: ``ω²/(1 − w)`` is what is approximated).  ``neighbour`` is
+    ``[L−1/M−1]`` of the same series, for the error estimate."""
+
+    power: int
+    approximant: Pade
+    neighbour: Pade
+    R: Fraction | None = None
+    p: Fraction | None = None
+
+    def _x(self, z: np.ndarray) -> np.ndarray:
+        return np.asarray(z, dtype=float) ** self.power
+
+    def _value(self, approximant: Pade, z: np.ndarray) -> np.ndarray:
+        x = self._x(z)
+        if self.R is None:
+            return approximant(x)
+        w = w_of(x, float(self.R), float(self.p))
+        return np.sqrt((1 - w) * approximant(w))
+
+    def __call__(self, z: np.ndarray | float) -> np.ndarray:
+        return self._value(self.approximant, z)
+
+    def spread(self, z: np.ndarray | float) -> np.ndarray:
+        """``|f_[L/M] − f_[L−1/M−1]| / |f_[L/M]|``: the error estimate."""
+        a, b = self._value(self.approximant, z), self._value(self.neighbour, z)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.abs(a - b) / np.maximum(np.abs(a), 1.0 if self.R is None else 0.0)
+
+
+def in_power(coefficients: Sequence[Fraction]) -> tuple[int, list[Fraction]]:
+    """``(2, [c_0, c_2, …])`` for a series with only even powers (read in ``z²``), else
+    ``(1, c)``."""
+    c = [Fraction(x) for x in coefficients]
+    if len(c) > 2 and all(x == 0 for x in c[1::2]):
+        return 2, c[::2]
+    return 1, c
+
+
+def diagonal_pade(coefficients: Sequence[Fraction], lo: float, hi: float,
+                  variable: str = "x") -> tuple[Pade, Pade]:
+    """The pair ``[L/M]``, ``[L−1/M−1]`` with ``L + M`` = the last index and ``M`` nearest
+    ``L`` (then ``L + 1``, ``L − 1``, … while one of the pair has a real pole on
+    ``[lo, hi]``): the near-diagonal approximants converge best in the cut plane."""
+    N = len(coefficients) - 1
+    if N < 2:
+        raise InputError(f"Padé: {N + 1} coefficients are too few to resum")
+    half = N // 2
+    for M in sorted(range(1, N), key=lambda m: (abs(m - half), -m)):
+        try:
+            pair = (pade(coefficients, N - M, M, variable),
+                    pade(coefficients, N - M - 1, M - 1, variable))
+        except InputError:
+            continue
+        if not any(real_poles(P, lo, hi) for P in pair):
+            return pair
+    raise InputError(f"Padé in {variable}: every near-diagonal approximant has a pole on "
+                     f"[{lo}, {hi}]")
+
+
+def resum_series(coefficients: Sequence[Fraction], hi: float) -> Resummed:
+    """Padé in ``z`` or ``z²`` (even series) of ``Σ c_k z^k``, pole-free on ``0 ≤ z ≤ hi``
+    (Mathieu's a_m(q), b_m(q))."""
+    power, c = in_power(coefficients)
+    approximant, neighbour = diagonal_pade(c, 0.0, hi**power, "z**2" if power == 2 else "z")
+    return Resummed(power, approximant, neighbour)
+
+
+ANGLE_DIGITS = 1000
+# NOTE: R and R cos β of the measured singularity are rounded to rationals with denominators
+# ≤ 1000: w's re-expansion stays exact, and the measured convergence does not depend on the
+# third digit of the singularity (the transform only needs its neighbourhood).
+
+
+def resum_frequency(coefficients: Sequence[Fraction], radius: float, angle: float
+                    ) -> Resummed:
+    """A limit cycle's ω(ε) (a series in ε² with the nearest singularities at ``radius ·
+    e^(±i angle)`` in the ε² plane, :func:`lindstedt.nearest_singularity`) as
+    ``√((1 − w) [L/M](w))``: the series of ``ω²/(1 − w)`` re-expanded exactly in
+    ``w = ε²/(ε⁴ − 2ε²R cos β + R²)^½``, then Padé in w, pole-free on ``0 ≤ w ≤ 1``.
+
+    Measured (benchmarks/resum.py, van der Pol to order 130 against DOP853 shooting): the best
+    of the forms tried — Padé of ω, T/2π or (T/2π)² in ε² (3e-3 … 7e-2 at ε = 10, spurious
+    real poles in most near-diagonal ones), the partial sums in w (0.2 at ε = 10), Padé of ω
+    or ω² in w (4e-4 … 3e-3) — and the only one with every near-diagonal approximant
+    pole-free: 3e-14 to ε = 1, 1e-10 to ε = 3, 1e-7 to ε = 5, 2e-4 at ε = 10.
+    """
+    power, c = in_power(coefficients)
+    if power != 2:
+        raise InputError("resum_frequency: ω must be a series in ε² (only even powers)")
+    import math
+
+    R = Fraction(radius).limit_denominator(ANGLE_DIGITS)
+    p = Fraction(radius * math.cos(angle)).limit_denominator(ANGLE_DIGITS)
+    N = len(c) - 1
+    squared = [sum((c[i] * c[k - i] for i in range(k + 1)), Fraction(0)) for k in range(N + 1)]
+    in_w = compose(squared, w_substitution(R, p, N), N)
+    over = [sum(in_w[: k + 1], Fraction(0)) for k in range(N + 1)]  # / (1 − w)
+    approximant, neighbour = diagonal_pade(over, 0.0, 1.0, "w")
+    return Resummed(2, approximant, neighbour, R, p)

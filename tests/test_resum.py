@@ -1,0 +1,198 @@
+"""Resummation past the radius of convergence: exact Padé approximants against mpmath's and
+against rational functions they must recover, Andersen & Geer's w-variable against its
+definition, and the emitted van der Pol evaluators against DOP853 shooting (the literature's
+period at ε = 1 checks the shooting first)."""
+
+from __future__ import annotations
+
+from fractions import Fraction as F
+
+import mpmath
+import numpy as np
+import pytest
+from lindstedt import methods
+from lindstedt.errors import InputError
+from lindstedt.models import series_model
+from lindstedt.numerics import cycle_reference
+from lindstedt.resum import compose, pade, real_poles, resum_series, w_of, w_substitution
+
+
+def test_pade_recovers_a_rational_function_exactly():
+    """(1 + 2x − x²)/(1 − x − 3x²) from its Taylor coefficients (the recurrence
+    c_k = c_(k−1) + 3c_(k−2) beyond the numerator): [2/2] is the function itself."""
+    c = [F(1), F(3), F(5)]  # c_0 = 1, c_1 = 2 + c_0, c_2 = −1 + c_1 + 3c_0
+    for k in range(3, 12):
+        c.append(c[k - 1] + 3 * c[k - 2])
+    P = pade(c, 2, 2)
+    assert P.numerator == (1, 2, -1) and P.denominator == (1, -1, -3)
+    assert pade(c, 4, 2).exact(F(1, 7)) == (1 + F(2, 7) - F(1, 49)) / (1 - F(1, 7) - F(3, 49))
+    with pytest.raises(InputError, match=r"Padé \[5/4\] in x: singular"):
+        pade(c, 5, 4)  # the Padé table's infinite block below [2/2]: no unique denominator
+
+
+def test_pade_of_log_against_mpmath():
+    """[L/M] of log(1 + x)/x against mpmath.pade (its own linear solve at 50 digits)."""
+    c = [F((-1) ** k, k + 1) for k in range(21)]
+    for L, M in ((10, 10), (9, 10), (6, 5)):
+        P = pade(c, L, M)
+        with mpmath.workdps(50):
+            p, q = mpmath.pade([mpmath.mpf(x.numerator) / x.denominator for x in c], L, M)
+            for got, want in ((P.numerator, p), (P.denominator, q)):
+                assert [float(x) for x in got] == pytest.approx([float(x) for x in want],
+                                                                rel=1e-30, abs=1e-40)
+    x = np.array([0.5, 2.0, 9.0])  # [10/10] converges far past the radius |x| = 1
+    np.testing.assert_allclose(pade(c, 10, 10)(x), np.log1p(x) / x, rtol=3e-6)
+
+
+def test_pade_refuses_too_few_coefficients_and_finds_real_poles():
+    with pytest.raises(InputError, match=r"Padé \[3/3\]: needs 7 coefficients"):
+        pade([F(1)] * 5, 3, 3)
+    geometric = pade([F(1, 2**k) for k in range(6)], 2, 1)  # 1/(1 − x/2): a pole at 2
+    assert real_poles(geometric, 0, 3) == pytest.approx([2.0])
+    assert real_poles(geometric, 0, 1.5) == []
+
+
+def test_w_substitution_inverts_andersen_geer_w():
+    """x(w) from the exact series at w = 0.2 against w(x) = x/(x² − 2px + R²)^½; and the
+    composition of a series with it against direct evaluation."""
+    R, p = F(17, 5), F(-3, 4)
+    xs = w_substitution(R, p, 40)
+    w = 0.2
+    x = sum(float(c) * w**k for k, c in enumerate(xs))
+    assert w_of(np.array(x), float(R), float(p)) == pytest.approx(w, rel=1e-14)
+    exp_series = [F(1, int(mpmath.factorial(k))) for k in range(41)]
+    composed = compose(exp_series, xs, 40)
+    assert sum(float(c) * w**k for k, c in enumerate(composed)) == pytest.approx(
+        np.exp(x), rel=1e-12)
+
+
+def test_even_series_are_read_in_the_square():
+    """1/(1 + q²) = Σ (−1)^k q^(2k): Padé in q², exact, no pole on the real axis."""
+    r = resum_series([F((-1) ** (k // 2)) if k % 2 == 0 else F(0) for k in range(9)], 10.0)
+    assert r.power == 2
+    assert float(r(3.0)) == pytest.approx(0.1, rel=1e-15)
+
+
+def test_the_shooting_reference_against_the_literature():
+    """T(ε = 1) = 6.66328685932313 (van der Pol, many sources) and T(10) = 19.0784 (the
+    relaxation oscillation, e.g. Andersen & Geer's table)."""
+    vdp = series_model("van_der_pol", 4)
+    one = cycle_reference(vdp, 1.0)
+    assert one.period == pytest.approx(6.663286859323130, rel=1e-13)
+    assert one.accuracy < 1e-12
+    assert cycle_reference(vdp, 10.0, rtol=1e-9).period == pytest.approx(19.0784, rel=1e-5)
+
+
+@pytest.fixture(scope="module")
+def emitted(tmp_path_factory):
+    """The module `lindstedt generate van_der_pol --order 58` writes (ω derived to order 60:
+    the resummed evaluators are then verified to |ε| ≈ 3), with fewer shooting checks."""
+    from lindstedt.compiler import generate_limit_cycle
+    from lindstedt.emit import load_generated
+
+    out = tmp_path_factory.mktemp("vdp")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(methods, "RESUM_CHECKS", (1.0, 2.0))
+        paths = generate_limit_cycle(series_model("van_der_pol", 60), 58, out)
+    return load_generated(out / "van_der_pol.py"), paths
+
+
+def test_emitted_resummed_frequency_against_shooting(emitted):
+    """omega_resummed, period_resummed and amplitude_resummed within 1e-12 of DOP853 shooting
+    for ε ≤ 1 (the series alone stops at 0.9·√3.42 = 1.66) and within 1e-6 up to the verified
+    limit; NaN beyond it; the error estimate is below the tolerance there."""
+    mod, _ = emitted
+    assert 2.5 < mod.RESUMMED_LIMIT < 3.5
+    vdp = series_model("van_der_pol", 4)
+    for eps, tol in ((0.1, 1e-12), (1.0, 1e-12), (2.5, 1e-6), (mod.RESUMMED_LIMIT, 1e-6)):
+        ref = cycle_reference(vdp, eps)
+        assert mod.period_resummed(eps) == pytest.approx(ref.period, rel=tol)
+        assert mod.omega_resummed(-eps) == pytest.approx(2 * np.pi / ref.period, rel=tol)
+        assert mod.resummed_error(eps) < 1e-6
+        if eps <= mod.AMPLITUDE_RESUMMED_LIMIT:
+            assert mod.amplitude_resummed(eps) == pytest.approx(ref.q0, rel=tol)
+    assert np.isnan(mod.omega(1.8)) and np.isnan(mod.amplitude(1.8))  # the series' guard
+    assert mod.AMPLITUDE_RESUMMED_LIMIT > 2.5 and np.isnan(mod.amplitude_resummed(5.0))
+    assert np.all(np.isnan(mod.omega_resummed(np.array([mod.RESUMMED_LIMIT + 1e-9, 5.0, 10.0,
+                                                          np.nan]))))
+
+
+def test_generated_limit_cycle_module_is_byte_identical(emitted, tmp_path):
+    """A second, independent generation writes the same bytes."""
+    from lindstedt.compiler import generate_limit_cycle
+
+    _, paths = emitted
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(methods, "RESUM_CHECKS", (1.0, 2.0))
+        again = generate_limit_cycle(series_model("van_der_pol", 60), 58, tmp_path)
+    assert [p.name for p in again] == [p.name for p in paths]
+    for a, b in zip(paths, again, strict=True):
+        assert a.read_bytes() == b.read_bytes()
+
+
+def test_mathieu_reference_against_dlmf_and_mpmath():
+    """The eigenvalue reference at q = 1 against Abramowitz & Stegun's Table 20.1 (8 decimals:
+    a_0 = −0.45513860, a_1 = 1.85910807, b_1 = −0.11024882, b_2 = 3.91702477), and float64
+    against mpmath at 30 digits at q = 40."""
+    from lindstedt.numerics import mathieu_reference
+
+    for kind, m, value in (("a", 0, -0.45513860), ("a", 1, 1.85910807),
+                           ("b", 1, -0.11024882), ("b", 2, 3.91702477)):
+        assert mathieu_reference(kind, m, 1.0) == pytest.approx(value, abs=6e-9)
+    for kind, m in (("a", 0), ("a", 3), ("b", 6)):
+        exact = mathieu_reference(kind, m, 40.0, dps=30)
+        assert mathieu_reference(kind, m, 40.0) == pytest.approx(exact, rel=1e-14)
+
+
+@pytest.mark.parametrize(("kind", "m", "past"), [("a", 0, 2.0), ("a", 3, 1.0), ("b", 6, 5.0)])
+def test_emitted_mathieu_against_the_eigenvalue_reference(kind, m, past, tmp_path):
+    """`lindstedt mathieu KIND --m M --order 60 --emit DIR`: the ufunc within 2e-14·max(1,
+    |a|) of the mpmath eigenvalues inside its verified q (1e-14 from the float64 reference it
+    is verified against, which is ≤ 1e-14 from mpmath), past the series' radius (|q| ≈ 1.47
+    for a_0), NaN beyond (and below q = 0 for a series with odd powers)."""
+    from lindstedt.cli import main
+    from lindstedt.emit import load_generated
+    from lindstedt.numerics import mathieu_reference
+
+    assert main(["mathieu", kind, "--m", str(m), "--order", "60", "--emit",
+                 str(tmp_path)]) == 0
+    mod = load_generated(tmp_path / f"mathieu_{kind}{m}.py")
+    f = getattr(mod, f"{kind}{m}")
+    assert past < mod.LIMIT
+    for q in np.linspace(0.1, mod.LIMIT, 6):
+        exact = mathieu_reference(kind, m, float(q), dps=30)
+        assert abs(f(q) - exact) <= 2e-14 * max(1.0, abs(exact))
+    assert np.isnan(f(mod.LIMIT + 0.01)) and np.isnan(f(np.nan))
+    assert np.isnan(f(-0.5)) != mod.SYMMETRIC
+
+
+def test_mathieu_emit_refuses_bad_input(tmp_path, capsys):
+    from lindstedt.cli import main
+
+    assert main(["mathieu", "b", "--m", "0", "--order", "60", "--emit", str(tmp_path)]) == 2
+    assert "b_0 does not exist" in capsys.readouterr().err
+    assert main(["mathieu", "a", "--m", "1", "--order", "2", "--emit", str(tmp_path)]) == 2
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_choose_mathieu_weighs_series_pade_and_the_solver():
+    """Past the series' radius (q = 2 > 1.47) the partial sums miss; the Padé evaluator meets
+    1e-13 against mpmath and is the cheapest; on (0, 45], where it is NaN, the solver wins."""
+    from lindstedt.choose import choose_mathieu
+
+    near = choose_mathieu("a", 0, 1e-13, 0.0, 2.0, order=60, points=5)
+    rows = {m: e for m, _, e, _, _ in near.considered}
+    assert near.method == "pade" and rows["series"] > 1e-3 and rows["pade"] <= 1e-13
+    far = choose_mathieu("a", 0, 1e-13, 0.0, 45.0, order=60, points=5)
+    assert far.method == "reference" and far.max_error <= 1e-14
+    with pytest.raises(InputError, match="no method meets it"):
+        choose_mathieu("a", 0, 1e-30, 0.0, 2.0, order=60, points=3)
+
+
+def test_generated_mathieu_module_is_byte_identical(tmp_path):
+    from lindstedt.compiler import generate_mathieu
+
+    first = generate_mathieu("b", 3, 40, tmp_path / "one")
+    second = generate_mathieu("b", 3, 40, tmp_path / "two")
+    assert [p.name for p in first] == ["mathieu_b3.py"]
+    assert first[0].read_bytes() == second[0].read_bytes()
