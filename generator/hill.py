@@ -11,8 +11,14 @@ coefficient of ``2 cos 2z · y_(k−1)``, and ``y_k`` follows harmonic by harmon
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
 from fractions import Fraction
 
+import sympy as sp
+from flint import fmpq
+
+from .equation import TIME, parse_expression
 from .errors import InputError
 from .models import check_order
 
@@ -54,3 +60,231 @@ def mathieu_series(kind: str, m: int, order: int) -> list[Fraction]:
                 rhs[n] = rhs.get(n, Fraction(0)) - alphas[i] * c
         ys.append({n: c / (m * m - n * n) for n, c in rhs.items() if n != m and c})
     return alphas
+
+
+# --- Hill's equation ẍ + (δ + ε p(t)) x = 0: the transition curves out of every tongue --------
+
+MAX_HARMONIC = 64
+# NOTE: the highest harmonic of p(t) taken; a user's p is a short trigonometric sum.
+QUARTER = {0: (1, 0), 1: (0, 1), 2: (-1, 0), 3: (0, -1)}
+# NOTE: (cos kπ/2, sin kπ/2) for k mod 4: a quarter-period shift keeps p's coefficients exact.
+
+Harmonics = dict[int, tuple[Fraction, Fraction]]  # k -> (cos kt, sin kt) coefficients of p
+Modes = dict[tuple[int, int], Fraction]  # (0, j): cos(jτ), (1, j): sin(jτ), τ = t/2
+
+
+@dataclass(frozen=True)
+class TransitionCurve:
+    """One transition curve ``δ = Σ_k delta[k] ε^k`` out of the tongue ``δ = n²/4`` of
+    ``ẍ + (δ + ε p(t))x = 0``, and the periodic solution on it: ``solution[k]`` holds the
+    Fourier coefficients of the ε^k term in ``τ = (t − shift)/2``: ``{(0, j): c}`` for
+    ``c cos jτ``, ``{(1, j): c}`` for ``c sin jτ`` (period 2π in t for n even, 4π for n odd)."""
+
+    label: str
+    delta: tuple[Fraction, ...]
+    solution: tuple[Modes, ...]
+
+
+@dataclass(frozen=True)
+class Tongue:
+    """The transition curves of tongue ``n`` (one for n = 0, two otherwise), for ``p`` given by
+    its harmonics; ``shift``: the quarter periods ``t₀ = shift·π/2`` by which ``p`` was moved
+    to make it even (the solutions are written in ``t − t₀``; the curves do not move)."""
+
+    n: int
+    p: Harmonics
+    shift: int
+    curves: tuple[TransitionCurve, ...]
+
+
+def fourier_of_text(text: str) -> Harmonics:
+    """``p(t)`` given as text (the oscillator parser's whitelist) as its harmonics ``{k: (a_k,
+    b_k)}`` of ``Σ a_k cos kt + b_k sin kt``; :class:`InputError` unless it is a finite
+    trigonometric polynomial of period 2π in t with rational coefficients."""
+    expr = parse_expression(text, "p(t)")
+    t = sp.Symbol(TIME)
+    others = sorted(str(s) for s in expr.free_symbols - {t})
+    if others:
+        raise InputError(f"p(t) {text!r}: {', '.join(others)} is not t; give numbers "
+                         "(p may depend on t only)")
+    out: Harmonics = {}
+
+    def add(k: int, a: Fraction, b: Fraction) -> None:
+        if k > MAX_HARMONIC:
+            raise InputError(f"p(t) {text!r}: harmonic {k} above the limit {MAX_HARMONIC}")
+        old = out.get(k, (Fraction(0), Fraction(0)))
+        out[k] = (old[0] + a, old[1] + b)
+
+    for term in sp.Add.make_args(sp.expand(expr)):
+        coeff, factors = term.as_coeff_mul()
+        if not coeff.is_Rational:
+            raise InputError(f"p(t) {text!r}: the coefficient {coeff} is not rational")
+        modes: Modes = {(0, 0): Fraction(coeff.p, coeff.q)}
+        for factor in factors:
+            base, power = factor.as_base_exp()
+            if not (power.is_Integer and power > 0) or not isinstance(base, (sp.cos, sp.sin)):
+                reason = ("a coefficient that is not rational" if t not in factor.free_symbols
+                          else "not a finite sum of cos(k*t), sin(k*t) with integer k")
+                raise InputError(f"p(t) {text!r}: {factor} is {reason}")
+            k = sp.simplify(base.args[0] / t)
+            if not k.is_Rational or k.free_symbols:
+                raise InputError(f"p(t) {text!r}: {base} is not periodic in t as a sum of "
+                                 "cos(k*t), sin(k*t) (k an integer)")
+            if not k.is_Integer:
+                raise InputError(f"p(t) {text!r}: {base} has period {sp.Abs(2 * sp.pi / k)}, "
+                                 "not 2*pi (write t for the period-2π time: k an integer)")
+            kind, k = int(isinstance(base, sp.sin)), int(k)
+            one = {(kind, abs(k)): Fraction(-1 if kind and k < 0 else 1)} if k else \
+                {(0, 0): Fraction(1 - kind)}
+            for _ in range(int(power)):
+                modes = _product(modes, one)
+        for (kind, k), c in modes.items():
+            add(k, c if kind == 0 else Fraction(0), c if kind == 1 else Fraction(0))
+    out = {k: ab for k, ab in sorted(out.items()) if ab != (0, 0)}
+    if not any(k for k in out):
+        raise InputError(f"p(t) {text!r}: no harmonic k ≥ 1 (a constant p only moves δ)")
+    return out
+
+
+def _product(a: Modes, b: Modes) -> Modes:
+    """The product of two trigonometric sums by ``cos x cos y = (cos(x−y) + cos(x+y))/2`` and
+    its sine forms, exact (Fraction or fmpq coefficients)."""
+    out: Modes = {}
+    for (ka, i), ca in a.items():
+        for (kb, j), cb in b.items():
+            c = ca * cb / 2
+            d, s = abs(i - j), (1 if i >= j else -1)
+            if ka == 0 and kb == 0:
+                terms = (((0, i + j), c), ((0, d), c))
+            elif ka == 1 and kb == 1:
+                terms = (((0, d), c), ((0, i + j), -c))
+            elif ka == 1:  # sin i cos j
+                terms = (((1, i + j), c), ((1, d), s * c))
+            else:  # cos i sin j
+                terms = (((1, i + j), c), ((1, d), -s * c))
+            for key, v in terms:
+                if key != (1, 0):
+                    out[key] = out.get(key, 0) + v
+    return {key: v for key, v in out.items() if v}
+
+
+def _shifted(p: Harmonics, quarters: int) -> Harmonics:
+    """``p(t + quarters·π/2)``: ``cos k(t+t₀) = cos kt cos kt₀ − sin kt sin kt₀`` and sine."""
+    out = {}
+    for k, (a, b) in p.items():
+        c, s = QUARTER[(k * quarters) % 4]
+        out[k] = (a * c + b * s, b * c - a * s)
+    return out
+
+
+def _rational_sqrt(x: Fraction) -> Fraction | None:
+    if x < 0:
+        return None
+    num, den = math.isqrt(x.numerator), math.isqrt(x.denominator)
+    return Fraction(num, den) if num * num == x.numerator and den * den == x.denominator \
+        else None
+
+
+def _dot(f: Modes, u: Modes) -> Fraction:
+    return sum(c * f.get(key, 0) for key, c in u.items())
+
+
+def transition_curves(p: Harmonics | str, n: int, order: int) -> Tongue:
+    """Both transition curves out of the tongue ``δ = n²/4`` of ``ẍ + (δ + ε p(t))x = 0`` (one
+    for n = 0) to ``ε^order``, exact, by L–P in ``τ = t/2``: ``x'' + (α + εP(τ))x = 0`` with
+    ``α = 4δ = n² + Σ α_k ε^k``, ``P = 4p(2τ)``, ``x = Σ ε^k x_k``.  Order k reads
+    ``x_k'' + n² x_k = −P x_(k−1) − Σ_(i=1..k) α_i x_(k−i)``: its right side must hold no
+    ``x₀`` (that gives α_k) and no ``w``, the other solution of period 2π of ``x'' + n²x = 0``
+    (that gives the w-part β_(k−1) of x_(k−1): degenerate perturbation theory, divided by the
+    first-order split of the two curves).  ``x₀``, ``w``: ``cos nτ``, ``sin nτ`` when p is
+    even (about t = 0 or, after a shift, about t = π/2: the two never mix); otherwise the
+    eigenvectors of the first-order 2 × 2 problem, where the split is a rational number.
+    Refused (one line) where neither holds: the split is irrational or comes only at a
+    higher order."""
+    if isinstance(p, str):
+        p = fourier_of_text(p)
+    if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= MAX_M:
+        raise InputError(f"--n {n!r}: the tongue index, an integer 0..{MAX_M} (δ = n²/4)")
+    order = check_order(order)
+    shift = next((s for s in (0, 1) if all(b == 0 for _, b in _shifted(p, s).values())), None)
+    q = _shifted(p, shift or 0)
+    P: Modes = {}
+    for k, (a, b) in q.items():
+        for kind, c in ((0, a), (1, b)):
+            if c and (kind, 2 * k) != (1, 0):
+                P[(kind, 2 * k)] = 4 * c
+    if n == 0:
+        bases = [({(0, 0): Fraction(1)}, {}, "1")]
+    else:
+        cos_n, sin_n = {(0, n): Fraction(1)}, {(1, n): Fraction(1)}
+        half = {1: "t/2", 2: "t"}.get(n, f"{n}*t/2" if n % 2 else f"{n // 2}*t")
+        if shift is not None:
+            bases = [(cos_n, sin_n, f"cos({half})"), (sin_n, cos_n, f"sin({half})")]
+        else:
+            A = _dot(_product(P, cos_n), cos_n)
+            B = _dot(_product(P, sin_n), cos_n)
+            D = _dot(_product(P, sin_n), sin_n)
+            root = _rational_sqrt(((A - D) / 2) ** 2 + B * B)
+            if not root:
+                why = ("the first-order split is irrational (sqrt of "
+                       f"{((A - D) / 2) ** 2 + B * B})" if root is None else
+                       f"p has no harmonic {n} (the curves split only at a higher order)")
+                raise InputError(f"p(t): tongue n = {n}: p is even about no quarter period "
+                                 f"and {why}; the curves do not split over the rationals")
+            bases = []
+            for sign, name in ((1, "lower"), (-1, "upper")):  # δ₁ = −λ/4
+                lam = (A + D) / 2 + sign * root  # eigenvalue of the kernel block of P
+                u, v = (B, lam - A) if B else ((1, 0) if lam == A else (0, 1))
+                x0 = {key: Fraction(c) for key, c in (((0, n), u), ((1, n), v)) if c}
+                w = {key: Fraction(c) for key, c in (((0, n), -v), ((1, n), u)) if c}
+                bases.append((x0, w, f"{name} ({u}*cos({half}) + {v}*sin({half}))"))
+    curves = tuple(_curve(P, n, x0, w, label, order) for x0, w, label in bases)
+    return Tongue(n, dict(p), shift or 0, curves)
+
+
+def _curve(P: Modes, n: int, x0: Modes, w: Modes, label: str, order: int) -> TransitionCurve:
+    """One curve of :func:`transition_curves` about ``x₀`` (``w``: the other kernel
+    direction, empty for n = 0)."""
+    kernel = {(0, n), (1, n)}
+    # NOTE: FLINT's fmpq inside the loop (7× faster than Fraction at order 100)
+    P = {key: fmpq(c.numerator, c.denominator) for key, c in P.items()}
+    x0 = {key: fmpq(c.numerator, c.denominator) for key, c in x0.items()}
+    w = {key: fmpq(c.numerator, c.denominator) for key, c in w.items()}
+    norm0, normw = _dot(x0, x0), _dot(w, w)
+    gap = (_dot(_product(P, w), w) / normw - _dot(_product(P, x0), x0) / norm0) if w \
+        else fmpq(0)
+    xs: list[Modes] = [dict(x0)]
+    alphas = [fmpq(n * n)]
+    for k in range(1, order + 1):
+        rhs = _product(P, xs[k - 1])
+        for i in range(1, k):
+            if alphas[i]:  # (half of them vanish where p is even)
+                a = alphas[i]
+                for key, c in xs[k - i].items():
+                    rhs[key] = rhs.get(key, 0) + a * c
+        rhs = {key: -c for key, c in rhs.items() if c}
+        if w and k > 1:  # the w-part of x_(k−1): this order's right side holds no w
+            along = _dot(rhs, w)
+            if along and not gap:
+                raise InputError(f"p(t): tongue n = {n}: the two curves split only at order "
+                                 f"{k}; not handled")
+            beta = along / (gap * normw) if along else fmpq(0)
+            if beta:
+                # adding βw to x_(k−1) adds −β(P + α₁)w here (and β w to the solution)
+                for key, c in w.items():
+                    xs[k - 1][key] = xs[k - 1].get(key, fmpq(0)) + beta * c
+                extra = _product(P, {key: beta * c for key, c in w.items()})
+                for key, c in extra.items():
+                    rhs[key] = rhs.get(key, fmpq(0)) - c
+                for key, c in w.items():
+                    rhs[key] = rhs.get(key, fmpq(0)) - alphas[1] * beta * c
+        alpha = _dot(rhs, x0) / norm0  # the secular condition along x₀
+        alphas.append(alpha)
+        xs.append({key: c / (n * n - key[1] ** 2) for key, c in rhs.items()
+                   if key not in kernel and c})
+    return TransitionCurve(label, tuple(_fraction(a / 4) for a in alphas),
+                           tuple({key: _fraction(c) for key, c in sorted(x.items())} for x in xs))
+
+
+def _fraction(x: fmpq) -> Fraction:
+    return Fraction(int(x.p), int(x.q))
