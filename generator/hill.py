@@ -15,8 +15,9 @@ import math
 from dataclasses import dataclass
 from fractions import Fraction
 
+import flint
 import sympy as sp
-from flint import fmpq
+from flint import fmpq, fmpq_series
 
 from .equation import TIME, parse_expression
 from .errors import InputError
@@ -288,3 +289,128 @@ def _curve(P: Modes, n: int, x0: Modes, w: Modes, label: str, order: int) -> Tra
 
 def _fraction(x: fmpq) -> Fraction:
     return Fraction(int(x.p), int(x.q))
+
+
+@dataclass(frozen=True)
+class TongueTip:
+    """The lowest point of tongue ``n`` of the damped ``ẍ + 2ζẋ + (δ + ε p(t))x = 0``:
+    ``ε_min(ζ) = Σ eps_min[k] ζ^k`` at ``δ = Σ delta[k] ζ^k``; and on the way the largest
+    Floquet exponent of the undamped equation inside the tongue, ``μ_max(ε) = Σ mu[k] ε^k``."""
+
+    n: int
+    eps_min: tuple[Fraction, ...]
+    delta: tuple[Fraction, ...]
+    mu: tuple[Fraction, ...]
+
+
+def _derivative(f: Modes) -> Modes:
+    """d/dτ: ``cos jτ → −j sin jτ``, ``sin jτ → j cos jτ``."""
+    return {(1 - kind, j): (-j * c if kind == 0 else j * c) for (kind, j), c in f.items() if j}
+
+
+def _reflection(f: Modes, g: Modes) -> fmpq:
+    """``(1/π)∫₀^2π f(τ) g(−τ) dτ`` from the coefficients (cosines +, sines −, the mean 2×)."""
+    return sum(((2 if j == 0 else 1) * (1 if kind == 0 else -1)) * c * g.get((kind, j), 0)
+               for (kind, j), c in f.items())
+
+
+def tongue_tip(p: Harmonics | str, n: int, order: int) -> TongueTip:
+    """The tip of tongue ``n ≥ 1`` under damping, exact, for ``p`` even (about t = 0 or a
+    quarter period) with a harmonic ``n`` (the tongue opens at first order in ε).
+
+    ``x = e^(−ζt) y`` turns ``ẍ + 2ζẋ + (δ + εp)x = 0`` into ``ÿ + (δ − ζ² + εp)y = 0``: x is
+    stable where y's Floquet exponent μ < ζ, so the tongue's lowest ε is where ``μ_max(ε) =
+    max_δ μ = ζ``, at ``δ = δ* + ζ²``.  In ``τ = t/2`` the Floquet form ``y = e^(μ̃τ)φ(τ)``
+    (``μ̃ = 2μ``, φ of period 2π) reads ``φ'' + 2μ̃φ' + (μ̃² + α + εP)φ = 0``; the maximum over
+    α holds where ``∫φ(τ)φ(−τ)dτ = 0`` (``y(−τ)`` is the other Floquet solution; ``∂μ/∂α`` is
+    that integral over their Wronskian).  L–P in ε with ``α = n² + Σσ_kε^k``, ``μ̃ = Σ m_kε^k``:
+    order k's two secular conditions give ``σ_k, m_k``; the integral condition fixes the
+    ``w``-part of ``φ_(k−1)``.  Then ``ε_min(ζ)`` is the reversion of ``ζ = μ̃(ε)/2``."""
+    if isinstance(p, str):
+        p = fourier_of_text(p)
+    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_M:
+        raise InputError(f"--n {n!r}: the damped tongue's index, an integer 1..{MAX_M}")
+    order = check_order(order)
+    shift = next((s for s in (0, 1) if all(b == 0 for _, b in _shifted(p, s).values())), None)
+    if shift is None:
+        raise InputError("--damping: p(t) must be even about t = 0 or a quarter period (then "
+                         "the damped tongue's tip is an exact series)")
+    q = _shifted(p, shift)
+    if not q.get(n, (0, 0))[0]:
+        raise InputError(f"--damping: p(t) has no harmonic {n}: tongue n = {n} opens only at "
+                         "a higher order in ε (its tip under damping is not handled)")
+    P = {(0, 2 * k): fmpq(4 * a.numerator, a.denominator) for k, (a, _) in q.items() if a}
+    kernel = {(0, n), (1, n)}
+
+    def solve(rhs: Modes, phi0: Modes, dphi0: Modes) -> tuple[fmpq, fmpq]:
+        """σ, m with the kernel part of ``rhs − σφ₀ − 2m φ₀'`` zero (Cramer)."""
+        r = [rhs.get(key, fmpq(0)) for key in sorted(kernel)]
+        a = [phi0.get(key, fmpq(0)) for key in sorted(kernel)]
+        b = [2 * dphi0.get(key, fmpq(0)) for key in sorted(kernel)]
+        det = a[0] * b[1] - a[1] * b[0]
+        return (r[0] * b[1] - r[1] * b[0]) / det, (a[0] * r[1] - a[1] * r[0]) / det
+
+    for s in (1, -1):  # φ₀ = cos nτ − s sin nτ: the max condition at order 0, μ̃₁ > 0
+        phi0 = {(0, n): fmpq(1), (1, n): fmpq(-s)}
+        w = {(0, n): fmpq(s), (1, n): fmpq(1)}
+        dphi0 = _derivative(phi0)
+        sigma1, m1 = solve({key: -c for key, c in _product(P, phi0).items()}, phi0, dphi0)
+        if m1 > 0:
+            break
+    phis, sigmas, ms = [phi0], [fmpq(0), sigma1], [fmpq(0), m1]
+    wgap = 2 * _reflection(phi0, w)
+    dphis = [dphi0]
+    for k in range(1, order + 1):
+        if k > 1:  # the w-part of φ_(k−1) from the integral condition at order k − 1
+            known = sum((_reflection(phis[i], phis[k - 1 - i]) for i in range(1, k - 1)),
+                        fmpq(0))
+            gamma = -known / wgap
+            if gamma:
+                for key, c in w.items():
+                    phis[k - 1][key] = phis[k - 1].get(key, 0) + gamma * c
+                dphis[k - 1] = _derivative(phis[k - 1])
+        rhs: Modes = {key: -c for key, c in _product(P, phis[k - 1]).items()}
+        for i in range(1, k):
+            for coeff, fs in ((sigmas[i], phis[k - i]), (2 * ms[i], dphis[k - i])):
+                if coeff:
+                    for key, c in fs.items():
+                        rhs[key] = rhs.get(key, 0) - coeff * c
+        for i in range(1, k):
+            for j in range(1, k - i + 1):
+                coeff = ms[i] * ms[j]
+                if coeff:
+                    for key, c in phis[k - i - j].items():
+                        rhs[key] = rhs.get(key, 0) - coeff * c
+        if k > 1:
+            sigma, m = solve(rhs, phi0, dphi0)
+            sigmas.append(sigma)
+            ms.append(m)
+            for key, c in phi0.items():
+                rhs[key] = rhs.get(key, 0) - sigma * c
+            for key, c in dphi0.items():
+                rhs[key] = rhs.get(key, 0) - 2 * m * c
+        else:
+            for key, c in phi0.items():
+                rhs[key] = rhs.get(key, 0) - sigma1 * c
+            for key, c in dphi0.items():
+                rhs[key] = rhs.get(key, 0) - 2 * m1 * c
+        phi = {key: c / (n * n - key[1] ** 2) for key, c in rhs.items()
+               if key not in kernel and c}
+        phis.append(phi)
+        dphis.append(_derivative(phi))
+    prec = order + 1
+    cap, flint.ctx.cap = flint.ctx.cap, prec  # FLINT's series keep ctx.cap terms
+    try:
+        zeta = fmpq_series([m / 2 for m in ms], prec=prec)  # ζ = μ_max(ε) = μ̃/2
+        eps_min = zeta.reversion()
+        alpha = fmpq_series([fmpq(0), *sigmas[1:]], prec=prec)  # α − n²
+        z = fmpq_series([0, 1], prec=prec)
+        tip = (alpha(eps_min) / 4 + z * z).coeffs()
+        eps = eps_min.coeffs()
+    finally:
+        flint.ctx.cap = cap
+    tip = [fmpq(n * n, 4) + (tip[0] if tip else 0)] + [
+        tip[i] if i < len(tip) else fmpq(0) for i in range(1, prec)]
+    eps = [eps[i] if i < len(eps) else fmpq(0) for i in range(prec)]
+    return TongueTip(n, tuple(map(_fraction, eps)), tuple(map(_fraction, tip)),
+                     tuple(_fraction(m / 2) for m in ms))
