@@ -354,6 +354,21 @@ def mathieu_cost(args: argparse.Namespace) -> Cost:
                 "the Mathieu series")
 
 
+TONGUES_FIT = (0.5, 1.0, 100, 3.0)
+# NOTE: `lindstedt tongues`: both curves of p = cos t at order 100 in 1.0 s; the harmonics of
+# x_k grow with p's highest harmonic h, the cost as h^2.5 (7.7 s for h = 2 at order 100).
+
+
+def tongues_cost(args: argparse.Namespace) -> Cost:
+    from .hill import fourier_of_text
+
+    top = max(fourier_of_text(args.p))
+    seconds = power_law(*TONGUES_FIT, args.order) * top**2.5
+    if args.damping is not None:
+        seconds *= 2
+    return Cost(seconds, f"order {args.order}, harmonic {top}", "the transition curves")
+
+
 COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "series": series_cost,
     "generate": generate_cost,
@@ -367,6 +382,7 @@ COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "scene": fixed_cost("scene"),
     "models": fixed_cost("models"),
     "mathieu": mathieu_cost,
+    "tongues": tongues_cost,
 }
 # NOTE: one estimator per command; `demo` has none: its work is the fixed built-in job
 # (`make demo`), which nothing on its command line scales.
