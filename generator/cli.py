@@ -284,11 +284,19 @@ def _radius(coefficients) -> float:
     return math.sqrt(est.radius) if est.variable == "x**2" else est.radius
 
 
+DAMPING_PANEL = 0.05
+# NOTE: the damped panel of `tongues --plot` without --damping: the tongues visibly lift.
+
+
 def _cmd_tongues(args: argparse.Namespace) -> int:
     """``lindstedt tongues P --n N --order K``: the transition curves out of tongue n of
     x'' + (δ + ε p(t))x = 0, exact; ``--damping Z``: the damped tongue's tip."""
     from .hill import fourier_of_text, tongue_tip, transition_curves
 
+    if args.plot:
+        from .charts import check_plot_path
+
+        check_plot_path(Path(args.plot))  # before any work
     p = fourier_of_text(args.p)
     tongue = transition_curves(p, args.n, args.order)
     period = "2*pi" if args.n % 2 == 0 else "4*pi"
@@ -343,6 +351,13 @@ def _cmd_tongues(args: argparse.Namespace) -> int:
                   for k, (e, d) in enumerate(zip(tip.eps_min, tip.delta, strict=True))]
         lines.append(f"at zeta = {args.damping:g}: eps_min = {eps:.12g}, delta = {delta:.12g}")
     print(json.dumps(data) if args.json else "\n".join(lines))
+    if args.plot:
+        from .charts import ince_strutt_figure
+
+        path = ince_strutt_figure(Path(args.plot), args.p, args.damping or DAMPING_PANEL,
+                                  order=args.order, tongues=range(max(4, args.n + 1)))
+        if not args.json:
+            print(f"Ince–Strutt chart: {path}")
     return 0
 
 
@@ -483,6 +498,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     # (benchmarks/*speed_accuracy.py refresh the committed copies the README shows).
     print(f"  {speed_accuracy_figure(figures / 'speed_accuracy.png')}")
     print(f"  {driven_speed_accuracy_figure(figures / 'driven_speed_accuracy.png')}")
+    from .charts import ince_strutt_figure  # Hill's equation: Floquet grid and series curves
+
+    print(f"  {ince_strutt_figure(figures / 'ince_strutt.png')}")
     if shutil.which("pdflatex"):
         for tex in sorted(out.glob("*.tex")):
             for _ in range(2):  # longtable settles its column widths on the second pass
@@ -1612,6 +1630,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--singularities", action="store_true",
                    help="also estimate each curve's nearest singularity in eps (radius of "
                    "convergence) with its spread")
+    p.add_argument("--plot", metavar="FILE",
+                   help="also draw the Ince–Strutt chart of this p into FILE (.png, .svg or "
+                   ".pdf): Floquet multipliers on a 400 x 400 grid, undamped and with damping "
+                   f"Z (default {DAMPING_PANEL}), the series curves of tongues 0..max(3, N)")
     _flag_json(p, "the curves as JSON {p, n, variable, delta0, harmonics, time_origin, period, "
                "solution_variable, curves: [{label, series, solution}], damping}")
     _flag_allow_slow(p, deprecated_force=False)

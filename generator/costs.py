@@ -354,6 +354,8 @@ def mathieu_cost(args: argparse.Namespace) -> Cost:
                 "the Mathieu series")
 
 
+INCE_STRUTT_SECONDS = 20.0
+# NOTE: `tongues --plot`: two 400 × 400 Floquet grids (~5 s each, 2 cores) and the curves.
 TONGUES_FIT = (0.5, 1.0, 100, 3.0)
 # NOTE: `lindstedt tongues`: both curves of p = cos t at order 100 in 1.0 s; the harmonics of
 # x_k grow with p's highest harmonic h, the cost as h^2.5 (7.7 s for h = 2 at order 100).
@@ -366,6 +368,8 @@ def tongues_cost(args: argparse.Namespace) -> Cost:
     seconds = power_law(*TONGUES_FIT, args.order) * top**2.5
     if args.damping is not None:
         seconds *= 2
+    if args.plot:
+        seconds += INCE_STRUTT_SECONDS
     return Cost(seconds, f"order {args.order}, harmonic {top}", "the transition curves")
 
 
