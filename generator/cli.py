@@ -10,6 +10,7 @@ import re
 import sys
 import time
 from collections.abc import Sequence
+from fractions import Fraction
 from pathlib import Path
 
 from . import __version__
@@ -301,12 +302,13 @@ def _cmd_tongues(args: argparse.Namespace) -> int:
     tongue = transition_curves(p, args.n, args.order)
     period = "2*pi" if args.n % 2 == 0 else "4*pi"
     data: dict = {
-        "p": args.p, "n": args.n, "variable": "eps", "delta0": f"{args.n * args.n}/4",
+        "p": args.p, "n": args.n, "variable": "eps",
+        "delta0": _fraction_text(Fraction(args.n * args.n, 4)),
         "harmonics": {str(k): [_fraction_text(a), _fraction_text(b)] for k, (a, b) in p.items()},
         "time_origin": "pi/2" if tongue.shift else "0", "period": period,
         "solution_variable": "tau = (t - time_origin)/2", "curves": []}
     lines = [f"tongue n = {args.n} of x'' + (delta + eps p(t)) x = 0, p(t) = {args.p}: "
-             f"delta = {args.n * args.n}/4 + sum_k delta_k eps^k, order {args.order}; "
+             f"delta = {data['delta0']} + sum_k delta_k eps^k, order {args.order}; "
              f"periodic solutions of period {period}"
              + (" (in t - pi/2: p is even about t = pi/2)" if tongue.shift else "")]
     for curve in tongue.curves:

@@ -236,9 +236,14 @@ def transition_curves(p: Harmonics | str, n: int, order: int) -> Tongue:
             for sign, name in ((1, "lower"), (-1, "upper")):  # δ₁ = −λ/4
                 lam = (A + D) / 2 + sign * root  # eigenvalue of the kernel block of P
                 u, v = (B, lam - A) if B else ((1, 0) if lam == A else (0, 1))
+                scale = math.lcm(Fraction(u).denominator, Fraction(v).denominator)
+                u, v = int(u * scale), int(v * scale)  # the smallest integer eigenvector
+                g = math.gcd(u, v)
+                u, v = u // g, v // g
                 x0 = {key: Fraction(c) for key, c in (((0, n), u), ((1, n), v)) if c}
                 w = {key: Fraction(c) for key, c in (((0, n), -v), ((1, n), u)) if c}
-                bases.append((x0, w, f"{name} ({u}*cos({half}) + {v}*sin({half}))"))
+                bases.append((x0, w, f"{name} ({u}*cos({half}) {'-' if v < 0 else '+'} "
+                                     f"{abs(v)}*sin({half}))"))
     curves = tuple(_curve(P, n, x0, w, label, order) for x0, w, label in bases)
     return Tongue(n, dict(p), shift or 0, curves)
 

@@ -164,9 +164,11 @@ def test_the_cli_json():
                           "--n", "2", "--order", "6", "--json", "--at", "0.1"],
                          capture_output=True, text=True, check=True)
     data = json.loads(out.stdout)
-    assert data["variable"] == "eps" and data["delta0"] == "4/4" and data["period"] == "2*pi"
+    assert data["variable"] == "eps" and data["delta0"] == "1/1" and data["period"] == "2*pi"
     assert len(data["curves"]) == 2 and all(len(c["series"]) == 7 for c in data["curves"])
     assert data["curves"][0]["series"][0] == "1/1"
+    assert [c["label"] for c in data["curves"]] == ["lower (1*cos(t) + 1*sin(t))",
+                                                    "upper (1*cos(t) - 1*sin(t))"]
     assert data["curves"][0]["solution"][0] and "at" in data["curves"][0]
 
 
