@@ -192,3 +192,13 @@ def test_the_tolerance_refusal_names_the_best_reachable(capsys):
     assert "best reachable" in capsys.readouterr().err
     with pytest.raises(InputError, match="not periodic"):
         transition_curves("cos(sqrt(2)*t)", 1, 4)
+
+
+def test_the_chart_is_reproducible(tmp_path):
+    from lindstedt.charts import ince_strutt_figure
+
+    first = ince_strutt_figure(tmp_path / "a.png", grid=40, order=12).read_bytes()
+    again = ince_strutt_figure(tmp_path / "a.png", grid=40, order=12).read_bytes()
+    assert first == again and first.startswith(b"\x89PNG")
+    with pytest.raises(InputError):
+        ince_strutt_figure(tmp_path / "a.txt", grid=40)
