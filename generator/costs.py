@@ -356,9 +356,9 @@ def mathieu_cost(args: argparse.Namespace) -> Cost:
 
 INCE_STRUTT_SECONDS = 20.0
 # NOTE: `tongues --plot`: two 400 × 400 Floquet grids (~5 s each, 2 cores) and the curves.
-TONGUES_FIT = (0.5, 1.0, 100, 3.0)
-# NOTE: `lindstedt tongues`: both curves of p = cos t at order 100 in 1.0 s; the harmonics of
-# x_k grow with p's highest harmonic h, the cost as h^2.5 (7.7 s for h = 2 at order 100).
+TONGUES_FIT = (0.5, 0.4, 100, 3.0)
+# NOTE: `lindstedt tongues`: both curves of p = cos t at order 100 in 0.35 s; the harmonics of
+# x_k grow with p's highest harmonic h, the cost as h^2.5 (2.2 s for h = 2 at order 100).
 
 
 def tongues_cost(args: argparse.Namespace) -> Cost:

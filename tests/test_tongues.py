@@ -29,17 +29,32 @@ def harmonics(text: str) -> dict[int, tuple[float, float]]:
     return {k: (float(a), float(b)) for k, (a, b) in fourier_of_text(text).items()}
 
 
-@pytest.mark.parametrize("n", range(6))
+DLMF_28_6 = {  # 28.6.1–28.6.5: coefficients of q^0 … q^8 (a_1, b_1 to q^6)
+    ("a", 0): [0, 0, F(-1, 2), 0, F(7, 128), 0, F(-29, 2304), 0, F(68687, 18874368)],
+    ("a", 1): [1, 1, F(-1, 8), F(-1, 64), F(-1, 1536), F(11, 36864), F(49, 589824)],
+    ("b", 1): [1, -1, F(-1, 8), F(1, 64), F(-1, 1536), F(-11, 36864), F(49, 589824)],
+    ("a", 2): [4, 0, F(5, 12), 0, F(-763, 13824), 0, F(1002401, 79626240), 0,
+               F(-1669068401, 458647142400)],
+    ("b", 2): [4, 0, F(-1, 12), 0, F(5, 13824), 0, F(-289, 79626240), 0,
+               F(21391, 458647142400)],
+}
+
+
+@pytest.mark.parametrize("n", range(3))
 def test_mathieu_is_the_named_case(n):
-    """p = cos t: δ = a/4 with q = −2ε (y'' + (a − 2q cos 2z)y = 0 with z = t/2)."""
-    tongue = transition_curves("cos(t)", n, 24)
+    """p = cos t: δ = a/4 with q = −2ε (y'' + (a − 2q cos 2z)y = 0 with z = t/2): the cos
+    curve is a_n, the sin curve b_n, coefficient by coefficient against DLMF 28.6."""
+    tongue = transition_curves("cos(t)", n, 8)
     kinds = ["a"] if n == 0 else ["a", "b"]
     assert len(tongue.curves) == len(kinds)
     for kind, curve in zip(kinds, tongue.curves, strict=True):
-        expected = [c * (-2) ** k / 4 for k, c in enumerate(mathieu_series(kind, n, 24))]
-        assert list(curve.delta) == expected, (kind, n)
-    if n == 1:  # DLMF 28.6.2 directly: a_1(q) = 1 + q − q²/8 − q³/64 …, q = −2ε
-        assert tongue.curves[0].delta[:4] == (F(1, 4), F(-1, 2), F(-1, 8), F(1, 32))
+        expected = DLMF_28_6[(kind, n)]
+        assert [4 * d * F(-1, 2) ** k for k, d in enumerate(curve.delta)][:len(expected)] \
+            == expected, (kind, n)
+    for m in range(6):  # and mathieu_series is this named case
+        assert mathieu_series("a", m, 10) == [4 * d * F(-1, 2) ** k for k, d in
+                                              enumerate(transition_curves("cos(t)", m, 10)
+                                                        .curves[0].delta)]
 
 
 def hill_matrix_values(text: str, n: int, eps: float, size: int = 21) -> list[mp.mpf]:
