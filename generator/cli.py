@@ -294,6 +294,8 @@ def _cmd_tongues(args: argparse.Namespace) -> int:
     x'' + (δ + ε p(t))x = 0, exact; ``--damping Z``: the damped tongue's tip."""
     from .hill import fourier_of_text, tongue_tip, transition_curves
 
+    if args.tol is not None and args.at is None:
+        raise InputError("--tol: give --at EPS, the eps the tolerance is asked at")
     if args.plot:
         from .charts import check_plot_path
 

@@ -338,7 +338,8 @@ def tongue_tip(p: Harmonics | str, n: int, order: int) -> TongueTip:
         p = fourier_of_text(p)
     if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_M:
         raise InputError(f"--n {n!r}: the damped tongue's index, an integer 1..{MAX_M}")
-    order = check_order(order)
+    wanted = check_order(order)
+    order = max(wanted, 1)  # ζ = μ̃(ε)/2 starts at ε¹: its reversion needs that term
     shift = next((s for s in (0, 1) if all(b == 0 for _, b in _shifted(p, s).values())), None)
     if shift is None:
         raise InputError("--damping: p(t) must be even about t = 0 or a quarter period (then "
@@ -420,5 +421,6 @@ def tongue_tip(p: Harmonics | str, n: int, order: int) -> TongueTip:
     tip = [fmpq(n * n, 4) + (tip[0] if tip else 0)] + [
         tip[i] if i < len(tip) else fmpq(0) for i in range(1, prec)]
     eps = [eps[i] if i < len(eps) else fmpq(0) for i in range(prec)]
-    return TongueTip(n, tuple(map(_fraction, eps)), tuple(map(_fraction, tip)),
-                     tuple(_fraction(m / 2) for m in ms))
+    return TongueTip(n, tuple(map(_fraction, eps[:wanted + 1])),
+                     tuple(map(_fraction, tip[:wanted + 1])),
+                     tuple(_fraction(m / 2) for m in ms[:wanted + 1]))

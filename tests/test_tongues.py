@@ -137,6 +137,7 @@ def test_the_damped_tongue_tip_against_floquet():
     multiplier outside the unit circle (RK4 monodromy, minimised over δ, bisected in ε)."""
     tip = tongue_tip("cos(t)", 1, 12)
     assert tip.eps_min[:4] == (0, 2, 0, F(3, 2))  # ε_min = 2ζ + 3ζ³/2 + …
+    assert tongue_tip("cos(t)", 1, 0).eps_min == (0,) and len(tip.delta) == 13
     p = {1: (1.0, 0.0)}
     zeta = 0.05
     bound = 1 + math.exp(-4 * math.pi * zeta)
@@ -194,6 +195,7 @@ def test_the_cli_json():
     ["cos(t)", "--order", "20", "--at", "1.5", "--tol", "1e-30"],
     ["cos(t) + sin(t)", "--n", "1"], ["cos(t) + sin(2*t)", "--n", "3"],
     ["cos(t)", "--n", "2", "--damping", "0.1"], ["cos(t)", "--n", "0", "--damping", "0.1"],
+    ["cos(t)", "--tol", "1e-3"], ["cos(t)", "--plot", "chart.txt"],
 ])
 def test_bad_input_is_one_line_and_exit_2(args):
     done = subprocess.run([sys.executable, "-m", "lindstedt", "tongues", *args],
