@@ -78,7 +78,7 @@ def main() -> None:
           f"{'rel. diff':>10} {'spread':>9}")
     for (kind, m), rho in TABLE_28_6_1.items():
         for order in (100, 150):
-            est = nearest_singularity(mathieu_series(kind, m, order), "q")
+            est = nearest_singularity(mathieu_series(kind, m, order), "q", None)
             radius = math.sqrt(est.radius) if est.variable == "q**2" else est.radius
             print(f"{kind}_{m:<4} {order:>5} {est.variable:>8} {radius:>12.8f} {rho:>13.10f} "
                   f"{radius / rho - 1:>10.2e} {est.spread:>9.1e}")

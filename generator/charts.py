@@ -506,7 +506,7 @@ def ince_strutt_figure(path: Path, p: str = "cos(t)", zeta: float = 0.05, grid: 
                    linewidths=0.6)
         for curve in curves:
             values = sum(float(c) * eps_line**k for k, c in enumerate(curve.delta))
-            est = nearest_singularity(list(curve.delta), "eps")
+            est = nearest_singularity(list(curve.delta), "eps", None)
             radius = np.inf if est is None else (
                 np.sqrt(est.radius) if est.variable == "eps**2" else est.radius)
             if z:  # with damping the undamped curves only for reference
@@ -531,7 +531,7 @@ def ince_strutt_figure(path: Path, p: str = "cos(t)", zeta: float = 0.05, grid: 
                     tip = tongue_tip(harmonics, n, order)
                 except InputError:
                     continue  # no first-order tongue (or p not even): no tip series
-                est = nearest_singularity(list(tip.eps_min), "zeta")
+                est = nearest_singularity(list(tip.eps_min), "zeta", None)
                 if est is not None and abs(z) >= 0.5 * (
                         np.sqrt(est.radius) if est.variable == "zeta**2" else est.radius):
                     continue  # not within half the estimated radius: no trustworthy tip

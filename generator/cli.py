@@ -216,16 +216,17 @@ def _cmd_series(args: argparse.Namespace) -> int:
     return 0
 
 
-def _singularities(omega, variable: str, of: str = "omega") -> tuple[list[dict], str]:
+def _singularities(omega, variable: str, of: str = "omega", degree: int | None = 1
+                   ) -> tuple[list[dict], str]:
     """``--singularities``: the nearest singularity of ω (or of the series ``of``) estimated
-    from its exact series."""
+    from its exact series (``degree``: of :func:`lindstedt.nearest_singularity`)."""
     from .lindstedt import nearest_singularity
 
     if omega is None:
         raise InputError("--singularities: the coefficients stay symbolic; give every "
                          "parameter a value (--param)")
     name = variable.partition("=")[0].strip() or variable
-    est = nearest_singularity(omega, name)
+    est = nearest_singularity(omega, name, degree)
     if est is None:
         return [], "singularities: too few nonzero coefficients for an estimate (raise --order)"
     row = {"variable": est.variable, "radius": est.radius, "angle": est.angle,
@@ -243,7 +244,7 @@ def _cmd_mathieu(args: argparse.Namespace) -> int:
             "series": [_fraction_text(c) for c in series]}
     line = ""
     if args.singularities:  # a_2n, b_2n live in q²: the estimate names q**2
-        data["singularities"], line = _singularities(series, "q", f"{args.kind}_{args.m}")
+        data["singularities"], line = _singularities(series, "q", f"{args.kind}_{args.m}", None)
         if data["singularities"] and data["singularities"][0]["variable"] == "q**2":
             row = data["singularities"][0]
             line += f" (|q| = {math.sqrt(row['radius']):.6g})"
@@ -279,7 +280,7 @@ def _radius(coefficients) -> float:
     """The estimated radius of convergence in the series' own variable (inf if too short)."""
     from .lindstedt import nearest_singularity
 
-    est = nearest_singularity(coefficients, "x")
+    est = nearest_singularity(coefficients, "x", None)
     if est is None:
         return math.inf
     return math.sqrt(est.radius) if est.variable == "x**2" else est.radius
@@ -323,7 +324,7 @@ def _cmd_tongues(args: argparse.Namespace) -> int:
         lines += [f"{k:>4}  {_fraction_text(c)}" for k, c in enumerate(curve.delta)]
         if args.singularities:
             row["singularities"], line = _singularities(list(curve.delta), "eps",
-                                                        f"delta ({curve.label})")
+                                                        f"delta ({curve.label})", None)
             lines.append(line)
         if args.at is not None:
             value, error, best = _series_value(curve.delta, args.at)
