@@ -829,17 +829,23 @@ def nearest_singularity(coefficients: Sequence[Fraction], variable: str = "eps",
             sxx = sum((a - mx) ** 2 for a in x)
             slope = sum((a - mx) * (b - my) for a, b in zip(x, y, strict=True)) / sxx
             return float(my - slope * mx)
-        A = mpmath.matrix([[a**d for d in range(degree + 1)] for a in x])
-        return float(mpmath.lu_solve(A.T * A, A.T * mpmath.matrix(y))[0])  # least squares
+        with mpmath.workdps(50):  # least squares in x·n_lo ∈ (0, 1]: well conditioned
+            A = mpmath.matrix([[(a * ns[lo]) ** d for d in range(degree + 1)] for a in x])
+            return float(mpmath.lu_solve(A.T * A, A.T * mpmath.matrix(y))[0])
 
     half = len(ns) // 2
     degrees = [degree] if degree is not None else [
         d for d in (1, 2, 3) if len(ns) - half >= d + 2]
     best = None
     for d in degrees:
-        fits = [extrapolate(radii, lo, d) for lo in range(0, half + 1)]
+        try:
+            fits = [extrapolate(radii, lo, d) for lo in range(0, half + 1)]
+        except ZeroDivisionError:  # too few distinct orders for this degree
+            continue
         if best is None or max(fits) - min(fits) < best[1]:
             best = (d, max(fits) - min(fits), fits)
+    if best is None:
+        return None
     chosen, spread, fits = best
     angle_fits = [extrapolate(angles, lo, chosen) for lo in range(0, half + 1)]
     radius, angle = fits[-1], angle_fits[-1] if not real else angles[-1]
