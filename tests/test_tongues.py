@@ -219,3 +219,13 @@ def test_the_chart_is_reproducible(tmp_path):
     assert first == again and first.startswith(b"\x89PNG")
     with pytest.raises(InputError):
         ince_strutt_figure(tmp_path / "a.txt", grid=40)
+
+
+def test_the_curves_radius_is_mathieus(capsys):
+    """Tongue 1 of p = cos t is a_1, b_1 at q = −2ε: its radius in ε is ρ⁽³⁾₀/2 (DLMF Table
+    28.6.1: 3.7699574940), within 0.1 % from order 100."""
+    assert main(["tongues", "cos(t)", "--n", "1", "--order", "100", "--singularities",
+                 "--json"]) == 0
+    for curve in json.loads(capsys.readouterr().out)["curves"]:
+        (row,) = curve["singularities"]
+        assert row["variable"] == "eps" and abs(row["radius"] / (3.7699574940 / 2) - 1) < 1e-3
