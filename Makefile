@@ -38,11 +38,15 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/speed_accuracy.py
 	$(BIN)/python benchmarks/q_speed_accuracy.py
 	$(BIN)/python benchmarks/driven_speed_accuracy.py
+	$(BIN)/python benchmarks/slow_flow.py
 
 # The committed copies: docs/figures (the README's computed figures, byte-identical run to run)
 # and generated/ (the default evaluators and LaTeX).
 figures: $(STAMP)
 	$(BIN)/python -c "from lindstedt.charts import gallery; gallery('docs/figures')"
+	$(BIN)/python -c "from lindstedt.charts import slow_flow_figures; slow_flow_figures('docs/figures')"
+	$(BIN)/python -c "from lindstedt.charts import PARAMETRIC_FIGURE, parametric_figure; \
+	parametric_figure(*PARAMETRIC_FIGURE, 'docs/figures/parametric.png')"
 
 generated: $(STAMP)
 	$(BIN)/lindstedt generate duffing --order 12 --out generated

@@ -14,3 +14,13 @@ def best(fn: Callable[[], object], repeat: int = 3) -> float:
         fn()
         out.append(time.perf_counter() - t0)
     return min(out)
+
+
+def median(fn: Callable[[], object], repeat: int = 5) -> float:
+    """Median over ``repeat`` calls of ``fn``: the typical time on a shared machine."""
+    out = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - t0)
+    return sorted(out)[len(out) // 2]

@@ -12,12 +12,17 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
     hill       Hill's equation x'' + (δ + ε p(t))x = 0: transition      p(t), n, K -> curves
                curves out of each tongue, a damped tongue's tip, and
                Mathieu's a_m(q), b_m(q), exact (L–P about cos nτ, sin nτ)
+    averaging  the slow flow of q'' + q = ε f (+ ε F cos ωt): near-     Oscillator, K -> SlowFlow
+               identity averaging to any order in van der Pol's
+               variables, exact (R_k, Φ_k of dr/dt, dφ/dt)
     numerics   references: elliptic periods, Jacobi cn; one RK4 step for any polynomial force
                table: shooting + Floquet, sweeps, true folds, simulations
     driven     μ-expansion with phase, harmonic balance (Duffing; and a  Drive | equation ->
                user's polynomial force by alternating frequency/time)   branches
     response   one-harmonic curves and folds, balance continuation in   Drive | equation,
                ω or in the drive; periodic orbits, subharmonic, mixing  ω range -> folds
+    parametric  q̈ + 2ζq̇ + (1 + ε cos 2ωt)q + γq³ = 0: one-harmonic     Pump, ω range ->
+                branches, tongue, onsets, balance, full-Hill stability branches
     printers   NumbaPrinter(PythonCodePrinter), LaTeX rationals         Expr -> str
     lower      solutions -> IR records (Module, Evaluator, Derivation,  solution -> Unit
                PeriodFormula); Horner, Chebyshev recurrence, AGM steps

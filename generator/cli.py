@@ -366,6 +366,81 @@ def _cmd_tongues(args: argparse.Namespace) -> int:
     return 0
 
 
+def slow_flow_json(flow) -> dict:
+    """The contract of ``lindstedt slowflow … --json``: ``radial[k-1]`` and ``phase[k-1]`` are
+    R_k and Φ_k of dr/dt = Σ eps^k R_k, dphi/dt = Σ eps^k Φ_k (SymPy text in r, phi and the
+    parameters), for q = r cos(t + phi) (a drive: q = r cos(w t + phi), w = 1 + eps*sigma);
+    ``cycles``: each limit cycle (a root of dr/dt) of an autonomous flow without symbolic
+    parameters, its radius r* (to eps^(K-1)) and frequency ω (to eps^K) as series in eps."""
+    return {
+        "equation": flow.source, "name": flow.name, "order": flow.order, "variable": "eps",
+        "parameters": [str(p) for p in flow.parameters], "driven": flow.driven,
+        "convention": ("q = r cos(w t + phi), q' = -r w sin(w t + phi) + O(eps), "
+                       "w = 1 + eps*sigma" if flow.driven else
+                       "q = r cos(t + phi), q' = -r sin(t + phi) + O(eps)")
+        + "; mean-free near-identity transformation",
+        "radial": [sp_text(e) for e in flow.radial],
+        "phase": [sp_text(e) for e in flow.phase],
+        "cycles": [{"radius": [sp_text(c) for c in cyc.radius],
+                    "omega": [sp_text(c) for c in cyc.omega],
+                    "stable_for": "eps > 0" if cyc.slope < 0 else "eps < 0"}
+                   for cyc in _cycles(flow)],
+    }
+
+
+def _cycles(flow) -> list:
+    """The limit cycles of an autonomous flow with numeric coefficients (none otherwise)."""
+    from .averaging import cycle_series
+
+    return [] if flow.driven or flow.parameters else cycle_series(flow)
+
+
+def sp_text(expr) -> str:
+    import sympy as sp
+
+    return sp.sstr(expr, order="lex")
+
+
+def _cmd_slowflow(args: argparse.Namespace) -> int:
+    """``lindstedt slowflow EQUATION|NAME --order K``: the averaged equations, exact."""
+    from .averaging import slow_flow
+    from .models import REGISTRY, oscillator
+
+    text, name = args.model, args.name or "oscillator"
+    if text in REGISTRY:
+        text, name = REGISTRY[text].equation, args.name or text
+    out = _out_folder(args.out) if args.out is not None else None
+    osc = oscillator(text, _params(args.param), name)
+    flow = slow_flow(osc, args.order)
+    written = []
+    if out is not None:  # written before anything is printed: a refusal prints nothing
+        from .compiler import generate_slow_flow
+
+        params = "".join(f" --param {k}={v}" for k, v in sorted(_params(args.param).items()))
+        command = f'lindstedt slowflow "{text}" --name {name} --order {args.order}{params}'
+        written = generate_slow_flow(osc, args.order, command, out,
+                                     overwrite_edited=args.overwrite_edited)
+    if args.json:
+        print(json.dumps(slow_flow_json(flow)))
+    else:
+        frame = "q = r cos(w t + phi), w = 1 + eps*sigma" if flow.driven else \
+            "q = r cos(t + phi)"
+        print(f"{flow.name}: {flow.source}, the slow flow to order {flow.order} ({frame})")
+        print("dr/dt = sum_k eps^k R_k, dphi/dt = sum_k eps^k Phi_k")
+        for k in range(flow.order):
+            print(f"R_{k + 1}   = {sp_text(flow.radial[k])}")
+            print(f"Phi_{k + 1} = {sp_text(flow.phase[k])}")
+        for cyc in _cycles(flow):
+            print(f"limit cycle (dr/dt = 0, attracting for "
+                  f"{'eps > 0' if cyc.slope < 0 else 'eps < 0'}): r = sum_j eps^j r_j, "
+                  "omega = sum_j eps^j omega_j")
+            print("  r_j:     " + ", ".join(sp_text(c) for c in cyc.radius))
+            print("  omega_j: " + ", ".join(sp_text(c) for c in cyc.omega))
+    for path in written:
+        print(f"  {path}", file=sys.stderr if args.json else sys.stdout)
+    return 0
+
+
 def _cmd_models(args: argparse.Namespace) -> int:
     from .models import REGISTRY
 
@@ -387,9 +462,13 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         raise InputError(f"--allow-divergent: the {args.model} evaluators have no radius to lift")
     from . import compiler
 
+    if args.damped and args.model != "driven":
+        raise InputError(f"--damped: only `generate driven` has a damped variant, not "
+                         f"{args.model}")
     out = _out_folder(args.out)
     if args.model == "driven":
-        paths = compiler.generate_driven(order, out, overwrite_edited=args.overwrite_edited)
+        paths = compiler.generate_driven(order, out, damped=args.damped,
+                                         overwrite_edited=args.overwrite_edited)
     elif args.model == "balance":
         paths = compiler.generate_balance(args.harmonics, out,
                                           overwrite_edited=args.overwrite_edited)
@@ -462,7 +541,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     modules = ["duffing", "pendulum", "driven", "balance"]
     check_writable(out, [*(f"{m}.py" for m in modules), "duffing_tables.tex",
                          "duffing_derivation.tex", "pendulum_tables.tex",
-                         "pendulum_derivation.tex", "driven_derivation.tex"],
+                         "pendulum_derivation.tex", "driven_derivation.tex",
+                         "van_der_pol_slow_flow.py", "van_der_pol_slow_flow.tex"],
                    overwrite_edited=args.overwrite_edited)
     figures.mkdir(parents=True, exist_ok=True)
     check_plot_path(figures / "speed_accuracy.png")
@@ -506,6 +586,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from .charts import ince_strutt_figure  # Hill's equation: Floquet grid and series curves
 
     print(f"  {ince_strutt_figure(figures / 'ince_strutt.png')}")
+    _demo_slow_flow(out, figures, args.overwrite_edited)
+    _demo_parametric(figures)
     if shutil.which("pdflatex"):
         for tex in sorted(out.glob("*.tex")):
             for _ in range(2):  # longtable settles its column widths on the second pass
@@ -518,6 +600,56 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _demo_slow_flow(out: Path, figures: Path, overwrite_edited: bool) -> None:
+    """The demo's slow flow: van der Pol's to order 2, emitted and typeset, run from r = 0.1
+    against simulation, and its two figures."""
+    import numpy as np
+
+    from .averaging import simulate, slow_flow, transient
+    from .charts import slow_flow_figures
+    from .compiler import generate_slow_flow
+    from .emit import load_generated
+    from .models import REGISTRY, oscillator
+
+    text = REGISTRY["van_der_pol"].equation
+    osc = oscillator(text, name="van_der_pol")
+    command = f'lindstedt slowflow "{text}" --name van_der_pol --order 2'
+    print(f"\nthe slow flow of van der Pol to order 2 ({command} --out {out}):")
+    for path in generate_slow_flow(osc, 2, command, out, overwrite_edited=overwrite_edited):
+        print(f"  {path}")
+    emitted = load_generated(out / "van_der_pol_slow_flow.py")
+    rate = emitted.slow_flow(np.array([2.0, 0.0]), 0.1)
+    print(f"  at the cycle r = 2, eps = 0.1: dr/dt = {rate[0]:.3g}, dphi/dt = {rate[1]:.6f} "
+          "(-eps^2/16 = -0.000625)")
+    flow, eps = slow_flow(osc, 2), 0.1
+    t = np.linspace(0.0, 80.0, 9)
+    r_sim = np.hypot(*simulate(osc, eps, 0.1, 0.0, t))
+    r_avg = np.hypot(*transient(flow, eps, 0.1, 0.0, t))
+    print(f"  from r = 0.1 at eps = {eps}:")
+    print(f"  {'t':>6}  {'r (simulation)':>15}  {'r (slow flow)':>14}")
+    for ti, a, b in zip(t, r_sim, r_avg, strict=True):
+        print(f"  {ti:>6.0f}  {a:>15.6f}  {b:>14.6f}")
+    for path in slow_flow_figures(figures):
+        print(f"  {path}")
+
+
+DEMO_SUBHARMONIC = (0.1, 0.5, 1.3)
+# NOTE: (ε, f, ω) where the notes' q₀ Hill test calls the "−" root stable and it is not.
+
+
+def _demo_parametric(figures: Path) -> None:
+    """The demo's parametric block: the response figure under ``figures``, the tongue and
+    onsets, and one subharmonic where the full Hill equation corrects the notes' verdict."""
+    from .charts import PARAMETRIC_FIGURE, parametric_figure
+
+    data = parametric_json(*PARAMETRIC_FIGURE, points=2)
+    print(f"  {parametric_figure(*PARAMETRIC_FIGURE, figures / 'parametric.png')}")
+    print()
+    for line in [*_parametric_table(data)[:5], *_subharmonic_table(subharmonic_json(
+            *DEMO_SUBHARMONIC))]:
+        print(line)
+
+
 def driven_json(d, order: int, harmonics: int) -> dict:
     """The contract of ``lindstedt driven … --json``: every distinct 1:1 orbit found
     (:func:`response.periodic_orbits`), largest first, each three ways where it can be.
@@ -527,6 +659,7 @@ def driven_json(d, order: int, harmonics: int) -> dict:
     stands for (found by continuing the balance through a fold the cubic does not have) has
     ``A1``, ``r``, ``delta0`` null and no μ-expansion, with ``mu_note`` saying why."""
     from .driven import amplitudes, mu_expansion
+    from .numerics import multipliers_stable, orbit_hill_multipliers
     from .response import periodic_orbits
 
     damped = d.damping > 0
@@ -557,6 +690,11 @@ def driven_json(d, order: int, harmonics: int) -> dict:
                        "converged": hb.converged, "r": _first_harmonic(A, B)}
             if damped:
                 hb_json["B"] = _keyed(B)
+            # the full Hill equation about this balance orbit (no shooting)
+            lam = orbit_hill_multipliers({(1, 0): 1.0, (3, 0): d.eps, (0, 1): d.damping}, A,
+                                         B, d.omega)
+            hb_json["full_hill_stable"] = multipliers_stable(lam, damped)
+            hb_json["full_hill_moduli"] = sorted(float(abs(m)) for m in lam)
         else:
             hb_json = {"harmonics": harmonics, "A": {}, "residual": None, "converged": False,
                        "r": None}
@@ -639,6 +777,10 @@ def driven_table(data: dict) -> str:
             cells = " ".join(f"{values[c]:>12.6f}" if c in values else f"{'':>12}"
                              for c in columns)
             lines.append(f"{label:>22} {cells}")
+        if "full_hill_stable" in hb:
+            lines.append("  full Hill equation about the balance: "
+                         f"{'stable' if hb['full_hill_stable'] else 'unstable'} (|multipliers| "
+                         + ", ".join(f"{m:.6g}" for m in hb["full_hill_moduli"]) + ")")
         if br.get("first_order") == "rank":
             lines.append("  note: the first-order root of the same rank in amplitude (shooting "
                          "from it reached another orbit)")
@@ -983,6 +1125,9 @@ def subharmonic_json(eps: float, force: float, omega: float) -> dict:
                 "a1": s.orbit.A[1], "a3": s.orbit.A[3], "stable": s.orbit.stable,
                 "simulation_locks": s.locked,
                 "floquet_moduli": sorted(float(abs(m)) for m in s.orbit.multipliers)},
+            "full_hill": None if s.balance is None else {
+                "a1": s.balance[0][1], "a3": s.balance[0][3], "stable": s.full_hill_stable,
+                "floquet_moduli": sorted(float(abs(m)) for m in s.full_hill_multipliers)},
         } for s in solutions],
     }
 
@@ -1042,9 +1187,103 @@ def _subharmonic_table(data: dict) -> list[str]:
         true = "no orbit found" if num is None else (
             f"true orbit a1 = {num['a1']:.6f}, {'stable' if num['stable'] else 'unstable'}, "
             f"a simulation 1% off it {'locks on' if num['simulation_locks'] else 'drifts away'}")
+        full = s["full_hill"]
         lines.append(f"  root {s['root']}: a = {s['a']:.6f}, Hill: "
-                     f"{'stable' if s['hill_stable'] else 'unstable'}; {true}")
+                     f"{'stable' if s['hill_stable'] else 'unstable'}; full Hill: "
+                     + ("no balance" if full is None else
+                        f"{'stable' if full['stable'] else 'unstable'} (a1 = {full['a1']:.6f})")
+                     + f"; {true}")
     return lines
+
+
+MAX_PARAMETRIC_POINTS = 401
+# NOTE: ω points of the range: 401 draw a smooth curve; their cost with --harmonics is
+# costs.parametric_cost's.
+PARAMETRIC_SHOTS = 10
+# NOTE: shooting at about ten ω of the range, every branch there: the numerical truth.
+
+
+def parametric_json(eps: float, zeta: float, gamma: float, omega_from: float, omega_to: float,
+                    points: int = 41, harmonics: int = 8) -> dict:
+    """The contract of ``lindstedt parametric … --json``: the tongue, the onsets, the fold and
+    every branch point (one harmonic, balance with its full-Hill verdict, shooting)."""
+    import numpy as np
+
+    from .parametric import Pump, check_omega, fold, onsets, response, tongue_edges
+
+    p = Pump(eps, zeta, gamma)
+    lo, hi = check_omega(omega_from, "--omega-from"), check_omega(omega_to, "--omega-to")
+    if not lo < hi:
+        raise InputError(f"--omega-from {lo:g} --omega-to {hi:g}: the range must increase")
+    if not 2 <= points <= MAX_PARAMETRIC_POINTS:
+        raise InputError(f"--points {points}: must be in 2..{MAX_PARAMETRIC_POINTS}")
+    if isinstance(harmonics, bool) or not 1 <= harmonics <= MAX_HARMONICS:
+        raise InputError(f"--harmonics {harmonics}: must be in 1..{MAX_HARMONICS}")
+    rows = response(p, np.linspace(lo, hi, points), harmonics,
+                    shoot_every=max(1, (points - 1) // PARAMETRIC_SHOTS))
+    edges, top = tongue_edges(p), fold(p)
+
+    def moduli(lam) -> list[float]:
+        return sorted(float(abs(m)) for m in lam)
+
+    return {
+        "equation": "q'' + 2 zeta q' + (1 + eps cos 2wt) q + gamma q^3 = 0",
+        "parameters": {"eps": eps, "zeta": zeta, "gamma": gamma, "omega_from": lo,
+                       "omega_to": hi, "points": points, "harmonics": harmonics},
+        "tongue": None if edges is None else {"lower": edges[0], "upper": edges[1]},
+        "onsets": [{"omega": o.omega, "branch": o.branch, "supercritical": o.supercritical}
+                   for o in onsets(p)],
+        "fold": None if top is None else {"omega": top[0], "r": top[1]},
+        "branches": [{
+            "branch": r.one.branch, "omega": r.one.omega,
+            "one_harmonic": {"a": r.one.a, "b": r.one.b, "r": r.one.r, "stable": r.one.stable},
+            "balance": None if r.balance is None else {
+                "r": r.balance.r, "residual": r.balance.residual,
+                "full_hill_stable": r.balance.stable,
+                "floquet_moduli": moduli(r.balance.multipliers)},
+            "shooting": None if r.orbit is None else {
+                "r": math.hypot(r.orbit.A[1], r.orbit.B[1]), "stable": r.orbit.stable,
+                "floquet_moduli": moduli(r.orbit.multipliers)},
+        } for r in rows],
+    }
+
+
+def _parametric_table(data: dict) -> list[str]:
+    p, t = data["parameters"], data["tongue"]
+    lines = [f"{data['equation']}: eps = {p['eps']}, zeta = {p['zeta']}, gamma = {p['gamma']}",
+             "tongue (one harmonic): " + ("closed by the damping" if t is None else
+                                          f"{t['lower']:.6f} < omega < {t['upper']:.6f}")]
+    for o in data["onsets"]:
+        lines.append(f"onset of branch {o['branch']} at omega = {o['omega']:.6f}: "
+                     + ("supercritical" if o["supercritical"] else "subcritical"))
+    if data["fold"] is not None:
+        lines.append(f"fold (branches + and - meet): omega = {data['fold']['omega']:.6g}, "
+                     f"r = {data['fold']['r']:.6g}")
+    lines.append(f"{'omega':>9} {'branch':>6} {'r (1 harm.)':>12} {'stable':>7} "
+                 f"{'r (balance)':>12} {'full Hill':>9} {'r (shot)':>12} {'shot':>8}")
+    lines.append("  (branch 0 is q = 0: its Floquet multipliers are Mathieu's; a balance 'none' "
+                 "fell onto q = 0: the true tongue is O(eps^2) off the one-harmonic one)")
+    for b in data["branches"]:
+        one, bal, shot = b["one_harmonic"], b["balance"], b["shooting"]
+        lines.append((
+            f"{b['omega']:>9.5f} {b['branch']:>6} {one['r']:>12.8f} "
+            f"{'yes' if one['stable'] else 'no':>7} "
+            + (f"{'' if b['branch'] == '0' else 'none':>12} {'':>9}" if bal is None else
+               f"{bal['r']:>12.8f} {'yes' if bal['full_hill_stable'] else 'no':>9}")
+            + ("" if shot is None else
+               f" {shot['r']:>12.8f} {'stable' if shot['stable'] else 'unstable':>8}"))
+            .rstrip())
+    return lines
+
+
+def _cmd_parametric(args: argparse.Namespace) -> int:
+    return _report(args, lambda: parametric_json(args.eps, args.zeta, args.gamma,
+                                                 args.omega_from, args.omega_to, args.points,
+                                                 args.harmonics),
+                   lambda path: _charts().parametric_figure(args.eps, args.zeta, args.gamma,
+                                                            args.omega_from, args.omega_to,
+                                                            path),
+                   _parametric_table)
 
 
 def mixing_json(eps: float, Q: float, drives: list[tuple[float, float]]) -> dict:
@@ -1662,6 +1901,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--allow-divergent", action="store_true",
                    help="evaluate beyond the radius of convergence instead of returning NaN "
                    "(default: NaN)")
+    p.add_argument("--damped", action="store_true",
+                   help="driven only: the μ-expansion with damping 1/Q, A_n and B_n (n = 1, 3, "
+                   "5) of Q < inf (driven_damped.py, driven_damped_derivation.tex)")
     _flag_allow_slow(p)
     _flag_overwrite_edited(p)
     p.set_defaults(func=_cmd_generate)
@@ -1723,6 +1965,29 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_json(p)
     _flag_plot(p)
     p.set_defaults(func=_cmd_subharmonic)
+
+    p = sub.add_parser("parametric", help="the parametrically driven oscillator's response "
+                       "in its first tongue",
+                       description="q'' + 2 zeta q' + (1 + eps cos 2wt) q + gamma q^3 = 0: the "
+                       "1:1 response at w (the pump at 2w), every branch with its stability "
+                       "(one harmonic, harmonic balance with the full Hill equation, shooting), "
+                       "the tongue's edges, the onsets and the fold.")
+    p.add_argument("--eps", type=_real, required=True, metavar="EPS",
+                   help="ε, the pump depth, 0 < ε < 1 (required)")
+    p.add_argument("--zeta", type=_real, default=0.0, metavar="ZETA",
+                   help="ζ ≥ 0, the damping ratio of 2ζq' (default 0: undamped)")
+    p.add_argument("--gamma", type=_real, default=1.0, metavar="GAMMA",
+                   help="γ, the cubic stiffness (> 0 hardens, < 0 softens; default 1)")
+    p.add_argument("--omega-from", type=_real, required=True, metavar="W",
+                   help="the lowest ω, half the pump frequency (required)")
+    p.add_argument("--omega-to", type=_real, required=True, metavar="W",
+                   help="the highest ω (required)")
+    p.add_argument("--points", type=_positive, default=41, metavar="N",
+                   help=f"ω points in the range, 2..{MAX_PARAMETRIC_POINTS} (default 41)")
+    _flag_harmonics(p, "odd harmonics of the balance (1, 3, …, 2N − 1)")
+    _flag_json(p)
+    _flag_plot(p)
+    p.set_defaults(func=_cmd_parametric)
 
     p = sub.add_parser("mixing", help="combination tones of a two-tone drive",
                        description="q'' + q'/Q + q + eps q^3 = Σ f_i cos(w_i t): "
@@ -1810,6 +2075,22 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("name", choices=SCENE_NAMES, help="the scene")
     _flag_json(p, "JSON")
     p.set_defaults(func=_cmd_scene)
+
+    p = sub.add_parser("slowflow", help="the slow flow (averaging) of q'' + q = eps*f, free, "
+                       "self-excited or driven", description="Average q'' + q = eps*f(q, q') "
+                       "(+ eps*F*cos(w*t), w = 1 + eps*sigma) to order K: dr/dt and dphi/dt "
+                       "exactly, for q = r cos(t + phi); with --out the compiled right sides and "
+                       "the LaTeX of the flow.")
+    _flag_oscillator(p)
+    p.add_argument("--order", type=_order, default=2, metavar="K",
+                   help="the order in eps, 1..6 (default 2)")
+    _flag_json(p, "the contract {equation, name, order, variable, parameters, driven, "
+               "convention, radial, phase, cycles}")
+    p.add_argument("--out", metavar="DIR", help="also write <name>_slow_flow.py (numba "
+                   "slow_flow, slow_flow_jacobian, slow_flow_cartesian) and "
+                   "<name>_slow_flow.tex into DIR")
+    _flag_overwrite_edited(p)
+    p.set_defaults(func=_cmd_slowflow)
 
     p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults",
                        description="The main job on the built-in defaults; writes only under "

@@ -22,6 +22,8 @@ from .methods import (
     FREE,
     LIMIT_CYCLE,
     MU,
+    MU_DAMPED,
+    SLOW_FLOW,
     Candidate,
     Method,
     Request,
@@ -76,9 +78,14 @@ def generate_limit_cycle(model: object, order: int, out: Path, *,
                           overwrite_edited=overwrite_edited, flag=flag)
 
 
-def generate_driven(order: int, out: Path, *, overwrite_edited: bool = False,
-                    flag: str = "--out") -> list[Path]:
-    """``lindstedt generate driven``: A_n(ω) evaluators and the μ-expansion's derivation."""
+def generate_driven(order: int, out: Path, *, damped: bool = False,
+                    overwrite_edited: bool = False, flag: str = "--out") -> list[Path]:
+    """``lindstedt generate driven``: A_n(ω) evaluators and the μ-expansion's derivation;
+    ``damped``: A_n, B_n(ω, ε, f, Q) and the derivation with both secular conditions."""
+    if damped:
+        command = f"lindstedt generate driven --order {order} --damped"
+        return compile_target(MU_DAMPED, Request(order, command), out,
+                              overwrite_edited=overwrite_edited, flag=flag)
     return compile_target(MU, Request(order, f"lindstedt generate driven --order {order}"),
                           out, overwrite_edited=overwrite_edited, flag=flag)
 
@@ -117,3 +124,11 @@ def generate_method(m: Method, order: int, out: Path, *, overwrite_edited: bool 
     writer = {FREE: partial(generate, "duffing"), MU: generate_driven,
               BALANCE: generate_balance, FOURIER: generate_fourier}[m.target]
     return writer(order, out, overwrite_edited=overwrite_edited, flag=flag)
+
+
+def generate_slow_flow(osc: object, order: int, command: str, out: Path, *,
+                       overwrite_edited: bool = False, flag: str = "--out") -> list[Path]:
+    """``lindstedt slowflow … --out DIR``: the compiled slow-flow right sides of the
+    :class:`models.Oscillator` ``osc`` to ``order`` and the LaTeX of the flow."""
+    return compile_target(SLOW_FLOW, Request(order, command, osc), out,
+                          overwrite_edited=overwrite_edited, flag=flag)

@@ -76,9 +76,11 @@ GENERATE_COSTS = {
     "balance": (3.0, 59.0, 12, 4.0),
     "fourier": (3.5, 0.0, 60, 1.0),
     "driven": (12.0, 29.0, 5, "6"),
+    "driven_damped": (2.0, 53.0, 6, "1.8"),
 }
 # NOTE: wall time of `lindstedt generate MODEL` (derive, lower, print, compile) against its size
-# (--order; --harmonics for balance and fourier), each fitted to its own runs.
+# (--order; --harmonics for balance and fourier), each fitted to its own runs.  driven_damped
+# (`generate driven --damped`): 5.7 s at order 2, 16 at 4, 55 at 6 (load 5 on 2 cores).
 
 DRIVEN_COSTS = (3.0, 13.3, 100, 3.5)
 # NOTE: `lindstedt driven --order K`: start-up, the numba kernels from cache, balance and
@@ -190,6 +192,9 @@ def generate_cost(args: argparse.Namespace) -> Cost:
                                                     order=size + 2)).seconds
         return Cost(derivation + generate_seconds("duffing", size), f"order {size}",
                     "generating the oscillator")
+    if args.model == "driven" and getattr(args, "damped", False):
+        return Cost(generate_seconds("driven_damped", size), f"order {size}",
+                    "generating driven --damped")
     return Cost(generate_seconds(args.model, size),
                 f"--harmonics {size}" if harmonic else f"order {size}",
                 f"generating {args.model if args.model in GENERATE_COSTS else 'the oscillator'}")
@@ -373,12 +378,45 @@ def tongues_cost(args: argparse.Namespace) -> Cost:
     return Cost(seconds, f"order {args.order}, harmonic {top}", "the transition curves")
 
 
+SLOW_FLOW_FIT = (2.0, 0.95, 4, "2.2")
+# NOTE: `lindstedt slowflow` (start-up, then derive): the driven Duffing, the costliest family,
+# takes 0.95 s to derive at order 4, and the whole command 4.2 s at order 5, 6.1 s at order 6
+# (load 6): about 2.2× per order; van der Pol a third of that.
+
+
+def slow_flow_cost(args: argparse.Namespace) -> Cost:
+    from .averaging import MAX_ORDER
+
+    # NOTE: beyond MAX_ORDER the derivation refuses at once (its own one-line message)
+    order = args.order if args.order <= MAX_ORDER else 0
+    return Cost(power_law(*SLOW_FLOW_FIT, order), f"order {args.order}", "the slow flow")
+
+
+PARAMETRIC_FIT = (2.0, 1.5e-3)
+# NOTE: `lindstedt parametric`: start-up and ten shot ω, then per ω and nontrivial branch a
+# balance and a full Hill pass, ~1.5 ms per odd harmonic (measured at load 5: 401 points
+# 10.5 s at 8 harmonics, 116 s at 100).
+
+
+def parametric_cost(args: argparse.Namespace) -> Cost:
+    """Two branches at each of ``--points`` ω, each ``--harmonics`` deep; above the limit a
+    bound (the command has no --allow-slow: fewer points or harmonics answer the same)."""
+    points, harmonics = max(args.points, 1), max(args.harmonics, 8)
+    seconds = PARAMETRIC_FIT[0] + 2 * points * PARAMETRIC_FIT[1] * harmonics
+    if seconds > COST_LIMIT_SECONDS:
+        raise InputError(f"--points {args.points} --harmonics {args.harmonics}: about "
+                         f"{seconds:,.0f} s of balances; the limit is {COST_LIMIT_SECONDS:.0f} "
+                         "s: give fewer points or harmonics")
+    return Cost(seconds, f"--points {args.points}", "the parametric response")
+
+
 COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "series": series_cost,
     "generate": generate_cost,
     "driven": driven_cost,
     "response": response_cost,
     "subharmonic": fixed_cost("subharmonic"),
+    "parametric": parametric_cost,
     "mixing": fixed_cost("mixing"),
     "choose": choose_cost,
     "sweep": sweep_cost,
@@ -387,6 +425,7 @@ COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "models": fixed_cost("models"),
     "mathieu": mathieu_cost,
     "tongues": tongues_cost,
+    "slowflow": slow_flow_cost,
 }
 # NOTE: one estimator per command; `demo` has none: its work is the fixed built-in job
 # (`make demo`), which nothing on its command line scales.

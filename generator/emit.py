@@ -29,8 +29,10 @@ from .lower import (
     Derivation,
     Evaluator,
     Module,
+    MuDampedDerivation,
     MuDerivation,
     Provenance,
+    SlowFlowDocument,
     Unit,
 )
 from .printers import latex_coefficient, latex_expr, latex_rational, pycode
@@ -260,12 +262,49 @@ def render_mu_derivation(d: MuDerivation, p: Provenance) -> dict[str, str]:
     return {f"{p.model}_derivation.tex": tex}
 
 
+def render_mu_damped_derivation(d: MuDampedDerivation, p: Provenance) -> dict[str, str]:
+    """``{"driven_damped_derivation.tex": text}``: the damped μ-expansion order by order."""
+    def harmonics(parts: tuple[dict, dict]) -> list[tuple[str, str]]:
+        return [(f"\\{trig} {n}\\tau" if n != 1 else f"\\{trig}\\tau", _dmath(c))
+                for trig, part in zip(("cos", "sin"), parts, strict=True)
+                for n, c in sorted(part.items())]
+
+    orders = [{
+        "j": o.order,
+        "forcing": harmonics(o.forcing),
+        "secular": [_dmath(c) for c in o.secular],
+        "unknowns": [_dmath(u) for u in o.unknowns],
+        "solved": [_dmath(v) for v in o.values] if o.values is not None else [],
+        "solution": harmonics(o.q),
+        "delta": _dmath(o.delta),
+    } for o in d.orders]
+    tex = environment(latex=True).get_template("mu_damped_derivation.tex.j2").render(
+        banner=banner(p, "%"), order=d.order, orders=orders,
+        determinant=sp.latex(d.determinant))
+    return {f"{p.model}_derivation.tex": tex}
+
+
+def render_slow_flow(d: SlowFlowDocument, p: Provenance) -> dict[str, str]:
+    """``{"<name>_slow_flow.tex": text}``: ``R_k`` and ``Φ_k`` order by order."""
+    names = {sp.Symbol("phi"): r"\varphi", sp.Symbol("sigma"): r"\sigma"}
+    orders = [{"k": k + 1, "radial": sp.latex(a, symbol_names=names),
+               "phase": sp.latex(b, symbol_names=names)}
+              for k, (a, b) in enumerate(zip(d.radial, d.phase, strict=True))]
+    tex = environment(latex=True).get_template("slow_flow.tex.j2").render(
+        banner=banner(p, "%"), source=d.source.replace("'", r"\textquotesingle{}")
+        .replace("_", r"\_").replace("**", "\\^{}"), order=d.order, driven=d.driven,
+        orders=orders)
+    return {f"{p.model}.tex": tex}
+
+
 def render(unit: Unit) -> dict[str, str]:
     """``{file name: text}`` of a unit: its module, then each document beside it."""
     files = {f"{unit.module.name}.py": render_module(unit.module)}
+    renderers = {Derivation: render_latex, MuDerivation: render_mu_derivation,
+                 MuDampedDerivation: render_mu_damped_derivation,
+                 SlowFlowDocument: render_slow_flow}
     for doc in unit.documents:
-        render_doc = render_latex if isinstance(doc, Derivation) else render_mu_derivation
-        files.update(render_doc(doc, unit.module.provenance))
+        files.update(renderers[type(doc)](doc, unit.module.provenance))
     return files
 
 

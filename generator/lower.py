@@ -21,7 +21,24 @@ import numpy as np
 import sympy as sp
 
 from . import __version__
-from .driven import A1_, BalanceEquations, MuOrder, eps_, omega_
+from .averaging import PHI as PHI_SLOW
+from .averaging import R as R_SLOW
+from .averaging import SlowFlow
+from .averaging import U as U_SLOW
+from .averaging import V as V_SLOW
+from .driven import (
+    A1_,
+    BalanceEquations,
+    Delta_,
+    MuDampedOrder,
+    MuOrder,
+    a_,
+    damped_determinant,
+    eps_,
+    gamma_,
+    omega_,
+)
+from .driven import x_ as damped_x
 from .errors import InputError
 from .lindstedt import LimitCycle, SeriesSolution, nearest_singularity, order_terms
 from .models import Model
@@ -429,8 +446,12 @@ def cubic_branches(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol) -> tuple[
     trigonometric formula when ``4p³ + 27q² < 0`` (the middle one from the product of the roots;
     NaN for the missing ones otherwise), else Cardano's single root in its stable form.
     """
-    p = -4 * (omega**2 - 1) / (3 * eps)
-    q = -4 * force / (3 * eps)
+    return depressed_cubic_roots(-4 * (omega**2 - 1) / (3 * eps), -4 * force / (3 * eps))
+
+
+def depressed_cubic_roots(p: sp.Expr, q: sp.Expr) -> tuple[sp.Expr, ...]:
+    """Real roots of ``y³ + py + q = 0``, largest first (NaN for missing ones), as SymPy
+    expressions: the trigonometric formula when ``4p³ + 27q² < 0``, else Cardano's one root."""
     three = 4 * p**3 + 27 * q**2 < 0
     arg = sp.Min(sp.Max(3 * q / (2 * p) * sp.sqrt(-3 / p), -1), 1)
     trig = [2 * sp.sqrt(-p / 3) * sp.cos(sp.acos(arg) / 3 - 2 * sp.pi * k / 3) for k in range(3)]
@@ -492,6 +513,147 @@ def lower_driven(orders: tuple[MuOrder, ...], command: str) -> Module:
         constants=(("ORDER", K), ("MODEL", "driven (undamped)")),
         evaluators=tuple(evaluators),
         provenance=provenance("driven", K, command),
+    )
+
+
+ROOT_POLISH = 3
+# NOTE: Newton steps on the one-harmonic cubic after its closed form: the shift of the
+# depressed cubic costs the small root digits where |ε|f² ≪ (ω² − 1)², and three quadratic
+# steps restore them from a closed form good to 1e-2 (a start worse than that is NaN).
+ROOT_RESOLVED = 1e-9
+# NOTE: the last Newton step must move the root by less than this (relative): beside a fold,
+# where the root is double, it does not, and the evaluators return NaN.
+DAMPED_TRUNCATION = 1e-2
+# NOTE: the damped evaluators' verified domain: the first omitted term of the μ-series (its
+# b_{K+1} and δ_{K+1}, which track the error against shooting within a factor 2) at most 1 % of
+# A₁; beyond it, near a fold or at large εA₁², they return NaN rather than a guess.
+DAMPED_HARMONICS = 5
+# NOTE: A_n, B_n for n = 1, 3, 5: the harmonics the tables and charts show (and the first three of
+# the undamped module's).
+
+
+def nested_horner(expr: sp.Expr, gens: tuple[sp.Symbol, ...]) -> sp.Expr:
+    """A polynomial in ``gens`` as Horner's rule in the first, each coefficient in the rest."""
+    if not gens:
+        return expr
+    poly = sp.Poly(expr, gens[0])
+    acc = sp.Integer(0)
+    for c in poly.all_coeffs():
+        acc = acc * gens[0] + nested_horner(sp.expand(c), gens[1:])
+    return acc
+
+
+def _damped_horner(expr: sp.Expr) -> sp.Expr:
+    """``A₁N/(ω^{2j}Δ^m)`` (or ``N/(…)``) with ``N`` by :func:`nested_horner` in x, a, γ."""
+    # NOTE: no together(): it would clear the rationals into integers beyond int64
+    num, den = sp.fraction(expr)
+    if num == 0:
+        return num
+    factor = A1_ if num.has(A1_) else sp.Integer(1)
+    out = factor * nested_horner(sp.expand(num / factor), (damped_x, a_, gamma_)) / den
+    # an integer literal beyond int64 does not compile: as the nearest double
+    return out.xreplace({n: sp.Float(int(n), 17) for n in out.atoms(sp.Integer)
+                         if abs(n) > 2**53})
+
+
+def damped_cubic_branches(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol,
+                          gamma: sp.Symbol) -> tuple[list[Assign], tuple[sp.Expr, ...], sp.Expr,
+                                                     sp.Expr]:
+    """``z = |ε|u`` (``u = A₁²``) of each root of the one-harmonic cubic
+    ``u[(1 − ω² + ¾εu)² + γ²] = f²`` (:func:`driven.one_harmonic_roots`), largest first, NaN
+    where a branch does not exist, in closed form: the assignments they need, the roots, and
+    the cubic ``H(z)`` with ``H'(z)`` in the symbol ``z``.
+
+    With ``a' = sign(ε)(ω² − 1)`` the cubic is ``H = z[(¾z − a')² + γ²] − |ε|f²``, whose
+    real roots are all positive (``H < 0`` for ``z ≤ 0``); ``z = y + 8a'/9`` gives the depressed
+    ``y³ + py + q`` with ``p = 16γ²/9 − 16a'²/27``, ``q = 128a'³/729 + 128a'γ²/81 − 16|ε|f²/9``
+    (:func:`depressed_cubic_roots`: the conventions of :func:`cubic_branches`)."""
+    z, shifted, p, q = sp.symbols("z a_shifted p q")
+    steps = [(shifted, sp.sign(eps) * (omega**2 - 1)),
+             (p, sp.Rational(16, 9) * gamma**2 - sp.Rational(16, 27) * shifted**2),
+             (q, sp.Rational(128, 729) * shifted**3 + sp.Rational(128, 81) * shifted * gamma**2
+              - sp.Rational(16, 9) * sp.Abs(eps) * force**2)]
+    roots = tuple(r + sp.Rational(8, 9) * shifted for r in depressed_cubic_roots(p, q))
+    bracket = sp.Rational(3, 4) * z - shifted
+    H = z * (bracket**2 + gamma**2) - sp.Abs(eps) * force**2
+    slope = bracket**2 + gamma**2 + sp.Rational(3, 2) * z * bracket
+    return steps, roots, H, slope
+
+
+def lower_driven_damped(orders: tuple[MuDampedOrder, ...], command: str) -> Module:
+    """Evaluators ``A_n``, ``B_n(omega, eps, force, Q, branch)`` of the damped μ-expansion at
+    order K: ``q(t) = Σ A_n cos nωt + B_n sin nωt`` for odd ``n ≤ 2K + 1``.
+
+    ``branch`` 0, 1, 2 picks a root ``u = A₁²`` of the one-harmonic cubic, largest first
+    (:func:`damped_cubic_branches`, polished by ``ROOT_POLISH`` Newton steps); ``δ₀`` is
+    :func:`driven.one_harmonic_phase`'s.  With ``τ = ωt − δ`` the sum ``Σ_j q_j(τ)`` has
+    coefficients ``α_n`` (cos nτ), ``β_n`` (sin nτ), and ``A_n = α_n cos nδ − β_n sin nδ``,
+    ``B_n = α_n sin nδ + β_n cos nδ``.  ``orders`` holds K + 1 orders: the last one only
+    estimates the truncation error.  NaN (the verified domain): ``ε = 0`` (no cubic), a root
+    Newton does not resolve or ``Δ = 0`` (a fold), and where the first omitted term
+    ``t_{K+1} = |b_{K+1}| + A₁|δ_{K+1}|`` exceeds ``DAMPED_TRUNCATION·A₁`` or the last summed one
+    ``t_K`` (near a fold ``Δ → 0`` and the terms grow).  ``Q = inf`` is the undamped
+    oscillator (``A₁ > 0``, ``δ₀`` = 0 or π).
+    """
+    K = len(orders) - 1
+    omega, eps, force, Q, branch = sp.symbols("omega eps force Q branch")
+    A1, delta, z, gamma = sp.symbols("A1 delta z gamma")
+    x, a, Delta = sp.symbols("x a Delta")
+    steps, roots, H, slope = damped_cubic_branches(omega, eps, force, gamma)
+    pick = sp.Piecewise((roots[0], sp.Eq(branch, 0)), (roots[1], sp.Eq(branch, 1)),
+                        (roots[2], sp.Eq(branch, 2)), (sp.nan, True))
+    zs = [sp.Symbol(f"z{k}") for k in range(ROOT_POLISH + 1)]
+    zsym = sp.Symbol("z")
+    prelude: list[Assign] = [(gamma, omega / Q), *steps, (zs[0], pick)]
+    for k in range(ROOT_POLISH):
+        prelude.append((zs[k + 1], zs[k] - (H / slope).xreplace({zsym: zs[k]})))
+    to_args = {A1_: A1, omega_: omega, damped_x: x, a_: a, gamma_: gamma, Delta_: Delta}
+    sign = sp.sign(force)
+    prelude += [(z, zs[-1]), (A1, sp.sqrt(z / sp.Abs(eps))), (x, sp.sign(eps) * z),
+                (a, omega**2 - 1), (Delta, damped_determinant().xreplace(to_args)),
+                (sp.Symbol("delta0"), sp.atan2(sign * gamma,
+                                               sign * (sp.Rational(3, 4) * x - a)))]
+    # the phase and the last two terms' sizes, shared subexpressions first
+    named = [sp.Symbol(f"delta{j}") for j in range(1, K + 2)]
+    constants = [sp.Symbol(f"b{j}") for j in (K, K + 1)]
+    sizes = [sp.Abs(b) + A1 * sp.Abs(d) for b, d in zip(constants, named[K - 1:], strict=True)]
+    wanted = [*(o.delta for o in orders), *(o.q[0].get(1, sp.Integer(0))
+                                            for o in orders[K - 1:])]
+    subexprs, reduced = sp.cse([_damped_horner(e).xreplace(to_args) for e in wanted],
+                               symbols=sp.numbered_symbols("d_"), order="canonical")
+    prelude += [*subexprs, *zip([*named, *constants], reduced, strict=True),
+                (delta, sp.Symbol("delta0") + sum(named[:K]))]
+    omitted, last = sizes[1], sizes[0]
+    guard = sp.And(sp.Ne(eps, 0), Q > 0, sp.Ne(Delta, 0), omitted <= last,
+                   omitted <= DAMPED_TRUNCATION * A1,
+                   sp.Abs(zs[-1] - zs[-2]) <= ROOT_RESOLVED * sp.Abs(z))
+    summed = orders[:K]
+    evaluators = []
+    for n in range(1, min(2 * K + 1, DAMPED_HARMONICS) + 1, 2):
+        alpha = (A1 if n == 1 else 0) + sum(_damped_horner(o.q[0].get(n, sp.Integer(0)))
+                                            for o in summed)
+        beta = sum(_damped_horner(o.q[1].get(n, sp.Integer(0))) for o in summed)
+        c, s = sp.cos(n * delta), sp.sin(n * delta)
+        for name, out, what in ((f"A_{n}", alpha * c - beta * s, f"cos {n}ωt"),
+                                (f"B_{n}", alpha * s + beta * c, f"sin {n}ωt")):
+            subexprs, (expr,) = sp.cse(out.xreplace(to_args), symbols=sp.numbered_symbols("x_"),
+                                       order="canonical")
+            evaluators.append(Evaluator(
+                name, f"Coefficient of {what}, damped μ-expansion order {K} (eq. 10.66–10.72).",
+                (omega, eps, force, Q, branch), tuple(prelude), guard, tuple(subexprs), expr))
+    root_prelude = tuple(prelude[: len(steps) + ROOT_POLISH + 5])
+    evaluators.append(Evaluator(
+        "first_order", "A₁ of the branch: √u, u a root of u[(1 − ω² + ¾εu)² + ω²/Q²] = f².",
+        (omega, eps, force, Q, branch), root_prelude,
+        sp.And(sp.Ne(eps, 0), Q > 0, sp.Abs(zs[-1] - zs[-2]) <= ROOT_RESOLVED * sp.Abs(z)),
+        (), A1))
+    return Module(
+        name="driven_damped",
+        doc=f"Driven Duffing q'' + q'/Q + q + eps*q**3 = f cos(omega t): μ-expansion with phase "
+            f"to order {K}.",
+        constants=(("ORDER", K), ("MODEL", "driven (damped)")),
+        evaluators=tuple(evaluators),
+        provenance=provenance("driven_damped", K, command),
     )
 
 
@@ -699,8 +861,85 @@ class MuDerivation:
 
 
 @dataclass(frozen=True)
+class MuDampedDerivation:
+    """The damped μ-expansion's derivation to ``order`` (``mu_damped_derivation.tex.j2``):
+    ``F_j``, both secular conditions, ``b_{j−1}``, ``δ_{j−1}``, ``q_j`` and ``δ_j`` per order."""
+
+    order: int
+    orders: tuple[MuDampedOrder, ...]
+    determinant: sp.Expr  # Δ in x, a, γ
+
+
+@dataclass(frozen=True)
 class Unit:
     """What one command writes: a module and the documents beside it."""
 
     module: Module
-    documents: tuple[Derivation | MuDerivation, ...] = ()
+    documents: tuple[Derivation | MuDerivation | MuDampedDerivation | SlowFlowDocument, ...] = ()
+
+
+# --- the slow flow (averaging) ---------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SlowFlowDocument:
+    """The slow flow's equations for ``slow_flow.tex.j2``: ``R_k``, ``Φ_k`` by order."""
+
+    name: str
+    source: str  # the equation as the user wrote it
+    order: int
+    driven: bool
+    radial: tuple[sp.Expr, ...]
+    phase: tuple[sp.Expr, ...]
+
+
+def lower_slow_flow(flow: SlowFlow, command: str) -> Unit:
+    """Compiled right sides of the slow flow: ``slow_flow`` (``x = (r, φ)``),
+    ``slow_flow_jacobian`` and ``slow_flow_cartesian`` (``x = (u, v)``, ``u = r cos φ``,
+    ``v = −r sin φ``: regular through ``r = 0``), all in t, with the LaTeX of the flow."""
+    eps = sp.Symbol("eps")
+    taken = MODULE_NAMES | LOCAL_NAMES | frozenset(dir(builtins)) | frozenset(keyword.kwlist)
+    for p in flow.parameters:
+        if str(p) in taken or _LOCAL.fullmatch(str(p)) or re.fullmatch(r"x_\d+", str(p)):
+            raise InputError(f"parameter {str(p)!r}: the emitted module uses this name; "
+                             "rename the parameter")
+    params = tuple(sp.Symbol(str(p)) for p in flow.parameters)
+    r, phi, u, v = sp.symbols("r phi u v")
+    polar = [e.xreplace({R_SLOW: r, PHI_SLOW: phi}) for e in flow.rates]
+    cart = [sp.Add(*(eps ** (k + 1) * G[i] for k, G in enumerate(flow.cartesian)))
+            .xreplace({U_SLOW: u, V_SLOW: v}) for i in range(2)]
+    args = (eps, *params)
+    kernels = []
+    for name, doc, unpack, shape, entries in (
+        ("slow_flow", "(dr/dt, dphi/dt) at x = (r, phi); q = r cos("
+         + ("w t + phi), w = 1 + eps*sigma" if flow.driven else "t + phi)"), (r, phi), (2,),
+         tuple(((i,), e) for i, e in enumerate(polar))),
+        ("slow_flow_jacobian", "d(dr/dt, dphi/dt)/d(r, phi)", (r, phi), (2, 2),
+         tuple(((i, j), sp.diff(e, x)) for i, e in enumerate(polar)
+               for j, x in enumerate((r, phi)))),
+        ("slow_flow_cartesian", "(du/dt, dv/dt) at x = (u, v); q = u cos "
+         + ("w t + v sin w t" if flow.driven else "t + v sin t"),
+         (u, v), (2,), tuple(((i,), e) for i, e in enumerate(cart))),
+    ):
+        exprs = [e for _, e in entries]
+        subexprs, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x_"),
+                                   order="canonical")
+        kernels.append(ArrayKernel(
+            name, doc, unpack, args, shape, tuple(subexprs),
+            tuple((idx, e) for (idx, _), e in zip(entries, reduced, strict=True))))
+    module = Module(
+        name=f"{flow.name}_slow_flow",
+        doc=f"The slow flow of {flow.source} to order {flow.order} in eps (averaging, "
+            "near-identity transformation with mean-free generators)"
+            + (": the drive's frequency is w = 1 + eps*sigma" if flow.driven else "") + ".",
+        constants=(("ORDER", flow.order), ("UNKNOWNS", ("r", "phi")),
+                   ("PARAMETERS", tuple(str(a) for a in args))),
+        evaluators=(),
+        provenance=provenance(f"{flow.name}_slow_flow", flow.order, command,
+                              source=flow.source, parameters=[str(p) for p in params]),
+        kernels=tuple(kernels),
+    )
+    doc = SlowFlowDocument(flow.name, flow.source, flow.order, flow.driven,
+                           tuple(e.xreplace({R_SLOW: r, PHI_SLOW: phi}) for e in flow.radial),
+                           tuple(e.xreplace({R_SLOW: r, PHI_SLOW: phi}) for e in flow.phase))
+    return Unit(module, (doc,))

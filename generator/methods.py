@@ -41,14 +41,17 @@ from numba import njit
 from scipy.integrate import solve_ivp
 from scipy.special import ellipj
 
+from .averaging import slow_flow
 from .driven import (
     Branch,
     Drive,
     amplitudes,
     balance_equations,
+    damped_determinant,
     first_order_branches,
     harmonic_balance,
     mu_expansion,
+    mu_expansion_damped,
     mu_expansion_exact,
     one_harmonic,
 )
@@ -56,6 +59,7 @@ from .errors import InputError
 from .lindstedt import derive, derive_limit_cycle
 from .lower import (
     FOURIER_AGM_STEPS,
+    MuDampedDerivation,
     MuDerivation,
     NotesTable,
     PeriodFormula,
@@ -66,9 +70,11 @@ from .lower import (
     lower_choice,
     lower_derivation,
     lower_driven,
+    lower_driven_damped,
     lower_fourier,
     lower_free,
     lower_limit_cycle,
+    lower_slow_flow,
     x_,
 )
 from .models import Model, SelfExcited, check_order, duffing
@@ -531,8 +537,27 @@ FREE = Target(_free_files, _free_derive, _free_lower)
 LIMIT_CYCLE = Target(_cycle_files, _cycle_derive, _cycle_lower)
 MU = Target(lambda r: ("driven.py", "driven_derivation.tex"), _mu_derive, _mu_lower)
 BALANCE = Target(lambda r: ("balance.py",), _balance_derive, _balance_lower)
+
+
+def _mu_damped_derive(r: Request, progress: Progress | None) -> object:
+    if isinstance(r.order, bool) or not isinstance(r.order, int) or not 1 <= r.order <= 11:
+        raise InputError(f"order {r.order!r}: the damped μ-expansion is emitted at orders 1..11")
+    return mu_expansion_damped(r.order + 1)  # one order more: the truncation error's estimate
+
+
+def _mu_damped_lower(orders: object, r: Request) -> Unit:
+    return Unit(lower_driven_damped(orders, r.command),
+                (MuDampedDerivation(r.order, orders[: r.order], damped_determinant()),))
+
+
+MU_DAMPED = Target(lambda r: ("driven_damped.py", "driven_damped_derivation.tex"),
+                   _mu_damped_derive, _mu_damped_lower)
 FOURIER = Target(lambda r: ("fourier.py",), _fourier_derive, _fourier_lower)
 CHOSEN_PERIOD = Target(lambda r: ("chosen_period.py",), _choice_derive, _choice_lower)
+SLOW_FLOW = Target(lambda r: (f"{r.model.name}_slow_flow.py", f"{r.model.name}_slow_flow.tex"),
+                   lambda r, progress: slow_flow(r.model, r.order),
+                   lambda flow, r: lower_slow_flow(flow, r.command))
+# NOTE: the slow flow's request carries the user's models.Oscillator as its model.
 
 
 # --- driven: one method at one order at one ω ---------------------------------------------------

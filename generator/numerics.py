@@ -258,21 +258,22 @@ def escape_bound(eps: float, force: float) -> float:
 
 def flow_table(table: ForceTable, force: float, omega: float, y0: np.ndarray, period: float,
                samples: int = 64, steps: int | None = None,
-               bound: float = math.inf) -> tuple[np.ndarray, np.ndarray, float]:
-    """One period of ``q̈ + g(q, q̇) = f cos ωt`` (``g`` the table) from ``y0`` with its
-    monodromy columns, ``samples`` values of q over it and the time the trajectory escaped
-    past ``bound`` (−1 if it did not; the state and the samples from there are NaN):
-    Richardson-extrapolated from two RK4 step sizes, or plain RK4 with ``steps`` steps."""
+               bound: float = math.inf, extra: np.ndarray = NO_TERMS
+               ) -> tuple[np.ndarray, np.ndarray, float]:
+    """One period of ``q̈ + g(q, q̇) = f cos ωt`` (``g`` the table; the time-dependent rows
+    ``extra`` of :func:`_field` added) from ``y0`` with its monodromy columns, ``samples``
+    values of q over it and the time the trajectory escaped past ``bound`` (−1 if it did not;
+    the state and the samples from there are NaN): Richardson-extrapolated from two RK4 step
+    sizes, or plain RK4 with ``steps`` steps."""
     state = np.concatenate([np.asarray(y0, dtype=float), [1.0, 0.0, 0.0, 1.0]])
     bound = float(bound)
     args = (table.q_powers, table.v_powers, table.coefficients, table.cubic, float(force),
             float(omega))
+    extra = np.asarray(extra, dtype=float).reshape(-1, 4)
     if steps is not None:
-        return _rk4(state, 0.0, period, steps, *args, samples, bound, NO_TERMS)
-    coarse, qc, tc = _rk4(state, 0.0, period, STEPS_PER_PERIOD, *args, samples, bound,
-                          NO_TERMS)
-    fine, qf, tf = _rk4(state, 0.0, period, 2 * STEPS_PER_PERIOD, *args, samples, bound,
-                        NO_TERMS)
+        return _rk4(state, 0.0, period, steps, *args, samples, bound, extra)
+    coarse, qc, tc = _rk4(state, 0.0, period, STEPS_PER_PERIOD, *args, samples, bound, extra)
+    fine, qf, tf = _rk4(state, 0.0, period, 2 * STEPS_PER_PERIOD, *args, samples, bound, extra)
     escaped = min((t for t in (tc, tf) if t >= 0), default=-1.0)
     return fine + (fine - coarse) / 15, qf + (qf - qc) / 15, escaped
 
@@ -370,8 +371,8 @@ def shoot_explained(eps: float, force: float, omega: float, damping: float, gues
 
 def shoot_table(table: ForceTable, force: float, omega: float, guess: np.ndarray,
                 harmonics: int = 9, tol: float = 1e-12, max_iter: int = 30,
-                periods: int = 1, steps: int | None = None, bound: float = math.inf
-                ) -> PeriodicOrbit | ShootingFailure:
+                periods: int = 1, steps: int | None = None, bound: float = math.inf,
+                extra: np.ndarray = NO_TERMS) -> PeriodicOrbit | ShootingFailure:
     """Newton's method on ``φ_T(y₀) − y₀ = 0`` for ``q̈ + g(q, q̇) = f cos ωt`` (``g`` the
     polynomial ``table``); the monodromy matrix is its Jacobian + I.
 
@@ -386,7 +387,8 @@ def shoot_table(table: ForceTable, force: float, omega: float, guess: np.ndarray
     method finds no orbit, a :class:`ShootingFailure` says why: a trajectory that escapes
     past ``bound`` (a softening spring's well: ``|q|`` past :func:`escape_bound` moving
     outward, from the guess or from a Newton iterate), RK4 overflowing, a singular ``M − I``,
-    or no convergence.
+    or no convergence.  ``extra``: the time-dependent rows of :func:`_field` (a pump
+    ``c q cos(νt + φ)``, further drives), of a period dividing the orbit's.
     """
     T = periods * 2 * np.pi / omega  # periods = 3: the 1/3 subharmonic (eq. 10.83)
     samples = _samples(harmonics, STEPS_PER_PERIOD if steps is None else steps)
@@ -404,7 +406,8 @@ def shoot_table(table: ForceTable, force: float, omega: float, guess: np.ndarray
 
     step = np.full(2, np.nan)
     for k in range(max_iter):
-        end, _, at = flow_table(table, force, omega, y, T, steps=steps, bound=bound)
+        end, _, at = flow_table(table, force, omega, y, T, steps=steps, bound=bound,
+                                extra=extra)
         if at >= 0:
             return escape(k, y, at)
         if not np.all(np.isfinite(end)):  # RK4 overflowed: h is too big for the amplitude
@@ -427,7 +430,7 @@ def shoot_table(table: ForceTable, force: float, omega: float, guess: np.ndarray
                                f"(last step {np.max(np.abs(step)):.1e}, tolerance {tol:g})",
                                False, bound)
     end, qs, at = flow_table(table, force, omega, y, T, samples=samples, steps=steps,
-                           bound=bound)
+                             bound=bound, extra=extra)
     if at >= 0:
         return escape(None, y, at)
     if not (np.all(np.isfinite(end)) and np.all(np.isfinite(qs))):
@@ -837,3 +840,88 @@ def floquet_stable(trace: np.ndarray, zeta: float = 0.0) -> np.ndarray:
     (ζ = 0: ``|tr M| < 2``): with ``det M = e^(−4πζ)`` (Liouville) the roots of
     ``λ² − tr λ + det`` lie in the closed unit disc iff ``|tr M| ≤ 1 + det M`` (Jury)."""
     return np.abs(trace) < 1 + math.exp(-4 * math.pi * zeta)
+
+
+# --- the full Hill equation: stability of a periodic orbit known as a Fourier sum -------------
+
+HILL_STEPS = 2048
+# NOTE: RK4 steps per orbit period for the variational equation, Richardson-combined with
+# twice as many (as hill_multipliers): the multipliers to ~1e-10 for the orbits of the notes.
+
+
+def orbit_hill_rows(terms: dict[tuple[int, int], float], A: dict[int, float],
+                    B: dict[int, float], omega: float) -> np.ndarray:
+    """The ``extra`` rows ``(1, −2|c_n|, nω, arg c_n)`` (and ``(1, −c_0, 0, 0)``) of
+    ``−∂g/∂q(q(t)) ξ`` for ``q = Σ A_n cos nωt + B_n sin nωt`` and a force ``g = k(q) + c q̇``
+    (``terms`` ``{(a, b): c}``): ``∂g/∂q = Σ a c_a q^(a−1)`` by the float Fourier kernel,
+    exact (no truncation: ``M`` covers the top harmonic of ``q^(degree−1)``)."""
+    if any(b and (a, b) != (0, 1) for a, b in terms):
+        raise ValueError("orbit_hill_rows: the q̇ part of the force must be linear (c q̇)")
+    orders = sorted(set(A) | set(B))
+    degree = max((a for a, b in terms if b == 0), default=1)
+    M = max(1, max(orders, default=0) * max(degree - 1, 1))
+    q = laurent_from_fourier(M, np.array(orders), np.array([A.get(n, 0.0) for n in orders]),
+                             np.array([B.get(n, 0.0) for n in orders]))
+    stiffness = np.zeros(2 * M + 1, dtype=complex)
+    power = np.zeros(2 * M + 1, dtype=complex)
+    power[M] = 1.0  # q⁰
+    for a in range(1, degree + 1):
+        c = terms.get((a, 0), 0.0)
+        if c:
+            stiffness += a * c * power
+        power = laurent_product(power, q)
+    # NOTE: a harmonic below 1e-17 of the stiffness's size moves the monodromy by less than a
+    # rounding error: its row is dropped (each row is a cosine per RK4 stage).
+    negligible = 1e-17 * float(np.sum(np.abs(stiffness)))
+    rows = [(1.0, -stiffness[M].real, 0.0, 0.0)]
+    rows += [(1.0, -2 * abs(c), n * omega, float(np.angle(c)))
+             for n, c in enumerate(stiffness[M + 1:], start=1) if abs(c) > negligible]
+    return np.array(rows)
+
+
+def orbit_hill_multipliers(terms: dict[tuple[int, int], float], A: dict[int, float],
+                           B: dict[int, float], omega: float, extra: np.ndarray = NO_TERMS,
+                           steps: int = HILL_STEPS) -> np.ndarray:
+    """Floquet multipliers of the full Hill equation of an orbit ``q(t)`` of period ``2π/ω``
+    known as a Fourier sum (harmonic balance, a series): the variational equation
+    ``ξ̈ + c ξ̇ + ∂g/∂q(q(t)) ξ = Σ c_i ξ cos(ν_i t + φ_i)`` of ``q̈ + g(q, q̇) = f(t)``
+    (``g = k(q) + c q̇``, ``terms``; ``extra``: parametric rows ``(1, c_i, ν_i, φ_i)`` of the
+    equation itself, e.g. a pump).  Its coefficients are periodic and known: one RK4 pass of
+    the monodromy columns over the period (the compiled :func:`_rk4`, Richardson pair), with no
+    shooting of the nonlinear orbit.  The notes' test (:func:`hill_multipliers`) is this with
+    ``q`` cut to ``q₀``.
+
+    Why a pass and not Hill's truncated infinite determinant: the pass gives both multipliers
+    themselves (the verdict and the margin), damping and a pump need nothing new, its error is
+    the integrator's known O(h⁶) after Richardson; the determinant gives ``cos(2πν)`` only after
+    a truncation whose convergence must be checked harmonic by harmonic, and its damped form
+    needs the complex exponent."""
+    rows = orbit_hill_rows(terms, A, B, omega)
+    extra = np.asarray(extra, dtype=float).reshape(-1, 4)
+    if np.any(extra[:, 0] != 1.0):
+        raise ValueError("orbit_hill_multipliers: extra rows must be parametric (a = 1)")
+    rows = np.vstack([rows, extra])
+    damping = ForceTable.of({(0, 1): terms.get((0, 1), 0.0)})
+    T = 2 * np.pi / omega
+
+    def monodromy(n: int) -> np.ndarray:
+        y, _, _ = _rk4(np.array([1.0, 0.0, 1.0, 0.0, 0.0, 1.0]), 0.0, T, n,
+                       damping.q_powers, damping.v_powers, damping.coefficients, damping.cubic,
+                       0.0, 0.0, 1, math.inf, rows)
+        return y[2:].reshape(2, 2).T
+
+    with np.errstate(over="ignore", invalid="ignore"):
+        coarse, fine = monodromy(steps), monodromy(2 * steps)
+        M = fine + (fine - coarse) / 15
+    if not np.all(np.isfinite(M)):  # ξ grows past 1e308 within one period
+        return np.array([np.inf, 0.0], dtype=complex)
+    return np.linalg.eigvals(M)
+
+
+def multipliers_stable(multipliers: np.ndarray, dissipative: bool) -> bool:
+    """The verdict of :func:`shoot_table` on Floquet multipliers: all ``|λ| < 1`` with
+    damping; without, the pair on the unit circle (``|λ₁ + λ₂| = |tr M| < 2``)."""
+    lam = np.asarray(multipliers)
+    if dissipative:
+        return bool(np.all(np.abs(lam) < 1))
+    return bool(abs(np.sum(lam).real) < 2)

@@ -188,6 +188,13 @@ SUBHARMONIC = command_line((
     Opt("--eps", real(-0.3, 1.0), NUMBER), Opt("--force", real(-1.0, 1.0), NUMBER),
     Opt("--omega", real(0.2, 2.5), NUMBER)), plot="slow")
 
+PARAMETRIC = command_line((
+    Opt("--eps", real(0.01, 0.9), NUMBER), Opt("--zeta", maybe(real(0.0, 0.1)), NUMBER),
+    Opt("--gamma", maybe(real(-2.0, 2.0)), NUMBER), Opt("--omega-from", real(0.5, 1.0), NUMBER),
+    Opt("--omega-to", real(1.0, 1.5), NUMBER), Opt("--points", maybe(whole(2, 12)), INTEGER),
+    Opt("--harmonics", maybe(whole(1, 8)), st.sampled_from(("0", "101", "abc")))), plot="slow")
+# NOTE: its figure (221 ω, ~7 s) only where a value fails to parse, as the subharmonic's.
+
 EDGE_DRIVES = ("0.3", "1@", "@", "1@2@3", "abc@1", "0.3@-1", "-0.3@1.3", "0@1", "1e308@1e308",
                "0.3@1e5", "nan@1", "1@inf", "1e100@1", "0.3@1e-100")
 DRIVE = st.tuples(real(-0.5, 0.5), real(0.3, 2.2)).map("@".join)
@@ -242,12 +249,23 @@ DEMO = st.tuples(st.sampled_from(BAD_FOLDERS), st.sampled_from([[], ["--bogus"]]
     lambda p: ["--out", p[0], *p[1]])
 # NOTE: a valid demo runs for minutes (the `make demo` target); only refusals are fuzzed.
 
+SLOWFLOW = command_line((
+    Opt(None, st.sampled_from(["van_der_pol", "rayleigh",
+                               "q'' + q = eps*(-k*q' - q**3 + F*cos(w*t))"]),
+        st.sampled_from(["nosuch", "q'' + q + q**3 = 0", "2*q'' + q = eps*q'",
+                         "q'' + q = eps*sin(q)", "q'' + q = eps*q'*cos(t)*q",
+                         "q'' + q = eps*r*q'", "q'' + __import__('os')"]), number=False),
+    Opt("--order", maybe(whole(1, 3)), INTEGER),
+    Opt("--out", maybe(st.sampled_from(WRITABLE_FOLDERS)), st.sampled_from(BAD_FOLDERS),
+        number=False)))
+
 BUDGET = {"series": (SERIES, 2), "generate": (GENERATE, 2), "driven": (DRIVEN, 4),
           "response": (RESPONSE, 3), "subharmonic": (SUBHARMONIC, 2),
           "mixing": (mixing(), 3), "choose": (CHOOSE, 2), "clock": (CLOCK, 1),
           "scene": (SCENE, 1), "demo": (DEMO, 1), "models": (MODELS, 1),
-          "mathieu": (MATHIEU, 2), "tongues": (TONGUES, 2)}
-# NOTE: examples (pairs of runs side by side) per command: 42 runs, the file ~60 s on the
+          "mathieu": (MATHIEU, 2), "parametric": (PARAMETRIC, 2),
+          "slowflow": (SLOWFLOW, 2), "tongues": (TONGUES, 2)}
+# NOTE: examples (pairs of runs side by side) per command: 54 runs, the file ~60 s on the
 # 2-core machine with other work loading it (a refusal takes 0.1–3 s, a valid run 2–8 s).
 
 
@@ -278,6 +296,8 @@ test_fuzz_demo = _fuzz("demo")
 test_fuzz_models = _fuzz("models")
 test_fuzz_mathieu = _fuzz("mathieu")
 test_fuzz_tongues = _fuzz("tongues")
+test_fuzz_slowflow = _fuzz("slowflow")
+test_fuzz_parametric = _fuzz("parametric")
 
 
 NOT_FUZZED = {"sweep": "new (generator/sweep.py, being written): a dask cluster per run"}

@@ -74,13 +74,21 @@ def written(tmp_path_factory) -> dict[str, Path]:
     for model in ("duffing", "pendulum"):
         generate(model, 40, out)
     generate_driven(3, out)
+    generate_driven(3, out, damped=True)
+    from lindstedt.compiler import generate_slow_flow
+    from lindstedt.models import oscillator
+
+    generate_slow_flow(oscillator("q'' + q = eps*(-k*q' - q**3 + F*cos(w*t))", name="forced"),
+                       3, "cmd", out)
     texs = {f"order-high/{p.name}": p for p in out.glob("*.tex")}
     texs.update({f"generated/{p.name}": p for p in GENERATED.glob("*.tex")})
     return texs
 
 
 TEX_NAMES = [f"order-high/{m}_{kind}.tex" for m in ("duffing", "pendulum")
-             for kind in ("tables", "derivation")] + ["order-high/driven_derivation.tex"]
+             for kind in ("tables", "derivation")] + ["order-high/driven_derivation.tex",
+                                                      "order-high/driven_damped_derivation.tex",
+                                                      "order-high/forced_slow_flow.tex"]
 
 
 @pytest.mark.skipif(PDFLATEX is None, reason="pdflatex not installed (`make tex` installs it)")

@@ -1,0 +1,473 @@
+"""The slow flow of ``q̈ + q = ε f(q, q̇) (+ ε F cos ωt)``: averaging to any order.
+
+Van der Pol's variables ``q = u cos τ + v sin τ``, ``q' = −u sin τ + v cos τ`` put the equation
+in the standard form of averaging, ``x' = Σ ε^k F_k(x, τ)`` with ``x = (u, v)`` and
+``F_k = (−g_k sin τ, g_k cos τ)`` (``g_k`` the ε^k part of the right side).  A near-identity
+transformation ``x = y + Σ_{j≥1} ε^j w_j(y, τ)`` with mean-free ``w_j`` (Sanders, Verhulst &
+Murdock, *Averaging Methods*, §2.9; the Krylov–Bogoliubov–Mitropolsky convention)
+turns it into the autonomous slow flow ``y' = Σ ε^k G_k(y)``: the order-ε^k part of
+``∂_τ W + G + DW·G = F(y + W, τ)`` reads
+
+    ∂_τ w_k + G_k = [F(y + W, τ)]_k − Σ_{i+j=k} Dw_i · G_j,
+
+whose mean over τ is ``G_k`` and whose rest, integrated, is ``w_k`` (for k = 2 the book's
+second-order averaging, §2.9).  Every average and integral runs in the exact Fourier kernel
+(:class:`series.Trig` over ``QQ[u, v, params]``): in these variables ``F`` is a polynomial, free
+of the ``1/r`` of the polar form.  The polar flow (``u = r cos φ``, ``v = −r sin φ``, so
+``q = r cos(τ + φ)``)
+
+    dr/dt = Σ ε^k R_k(r, φ),   dφ/dt = Σ ε^k Φ_k(r, φ)
+
+follows exactly from ``G`` (``r' = (u u' + v v')/r``, ``φ' = (v u' − u v')/r²``).  Beyond
+the first order the flow depends on the transformation's convention (mean-free here; Nayfeh's
+multiple scales or a stroboscopic choice give other, equivalent flows); what an orbit does does
+not: a cycle's frequency, the transients once mapped back with ``w_j``.
+
+Drive: a term ``ε F cos ωt`` (or ``sin ωt``) is taken near resonance, ``ω = 1 + εσ``, in the
+time ``τ = ωt`` (``ω² q'' + q = ε f(q, ω q') + ε F cos τ``, with ``1/ω²`` expanded in ε), so the
+slow flow lives in the frame rotating with the drive and its fixed points are the steady
+states; it is reported in ``t`` (``d/dt = ω d/dτ``, truncated at the same order).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from functools import cached_property
+
+import numpy as np
+import sympy as sp
+from sympy.polys.domains import QQ
+
+from .errors import InputError
+from .models import Oscillator
+from .series import Ground, MPoly, Trig
+
+MAX_ORDER = 6
+# NOTE: order 6 of van der Pol takes about half a second, the driven Duffing's order 4 one;
+# each order costs 2–4× the one before (docs/benchmarks.md, "The slow flow").
+U, V = sp.Symbol("_u"), sp.Symbol("_v")  # van der Pol's variables ("_": no user name clashes)
+R, PHI = sp.Symbol("r", positive=True), sp.Symbol("phi")
+SIGMA = sp.Symbol("sigma")  # the detuning of a drive, ω = 1 + ε σ
+METHOD = "the slow flow"
+RESERVED = frozenset({"r", "phi", "u", "v", "x"})
+# NOTE: the polar and Cartesian variables and the emitted kernels' state vector x.
+
+
+@dataclass(frozen=True)
+class SlowFlow:
+    """The averaged equations of ``q̈ + q = ε f`` to order ``order`` (see the module docstring).
+
+    ``radial[k−1]``, ``phase[k−1]``: ``R_k(r, φ)`` and ``Φ_k(r, φ)`` (SymPy, exact rationals or
+    polynomials in ``parameters``); ``cartesian[k−1]``: ``G_k = (U_k, V_k)`` in ``(_u, _v)`` (the
+    τ-time flow); ``transform[j−1]``: ``w_j = (w_u, w_v)`` as SymPy expressions in ``_u, _v`` and
+    ``tau`` (j < order), the near-identity transformation back to ``q``.
+    """
+
+    name: str
+    source: str
+    order: int
+    coordinate: str
+    parameters: tuple[sp.Symbol, ...]
+    driven: bool
+    radial: tuple[sp.Expr, ...]
+    phase: tuple[sp.Expr, ...]
+    cartesian: tuple[tuple[sp.Expr, sp.Expr], ...]
+    transform: tuple[tuple[sp.Expr, sp.Expr], ...]
+
+    @cached_property
+    def rates(self) -> tuple[sp.Expr, sp.Expr]:
+        """``(dr/dt, dφ/dt)`` as SymPy expressions in ``r, phi, eps`` and the parameters."""
+        eps = sp.Symbol("eps")
+        return (sp.Add(*(eps ** (k + 1) * c for k, c in enumerate(self.radial))),
+                sp.Add(*(eps ** (k + 1) * c for k, c in enumerate(self.phase))))
+
+
+def slow_flow(osc: Oscillator, order: int) -> SlowFlow:
+    """The slow flow of ``osc`` (``q'' + q = eps*f(q, q')``, optionally ``+ eps*F*cos(w*t)``) to
+    order ``order``, or a one-line :class:`InputError` naming what does not fit."""
+    if isinstance(order, bool) or not isinstance(order, int) or not 1 <= order <= MAX_ORDER:
+        raise InputError(f"order {order!r}: the slow flow is derived to orders 1 … {MAX_ORDER}")
+    g, params, driven = _right_side(osc, order)
+    symbols = (U, V, *params)
+    ground = _ground(symbols)
+    F = _standard_form(g, ground, symbols, order)
+    G, W = _average(F, ground, order)
+    to_sp = ground.to_sympy
+    Gs = [tuple(sp.expand(to_sp(_mean(c))) for c in Gk) for Gk in G]
+    if driven:  # τ = ωt: d/dt = (1 + εσ) d/dτ, truncated
+        Gs = [tuple(sp.expand(a + (SIGMA * b if k else 0)) for a, b in
+                    zip(Gs[k], Gs[k - 1] if k else (0, 0), strict=True))
+              for k in range(order)]
+    radial, phase = zip(*(_polar(Gk) for Gk in Gs), strict=True)
+    if not driven and any(e.has(PHI) for e in radial + phase):
+        raise AssertionError(f"{osc.name}: an autonomous slow flow depends on φ")
+    tau = sp.Symbol("tau")
+    transform = tuple(tuple(_trig_expr(c, ground, tau) for c in Wj) for Wj in W[: order - 1])
+    return SlowFlow(name=osc.name, source=osc.equation.text, order=order,
+                    coordinate=str(osc.coordinate), parameters=params, driven=driven,
+                    radial=tuple(radial), phase=tuple(phase),
+                    cartesian=tuple(Gs), transform=transform)
+
+
+def _right_side(osc: Oscillator, order: int
+                ) -> tuple[dict[int, sp.Expr], tuple[sp.Symbol, ...], bool]:
+    """``{k: g_k}``: the ε^k part of ``q'' + q = g(q, q', cos τ, sin τ)`` (``q'`` the τ
+    derivative, ``τ = ωt``), with the symbolic parameters (σ added for a drive)."""
+    eq = osc.equation
+    q, qdot, qddot = eq.derivatives[:3]
+    eps = eq.small
+    form = "write it as q'' + q = eps*f(q, q') [+ eps*F*cos(w*t)]"
+    if eps is None:
+        raise osc.refuse(METHOD, f"no small parameter eps: {form}")
+    if osc.parametric != 0:
+        raise osc.refuse(METHOD, "it is parametrically excited (terms in both t and q)")
+    mass = sp.expand(eq.expression).coeff(qddot)
+    if mass != 1:
+        raise osc.refuse(METHOD, f"the coefficient of {qddot} is {mass}, not 1: {form}")
+    c, s = sp.Symbol("_cos"), sp.Symbol("_sin")
+    drive, omega = _drive(osc, c, s)
+    params = tuple(sorted(set(osc.parameters) - ({omega} if omega is not None else set())
+                          | ({SIGMA} if drive != 0 else set()), key=str))
+    taken = sorted({str(p) for p in params} & RESERVED)
+    if taken:
+        raise osc.refuse(METHOD, f"the parameter name(s) {', '.join(taken)}: r, phi, u, v and "
+                         "x are the slow flow's own variables; rename them")
+    if drive != 0 and omega is not None and SIGMA in set(osc.parameters):
+        raise osc.refuse(METHOD, "the name sigma is the detuning (w = 1 + eps*sigma); rename "
+                         "the parameter")
+    h = sp.expand(q - osc.force)
+    if not h.is_polynomial(q, qdot, eps):
+        raise osc.refuse(METHOD, "f(q, q') must be a polynomial")
+    if sp.expand(h.subs(eps, 0)) != 0:
+        raise osc.refuse(METHOD, f"at eps = 0 it is not q'' + q = 0 (left over: "
+                         f"{sp.sstr(sp.expand(h.subs(eps, 0)))}): {form}")
+    qp = sp.Symbol("_qp")  # dq/dτ
+    sigma_eps = eps * SIGMA if drive != 0 else sp.Integer(0)
+    w = 1 + sigma_eps
+    inverse = sp.Add(*((n + 1) * (-sigma_eps) ** n for n in range(order + 1)))  # 1/ω²
+    g = sp.expand(q * (1 - inverse) + (h.xreplace({qdot: w * qp}) + drive) * inverse)
+    parts = sp.Poly(g, eps).as_dict() if g != 0 else {}
+    out = {k: gk for (k,), gk in sorted(parts.items()) if 1 <= k <= order}
+    for k, gk in out.items():
+        try:
+            sp.Poly(gk, q, qp, c, s, *params, domain=QQ)
+        except (sp.PolynomialError, sp.CoercionFailed, sp.GeneratorsNeeded):
+            raise osc.refuse(METHOD, f"the coefficient {sp.sstr(gk)} of eps^{k} is not a "
+                             "polynomial with rational coefficients in the parameters (give "
+                             "values with --param)") from None
+    return ({k: gk.xreplace({q: sp.Symbol("_q")}) for k, gk in out.items()}, params,
+            drive != 0)
+
+
+def _drive(osc: Oscillator, c: sp.Symbol, s: sp.Symbol) -> tuple[sp.Expr, sp.Symbol | None]:
+    """The drive with ``cos(ωt) → _cos``, ``sin(ωt) → _sin`` (``τ = ωt``) and ``ω``'s symbol
+    (None for ω = 1 or no drive); a drive of another form is refused."""
+    t, eps = osc.equation.time, osc.equation.small
+    drive = sp.expand(osc.drive)
+    if drive == 0:
+        return drive, None
+    trig = {f for f in drive.atoms(sp.cos, sp.sin) if f.has(t)}
+    arguments = {f.args[0] for f in trig}
+    if len(arguments) != 1:
+        raise osc.refuse(METHOD, "the drive must be F*cos(w*t) (one frequency w, near 1)")
+    (arg,) = arguments
+    omega = sp.simplify(arg / t)
+    if omega.has(t) or not (omega == 1 or (omega.is_Symbol and omega != eps)):
+        raise osc.refuse(METHOD, f"the drive's frequency is {sp.sstr(omega)}: write "
+                         "cos(w*t) with w a parameter (taken as w = 1 + eps*sigma) or cos(t)")
+    out = drive.xreplace({sp.cos(arg): c, sp.sin(arg): s})
+    if out.has(t) or not out.is_polynomial(c, s) or sp.expand(out.subs(eps, 0)) != 0:
+        raise osc.refuse(METHOD, f"the drive {sp.sstr(drive)} is not eps*(F cos(w*t) + G "
+                         "sin(w*t)) (the forcing must be small, of order eps)")
+    return out, (omega if omega != 1 else None)
+
+
+def _ground(symbols: tuple[sp.Symbol, ...]) -> Ground:
+    """``QQ[u, v, params]``, the coefficient ring of every Fourier sum of the derivation."""
+    return Ground(QQ.poly_ring(*symbols))
+
+
+def _standard_form(g: dict[int, sp.Expr], ground, symbols, order: int
+                   ) -> list[tuple[Trig, Trig]]:
+    """``F_k = (−g_k sin τ, g_k cos τ)`` for ``k = 1 … order`` as Trig sums."""
+    zero = ground.poly([])
+
+    def const(value) -> Trig:
+        return Trig(ground.poly([ground.scalar(value)]), zero, ground)
+
+    C = Trig(ground.poly([ground.scalar(0), ground.scalar(1)]), zero, ground)
+    S = Trig(zero, ground.poly([ground.scalar(1)]), ground)
+    q = C * ground.scalar(U) + S * ground.scalar(V)
+    qp = C * ground.scalar(V) - S * ground.scalar(U)
+    powers: dict[tuple[str, int], Trig] = {}
+
+    def power(kind: str, base: Trig, n: int) -> Trig:
+        if n == 0:
+            return const(1)
+        if (kind, n) not in powers:
+            powers[kind, n] = power(kind, base, n - 1) * base
+        return powers[kind, n]
+
+    qs, qps, cs, ss = (sp.Symbol(n) for n in ("_q", "_qp", "_cos", "_sin"))
+    out = []
+    for k in range(1, order + 1):
+        gk = Trig(zero, zero, ground)
+        if k in g:
+            poly = sp.Poly(g[k], qs, qps, cs, ss)
+            for (a, b, i, j), coeff in sorted(poly.as_dict().items()):
+                term = power("q", q, a) * power("p", qp, b) * power("c", C, i) * \
+                    power("s", S, j)
+                gk = gk + term * ground.scalar(coeff)
+        out.append((gk * S * ground.scalar(-1), gk * C))
+    return out
+
+
+def _mean(T: Trig):
+    """The mean over τ of a Trig sum (its Fourier ``a_0``)."""
+    cos, _ = T.to_fourier()
+    return cos.get(0, T.ground.scalar(0))
+
+
+def _constant(T: Trig) -> Trig:
+    g = T.ground
+    return Trig(g.poly([_mean(T)]), g.poly([]), g)
+
+
+def _antiderivative(T: Trig) -> Trig:
+    """The mean-free antiderivative in τ: ``a_n cos nτ → (a_n/n) sin nτ``,
+    ``b_n sin nτ → −(b_n/n) cos nτ``."""
+    g = T.ground
+    cos, sin = T.to_fourier()
+    return Trig.from_fourier({n: b * g.scalar(Fraction(-1, n)) for n, b in sin.items()},
+                             {n: a * g.scalar(Fraction(1, n)) for n, a in cos.items() if n},
+                             g)
+
+
+def _partial(T: Trig, index: int) -> Trig:
+    """``∂/∂x_index`` (0 = u, 1 = v) of a Trig sum over ``QQ[u, v, …]`` (C is FLINT's gen 0)."""
+    return Trig(MPoly(T.cos_part.p.derivative(index + 1)),
+                MPoly(T.sin_part.p.derivative(index + 1)), T.ground)
+
+
+def _average(F: list[tuple[Trig, Trig]], ground, order: int
+             ) -> tuple[list[tuple[Trig, Trig]], list[tuple[Trig, Trig]]]:
+    """``G_k`` and ``w_k`` (k = 1 … order) by the order-ε^k equations of the module docstring;
+    ``F(y + W)`` by Taylor's formula in ``(u, v)``."""
+    zero = Trig(ground.poly([]), ground.poly([]), ground)
+    G: list[tuple[Trig, Trig]] = []
+    W: list[tuple[Trig, Trig]] = []
+    derivs: dict[tuple[int, int, int], tuple[Trig, Trig]] = {}
+
+    def d(m: int, a: int, b: int) -> tuple[Trig, Trig]:  # ∂_u^a ∂_v^b F_m / (a! b!)
+        key = (m, a, b)
+        if key not in derivs:
+            if a == b == 0:
+                derivs[key] = F[m - 1]
+            elif a:
+                prev = d(m, a - 1, b)
+                derivs[key] = tuple(_partial(c, 0) * ground.scalar(Fraction(1, a))
+                                    for c in prev)
+            else:
+                prev = d(m, 0, b - 1)
+                derivs[key] = tuple(_partial(c, 1) * ground.scalar(Fraction(1, b))
+                                    for c in prev)
+        return derivs[key]
+
+    for k in range(1, order + 1):
+        monomials: dict[tuple[int, int], list[Trig]] = {}  # [W_u^a W_v^b]_n, n < k
+        rhs = [zero, zero]
+        for m in range(1, k + 1):
+            n = k - m  # the order still needed from the Taylor terms
+            for a in range(n + 1):
+                for b in range(n + 1 - a):  # W = O(ε): W_u^a W_v^b starts at ε^(a+b)
+                    mono = _w_monomial(a, b, k, W, monomials, ground)[n]
+                    dm = d(m, a, b)
+                    rhs = [rhs[i] + dm[i] * mono for i in range(2)]
+        for i in range(1, k):
+            Gj = G[k - i - 1]
+            wi = W[i - 1]
+            for comp in range(2):
+                rhs[comp] = rhs[comp] - (_partial(wi[comp], 0) * Gj[0]
+                                         + _partial(wi[comp], 1) * Gj[1])
+        Gk = tuple(_constant(c) for c in rhs)
+        G.append(Gk)
+        if k < order:
+            W.append(tuple(_antiderivative(c - gk) for c, gk in zip(rhs, Gk, strict=True)))
+    return G, W
+
+
+def _w_monomial(a: int, b: int, k: int, W: list[tuple[Trig, Trig]],
+                monomials: dict[tuple[int, int], list[Trig]], ground) -> list[Trig]:
+    """``[W_u^a W_v^b]_n`` for ``n < k`` from the known ``w_1 … w_(k−1)`` (cached)."""
+    if (a, b) not in monomials:
+        zero = Trig(ground.poly([]), ground.poly([]), ground)
+        if a == b == 0:
+            one = Trig(ground.poly([ground.scalar(1)]), ground.poly([]), ground)
+            monomials[a, b] = [one] + [zero] * (k - 1)
+        else:
+            comp, base = ((0, _w_monomial(a - 1, b, k, W, monomials, ground)) if a
+                          else (1, _w_monomial(a, b - 1, k, W, monomials, ground)))
+            out = []
+            for n in range(k):
+                acc = zero
+                for j in range(1, min(n, len(W)) + 1):
+                    acc = acc + W[j - 1][comp] * base[n - j]
+                out.append(acc)
+            monomials[a, b] = out
+    return monomials[a, b]
+
+
+def _polar(Gk: tuple[sp.Expr, sp.Expr]) -> tuple[sp.Expr, sp.Expr]:
+    """``(R_k, Φ_k)`` from ``G_k = (U_k, V_k)``: ``u = r cos φ``, ``v = −r sin φ``,
+    ``r' = (u U + v V)/r``, ``φ' = (v U − u V)/r²``, reduced by ``sin² φ = 1 − cos² φ``."""
+    c, s = sp.Symbol("_c"), sp.Symbol("_s")
+    Uk, Vk = (e.xreplace({U: R * c, V: -R * s}) for e in Gk)
+    radial = sp.expand((R * c * Uk - R * s * Vk) / R)
+    phase = sp.expand((-R * s * Uk - R * c * Vk) / R**2)
+    out = []
+    for e in (radial, phase):
+        e = sp.reduced(e, [s**2 + c**2 - 1], s, c)[1] if e.has(s) else e
+        out.append(sp.collect(sp.expand(e.xreplace({c: sp.cos(PHI), s: sp.sin(PHI)})), R))
+    return out[0], out[1]
+
+
+def _trig_expr(T: Trig, ground, tau: sp.Symbol) -> sp.Expr:
+    """A Trig sum as ``Σ a_n cos nτ + b_n sin nτ`` (SymPy)."""
+    cos, sin = T.to_fourier()
+    return sp.Add(*(ground.to_sympy(a) * sp.cos(n * tau) for n, a in sorted(cos.items())),
+                  *(ground.to_sympy(b) * sp.sin(n * tau) for n, b in sorted(sin.items())))
+
+
+def fixed_points(flow: SlowFlow, eps: float, values: dict[str, float] | None = None,
+                 guesses: tuple[tuple[float, float], ...] = ((1.0, 0.0),)
+                 ) -> list[tuple[float, float]]:
+    """Fixed points ``(r, φ)`` of a driven slow flow (the steady states), by Newton's method in
+    van der Pol's variables from each guess; for an autonomous flow the positive roots ``r`` of
+    ``dr/dt`` (the limit cycles) with ``φ`` the phase rate ``dφ/dt`` there."""
+    subs = {sp.Symbol("eps"): eps, **{sp.Symbol(k): v for k, v in (values or {}).items()}}
+    if not flow.driven:
+        dr, dphi = (e.subs(subs) for e in flow.rates)
+        out = []
+        coeffs = [float(c) for c in sp.Poly(sp.expand(dr), R).all_coeffs()]
+        dp = sp.lambdify(R, dphi, "math")
+        for root in np.roots(coeffs):
+            if abs(root.imag) < 1e-12 * (1 + abs(root)) and root.real > 0:
+                out.append((float(root.real), float(dp(root.real))))
+        return sorted(out)
+    Gs = [sp.Add(*(sp.Symbol("eps") ** (k + 1) * Gk[i] for k, Gk in enumerate(flow.cartesian)))
+          for i in range(2)]
+    f = sp.lambdify((U, V), [e.subs(subs) for e in Gs], "numpy")
+    J = sp.lambdify((U, V), sp.Matrix([[sp.diff(e.subs(subs), x) for x in (U, V)]
+                                        for e in Gs]), "numpy")
+    found = []
+    for r0, p0 in guesses:
+        x = np.array([r0 * np.cos(p0), -r0 * np.sin(p0)])
+        for _ in range(100):
+            step = np.linalg.solve(np.asarray(J(*x), dtype=float), np.asarray(f(*x), dtype=float))
+            x = x - step
+            if np.max(np.abs(step)) < 1e-15 * (1 + np.max(np.abs(x))):
+                break
+        else:
+            continue
+        found.append((float(np.hypot(*x)), float(np.arctan2(-x[1], x[0]))))
+    return found
+
+
+def transient(flow: SlowFlow, eps: float, q0: float, p0: float, times: np.ndarray,
+              values: dict[str, float] | None = None, rtol: float = 1e-12) -> np.ndarray:
+    """``q(t)`` and ``q̇(t)`` predicted by the slow flow from ``q(0) = q0``, ``q̇(0) = p0``: the
+    averaged equations integrated (SciPy's DOP853) from ``y(0)`` that the near-identity
+    transformation maps to the initial state, then mapped back, ``x = y + Σ ε^j w_j(y, τ)``.
+    Shape ``(2, len(times))``.  Error ``O(ε^order)`` over ``t = O(1/ε)``."""
+    from scipy.integrate import solve_ivp
+
+    eps_s, tau = sp.Symbol("eps"), sp.Symbol("tau")
+    subs = {eps_s: eps, **{sp.Symbol(k): v for k, v in (values or {}).items()}}
+    sigma = float(subs.get(SIGMA, 0.0)) if flow.driven else 0.0
+    w = 1 + eps * sigma
+    # the τ-time flow: the t-time G divided by ω (exact in floating point)
+    Gs = [sp.Add(*(eps_s ** (k + 1) * Gk[i] for k, Gk in enumerate(flow.cartesian))).subs(subs)
+          / w for i in range(2)]
+    rhs = sp.lambdify((U, V), Gs, "numpy")
+    Ws = [sp.Add(*(eps_s ** (j + 1) * Wj[i] for j, Wj in enumerate(flow.transform))).subs(subs)
+          for i in range(2)]
+    back = sp.lambdify((U, V, tau), Ws, "numpy")
+
+    def to_x(y: np.ndarray, t: np.ndarray) -> np.ndarray:
+        dw = np.asarray([np.broadcast_to(c, np.shape(t)) for c in back(y[0], y[1], t)])
+        return y + dw
+
+    x0 = np.array([q0, p0 / w])  # at τ = 0: q = u, dq/dτ = v
+    y0 = x0.copy()
+    for _ in range(60):  # y0 = x0 − W(y0, 0), a contraction for small ε
+        y0 = x0 - (to_x(y0, np.float64(0.0)) - y0)
+    taus = w * np.asarray(times, dtype=float)
+    sol = solve_ivp(lambda _t, y: np.asarray(rhs(*y), dtype=float), (0.0, taus[-1]), y0,
+                    method="DOP853", t_eval=taus, rtol=rtol, atol=rtol * 1e-2)
+    x = to_x(sol.y, taus)
+    q = x[0] * np.cos(taus) + x[1] * np.sin(taus)
+    qp = -x[0] * np.sin(taus) + x[1] * np.cos(taus)
+    return np.array([q, w * qp])
+
+
+def simulate(osc: Oscillator, eps: float, q0: float, p0: float, times: np.ndarray,
+             values: dict[str, float] | None = None, rtol: float = 1e-12) -> np.ndarray:
+    """The equation itself (SciPy's DOP853 at ``rtol``): ``(q, q̇)`` at ``times`` from
+    ``(q0, p0)``, the reference the slow flow's transients are measured against.  ``values``
+    gives the symbolic parameters numbers (``w`` the drive's frequency, not σ)."""
+    from scipy.integrate import solve_ivp
+
+    eq = osc.equation
+    q, qdot = eq.derivatives[:2]
+    subs = {eq.small: eps, **{sp.Symbol(k): v for k, v in (values or {}).items()}}
+    accel = sp.lambdify((eq.time, q, qdot), (osc.drive - osc.force).subs(subs), "math")
+    sol = solve_ivp(lambda t, y: (y[1], accel(t, y[0], y[1])), (0.0, float(times[-1])),
+                    (q0, p0), method="DOP853", t_eval=times, rtol=rtol, atol=rtol * 1e-2)
+    return sol.y
+
+
+@dataclass(frozen=True)
+class CycleSeries:
+    """A limit cycle as a fixed point of an autonomous slow flow: ``r* = Σ ε^j radius[j]``
+    (the root of ``dr/dt``, to ``ε^(order−1)``) and its frequency ``ω = Σ ε^j omega[j]``
+    (``1 + dφ/dt`` there, to ``ε^order``, exact: ω does not depend on the convention)."""
+
+    radius: tuple[sp.Expr, ...]
+    omega: tuple[sp.Expr, ...]
+    slope: sp.Expr  # R_1'(r₀): the cycle attracts for ε·slope < 0
+
+
+def cycle_series(flow: SlowFlow) -> list[CycleSeries]:
+    """Every positive root ``r₀`` of ``R_1`` where ``R_1'(r₀) ≠ 0`` (rational roots; an
+    irrational one is kept as SymPy's exact algebraic number), continued order by order:
+    ``r_i`` from the ε^i part of ``(dr/dt)/ε``, linear in ``r_i`` with slope ``R_1'(r₀)``."""
+    if flow.driven:
+        raise InputError(f"{flow.name}: a driven flow's fixed points depend on the drive; "
+                         "use fixed_points with values")
+    eps = sp.Symbol("eps")
+    N = flow.order
+
+    def truncated(expr: sp.Expr, top: int) -> sp.Expr:
+        expr = sp.expand(expr)
+        return sp.Add(*(expr.coeff(eps, i) * eps**i for i in range(top + 1)))
+
+    out = []
+    R1 = flow.radial[0]
+    if R1 == 0 or R1.free_symbols - {R}:
+        return out
+    for r0 in sp.Poly(R1, R).real_roots():
+        slope = sp.diff(R1, R).subs(R, r0)
+        if r0 <= 0 or slope == 0 or any(c.radius[0] == r0 for c in out):
+            continue
+        rstar = r0
+        for i in range(1, N):
+            radial = truncated(sum(eps**k * flow.radial[k].subs(R, rstar) for k in range(N)), i)
+            rstar = rstar - sp.radsimp(radial.coeff(eps, i) / slope) * eps**i
+        phase = truncated(sum(eps ** (k + 1) * flow.phase[k].subs(R, rstar) for k in range(N)),
+                          N)
+        out.append(CycleSeries(
+            radius=tuple(sp.expand(rstar).coeff(eps, i) if i else r0 for i in range(N)),
+            omega=(sp.Integer(1), *(sp.radsimp(phase.coeff(eps, k)) for k in range(1, N + 1))),
+            slope=slope))
+    return out
