@@ -39,6 +39,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/q_speed_accuracy.py
 	$(BIN)/python benchmarks/driven_speed_accuracy.py
 	$(BIN)/python benchmarks/slow_flow.py
+	$(BIN)/python benchmarks/ince_strutt.py
 
 # The committed copies: docs/figures (the README's computed figures, byte-identical run to run)
 # and generated/ (the default evaluators and LaTeX).
@@ -47,6 +48,8 @@ figures: $(STAMP)
 	$(BIN)/python -c "from lindstedt.charts import slow_flow_figures; slow_flow_figures('docs/figures')"
 	$(BIN)/python -c "from lindstedt.charts import PARAMETRIC_FIGURE, parametric_figure; \
 	parametric_figure(*PARAMETRIC_FIGURE, 'docs/figures/parametric.png')"
+	$(BIN)/python -c "from lindstedt.charts import ince_strutt_figure; \
+	ince_strutt_figure('docs/figures/ince_strutt.png')"
 
 generated: $(STAMP)
 	$(BIN)/lindstedt generate duffing --order 12 --out generated

@@ -9,8 +9,9 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
                over complex128 for the numeric methods
     lindstedt  L–P series, order-by-order equations, naive expansion    Model, K -> SeriesSolution
                and the limit cycles of q'' + q = ε f(q, q')             SelfExcited, K -> LimitCycle
-    hill       Mathieu's a_m(q), b_m(q) as exact series (L–P about      kind, m, K -> [c_k]
-               cos mz, sin mz)
+    hill       Hill's equation x'' + (δ + ε p(t))x = 0: transition      p(t), n, K -> curves
+               curves out of each tongue, a damped tongue's tip, and
+               Mathieu's a_m(q), b_m(q), exact (L–P about cos nτ, sin nτ)
     averaging  the slow flow of q'' + q = ε f (+ ε F cos ωt): near-     Oscillator, K -> SlowFlow
                identity averaging to any order in van der Pol's
                variables, exact (R_k, Φ_k of dr/dt, dφ/dt)

@@ -10,6 +10,7 @@ import re
 import sys
 import time
 from collections.abc import Sequence
+from fractions import Fraction
 from pathlib import Path
 
 from . import __version__
@@ -215,20 +216,22 @@ def _cmd_series(args: argparse.Namespace) -> int:
     return 0
 
 
-def _singularities(omega, variable: str) -> tuple[list[dict], str]:
-    """``--singularities``: the nearest singularity of ω estimated from its exact series."""
+def _singularities(omega, variable: str, of: str = "omega", degree: int | None = 1
+                   ) -> tuple[list[dict], str]:
+    """``--singularities``: the nearest singularity of ω (or of the series ``of``) estimated
+    from its exact series (``degree``: of :func:`lindstedt.nearest_singularity`)."""
     from .lindstedt import nearest_singularity
 
     if omega is None:
         raise InputError("--singularities: the coefficients stay symbolic; give every "
                          "parameter a value (--param)")
     name = variable.partition("=")[0].strip() or variable
-    est = nearest_singularity(omega, name)
+    est = nearest_singularity(omega, name, degree)
     if est is None:
         return [], "singularities: too few nonzero coefficients for an estimate (raise --order)"
     row = {"variable": est.variable, "radius": est.radius, "angle": est.angle,
            "spread": est.spread, "method": est.method}
-    return [row], (f"nearest singularity of omega ({est.method}): |{est.variable}| = "
+    return [row], (f"nearest singularity of {of} ({est.method}): |{est.variable}| = "
                    f"{est.radius:.6g}, angle ±{est.angle:.6g} rad, spread {est.spread:.2g}")
 
 
@@ -245,14 +248,129 @@ def _cmd_mathieu(args: argparse.Namespace) -> int:
             print(path)
         return 0
     series = mathieu_series(args.kind, args.m, args.order)
+    data = {"kind": args.kind, "m": args.m, "variable": "q",
+            "series": [_fraction_text(c) for c in series]}
+    line = ""
+    if args.singularities:  # a_2n, b_2n live in q²: the estimate names q**2
+        data["singularities"], line = _singularities(series, "q", f"{args.kind}_{args.m}", None)
+        if data["singularities"] and data["singularities"][0]["variable"] == "q**2":
+            row = data["singularities"][0]
+            line += f" (|q| = {math.sqrt(row['radius']):.6g})"
     if args.json:
-        print(json.dumps({"kind": args.kind, "m": args.m, "variable": "q",
-                          "series": [_fraction_text(c) for c in series]}))
+        print(json.dumps(data))
         return 0
     print(f"{args.kind}_{args.m}(q) of y'' + (a - 2q cos 2z) y = 0 (DLMF 28.2.1), order "
           f"{args.order}: coefficient of q^k")
     for k, c in enumerate(series):
         print(f"{k:>4}  {_fraction_text(c)}")
+    if line:
+        print(line)
+    return 0
+
+
+def _series_value(coefficients, x: float) -> tuple[float, float, int]:
+    """The partial sum at ``x``, its change over the last two nonzero terms (the truncation
+    error estimate) and the order K of the smallest such change (the best reachable)."""
+    total, last, changes = 0.0, [], []
+    for k, c in enumerate(coefficients):
+        term = float(c) * x**k
+        total += term
+        if c:
+            last.append(abs(term))
+            changes.append((sum(last[-2:]), k))
+    if len(changes) < 2:
+        return total, 0.0, len(coefficients) - 1
+    best = min(changes[1:])
+    return total, changes[-1][0], best[1]
+
+
+def _radius(coefficients) -> float:
+    """The estimated radius of convergence in the series' own variable (inf if too short)."""
+    from .lindstedt import nearest_singularity
+
+    est = nearest_singularity(coefficients, "x", None)
+    if est is None:
+        return math.inf
+    return math.sqrt(est.radius) if est.variable == "x**2" else est.radius
+
+
+DAMPING_PANEL = 0.05
+# NOTE: the damped panel of `tongues --plot` without --damping: the tongues visibly lift.
+
+
+def _cmd_tongues(args: argparse.Namespace) -> int:
+    """``lindstedt tongues P --n N --order K``: the transition curves out of tongue n of
+    x'' + (δ + ε p(t))x = 0, exact; ``--damping Z``: the damped tongue's tip."""
+    from .hill import fourier_of_text, tongue_tip, transition_curves
+
+    if args.tol is not None and args.at is None:
+        raise InputError("--tol: give --at EPS, the eps the tolerance is asked at")
+    if args.plot:
+        from .charts import check_plot_path
+
+        check_plot_path(Path(args.plot))  # before any work
+    p = fourier_of_text(args.p)
+    tongue = transition_curves(p, args.n, args.order)
+    period = "2*pi" if args.n % 2 == 0 else "4*pi"
+    data: dict = {
+        "p": args.p, "n": args.n, "variable": "eps",
+        "delta0": _fraction_text(Fraction(args.n * args.n, 4)),
+        "harmonics": {str(k): [_fraction_text(a), _fraction_text(b)] for k, (a, b) in p.items()},
+        "time_origin": "pi/2" if tongue.shift else "0", "period": period,
+        "solution_variable": "tau = (t - time_origin)/2", "curves": []}
+    lines = [f"tongue n = {args.n} of x'' + (delta + eps p(t)) x = 0, p(t) = {args.p}: "
+             f"delta = {data['delta0']} + sum_k delta_k eps^k, order {args.order}; "
+             f"periodic solutions of period {period}"
+             + (" (in t - pi/2: p is even about t = pi/2)" if tongue.shift else "")]
+    for curve in tongue.curves:
+        row = {"label": curve.label, "series": [_fraction_text(c) for c in curve.delta],
+               "solution": [{"cos": {str(j): _fraction_text(c) for (kind, j), c in x.items()
+                                     if kind == 0},
+                             "sin": {str(j): _fraction_text(c) for (kind, j), c in x.items()
+                                     if kind == 1}} for x in curve.solution]}
+        lines.append(f"curve {curve.label}: k, delta_k")
+        lines += [f"{k:>4}  {_fraction_text(c)}" for k, c in enumerate(curve.delta)]
+        if args.singularities:
+            row["singularities"], line = _singularities(list(curve.delta), "eps",
+                                                        f"delta ({curve.label})", None)
+            lines.append(line)
+        if args.at is not None:
+            value, error, best = _series_value(curve.delta, args.at)
+            radius = _radius(curve.delta)
+            if abs(args.at) >= radius:  # outside the disc of convergence: no value
+                value, error = math.nan, math.inf
+            if args.tol is not None and not error <= args.tol:
+                _, best_error, _ = _series_value(curve.delta[:best + 1], args.at)
+                raise InputError(f"--tol {args.tol:g}: not reached at eps = {args.at:g} by order "
+                                 f"{args.order} (estimate {error:.2g}); the best reachable is "
+                                 f"{best_error:.2g} at order {best}")
+            row["at"] = {"eps": args.at, "delta": value, "error": error, "radius": radius}
+            lines.append(f"at eps = {args.at:g}: delta = {value:.15g} (truncation ~{error:.2g}"
+                         f"; radius of convergence ~{radius:.4g})")
+        data["curves"].append(row)
+    if args.damping is not None:
+        tip = tongue_tip(p, args.n, args.order)
+        eps, _, _ = _series_value(tip.eps_min, args.damping)
+        delta, err, _ = _series_value(tip.delta, args.damping)
+        data["damping"] = {
+            "variable": "zeta", "equation": "x'' + 2 zeta x' + (delta + eps p(t)) x = 0",
+            "eps_min": [_fraction_text(c) for c in tip.eps_min],
+            "delta_at_min": [_fraction_text(c) for c in tip.delta],
+            "mu_max": [_fraction_text(c) for c in tip.mu],
+            "at": {"zeta": args.damping, "eps_min": eps, "delta": delta, "error": err}}
+        lines.append("damped tongue tip: eps_min(zeta) = sum_k e_k zeta^k at delta = sum_k "
+                     "d_k zeta^k (k, e_k, d_k)")
+        lines += [f"{k:>4}  {_fraction_text(e):>24}  {_fraction_text(d)}"
+                  for k, (e, d) in enumerate(zip(tip.eps_min, tip.delta, strict=True))]
+        lines.append(f"at zeta = {args.damping:g}: eps_min = {eps:.12g}, delta = {delta:.12g}")
+    print(json.dumps(data) if args.json else "\n".join(lines))
+    if args.plot:
+        from .charts import ince_strutt_figure
+
+        path = ince_strutt_figure(Path(args.plot), args.p, args.damping or DAMPING_PANEL,
+                                  order=args.order, tongues=range(max(4, args.n + 1)))
+        if not args.json:
+            print(f"Ince–Strutt chart: {path}")
     return 0
 
 
@@ -473,6 +591,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     # (benchmarks/*speed_accuracy.py refresh the committed copies the README shows).
     print(f"  {speed_accuracy_figure(figures / 'speed_accuracy.png')}")
     print(f"  {driven_speed_accuracy_figure(figures / 'driven_speed_accuracy.png')}")
+    from .charts import ince_strutt_figure  # Hill's equation: Floquet grid and series curves
+
+    print(f"  {ince_strutt_figure(figures / 'ince_strutt.png')}")
     _demo_slow_flow(out, figures, args.overwrite_edited)
     _demo_parametric(figures)
     if shutil.which("pdflatex"):
@@ -1601,6 +1722,22 @@ def _real(text: str) -> float:
     return value
 
 
+def _nonnegative(text: str) -> float:
+    """A finite real number ≥ 0 (a damping ratio)."""
+    value = _real(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be ≥ 0")
+    return value
+
+
+def _positive_real(text: str) -> float:
+    """A finite real number > 0 (a tolerance)."""
+    value = _real(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be > 0")
+    return value
+
+
 def _quality(text: str) -> float:
     """A quality factor Q > 0; ``inf`` means undamped."""
     if not _number(text) > 0:
@@ -1764,7 +1901,42 @@ def build_parser() -> argparse.ArgumentParser:
                    "reference on a grid of q up to 50 and NaN beyond where it was verified")
     p.add_argument("--overwrite-edited", action="store_true",
                    help="with --emit: overwrite a file edited since it was generated")
+    p.add_argument("--singularities", action="store_true",
+                   help="also estimate the nearest singularity (radius of convergence) from "
+                   "the exact series, with its spread; in q**2 for a_2n, b_2n; with --json a "
+                   "key 'singularities'")
     p.set_defaults(func=_cmd_mathieu)
+
+    p = sub.add_parser("tongues", help="transition curves of Hill's equation x'' + (delta + "
+                       "eps p(t)) x = 0 out of a tongue", description="Both transition curves "
+                       "delta(eps) out of the tongue delta = n^2/4 of x'' + (delta + eps p(t))"
+                       " x = 0 as exact series, with the periodic solution on each (period 2pi "
+                       "for n even, 4pi for n odd); p(t) a finite sum of cos(k*t), sin(k*t) "
+                       "with rational coefficients.  Mathieu's a_m, b_m: p = cos(t), "
+                       "delta = a/4, eps = -q/2.")
+    p.add_argument("p", help="p(t), e.g. 'cos(t)' or 'cos(t) + 1/2*cos(2*t)'")
+    p.add_argument("--n", type=_order, default=1, metavar="N",
+                   help="the tongue delta = N^2/4, an integer ≥ 0 (default 1)")
+    _flag_order(p, "highest power K of eps")
+    p.add_argument("--damping", type=_nonnegative, metavar="Z",
+                   help="also the tip of the tongue of x'' + 2Z x' + (delta + eps p) x = 0: "
+                   "eps_min and its delta as series in zeta, and their values at Z")
+    p.add_argument("--at", type=_real, metavar="EPS",
+                   help="also evaluate each curve at eps = EPS with its truncation estimate")
+    p.add_argument("--tol", type=_positive_real, metavar="TOL",
+                   help="with --at: refuse unless the truncation estimate is ≤ TOL (naming "
+                   "the best reachable)")
+    p.add_argument("--singularities", action="store_true",
+                   help="also estimate each curve's nearest singularity in eps (radius of "
+                   "convergence) with its spread")
+    p.add_argument("--plot", metavar="FILE",
+                   help="also draw the Ince–Strutt chart of this p into FILE (.png, .svg or "
+                   ".pdf): Floquet multipliers on a 400 x 400 grid, undamped and with damping "
+                   f"Z (default {DAMPING_PANEL}), the series curves of tongues 0..max(3, N)")
+    _flag_json(p, "the curves as JSON {p, n, variable, delta0, harmonics, time_origin, period, "
+               "solution_variable, curves: [{label, series, solution}], damping}")
+    _flag_allow_slow(p, deprecated_force=False)
+    p.set_defaults(func=_cmd_tongues)
 
     p = sub.add_parser("models", help="list the named oscillators",
                        description="The named oscillators: each is an equation (any equation "

@@ -361,6 +361,25 @@ def mathieu_cost(args: argparse.Namespace) -> Cost:
                 "the Mathieu series")
 
 
+INCE_STRUTT_SECONDS = 20.0
+# NOTE: `tongues --plot`: two 400 × 400 Floquet grids (~5 s each, 2 cores) and the curves.
+TONGUES_FIT = (0.5, 0.4, 100, 3.0)
+# NOTE: `lindstedt tongues`: both curves of p = cos t at order 100 in 0.35 s; the harmonics of
+# x_k grow with p's highest harmonic h, the cost as h^2.5 (2.2 s for h = 2 at order 100).
+
+
+def tongues_cost(args: argparse.Namespace) -> Cost:
+    from .hill import fourier_of_text
+
+    top = max(fourier_of_text(args.p))
+    seconds = power_law(*TONGUES_FIT, args.order) * top**2.5
+    if args.damping is not None:
+        seconds *= 2
+    if args.plot:
+        seconds += INCE_STRUTT_SECONDS
+    return Cost(seconds, f"order {args.order}, harmonic {top}", "the transition curves")
+
+
 SLOW_FLOW_FIT = (2.0, 0.95, 4, "2.2")
 # NOTE: `lindstedt slowflow` (start-up, then derive): the driven Duffing, the costliest family,
 # takes 0.95 s to derive at order 4, and the whole command 4.2 s at order 5, 6.1 s at order 6
@@ -407,6 +426,7 @@ COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "scene": fixed_cost("scene"),
     "models": fixed_cost("models"),
     "mathieu": mathieu_cost,
+    "tongues": tongues_cost,
     "slowflow": slow_flow_cost,
 }
 # NOTE: one estimator per command; `demo` has none: its work is the fixed built-in job

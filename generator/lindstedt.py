@@ -774,13 +774,15 @@ class Singularity:
     method: str
 
 
-def nearest_singularity(coefficients: Sequence[Fraction], variable: str = "eps"
-                        ) -> Singularity | None:
+def nearest_singularity(coefficients: Sequence[Fraction], variable: str = "eps",
+                        degree: int | None = 1) -> Singularity | None:
     """Domb–Sykes (ratios c_n/c_(n−1), for one real singularity: a tail of one sign or of
     alternating signs) or Mercer–Roberts (a complex-conjugate pair: B_n² = (c_(n+1)c_(n−1) −
     c_n²)/(c_n c_(n−2) − c_(n−1)²) → 1/R², cos θ from the same), each estimate extrapolated
-    linearly in 1/n over the last orders.  A series with zero odd terms is read in the square
-    of ``variable``.  None with fewer than 12 usable coefficients."""
+    linearly in 1/n over the last orders — or by a polynomial of ``degree`` in 1/n (the
+    ratios of an algebraic branch point go as 1 + a/n + b/n² + …); ``degree=None`` takes the
+    degree 1..3 whose fits over the last orders spread least.  A series with zero odd terms is
+    read in the square of ``variable``.  None with fewer than 12 usable coefficients."""
     import mpmath
 
     c = list(coefficients)
@@ -819,18 +821,35 @@ def nearest_singularity(coefficients: Sequence[Fraction], variable: str = "eps"
     if len(ns) < 4:
         return None
 
-    def extrapolate(values: list, lo: int) -> float:
+    def extrapolate(values: list, lo: int, degree: int) -> float:
         x = [1 / mpmath.mpf(n) for n in ns[lo:]]
         y = [mpmath.mpf(v) for v in values[lo:]]
-        mx, my = sum(x) / len(x), sum(y) / len(y)
-        sxx = sum((a - mx) ** 2 for a in x)
-        slope = sum((a - mx) * (b - my) for a, b in zip(x, y, strict=True)) / sxx
-        return float(my - slope * mx)
+        if degree == 1:
+            mx, my = sum(x) / len(x), sum(y) / len(y)
+            sxx = sum((a - mx) ** 2 for a in x)
+            slope = sum((a - mx) * (b - my) for a, b in zip(x, y, strict=True)) / sxx
+            return float(my - slope * mx)
+        with mpmath.workdps(50):  # least squares in x·n_lo ∈ (0, 1]: well conditioned
+            A = mpmath.matrix([[(a * ns[lo]) ** d for d in range(degree + 1)] for a in x])
+            return float(mpmath.lu_solve(A.T * A, A.T * mpmath.matrix(y))[0])
 
     half = len(ns) // 2
-    fits = [extrapolate(radii, lo) for lo in range(0, half + 1)]
-    angle_fits = [extrapolate(angles, lo) for lo in range(0, half + 1)]
+    degrees = [degree] if degree is not None else [
+        d for d in (1, 2, 3) if len(ns) - half >= d + 2]
+    best = None
+    for d in degrees:
+        try:
+            fits = [extrapolate(radii, lo, d) for lo in range(0, half + 1)]
+        except ZeroDivisionError:  # too few distinct orders for this degree
+            continue
+        if best is None or max(fits) - min(fits) < best[1]:
+            best = (d, max(fits) - min(fits), fits)
+    if best is None:
+        return None
+    chosen, spread, fits = best
+    angle_fits = [extrapolate(angles, lo, chosen) for lo in range(0, half + 1)]
     radius, angle = fits[-1], angle_fits[-1] if not real else angles[-1]
-    spread = max(fits) - min(fits)
-    return Singularity(variable, radius, float(angle), float(spread),
-                       "Domb–Sykes" if real else "Mercer–Roberts")
+    method = "Domb–Sykes" if real else "Mercer–Roberts"
+    if degree is None:
+        method += f", degree {chosen} in 1/n"
+    return Singularity(variable, radius, float(angle), float(spread), method)

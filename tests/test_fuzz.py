@@ -231,6 +231,16 @@ MATHIEU = command_line((
     Opt(None, st.sampled_from(["a", "b"]), st.sampled_from(["c", "", "A"]), number=False),
     Opt("--m", maybe(whole(1, 6)), INTEGER), Opt("--order", maybe(whole(0, 30)), INTEGER)))
 
+TONGUES = command_line((
+    Opt(None, st.sampled_from(["cos(t)", "cos(t) + 1/2*cos(2*t)", "sin(t)", "cos(t) + sin(2*t)"]),
+        st.sampled_from(["cos(sqrt(2)*t)", "t*cos(t)", "cos(t/2)", "a*cos(t)", "1", "",
+                         "__import__('os')", "cos(t) + sin(t)", "cos(99*t)"]), number=False),
+    Opt("--n", maybe(whole(0, 4)), INTEGER), Opt("--order", maybe(whole(0, 20)), INTEGER),
+    Opt("--damping", maybe(real(0.0, 0.1)), NUMBER), Opt("--at", maybe(real(-0.5, 0.5)), NUMBER),
+    Opt("--tol", maybe(real(1e-12, 1e-3)), NUMBER)), switches=("--json", "--singularities"),
+    plot="slow")
+# NOTE: a chart (two 400 × 400 Floquet grids, ~15 s) only where a value fails to parse.
+
 SCENE = command_line((Opt(None, st.just("clock"), st.sampled_from(["nosuch", "CLOCK", ""]),
                           number=False),))
 # NOTE: hard-spring (14 s) and notes-driven (9 s) are valid but slow; `choose` covers them.
@@ -254,8 +264,8 @@ BUDGET = {"series": (SERIES, 2), "generate": (GENERATE, 2), "driven": (DRIVEN, 4
           "mixing": (mixing(), 3), "choose": (CHOOSE, 2), "clock": (CLOCK, 1),
           "scene": (SCENE, 1), "demo": (DEMO, 1), "models": (MODELS, 1),
           "mathieu": (MATHIEU, 2), "parametric": (PARAMETRIC, 2),
-          "slowflow": (SLOWFLOW, 2)}
-# NOTE: examples (pairs of runs side by side) per command: 50 runs, the file ~60 s on the
+          "slowflow": (SLOWFLOW, 2), "tongues": (TONGUES, 2)}
+# NOTE: examples (pairs of runs side by side) per command: 54 runs, the file ~60 s on the
 # 2-core machine with other work loading it (a refusal takes 0.1–3 s, a valid run 2–8 s).
 
 
@@ -285,6 +295,7 @@ test_fuzz_scene = _fuzz("scene")
 test_fuzz_demo = _fuzz("demo")
 test_fuzz_models = _fuzz("models")
 test_fuzz_mathieu = _fuzz("mathieu")
+test_fuzz_tongues = _fuzz("tongues")
 test_fuzz_slowflow = _fuzz("slowflow")
 test_fuzz_parametric = _fuzz("parametric")
 

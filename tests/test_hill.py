@@ -75,3 +75,28 @@ def test_the_contract_and_bad_input(capsys):
                               text=True, check=False)
         assert done.returncode == 2 and done.stdout == "", args
         assert done.stderr.count("\n") == 1 and done.stderr.startswith("lindstedt: error:")
+
+
+TABLE_28_6_1 = {  # ρ_n^(j), n = 0 or 1: j = 1 for a_2n, 2 for b_2n+2, 3 for a_2n+1 and b_2n+1
+    ("a", 0): 1.4687686138, ("a", 2): 1.4687686138, ("b", 2): 6.9289547588,
+    ("b", 4): 6.9289547588, ("a", 1): 3.7699574940, ("b", 1): 3.7699574940,
+    ("a", 3): 3.7699574940,
+}
+
+
+@pytest.mark.parametrize(("kind", "m"), sorted(TABLE_28_6_1))
+def test_radius_of_convergence_against_table_28_6_1(kind, m, capsys):
+    """``mathieu --singularities`` at order 100: within 0.1 % of DLMF Table 28.6.1 (Meixner et
+    al. 1980), read in q**2 where the series lives in q² (a_2n, b_2n)."""
+    assert main(["mathieu", kind, "--m", str(m), "--order", "100", "--singularities",
+                 "--json"]) == 0
+    (row,) = json.loads(capsys.readouterr().out)["singularities"]
+    expected = TABLE_28_6_1[(kind, m)]
+    assert row["variable"] == ("q**2" if m % 2 == 0 else "q")
+    radius = row["radius"] ** 0.5 if row["variable"] == "q**2" else row["radius"]
+    assert abs(radius / expected - 1) < 1e-3, (kind, m, radius)
+    assert 0 < row["spread"] < 0.01 * row["radius"]
+    if row["method"].startswith("Domb–Sykes"):  # a real branch point: the fit in 1/n of
+        # degree 3 lands within 2e-6 and its spread covers the error
+        assert abs(radius / expected - 1) < 2e-6
+        assert abs(row["radius"] - expected ** 2) <= row["spread"]
