@@ -249,15 +249,18 @@ def _cmd_mathieu(args: argparse.Namespace) -> int:
 
 
 def _cmd_models(args: argparse.Namespace) -> int:
-    from .models import REGISTRY
+    from .models import ALIASES, REGISTRY
 
+    aliases = {e.name: sorted(a for a, name in ALIASES.items() if name == e.name)
+               for e in REGISTRY.values()}
     if args.json:
-        print(json.dumps([{"name": e.name, "equation": e.equation, "about": e.about}
-                          for e in REGISTRY.values()]))
+        print(json.dumps([{"name": e.name, "equation": e.equation, "about": e.about,
+                           "aliases": aliases[e.name]} for e in REGISTRY.values()]))
         return 0
     width = max(len(name) for name in REGISTRY)
     for e in REGISTRY.values():
-        print(f"{e.name:<{width}}  {e.equation:<44}  {e.about}")
+        also = f" (also: {', '.join(aliases[e.name])})" if aliases[e.name] else ""
+        print(f"{e.name:<{width}}  {e.equation:<44}  {e.about}{also}")
     return 0
 
 

@@ -159,9 +159,9 @@ def series_cost(args: argparse.Namespace) -> Cost:
     if args.model in SERIES_COSTS:
         seconds = power_law(*SERIES_COSTS[args.model], args.order)
     elif args.model.isidentifier():  # another registry name: its equation is known
-        from .models import REGISTRY
+        from .models import registry_entry
 
-        entry = REGISTRY.get(args.model)
+        entry = registry_entry(args.model)
         seconds = (oscillator_seconds(entry.equation, args.param, args.order) if entry
                    else power_law(*SERIES_COSTS["oscillator"], args.order))
     else:

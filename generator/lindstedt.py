@@ -25,7 +25,18 @@ import sympy as sp
 from .display import SHOWN_ORDERS, latex_aligned, latex_sum, latex_text, more
 from .errors import InputError
 from .models import Model, check_order, t
-from .series import Basis, Ground, Trig, solve_oscillator, solve_trig, to_fourier
+from .series import (
+    Basis,
+    Ground,
+    RelaxedProduct,
+    Trig,
+    TrigMap,
+    TrigSeries,
+    TrigTerms,
+    solve_oscillator,
+    solve_trig,
+    to_fourier,
+)
 
 CONVENTION = "q(0) = A, q'(0) = 0, so q_j(0) = 0 for j >= 1"
 s = sp.Symbol("s")
@@ -629,7 +640,8 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
     """ω, T/2π, q(0) and q_j of limit cycle ``cycle`` (by amplitude, smallest first) to order
     K.  At order j, ``q_j'' + q_j = F_j`` holds ``a_(j−1)`` (the unknown cos s of ``q_(j−1)``)
     and ``W_j`` (from ω²) linearly: the sin s condition fixes ``a_(j−1)``, the cos s one
-    ``W_j``; ``q_j'(0) = 0`` fixes its sin s."""
+    ``W_j``; ``q_j'(0) = 0`` fixes its sin s.  ``F_j = [ε^(j−1)] f(q, ω q') −
+    Σ_(i<j) W_i q''_(j−i) + W_j a₀ cos s``: every ε-product is a :class:`RelaxedProduct`."""
     order = check_order(order)
     top = order + 1  # q_K's cos s (so q(0)'s ε^K) is fixed by the secular condition of K + 1
     cycles = limit_cycle_amplitudes(model)
@@ -638,89 +650,67 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
     a0, slope = cycles[cycle]
     g = Ground.for_coefficients([])
     zero = g.scalar(0)
+    nothing = Trig(g.poly([]), g.poly([]), g)
 
-    def trig(cos: dict, sin: dict) -> Trig:
-        return Trig.from_fourier({n: g.scalar(c) for n, c in cos.items() if c},
-                                 {n: g.scalar(c) for n, c in sin.items() if c}, g)
+    def constant(c: Any) -> Trig:
+        return Trig(g.poly([c]), g.poly([]), g)
 
-    cos_s = trig({1: 1}, {})
-    one = Trig(g.poly([g.scalar(1)]), g.poly([]), g)
-    qs = [trig({1: a0}, {})]
+    cos_s = Trig.from_fourier({1: g.scalar(1)}, {}, g)
+    qs = [cos_s * g.scalar(a0)]
     W, omega = [g.scalar(1)], [g.scalar(1)]
-    powers: dict[tuple[str, int], list] = {}
+    # the series: q, q', q'', ω, X = (ω² − 1)/ε (X_k = W_(k+1)), and the products of f
+    q = TrigTerms(qs)
+    slope_q = TrigMap(q, Trig.derivative)
+    curvature = TrigMap(slope_q, Trig.derivative)
+    omegas = TrigTerms([constant(g.scalar(1))])
+    X = TrigTerms([])
+    nodes: list[TrigSeries] = [slope_q, curvature]
+    products: dict[tuple[str, int], TrigSeries] = {("q", 1): q}
 
-    slopes: dict[int, Trig] = {}  # q_i' and q_i'', each made once (index j − 1 remade when
-    curvatures: dict[int, Trig] = {}  # its cos s arrives)
+    def product(a: TrigSeries, b: TrigSeries) -> RelaxedProduct:
+        node = RelaxedProduct(a, b)
+        nodes.append(node)
+        return node
 
-    def slope_of(i: int) -> Trig:
-        if i not in slopes:
-            slopes[i] = qs[i].derivative()
-        return slopes[i]
+    products[("v", 1)] = product(omegas, slope_q)  # [ε^i] ω q'
 
-    def curvature_of(i: int) -> Trig:
-        if i not in curvatures:
-            curvatures[i] = slope_of(i).derivative()
-        return curvatures[i]
+    def power(kind: str, n: int) -> TrigSeries:
+        if (kind, n) not in products:
+            half = power(kind, n // 2)
+            sq = product(half, half)
+            products[(kind, n)] = sq if n % 2 == 0 else product(sq, power(kind, 1))
+        return products[(kind, n)]
 
-    def velocity(i: int) -> Trig:  # [ε^i] ω q'
-        acc = slope_of(i)
-        for k in range(1, i + 1):
-            acc = acc + slope_of(i - k) * omega[k]
-        return acc
-
-    def series(kind: str, n: int, i: int) -> Trig | None:
-        """[ε^i] q^n or (ω q')^n (None for n = 0 beyond i = 0), cached by index; an index is
-        recomputed once its q gains its cos s."""
-        if n == 0:
-            return one if i == 0 else None
-        table = powers.setdefault((kind, n), [])
-        while len(table) <= i:
-            m = len(table)
-            if n == 1:
-                table.append(qs[m] if kind == "q" else velocity(m))
-                continue
-            base = [series(kind, 1, k) for k in range(m + 1)]
-            acc = series(kind, n - 1, 0) * base[m]
-            for k in range(1, m + 1):
-                acc = acc + series(kind, n - 1, k) * base[m - k]
-            table.append(acc)
-        return table[i]
+    terms = []  # (series of q^a (ω q')^b, c); the constant term is only at ε^0
+    for a, b, c in model.terms:
+        if a and b:
+            terms.append((product(power("q", a), power("v", b)), g.scalar(c)))
+        elif a or b:
+            terms.append((power("q", a) if a else power("v", b), g.scalar(c)))
+        else:
+            terms.append((None, g.scalar(c)))
+    X_curvature = product(X, curvature)  # [ε^(j−1)]: Σ_(i≤j) W_i q''_(j−i), W_j (unknown) as 0
 
     def force(i: int) -> Trig:  # [ε^i] f(q, ω q')
-        total = Trig(g.poly([]), g.poly([]), g)
-        for a, b, c in model.terms:
-            for k in range(i + 1):
-                left, right = series("q", a, k), series("v", b, i - k)
-                if left is not None and right is not None:
-                    total = total + left * right * g.scalar(c)
+        total = nothing
+        for series, c in terms:
+            if series is not None:
+                total = total + series.coeff(i) * c
+            elif i == 0:
+                total = total + constant(c)
         return total
 
     lin = None  # the a_(j−1) cos s part's image in F_j: f's linearisation at q_0, + W_1 cos s
     for j in range(1, top + 1):
-        known = force(j - 1)
-        for i in range(1, j):
-            known = known - curvature_of(j - i) * W[i]
+        X.terms.append(nothing)  # X_(j−1) = W_j, found below
+        known = force(j - 1) - X_curvature.coeff(j - 1)
+        a_prev = zero
         if j >= 2:
             if lin is None:
-                x = Trig.from_fourier({1: g.scalar(1)}, {}, g)
-                q0, v0 = qs[0], qs[0].derivative()
-                lin = Trig(g.poly([]), g.poly([]), g)
-                for a, b, c in model.terms:  # d/dλ (q0 + λx)^a (v0 + λx')^b at λ = 0
-                    if a:
-                        lin = lin + (_trig_power(q0, a - 1, g) * _trig_power(v0, b, g) * x
-                                     * g.scalar(c * a))
-                    if b:
-                        lin = lin + (_trig_power(q0, a, g) * _trig_power(v0, b - 1, g)
-                                     * x.derivative() * g.scalar(c * b))
-                lin = lin + cos_s * W[1]
+                lin = _linearisation(model, qs[0], g) + cos_s * W[1]
             _, ks = _secular_parts(known, g)
             _, ls = _secular_parts(lin, g)
             a_prev = -ks / ls if ls else zero  # the sin s condition
-            qs[j - 1] = qs[j - 1] + cos_s * a_prev
-            for key in powers:  # index j−1 was cached without a_(j−1): made again when used
-                del powers[key][j - 1:]
-            slopes.pop(j - 1, None)
-            curvatures.pop(j - 1, None)
             # F_j holds a_(j−1) linearly, through f's linearisation at q_0 and W_1 q_(j−1)''
             known = known + lin * a_prev
         kc, _ = _secular_parts(known, g)
@@ -728,6 +718,13 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
         W.append(Wj)
         S = sum((omega[a] * omega[j - a] for a in range(1, j)), zero)
         omega.append((Wj - S) * g.scalar(Fraction(1, 2)))
+        # order j − 1 of every input is final now: q_(j−1) with its cos s, X_(j−1) = W_j
+        if j >= 2:
+            qs[j - 1] = qs[j - 1] + cos_s * a_prev
+        X.terms[j - 1] = constant(Wj)
+        omegas.terms.append(constant(omega[j]))
+        for node in nodes:
+            node.forget(j - 1)
         F = known + cos_s * (Wj * g.scalar(a0))
         p = solve_trig(F).particular
         # its cos s (a_j) waits for the next order's sin s condition; its sin s makes
@@ -746,6 +743,22 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
         period=tuple(g.to_fraction(p) for p in period),
         amplitude=tuple(sum(cos.values(), Fraction(0)) for cos, _ in fourier),
         q=tuple(fourier), slope=slope)
+
+
+def _linearisation(model: Any, q0: Trig, g: Ground) -> Trig:
+    """``d/dλ f(q_0 + λ cos s, q_0' + λ (cos s)')`` at λ = 0: how ``a cos s`` added to
+    ``q_(j−1)`` moves ``[ε^(j−1)] f`` (ω₀ = 1)."""
+    x = Trig.from_fourier({1: g.scalar(1)}, {}, g)
+    v0 = q0.derivative()
+    lin = Trig(g.poly([]), g.poly([]), g)
+    for a, b, c in model.terms:  # d/dλ (q0 + λx)^a (v0 + λx')^b at λ = 0
+        if a:
+            lin = lin + (_trig_power(q0, a - 1, g) * _trig_power(v0, b, g) * x
+                         * g.scalar(c * a))
+        if b:
+            lin = lin + (_trig_power(q0, a, g) * _trig_power(v0, b - 1, g)
+                         * x.derivative() * g.scalar(c * b))
+    return lin
 
 
 def _trig_power(x: Trig, n: int, g: Ground) -> Trig:

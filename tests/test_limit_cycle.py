@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 from fractions import Fraction as F
+from functools import reduce
 
 import numpy as np
 import pytest
@@ -17,6 +18,8 @@ from scipy.integrate import solve_ivp
 
 VDP = "q'' + q = eps*(1 - q**2)*q'"
 LIENARD = "q'' + q = eps*(1 - 5*q**2/4 + q**4/8)*q'"
+MIXED = "q'' + q = eps*((1 - q**2)*q' + q**2/3)"
+# NOTE: an even term beside van der Pol's: even harmonics and both cos and sin at every order
 # NOTE: S(a) = −a(1 − 5a²/16 + a⁴/64): two cycles, a = 2 and a = 4, of opposite stability
 
 
@@ -189,3 +192,121 @@ def test_emitted_limit_cycle_module_against_the_true_cycle(tmp_path):
                         (0, cycle.period), [cycle.q0, 0.0], method="DOP853", rtol=1e-12,
                         atol=1e-14, t_eval=t)
         np.testing.assert_allclose(mod.q(t, eps), run.y[0], atol=max(1e-9, 30 * bound))
+
+
+# --- an independent slow route: Fourier dictionaries of Fractions, product-to-sum ------------
+
+def _trig_mul(x: tuple[dict, dict], y: tuple[dict, dict]) -> tuple[dict, dict]:
+    """(cos, sin) coefficients of a product: cos a cos b = (cos(a−b) + cos(a+b))/2, …"""
+    cos: dict[int, F] = {}
+    sin: dict[int, F] = {}
+
+    def add(d, n, v):
+        if n < 0:
+            n, v = -n, (v if d is cos else -v)
+        if n == 0 and d is sin:
+            return
+        d[n] = d.get(n, F(0)) + v
+
+    for n, a in x[0].items():
+        for m, b in y[0].items():
+            add(cos, n - m, a * b / 2)
+            add(cos, n + m, a * b / 2)
+        for m, b in y[1].items():  # cos ns sin ms = (sin(m+n)s + sin(m−n)s)/2
+            add(sin, m + n, a * b / 2)
+            add(sin, m - n, a * b / 2)
+    for n, a in x[1].items():
+        for m, b in y[0].items():
+            add(sin, n + m, a * b / 2)
+            add(sin, n - m, a * b / 2)
+        for m, b in y[1].items():  # sin ns sin ms = (cos(n−m)s − cos(n+m)s)/2
+            add(cos, n - m, a * b / 2)
+            add(cos, n + m, -a * b / 2)
+    return ({n: v for n, v in cos.items() if v}, {n: v for n, v in sin.items() if v})
+
+
+def _trig_add(x, y, c=F(1)):
+    out = ({**x[0]}, {**x[1]})
+    for part in (0, 1):
+        for n, v in y[part].items():
+            out[part][n] = out[part].get(n, F(0)) + c * v
+    return ({n: v for n, v in out[0].items() if v}, {n: v for n, v in out[1].items() if v})
+
+
+def _d(x):  # d/ds
+    return ({n: n * b for n, b in x[1].items()}, {n: -n * a for n, a in x[0].items()})
+
+
+def slow_limit_cycle(terms, a0: F, order: int) -> tuple[list[F], list[F]]:
+    """ω and q(0) of ω² q'' + q = ε Σ c q^a (ω q')^b, the textbook way: at order j the
+    force's [ε^(j−1)] is evaluated twice, with the unknown cos s of q_(j−1) at 0 and at 1 (F_j
+    is affine in it); every product a Cauchy sum of Fourier dictionaries (orders below j − 1
+    kept, order j − 1 made afresh)."""
+    zero = ({}, {})
+    one = ({0: F(1)}, {})
+    q = [({1: a0}, {})]
+    W, omega = [F(1)], [F(1)]
+    kept: dict[tuple, tuple] = {}  # (kind, power, n) → coefficient, for n final
+
+    def entry(kind, p, n, last):
+        """[ε^n] q^p ("q") or (ω q')^p ("v"); ``last``: q_(j−1) as tried."""
+        if (kind, p, n) in kept:
+            return kept[kind, p, n]
+
+        def qn(k):
+            return last if k == len(q) - 1 else q[k]
+
+        if p == 0:
+            out = one if n == 0 else zero
+        elif kind == "q" and p == 1:
+            out = qn(n)
+        elif p == 1:
+            out = reduce(lambda acc, k: _trig_add(acc, _d(qn(n - k)), omega[k]),
+                         range(n + 1), zero)
+        else:
+            out = reduce(_trig_add, (_trig_mul(entry(kind, p - 1, k, last),
+                                               entry(kind, 1, n - k, last))
+                                     for k in range(n + 1)), zero)
+        if n < len(q) - 1:
+            kept[kind, p, n] = out
+        return out
+
+    def F_j(j, last, Wj):
+        out = zero
+        for a, b, c in terms:
+            for k in range(j):
+                out = _trig_add(out, _trig_mul(entry("q", a, k, last),
+                                               entry("v", b, j - 1 - k, last)), F(c))
+        for i in range(1, j):
+            out = _trig_add(out, _d(_d(last if j - i == len(q) - 1 else q[j - i])), -W[i])
+        return _trig_add(out, ({1: a0 * Wj}, {}))  # −W_j q_0''
+
+    for j in range(1, order + 2):
+        base = F_j(j, q[-1], F(0))
+        if j >= 2:
+            tried = F_j(j, _trig_add(q[-1], ({1: F(1)}, {})), F(0))
+            a_prev = -base[1].get(1, F(0)) / (tried[1].get(1, F(0)) - base[1].get(1, F(0)))
+            q[-1] = _trig_add(q[-1], ({1: a_prev}, {}))
+            base = F_j(j, q[-1], F(0))
+        Wj = -base[0].get(1, F(0)) / a0
+        W.append(Wj)
+        omega.append((Wj - sum((omega[k] * omega[j - k] for k in range(1, j)), F(0))) / 2)
+        rhs = _trig_add(base, ({1: a0 * Wj}, {}))
+        cos = {n: c / (1 - n * n) for n, c in rhs[0].items() if n != 1}
+        sin = {n: c / (1 - n * n) for n, c in rhs[1].items() if n != 1}
+        sin[1] = -sum(n * b for n, b in sin.items())  # q_j'(0) = 0
+        q.append(({n: v for n, v in cos.items() if v}, {n: v for n, v in sin.items() if v}))
+    return omega[: order + 1], [sum(c.values(), F(0)) for c, _ in q[: order + 1]]
+
+
+@pytest.mark.parametrize(("text", "cycle", "order"), [(VDP, 0, 32), (LIENARD, 1, 14),
+                                                      (MIXED, 0, 14)])
+def test_the_relaxed_products_against_the_textbook_route(text, cycle, order):
+    """Every ω_j and amplitude coefficient exact, against :func:`slow_limit_cycle` (van der Pol
+    to order 32: the relaxed squares of four orders and more are used from order 6 on)."""
+    m = model(text)
+    lc = derive_limit_cycle(m, order, cycle)
+    a0, _ = limit_cycle_amplitudes(m)[cycle]
+    omega, amplitude = slow_limit_cycle(m.terms, a0, order)
+    assert list(lc.omega) == omega
+    assert list(lc.amplitude) == amplitude
