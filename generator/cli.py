@@ -172,7 +172,16 @@ def limit_cycle_json(lc) -> dict:
         "convention": "q'(0) = 0; q(0) = sum_j amplitude[j] eps^j, s = omega t",
         "equation": m.source, "slope": frac(lc.slope),
         "stable_for": "eps > 0" if lc.slope > 0 else "eps < 0",
+        "stability": limit_cycle_stability(lc),
     }
+
+
+def limit_cycle_stability(lc) -> str:
+    """The cycle attracts for ``ε S'(a₀) > 0`` and repels for the other sign of ε, where the
+    same series holds (time reversed: t → −t, ε → −ε)."""
+    good, bad = ("eps > 0", "eps < 0") if lc.slope > 0 else ("eps < 0", "eps > 0")
+    return (f"stable (attracting) for {good}, unstable (repelling) for {bad}; the series holds "
+            "for both signs")
 
 
 def _fraction_text(c) -> str:
@@ -182,8 +191,8 @@ def _fraction_text(c) -> str:
 def limit_cycle_table(lc) -> str:
     m = lc.model
     lines = [f"{m.name}: {m.title}, a limit cycle, expansion variable eps, order {lc.order}",
-             "convention: q'(0) = 0, q(0) = sum_j amplitude_j eps^j; attracting for "
-             + ("eps > 0" if lc.slope > 0 else "eps < 0"),
+             "convention: q'(0) = 0, q(0) = sum_j amplitude_j eps^j",
+             f"stability: {limit_cycle_stability(lc)}",
              f"{'j':>3}  {'omega_j':>22}  {'(T/2pi)_j':>22}  {'amplitude_j':>22}"]
     for j in range(lc.order + 1):
         lines.append(f"{j:>3}  {_fraction_text(lc.omega[j]):>22}  "

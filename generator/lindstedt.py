@@ -612,9 +612,15 @@ def limit_cycle_amplitudes(model: Any) -> list[tuple[Fraction, Fraction]]:
         found.append((Fraction(int(root.p), int(root.q)),
                       _fraction(sp.diff(S, a).subs(a, root))))
     if not found:
+        probe = S.subs(a, 1) if S.has(a) else S
+        # NOTE: S(a) > 0 shrinks the amplitude for eps > 0 (averaged: da/dt = −ε S(a)/2)
+        fate = ("for eps > 0 every orbit loses energy and decays to rest (all energy "
+                "dissipated; for eps < 0 every orbit grows)" if probe > 0 else
+                "for eps > 0 every orbit gains energy and grows (for eps < 0 all energy is "
+                "dissipated)" if probe < 0 else "the terms odd in q' do no work at first order")
         raise InputError(f"{model.name} ({model.source}): no limit cycle: the first-order "
-                         f"amplitude function S(a) = {S} has no positive root (the terms odd "
-                         "in q' only dissipate or only feed energy)")
+                         f"amplitude function S(a) = {S} has no positive root, so no cycle "
+                         f"branches from the linear oscillator at eps = 0: {fate}")
     return found
 
 
@@ -648,6 +654,11 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
     if not 0 <= cycle < len(cycles):
         raise InputError(f"cycle {cycle}: {model.name} has {len(cycles)} limit cycle(s)")
     a0, slope = cycles[cycle]
+    if slope == 0:
+        raise InputError(f"{model.name}: the cycle at amplitude {a0} is semi-stable (a double "
+                         "root of the first-order amplitude function S(a), S'(a) = 0): the "
+                         "secular conditions cannot fix its amplitude order by order, and it "
+                         "need not persist for eps ≠ 0; no series in eps")
     g = Ground.for_coefficients([])
     zero = g.scalar(0)
     nothing = Trig(g.poly([]), g.poly([]), g)

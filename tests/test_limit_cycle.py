@@ -109,6 +109,61 @@ def test_refusals_name_what_is_wrong():
         model("q'' + q = eps*q**3")
     with pytest.raises(InputError, match="cycle 1"):
         derive_limit_cycle(model(VDP), 2, cycle=1)
+    # S(a) ∝ a(a² − 4)²: a double root, a semi-stable cycle (S'(2) = 0)
+    with pytest.raises(InputError, match="semi-stable"):
+        derive_limit_cycle(model("q'' + q = eps*(1 - 2*q**2 + q**4/2)*q'"), 4)
+    with pytest.raises(InputError, match="decays to rest"):  # damping: S(a) = a/2 > 0
+        derive_limit_cycle(model("q'' + q + eps*(q' + q**2*q') = 0"), 4)
+    with pytest.raises(InputError, match="gains energy"):
+        derive_limit_cycle(model("q'' + q = eps*q'"), 4)
+
+
+def test_the_issues_command_vdp(capsys):
+    """`lindstedt series vdp --order K --json` (vdp: the registry's alias of van_der_pol):
+    the published first coefficients, the stability of both signs of ε, and partial sums of
+    ω against the period of the cycle shot numerically (numerics.true_limit_cycle)."""
+    from lindstedt.numerics import true_limit_cycle
+
+    assert main(["series", "vdp", "--order", "40", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["model"] == "van_der_pol"
+    assert data["omega"][:5] == ["1/1", "0/1", "-1/16", "0/1", "17/3072"]
+    assert data["stability"].startswith("stable (attracting) for eps > 0, unstable "
+                                        "(repelling) for eps < 0")
+    omega = [F(c) for c in data["omega"]]
+    for eps in (0.1, 0.3):
+        cycle = true_limit_cycle(model(VDP), eps)
+        partial = sum(float(c) * eps**j for j, c in enumerate(omega))
+        assert partial == pytest.approx(2 * np.pi / cycle.period, rel=1e-12, abs=0)
+
+
+def test_the_alias_is_listed(capsys):
+    assert main(["models"]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("van_der_pol"))
+    assert "(also: vdp)" in line
+    assert main(["models", "--json"]) == 0
+    rows = {r["name"]: r for r in json.loads(capsys.readouterr().out)}
+    assert rows["van_der_pol"]["aliases"] == ["vdp"] and rows["duffing"]["aliases"] == []
+
+
+def test_the_series_holds_for_the_repelling_sign_of_eps():
+    """ε < 0: the cycle repels, and the same series gives it (traced backwards in time).  With
+    an even term beside van der Pol's, q(0) has odd orders: ε and −ε differ."""
+    lc = derive_limit_cycle(model(MIXED), 24)
+    assert lc.slope > 0 and lc.amplitude[1] != 0
+    f = lambda q, p: (1 - q * q) * p + q * q / 3  # noqa: E731
+    for eps in (0.15, -0.15):
+        T, q_max = numerical_cycle(f, eps, 2.0, backwards=eps < 0)
+        assert 2 * np.pi * sum(float(c) * eps**j for j, c in enumerate(lc.period)) == \
+            pytest.approx(T, rel=1e-9)
+        assert sum(float(c) * eps**j for j, c in enumerate(lc.amplitude)) == \
+            pytest.approx(q_max, rel=1e-8)
+
+
+def test_an_order_beyond_a_minute_is_refused_with_its_estimate(capsys):
+    assert main(["series", "vdp", "--order", "3000"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--allow-slow" in err and "order 3000" in err
 
 
 def test_series_json_of_a_limit_cycle(capsys):
