@@ -590,6 +590,29 @@ class LimitCycle:
     amplitude: tuple[Fraction, ...]
     q: tuple[tuple[dict[int, Fraction], dict[int, Fraction]], ...]
     slope: Fraction
+    linearisation: tuple[dict[int, Fraction], dict[int, Fraction]] = ({}, {})
+    orders: tuple[CycleOrder, ...] = ()  # the first DOCUMENTED_ORDERS, for the LaTeX
+
+
+DOCUMENTED_ORDERS = 6
+# NOTE: orders whose equations a LimitCycle keeps for its document (each costs two Fourier
+# conversions; a page holds about this many).
+
+
+@dataclass(frozen=True)
+class CycleOrder:
+    """Order j as derived: ``q_j'' + q_j = F_j = K_j + a_(j−1) L + a₀ W_j cos s`` with ``K_j``
+    (``known``, cos and sin coefficients) made of the lower orders, ``L`` the linearisation of
+    f at q₀ (:attr:`LimitCycle.linearisation`, with ``W_1 cos s``); the sin s condition gives
+    ``a_prev = a_(j−1)`` (None at j = 1), the cos s one ``W_j``, then ``ω_j``; ``q`` is the
+    periodic solution with ``q_j'(0) = 0``, its own cos s left to order j + 1."""
+
+    j: int
+    known: tuple[dict[int, Fraction], dict[int, Fraction]]
+    a_prev: Fraction | None
+    W: Fraction
+    omega: Fraction
+    q: tuple[dict[int, Fraction], dict[int, Fraction]]
 
 
 def limit_cycle_amplitudes(model: Any) -> list[tuple[Fraction, Fraction]]:
@@ -711,10 +734,16 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
                 total = total + constant(c)
         return total
 
+    def fourier(x: Trig) -> tuple[dict[int, Fraction], dict[int, Fraction]]:
+        return tuple({n: g.to_fraction(c) for n, c in part.items() if c}
+                     for part in x.to_fourier())
+
+    documented: list[CycleOrder] = []
     lin = None  # the a_(j−1) cos s part's image in F_j: f's linearisation at q_0, + W_1 cos s
     for j in range(1, top + 1):
         X.terms.append(nothing)  # X_(j−1) = W_j, found below
         known = force(j - 1) - X_curvature.coeff(j - 1)
+        shown = fourier(known) if j <= DOCUMENTED_ORDERS else None
         a_prev = zero
         if j >= 2:
             if lin is None:
@@ -743,17 +772,21 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
         r = p.sin_part.coeffs()
         r_at_one = sum(r, zero)
         qs.append(Trig(p.cos_part, p.sin_part - g.poly([r_at_one]), g))
+        if shown is not None:
+            documented.append(CycleOrder(j, shown, g.to_fraction(a_prev) if j >= 2 else None,
+                                         g.to_fraction(Wj), g.to_fraction(omega[j]),
+                                         fourier(qs[j])))
     period = [g.scalar(1)]
     for j in range(1, order + 1):
         period.append(-sum((omega[a] * period[j - a] for a in range(1, j + 1)), zero))
-    fourier = [tuple({n: g.to_fraction(c) for n, c in part.items() if c}
-                     for part in qj.to_fourier()) for qj in qs[: order + 1]]
+    fourier_q = [fourier(qj) for qj in qs[: order + 1]]
     return LimitCycle(
         model=model, order=order,
         omega=tuple(g.to_fraction(w) for w in omega[: order + 1]),
         period=tuple(g.to_fraction(p) for p in period),
-        amplitude=tuple(sum(cos.values(), Fraction(0)) for cos, _ in fourier),
-        q=tuple(fourier), slope=slope)
+        amplitude=tuple(sum(cos.values(), Fraction(0)) for cos, _ in fourier_q),
+        q=tuple(fourier_q), slope=slope,
+        linearisation=fourier(lin) if lin is not None else ({}, {}), orders=tuple(documented))
 
 
 def _linearisation(model: Any, q0: Trig, g: Ground) -> Trig:

@@ -64,6 +64,7 @@ from .lower import (
     horner,
     lower_balance,
     lower_choice,
+    lower_cycle_derivation,
     lower_derivation,
     lower_driven,
     lower_fourier,
@@ -449,7 +450,7 @@ def _free_lower(solution: object, r: Request) -> Unit:
 
 
 def _cycle_files(r: Request) -> tuple[str, ...]:
-    return (f"{r.model.name}.py",)
+    return (f"{r.model.name}.py", f"{r.model.name}_derivation.tex")
 
 
 RADIUS_ORDER = 60
@@ -462,7 +463,8 @@ def _cycle_derive(r: Request, progress: Progress | None) -> object:
 
 
 def _cycle_lower(cycle: object, r: Request) -> Unit:
-    return Unit(lower_limit_cycle(cycle, r.command, r.order))
+    return Unit(lower_limit_cycle(cycle, r.command, r.order),
+                (lower_cycle_derivation(cycle, r.order),))
 
 
 NOTES_DRIVE = (0.1, 1.0, 1.0)

@@ -365,3 +365,41 @@ def test_the_relaxed_products_against_the_textbook_route(text, cycle, order):
     omega, amplitude = slow_limit_cycle(m.terms, a0, order)
     assert list(lc.omega) == omega
     assert list(lc.amplitude) == amplitude
+
+
+def test_the_derivation_document(tmp_path):
+    """`generate` writes the order-by-order equations beside the module: F_j's sin s and cos s
+    vanish with the a_(j−1) and W_j it prints (an exact identity), ω_2 = −1/16 and
+    ω_4 = 17/3072 as published, q_j + a_j cos s the series' own q_j; byte-identical when
+    written again; pdflatex compiles it without an overfull line."""
+    import shutil
+    import subprocess
+
+    lc = derive_limit_cycle(model(VDP), 8)
+    a0 = lc.amplitude[0]
+    lin_cos, lin_sin = lc.linearisation
+    assert [o.j for o in lc.orders] == [1, 2, 3, 4, 5, 6]
+    for o in lc.orders:
+        a = o.a_prev or 0
+        assert o.known[1].get(1, 0) + a * lin_sin.get(1, 0) == 0
+        assert o.known[0].get(1, 0) + a * lin_cos.get(1, 0) + a0 * o.W == 0
+        nxt = lc.orders[o.j] if o.j < len(lc.orders) else None
+        if nxt is not None:
+            cos = {**o.q[0], 1: o.q[0].get(1, 0) + nxt.a_prev}
+            assert ({n: c for n, c in cos.items() if c}, o.q[1]) == lc.q[o.j]
+    assert [o.omega for o in lc.orders[:4]] == [0, F(-1, 16), 0, F(17, 3072)]
+    for folder in ("one", "two"):
+        assert main(["generate", "vdp", "--order", "8", "--out", str(tmp_path / folder)]) == 0
+    tex = (tmp_path / "one" / "van_der_pol_derivation.tex").read_text()
+    assert tex == (tmp_path / "two" / "van_der_pol_derivation.tex").read_text()
+    assert r"\omega_{4} = \frac{17}{3072}" in tex and r"W_{2} = -\frac{1}{8}" in tex
+    pdflatex = shutil.which("pdflatex")
+    if pdflatex is None:
+        pytest.skip("pdflatex not installed (`make tex` installs it)")
+    run = subprocess.run([pdflatex, "-interaction=nonstopmode", "-halt-on-error",
+                          "van_der_pol_derivation.tex"], cwd=tmp_path / "one",
+                         stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=300,
+                         check=False)
+    assert run.returncode == 0, run.stdout[-2000:]
+    log = (tmp_path / "one" / "van_der_pol_derivation.log").read_text(errors="replace")
+    assert "Overfull \\hbox" not in log
