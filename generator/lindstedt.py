@@ -745,15 +745,15 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
         known = force(j - 1) - X_curvature.coeff(j - 1)
         shown = fourier(known) if j <= DOCUMENTED_ORDERS else None
         a_prev = zero
+        kc, ks = _secular_parts(known, g)
         if j >= 2:
             if lin is None:
                 lin = _linearisation(model, qs[0], g) + cos_s * W[1]
-            _, ks = _secular_parts(known, g)
-            _, ls = _secular_parts(lin, g)
+                lc_, ls = _secular_parts(lin, g)
             a_prev = -ks / ls if ls else zero  # the sin s condition
             # F_j holds a_(j−1) linearly, through f's linearisation at q_0 and W_1 q_(j−1)''
             known = known + lin * a_prev
-        kc, _ = _secular_parts(known, g)
+            kc = kc + lc_ * a_prev
         Wj = -kc / g.scalar(a0)  # the cos s condition, kc + W_j a0 = 0 (−W_j q_0'' = W_j a0 cos s)
         W.append(Wj)
         S = sum((omega[a] * omega[j - a] for a in range(1, j)), zero)

@@ -389,7 +389,11 @@ class Trig:
         """``({n: a_n}, {n: b_n})``, zero coefficients left out."""
         g = self.ground
         basis = Basis(False)
-        cosines = to_fourier(self.cos_part, basis, g)
+        cs = self.cos_part.coeffs()
+        if g.is_rational and len(cs) > 1 and not any(cs[0::2]):  # odd harmonics: in C²
+            cosines = to_fourier(g.poly(cs[1::2]), Basis(True), g)
+        else:
+            cosines = to_fourier(self.cos_part, basis, g)
         # S·R(C) with R(C) = Σ ρ_n cos ns: cos ns · sin s = (sin(n+1)s − sin(n−1)s)/2
         half = g.scalar(Fraction(1, 2))
         sines: dict[int, Any] = {}
