@@ -178,19 +178,21 @@ def test_series_json_of_a_limit_cycle(capsys):
     assert err.count("\n") == 1 and "no limit cycle" in err
 
 
-def test_nearest_singularities_from_the_exact_series():
+def test_nearest_singularities_from_the_exact_series(capsys):
     """Van der Pol's ω: a conjugate pair at |ε²| ≈ 3.42 (Andersen & Geer 1982, by Padé from ε²⁴
-    exact and ε¹⁶⁴ in floating point) — order 60 here, within 1 %; the free Duffing period's
-    separatrix at x = −1 and the pendulum's at θ₀² = π², on the real axis."""
+    exact and ε¹⁶⁴ in floating point) — `series vdp --order 100 --singularities`, within 1 %;
+    the free Duffing period's separatrix at x = −1 and the pendulum's at θ₀² = π², on the real
+    axis."""
     import math
 
     from lindstedt.lindstedt import derive, nearest_singularity
     from lindstedt.models import duffing, pendulum
 
-    vdp = nearest_singularity(derive_limit_cycle(model(VDP), 60).omega)
-    assert vdp.variable == "eps**2" and vdp.method == "Mercer–Roberts"
-    assert abs(vdp.radius / 3.42 - 1) < 0.01 and vdp.spread < 0.05
-    assert 0.5 < vdp.angle < math.pi - 0.5  # off the real axis
+    assert main(["series", "vdp", "--order", "100", "--singularities", "--json"]) == 0
+    (vdp,) = json.loads(capsys.readouterr().out)["singularities"]
+    assert vdp["variable"] == "eps**2" and vdp["method"] == "Mercer–Roberts"
+    assert abs(vdp["radius"] / 3.42 - 1) < 0.01 and vdp["spread"] < 0.01
+    assert 0.5 < vdp["angle"] < math.pi - 0.5  # off the real axis
     for m, where, angle in ((duffing(), 1.0, math.pi), (pendulum(40), math.pi**2, 0.0)):
         sol = derive(m, 40)
         est = nearest_singularity([sol.ground.to_fraction(c) for c in sol.period], "y")
