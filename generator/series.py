@@ -546,6 +546,8 @@ class TrigMap(TrigSeries):
 
 
 PACKED_FROM = 2
+# NOTE: squares of this many orders and more are packed (Kronecker); a single pair is one Trig
+# product (2 and 4 measured alike: van der Pol to order 100, 6.0–6.1 s against 6.1–6.3).
 
 
 class RelaxedProduct(TrigSeries):
