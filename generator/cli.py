@@ -185,7 +185,22 @@ def limit_cycle_stability(lc) -> str:
 
 
 def _fraction_text(c) -> str:
-    return f"{c.numerator}/{c.denominator}"
+    return f"{_int_text(c.numerator)}/{_int_text(c.denominator)}"
+
+
+INT_TEXT_BITS = 14_000
+# NOTE: below 4300 digits, Python's own str(); beyond it Python refuses (a guard against slow
+# parsing of untrusted text), and van der Pol's coefficients pass it near order 150.
+
+
+def _int_text(n: int) -> str:
+    """The decimal digits of an exact integer, however long (FLINT's conversion beyond
+    :data:`INT_TEXT_BITS`)."""
+    if n.bit_length() < INT_TEXT_BITS:
+        return str(n)
+    from flint import fmpz
+
+    return str(fmpz(n))
 
 
 def limit_cycle_table(lc) -> str:

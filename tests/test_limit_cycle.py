@@ -405,3 +405,19 @@ def test_the_derivation_document(tmp_path):
     assert run.returncode == 0, run.stdout[-2000:]
     log = (tmp_path / "one" / "van_der_pol_derivation.log").read_text(errors="replace")
     assert "Overfull \\hbox" not in log
+
+
+def test_coefficients_of_any_length_are_printed():
+    """Van der Pol's coefficients pass Python's 4300-digit str() limit near order 150; the
+    series JSON and table print them whole (digits checked by arithmetic, not by str())."""
+    from lindstedt.cli import _fraction_text
+
+    for value in (F(7**6000 + 1, 3**12000), F(-(10**5000) - 3, 1), F(-17, 3072)):
+        num, den = _fraction_text(value).split("/")
+        for text, n in ((num, value.numerator), (den, value.denominator)):
+            digits = text.lstrip("-")
+            assert text.startswith("-") == (n < 0) and digits.isdigit()
+            assert 10 ** (len(digits) - 1) <= abs(n) < 10 ** len(digits)
+            head = min(30, len(digits))
+            assert int(digits[:head]) == abs(n) // 10 ** (len(digits) - head)
+            assert int(digits[-3:]) == abs(n) % 1000
