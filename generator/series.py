@@ -394,9 +394,15 @@ class Trig:
             cosines = to_fourier(g.poly(cs[1::2]), Basis(True), g)
         else:
             cosines = to_fourier(self.cos_part, basis, g)
+        rs = self.sin_part.coeffs()
+        if g.is_rational and len(rs) > 1 and not any(rs[1::2]):  # R even in C: odd harmonics
+            # S·R(C) = −d/ds Q(C) with Q = ∫R dC = C·Σ r_k v^k/(2k+1): sin ns gets n γ_n
+            Q = g.poly([r * g.scalar(Fraction(1, 2 * k + 1)) for k, r in enumerate(rs[0::2])])
+            sines = {n: gamma * n for n, gamma in to_fourier(Q, Basis(True), g).items()}
+            return cosines, {n: b for n, b in sorted(sines.items()) if b}
         # S·R(C) with R(C) = Σ ρ_n cos ns: cos ns · sin s = (sin(n+1)s − sin(n−1)s)/2
         half = g.scalar(Fraction(1, 2))
-        sines: dict[int, Any] = {}
+        sines = {}
         for n, rho in to_fourier(self.sin_part, basis, g).items():
             if n == 0:
                 sines[1] = sines.get(1, g.scalar(0)) + rho
