@@ -563,7 +563,7 @@ class RelaxedProduct(TrigSeries):
 
     def __init__(self, a: TrigSeries, b: TrigSeries) -> None:
         self.a, self.b = a, b
-        self.blocks: dict[int, list] = {}  # [cos, sin] polynomial sums from the squares
+        self.blocks: dict[int, list] = {}  # (cos, sin, denominator) pieces from the squares
         self.cache: dict[int, Trig] = {}
         self.started = 1  # squares of output index ≤ started are made
 
@@ -577,7 +577,7 @@ class RelaxedProduct(TrigSeries):
         out = a.coeff(0) * b.coeff(0) if i == 0 else \
             a.coeff(0) * b.coeff(i) + a.coeff(i) * b.coeff(0)
         if i in self.blocks:
-            cos, sin = self.blocks[i]
+            cos, sin = _sum_pieces(self.blocks[i])
             out = Trig(out.cos_part + cos, out.sin_part + sin, out.ground)
         self.cache[i] = out
         return out
@@ -606,24 +606,22 @@ class RelaxedProduct(TrigSeries):
         b = [self.b.coeff(ll) for ll in ls]
         base = ks[0] + ls[0]
         if len(ks) < PACKED_FROM:
-            sums = [None] * (len(ks) + len(ls) - 1)
+            pieces = []
             for k, x in enumerate(a):
                 for m, y in enumerate(b):
                     xy = x * y
-                    sums[k + m] = (xy.cos_part, xy.sin_part) if sums[k + m] is None else \
-                        (sums[k + m][0] + xy.cos_part, sums[k + m][1] + xy.sin_part)
+                    for part, poly in ((0, xy.cos_part), (1, xy.sin_part)):
+                        if poly:
+                            pieces.append((k + m, part, poly.numer(), poly.denom()))
         else:
-            sums = _block_product(a, b)
-        for r, (cos, sin) in enumerate(sums):
-            if twice:
-                cos, sin = cos * 2, sin * 2
-            slot = self.blocks.get(base + r)
-            self.blocks[base + r] = [cos, sin] if slot is None else [slot[0] + cos,
-                                                                     slot[1] + sin]
+            pieces = _block_product(a, b)
+        for r, part, num, den in pieces:
+            self.blocks.setdefault(base + r, []).append((part, num * 2 if twice else num, den))
 
 
-def _block_product(a: list[Trig], b: list[Trig]) -> list[tuple[Any, Any]]:
-    """``[Σ_(k+l=r) a_k b_l]`` for ``r = 0 … len(a)+len(b)−2``, as (cos, sin) polynomials.
+def _block_product(a: list[Trig], b: list[Trig]) -> list[tuple[int, int, Any, Any]]:
+    """``Σ_(k+l=r) a_k b_l`` for ``r = 0 … len(a)+len(b)−2``, as pieces ``(r, 0 for the cos
+    part or 1 for the sin part, integer numerator polynomial, denominator)``.
 
     Each Trig is split into four parts ``C^c S^s · p(v)``, ``v = C²`` (the even and odd powers
     of C in P and R), so a product of parts is one part again, times ``v`` for ``c = c' = 1``
@@ -664,11 +662,28 @@ def _block_product(a: list[Trig], b: list[Trig]) -> list[tuple[Any, Any]]:
                 parts[r][(c, s_)] = piece if old is None else _add_lists(old, piece)
     den = den_a * den_b
     out = []
-    for part in parts:
-        cos = _interleave(part.get((0, 0), []), part.get((1, 0), []))
-        sin = _interleave(part.get((0, 1), []), part.get((1, 1), []))
-        out.append((fmpq_poly(cos, den), fmpq_poly(sin, den)))
+    for r, part in enumerate(parts):
+        for which, even, odd in ((0, (0, 0), (1, 0)), (1, (0, 1), (1, 1))):
+            if even in part or odd in part:
+                out.append((r, which, fmpz_poly(_interleave(part.get(even, []),
+                                                             part.get(odd, []))), den))
     return out
+
+
+def _sum_pieces(pieces: list) -> tuple[Any, Any]:
+    """``(cos, sin)`` polynomials of ``(part, numerator, denominator)`` pieces: over one common
+    denominator, reduced once (not at each partial sum)."""
+    out = []
+    for which in (0, 1):
+        mine = [(num, den) for part, num, den in pieces if part == which]
+        common = fmpz(1)
+        for _, den in mine:
+            common = common.lcm(den)
+        total = fmpz_poly([])
+        for num, den in mine:
+            total += num * (common // den)
+        out.append(fmpq_poly(total, common))
+    return out[0], out[1]
 
 
 def _parts(terms: list[Trig]) -> tuple[list[dict], Any]:
