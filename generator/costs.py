@@ -117,7 +117,7 @@ def _fit(table: dict, model: str) -> tuple:
 LIMIT_CYCLE_FIT = (0.9, 50.0, 164, 4.8)
 # NOTE: `series` of a limit cycle (van der Pol, relaxed ε-products; CPU seconds, which are the
 # wall time of a quiet machine): 0.55 at order 60, 6.2 at 100, 28 at 130, 50 at 164
-# (benchmarks/limit_cycle.py); a minute buys order ~170.
+# (benchmarks/limit_cycle.py); a minute buys order 169.
 SYMBOLIC_FIT = (0.0, 1.7, 30, 4.0)
 # NOTE: a series in ε with coefficients in QQ[A, α] (Helmholtz–Duffing, α symbolic): 0.29 s at
 # order 20, 1.7 at 30, 4.8 at 40 under load; each further symbol 1.5× (α, β: 2.0 s at 30).
