@@ -563,7 +563,7 @@ class RelaxedProduct(TrigSeries):
 
     def __init__(self, a: TrigSeries, b: TrigSeries) -> None:
         self.a, self.b = a, b
-        self.blocks: dict[int, list] = {}  # (cos, sin, denominator) pieces from the squares
+        self.blocks: dict[int, list] = {}  # (part, numerator, denominator) from the squares
         self.cache: dict[int, Trig] = {}
         self.started = 1  # squares of output index ≤ started are made
 
