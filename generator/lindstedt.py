@@ -708,11 +708,11 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
 
     products[("v", 1)] = product(omegas, slope_q)  # [ε^i] ω q'
 
-    def power(kind: str, n: int) -> TrigSeries:
+    def power(kind: str, n: int) -> TrigSeries:  # each power made once, by squaring
         if (kind, n) not in products:
             half = power(kind, n // 2)
-            sq = product(half, half)
-            products[(kind, n)] = sq if n % 2 == 0 else product(sq, power(kind, 1))
+            products[(kind, n)] = product(half, half) if n % 2 == 0 else \
+                product(power(kind, n - 1), power(kind, 1))
         return products[(kind, n)]
 
     terms = []  # (series of q^a (ω q')^b, c); the constant term is only at ε^0
