@@ -5,8 +5,9 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
     equation   user text through a whitelist walker over ``ast``         str -> Equation
     models     the oscillator registry, a user's Oscillator, its L–P Model  Equation, K -> Model
     series     the one Fourier kernel: exact P(C) + S·R(C) over QQ       (FLINT fmpq_poly) and
-               QQ[params] (fmpq_mpoly), the odd-cosine fast path, and the Laurent form in e^{is}
-               over complex128 for the numeric methods
+               QQ[params] (fmpq_mpoly), the odd-cosine fast path, relaxed (online) products
+               of ε-series of Trig sums, and the Laurent form in e^{is} over complex128 for the
+               numeric methods
     lindstedt  L–P series, order-by-order equations, naive expansion    Model, K -> SeriesSolution
                and the limit cycles of q'' + q = ε f(q, q')             SelfExcited, K -> LimitCycle
     hill       Hill's equation x'' + (δ + ε p(t))x = 0: transition      p(t), n, K -> curves

@@ -173,18 +173,42 @@ def limit_cycle_json(lc) -> dict:
         "convention": "q'(0) = 0; q(0) = sum_j amplitude[j] eps^j, s = omega t",
         "equation": m.source, "slope": frac(lc.slope),
         "stable_for": "eps > 0" if lc.slope > 0 else "eps < 0",
+        "stability": limit_cycle_stability(lc),
     }
 
 
+def limit_cycle_stability(lc) -> str:
+    """The cycle attracts for ``ε S'(a₀) > 0`` and repels for the other sign of ε, where the
+    same series holds (time reversed: t → −t, ε → −ε)."""
+    good, bad = ("eps > 0", "eps < 0") if lc.slope > 0 else ("eps < 0", "eps > 0")
+    return (f"stable (attracting) for {good}, unstable (repelling) for {bad}; the series holds "
+            "for both signs")
+
+
 def _fraction_text(c) -> str:
-    return f"{c.numerator}/{c.denominator}"
+    return f"{_int_text(c.numerator)}/{_int_text(c.denominator)}"
+
+
+INT_TEXT_BITS = 14_000
+# NOTE: below 4300 digits, Python's own str(); beyond it Python refuses (a guard against slow
+# parsing of untrusted text), and van der Pol's coefficients pass it near order 150.
+
+
+def _int_text(n: int) -> str:
+    """The decimal digits of an exact integer, however long (FLINT's conversion beyond
+    :data:`INT_TEXT_BITS`)."""
+    if n.bit_length() < INT_TEXT_BITS:
+        return str(n)
+    from flint import fmpz
+
+    return str(fmpz(n))
 
 
 def limit_cycle_table(lc) -> str:
     m = lc.model
     lines = [f"{m.name}: {m.title}, a limit cycle, expansion variable eps, order {lc.order}",
-             "convention: q'(0) = 0, q(0) = sum_j amplitude_j eps^j; attracting for "
-             + ("eps > 0" if lc.slope > 0 else "eps < 0"),
+             "convention: q'(0) = 0, q(0) = sum_j amplitude_j eps^j",
+             f"stability: {limit_cycle_stability(lc)}",
              f"{'j':>3}  {'omega_j':>22}  {'(T/2pi)_j':>22}  {'amplitude_j':>22}"]
     for j in range(lc.order + 1):
         lines.append(f"{j:>3}  {_fraction_text(lc.omega[j]):>22}  "
@@ -450,15 +474,18 @@ def _cmd_slowflow(args: argparse.Namespace) -> int:
 
 
 def _cmd_models(args: argparse.Namespace) -> int:
-    from .models import REGISTRY
+    from .models import ALIASES, REGISTRY
 
+    aliases = {e.name: sorted(a for a, name in ALIASES.items() if name == e.name)
+               for e in REGISTRY.values()}
     if args.json:
-        print(json.dumps([{"name": e.name, "equation": e.equation, "about": e.about}
-                          for e in REGISTRY.values()]))
+        print(json.dumps([{"name": e.name, "equation": e.equation, "about": e.about,
+                           "aliases": aliases[e.name]} for e in REGISTRY.values()]))
         return 0
     width = max(len(name) for name in REGISTRY)
     for e in REGISTRY.values():
-        print(f"{e.name:<{width}}  {e.equation:<44}  {e.about}")
+        also = f" (also: {', '.join(aliases[e.name])})" if aliases[e.name] else ""
+        print(f"{e.name:<{width}}  {e.equation:<44}  {e.about}{also}")
     return 0
 
 

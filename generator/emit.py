@@ -26,6 +26,7 @@ import sympy as sp
 from .errors import InputError
 from .lower import (
     ArrayKernel,
+    CycleDerivation,
     Derivation,
     Evaluator,
     Module,
@@ -297,12 +298,79 @@ def render_slow_flow(d: SlowFlowDocument, p: Provenance) -> dict[str, str]:
     return {f"{p.model}.tex": tex}
 
 
+def _trig_terms(cos: tuple, sin: tuple) -> list[str]:
+    """Signed LaTeX terms ``c cos ns`` then ``c sin ns``, the first without ``+``."""
+    terms = [(c, r"\cos s" if n == 1 else rf"\cos {n}s") for n, c in cos]
+    terms += [(c, r"\sin s" if n == 1 else rf"\sin {n}s") for n, c in sin]
+    return [_signed(c, trig, first=i == 0) for i, (c, trig) in enumerate(terms)] or ["0"]
+
+
+def _linear_form(terms: list[tuple[sp.Rational, str]]) -> str:
+    """``c₁ x₁ + c₂ x₂ + …`` in LaTeX, zero terms left out (``0`` if all are)."""
+    kept = [(c, x) for c, x in terms if c != 0]
+    out = []
+    for i, (c, x) in enumerate(kept):
+        sign = "-" if c < 0 else ("" if i == 0 else "+")
+        mag = abs(sp.Rational(c))
+        body = x if mag == 1 and x else f"{latex_rational(mag)}\\,{x}" if x else \
+            latex_rational(mag)
+        out.append(f"{sign} {body}".strip())
+    return " ".join(out) or "0"
+
+
+def render_cycle_derivation(d: CycleDerivation, p: Provenance) -> dict[str, str]:
+    """``{"<model>_derivation.tex": text}``: a limit cycle's equations order by order."""
+    lin_cos, lin_sin = dict(d.lin_cos), dict(d.lin_sin)
+    zero = sp.Integer(0)
+    orders = []
+    for o in d.orders:
+        a = f"a_{{{o.j - 1}}}"
+        W = f"W_{{{o.j}}}"
+        k_cos, k_sin = dict(o.known_cos), dict(o.known_sin)
+        if o.a_prev is None:  # order 1: the sin s condition is S(a₀) = 0 itself
+            sin_condition = (_linear_form([(k_sin.get(1, zero), "")])
+                             + r" = 0 \quad \text{($a_0$ is a root of $S$)}")
+            cos_condition = _linear_form([(k_cos.get(1, zero), ""), (d.a0, W)]) + " = 0"
+        else:
+            sin_condition = _linear_form([(k_sin.get(1, zero), ""),
+                                          (lin_sin.get(1, zero), a)]) + " = 0"
+            cos_condition = _linear_form([(k_cos.get(1, zero), ""), (lin_cos.get(1, zero), a),
+                                          (d.a0, W)]) + " = 0"
+        orders.append({
+            "j": o.j,
+            "with_a": "" if o.a_prev is None else f" + {a} L(s)",
+            "known": _trig_terms(o.known_cos, o.known_sin),
+            "sin_condition": sin_condition,
+            "a_value": "" if o.a_prev is None else latex_rational(o.a_prev),
+            "cos_condition": cos_condition,
+            "W": latex_rational(o.W),
+            "omega": latex_rational(o.omega),
+            "solution": _trig_terms(o.q_cos, o.q_sin),
+        })
+    stability = (r"attracting for $\varepsilon > 0$ and repelling for $\varepsilon < 0$"
+                 if d.slope > 0 else
+                 r"attracting for $\varepsilon < 0$ and repelling for $\varepsilon > 0$")
+    tex = environment(latex=True).get_template("cycle_derivation.tex.j2").render(
+        banner=banner(p, "%"), model=_tex_text(d.model), equation=_tex_text(d.equation),
+        a0=latex_rational(d.a0), slope=latex_rational(d.slope), stability=stability,
+        lin=_trig_terms(d.lin_cos, d.lin_sin), orders=orders)
+    return {f"{p.model}_derivation.tex": tex}
+
+
+def _tex_text(text: str) -> str:
+    """Plain text (an equation as typed) safe in LaTeX's text mode."""
+    return "".join({"_": r"\_", "^": r"\^{}", "&": r"\&", "%": r"\%", "#": r"\#",
+                    "$": r"\$", "{": r"\{", "}": r"\}", "~": r"\~{}",
+                    "\\": r"\textbackslash{}"}.get(ch, ch) for ch in text)
+
+
 def render(unit: Unit) -> dict[str, str]:
     """``{file name: text}`` of a unit: its module, then each document beside it."""
     files = {f"{unit.module.name}.py": render_module(unit.module)}
     renderers = {Derivation: render_latex, MuDerivation: render_mu_derivation,
                  MuDampedDerivation: render_mu_damped_derivation,
-                 SlowFlowDocument: render_slow_flow}
+                 SlowFlowDocument: render_slow_flow,
+                 CycleDerivation: render_cycle_derivation}
     for doc in unit.documents:
         files.update(renderers[type(doc)](doc, unit.module.provenance))
     return files

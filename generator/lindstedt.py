@@ -25,7 +25,18 @@ import sympy as sp
 from .display import SHOWN_ORDERS, latex_aligned, latex_sum, latex_text, more
 from .errors import InputError
 from .models import Model, check_order, t
-from .series import Basis, Ground, Trig, solve_oscillator, solve_trig, to_fourier
+from .series import (
+    Basis,
+    Ground,
+    RelaxedProduct,
+    Trig,
+    TrigMap,
+    TrigSeries,
+    TrigTerms,
+    solve_oscillator,
+    solve_trig,
+    to_fourier,
+)
 
 CONVENTION = "q(0) = A, q'(0) = 0, so q_j(0) = 0 for j >= 1"
 s = sp.Symbol("s")
@@ -579,6 +590,29 @@ class LimitCycle:
     amplitude: tuple[Fraction, ...]
     q: tuple[tuple[dict[int, Fraction], dict[int, Fraction]], ...]
     slope: Fraction
+    linearisation: tuple[dict[int, Fraction], dict[int, Fraction]] = ({}, {})
+    orders: tuple[CycleOrder, ...] = ()  # the first DOCUMENTED_ORDERS, for the LaTeX
+
+
+DOCUMENTED_ORDERS = 6
+# NOTE: orders whose equations a LimitCycle keeps for its document (each costs two Fourier
+# conversions; a page holds about this many).
+
+
+@dataclass(frozen=True)
+class CycleOrder:
+    """Order j as derived: ``q_j'' + q_j = F_j = K_j + a_(j−1) L + a₀ W_j cos s`` with ``K_j``
+    (``known``, cos and sin coefficients) made of the lower orders, ``L`` the linearisation of
+    f at q₀ (:attr:`LimitCycle.linearisation`, with ``W_1 cos s``); the sin s condition gives
+    ``a_prev = a_(j−1)`` (None at j = 1), the cos s one ``W_j``, then ``ω_j``; ``q`` is the
+    periodic solution with ``q_j'(0) = 0``, its own cos s left to order j + 1."""
+
+    j: int
+    known: tuple[dict[int, Fraction], dict[int, Fraction]]
+    a_prev: Fraction | None
+    W: Fraction
+    omega: Fraction
+    q: tuple[dict[int, Fraction], dict[int, Fraction]]
 
 
 def limit_cycle_amplitudes(model: Any) -> list[tuple[Fraction, Fraction]]:
@@ -601,9 +635,15 @@ def limit_cycle_amplitudes(model: Any) -> list[tuple[Fraction, Fraction]]:
         found.append((Fraction(int(root.p), int(root.q)),
                       _fraction(sp.diff(S, a).subs(a, root))))
     if not found:
+        probe = S.subs(a, 1) if S.has(a) else S
+        # NOTE: S(a) > 0 shrinks the amplitude for eps > 0 (averaged: da/dt = −ε S(a)/2)
+        fate = ("for eps > 0 every orbit loses energy and decays to rest (all energy "
+                "dissipated; for eps < 0 every orbit grows)" if probe > 0 else
+                "for eps > 0 every orbit gains energy and grows (for eps < 0 all energy is "
+                "dissipated)" if probe < 0 else "the terms odd in q' do no work at first order")
         raise InputError(f"{model.name} ({model.source}): no limit cycle: the first-order "
-                         f"amplitude function S(a) = {S} has no positive root (the terms odd "
-                         "in q' only dissipate or only feed energy)")
+                         f"amplitude function S(a) = {S} has no positive root, so no cycle "
+                         f"branches from the linear oscillator at eps = 0: {fate}")
     return found
 
 
@@ -629,105 +669,102 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
     """ω, T/2π, q(0) and q_j of limit cycle ``cycle`` (by amplitude, smallest first) to order
     K.  At order j, ``q_j'' + q_j = F_j`` holds ``a_(j−1)`` (the unknown cos s of ``q_(j−1)``)
     and ``W_j`` (from ω²) linearly: the sin s condition fixes ``a_(j−1)``, the cos s one
-    ``W_j``; ``q_j'(0) = 0`` fixes its sin s."""
+    ``W_j``; ``q_j'(0) = 0`` fixes its sin s.  ``F_j = [ε^(j−1)] f(q, ω q') −
+    Σ_(i<j) W_i q''_(j−i) + W_j a₀ cos s``: every ε-product is a :class:`RelaxedProduct`."""
     order = check_order(order)
     top = order + 1  # q_K's cos s (so q(0)'s ε^K) is fixed by the secular condition of K + 1
     cycles = limit_cycle_amplitudes(model)
     if not 0 <= cycle < len(cycles):
         raise InputError(f"cycle {cycle}: {model.name} has {len(cycles)} limit cycle(s)")
     a0, slope = cycles[cycle]
+    if slope == 0:
+        raise InputError(f"{model.name}: the cycle at amplitude {a0} is semi-stable (a double "
+                         "root of the first-order amplitude function S(a), S'(a) = 0): the "
+                         "secular conditions cannot fix its amplitude order by order, and it "
+                         "need not persist for eps ≠ 0; no series in eps")
     g = Ground.for_coefficients([])
     zero = g.scalar(0)
+    nothing = Trig(g.poly([]), g.poly([]), g)
 
-    def trig(cos: dict, sin: dict) -> Trig:
-        return Trig.from_fourier({n: g.scalar(c) for n, c in cos.items() if c},
-                                 {n: g.scalar(c) for n, c in sin.items() if c}, g)
+    def constant(c: Any) -> Trig:
+        return Trig(g.poly([c]), g.poly([]), g)
 
-    cos_s = trig({1: 1}, {})
-    one = Trig(g.poly([g.scalar(1)]), g.poly([]), g)
-    qs = [trig({1: a0}, {})]
+    cos_s = Trig.from_fourier({1: g.scalar(1)}, {}, g)
+    qs = [cos_s * g.scalar(a0)]
     W, omega = [g.scalar(1)], [g.scalar(1)]
-    powers: dict[tuple[str, int], list] = {}
+    # the series: q, q', q'', ω, X = (ω² − 1)/ε (X_k = W_(k+1)), and the products of f
+    q = TrigTerms(qs)
+    slope_q = TrigMap(q, Trig.derivative)
+    curvature = TrigMap(slope_q, Trig.derivative)
+    omegas = TrigTerms([constant(g.scalar(1))])
+    X = TrigTerms([])
+    nodes: list[TrigSeries] = [slope_q, curvature]
+    products: dict[tuple[str, int], TrigSeries] = {("q", 1): q}
 
-    slopes: dict[int, Trig] = {}  # q_i' and q_i'', each made once (index j − 1 remade when
-    curvatures: dict[int, Trig] = {}  # its cos s arrives)
+    def product(a: TrigSeries, b: TrigSeries) -> RelaxedProduct:
+        node = RelaxedProduct(a, b)
+        nodes.append(node)
+        return node
 
-    def slope_of(i: int) -> Trig:
-        if i not in slopes:
-            slopes[i] = qs[i].derivative()
-        return slopes[i]
+    products[("v", 1)] = product(omegas, slope_q)  # [ε^i] ω q'
 
-    def curvature_of(i: int) -> Trig:
-        if i not in curvatures:
-            curvatures[i] = slope_of(i).derivative()
-        return curvatures[i]
+    def power(kind: str, n: int) -> TrigSeries:  # each power made once, by squaring
+        if (kind, n) not in products:
+            half = power(kind, n // 2)
+            products[(kind, n)] = product(half, half) if n % 2 == 0 else \
+                product(power(kind, n - 1), power(kind, 1))
+        return products[(kind, n)]
 
-    def velocity(i: int) -> Trig:  # [ε^i] ω q'
-        acc = slope_of(i)
-        for k in range(1, i + 1):
-            acc = acc + slope_of(i - k) * omega[k]
-        return acc
-
-    def series(kind: str, n: int, i: int) -> Trig | None:
-        """[ε^i] q^n or (ω q')^n (None for n = 0 beyond i = 0), cached by index; an index is
-        recomputed once its q gains its cos s."""
-        if n == 0:
-            return one if i == 0 else None
-        table = powers.setdefault((kind, n), [])
-        while len(table) <= i:
-            m = len(table)
-            if n == 1:
-                table.append(qs[m] if kind == "q" else velocity(m))
-                continue
-            base = [series(kind, 1, k) for k in range(m + 1)]
-            acc = series(kind, n - 1, 0) * base[m]
-            for k in range(1, m + 1):
-                acc = acc + series(kind, n - 1, k) * base[m - k]
-            table.append(acc)
-        return table[i]
+    terms = []  # (series of q^a (ω q')^b, c); the constant term is only at ε^0
+    for a, b, c in model.terms:
+        if a and b:
+            terms.append((product(power("q", a), power("v", b)), g.scalar(c)))
+        elif a or b:
+            terms.append((power("q", a) if a else power("v", b), g.scalar(c)))
+        else:
+            terms.append((None, g.scalar(c)))
+    X_curvature = product(X, curvature)  # [ε^(j−1)]: Σ_(i≤j) W_i q''_(j−i), W_j (unknown) as 0
 
     def force(i: int) -> Trig:  # [ε^i] f(q, ω q')
-        total = Trig(g.poly([]), g.poly([]), g)
-        for a, b, c in model.terms:
-            for k in range(i + 1):
-                left, right = series("q", a, k), series("v", b, i - k)
-                if left is not None and right is not None:
-                    total = total + left * right * g.scalar(c)
+        total = nothing
+        for series, c in terms:
+            if series is not None:
+                total = total + series.coeff(i) * c
+            elif i == 0:
+                total = total + constant(c)
         return total
 
+    def fourier(x: Trig) -> tuple[dict[int, Fraction], dict[int, Fraction]]:
+        return tuple({n: g.to_fraction(c) for n, c in part.items() if c}
+                     for part in x.to_fourier())
+
+    documented: list[CycleOrder] = []
     lin = None  # the a_(j−1) cos s part's image in F_j: f's linearisation at q_0, + W_1 cos s
     for j in range(1, top + 1):
-        known = force(j - 1)
-        for i in range(1, j):
-            known = known - curvature_of(j - i) * W[i]
+        X.terms.append(nothing)  # X_(j−1) = W_j, found below
+        known = force(j - 1) - X_curvature.coeff(j - 1)
+        shown = fourier(known) if j <= DOCUMENTED_ORDERS else None
+        a_prev = zero
+        kc, ks = _secular_parts(known, g)
         if j >= 2:
             if lin is None:
-                x = Trig.from_fourier({1: g.scalar(1)}, {}, g)
-                q0, v0 = qs[0], qs[0].derivative()
-                lin = Trig(g.poly([]), g.poly([]), g)
-                for a, b, c in model.terms:  # d/dλ (q0 + λx)^a (v0 + λx')^b at λ = 0
-                    if a:
-                        lin = lin + (_trig_power(q0, a - 1, g) * _trig_power(v0, b, g) * x
-                                     * g.scalar(c * a))
-                    if b:
-                        lin = lin + (_trig_power(q0, a, g) * _trig_power(v0, b - 1, g)
-                                     * x.derivative() * g.scalar(c * b))
-                lin = lin + cos_s * W[1]
-            _, ks = _secular_parts(known, g)
-            _, ls = _secular_parts(lin, g)
+                lin = _linearisation(model, qs[0], g) + cos_s * W[1]
+                lc_, ls = _secular_parts(lin, g)
             a_prev = -ks / ls if ls else zero  # the sin s condition
-            qs[j - 1] = qs[j - 1] + cos_s * a_prev
-            for key in powers:  # index j−1 was cached without a_(j−1): made again when used
-                del powers[key][j - 1:]
-            slopes.pop(j - 1, None)
-            curvatures.pop(j - 1, None)
             # F_j holds a_(j−1) linearly, through f's linearisation at q_0 and W_1 q_(j−1)''
             known = known + lin * a_prev
-        kc, _ = _secular_parts(known, g)
+            kc = kc + lc_ * a_prev
         Wj = -kc / g.scalar(a0)  # the cos s condition, kc + W_j a0 = 0 (−W_j q_0'' = W_j a0 cos s)
         W.append(Wj)
         S = sum((omega[a] * omega[j - a] for a in range(1, j)), zero)
         omega.append((Wj - S) * g.scalar(Fraction(1, 2)))
+        # order j − 1 of every input is final now: q_(j−1) with its cos s, X_(j−1) = W_j
+        if j >= 2:
+            qs[j - 1] = qs[j - 1] + cos_s * a_prev
+        X.terms[j - 1] = constant(Wj)
+        omegas.terms.append(constant(omega[j]))
+        for node in nodes:
+            node.forget(j - 1)
         F = known + cos_s * (Wj * g.scalar(a0))
         p = solve_trig(F).particular
         # its cos s (a_j) waits for the next order's sin s condition; its sin s makes
@@ -735,17 +772,37 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
         r = p.sin_part.coeffs()
         r_at_one = sum(r, zero)
         qs.append(Trig(p.cos_part, p.sin_part - g.poly([r_at_one]), g))
+        if shown is not None:
+            documented.append(CycleOrder(j, shown, g.to_fraction(a_prev) if j >= 2 else None,
+                                         g.to_fraction(Wj), g.to_fraction(omega[j]),
+                                         fourier(qs[j])))
     period = [g.scalar(1)]
     for j in range(1, order + 1):
         period.append(-sum((omega[a] * period[j - a] for a in range(1, j + 1)), zero))
-    fourier = [tuple({n: g.to_fraction(c) for n, c in part.items() if c}
-                     for part in qj.to_fourier()) for qj in qs[: order + 1]]
+    fourier_q = [fourier(qj) for qj in qs[: order + 1]]
     return LimitCycle(
         model=model, order=order,
         omega=tuple(g.to_fraction(w) for w in omega[: order + 1]),
         period=tuple(g.to_fraction(p) for p in period),
-        amplitude=tuple(sum(cos.values(), Fraction(0)) for cos, _ in fourier),
-        q=tuple(fourier), slope=slope)
+        amplitude=tuple(sum(cos.values(), Fraction(0)) for cos, _ in fourier_q),
+        q=tuple(fourier_q), slope=slope,
+        linearisation=fourier(lin) if lin is not None else ({}, {}), orders=tuple(documented))
+
+
+def _linearisation(model: Any, q0: Trig, g: Ground) -> Trig:
+    """``d/dλ f(q_0 + λ cos s, q_0' + λ (cos s)')`` at λ = 0: how ``a cos s`` added to
+    ``q_(j−1)`` moves ``[ε^(j−1)] f`` (ω₀ = 1)."""
+    x = Trig.from_fourier({1: g.scalar(1)}, {}, g)
+    v0 = q0.derivative()
+    lin = Trig(g.poly([]), g.poly([]), g)
+    for a, b, c in model.terms:  # d/dλ (q0 + λx)^a (v0 + λx')^b at λ = 0
+        if a:
+            lin = lin + (_trig_power(q0, a - 1, g) * _trig_power(v0, b, g) * x
+                         * g.scalar(c * a))
+        if b:
+            lin = lin + (_trig_power(q0, a, g) * _trig_power(v0, b - 1, g)
+                         * x.derivative() * g.scalar(c * b))
+    return lin
 
 
 def _trig_power(x: Trig, n: int, g: Ground) -> Trig:

@@ -1024,11 +1024,61 @@ class MuDampedDerivation:
 
 
 @dataclass(frozen=True)
+class CycleOrderPieces:
+    """Order j of a limit cycle's document: ``F_j = K_j + a_(j−1) L + a₀ W_j cos s``, the two
+    secular conditions and ``q_j`` (exact rationals; :class:`lindstedt.CycleOrder`)."""
+
+    j: int
+    known_cos: tuple[tuple[int, sp.Rational], ...]
+    known_sin: tuple[tuple[int, sp.Rational], ...]
+    a_prev: sp.Rational | None  # a_(j−1), from the sin s condition (None at j = 1)
+    W: sp.Rational
+    omega: sp.Rational
+    q_cos: tuple[tuple[int, sp.Rational], ...]
+    q_sin: tuple[tuple[int, sp.Rational], ...]
+
+
+@dataclass(frozen=True)
+class CycleDerivation:
+    """The order-by-order derivation of a limit cycle (``cycle_derivation.tex.j2``): the
+    amplitude equation ``S(a₀) = 0``, the linearisation ``L`` and the first orders."""
+
+    model: str
+    equation: str  # q'' + q = eps*f(q, q') as the user wrote it
+    a0: sp.Rational
+    slope: sp.Rational
+    lin_cos: tuple[tuple[int, sp.Rational], ...]
+    lin_sin: tuple[tuple[int, sp.Rational], ...]
+    orders: tuple[CycleOrderPieces, ...]
+
+
+def _rational_items(d: dict) -> tuple[tuple[int, sp.Rational], ...]:
+    return tuple((n, sp.Rational(c.numerator, c.denominator)) for n, c in sorted(d.items()))
+
+
+def lower_cycle_derivation(lc: LimitCycle, order: int) -> CycleDerivation:
+    """The document of ``lc``'s first ``min(order, len(lc.orders))`` orders."""
+
+    def rational(c):
+        return sp.Rational(c.numerator, c.denominator)
+
+    pieces = tuple(CycleOrderPieces(
+        o.j, _rational_items(o.known[0]), _rational_items(o.known[1]),
+        None if o.a_prev is None else rational(o.a_prev), rational(o.W), rational(o.omega),
+        _rational_items(o.q[0]), _rational_items(o.q[1])) for o in lc.orders[:order])
+    a0 = rational(lc.amplitude[0])
+    return CycleDerivation(lc.model.name, lc.model.source, a0, rational(lc.slope),
+                           _rational_items(lc.linearisation[0]),
+                           _rational_items(lc.linearisation[1]), pieces)
+
+
+@dataclass(frozen=True)
 class Unit:
     """What one command writes: a module and the documents beside it."""
 
     module: Module
-    documents: tuple[Derivation | MuDerivation | MuDampedDerivation | SlowFlowDocument, ...] = ()
+    documents: tuple[Derivation | MuDerivation | MuDampedDerivation
+                     | SlowFlowDocument | CycleDerivation, ...] = ()
 
 
 # --- the slow flow (averaging) ---------------------------------------------------------------

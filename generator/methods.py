@@ -70,6 +70,7 @@ from .lower import (
     horner,
     lower_balance,
     lower_choice,
+    lower_cycle_derivation,
     lower_derivation,
     lower_driven,
     lower_driven_damped,
@@ -460,7 +461,7 @@ def _free_lower(solution: object, r: Request) -> Unit:
 
 
 def _cycle_files(r: Request) -> tuple[str, ...]:
-    return (f"{r.model.name}.py",)
+    return (f"{r.model.name}.py", f"{r.model.name}_derivation.tex")
 
 
 RADIUS_ORDER = 60
@@ -475,7 +476,8 @@ def _cycle_derive(r: Request, progress: Progress | None) -> object:
 
 def _cycle_lower(derived: object, r: Request) -> Unit:
     cycle, resummed = derived
-    return Unit(lower_limit_cycle(cycle, r.command, r.order, resummed))
+    return Unit(lower_limit_cycle(cycle, r.command, r.order, resummed),
+                (lower_cycle_derivation(cycle, r.order),))
 
 
 RESUM_TOLERANCE = 1e-6

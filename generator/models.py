@@ -531,11 +531,19 @@ REGISTRY = {e.name: e for e in (
           "cycle"),
 )}
 MODELS = tuple(REGISTRY)
+ALIASES = {"vdp": "van_der_pol"}
+# NOTE: other names of an entry (the literature's short ones); `lindstedt models` lists each
+# beside its entry, and what is derived carries the entry's own name.
+
+
+def registry_entry(name: str) -> Entry | None:
+    """The registry's entry of a name or of an alias (:data:`ALIASES`), else None."""
+    return REGISTRY.get(ALIASES.get(name, name))
 
 
 def model_by_name(name: str, order: int) -> Model:
     """The named model, sized for ``order`` (the pendulum takes exactly what it needs)."""
-    entry = REGISTRY.get(name)
+    entry = registry_entry(name)
     if entry is None:
         raise InputError(f"model {name!r}: unknown; choose one of {', '.join(MODELS)}")
     return entry.model(order)
@@ -546,12 +554,12 @@ def series_model(text: str, order: int, values: dict[str, str] | None = None,
     """What ``lindstedt series`` derives for ``text``: the family of orbits of a conservative
     oscillator (:func:`model_from_text`), or the limit cycles of a self-excited one (a force
     odd in q', ``q'' + q = eps*f(q, q')``: :func:`self_excited_model`)."""
-    entry = REGISTRY.get(text) if NAME.fullmatch(text) else None
+    entry = registry_entry(text) if NAME.fullmatch(text) else None
     equation = entry.equation if entry is not None and entry.build is None else None
     if not NAME.fullmatch(text):
         equation = text
     if equation is not None:
-        osc = oscillator(equation, values, name or (text if entry else "oscillator"))
+        osc = oscillator(equation, values, name or (entry.name if entry else "oscillator"))
         q, v = osc.coordinate, osc.velocity
         if osc.drive == 0 and osc.parametric == 0 and osc.force.is_polynomial(q, v) and \
                 sp.expand(osc.force.xreplace({v: -v}) - osc.force) != 0:
@@ -563,12 +571,12 @@ def model_from_text(text: str, order: int, values: dict[str, str] | None = None,
                     name: str | None = None) -> Model:
     """A registry name or an equation (anything with a prime), sized for ``order``."""
     if NAME.fullmatch(text):  # a name (of the registry or not); anything else is an equation
+        entry = registry_entry(text)
         if values:
-            entry = REGISTRY.get(text)
             if entry is not None and entry.build is None:
-                return free_model(oscillator(entry.equation, values, name or text), order)
+                return free_model(oscillator(entry.equation, values, name or entry.name), order)
             raise InputError(f"--param: model {text!r} takes no parameters")
-        if name is not None and name != text:
+        if name is not None and name != (entry.name if entry else text):
             raise InputError(f"--name {name}: a built-in model keeps its name {text!r}")
         return model_by_name(text, order)
     return free_model(oscillator(text, values, name or "oscillator"), order)

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 import sympy as sp
-from flint import fmpq, fmpq_mpoly_ctx, fmpq_poly
+from flint import fmpq, fmpq_mpoly_ctx, fmpq_poly, fmpz, fmpz_poly
 from sympy.polys.densearith import dup_add, dup_mul, dup_mul_ground, dup_neg, dup_sub
 from sympy.polys.domains import QQ
 
@@ -389,10 +389,20 @@ class Trig:
         """``({n: a_n}, {n: b_n})``, zero coefficients left out."""
         g = self.ground
         basis = Basis(False)
-        cosines = to_fourier(self.cos_part, basis, g)
+        cs = self.cos_part.coeffs()
+        if g.is_rational and len(cs) > 1 and not any(cs[0::2]):  # odd harmonics: in C²
+            cosines = to_fourier(g.poly(cs[1::2]), Basis(True), g)
+        else:
+            cosines = to_fourier(self.cos_part, basis, g)
+        rs = self.sin_part.coeffs()
+        if g.is_rational and len(rs) > 1 and not any(rs[1::2]):  # R even in C: odd harmonics
+            # S·R(C) = −d/ds Q(C) with Q = ∫R dC = C·Σ r_k v^k/(2k+1): sin ns gets n γ_n
+            Q = g.poly([r * g.scalar(Fraction(1, 2 * k + 1)) for k, r in enumerate(rs[0::2])])
+            sines = {n: gamma * n for n, gamma in to_fourier(Q, Basis(True), g).items()}
+            return cosines, {n: b for n, b in sorted(sines.items()) if b}
         # S·R(C) with R(C) = Σ ρ_n cos ns: cos ns · sin s = (sin(n+1)s − sin(n−1)s)/2
         half = g.scalar(Fraction(1, 2))
-        sines: dict[int, Any] = {}
+        sines = {}
         for n, rho in to_fourier(self.sin_part, basis, g).items():
             if n == 0:
                 sines[1] = sines.get(1, g.scalar(0)) + rho
@@ -492,6 +502,246 @@ def trig_power(cosines: dict[int, sp.Expr], sines: dict[int, sp.Expr], power: in
     cos, sin = out.to_fourier()
     return ({n: ground.to_sympy(c) for n, c in cos.items()},
             {n: ground.to_sympy(c) for n, c in sin.items()})
+
+# --- ε-series of Trig sums over QQ, multiplied online (relaxed) ------------------------------
+# A perturbation series Σ_i X_i ε^i whose coefficients X_i are Trig sums over QQ is made one
+# order at a time, and a product c = a·b is wanted at order i as soon as a and b are known to
+# order i.  Term by term, [ε^i] c = Σ_k a_k b_(i−k) costs i Trig products at order i, K²/2 in
+# all.  The relaxed product (van der Hoeven) groups the pairs (k, l) with k, l ≥ 1 into squares
+# [m, 2m) × [m t, m(t+1)), m = 2^p — on the diagonal (t = 1) and off it (t ≥ 2, and the
+# transposed) — each multiplied as one bivariate product (Kronecker: the ε-index packed into
+# the power of C with a stride the products cannot overflow) as soon as its last input is
+# known, i.e. when [ε^(m(t+1))] c is first asked for.  The pairs (0, i) and (i, 0) stay term
+# by term: order i may still change its inputs' coefficient i (a limit cycle's amplitude is
+# fixed one order late), and :meth:`RelaxedProduct.forget` remakes just those.
+
+
+class TrigSeries:
+    """An ε-series of :class:`Trig` sums over QQ, known to some order."""
+
+    def coeff(self, i: int) -> Trig:
+        raise NotImplementedError
+
+    def forget(self, i: int) -> None:
+        """Coefficient ``i`` of an input changed: drop what was made from it."""
+
+
+class TrigTerms(TrigSeries):
+    """A series given term by term (``terms[i]``; the caller appends and replaces)."""
+
+    def __init__(self, terms: list[Trig]) -> None:
+        self.terms = terms
+
+    def coeff(self, i: int) -> Trig:
+        return self.terms[i]
+
+
+class TrigMap(TrigSeries):
+    """``fn`` applied to each coefficient of ``source`` (a derivative), each made once."""
+
+    def __init__(self, source: TrigSeries, fn: Any) -> None:
+        self.source, self.fn, self.cache = source, fn, {}
+
+    def coeff(self, i: int) -> Trig:
+        if i not in self.cache:
+            self.cache[i] = self.fn(self.source.coeff(i))
+        return self.cache[i]
+
+    def forget(self, i: int) -> None:
+        self.cache.pop(i, None)
+
+
+PACKED_FROM = 2
+# NOTE: squares of this many orders and more are packed (Kronecker); a single pair is one Trig
+# product (2 and 4 measured alike: van der Pol to order 100, 6.0–6.1 s against 6.1–6.3).
+
+
+class RelaxedProduct(TrigSeries):
+    """``a · b`` (``a is b``: a square), online: coefficient ``i`` may be asked for once ``a``
+    and ``b`` are final to order ``i − 1`` (their coefficient ``i`` may change later:
+    :meth:`forget`)."""
+
+    def __init__(self, a: TrigSeries, b: TrigSeries) -> None:
+        self.a, self.b = a, b
+        self.blocks: dict[int, list] = {}  # (part, numerator, denominator) from the squares
+        self.cache: dict[int, Trig] = {}
+        self.started = 1  # squares of output index ≤ started are made
+
+    def coeff(self, i: int) -> Trig:
+        if i in self.cache:
+            return self.cache[i]
+        while self.started < i:
+            self.started += 1
+            self._squares(self.started)
+        a, b = self.a, self.b
+        out = a.coeff(0) * b.coeff(0) if i == 0 else \
+            a.coeff(0) * b.coeff(i) + a.coeff(i) * b.coeff(0)
+        if i in self.blocks:
+            cos, sin = _sum_pieces(self.blocks[i])
+            out = Trig(out.cos_part + cos, out.sin_part + sin, out.ground)
+        self.cache[i] = out
+        return out
+
+    def forget(self, i: int) -> None:
+        self.cache.pop(i, None)
+
+    def _squares(self, n: int) -> None:
+        """The squares whose lowest output index is ``n``: ``m | n``, ``t = n/m − 1 ≥ 1``."""
+        m = 1
+        while 2 * m <= n:
+            if n % m == 0:
+                t = n // m - 1
+                low, high = range(m, 2 * m), range(m * t, m * t + m)
+                if t == 1:
+                    self._block(low, low)
+                elif self.a is self.b:
+                    self._block(low, high, twice=True)
+                else:
+                    self._block(low, high)
+                    self._block(high, low)
+            m *= 2
+
+    def _block(self, ks: range, ls: range, twice: bool = False) -> None:
+        a = [self.a.coeff(k) for k in ks]
+        b = [self.b.coeff(ll) for ll in ls]
+        base = ks[0] + ls[0]
+        if len(ks) < PACKED_FROM:
+            pieces = []
+            for k, x in enumerate(a):
+                for m, y in enumerate(b):
+                    xy = x * y
+                    for part, poly in ((0, xy.cos_part), (1, xy.sin_part)):
+                        if poly:
+                            pieces.append((k + m, part, poly.numer(), poly.denom()))
+        else:
+            pieces = _block_product(a, b)
+        for r, part, num, den in pieces:
+            self.blocks.setdefault(base + r, []).append((part, num * 2 if twice else num, den))
+
+
+def _block_product(a: list[Trig], b: list[Trig]) -> list[tuple[int, int, Any, Any]]:
+    """``Σ_(k+l=r) a_k b_l`` for ``r = 0 … len(a)+len(b)−2``, as pieces ``(r, 0 for the cos
+    part or 1 for the sin part, integer numerator polynomial, denominator)``.
+
+    Each Trig is split into four parts ``C^c S^s · p(v)``, ``v = C²`` (the even and odd powers
+    of C in P and R), so a product of parts is one part again, times ``v`` for ``c = c' = 1``
+    and ``1 − v`` for ``s = s' = 1``.  Each part is packed over the block into one integer
+    polynomial (``v^d ε^k → x^(S k + d)``, one common denominator a side) and only nonzero
+    parts are multiplied: van der Pol's q_k is ``C·p(v)`` for even k and ``S·r(v)`` for odd
+    k, so when every part lives on one parity of k the packing takes every other k.
+    """
+    da, den_a = _parts(a)
+    db, den_b = _parts(b)
+    length_a = max((len(c) for t in da for c in t.values()), default=1)
+    length_b = max((len(c) for t in db for c in t.values()), default=1)
+    S = length_a + length_b + 1  # room for a product of two parts and its factor v(1 − v)
+    pa, pb = _parities(da), _parities(db)
+    halved = pa is not None and pb is not None
+    if not halved:
+        pa = pb = None
+    packed_a, packed_b = _pack_parts(da, S, pa), _pack_parts(db, S, pb)
+    sums: dict[tuple, Any] = {}
+    for (ca, sa), (xa, oa) in packed_a.items():
+        for (cb, sb), (xb, ob) in packed_b.items():
+            prod = xa * xb
+            if ca and cb:
+                prod = prod.left_shift(1)
+            if sa and sb:
+                prod = prod - prod.left_shift(1)
+            key = (ca ^ cb, sa ^ sb, oa + ob)
+            sums[key] = sums[key] + prod if key in sums else prod
+    n_out = len(a) + len(b) - 1
+    parts: list[dict] = [{} for _ in range(n_out)]
+    for (c, s_, offset), poly in sorted(sums.items()):
+        coeffs = poly.coeffs()
+        for slot in range((len(coeffs) + S - 1) // S):
+            r = offset + (2 * slot if halved else slot)
+            piece = coeffs[S * slot: S * slot + S]
+            if any(piece):
+                old = parts[r].get((c, s_))
+                parts[r][(c, s_)] = piece if old is None else _add_lists(old, piece)
+    den = den_a * den_b
+    out = []
+    for r, part in enumerate(parts):
+        for which, even, odd in ((0, (0, 0), (1, 0)), (1, (0, 1), (1, 1))):
+            if even in part or odd in part:
+                out.append((r, which, fmpz_poly(_interleave(part.get(even, []),
+                                                             part.get(odd, []))), den))
+    return out
+
+
+def _sum_pieces(pieces: list) -> tuple[Any, Any]:
+    """``(cos, sin)`` polynomials of ``(part, numerator, denominator)`` pieces: over one common
+    denominator, reduced once (not at each partial sum)."""
+    out = []
+    for which in (0, 1):
+        mine = [(num, den) for part, num, den in pieces if part == which]
+        common = fmpz(1)
+        for _, den in mine:
+            common = common.lcm(den)
+        total = fmpz_poly([])
+        for num, den in mine:
+            total += num * (common // den)
+        out.append(fmpq_poly(total, common))
+    return out[0], out[1]
+
+
+def _parts(terms: list[Trig]) -> tuple[list[dict], Any]:
+    """Each Trig's nonzero parts ``{(c, s): integer coefficients in v}`` over one denominator."""
+    den = fmpz(1)
+    for t in terms:
+        den = den.lcm(t.cos_part.denom()).lcm(t.sin_part.denom())
+    out = []
+    for t in terms:
+        split = {}
+        for s_, p in ((0, t.cos_part), (1, t.sin_part)):
+            if p:
+                c = (p.numer() * (den // p.denom())).coeffs()
+                for parity in (0, 1):
+                    if any(c[parity::2]):
+                        split[(parity, s_)] = c[parity::2]
+        out.append(split)
+    return out, den
+
+
+def _parities(side: list[dict]) -> dict | None:
+    """``{part: parity of k}`` when each part is nonzero on one parity of k only, else None."""
+    found: dict = {}
+    for k, split in enumerate(side):
+        for key in split:
+            if found.setdefault(key, k % 2) != k % 2:
+                return None
+    return found
+
+
+def _pack_parts(side: list[dict], S: int, parities: dict | None) -> dict:
+    """``{part: (packed polynomial, offset of its first k)}``, every other k when halved."""
+    out = {}
+    keys = sorted({key for split in side for key in split})
+    for key in keys:
+        offset = parities[key] if parities is not None else 0
+        step = 2 if parities is not None else 1
+        coeffs: list = []
+        for k in range(offset, len(side), step):
+            c = side[k].get(key, [])
+            coeffs += c
+            coeffs += [0] * (S - len(c))
+        out[key] = (fmpz_poly(coeffs), offset)
+    return out
+
+
+def _add_lists(x: list, y: list) -> list:
+    if len(x) < len(y):
+        x, y = y, x
+    return [u + w for u, w in zip(x, y, strict=False)] + x[len(y):]
+
+
+def _interleave(even: list, odd: list) -> list:
+    out = [0] * max(2 * len(even) - 1, 2 * len(odd), 0)
+    out[0:2 * len(even):2] = even
+    out[1:2 * len(odd):2] = odd
+    return out
+
 
 # --- the float kernel: the same algebra in the Laurent form, for the numeric methods ---------
 # A real Fourier sum is held as the complex coefficients ``c_n`` of ``z^n = e^{ins}`` for

@@ -23,15 +23,31 @@ from lindstedt.driven import (
 )
 from lindstedt.emit import (
     environment,
+    render_cycle_derivation,
     render_latex,
     render_module,
     template_folder,
 )
 from lindstedt.emit import load_generated as load
 from lindstedt.errors import InputError
-from lindstedt.lindstedt import derive, omega_coefficients, period_series, solution_expression
-from lindstedt.lower import lower_derivation, lower_free
-from lindstedt.models import A, duffing, eps, pendulum, t, theta0
+from lindstedt.lindstedt import (
+    derive,
+    derive_limit_cycle,
+    omega_coefficients,
+    period_series,
+    solution_expression,
+)
+from lindstedt.lower import lower_cycle_derivation, lower_derivation, lower_free
+from lindstedt.models import (
+    A,
+    duffing,
+    eps,
+    oscillator,
+    pendulum,
+    self_excited_model,
+    t,
+    theta0,
+)
 from lindstedt.printers import identifier, latex_rational, pycode
 from reference import periodic_orbit
 from scipy.special import ellipj, ellipk
@@ -92,9 +108,10 @@ def test_templates_get_exactly_the_variables_they_use(tmp_path, monkeypatch):
     generate_driven(1, tmp_path)  # the driven module and mu_derivation.tex.j2
     generate_driven(1, tmp_path, damped=True)  # and mu_damped_derivation.tex.j2
     from lindstedt.compiler import generate_slow_flow
-    from lindstedt.models import oscillator
 
     generate_slow_flow(oscillator("q'' + q = eps*(1 - q**2)*q'"), 2, "cmd", tmp_path)
+    render_cycle_derivation(lower_cycle_derivation(derive_limit_cycle(self_excited_model(
+        oscillator("q'' + q = eps*(1 - q**2)*q'", name="vdp")), 4), 4), module.provenance)
     folder = template_folder()
     used, includes = {}, {}
     for path in folder.glob("*.j2"):
@@ -107,7 +124,7 @@ def test_templates_get_exactly_the_variables_they_use(tmp_path, monkeypatch):
         for ctx in contexts:
             assert reads <= ctx, (name, reads - ctx)  # nothing undefined
     for name in ("module.py.j2", "mu_derivation.tex.j2", "mu_damped_derivation.tex.j2",
-                 "slow_flow.tex.j2"):
+                 "slow_flow.tex.j2", "cycle_derivation.tex.j2"):
         assert passed[name] and all(ctx == used[name] for ctx in passed[name]), name
     latex = passed["tables.tex.j2"] + passed["derivation.tex.j2"]
     assert len(latex) == 2 and latex[0] == latex[1]

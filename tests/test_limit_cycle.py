@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 from fractions import Fraction as F
+from functools import reduce
 
 import numpy as np
 import pytest
@@ -17,6 +18,8 @@ from scipy.integrate import solve_ivp
 
 VDP = "q'' + q = eps*(1 - q**2)*q'"
 LIENARD = "q'' + q = eps*(1 - 5*q**2/4 + q**4/8)*q'"
+MIXED = "q'' + q = eps*((1 - q**2)*q' + q**2/3)"
+# NOTE: an even term beside van der Pol's: even harmonics and both cos and sin at every order
 # NOTE: S(a) = −a(1 − 5a²/16 + a⁴/64): two cycles, a = 2 and a = 4, of opposite stability
 
 
@@ -106,6 +109,61 @@ def test_refusals_name_what_is_wrong():
         model("q'' + q = eps*q**3")
     with pytest.raises(InputError, match="cycle 1"):
         derive_limit_cycle(model(VDP), 2, cycle=1)
+    # S(a) ∝ a(a² − 4)²: a double root, a semi-stable cycle (S'(2) = 0)
+    with pytest.raises(InputError, match="semi-stable"):
+        derive_limit_cycle(model("q'' + q = eps*(1 - 2*q**2 + q**4/2)*q'"), 4)
+    with pytest.raises(InputError, match="decays to rest"):  # damping: S(a) = a/2 > 0
+        derive_limit_cycle(model("q'' + q + eps*(q' + q**2*q') = 0"), 4)
+    with pytest.raises(InputError, match="gains energy"):
+        derive_limit_cycle(model("q'' + q = eps*q'"), 4)
+
+
+def test_the_issues_command_vdp(capsys):
+    """`lindstedt series vdp --order K --json` (vdp: the registry's alias of van_der_pol):
+    the published first coefficients, the stability of both signs of ε, and partial sums of
+    ω against the period of the cycle shot numerically (numerics.true_limit_cycle)."""
+    from lindstedt.numerics import true_limit_cycle
+
+    assert main(["series", "vdp", "--order", "40", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["model"] == "van_der_pol"
+    assert data["omega"][:5] == ["1/1", "0/1", "-1/16", "0/1", "17/3072"]
+    assert data["stability"].startswith("stable (attracting) for eps > 0, unstable "
+                                        "(repelling) for eps < 0")
+    omega = [F(c) for c in data["omega"]]
+    for eps in (0.1, 0.3):
+        cycle = true_limit_cycle(model(VDP), eps)
+        partial = sum(float(c) * eps**j for j, c in enumerate(omega))
+        assert partial == pytest.approx(2 * np.pi / cycle.period, rel=1e-12, abs=0)
+
+
+def test_the_alias_is_listed(capsys):
+    assert main(["models"]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("van_der_pol"))
+    assert "(also: vdp)" in line
+    assert main(["models", "--json"]) == 0
+    rows = {r["name"]: r for r in json.loads(capsys.readouterr().out)}
+    assert rows["van_der_pol"]["aliases"] == ["vdp"] and rows["duffing"]["aliases"] == []
+
+
+def test_the_series_holds_for_the_repelling_sign_of_eps():
+    """ε < 0: the cycle repels, and the same series gives it (traced backwards in time).  With
+    an even term beside van der Pol's, q(0) has odd orders: ε and −ε differ."""
+    lc = derive_limit_cycle(model(MIXED), 24)
+    assert lc.slope > 0 and lc.amplitude[1] != 0
+    f = lambda q, p: (1 - q * q) * p + q * q / 3  # noqa: E731
+    for eps in (0.15, -0.15):
+        T, q_max = numerical_cycle(f, eps, 2.0, backwards=eps < 0)
+        assert 2 * np.pi * sum(float(c) * eps**j for j, c in enumerate(lc.period)) == \
+            pytest.approx(T, rel=1e-9)
+        assert sum(float(c) * eps**j for j, c in enumerate(lc.amplitude)) == \
+            pytest.approx(q_max, rel=1e-8)
+
+
+def test_an_order_beyond_a_minute_is_refused_with_its_estimate(capsys):
+    assert main(["series", "vdp", "--order", "3000"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--allow-slow" in err and "order 3000" in err
 
 
 def test_series_json_of_a_limit_cycle(capsys):
@@ -120,19 +178,21 @@ def test_series_json_of_a_limit_cycle(capsys):
     assert err.count("\n") == 1 and "no limit cycle" in err
 
 
-def test_nearest_singularities_from_the_exact_series():
+def test_nearest_singularities_from_the_exact_series(capsys):
     """Van der Pol's ω: a conjugate pair at |ε²| ≈ 3.42 (Andersen & Geer 1982, by Padé from ε²⁴
-    exact and ε¹⁶⁴ in floating point) — order 60 here, within 1 %; the free Duffing period's
-    separatrix at x = −1 and the pendulum's at θ₀² = π², on the real axis."""
+    exact and ε¹⁶⁴ in floating point) — `series vdp --order 100 --singularities`, within 1 %;
+    the free Duffing period's separatrix at x = −1 and the pendulum's at θ₀² = π², on the real
+    axis."""
     import math
 
     from lindstedt.lindstedt import derive, nearest_singularity
     from lindstedt.models import duffing, pendulum
 
-    vdp = nearest_singularity(derive_limit_cycle(model(VDP), 60).omega)
-    assert vdp.variable == "eps**2" and vdp.method == "Mercer–Roberts"
-    assert abs(vdp.radius / 3.42 - 1) < 0.01 and vdp.spread < 0.05
-    assert 0.5 < vdp.angle < math.pi - 0.5  # off the real axis
+    assert main(["series", "vdp", "--order", "100", "--singularities", "--json"]) == 0
+    (vdp,) = json.loads(capsys.readouterr().out)["singularities"]
+    assert vdp["variable"] == "eps**2" and vdp["method"] == "Mercer–Roberts"
+    assert abs(vdp["radius"] / 3.42 - 1) < 0.01 and vdp["spread"] < 0.01
+    assert 0.5 < vdp["angle"] < math.pi - 0.5  # off the real axis
     for m, where, angle in ((duffing(), 1.0, math.pi), (pendulum(40), math.pi**2, 0.0)):
         sol = derive(m, 40)
         est = nearest_singularity([sol.ground.to_fraction(c) for c in sol.period], "y")
@@ -189,3 +249,193 @@ def test_emitted_limit_cycle_module_against_the_true_cycle(tmp_path):
                         (0, cycle.period), [cycle.q0, 0.0], method="DOP853", rtol=1e-12,
                         atol=1e-14, t_eval=t)
         np.testing.assert_allclose(mod.q(t, eps), run.y[0], atol=max(1e-9, 30 * bound))
+
+
+# --- an independent slow route: Fourier dictionaries of Fractions, product-to-sum ------------
+
+def _trig_mul(x: tuple[dict, dict], y: tuple[dict, dict]) -> tuple[dict, dict]:
+    """(cos, sin) coefficients of a product: cos a cos b = (cos(a−b) + cos(a+b))/2, …"""
+    cos: dict[int, F] = {}
+    sin: dict[int, F] = {}
+
+    def add(d, n, v):
+        if n < 0:
+            n, v = -n, (v if d is cos else -v)
+        if n == 0 and d is sin:
+            return
+        d[n] = d.get(n, F(0)) + v
+
+    for n, a in x[0].items():
+        for m, b in y[0].items():
+            add(cos, n - m, a * b / 2)
+            add(cos, n + m, a * b / 2)
+        for m, b in y[1].items():  # cos ns sin ms = (sin(m+n)s + sin(m−n)s)/2
+            add(sin, m + n, a * b / 2)
+            add(sin, m - n, a * b / 2)
+    for n, a in x[1].items():
+        for m, b in y[0].items():
+            add(sin, n + m, a * b / 2)
+            add(sin, n - m, a * b / 2)
+        for m, b in y[1].items():  # sin ns sin ms = (cos(n−m)s − cos(n+m)s)/2
+            add(cos, n - m, a * b / 2)
+            add(cos, n + m, -a * b / 2)
+    return ({n: v for n, v in cos.items() if v}, {n: v for n, v in sin.items() if v})
+
+
+def _trig_add(x, y, c=F(1)):
+    out = ({**x[0]}, {**x[1]})
+    for part in (0, 1):
+        for n, v in y[part].items():
+            out[part][n] = out[part].get(n, F(0)) + c * v
+    return ({n: v for n, v in out[0].items() if v}, {n: v for n, v in out[1].items() if v})
+
+
+def _d(x):  # d/ds
+    return ({n: n * b for n, b in x[1].items()}, {n: -n * a for n, a in x[0].items()})
+
+
+def slow_limit_cycle(terms, a0: F, order: int) -> tuple[list[F], list[F]]:
+    """ω and q(0) of ω² q'' + q = ε Σ c q^a (ω q')^b, the textbook way: at order j the
+    force's [ε^(j−1)] is evaluated twice, with the unknown cos s of q_(j−1) at 0 and at 1 (F_j
+    is affine in it); every product a Cauchy sum of Fourier dictionaries (orders below j − 1
+    kept, order j − 1 made afresh)."""
+    zero = ({}, {})
+    one = ({0: F(1)}, {})
+    q = [({1: a0}, {})]
+    W, omega = [F(1)], [F(1)]
+    kept: dict[tuple, tuple] = {}  # (kind, power, n) → coefficient, for n final
+
+    def entry(kind, p, n, last):
+        """[ε^n] q^p ("q") or (ω q')^p ("v"); ``last``: q_(j−1) as tried."""
+        if (kind, p, n) in kept:
+            return kept[kind, p, n]
+
+        def qn(k):
+            return last if k == len(q) - 1 else q[k]
+
+        if p == 0:
+            out = one if n == 0 else zero
+        elif kind == "q" and p == 1:
+            out = qn(n)
+        elif p == 1:
+            out = reduce(lambda acc, k: _trig_add(acc, _d(qn(n - k)), omega[k]),
+                         range(n + 1), zero)
+        else:
+            out = reduce(_trig_add, (_trig_mul(entry(kind, p - 1, k, last),
+                                               entry(kind, 1, n - k, last))
+                                     for k in range(n + 1)), zero)
+        if n < len(q) - 1:
+            kept[kind, p, n] = out
+        return out
+
+    def F_j(j, last, Wj):
+        out = zero
+        for a, b, c in terms:
+            for k in range(j):
+                out = _trig_add(out, _trig_mul(entry("q", a, k, last),
+                                               entry("v", b, j - 1 - k, last)), F(c))
+        for i in range(1, j):
+            out = _trig_add(out, _d(_d(last if j - i == len(q) - 1 else q[j - i])), -W[i])
+        return _trig_add(out, ({1: a0 * Wj}, {}))  # −W_j q_0''
+
+    for j in range(1, order + 2):
+        base = F_j(j, q[-1], F(0))
+        if j >= 2:
+            tried = F_j(j, _trig_add(q[-1], ({1: F(1)}, {})), F(0))
+            a_prev = -base[1].get(1, F(0)) / (tried[1].get(1, F(0)) - base[1].get(1, F(0)))
+            q[-1] = _trig_add(q[-1], ({1: a_prev}, {}))
+            base = F_j(j, q[-1], F(0))
+        Wj = -base[0].get(1, F(0)) / a0
+        W.append(Wj)
+        omega.append((Wj - sum((omega[k] * omega[j - k] for k in range(1, j)), F(0))) / 2)
+        rhs = _trig_add(base, ({1: a0 * Wj}, {}))
+        cos = {n: c / (1 - n * n) for n, c in rhs[0].items() if n != 1}
+        sin = {n: c / (1 - n * n) for n, c in rhs[1].items() if n != 1}
+        sin[1] = -sum(n * b for n, b in sin.items())  # q_j'(0) = 0
+        q.append(({n: v for n, v in cos.items() if v}, {n: v for n, v in sin.items() if v}))
+    return omega[: order + 1], [sum(c.values(), F(0)) for c, _ in q[: order + 1]]
+
+
+@pytest.mark.parametrize(("text", "cycle", "order"), [
+    (VDP, 0, 24), (LIENARD, 1, 10), (MIXED, 0, 10),
+    ("q'' + q = eps*(1/3 + (1 - q**2)*q' + q*q' + q'**2/5)", 0, 8)])  # every kind of term
+def test_the_relaxed_products_against_the_textbook_route(text, cycle, order):
+    """Every ω_j and amplitude coefficient exact, against :func:`slow_limit_cycle` (van der Pol
+    to order 24: squares of 2, 4 and 8 orders are packed from orders 4, 8 and 16 on)."""
+    m = model(text)
+    lc = derive_limit_cycle(m, order, cycle)
+    a0, _ = limit_cycle_amplitudes(m)[cycle]
+    omega, amplitude = slow_limit_cycle(m.terms, a0, order)
+    assert list(lc.omega) == omega
+    assert list(lc.amplitude) == amplitude
+
+
+def test_the_derivation_document(tmp_path):
+    """`generate` writes the order-by-order equations beside the module: F_j's sin s and cos s
+    vanish with the a_(j−1) and W_j it prints (an exact identity), ω_2 = −1/16 and
+    ω_4 = 17/3072 as published, q_j + a_j cos s the series' own q_j; byte-identical when
+    written again; pdflatex compiles it without an overfull line."""
+    import shutil
+    import subprocess
+
+    lc = derive_limit_cycle(model(VDP), 8)
+    a0 = lc.amplitude[0]
+    lin_cos, lin_sin = lc.linearisation
+    assert [o.j for o in lc.orders] == [1, 2, 3, 4, 5, 6]
+    for o in lc.orders:
+        a = o.a_prev or 0
+        assert o.known[1].get(1, 0) + a * lin_sin.get(1, 0) == 0
+        assert o.known[0].get(1, 0) + a * lin_cos.get(1, 0) + a0 * o.W == 0
+        nxt = lc.orders[o.j] if o.j < len(lc.orders) else None
+        if nxt is not None:
+            cos = {**o.q[0], 1: o.q[0].get(1, 0) + nxt.a_prev}
+            assert ({n: c for n, c in cos.items() if c}, o.q[1]) == lc.q[o.j]
+    assert [o.omega for o in lc.orders[:4]] == [0, F(-1, 16), 0, F(17, 3072)]
+    for folder in ("one", "two"):
+        assert main(["generate", "vdp", "--order", "8", "--out", str(tmp_path / folder)]) == 0
+    tex = (tmp_path / "one" / "van_der_pol_derivation.tex").read_text()
+    assert tex == (tmp_path / "two" / "van_der_pol_derivation.tex").read_text()
+    assert r"\omega_{4} = \frac{17}{3072}" in tex and r"W_{2} = -\frac{1}{8}" in tex
+    pdflatex = shutil.which("pdflatex")
+    if pdflatex is None:
+        pytest.skip("pdflatex not installed (`make tex` installs it)")
+    run = subprocess.run([pdflatex, "-interaction=nonstopmode", "-halt-on-error",
+                          "van_der_pol_derivation.tex"], cwd=tmp_path / "one",
+                         stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=300,
+                         check=False)
+    assert run.returncode == 0, run.stdout[-2000:]
+    log = (tmp_path / "one" / "van_der_pol_derivation.log").read_text(errors="replace")
+    assert "Overfull \\hbox" not in log
+
+
+def test_coefficients_of_any_length_are_printed():
+    """Van der Pol's coefficients pass Python's 4300-digit str() limit near order 150; the
+    series JSON and table print them whole (digits checked by arithmetic, not by str())."""
+    from lindstedt.cli import _fraction_text
+
+    for value in (F(7**6000 + 1, 3**12000), F(-(10**5000) - 3, 1), F(-17, 3072)):
+        num, den = _fraction_text(value).split("/")
+        for text, n in ((num, value.numerator), (den, value.denominator)):
+            digits = text.lstrip("-")
+            assert text.startswith("-") == (n < 0) and digits.isdigit()
+            assert 10 ** (len(digits) - 1) <= abs(n) < 10 ** len(digits)
+            head = min(30, len(digits))
+            assert int(digits[:head]) == abs(n) // 10 ** (len(digits) - head)
+            assert int(digits[-3:]) == abs(n) % 1000
+
+
+def test_odd_harmonic_sums_round_trip_through_the_kernel():
+    """The kernel's C² route for odd harmonics (cos: C·p(C²); sin: S·r(C²), via −d/ds of
+    ∫r dC) gives back the Fourier coefficients a sum was built from (Chebyshev's route)."""
+    import random
+
+    from lindstedt.series import Ground, Trig
+
+    g = Ground.for_coefficients([])
+    rng = random.Random(3)
+    for _ in range(40):
+        sums = [{n: F(rng.randint(-50, 50), rng.randint(1, 30))
+                 for n in range(1, 2 * rng.randint(1, 12) + 1, 2)} for _ in range(2)]
+        t = Trig.from_fourier(*({n: g.scalar(c) for n, c in d.items()} for d in sums), g)
+        back = [{n: g.to_fraction(v) for n, v in part.items()} for part in t.to_fourier()]
+        assert back == [{n: c for n, c in d.items() if c} for d in sums]
