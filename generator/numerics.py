@@ -1092,27 +1092,44 @@ def mathieu_newton(kind: str, m: int, q: ArrayLike, start: ArrayLike, rows: int,
 
 
 def mathieu_truncation_bound(kind: str, m: int, q: float, a: float, rows: int) -> float:
-    """A bound on ``|a_rows − a|``: the eigenvalue of the ``rows``-row truncation against
-    the exact ``a`` of the infinite recurrence.  The exact eigenvector ``v`` restricted to the
-    rows leaves the residual ``|e_(rows−1) v_rows| / ‖v_(<rows)‖``, and a symmetric matrix
-    has an eigenvalue within its residual (Bauer–Fike).  Past the first row ``J`` with
-    ``c_j − a ≥ 2ê`` (``ê = √2 |q|`` ≥ every coupling), the tail's continued fraction
-    ``B_j = e²_(j−1) / (c_j − a − B_(j+1))`` stays in ``[0, ê]``, so ``|v_j / v_(j−1)| =
-    e_(j−1) / (c_j − a − B_(j+1)) ≤ ê / (c_j − a − ê)``, and the residual is at most
-    ``ê Π_(j=J…rows) ê / (c_j − a − ê)``.  ``inf`` when the tail starts past ``rows``."""
-    _, diag, _ = mathieu_recurrence(kind, m, rows + 1)
+    """A bound on ``|a_rows − a|``: the eigenvalue of the ``rows``-row truncation (N = rows)
+    against the exact ``a`` of the infinite recurrence, with ``v`` its unit eigenvector.
+
+    Cutting the coupling ``e = e_(N−1)`` leaves ``A' = T_N ⊕ T_tail`` and ``(A' − a)v =
+    −e(v_N u_(N−1) + v_(N−1) u_N)``: the Rayleigh quotient ``ρ = a − 2e v_(N−1) v_N`` and the
+    residual ``r ≤ e (v²_(N−1) + v²_N)^½``; by Kato–Temple ``|μ − ρ| ≤ r²/g`` for the one
+    eigenvalue ``μ`` of ``A'`` within the gap ``g`` of ``ρ`` to the rest of its spectrum
+    (``T_N``'s neighbours of ``μ``, and ``T_tail ≥ c_N − 2ê`` by Gershgorin).  So ``|μ − a| ≤
+    2e|v_(N−1) v_N| + r²/g``.  Past the first row ``J`` with ``c_j − a ≥ 2ê`` (``ê = √2 |q|``
+    ≥ every coupling), the tail's continued fraction ``B_j = e²_(j−1) / (c_j − a − B_(j+1))``
+    stays in ``[0, ê]``, so ``|v_j / v_(j−1)| = e_(j−1) / (c_j − a − B_(j+1)) ≤ ê / (c_j − a
+    − ê)`` and ``|v_n| ≤ Π_(j=J…n) ê / (c_j − a − ê)``.  ``inf`` when the tail starts past
+    ``N − 1`` or the gap closes."""
+    from scipy.linalg import eigvalsh_tridiagonal
+
+    index, diag, couplings = mathieu_recurrence(kind, m, rows + 1)
     e = math.sqrt(2.0) * abs(q)
     if e == 0.0:
         return 0.0
     c = [r2 + s * q - a for r2, s in diag]
-    J = next((j for j in range(1, rows + 1) if all(c[i] >= 2 * e for i in range(j, rows + 1))),
+    J = next((j for j in range(1, rows) if all(c[i] >= 2 * e for i in range(j, rows + 1))),
              None)
     if J is None:
         return math.inf
-    bound = e
+    v = [1.0]
     for j in range(J, rows + 1):
-        bound *= e / (c[j] - e)
-    return bound
+        v.append(v[-1] * e / (c[j] - e))
+    v_last, v_cut = v[-2], v[-1]  # |v_(N−1)|, |v_N|
+    first = 2 * e * v_last * v_cut
+    values = eigvalsh_tridiagonal(
+        np.array([float(r2 + s * q) for r2, s in diag[:rows]]),
+        np.array([math.sqrt(t) * abs(q) for t in couplings[: rows - 1]]))
+    others = [abs(x - a) for i, x in enumerate(values) if i != index]
+    others.append(diag[rows][0] + diag[rows][1] * q - 2 * e - a)
+    gap = min(others) - first - 1e-9 * max(1.0, abs(a))  # the float64 eigenvalues' error
+    if gap <= 0:
+        return math.inf
+    return first + e * e * (v_last**2 + v_cut**2) / gap
 
 
 def mathieu_refined(kind: str, m: int, q: float, dps: int = 30) -> float:
