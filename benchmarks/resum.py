@@ -10,11 +10,14 @@
    where the neighbour spread exceeds 1e-7, the generation rule before its shooting checks),
    shooting at three tolerances; ns per point measured in this run beside the recorded ones
    the chart uses (so that it is byte-identical on every run).
-3. SciPy's mathieu_a, mathieu_b and the resummed evaluators against the eigenvalue reference
-   (numerics.mathieu_reference, float64, checked against mpmath at 30 digits) on q ∈ (0, 50];
-   ns per point of the emitted a_0 against SciPy and SymPy's lambdify of the series.
+3. SciPy's mathieu_a, mathieu_b and the emitted evaluators (Padé + one Newton step, order 100)
+   for every m ≤ 6 against the 30-digit reference (numerics.mathieu_refined) on q ∈ (0, 50];
+   ns per point of each against SciPy in the same run, and of SymPy's lambdify of the series.
 
-Writes docs/figures/resummed_speed_accuracy.png and prints the tables.
+Writes docs/figures/resummed_speed_accuracy.png and docs/figures/mathieu_accuracy.png and
+prints the tables; with --mathieu-only, part 3 and docs/figures/mathieu_accuracy.png alone:
+
+    .venv/bin/python benchmarks/resum.py --mathieu-only
 """
 
 from __future__ import annotations
@@ -26,15 +29,15 @@ from pathlib import Path
 
 import numpy as np
 import sympy as sp
-from lindstedt.charts import resummed_speed_accuracy_figure
+from lindstedt.charts import mathieu_accuracy_figure, resummed_speed_accuracy_figure
 from lindstedt.compiler import generate_limit_cycle, generate_mathieu
 from lindstedt.emit import load_generated
 from lindstedt.errors import InputError
 from lindstedt.hill import mathieu_series
 from lindstedt.lindstedt import derive_limit_cycle, nearest_singularity
-from lindstedt.methods import RESUM_SPREAD_MARGIN, RESUM_TOLERANCE, resum_mathieu
+from lindstedt.methods import RESUM_SPREAD_MARGIN, RESUM_TOLERANCE
 from lindstedt.models import series_model
-from lindstedt.numerics import cycle_reference, mathieu_reference
+from lindstedt.numerics import cycle_reference, mathieu_reference, mathieu_refined
 from lindstedt.resum import (
     compose,
     diagonal_pade,
@@ -60,9 +63,11 @@ RECORDED_NS = {"series": 3.0, "resummed": 5.5, "lambdify": 60.0,
 # NOTE: ns per point recorded on the 2-core machine (docs/benchmarks.md, load ≈ 2): the
 # emitted `_into` loops of omega (series) and omega_resummed over 10⁶ points, lambdify of the
 # order-60 partial sum, one DOP853 shooting per ε (two tolerances for the 1e-13 reference).
-MATHIEU = (("a", 0), ("a", 1), ("a", 2), ("a", 6), ("b", 2), ("b", 6))
-FIGURE = Path(__file__).resolve().parent.parent / "docs" / "figures" / \
-    "resummed_speed_accuracy.png"
+MATHIEU = (*(("a", m) for m in range(7)), *(("b", m) for m in range(1, 7)))
+MATHIEU_DRAWN = (("a", 0), ("a", 6), ("b", 6))
+FIGURE_DIR = Path(__file__).resolve().parent.parent / "docs" / "figures"
+FIGURE = FIGURE_DIR / "resummed_speed_accuracy.png"
+MATHIEU_FIGURE = FIGURE_DIR / "mathieu_accuracy.png"
 
 
 def forms_table(omega: list, eps: np.ndarray, truth: np.ndarray) -> None:
@@ -175,36 +180,40 @@ def cycle_timings(lc) -> None:
 
 
 def mathieu_part() -> tuple[np.ndarray, dict]:
+    """Per m ≤ 6: SciPy's and the emitted (order 100) values against the 30-digit reference
+    on 200 points of (0, 50], and ns per point of each against SciPy in the same run."""
     q = np.linspace(0, 50, 201)[1:]
     errors = {}
-    print("\nMathieu, against the eigenvalue reference on q ∈ (0, 50] (relative to max(1, |a|)):")
-    print(f"{'':<6}{'ref vs mpmath':>14}{'SciPy max':>12}{'at q':>8}{'resummed to q':>15}"
-          f"{'its max':>10}{'SciPy there':>13}")
-    for kind, m in MATHIEU:
-        ref = np.array([mathieu_reference(kind, m, float(v)) for v in q])
-        mp = np.array([mathieu_reference(kind, m, float(v), dps=30) for v in q[::50]])
-        check = np.max(np.abs(ref[::50] - mp) / np.maximum(1, np.abs(mp)))
-        scipy = (mathieu_a if kind == "a" else mathieu_b)(m, q)
-        es = np.abs(scipy - ref) / np.maximum(1, np.abs(ref))
-        r = resum_mathieu(kind, m, 100)
-        val = np.where(q <= r.limit, r.form(q), np.nan)
-        er = np.abs(val - ref) / np.maximum(1, np.abs(ref))
-        inside = q <= r.limit
-        print(f"{kind}_{m:<4}{check:>14.1e}{es.max():>12.1e}{q[np.argmax(es)]:>8.3g}"
-              f"{r.limit:>15.4g}{np.nanmax(er):>10.1e}{es[inside].max():>13.1e}")
-        if (kind, m) in (("a", 0), ("a", 6), ("b", 6)):
-            errors[f"SciPy {kind}_{m}"] = es
-            errors[f"resummed {kind}_{m}"] = er
-    qs = np.random.default_rng(0).uniform(0, 5, 1_000_000)
-    out = np.empty_like(qs)
+    print("\nMathieu, against numerics.mathieu_refined (30 digits) on 200 points of (0, 50], "
+          "relative to max(1, |a|); ns per point on [0, min(5, verified q)], best of 5:")
+    print(f"{'':<6}{'SciPy max':>10}{'at q':>7}{'verified to q':>15}{'rows':>6}{'emitted max':>13}"
+          f"{'SciPy there':>13}{'ufunc ns':>10}{'_into ns':>10}{'SciPy ns':>10}{'ratio':>8}")
     with tempfile.TemporaryDirectory() as folder:
-        generate_mathieu("a", 0, 100, Path(folder))
-        mod = load_generated(Path(folder) / "mathieu_a0.py")
-        mod.a0(qs[:10]), mod.a0_into(out, qs)
-        ufunc = best(lambda: mod.a0(qs), 5) / qs.size * 1e9
-        into = best(lambda: mod.a0_into(out, qs), 5) / qs.size * 1e9
+        for kind, m in MATHIEU:
+            ref = np.array([float(mathieu_refined(kind, m, float(v))) for v in q])
+            scale = np.maximum(1, np.abs(ref))
+            scipy_f = mathieu_a if kind == "a" else mathieu_b
+            es = np.abs(scipy_f(m, q) - ref) / scale
+            generate_mathieu(kind, m, 100, Path(folder))
+            mod = load_generated(Path(folder) / f"mathieu_{kind}{m}.py")
+            f, f_into = getattr(mod, f"{kind}{m}"), getattr(mod, f"{kind}{m}_into")
+            er = np.abs(f(q) - ref) / scale
+            inside = q <= mod.LIMIT
+            qs = np.random.default_rng(0).uniform(0, min(5.0, mod.LIMIT), 100_000)
+            out = np.empty_like(qs)
+            f(qs[:10]), f_into(out, qs)
+            ufunc = best(lambda f=f, qs=qs: f(qs), 5) / qs.size * 1e9
+            into = best(lambda f_into=f_into, qs=qs, out=out: f_into(out, qs), 5) / qs.size * 1e9
+            small = qs[:20_000]
+            scipy_ns = best(lambda m=m, small=small, g=scipy_f: g(m, small), 5) / small.size * 1e9
+            print(f"{kind}_{m:<4}{es.max():>10.1e}{q[np.argmax(es)]:>7.3g}{mod.LIMIT:>15.4g}"
+                  f"{mod.ROWS:>6}{np.nanmax(er[inside]):>13.1e}{es[inside].max():>13.1e}"
+                  f"{ufunc:>10.3g}{into:>10.3g}{scipy_ns:>10.3g}{scipy_ns / ufunc:>8.1f}")
+            if (kind, m) in MATHIEU_DRAWN:
+                errors[f"SciPy {kind}_{m}"] = es
+                errors[f"emitted {kind}_{m}"] = er
+    qs = np.random.default_rng(0).uniform(0, 5, 1_000_000)
     small = qs[:20_000]
-    scipy_ns = best(lambda: mathieu_a(0, small), 3) / small.size * 1e9
     z = sp.Symbol("q")
     series = mathieu_series("a", 0, 100)
     lam = sp.lambdify(z, sum(sp.Rational(c.numerator, c.denominator) * z**k
@@ -212,14 +221,18 @@ def mathieu_part() -> tuple[np.ndarray, dict]:
     lam_ns = best(lambda: lam(qs), 3) / qs.size * 1e9
     ref_ns = best(lambda: [mathieu_reference("a", 0, float(v)) for v in small[:200]], 1) \
         / 200 * 1e9
-    print(f"\na_0(q) on q ∈ [0, 5], ns per point this run: emitted ufunc {ufunc:.3g}, _into "
-          f"{into:.3g}; scipy.special.mathieu_a {scipy_ns:.3g}; lambdify of the order-100 "
-          f"series {lam_ns:.3g}; eigenvalue reference {ref_ns:.3g}")
+    print(f"\na_0(q) on q ∈ [0, 5], ns per point this run: lambdify of the order-100 series "
+          f"{lam_ns:.3g}; float64 eigenvalue reference {ref_ns:.3g}")
     return q, errors
 
 
 def main() -> int:
     t0 = time.perf_counter()
+    if "--mathieu-only" in sys.argv[1:]:
+        q, errors = mathieu_part()
+        mathieu_accuracy_figure(q, errors, MATHIEU_FIGURE)
+        print(f"\nwrote {MATHIEU_FIGURE} ({time.perf_counter() - t0:.0f} s)")
+        return 0
     vdp = series_model("van_der_pol", ORDER)
     lc = derive_limit_cycle(vdp, ORDER)
     eps = np.array(EPS)
@@ -240,6 +253,7 @@ def main() -> int:
     cycle_timings(lc)
     mathieu = mathieu_part()
     resummed_speed_accuracy_figure(panels, mathieu, FIGURE)
+    mathieu_accuracy_figure(*mathieu, MATHIEU_FIGURE)
     print(f"\nwrote {FIGURE} ({time.perf_counter() - t0:.0f} s)")
     return 0
 

@@ -737,3 +737,22 @@ def resummed_speed_accuracy_figure(panels: Sequence[tuple[str, Sequence[tuple[st
     ax.legend(fontsize=7, ncol=4)
     fig.tight_layout()
     return _save(fig, path)
+
+
+def mathieu_accuracy_figure(q: np.ndarray, errors: dict[str, np.ndarray], path: Path) -> Path:
+    """Mathieu's characteristic values against the 30-digit reference over q: ``errors``
+    maps a label (``"SciPy a_6"``, ``"emitted a_6"``) to the relative error (to max(1, |a|))
+    on ``q``; the emitted evaluators' NaN beyond their verified q is not drawn, a zero error
+    sits on the floor."""
+    check_plot_path(path)
+    fig, ax = plt.subplots(figsize=(10, 4.5))
+    names = sorted({label.split()[-1] for label in errors})
+    for label, err in sorted(errors.items()):
+        ax.plot(q, np.maximum(err, FLOOR), "--" if label.startswith("SciPy") else "-", lw=1,
+                color=f"C{names.index(label.split()[-1])}", label=label)
+    ax.set(yscale="log", xlabel="q", ylabel="|error| / max(1, |a|)",
+           title="Mathieu's a_m(q), b_m(q) against the eigenvalues at 30 digits (emitted: "
+                 "NaN beyond the verified q, not drawn)")
+    ax.legend(fontsize=7, ncol=3)
+    fig.tight_layout()
+    return _save(fig, path)

@@ -709,12 +709,13 @@ def _generated_q_cost(order: int, x_min: float, x_max: float) -> float:
 
 RESUMMED_COSTS = {
     "cycle": {"series": 3.0, "resummed": 5.5, "shooting": 1.5e9},
-    "mathieu": {"series": 60.0, "pade": 3.0, "reference": 1.0e5},
+    "mathieu": {"series": 60.0, "pade": 7.0, "reference": 1.0e5},
 }
 # NOTE: ns per point, recorded on the 2-core reference machine by benchmarks/resum.py
 # (docs/benchmarks.md): the emitted ufuncs' `_into` loops over a million points (the series
-# and the Padé form), the NumPy Horner sum of Mathieu's series, one DOP853 shooting of the
-# cycle (two tolerances) and one float64 tridiagonal eigenvalue solve.  The choice decides by
+# and the Padé form, Mathieu's with its Newton step), the NumPy Horner sum of Mathieu's
+# series, one DOP853 shooting of the cycle (two tolerances) and one float64 tridiagonal
+# eigenvalue solve.  The choice decides by
 # these, so it does not depend on this run's load; each run's timings are reported beside.
 RESUMMED_ORDER = {"cycle": 60, "mathieu": 100}
 # NOTE: the default orders: the limit cycle's derivation at 60 is ~2 s (its resummed form is

@@ -1924,8 +1924,9 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_allow_slow(p, deprecated_force=False)
     p.add_argument("--emit", metavar="DIR", default=None,
                    help="write DIR/mathieu_<kind><m>.py instead: a numba ufunc of the value, "
-                   "Padé-resummed from the series to --order, verified against the eigenvalue "
-                   "reference on a grid of q up to 50 and NaN beyond where it was verified")
+                   "Padé-resummed from the series to --order and refined by a Newton step on "
+                   "the recurrence's determinant, verified against the eigenvalues at 30 digits "
+                   "on a grid of q up to 50 and NaN beyond where it was verified")
     p.add_argument("--overwrite-edited", action="store_true",
                    help="with --emit: overwrite a file edited since it was generated")
     p.add_argument("--singularities", action="store_true",

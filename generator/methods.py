@@ -554,43 +554,71 @@ def _verified(form: Resummed, truth: Callable[[float], float], tolerance: float
     return float(limit), tuple(points), worst
 
 
-MATHIEU_TOLERANCE = 1e-14
-# NOTE: relative to max(1, |a|): the float64 eigenvalue reference agrees with mpmath to
-# ≤ 7e-15 on q ≤ 50 (m ≤ 6), so no finer tolerance can be verified with it; SciPy's
-# mathieu_a, mathieu_b are 4e-16 … 0.7 off (benchmarks/resum.py).
+MATHIEU_TOLERANCE = 1e-15
+# NOTE: relative to max(1, |a|), about four units in the last place: the Padé value is the
+# start of a Newton step on the determinant of the recurrence (numerics.mathieu_newton),
+# verified against numerics.mathieu_refined (30 digits); SciPy's mathieu_a, mathieu_b are
+# 2e-16 … 0.7 off (benchmarks/resum.py).
+MATHIEU_START_TOLERANCE = 1e-9
+# NOTE: the Padé value must be this close for one Newton step: the step squares the relative
+# error (times |a| over the gap to the neighbouring eigenvalue, ≥ 1 here), so 1e-9 → ~1e-18.
+MATHIEU_TRUNCATION = 1e-17
+# NOTE: relative to max(1, |a|): the truncated recurrence's eigenvalue is within this of the
+# infinite one (numerics.mathieu_truncation_bound), well below the rounding of a float64.
+MATHIEU_NEWTON_STEPS = 1
 MATHIEU_RANGE = 50.0
 MATHIEU_GRID = 400
 # NOTE: q ∈ (0, 50] on 400 points: beyond q ≈ 50 no Padé of an order-100 series is within
-# 1e-12 (a_m(q) ~ −2q + 2(2m + 1)√q, a branch at infinity); the eigenvalue solver is the
+# 1e-9 (a_m(q) ~ −2q + 2(2m + 1)√q, a branch at infinity); the eigenvalue solver is the
 # method there.
+
+
+def mathieu_rows(kind: str, m: int, q: float, a: float) -> int:
+    """The fewest rows of the recurrence whose eigenvalue is within ``MATHIEU_TRUNCATION``
+    ·max(1, |a|) of the infinite one at ``q`` (:func:`numerics.mathieu_truncation_bound`)."""
+    from .numerics import mathieu_recurrence, mathieu_truncation_bound
+
+    rows = mathieu_recurrence(kind, m, 1)[0] + 2
+    while mathieu_truncation_bound(kind, m, q, a, rows) > MATHIEU_TRUNCATION * max(1.0, abs(a)):
+        rows += 1
+    return rows
 
 
 def resum_mathieu(kind: str, m: int, order: int, tolerance: float = MATHIEU_TOLERANCE
                   ) -> ResummedMathieu:
     """Padé of Mathieu's exact series (:func:`hill.mathieu_series`, in q², or in q when it
-    has odd powers), verified on a dense grid of ``(0, 50]`` against
-    :func:`numerics.mathieu_reference` (whose float64 values are checked against its mpmath
-    run at the grid's end): ``limit`` is the last grid point before the first failure."""
+    has odd powers), then one Newton step on the determinant of the recurrence truncated to
+    the rows :func:`mathieu_rows` asks for on the whole range (one row more, for between the
+    grid points), verified on a dense grid of ``(0, 50]`` against
+    :func:`numerics.mathieu_refined`: ``limit`` is the last grid point before the first
+    where the Padé start misses ``MATHIEU_START_TOLERANCE`` or the refined value misses
+    ``tolerance``."""
     import numpy as np
 
     from .hill import mathieu_series
-    from .numerics import mathieu_reference
+    from .numerics import mathieu_newton, mathieu_refined
 
     form = resum_series(mathieu_series(kind, m, order), MATHIEU_RANGE)
     grid = np.linspace(0.0, MATHIEU_RANGE, MATHIEU_GRID + 1)[1:]
-    ref = np.array([mathieu_reference(kind, m, float(q)) for q in grid])
-    for q in (grid[0], grid[-1]):
-        exact = mathieu_reference(kind, m, float(q), dps=30)
-        if abs(ref[grid == q][0] - exact) > tolerance * max(1.0, abs(exact)):
-            raise RuntimeError(f"mathieu_reference {kind}_{m}({q}): float64 and mpmath differ")
-    error = np.abs(form(grid) - ref) / np.maximum(1.0, np.abs(ref))
-    ok = error <= tolerance
+    ref = np.array([float(mathieu_refined(kind, m, float(q))) for q in grid])
+    scale = np.maximum(1.0, np.abs(ref))
+    start = form(grid)
+    ok = np.abs(start - ref) / scale <= MATHIEU_START_TOLERANCE
     n = int(np.argmin(ok)) if not ok.all() else len(grid)
     if n == 0:
         raise InputError(f"{kind}_{m}, order {order}: the resummed series misses "
-                         f"{tolerance:g} already at q = {grid[0]:g}; raise --order")
+                         f"{MATHIEU_START_TOLERANCE:g} already at q = {grid[0]:g}; raise --order")
+    rows = 1 + max(mathieu_rows(kind, m, float(q), float(a)) for q, a in zip(grid[:n], ref[:n],
+                                                                             strict=True))
+    value = mathieu_newton(kind, m, grid[:n], start[:n], rows, MATHIEU_NEWTON_STEPS)
+    error = np.abs(value - ref[:n]) / scale[:n]
+    ok = error <= tolerance
+    n = int(np.argmin(ok)) if not ok.all() else n
+    if n == 0:
+        raise InputError(f"{kind}_{m}, order {order}: the refined value misses "
+                         f"{tolerance:g} already at q = {grid[0]:g}")
     return ResummedMathieu(kind, m, order, form, float(grid[n - 1]), tolerance,
-                           float(error[:n].max()))
+                           float(error[:n].max()), rows, MATHIEU_NEWTON_STEPS)
 
 
 def _mathieu_files(r: Request) -> tuple[str, ...]:

@@ -1036,3 +1036,123 @@ def mathieu_reference(kind: str, m: int, q: float, size: int | None = None,
                                                                  and i == 0) else 1)
         values = sorted(mpmath.eigsy(A, eigvals_only=True))
         return float(values[index])
+
+
+def mathieu_recurrence(kind: str, m: int, rows: int
+                       ) -> tuple[int, tuple[tuple[int, int], ...], tuple[int, ...]]:
+    """The symmetrised recurrence of the Fourier coefficients of ``ce_m`` or ``se_m`` (DLMF
+    28.4.5–8) as exact integers, ``rows`` of it: the diagonal ``c_j = r_j² + s_j q`` as
+    ``(r_j², s_j)``, the squared couplings ``e_j² = t_j q²`` as ``t_j`` (2 for ``A_0``–``A_2``,
+    the ``√2`` of the symmetrised ``ce_(2n)``), and the index of ``m`` among its class's sorted
+    eigenvalues."""
+    even = m % 2 == 0
+    if kind == "a":
+        orders = [2 * k + (0 if even else 1) for k in range(rows)]
+    else:
+        orders = [2 * k + (2 if even else 1) for k in range(rows)]
+    diag = [(r * r, 0) for r in orders]
+    if not even:
+        diag[0] = (1, 1 if kind == "a" else -1)  # a − 1 ∓ q on A_1, B_1 (DLMF 28.4.6–7)
+    couplings = [2 if (kind == "a" and even and j == 0) else 1 for j in range(rows - 1)]
+    index = m // 2 if kind == "a" or not even else m // 2 - 1
+    return index, tuple(diag), tuple(couplings)
+
+
+def mathieu_newton(kind: str, m: int, q: ArrayLike, start: ArrayLike, rows: int,
+                   steps: int) -> np.ndarray:
+    """Newton steps on ``det(T_rows − a)`` of :func:`mathieu_recurrence`'s matrix from
+    ``start``, vectorised over q (DLMF 28.6.16–20 in determinant form, no division but the
+    step's).  The matrix is split after row ``k = rows // 2``: the leading minors ``p_j =
+    (c_j − a) p_(j−1) − e²_(j−1) p_(j−2)`` (rows 0…k) and the trailing ones ``s_j = (c_j − a)
+    s_(j+1) − e²_j s_(j+2)`` (rows j…rows−1) are two independent chains, and ``det = p_k
+    s_(k+1) − e²_k p_(k−1) s_(k+2)``; the a-derivatives run beside them.  The emitted
+    evaluators unroll the same steps (:func:`lower.mathieu_newton_steps`)."""
+    _, diag, couplings = mathieu_recurrence(kind, m, rows)
+    q = np.asarray(q, dtype=float)
+    a = np.asarray(start, dtype=float) + 0.0 * q
+    qq = q * q
+    k = rows // 2
+    for _ in range(steps):
+        one, zero = np.ones_like(a), np.zeros_like(a)
+        p_prev, dp_prev, p, dp = one, zero, diag[0][0] + diag[0][1] * q - a, -one
+        for j in range(1, k + 1):
+            c = diag[j][0] + diag[j][1] * q - a
+            e2 = couplings[j - 1] * qq
+            p, p_prev, dp, dp_prev = (c * p - e2 * p_prev, p, c * dp - p - e2 * dp_prev, dp)
+        s_next, ds_next, s, ds = one, zero, diag[rows - 1][0] + diag[rows - 1][1] * q - a, -one
+        for j in range(rows - 2, k, -1):
+            c = diag[j][0] + diag[j][1] * q - a
+            e2 = couplings[j] * qq
+            s, s_next, ds, ds_next = (c * s - e2 * s_next, s, c * ds - s - e2 * ds_next, ds)
+        e2 = couplings[k] * qq
+        det = p * s - e2 * p_prev * s_next
+        ddet = dp * s + p * ds - e2 * (dp_prev * s_next + p_prev * ds_next)
+        a = a - det / ddet
+    return a
+
+
+def mathieu_truncation_bound(kind: str, m: int, q: float, a: float, rows: int) -> float:
+    """A bound on ``|a_rows − a|``: the eigenvalue of the ``rows``-row truncation (N = rows)
+    against the exact ``a`` of the infinite recurrence, with ``v`` its unit eigenvector.
+
+    Cutting the coupling ``e = e_(N−1)`` leaves ``A' = T_N ⊕ T_tail`` and ``(A' − a)v =
+    −e(v_N u_(N−1) + v_(N−1) u_N)``: the Rayleigh quotient ``ρ = a − 2e v_(N−1) v_N`` and the
+    residual ``r ≤ e (v²_(N−1) + v²_N)^½``; by Kato–Temple ``|μ − ρ| ≤ r²/g`` for the one
+    eigenvalue ``μ`` of ``A'`` within the gap ``g`` of ``ρ`` to the rest of its spectrum
+    (``T_N``'s neighbours of ``μ``, and ``T_tail ≥ c_N − 2ê`` by Gershgorin).  So ``|μ − a| ≤
+    2e|v_(N−1) v_N| + r²/g``.  Past the first row ``J`` with ``c_j − a ≥ 2ê`` (``ê = √2 |q|``
+    ≥ every coupling), the tail's continued fraction ``B_j = e²_(j−1) / (c_j − a − B_(j+1))``
+    stays in ``[0, ê]``, so ``|v_j / v_(j−1)| = e_(j−1) / (c_j − a − B_(j+1)) ≤ ê / (c_j − a
+    − ê)`` and ``|v_n| ≤ Π_(j=J…n) ê / (c_j − a − ê)``.  ``inf`` when the tail starts past
+    ``N − 1`` or the gap closes."""
+    from scipy.linalg import eigvalsh_tridiagonal
+
+    index, diag, couplings = mathieu_recurrence(kind, m, rows + 1)
+    e = math.sqrt(2.0) * abs(q)
+    if e == 0.0:
+        return 0.0
+    c = [r2 + s * q - a for r2, s in diag]
+    J = next((j for j in range(1, rows) if all(c[i] >= 2 * e for i in range(j, rows + 1))),
+             None)
+    if J is None:
+        return math.inf
+    v = [1.0]
+    for j in range(J, rows + 1):
+        v.append(v[-1] * e / (c[j] - e))
+    v_last, v_cut = v[-2], v[-1]  # |v_(N−1)|, |v_N|
+    first = 2 * e * v_last * v_cut
+    values = eigvalsh_tridiagonal(
+        np.array([float(r2 + s * q) for r2, s in diag[:rows]]),
+        np.array([math.sqrt(t) * abs(q) for t in couplings[: rows - 1]]))
+    others = [abs(x - a) for i, x in enumerate(values) if i != index]
+    others.append(diag[rows][0] + diag[rows][1] * q - 2 * e - a)
+    gap = min(others) - first - 1e-9 * max(1.0, abs(a))  # the float64 eigenvalues' error
+    if gap <= 0:
+        return math.inf
+    return first + e * e * (v_last**2 + v_cut**2) / gap
+
+
+def mathieu_refined(kind: str, m: int, q: float, dps: int = 30) -> float:
+    """``a_m(q)`` or ``b_m(q)`` to ``dps`` digits, fast: the float64 eigenvalue of
+    :func:`mathieu_reference` refined by Newton steps on the determinant of the same
+    truncated recurrence in mpmath (quadratic: 1e-15 → 1e-30 in one step; a third step
+    checks it), as an ``mpf``."""
+    import mpmath
+
+    n = int(2 * math.sqrt(abs(q)) + 40)
+    _, diag, couplings = mathieu_recurrence(kind, m, n)
+    with mpmath.workdps(dps + 5):
+        qq = mpmath.mpf(q)
+        a = mpmath.mpf(mathieu_reference(kind, m, q))
+        for step in range(3):
+            p_prev, dp_prev = mpmath.mpf(1), mpmath.mpf(0)
+            p, dp = diag[0][0] + diag[0][1] * qq - a, mpmath.mpf(-1)
+            for j in range(1, n):
+                c = diag[j][0] + diag[j][1] * qq - a
+                e2 = couplings[j - 1] * qq * qq
+                p, p_prev, dp, dp_prev = (c * p - e2 * p_prev, p, c * dp - p - e2 * dp_prev, dp)
+            delta = p / dp
+            a -= delta
+            if step == 2 and abs(delta) > mpmath.mpf(10) ** (-dps) * max(1, abs(a)):
+                raise RuntimeError(f"mathieu_refined {kind}_{m}({q}): Newton did not converge")
+        return +a

@@ -1,4 +1,4 @@
-"""Mathieu's characteristic values as exact series: DLMF 28.6.1–28.6.6 where they are printed,
+"""Mathieu's characteristic values as exact series: DLMF 28.6.1–28.6.13 where they are printed,
 and at any order against the eigenvalues of the truncated Hill matrix (mpmath, 40 digits)."""
 
 from __future__ import annotations
@@ -14,15 +14,35 @@ from lindstedt.cli import main
 from lindstedt.errors import InputError
 from lindstedt.hill import mathieu_series
 
-DLMF = {  # coefficients of q^0 … q^8 (28.6.1–28.6.6); a_1 and b_1 to q^6 here
-    ("a", 0): [0, 0, F(-1, 2), 0, F(7, 128), 0, F(-29, 2304), 0, F(68687, 18874368)],
-    ("a", 1): [1, 1, F(-1, 8), F(-1, 64), F(-1, 1536), F(11, 36864), F(49, 589824)],
-    ("b", 1): [1, -1, F(-1, 8), F(1, 64), F(-1, 1536), F(-11, 36864), F(49, 589824)],
+DLMF = {  # coefficients of q^0, q^1, … as far as DLMF 28.6.1–28.6.13 print them
+    # (https://dlmf.nist.gov/28.6, §28.6(i); the same as Abramowitz & Stegun 20.2.25)
+    ("a", 0): [0, 0, F(-1, 2), 0, F(7, 128), 0, F(-29, 2304), 0, F(68687, 18874368)],  # 28.6.1
+    ("a", 1): [1, 1, F(-1, 8), F(-1, 64), F(-1, 1536), F(11, 36864), F(49, 589824),
+               F(55, 9437184), F(-83, 35389440)],  # 28.6.2
+    ("b", 1): [1, -1, F(-1, 8), F(1, 64), F(-1, 1536), F(-11, 36864), F(49, 589824),
+               F(-55, 9437184), F(-83, 35389440)],  # 28.6.3
     ("a", 2): [4, 0, F(5, 12), 0, F(-763, 13824), 0, F(1002401, 79626240), 0,
-               F(-1669068401, 458647142400)],
+               F(-1669068401, 458647142400)],  # 28.6.4
     ("b", 2): [4, 0, F(-1, 12), 0, F(5, 13824), 0, F(-289, 79626240), 0,
-               F(21391, 458647142400)],
+               F(21391, 458647142400)],  # 28.6.5
+    ("a", 3): [9, 0, F(1, 16), F(1, 64), F(13, 20480), F(-5, 16384), F(-1961, 23592960),
+               F(-609, 104857600)],  # 28.6.6
+    ("b", 3): [9, 0, F(1, 16), F(-1, 64), F(13, 20480), F(5, 16384), F(-1961, 23592960),
+               F(609, 104857600)],  # 28.6.7
+    ("a", 4): [16, 0, F(1, 30), 0, F(433, 864000), 0, F(-5701, 2721600000)],  # 28.6.8
+    ("b", 4): [16, 0, F(1, 30), 0, F(-317, 864000), 0, F(10049, 2721600000)],  # 28.6.9
+    ("a", 5): [25, 0, F(1, 48), 0, F(11, 774144), F(1, 147456), F(37, 891813888)],  # 28.6.10
+    ("b", 5): [25, 0, F(1, 48), 0, F(11, 774144), F(-1, 147456), F(37, 891813888)],  # 28.6.11
+    ("a", 6): [36, 0, F(1, 70), 0, F(187, 43904000), 0,
+               F(6743617, 92935987200000)],  # 28.6.12
+    ("b", 6): [36, 0, F(1, 70), 0, F(187, 43904000), 0,
+               F(-5861633, 92935987200000)],  # 28.6.13
 }
+
+
+def test_dlmf_covers_every_printed_value():
+    """a_0 … a_6 and b_1 … b_6: the thirteen series DLMF §28.6(i) prints."""
+    assert sorted(DLMF) == sorted([("a", m) for m in range(7)] + [("b", m) for m in range(1, 7)])
 
 
 @pytest.mark.parametrize(("kind", "m"), sorted(DLMF))

@@ -144,12 +144,38 @@ def test_mathieu_reference_against_dlmf_and_mpmath():
         assert mathieu_reference(kind, m, 40.0) == pytest.approx(exact, rel=1e-14)
 
 
+def test_mathieu_refined_and_truncation_bound_against_mpmath():
+    """The fast 30-digit reference (float64 eigenvalue + mpmath Newton on the determinant)
+    against mpmath's own symmetric eigensolver at 40 digits (60 rows), and the truncation
+    bound against the true change of the eigenvalue when the matrix is cut to N rows."""
+    import mpmath
+    from lindstedt.numerics import mathieu_recurrence, mathieu_refined, mathieu_truncation_bound
+
+    def eigsy(kind, m, q, n):
+        index, diag, couplings = mathieu_recurrence(kind, m, n)
+        with mpmath.workdps(40):
+            A = mpmath.zeros(n, n)
+            for i, (r2, s) in enumerate(diag):
+                A[i, i] = r2 + s * mpmath.mpf(q)
+            for i, t in enumerate(couplings):
+                A[i, i + 1] = A[i + 1, i] = mpmath.sqrt(t) * mpmath.mpf(q)
+            return sorted(mpmath.eigsy(A, eigvals_only=True))[index]
+
+    for kind, m, q in (("a", 0, 3.0), ("b", 1, 40.0), ("a", 6, 25.0), ("b", 6, 32.0)):
+        exact = eigsy(kind, m, q, 60)
+        with mpmath.workdps(40):
+            assert abs(mathieu_refined(kind, m, q) - exact) <= 1e-27 * max(1, abs(exact))
+        for n in (8, 10, 12, 14):
+            bound = mathieu_truncation_bound(kind, m, q, float(exact), n)
+            assert abs(eigsy(kind, m, q, n) - exact) <= bound
+
+
 @pytest.mark.parametrize(("kind", "m", "past"), [("a", 0, 2.0), ("a", 3, 1.0), ("b", 6, 5.0)])
 def test_emitted_mathieu_against_the_eigenvalue_reference(kind, m, past, tmp_path):
-    """`lindstedt mathieu KIND --m M --order 60 --emit DIR`: the ufunc within 2e-14·max(1,
-    |a|) of the mpmath eigenvalues inside its verified q (1e-14 from the float64 reference it
-    is verified against, which is ≤ 1e-14 from mpmath), past the series' radius (|q| ≈ 1.47
-    for a_0), NaN beyond (and below q = 0 for a series with odd powers)."""
+    """`lindstedt mathieu KIND --m M --order 60 --emit DIR`: the ufunc within 1e-15·max(1,
+    |a|) (a few units in the last place) of the mpmath eigenvalues at 30 digits inside its
+    verified q, past the series' radius (|q| ≈ 1.47 for a_0), NaN beyond (and below q = 0 for
+    a series with odd powers); the error estimate (the Newton step) covers the error."""
     from lindstedt.cli import main
     from lindstedt.emit import load_generated
     from lindstedt.numerics import mathieu_reference
@@ -157,12 +183,14 @@ def test_emitted_mathieu_against_the_eigenvalue_reference(kind, m, past, tmp_pat
     assert main(["mathieu", kind, "--m", str(m), "--order", "60", "--emit",
                  str(tmp_path)]) == 0
     mod = load_generated(tmp_path / f"mathieu_{kind}{m}.py")
-    f = getattr(mod, f"{kind}{m}")
+    f, estimate = getattr(mod, f"{kind}{m}"), getattr(mod, f"{kind}{m}_error")
     assert past < mod.LIMIT
-    for q in np.linspace(0.1, mod.LIMIT, 6):
+    for q in np.linspace(0.1, mod.LIMIT, 9):
         exact = mathieu_reference(kind, m, float(q), dps=30)
-        assert abs(f(q) - exact) <= 2e-14 * max(1.0, abs(exact))
+        assert abs(f(q) - exact) <= 1e-15 * max(1.0, abs(exact))
+        assert 0 <= estimate(q) <= 1e-9
     assert np.isnan(f(mod.LIMIT + 0.01)) and np.isnan(f(np.nan))
+    assert np.isnan(estimate(mod.LIMIT + 0.01))
     assert np.isnan(f(-0.5)) != mod.SYMMETRIC
 
 
