@@ -683,6 +683,30 @@ DAMPED_TRUNCATION = 1e-2
 DAMPED_HARMONICS = 5
 # NOTE: A_n, B_n for n = 1, 3, 5: the harmonics the tables and charts show (and the first three of
 # the undamped module's).
+DAMPED_ARGUMENT_RANGE = (1e-6, 1e6)
+# NOTE: the damped evaluators' arguments enter as ω^{2j}, ω/Q, εf² and 1/(ω^{2j}Δ^m): outside
+# 1e-6 ≤ |ω|, Q and |ω|, |ε|, |f| ≤ 1e6 (NaN and ±inf included) they would overflow or divide by
+# zero (or make NaN, which raises "invalid" in comparisons) before the guard sees them: a
+# floating-point warning from the ufunc.  There the arguments are replaced by DAMPED_STAND_IN, a
+# point where every step is finite, and the guard returns NaN.
+DAMPED_STAND_IN = (2, sp.Rational(1, 10), sp.Rational(1, 10), 1)
+# NOTE: ω, ε, f, Q far above resonance: one branch, no fold, every step finite and quiet.
+
+
+def damped_entry(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol, Q: sp.Symbol,
+                 branch: sp.Symbol) -> tuple[list[Assign], sp.Basic]:
+    """Assignments that replace every argument by ``DAMPED_STAND_IN`` (``branch`` by 0)
+    outside ``DAMPED_ARGUMENT_RANGE`` (ε ≠ 0, Q > 0, ``Q = inf`` allowed, branch 0, 1 or 2),
+    and the condition the guard adds (a flag ``inside``, 1 or 0)."""
+    low, high = (sp.Float(v) for v in DAMPED_ARGUMENT_RANGE)
+    flag = sp.Symbol("inside")
+    inside = sp.And(sp.Abs(omega) >= low, sp.Abs(omega) <= high, sp.Ne(eps, 0),
+                    sp.Abs(eps) <= high, sp.Abs(force) <= high, low <= Q,
+                    sp.Or(sp.Eq(branch, 0), sp.Eq(branch, 1), sp.Eq(branch, 2)))
+    steps: list[Assign] = [(flag, sp.Piecewise((sp.Integer(1), inside), (sp.Integer(0), True)))]
+    for v, safe in zip((omega, eps, force, Q, branch), (*DAMPED_STAND_IN, 0), strict=True):
+        steps.append((v, sp.Piecewise((v, sp.Eq(flag, 1)), (safe, True))))
+    return steps, sp.Eq(flag, 1)
 
 
 def nested_horner(expr: sp.Expr, gens: tuple[sp.Symbol, ...]) -> sp.Expr:
@@ -757,7 +781,8 @@ def lower_driven_damped(orders: tuple[MuDampedOrder, ...], command: str) -> Modu
                         (roots[2], sp.Eq(branch, 2)), (sp.nan, True))
     zs = [sp.Symbol(f"z{k}") for k in range(ROOT_POLISH + 1)]
     zsym = sp.Symbol("z")
-    prelude: list[Assign] = [(gamma, omega / Q), *steps, (zs[0], pick)]
+    entry, inside = damped_entry(omega, eps, force, Q, branch)
+    prelude: list[Assign] = [*entry, (gamma, omega / Q), *steps, (zs[0], pick)]
     for k in range(ROOT_POLISH):
         prelude.append((zs[k + 1], zs[k] - (H / slope).xreplace({zsym: zs[k]})))
     to_args = {A1_: A1, omega_: omega, damped_x: x, a_: a, gamma_: gamma, Delta_: Delta}
@@ -777,7 +802,7 @@ def lower_driven_damped(orders: tuple[MuDampedOrder, ...], command: str) -> Modu
     prelude += [*subexprs, *zip([*named, *constants], reduced, strict=True),
                 (delta, sp.Symbol("delta0") + sum(named[:K]))]
     omitted, last = sizes[1], sizes[0]
-    guard = sp.And(sp.Ne(eps, 0), Q > 0, sp.Ne(Delta, 0), omitted <= last,
+    guard = sp.And(inside, sp.Ne(Delta, 0), omitted <= last,
                    omitted <= DAMPED_TRUNCATION * A1,
                    sp.Abs(zs[-1] - zs[-2]) <= ROOT_RESOLVED * sp.Abs(z))
     summed = orders[:K]
@@ -794,11 +819,11 @@ def lower_driven_damped(orders: tuple[MuDampedOrder, ...], command: str) -> Modu
             evaluators.append(Evaluator(
                 name, f"Coefficient of {what}, damped μ-expansion order {K} (eq. 10.66–10.72).",
                 (omega, eps, force, Q, branch), tuple(prelude), guard, tuple(subexprs), expr))
-    root_prelude = tuple(prelude[: len(steps) + ROOT_POLISH + 5])
+    root_prelude = tuple(prelude[: len(entry) + len(steps) + ROOT_POLISH + 5])
     evaluators.append(Evaluator(
         "first_order", "A₁ of the branch: √u, u a root of u[(1 − ω² + ¾εu)² + ω²/Q²] = f².",
         (omega, eps, force, Q, branch), root_prelude,
-        sp.And(sp.Ne(eps, 0), Q > 0, sp.Abs(zs[-1] - zs[-2]) <= ROOT_RESOLVED * sp.Abs(z)),
+        sp.And(inside, sp.Abs(zs[-1] - zs[-2]) <= ROOT_RESOLVED * sp.Abs(z)),
         (), A1))
     return Module(
         name="driven_damped",
