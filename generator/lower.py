@@ -629,12 +629,20 @@ def depressed_cubic_roots(p: sp.Expr, q: sp.Expr) -> tuple[sp.Expr, ...]:
     )
 
 
+DRIVEN_ARGUMENT_LIMIT = 1e6
+# NOTE: the undamped evaluators' range: 1e-6 ≤ |ω| ≤ 1e6, 0 < |ε| ≤ 1e6, |f| ≤ 1e6 (ε itself
+# has no lower bound: the cubic's closed form is exact down to ε = 1e-20).  Outside (NaN and
+# ±inf included) they computed ±inf at ω = 0 and raised floating-point warnings; there the
+# arguments are replaced by ω = 2, ε = f = 1/10 (:func:`argument_entry`) and the answer is NaN.
+
+
 def lower_driven(orders: tuple[MuOrder, ...], command: str) -> Module:
     """Evaluators ``A_n(omega, eps, force, branch)`` of the undamped μ-expansion at order K.
 
     ``branch`` 0, 1, 2 picks a real root of the first-order cubic, largest first (NaN where that
-    branch does not exist).  The sum is NaN at a fold (``D = 0``) and where its last constant
-    ``b_K`` exceeds ``b_{K−1}`` (``A₁`` for K = 1): a growing series is no answer.
+    branch does not exist).  NaN outside ``DRIVEN_ARGUMENT_LIMIT``.  The sum is NaN at a fold
+    (``D = 0``) and where its last constant ``b_K`` exceeds ``b_{K−1}`` (``A₁`` for K = 1): a
+    growing series is no answer.
     """
     K = len(orders)
     omega, eps, force, branch = sp.symbols("omega eps force branch")
@@ -646,8 +654,15 @@ def lower_driven(orders: tuple[MuOrder, ...], command: str) -> Module:
     b = [orders[j].q.get(1, 0) for j in range(K)]  # b_j is q_j's cos τ coefficient
     last = sp.Abs(b[-1].xreplace(to_args))
     before = sp.Abs(A1) if K == 1 else sp.Abs(b[-2].xreplace(to_args))
-    guard = sp.And(sp.Ne(eps, 0), sp.Ne(D, 0), last <= before)
-    prelude = ((A1, pick), (D, 1 - 1 / omega**2 - sp.Rational(9, 4) * eps * A1**2 / omega**2))
+    high = sp.Float(DRIVEN_ARGUMENT_LIMIT)
+    entry, inside = argument_entry((
+        (omega, sp.And(sp.Abs(omega) >= 1 / high, sp.Abs(omega) <= high), 2),
+        (eps, sp.And(sp.Ne(eps, 0), sp.Abs(eps) <= high), sp.Rational(1, 10)),
+        (force, sp.Abs(force) <= high, sp.Rational(1, 10)),
+        (branch, sp.Or(sp.Eq(branch, 0), sp.Eq(branch, 1), sp.Eq(branch, 2)), 0)))
+    guard = sp.And(inside, sp.Ne(D, 0), last <= before)
+    prelude = (*entry, (A1, pick),
+               (D, 1 - 1 / omega**2 - sp.Rational(9, 4) * eps * A1**2 / omega**2))
     evaluators = []
     for n in range(1, 2 * K + 2, 2):
         total = (A1 if n == 1 else 0) + sum(o.q.get(n, 0) for o in orders)
@@ -659,7 +674,7 @@ def lower_driven(orders: tuple[MuOrder, ...], command: str) -> Module:
             (omega, eps, force, branch), prelude, guard, tuple(subexprs), out))
     evaluators.append(Evaluator(
         "first_order", "A₁ of the branch: a real root of (ω² − 1)A₁ − ¾εA₁³ + f = 0.",
-        (omega, eps, force, branch), ((A1, pick),), sp.Ne(eps, 0), (), A1))
+        (omega, eps, force, branch), (*entry, (A1, pick)), inside, (), A1))
     return Module(
         name="driven",
         doc=f"Driven Duffing q'' + q + eps*q**3 = f cos(omega t): μ-expansion to order {K}.",
@@ -693,20 +708,32 @@ DAMPED_STAND_IN = (2, sp.Rational(1, 10), sp.Rational(1, 10), 1)
 # NOTE: ω, ε, f, Q far above resonance: one branch, no fold, every step finite and quiet.
 
 
-def damped_entry(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol, Q: sp.Symbol,
-                 branch: sp.Symbol) -> tuple[list[Assign], sp.Basic]:
-    """Assignments that replace every argument by ``DAMPED_STAND_IN`` (``branch`` by 0)
-    outside ``DAMPED_ARGUMENT_RANGE`` (ε ≠ 0, Q > 0, ``Q = inf`` allowed, branch 0, 1 or 2),
-    and the condition the guard adds (a flag ``inside``, 1 or 0)."""
-    low, high = (sp.Float(v) for v in DAMPED_ARGUMENT_RANGE)
+def argument_entry(arguments: tuple[tuple[sp.Symbol, sp.Basic, object], ...]
+                   ) -> tuple[list[Assign], sp.Basic]:
+    """Assignments that replace every argument by its stand-in unless every argument meets its
+    condition (false for NaN: comparisons with NaN are), and the condition the guard adds (a
+    flag ``inside``, 1 or 0): outside, the evaluator computes at the stand-in point, where
+    every step is finite, and returns NaN — no floating-point flag is raised on the way."""
     flag = sp.Symbol("inside")
-    inside = sp.And(sp.Abs(omega) >= low, sp.Abs(omega) <= high, sp.Ne(eps, 0),
-                    sp.Abs(eps) <= high, sp.Abs(force) <= high, low <= Q,
-                    sp.Or(sp.Eq(branch, 0), sp.Eq(branch, 1), sp.Eq(branch, 2)))
+    inside = sp.And(*(cond for _, cond, _ in arguments))
     steps: list[Assign] = [(flag, sp.Piecewise((sp.Integer(1), inside), (sp.Integer(0), True)))]
-    for v, safe in zip((omega, eps, force, Q, branch), (*DAMPED_STAND_IN, 0), strict=True):
+    for v, _, safe in arguments:
         steps.append((v, sp.Piecewise((v, sp.Eq(flag, 1)), (safe, True))))
     return steps, sp.Eq(flag, 1)
+
+
+def damped_entry(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol, Q: sp.Symbol,
+                 branch: sp.Symbol) -> tuple[list[Assign], sp.Basic]:
+    """:func:`argument_entry` of the damped evaluators: ``DAMPED_ARGUMENT_RANGE`` (ε ≠ 0,
+    Q > 0, ``Q = inf`` allowed, branch 0, 1 or 2), ``DAMPED_STAND_IN`` (branch 0) outside."""
+    low, high = (sp.Float(v) for v in DAMPED_ARGUMENT_RANGE)
+    w, e, f, q = DAMPED_STAND_IN
+    return argument_entry((
+        (omega, sp.And(sp.Abs(omega) >= low, sp.Abs(omega) <= high), w),
+        (eps, sp.And(sp.Ne(eps, 0), sp.Abs(eps) <= high), e),
+        (force, sp.Abs(force) <= high, f),
+        (Q, low <= Q, q),
+        (branch, sp.Or(sp.Eq(branch, 0), sp.Eq(branch, 1), sp.Eq(branch, 2)), 0)))
 
 
 def nested_horner(expr: sp.Expr, gens: tuple[sp.Symbol, ...]) -> sp.Expr:
