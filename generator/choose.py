@@ -486,7 +486,8 @@ def driven_tradeoffs(truth: DrivenTruth, eps: float, force: float,
 def emitted_driven(name: str, order: int, truth: DrivenTruth, eps: float, force: float,
                    Q: float) -> DrivenTradeoff:
     """The emitted module of method ``name`` at ``order`` (``generate driven``: the undamped
-    μ-expansion as compiled ufuncs; ``generate balance``: compiled Newton), generated into a
+    μ-expansion as compiled ufuncs, ``--damped`` the damped one; ``generate balance``: compiled
+    Newton), generated into a
     temporary folder through the compiler, run by the record's ``run_emitted``, timed and
     judged at every ω of ``truth``."""
     m = method("driven", name)
@@ -534,7 +535,8 @@ def choose_driven(quantity: str, tol: float, eps: float, force: float, Q: float,
     None), on the largest branch; "cheapest" by the recorded ``COST_MODEL["driven"]``, so the
     choice does not depend on this run's timings (which are reported).  ``emit`` = (highest
     μ-order, most harmonics): only what has an emitted module within those bounds competes —
-    harmonic balance, and the undamped μ-expansion; the modules are generated in the order of
+    harmonic balance, and the μ-expansion (the undamped module for Q = inf, the damped one,
+    ``mu_expansion_damped``, for a finite Q); the modules are generated in the order of
     their modelled cost, the first that meets ``tol`` is chosen (only it and the ones before
     it are generated)."""
     if quantity not in DRIVEN_QUANTITIES:
