@@ -22,7 +22,8 @@ The free Duffing period ``T/2π`` as a function of ``x = εA²`` (``choose perio
 Each is checked against :func:`reference_period` (mpmath, 30 digits).  The solution q(t)
 (``choose q``): the L–P series, the exact Fourier series in the nome (:func:`cn_fourier`) and
 SciPy's cn, checked against cn.  The driven amplitudes (``choose amplitudes|response``): one
-harmonic, the μ-expansion, harmonic balance and shooting, checked against shooting with
+harmonic, the μ-expansion (its emitted module undamped, ``mu_expansion``, or for a finite Q,
+``mu_expansion_damped``), harmonic balance and shooting, checked against shooting with
 Richardson-combined RK4.
 """
 
