@@ -163,21 +163,36 @@ def _first(system: object, x: np.ndarray) -> float:
     return float(np.hypot(A.get(1, 0.0), B.get(1, 0.0)))
 
 
+FULL_HILL_EVERY = 4
+# NOTE: every fourth ω of the subharmonic figure's 161 (steps of 0.025) carries the full Hill
+# verdict: dense enough to show where it parts from the q₀ test, sparse enough to read.
+
+
 def subharmonic_figure(eps: float, force: float, path: Path) -> Path:
-    """Amplitude a(ω) of both roots of eq. 10.87 where they exist; Hill verdict as line
-    style, the true orbit's verdict as markers."""
+    """Amplitude a(ω) of both roots of eq. 10.87 where they exist; the notes' Hill verdict
+    (about q₀) as line style, the true orbit's verdict as markers (o, x), and the full Hill
+    verdict (about the balance orbit) as small markers on the curve every ``FULL_HILL_EVERY``
+    points (filled dot stable, triangle unstable)."""
     check_plot_path(path)
     omega = np.linspace(1.0, 2.0, 161)
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for sign, color in (("+", "C0"), ("-", "C3")):
         a, hill, true_w, true_a, true_s = [], [], [], [], []
-        for w in omega:
+        full_w, full_a, full_s = [], [], []
+        for i, w in enumerate(omega):
             exists, _, sols = subharmonic(eps, force, float(w))
             s = next((s for s in sols if s.root == sign), None) if exists else None
             a.append(np.nan if s is None else s.a)
             hill.append(bool(s and s.hill_stable))
             if s is not None and s.orbit is not None and round(w * 160) % 8 == 0:
                 true_w.append(w), true_a.append(s.orbit.A[1]), true_s.append(s.orbit.stable)
+            if s is not None and s.full_hill_stable is not None and i % FULL_HILL_EVERY == 0:
+                full_w.append(w), full_a.append(s.a), full_s.append(s.full_hill_stable)
+        fs = np.array(full_s, dtype=bool)
+        ax.plot(np.array(full_w)[fs], np.array(full_a)[fs], f"{color}.", ms=4,
+                label=f"root {sign}, full Hill stable")
+        ax.plot(np.array(full_w)[~fs], np.array(full_a)[~fs], f"{color}v", ms=3,
+                label=f"root {sign}, full Hill unstable")
         a, hill = np.array(a), np.array(hill)
         ax.plot(omega, np.where(hill, a, np.nan), f"{color}-", lw=2,
                 label=f"root {sign}, Hill stable")
@@ -188,7 +203,8 @@ def subharmonic_figure(eps: float, force: float, path: Path) -> Path:
         ax.plot(np.array(true_w)[~ts], np.array(true_a)[~ts], f"{color}x", ms=5)
     ax.axhline(0, color="grey", lw=0.5)
     ax.set(xlabel="ω (drive at 3ω)", ylabel="a, first harmonic",
-           title=f"1/3 subharmonic (ε = {eps}, f = {force}); o stable, x unstable true orbit")
+           title=f"1/3 subharmonic (ε = {eps}, f = {force}); o stable, x unstable true orbit;\n"
+                 "line: Hill about q₀ (notes); · stable, ▾ unstable: full Hill")
     ax.legend(fontsize=8)
     fig.tight_layout()
     return _save(fig, path)

@@ -126,9 +126,14 @@ COST_MODEL = {
         "harmonic_balance": (6.61e5, 8.42e4),
         "shooting": (5.09e5, 920.0),
         "mu_expansion, emitted": (110.0, 26.0),
+        "mu_expansion_damped": (9.98e5, 0.0, 7.27e4),  # the same float solve as mu_expansion
+        "mu_expansion_damped, emitted": (129.0, 286.0),  # A_n, B_n, n = 1, 3, 5: six ufuncs
         "harmonic_balance, emitted": (1960.0, 3794.0),
     },
 }
+# NOTE: "mu_expansion_damped, emitted" is a least-squares line through orders 1–4 (medians of
+# five runs of the record's run_emitted over 10⁵ ω, load 3–4 on 2 cores), not yet in
+# benchmarks/cost_model.py's fit.
 # NOTE: ns/point ≈ c₀ + c₁·order + c₂·order² (the coefficients ≥ 0) of each method, per
 # quantity: period and q(t) of the compiled evaluators; for the driven quantities, each method
 # per ω as `choose` runs it (interpreted: the μ-expansion's series products grow with the
@@ -454,10 +459,15 @@ def driven_tradeoffs(truth: DrivenTruth, eps: float, force: float,
     out = [DrivenTradeoff("one_harmonic", 1, ns,
                           driven_errors(truth, np.column_stack([a1, zeros]),
                                         np.column_stack([b1, zeros])))]
-    for m in methods_for("driven"):
+    solved: dict[tuple[Callable, int], DrivenTradeoff] = {}  # two records, one solver
+    for m in methods_for("driven", Drive(eps, force, 1.0, Q)):
         if m.solve is None:
             continue  # the one-harmonic closed form, vectorised above
         for order in m.driven_orders:
+            if (m.solve, order) in solved:
+                t = solved[m.solve, order]
+                out.append(DrivenTradeoff(m.name, order, t.ns_per_point, t.errors))
+                continue
             A, B = np.full((n, 3), np.nan), np.full((n, 3), np.nan)
             seconds = 0.0
             for i, w in enumerate(truth.omega):
@@ -469,13 +479,15 @@ def driven_tradeoffs(truth: DrivenTruth, eps: float, force: float,
                     A[i], B[i] = _harmonics_135(values)
             out.append(DrivenTradeoff(m.name, order, seconds / n * 1e9,
                                       driven_errors(truth, A, B)))
+            solved[m.solve, order] = out[-1]
     return out
 
 
 def emitted_driven(name: str, order: int, truth: DrivenTruth, eps: float, force: float,
                    Q: float) -> DrivenTradeoff:
     """The emitted module of method ``name`` at ``order`` (``generate driven``: the undamped
-    μ-expansion as compiled ufuncs; ``generate balance``: compiled Newton), generated into a
+    μ-expansion as compiled ufuncs, ``--damped`` the damped one; ``generate balance``: compiled
+    Newton), generated into a
     temporary folder through the compiler, run by the record's ``run_emitted``, timed and
     judged at every ω of ``truth``."""
     m = method("driven", name)
@@ -523,7 +535,8 @@ def choose_driven(quantity: str, tol: float, eps: float, force: float, Q: float,
     None), on the largest branch; "cheapest" by the recorded ``COST_MODEL["driven"]``, so the
     choice does not depend on this run's timings (which are reported).  ``emit`` = (highest
     μ-order, most harmonics): only what has an emitted module within those bounds competes —
-    harmonic balance, and the undamped μ-expansion; the modules are generated in the order of
+    harmonic balance, and the μ-expansion (the undamped module for Q = inf, the damped one,
+    ``mu_expansion_damped``, for a finite Q); the modules are generated in the order of
     their modelled cost, the first that meets ``tol`` is chosen (only it and the ones before
     it are generated)."""
     if quantity not in DRIVEN_QUANTITIES:

@@ -1607,7 +1607,8 @@ def _choose_driven(args: argparse.Namespace) -> int:
 
     if args.emit:
         check_writable(_out_folder(args.emit, "--emit"),
-                       ["driven.py", "driven_derivation.tex", "balance.py"], "--emit")
+                       ["driven.py", "driven_derivation.tex", "balance.py", "driven_damped.py",
+                        "driven_damped_derivation.tex"], "--emit")
     progress = Progress("shooting the true orbits", not args.json)
     c = choose_driven(args.quantity, tol, args.eps, args.force, args.Q, lo, hi,
                       emit=(emit_bounds(args.allow_slow, DRIVEN_MAX, args.quantity)

@@ -123,6 +123,7 @@ def generate_method(m: Method, order: int, out: Path, *, overwrite_edited: bool 
     if m.target is None:
         raise InputError(f"{m.name}: no emitted module")
     writer = {FREE: partial(generate, "duffing"), MU: generate_driven,
+              MU_DAMPED: partial(generate_driven, damped=True),
               BALANCE: generate_balance, FOURIER: generate_fourier}[m.target]
     return writer(order, out, overwrite_edited=overwrite_edited, flag=flag)
 

@@ -686,12 +686,20 @@ def depressed_cubic_roots(p: sp.Expr, q: sp.Expr) -> tuple[sp.Expr, ...]:
     )
 
 
+DRIVEN_ARGUMENT_LIMIT = 1e6
+# NOTE: the undamped evaluators' range: 1e-6 ≤ |ω| ≤ 1e6, 0 < |ε| ≤ 1e6, |f| ≤ 1e6 (ε itself
+# has no lower bound: the cubic's closed form is exact down to ε = 1e-20).  Outside (NaN and
+# ±inf included) they computed ±inf at ω = 0 and raised floating-point warnings; there the
+# arguments are replaced by ω = 2, ε = f = 1/10 (:func:`argument_entry`) and the answer is NaN.
+
+
 def lower_driven(orders: tuple[MuOrder, ...], command: str) -> Module:
     """Evaluators ``A_n(omega, eps, force, branch)`` of the undamped μ-expansion at order K.
 
     ``branch`` 0, 1, 2 picks a real root of the first-order cubic, largest first (NaN where that
-    branch does not exist).  The sum is NaN at a fold (``D = 0``) and where its last constant
-    ``b_K`` exceeds ``b_{K−1}`` (``A₁`` for K = 1): a growing series is no answer.
+    branch does not exist).  NaN outside ``DRIVEN_ARGUMENT_LIMIT``.  The sum is NaN at a fold
+    (``D = 0``) and where its last constant ``b_K`` exceeds ``b_{K−1}`` (``A₁`` for K = 1): a
+    growing series is no answer.
     """
     K = len(orders)
     omega, eps, force, branch = sp.symbols("omega eps force branch")
@@ -703,8 +711,15 @@ def lower_driven(orders: tuple[MuOrder, ...], command: str) -> Module:
     b = [orders[j].q.get(1, 0) for j in range(K)]  # b_j is q_j's cos τ coefficient
     last = sp.Abs(b[-1].xreplace(to_args))
     before = sp.Abs(A1) if K == 1 else sp.Abs(b[-2].xreplace(to_args))
-    guard = sp.And(sp.Ne(eps, 0), sp.Ne(D, 0), last <= before)
-    prelude = ((A1, pick), (D, 1 - 1 / omega**2 - sp.Rational(9, 4) * eps * A1**2 / omega**2))
+    high = sp.Float(DRIVEN_ARGUMENT_LIMIT)
+    entry, inside = argument_entry((
+        (omega, sp.And(sp.Abs(omega) >= 1 / high, sp.Abs(omega) <= high), 2),
+        (eps, sp.And(sp.Ne(eps, 0), sp.Abs(eps) <= high), sp.Rational(1, 10)),
+        (force, sp.Abs(force) <= high, sp.Rational(1, 10)),
+        (branch, sp.Or(sp.Eq(branch, 0), sp.Eq(branch, 1), sp.Eq(branch, 2)), 0)))
+    guard = sp.And(inside, sp.Ne(D, 0), last <= before)
+    prelude = (*entry, (A1, pick),
+               (D, 1 - 1 / omega**2 - sp.Rational(9, 4) * eps * A1**2 / omega**2))
     evaluators = []
     for n in range(1, 2 * K + 2, 2):
         total = (A1 if n == 1 else 0) + sum(o.q.get(n, 0) for o in orders)
@@ -716,7 +731,7 @@ def lower_driven(orders: tuple[MuOrder, ...], command: str) -> Module:
             (omega, eps, force, branch), prelude, guard, tuple(subexprs), out))
     evaluators.append(Evaluator(
         "first_order", "A₁ of the branch: a real root of (ω² − 1)A₁ − ¾εA₁³ + f = 0.",
-        (omega, eps, force, branch), ((A1, pick),), sp.Ne(eps, 0), (), A1))
+        (omega, eps, force, branch), (*entry, (A1, pick)), inside, (), A1))
     return Module(
         name="driven",
         doc=f"Driven Duffing q'' + q + eps*q**3 = f cos(omega t): μ-expansion to order {K}.",
@@ -740,6 +755,42 @@ DAMPED_TRUNCATION = 1e-2
 DAMPED_HARMONICS = 5
 # NOTE: A_n, B_n for n = 1, 3, 5: the harmonics the tables and charts show (and the first three of
 # the undamped module's).
+DAMPED_ARGUMENT_RANGE = (1e-6, 1e6)
+# NOTE: the damped evaluators' arguments enter as ω^{2j}, ω/Q, εf² and 1/(ω^{2j}Δ^m): outside
+# 1e-6 ≤ |ω|, Q and |ω|, |ε|, |f| ≤ 1e6 (NaN and ±inf included) they would overflow or divide by
+# zero (or make NaN, which raises "invalid" in comparisons) before the guard sees them: a
+# floating-point warning from the ufunc.  There the arguments are replaced by DAMPED_STAND_IN, a
+# point where every step is finite, and the guard returns NaN.
+DAMPED_STAND_IN = (2, sp.Rational(1, 10), sp.Rational(1, 10), 1)
+# NOTE: ω, ε, f, Q far above resonance: one branch, no fold, every step finite and quiet.
+
+
+def argument_entry(arguments: tuple[tuple[sp.Symbol, sp.Basic, object], ...]
+                   ) -> tuple[list[Assign], sp.Basic]:
+    """Assignments that replace every argument by its stand-in unless every argument meets its
+    condition (false for NaN: comparisons with NaN are), and the condition the guard adds (a
+    flag ``inside``, 1 or 0): outside, the evaluator computes at the stand-in point, where
+    every step is finite, and returns NaN — no floating-point flag is raised on the way."""
+    flag = sp.Symbol("inside")
+    inside = sp.And(*(cond for _, cond, _ in arguments))
+    steps: list[Assign] = [(flag, sp.Piecewise((sp.Integer(1), inside), (sp.Integer(0), True)))]
+    for v, _, safe in arguments:
+        steps.append((v, sp.Piecewise((v, sp.Eq(flag, 1)), (safe, True))))
+    return steps, sp.Eq(flag, 1)
+
+
+def damped_entry(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol, Q: sp.Symbol,
+                 branch: sp.Symbol) -> tuple[list[Assign], sp.Basic]:
+    """:func:`argument_entry` of the damped evaluators: ``DAMPED_ARGUMENT_RANGE`` (ε ≠ 0,
+    Q > 0, ``Q = inf`` allowed, branch 0, 1 or 2), ``DAMPED_STAND_IN`` (branch 0) outside."""
+    low, high = (sp.Float(v) for v in DAMPED_ARGUMENT_RANGE)
+    w, e, f, q = DAMPED_STAND_IN
+    return argument_entry((
+        (omega, sp.And(sp.Abs(omega) >= low, sp.Abs(omega) <= high), w),
+        (eps, sp.And(sp.Ne(eps, 0), sp.Abs(eps) <= high), e),
+        (force, sp.Abs(force) <= high, f),
+        (Q, low <= Q, q),
+        (branch, sp.Or(sp.Eq(branch, 0), sp.Eq(branch, 1), sp.Eq(branch, 2)), 0)))
 
 
 def nested_horner(expr: sp.Expr, gens: tuple[sp.Symbol, ...]) -> sp.Expr:
@@ -814,7 +865,8 @@ def lower_driven_damped(orders: tuple[MuDampedOrder, ...], command: str) -> Modu
                         (roots[2], sp.Eq(branch, 2)), (sp.nan, True))
     zs = [sp.Symbol(f"z{k}") for k in range(ROOT_POLISH + 1)]
     zsym = sp.Symbol("z")
-    prelude: list[Assign] = [(gamma, omega / Q), *steps, (zs[0], pick)]
+    entry, inside = damped_entry(omega, eps, force, Q, branch)
+    prelude: list[Assign] = [*entry, (gamma, omega / Q), *steps, (zs[0], pick)]
     for k in range(ROOT_POLISH):
         prelude.append((zs[k + 1], zs[k] - (H / slope).xreplace({zsym: zs[k]})))
     to_args = {A1_: A1, omega_: omega, damped_x: x, a_: a, gamma_: gamma, Delta_: Delta}
@@ -834,7 +886,7 @@ def lower_driven_damped(orders: tuple[MuDampedOrder, ...], command: str) -> Modu
     prelude += [*subexprs, *zip([*named, *constants], reduced, strict=True),
                 (delta, sp.Symbol("delta0") + sum(named[:K]))]
     omitted, last = sizes[1], sizes[0]
-    guard = sp.And(sp.Ne(eps, 0), Q > 0, sp.Ne(Delta, 0), omitted <= last,
+    guard = sp.And(inside, sp.Ne(Delta, 0), omitted <= last,
                    omitted <= DAMPED_TRUNCATION * A1,
                    sp.Abs(zs[-1] - zs[-2]) <= ROOT_RESOLVED * sp.Abs(z))
     summed = orders[:K]
@@ -851,11 +903,11 @@ def lower_driven_damped(orders: tuple[MuDampedOrder, ...], command: str) -> Modu
             evaluators.append(Evaluator(
                 name, f"Coefficient of {what}, damped μ-expansion order {K} (eq. 10.66–10.72).",
                 (omega, eps, force, Q, branch), tuple(prelude), guard, tuple(subexprs), expr))
-    root_prelude = tuple(prelude[: len(steps) + ROOT_POLISH + 5])
+    root_prelude = tuple(prelude[: len(entry) + len(steps) + ROOT_POLISH + 5])
     evaluators.append(Evaluator(
         "first_order", "A₁ of the branch: √u, u a root of u[(1 − ω² + ¾εu)² + ω²/Q²] = f².",
         (omega, eps, force, Q, branch), root_prelude,
-        sp.And(sp.Ne(eps, 0), Q > 0, sp.Abs(zs[-1] - zs[-2]) <= ROOT_RESOLVED * sp.Abs(z)),
+        sp.And(inside, sp.Abs(zs[-1] - zs[-2]) <= ROOT_RESOLVED * sp.Abs(z)),
         (), A1))
     return Module(
         name="driven_damped",

@@ -12,7 +12,9 @@ what it stores:
   find the orbits the one-harmonic roots miss near a fold), how many are Floquet-stable, their
   largest Floquet modulus, and the orbit each first-order branch stands for;
 * ``subharmonic``: the 1/3 subharmonic (eq. 10.87, undamped; ``omega`` is its frequency, the
-  drive is at ``3ω``): whether it exists, both roots, Hill and true-orbit stability;
+  drive is at ``3ω``): whether it exists, both roots, Hill and true-orbit stability, and the
+  full Hill verdict (about the harmonic-balance orbit, :func:`numerics.orbit_hill_multipliers`)
+  with its largest multiplier modulus;
 * ``validity``: the μ-expansion's and low-order harmonic balance's error in ``A₁`` against
   harmonic balance with 10 harmonics on the largest branch (the driven validity chart).
 
@@ -64,6 +66,7 @@ from .errors import InputError
 from .response import (
     CONTINUATION_HARMONICS,
     SAME_ORBIT,
+    SUBHARMONIC_HARMONICS,
     amplitude_slope,
     periodic_orbits,
     subharmonic,
@@ -125,10 +128,14 @@ def _subharmonic(omega: float, force: float, eps: float) -> dict:
     exists, _, solutions = subharmonic(eps, force, omega)
     out = {"exists": int(exists), "F": solutions[0].F if solutions else math.nan,
            "a": [math.nan] * 2, "hill_stable": [-1] * 2, "orbit_a1": [math.nan] * 2,
-           "orbit_floquet": [math.nan] * 2, "orbit_stable": [-1] * 2, "locked": [-1] * 2}
+           "orbit_floquet": [math.nan] * 2, "orbit_stable": [-1] * 2, "locked": [-1] * 2,
+           "full_hill_stable": [-1] * 2, "full_hill_modulus": [math.nan] * 2}
     for s in solutions:
         k = 0 if s.root == "+" else 1
         out["a"][k], out["hill_stable"][k] = s.a, int(s.hill_stable)
+        if s.full_hill_stable is not None:  # None: the balance did not converge to this root
+            out["full_hill_stable"][k] = int(s.full_hill_stable)
+            out["full_hill_modulus"][k] = float(np.max(np.abs(s.full_hill_multipliers)))
         if s.orbit is not None:
             out["orbit_a1"][k] = s.orbit.A[1]
             out["orbit_floquet"][k] = float(np.max(np.abs(s.orbit.multipliers)))
@@ -270,9 +277,14 @@ SUBHARMONIC = Kind(
            flag=True),
      Field("locked", "a simulation 1 % off the true orbit stays on it", "int8", ("root",),
            flag=True),
-     Field("stable_roots", "roots whose true orbit is stable", "int8")),
+     Field("stable_roots", "roots whose true orbit is stable", "int8"),
+     Field("full_hill_stable", "full Hill stability: the variational equation about the "
+           "harmonic-balance orbit, not the notes' q0 = a cos tau + F cos 3tau", "int8",
+           ("root",), flag=True),
+     Field("full_hill_modulus", "largest multiplier modulus of the full Hill equation",
+           dims=("root",))),
     _subharmonic, (("omega", 1.5), ("force", 0.1), ("eps", 0.1)),
-    8, "stable_roots", ())
+    8, "stable_roots", (("full_hill_harmonics", SUBHARMONIC_HARMONICS),))
 # NOTE: 8 points: ~0.12 s a point (Hill, shooting over 3 periods, a locking simulation).
 
 VALIDITY = Kind(

@@ -113,3 +113,36 @@ def test_cli_refuses_bad_plot_path_before_computing(tmp_path, monkeypatch, capsy
         assert out.out == "" and "--plot" in out.err and len(out.err.splitlines()) == 1
         assert calls == []  # refused before any computation
     assert list(tmp_path.iterdir()) == []
+
+
+def test_subharmonic_figure_marks_the_full_hill_verdict(tmp_path, monkeypatch):
+    """Small markers on each root's curve give the full Hill verdict every FULL_HILL_EVERY ω
+    (dot stable, triangle unstable); where it parts from the notes' q₀ test (the line style)
+    it is the true orbit's Floquet verdict (shooting from the balance orbit, RK4 monodromy)."""
+    from lindstedt.response import subharmonic
+
+    drawn = []
+    save = charts._save
+    monkeypatch.setattr(charts, "_save", lambda fig, path: (drawn.append(fig), save(fig, path))[1])
+    charts.subharmonic_figure(0.1, 0.5, tmp_path / "s.png")
+    (fig,) = drawn
+    (ax,) = fig.axes
+    marks = {line.get_label(): line for line in ax.lines if "full Hill" in line.get_label()}
+    assert sorted(marks) == [f"root {s}, full Hill {v}" for s in "+-"
+                             for v in ("stable", "unstable")]
+    assert {marks[k].get_marker() for k in marks} == {".", "v"}
+    parted = []
+    for sign in "+-":
+        for verdict in ("stable", "unstable"):
+            line = marks[f"root {sign}, full Hill {verdict}"]
+            for w, a in zip(line.get_xdata(), line.get_ydata(), strict=True):
+                _, _, sols = subharmonic(0.1, 0.5, float(w))
+                s = next(s for s in sols if s.root == sign)
+                assert a == s.a
+                if s.hill_stable != (verdict == "stable"):
+                    parted.append((sign, verdict, s))
+    assert parted  # the q₀ test and the full one disagree somewhere on 1 ≤ ω ≤ 2
+    checked = [(sign, verdict, s) for sign, verdict, s in parted if s.orbit is not None]
+    assert checked
+    for sign, verdict, s in checked[:4]:
+        assert s.orbit.stable == (verdict == "stable"), (sign, verdict, s.a)

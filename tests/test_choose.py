@@ -482,3 +482,71 @@ def test_choose_period_for_an_equation_refuses_with_a_reason():
     done = subprocess.run(cmd, capture_output=True, text=True)
     assert done.returncode == 2 and done.stdout == ""
     assert done.stderr.count("\n") == 1 and "only the period" in done.stderr
+
+
+# --- the damped μ-expansion in the registry ------------------------------------------------------
+
+def test_damped_mu_expansion_is_a_registered_method_for_a_finite_Q():
+    """It applies to a driven oscillator with a finite Q and says why not for Q = inf (the
+    undamped record's) and for a free oscillator; the undamped module says why it cannot be
+    emitted for a finite Q; both records share the float μ-expansion's solve."""
+    from lindstedt.driven import Drive
+    from lindstedt.methods import MU_DAMPED, method, methods_for
+    from lindstedt.models import duffing
+
+    damped, undamped = method("driven", "mu_expansion_damped"), method("driven", "mu_expansion")
+    finite, infinite = Drive(0.1, 0.3, 0.8, 20.0), Drive(0.1, 0.3, 0.8, np.inf)
+    assert damped.why_not(finite) is None and damped.emittable(finite) is None
+    assert "Q = inf" in damped.why_not(infinite) and damped.why_not(duffing())
+    assert "finite Q" in undamped.emittable(finite) and undamped.emittable(infinite) is None
+    assert damped in methods_for("driven", finite) and damped not in methods_for("driven",
+                                                                                 infinite)
+    assert damped.target is MU_DAMPED and damped.solve is undamped.solve
+    assert damped.driven_orders == tuple(range(1, 12))
+
+
+def test_emitted_damped_module_is_not_verified_beside_a_fold():
+    """Beside the fold of the upper branch (ε = 0.1, f = 0.3, Q = 20) the emitted damped
+    module returns NaN there, so its error is NaN and ``choose`` cannot count it as meeting
+    any tolerance; 0.2 below the fold it meets shooting (the truth) to 1e-4."""
+    from lindstedt.choose import driven_truth, emitted_driven
+    from lindstedt.driven import one_harmonic_roots
+
+    w = np.linspace(1.3, 1.6, 30001)
+    fold = w[np.flatnonzero(np.isfinite(one_harmonic_roots(0.1, 0.3, 20.0, w)[:, 1]))[-1]]
+    omegas = np.array([fold - 0.2, fold - 1e-4])
+    truth = driven_truth(0.1, 0.3, 20.0, omegas)
+    t = emitted_driven("mu_expansion_damped", 3, truth, 0.1, 0.3, 20.0)
+    assert t.method == "mu_expansion_damped, emitted"
+    err = t.errors["amplitudes"]
+    assert err[0] <= 1e-4 and np.isnan(err[1])
+    assert np.isnan(np.max(err))  # what choose_driven tests: NaN anywhere is refused
+
+
+def test_choose_emits_the_damped_module_for_a_finite_Q(tmp_path):
+    """For Q = 20 with --emit the undamped module cannot compete and the damped one is the
+    cheapest verified; its A₁, B₁ at ω off the verified point agree with shooting (started
+    from the one-harmonic guess, not from the module's answer)."""
+    from lindstedt.driven import Drive, first_order_branches
+    from lindstedt.emit import load_generated
+    from lindstedt.numerics import shoot
+
+    run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "amplitudes", "--eps",
+                          "0.1", "--force", "0.3", "--Q", "20", "--omega", "0.8", "--tol",
+                          "1e-6", "--emit", str(tmp_path), "--json"],
+                         capture_output=True, text=True, check=False)
+    assert run.returncode == 0, run.stderr
+    data = json.loads(run.stdout)
+    assert data["method"] == "mu_expansion_damped" and data["max_error"] <= 1e-6
+    assert str(tmp_path / "driven_damped.py") in data["emitted"]
+    assert not any(c["method"].startswith("mu_expansion,") or c["method"] == "mu_expansion"
+                   for c in data["considered"])
+    mod = load_generated(tmp_path / "driven_damped.py")
+    assert data["order"] == mod.ORDER
+    for w in (0.75, 0.85):
+        br = first_order_branches(Drive(0.1, 0.3, w, 20.0))[0]
+        guess = br.A1 * np.array([np.cos(br.delta0), w * np.sin(br.delta0)])
+        orbit = shoot(0.1, 0.3, w, 0.05, guess)
+        assert abs(mod.A_1(w, 0.1, 0.3, 20.0, 0) - orbit.A[1]) <= 1e-6
+        assert abs(mod.B_1(w, 0.1, 0.3, 20.0, 0) - orbit.B[1]) <= 1e-6
+    del sys.modules["driven_damped"]

@@ -127,6 +127,28 @@ def test_subharmonic_against_eq_10_87():
     assert np.isnan(ds.a.sel(omega=0.9, force=f, eps=EPS)).all()
 
 
+def test_subharmonic_full_hill_verdict_against_the_true_orbit():
+    """The full Hill verdict (about the balance orbit) is the true orbit's Floquet verdict
+    (shooting, RK4 monodromy) wherever both exist, its largest modulus within 1e-9 of the
+    orbit's; it differs from the notes' q₀ test somewhere on the grid (a root the q₀ test calls
+    stable is not); the variables stored before are all still there."""
+    axes = {"omega": [0.9, 1.2, 1.5], "force": [0.1, 0.5], "eps": [EPS]}
+    ds = serial_sweep("subharmonic", axes)
+    assert {"exists", "F", "a", "hill_stable", "orbit_a1", "orbit_floquet", "orbit_stable",
+            "locked", "stable_roots", "full_hill_stable", "full_hill_modulus"} <= set(ds)
+    full, orbit = ds.full_hill_stable.values, ds.orbit_stable.values
+    both = (full >= 0) & (orbit >= 0)
+    assert both.sum() >= 6 and np.array_equal(full[both], orbit[both])
+    finite = np.isfinite(ds.full_hill_modulus.values) & np.isfinite(ds.orbit_floquet.values)
+    np.testing.assert_allclose(ds.full_hill_modulus.values[finite],
+                               ds.orbit_floquet.values[finite], atol=1e-9)
+    assert ((ds.hill_stable.values == 1) & (full == 0)).any()
+    below = ds.sel(omega=0.9)  # ω < 1: no subharmonic, no verdict
+    assert (below.full_hill_stable.values == -1).all()
+    assert np.isnan(below.full_hill_modulus.values).all()
+    assert ds.full_hill_stable.attrs["flag_meanings"] == "none no yes"
+
+
 def test_workers_are_warmed_once_and_never_recompile(scheduler, tmp_path):
     from distributed import Client
 
