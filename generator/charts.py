@@ -711,6 +711,20 @@ def parametric_figure(eps: float, zeta: float, gamma: float, omega_from: float,
     return _save(fig, path)
 
 
+def _mathieu_errors(ax: plt.Axes, q: np.ndarray, errors: dict[str, np.ndarray], against: str,
+                    ncol: int, by_value: bool) -> None:
+    """One panel of Mathieu's relative errors against q: SciPy's dashed, the emitted ones
+    solid; ``by_value``: one colour per characteristic value (``a_6``), SciPy's and ours."""
+    names = sorted({label.split()[-1] for label in errors})
+    for label, err in sorted(errors.items()):
+        color = {"color": f"C{names.index(label.split()[-1])}"} if by_value else {}
+        ax.plot(q, np.maximum(err, FLOOR), "--" if label.startswith("SciPy") else "-", lw=1,
+                label=label, **color)
+    ax.set(yscale="log", xlabel="q", ylabel="|error| / max(1, |a|)",
+           title=f"Mathieu's a_m(q), b_m(q) against {against}")
+    ax.legend(fontsize=7, ncol=ncol)
+
+
 def resummed_speed_accuracy_figure(panels: Sequence[tuple[str, Sequence[tuple[str, str, float,
                                                                                float]]]],
                                    mathieu: tuple[np.ndarray, dict[str, np.ndarray]],
@@ -742,15 +756,8 @@ def resummed_speed_accuracy_figure(panels: Sequence[tuple[str, Sequence[tuple[st
         if k == 0:
             ax.set_ylabel("max relative error of ω (top: NaN somewhere)")
             ax.legend(fontsize=7)
-    ax = fig.add_subplot(grid[1, :])
-    q, errors = mathieu
-    for label, err in sorted(errors.items()):
-        ax.plot(q, np.maximum(err, FLOOR), "--" if label.startswith("SciPy") else "-", lw=1,
-                label=label)
-    ax.set(yscale="log", xlabel="q", ylabel="|error| / max(1, |a|)",
-           title="Mathieu's a_m(q), b_m(q) against the eigenvalue reference (resummed: NaN "
-                 "beyond the verified q, not drawn)")
-    ax.legend(fontsize=7, ncol=4)
+    _mathieu_errors(fig.add_subplot(grid[1, :]), *mathieu, "the eigenvalue reference (resummed: "
+                    "NaN beyond the verified q, not drawn)", ncol=4, by_value=False)
     fig.tight_layout()
     return _save(fig, path)
 
@@ -762,13 +769,7 @@ def mathieu_accuracy_figure(q: np.ndarray, errors: dict[str, np.ndarray], path: 
     sits on the floor."""
     check_plot_path(path)
     fig, ax = plt.subplots(figsize=(10, 4.5))
-    names = sorted({label.split()[-1] for label in errors})
-    for label, err in sorted(errors.items()):
-        ax.plot(q, np.maximum(err, FLOOR), "--" if label.startswith("SciPy") else "-", lw=1,
-                color=f"C{names.index(label.split()[-1])}", label=label)
-    ax.set(yscale="log", xlabel="q", ylabel="|error| / max(1, |a|)",
-           title="Mathieu's a_m(q), b_m(q) against the eigenvalues at 30 digits (emitted: "
-                 "NaN beyond the verified q, not drawn)")
-    ax.legend(fontsize=7, ncol=3)
+    _mathieu_errors(ax, q, errors, "the eigenvalues at 30 digits (emitted: NaN beyond the "
+                    "verified q, not drawn)", ncol=3, by_value=True)
     fig.tight_layout()
     return _save(fig, path)
