@@ -327,6 +327,14 @@ def _cmd_tongues(args: argparse.Namespace) -> int:
     x'' + (δ + ε p(t))x = 0, exact; ``--damping Z``: the damped tongue's tip."""
     from .hill import fourier_of_text, tongue_tip, transition_curves
 
+    if args.emit is not None:
+        from . import compiler
+
+        for path in compiler.generate_tongue(args.p, args.n, args.order,
+                                             _out_folder(args.emit, "--emit"),
+                                             overwrite_edited=args.overwrite_edited):
+            print(path)
+        return 0
     if args.tol is not None and args.at is None:
         raise InputError("--tol: give --at EPS, the eps the tolerance is asked at")
     if args.plot:
@@ -2000,6 +2008,13 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_json(p, "the curves as JSON {p, n, variable, delta0, harmonics, time_origin, period, "
                "solution_variable, curves: [{label, series, solution}], damping}")
     _flag_allow_slow(p, deprecated_force=False)
+    p.add_argument("--emit", metavar="DIR", default=None,
+                   help="write DIR/tongue_<N>.py instead: numba ufuncs delta_<i>(eps) and "
+                   "delta_<i>_error(eps), one per curve, Padé-resummed from the series to "
+                   "--order (≥ 12), verified against the Floquet boundary |tr M| = 2 to 1e-10 "
+                   "in delta on 24 points up to 3 radii (at most eps = 10), NaN beyond")
+    p.add_argument("--overwrite-edited", action="store_true",
+                   help="with --emit: overwrite a file edited since it was generated")
     p.set_defaults(func=_cmd_tongues)
 
     p = sub.add_parser("models", help="list the named oscillators",

@@ -9,6 +9,7 @@ starts.
 
 from __future__ import annotations
 
+import shlex
 from collections.abc import Callable
 from functools import partial
 from pathlib import Path
@@ -25,6 +26,7 @@ from .methods import (
     MU,
     MU_DAMPED,
     SLOW_FLOW,
+    TONGUE,
     Candidate,
     Method,
     Request,
@@ -147,4 +149,23 @@ def generate_mathieu(kind: str, m: int, order: int, out: Path, *,
         raise InputError(f"order {order}: a resummed Mathieu evaluator needs order ≥ 4")
     command = f"lindstedt mathieu {kind} --m {m} --order {order} --emit DIR"
     return compile_target(MATHIEU, Request(order, command, mathieu=(kind, m)), out,
+                          overwrite_edited=overwrite_edited, flag=flag)
+
+
+TONGUE_MIN_ORDER = 12
+# NOTE: nearest_singularity needs 12 coefficients for the radius that sets the verified range.
+
+
+def generate_tongue(p: str, n: int, order: int, out: Path, *, overwrite_edited: bool = False,
+                    flag: str = "--emit") -> list[Path]:
+    """``lindstedt tongues P --n N --order K --emit DIR``: the resummed transition curves."""
+    from .hill import fourier_of_text, transition_curves
+
+    transition_curves(fourier_of_text(p), n, 0)  # p and n checked before the derivation
+    order = check_order(order)
+    if order < TONGUE_MIN_ORDER:
+        raise InputError(f"order {order}: resummed transition curves need order ≥ "
+                         f"{TONGUE_MIN_ORDER}")
+    command = f"lindstedt tongues {shlex.quote(p)} --n {n} --order {order} --emit DIR"
+    return compile_target(TONGUE, Request(order, command, tongue=(p, n)), out,
                           overwrite_edited=overwrite_edited, flag=flag)

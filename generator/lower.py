@@ -551,6 +551,74 @@ def lower_mathieu(r: ResummedMathieu, command: str) -> Module:
     )
 
 
+@dataclass(frozen=True)
+class ResummedCurve:
+    """One transition curve ``δ(ε)`` as the Padé of its exact series, verified against the
+    Floquet boundary on ``0 ≤ ε ≤ limit`` (``|ε|`` when the series is even in ε), with the
+    largest error ``checked`` there (absolute, in δ)."""
+
+    label: str
+    form: Resummed
+    limit: float
+    checked: float
+
+
+@dataclass(frozen=True)
+class ResummedTongue:
+    """The transition curves of tongue ``n`` of ``ẍ + (δ + ε p(t))x = 0`` (``p`` as its user
+    text, data only), each resummed and verified to ``tolerance`` in δ."""
+
+    p: str
+    n: int
+    order: int
+    tolerance: float
+    curves: tuple[ResummedCurve, ...]
+
+
+def lower_tongue(r: ResummedTongue, command: str) -> Module:
+    """``delta_<i>(eps)`` for curve i of the tongue (the Padé of its series), and
+    ``delta_<i>_error(eps)`` (|difference to the next lower approximant|, an estimate), NaN
+    outside the verified ε."""
+    eps = sp.Symbol("eps")
+    evaluators: list[Evaluator] = []
+    constants: list[tuple[str, object]] = [("ORDER", r.order), ("MODEL", f"tongue_{r.n}"),
+                                           ("VARIABLE", "eps"), ("TOLERANCE", r.tolerance)]
+    for i, c in enumerate(r.curves):
+        bound = sp.Rational(repr(c.limit))
+        guard = sp.Abs(eps) <= bound if c.form.power == 2 else sp.And(eps >= 0, eps <= bound)
+        body, value = resummed_expression(c.form, eps)
+        _, other = resummed_expression(c.form, eps, c.form.neighbour)
+        L, M = c.form.approximant.degrees
+        var = "eps²" if c.form.power == 2 else "eps"
+        domain = (f"NaN outside {'|eps|' if c.form.power == 2 else '0 ≤ eps'} ≤ {c.limit:g}, "
+                  f"where it was verified to {r.tolerance:g} in delta against the Floquet "
+                  "boundary |tr M| = 2")
+        delta, lower = sp.Symbol("delta"), sp.Symbol("delta_lower")
+        name = f"delta_{i}"
+        evaluators += [
+            Evaluator(name, f"Transition curve {c.label} of tongue {r.n}: Padé [{L}/{M}] in "
+                      f"{var} of the exact series to order {r.order} ({domain}).", (eps,), (),
+                      guard, body, value),
+            Evaluator(f"{name}_error", f"|{name} − Padé [{L - 1}/{M - 1}]|: an error estimate "
+                      f"in delta ({domain}).", (eps,), (), guard,
+                      (*body, (delta, value), (lower, other)), sp.Abs(delta - lower)),
+        ]
+        constants += [(f"LABEL_{i}", one_line(c.label)), (f"LIMIT_{i}", c.limit),
+                      (f"CHECKED_ERROR_{i}", c.checked), (f"DEGREES_{i}", (L, M)),
+                      (f"SYMMETRIC_{i}", c.form.power == 2)]
+    return Module(
+        name=f"tongue_{r.n}",
+        doc=f"Transition curves delta(eps) out of tongue n = {r.n} (delta = n²/4) of "
+            f"x'' + (delta + eps p(t)) x = 0, p(t) = {r.p}, resummed past the radius of "
+            "their series.",
+        constants=tuple(constants), evaluators=tuple(evaluators),
+        provenance=provenance(f"tongue_{r.n}", r.order, command, p=r.p, n=r.n, curves=[
+            {"numerator": [_hex(x) for x in c.form.approximant.numerator],
+             "denominator": [_hex(x) for x in c.form.approximant.denominator],
+             "limit": c.limit} for c in r.curves]),
+    )
+
+
 def _hex(c: Fraction) -> str:
     """An exact rational for the provenance hash, in hex: Python's decimal conversion refuses
     integers past 4300 digits, which a Padé of order 100 in q reaches."""

@@ -30,6 +30,7 @@ Richardson-combined RK4.
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from fractions import Fraction
@@ -64,8 +65,10 @@ from .lower import (
     MuDerivation,
     NotesTable,
     PeriodFormula,
+    ResummedCurve,
     ResummedCycle,
     ResummedMathieu,
+    ResummedTongue,
     Unit,
     agm_steps,
     horner,
@@ -80,6 +83,7 @@ from .lower import (
     lower_limit_cycle,
     lower_mathieu,
     lower_slow_flow,
+    lower_tongue,
     x_,
 )
 from .models import Model, SelfExcited, check_order, duffing
@@ -444,6 +448,7 @@ class Request:
     candidate: Candidate | None = None
     verified: tuple[float, float] = (0.0, 0.0)
     mathieu: tuple[str, int] | None = None  # (kind, m) of a Mathieu characteristic value
+    tongue: tuple[str, int] | None = None  # (p(t) as text, n) of a tongue's transition curves
 
 
 @dataclass(frozen=True)
@@ -645,6 +650,86 @@ def _mathieu_lower(derived: object, r: Request) -> Unit:
     return Unit(lower_mathieu(derived, r.command))
 
 
+TONGUE_TOLERANCE = 1e-10
+# NOTE: absolute, in δ.  The boundary is brentq on |tr M| − 2 with the compiled RK4 monodromy
+# at TONGUE_STEPS and twice as many; a grid point counts only where the two agree to
+# TONGUE_TOLERANCE / 10 (measured for p = cos t + cos 2t/2, n = 1: ≤ 5e-13 up to ε = 3).
+TONGUE_STEPS = 4096
+TONGUE_RADII = 3.0
+TONGUE_RANGE = 10.0
+TONGUE_GRID = 24
+# NOTE: each curve is verified on 24 points of (0, ε_max], ε_max = 3 × its estimated radius
+# (lindstedt.nearest_singularity; TONGUE_RANGE without an estimate), capped at 10: past a few
+# radii no near-diagonal Padé of an order-30 series holds 1e-10, and 24 points keep the
+# generation to seconds.
+TONGUE_BRACKET = 1e-4
+# NOTE: the boundary is searched within ±1e-4 of the Padé value; no crossing there is a miss.
+
+
+def floquet_boundary(p: dict[int, tuple[float, float]], eps: float, near: float,
+                     steps: int) -> float:
+    """The δ within ``TONGUE_BRACKET`` of ``near`` where ``|tr M| = 2`` at ``eps`` (brentq on
+    :func:`numerics.floquet_traces`), NaN if none crosses there."""
+    from scipy.optimize import brentq
+
+    from .numerics import floquet_traces
+
+    def margin(delta: float) -> float:
+        return abs(float(floquet_traces(delta, eps, p, steps=steps)[0])) - 2
+
+    lo, hi = near - TONGUE_BRACKET, near + TONGUE_BRACKET
+    if not margin(lo) * margin(hi) < 0:
+        return float("nan")
+    return brentq(margin, lo, hi, xtol=1e-15)
+
+
+def resum_tongue(text: str, n: int, order: int, tolerance: float = TONGUE_TOLERANCE
+                 ) -> ResummedTongue:
+    """Each transition curve of tongue ``n`` of ``ẍ + (δ + ε p(t))x = 0`` (``p`` as text) as
+    the Padé of its exact series (:func:`hill.transition_curves`, :func:`resum.resum_series`),
+    verified against the Floquet boundary (:func:`floquet_boundary` at ``TONGUE_STEPS`` and
+    twice as many) on ``TONGUE_GRID`` points of ``(0, ε_max]``: ``limit`` is the last grid
+    point before the first miss.  :class:`InputError` if a curve misses at the first point."""
+    import numpy as np
+
+    from .hill import fourier_of_text, transition_curves
+
+    harmonics = fourier_of_text(text)
+    p = {k: (float(a), float(b)) for k, (a, b) in harmonics.items()}
+    curves = []
+    for curve in transition_curves(harmonics, n, order).curves:
+        est = nearest_singularity(list(curve.delta), "eps", None)
+        radius = (math.sqrt(est.radius) if est.variable == "eps**2" else est.radius
+                  ) if est else TONGUE_RANGE
+        top = min(TONGUE_RADII * radius, TONGUE_RANGE)
+        form = resum_series(list(curve.delta), top)
+        grid = np.linspace(0.0, top, TONGUE_GRID + 1)[1:]
+        limit, worst = 0.0, 0.0
+        for eps in grid:
+            value = float(form(eps))
+            ref = floquet_boundary(p, float(eps), value, TONGUE_STEPS)
+            finer = floquet_boundary(p, float(eps), value, 2 * TONGUE_STEPS)
+            error = abs(value - finer)
+            if not (abs(ref - finer) <= tolerance / 10 and error <= tolerance):
+                break
+            limit, worst = round(float(eps), 12), max(worst, error)
+        if limit == 0.0:
+            raise InputError(f"tongue {n} of p(t) = {text!r}, curve {curve.label}: the "
+                             f"resummed series misses {tolerance:g} already at eps = "
+                             f"{grid[0]:g}; raise --order")
+        curves.append(ResummedCurve(curve.label, form, limit, worst))
+    return ResummedTongue(text, n, order, tolerance, tuple(curves))
+
+
+def _tongue_derive(r: Request, progress: Progress | None) -> object:
+    text, n = r.tongue
+    return resum_tongue(text, n, r.order)
+
+
+def _tongue_lower(derived: object, r: Request) -> Unit:
+    return Unit(lower_tongue(derived, r.command))
+
+
 NOTES_DRIVE = (0.1, 1.0, 1.0)
 # NOTE: ε, f, ω of the notes' table (§10.4, undamped), reproduced in every driven derivation.
 NOTES_TABLE_ORDERS = 6
@@ -739,6 +824,7 @@ SLOW_FLOW = Target(lambda r: (f"{r.model.name}_slow_flow.py", f"{r.model.name}_s
                    lambda flow, r: lower_slow_flow(flow, r.command))
 # NOTE: the slow flow's request carries the user's models.Oscillator as its model.
 MATHIEU = Target(_mathieu_files, _mathieu_derive, _mathieu_lower)
+TONGUE = Target(lambda r: (f"tongue_{r.tongue[1]}.py",), _tongue_derive, _tongue_lower)
 
 
 # --- driven: one method at one order at one ω ---------------------------------------------------
