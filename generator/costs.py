@@ -369,6 +369,10 @@ TONGUES_FIT = (0.5, 0.4, 100, 3.0)
 # NOTE: `lindstedt tongues`: both curves of p = cos t at order 100 in 0.35 s; the harmonics of
 # x_k grow with p's highest harmonic h, the cost as h^2.5 (2.2 s for h = 2 at order 100).
 
+TONGUE_EMIT_SECONDS = 6.0
+# NOTE: `tongues --emit`: per curve 24 Floquet boundaries at 4096 and 8192 RK4 steps (brentq)
+# and the numba compilation on import: 5.4 s for p = cos t + cos 2t/2, n = 1, order 30.
+
 
 def tongues_cost(args: argparse.Namespace) -> Cost:
     from .hill import fourier_of_text
@@ -379,6 +383,8 @@ def tongues_cost(args: argparse.Namespace) -> Cost:
         seconds *= 2
     if args.plot:
         seconds += INCE_STRUTT_SECONDS
+    if getattr(args, "emit", None) is not None:
+        seconds += TONGUE_EMIT_SECONDS
     return Cost(seconds, f"order {args.order}, harmonic {top}", "the transition curves")
 
 

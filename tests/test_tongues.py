@@ -229,3 +229,76 @@ def test_the_curves_radius_is_mathieus(capsys):
     for curve in json.loads(capsys.readouterr().out)["curves"]:
         (row,) = curve["singularities"]
         assert row["variable"] == "eps" and abs(row["radius"] / (3.7699574940 / 2) - 1) < 1e-3
+
+
+EMIT_P = "cos(t) + 1/2*cos(2*t)"
+EMIT_ARGS = ["tongues", EMIT_P, "--n", "1", "--order", "30", "--emit"]
+
+
+@pytest.fixture(scope="module")
+def emitted(tmp_path_factory):
+    """``tongues P --n 1 --order 30 --emit DIR``, twice into two folders, and the module."""
+    from lindstedt.emit import load_generated
+
+    first, again = tmp_path_factory.mktemp("tongue"), tmp_path_factory.mktemp("again")
+    assert main([*EMIT_ARGS, str(first)]) == 0 and main([*EMIT_ARGS, str(again)]) == 0
+    return first, again, load_generated(first / "tongue_1.py")
+
+
+def boundary(p, eps: float, near: float) -> float:
+    """|tr M| = 2 by brentq next to ``near`` (compiled RK4 at 8192 steps: ~1e-13 in δ)."""
+    def margin(delta):
+        return abs(float(floquet_traces(delta, eps, p, steps=8192)[0])) - 2
+
+    return brentq(margin, near - 1e-6, near + 1e-6, xtol=1e-15)
+
+
+def test_the_emitted_curves_are_the_floquet_boundary_past_the_radius(emitted):
+    """delta_0, delta_1 against brentq on |tr M| − 2 between and at the verified grid points,
+    to 2e-10; curve 0 past its radius (~1.33), where the partial sum is off by > 1e-3."""
+    _, _, mod = emitted
+    p = harmonics(EMIT_P)
+    tongue = transition_curves(EMIT_P, 1, 30)
+    assert mod.LIMIT_0 > 2.0 and mod.LIMIT_1 > 1.5
+    for i, curve in enumerate(tongue.curves):
+        f, limit = getattr(mod, f"delta_{i}"), getattr(mod, f"LIMIT_{i}")
+        for eps in (0.3, 1.0, 1.5, limit):
+            got = float(f(eps))
+            assert abs(got - boundary(p, eps, got)) < 2e-10, (i, eps)
+            assert 0 <= float(getattr(mod, f"delta_{i}_error")(eps)) < 1e-8, (i, eps)
+    got = float(mod.delta_0(2.0))
+    truth = boundary(p, 2.0, got)
+    assert abs(value(tongue.curves[0].delta, 2.0) - truth) > 1e-3  # the series is useless here
+    assert abs(got - truth) < 2e-10
+
+
+def test_the_emitted_curves_are_nan_beyond_the_verified_eps(emitted):
+    _, _, mod = emitted
+    outside = np.array([-0.1, mod.LIMIT_0 * 1.001, 50.0, np.nan, np.inf, -np.inf, 1e308])
+    with np.errstate(all="raise"):
+        for name in ("delta_0", "delta_1", "delta_0_error", "delta_1_error"):
+            assert np.isnan(getattr(mod, name)(outside)).all(), name
+    assert math.isnan(mod.delta_1(mod.LIMIT_1 * 1.001)) and math.isfinite(mod.delta_1(0.0))
+
+
+def test_the_emitted_module_is_byte_identical_on_rerun(emitted):
+    first, again, _ = emitted
+    text = (first / "tongue_1.py").read_bytes()
+    assert text == (again / "tongue_1.py").read_bytes()
+    assert b"cos(t) + 1/2*cos(2*t)" in text and b"def delta_1_error(eps)" in text
+
+
+def test_emit_refuses_in_one_line(tmp_path):
+    """A foreign file in the way, a bad P, a too low order: exit 2, one line, nothing written."""
+    (tmp_path / "tongue_1.py").write_text("mine\n")
+    for args in ([*EMIT_ARGS, str(tmp_path)],
+                 ["tongues", "cos(sqrt(2)*t)", "--emit", str(tmp_path / "new")],
+                 ["tongues", "cos(t)", "--order", "8", "--emit", str(tmp_path / "new")],
+                 ["tongues", "cos(t)", "--emit", " "]):
+        done = subprocess.run([sys.executable, "-m", "lindstedt", *args],
+                              capture_output=True, text=True, check=False)
+        assert done.returncode == 2 and done.stdout == "", args
+        assert done.stderr.count("\n") == 1 and done.stderr.startswith("lindstedt: error:"), \
+            (args, done.stderr)
+    assert (tmp_path / "tongue_1.py").read_text() == "mine\n"
+    assert not (tmp_path / "new").exists()
