@@ -663,12 +663,13 @@ TONGUE_GRID = 24
 # radii no near-diagonal Padé of an order-30 series holds 1e-10, and 24 points keep the
 # generation to seconds.
 TONGUE_BRACKET = 1e-4
-# NOTE: the boundary is searched within ±1e-4 of the Padé value; no crossing there is a miss.
+# NOTE: the boundary is searched within ±1e-4 of the Padé value, and within half the distance
+# to the other curve (the curves of tongue n split at ε^n only); no crossing there is a miss.
 
 
 def floquet_boundary(p: dict[int, tuple[float, float]], eps: float, near: float,
-                     steps: int) -> float:
-    """The δ within ``TONGUE_BRACKET`` of ``near`` where ``|tr M| = 2`` at ``eps`` (brentq on
+                     steps: int, bracket: float = TONGUE_BRACKET) -> float:
+    """The δ within ``bracket`` of ``near`` where ``|tr M| = 2`` at ``eps`` (brentq on
     :func:`numerics.floquet_traces`), NaN if none crosses there."""
     from scipy.optimize import brentq
 
@@ -677,7 +678,7 @@ def floquet_boundary(p: dict[int, tuple[float, float]], eps: float, near: float,
     def margin(delta: float) -> float:
         return abs(float(floquet_traces(delta, eps, p, steps=steps)[0])) - 2
 
-    lo, hi = near - TONGUE_BRACKET, near + TONGUE_BRACKET
+    lo, hi = near - bracket, near + bracket
     if not margin(lo) * margin(hi) < 0:
         return float("nan")
     return brentq(margin, lo, hi, xtol=1e-15)
@@ -696,27 +697,33 @@ def resum_tongue(text: str, n: int, order: int, tolerance: float = TONGUE_TOLERA
 
     harmonics = fourier_of_text(text)
     p = {k: (float(a), float(b)) for k, (a, b) in harmonics.items()}
-    curves = []
-    for curve in transition_curves(harmonics, n, order).curves:
+    series = transition_curves(harmonics, n, order).curves
+    tops, forms = [], []
+    for curve in series:
         est = nearest_singularity(list(curve.delta), "eps", None)
         radius = (math.sqrt(est.radius) if est.variable == "eps**2" else est.radius
                   ) if est else TONGUE_RANGE
-        top = min(TONGUE_RADII * radius, TONGUE_RANGE)
-        form = resum_series(list(curve.delta), top)
+        tops.append(min(TONGUE_RADII * radius, TONGUE_RANGE))
+        forms.append(resum_series(list(curve.delta), tops[-1]))
+    curves = []
+    for i, (curve, top, form) in enumerate(zip(series, tops, forms, strict=True)):
         grid = np.linspace(0.0, top, TONGUE_GRID + 1)[1:]
         limit, worst = 0.0, 0.0
         for eps in grid:
             value = float(form(eps))
-            ref = floquet_boundary(p, float(eps), value, TONGUE_STEPS)
-            finer = floquet_boundary(p, float(eps), value, 2 * TONGUE_STEPS)
+            gaps = [abs(float(other(eps)) - value) / 2 for j, other in enumerate(forms) if j != i]
+            bracket = min([TONGUE_BRACKET, *gaps])
+            ref = floquet_boundary(p, float(eps), value, TONGUE_STEPS, bracket)
+            finer = floquet_boundary(p, float(eps), value, 2 * TONGUE_STEPS, bracket)
             error = abs(value - finer)
             if not (abs(ref - finer) <= tolerance / 10 and error <= tolerance):
                 break
             limit, worst = round(float(eps), 12), max(worst, error)
         if limit == 0.0:
             raise InputError(f"tongue {n} of p(t) = {text!r}, curve {curve.label}: the "
-                             f"resummed series misses {tolerance:g} already at eps = "
-                             f"{grid[0]:g}; raise --order")
+                             f"resummed series misses the Floquet boundary by more than "
+                             f"{tolerance:g} already at eps = {grid[0]:g}; raise --order (or "
+                             "the curves coincide: a closed tongue)")
         curves.append(ResummedCurve(curve.label, form, limit, worst))
     return ResummedTongue(text, n, order, tolerance, tuple(curves))
 
