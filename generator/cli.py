@@ -330,6 +330,12 @@ def _cmd_tongues(args: argparse.Namespace) -> int:
     if args.emit is not None:
         from . import compiler
 
+        others = [flag for flag, given in (("--at", args.at is not None), ("--tol", args.tol),
+                                           ("--damping", args.damping is not None),
+                                           ("--plot", args.plot), ("--json", args.json),
+                                           ("--singularities", args.singularities)) if given]
+        if others:
+            raise InputError(f"--emit writes the module only: drop {', '.join(others)}")
         for path in compiler.generate_tongue(args.p, args.n, args.order,
                                              _out_folder(args.emit, "--emit"),
                                              overwrite_edited=args.overwrite_edited):

@@ -295,7 +295,8 @@ def test_emit_refuses_in_one_line(tmp_path):
     for args in ([*EMIT_ARGS, str(tmp_path)],
                  ["tongues", "cos(sqrt(2)*t)", "--emit", str(tmp_path / "new")],
                  ["tongues", "cos(t)", "--order", "8", "--emit", str(tmp_path / "new")],
-                 ["tongues", "cos(t)", "--emit", " "]):
+                 ["tongues", "cos(t)", "--emit", " "],
+                 ["tongues", "cos(t)", "--at", "0.1", "--emit", str(tmp_path / "new")]):
         done = subprocess.run([sys.executable, "-m", "lindstedt", *args],
                               capture_output=True, text=True, check=False)
         assert done.returncode == 2 and done.stdout == "", args
@@ -303,3 +304,18 @@ def test_emit_refuses_in_one_line(tmp_path):
             (args, done.stderr)
     assert (tmp_path / "tongue_1.py").read_text() == "mine\n"
     assert not (tmp_path / "new").exists()
+
+
+def test_an_even_curve_is_emitted_in_eps_squared(tmp_path):
+    """p = cos t, n = 0 (a_0(−2ε)/4, even in ε): Padé in ε², NaN only for |ε| beyond the
+    limit, and equal to the Floquet boundary at ±ε past the radius of a_0 (|q| ≈ 1.4688)."""
+    from lindstedt.emit import load_generated
+
+    assert main(["tongues", "cos(t)", "--n", "0", "--order", "30", "--emit", str(tmp_path)]) == 0
+    mod = load_generated(tmp_path / "tongue_0.py")
+    assert mod.SYMMETRIC_0 and mod.LIMIT_0 > 1.4688 / 2
+    eps = 0.99 * mod.LIMIT_0
+    got = float(mod.delta_0(-eps))
+    assert got == float(mod.delta_0(eps))
+    assert abs(got - boundary({1: (1.0, 0.0)}, -eps, got)) < 2e-10
+    assert math.isnan(mod.delta_0(-1.01 * mod.LIMIT_0)) and not hasattr(mod, "delta_1")
