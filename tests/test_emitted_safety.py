@@ -431,12 +431,15 @@ def domain_findings(mod, names: tuple[str, ...], skip: frozenset = frozenset()) 
 @pytest.fixture(scope="module")
 def newer_modules(tmp_path_factory):
     """The modules emitted on request: the damped μ-expansion (order 2), van der Pol's cycle
-    with its resummed evaluators (order 3), Mathieu's a₁ and van der Pol's slow flow."""
+    with its resummed evaluators (order 3), Mathieu's a₁, van der Pol's slow flow and the
+    transition curves of a two-harmonic p (order 12)."""
     out = tmp_path_factory.mktemp("newer")
     for args in (["generate", "driven", "--damped", "--order", "2"],
                  ["generate", "van_der_pol", "--order", "3"],
                  ["mathieu", "a", "--m", "1", "--order", "8", "--emit", str(out)],
-                 ["slowflow", "van_der_pol", "--name", "vdp", "--out", str(out)]):
+                 ["slowflow", "van_der_pol", "--name", "vdp", "--out", str(out)],
+                 ["tongues", "cos(t) + 1/2*cos(2*t)", "--n", "1", "--order", "12", "--emit",
+                  str(out)]):
         if args[0] == "generate":
             args = [*args, "--out", str(out)]
         made = subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
@@ -444,7 +447,8 @@ def newer_modules(tmp_path_factory):
         assert made.returncode == 0, made.stderr
     from lindstedt.emit import load_generated
     return {name: load_generated(out / f"{name}.py")
-            for name in ("driven_damped", "van_der_pol", "mathieu_a1", "vdp_slow_flow")}
+            for name in ("driven_damped", "van_der_pol", "mathieu_a1", "vdp_slow_flow",
+                         "tongue_1")}
 
 
 def test_damped_module_is_nan_without_a_warning_outside_its_domain(newer_modules):
@@ -476,6 +480,15 @@ def test_resummed_and_mathieu_evaluators_are_nan_without_a_warning(newer_modules
     found = domain_findings(vdp, resummed)
     found += domain_findings(newer_modules["mathieu_a1"], ("a1", "a1_error"))
     assert not found, "\n".join(found[:40])
+
+
+def test_tongue_evaluators_are_nan_without_a_warning(newer_modules):
+    """The emitted transition curves δ_i(ε) and their error estimates: the same rules."""
+    mod = newer_modules["tongue_1"]
+    names = tuple(sorted(n[:-5] for n in vars(mod) if n.endswith("_into")
+                         and not n.startswith("_")))
+    assert names == ("delta_0", "delta_0_error", "delta_1", "delta_1_error")
+    assert not (found := domain_findings(mod, names)), "\n".join(found[:40])
 
 
 def test_slow_flow_kernels_are_nan_for_nan_and_refuse_what_they_cannot_read(newer_modules):
