@@ -146,7 +146,7 @@ def oscillator_seconds(text: str, pairs: list[str] | None, order: int) -> float:
             return power_law(*SERIES_COSTS["pendulum"], order)
         return power_law(*SERIES_COSTS["oscillator"], order)
     poly = sp.Poly(force, q, v)
-    if any(b % 2 for _, b in poly.monoms()):  # odd in q': its limit cycles
+    if _has_odd_velocity(poly):  # its limit cycles
         return power_law(*LIMIT_CYCLE_FIT, order)
     degree = max(1, poly.total_degree())
     scale = max(1.0, ((degree - 1) / 2) ** 3)
@@ -159,6 +159,42 @@ def oscillator_seconds(text: str, pairs: list[str] | None, order: int) -> float:
         return 0.9 + power_law(*SYMBOLIC_FIT, order) * 1.5 ** (symbols - 1) * scale
     fixed, *fit = SERIES_COSTS["duffing"]
     return fixed + power_law(0.0, *fit, order) * scale
+
+
+def _has_odd_velocity(poly: object) -> bool:
+    """A term odd in q': the oscillator is self-excited (``series`` derives its limit cycles)."""
+    return any(b % 2 for _, b in poly.monoms())
+
+
+def limit_cycle_text(model: str) -> str | None:
+    """The equation of ``model`` (a registry name or a user's text) when its force is a
+    polynomial with a term odd in q' (a limit cycle's), else None; unparsable text is None
+    (the command's own parse reports it)."""
+    import sympy as sp
+
+    from .equation import parse_equation
+    from .errors import InputError
+    from .models import registry_entry
+
+    entry = registry_entry(model) if model.isidentifier() else None
+    text = entry.equation if entry else model
+    try:
+        eq = parse_equation(text)
+    except InputError:
+        return None
+    q, v, a = eq.derivatives
+    force = sp.expand(eq.expression.xreplace({a: 0}))
+    if not force.is_polynomial(q, v):
+        return None
+    return text if _has_odd_velocity(sp.Poly(force, q, v)) else None
+
+
+CYCLE_CHECKS = 25.0
+# NOTE: `generate` of a limit cycle derives its series to at least methods.RADIUS_ORDER and
+# shoots the cycle (DOP853) at the resummed evaluators' check points (methods.resum_cycle):
+# 24 s and 26 s wall at orders 12 and 58 (load 2–3), everything but the derivation.  The
+# verified range and so the checks grow with the order (ε ≤ 2.98 from order 60, 5.18 from 128,
+# where a run took 337 s at load 7): scaled by (order/60)².
 
 
 def series_cost(args: argparse.Namespace) -> Cost:
@@ -194,6 +230,13 @@ def generate_cost(args: argparse.Namespace) -> Cost:
     if args.model not in GENERATE_COSTS:  # a user's: its derivation, then Duffing's emission
         derivation = series_cost(argparse.Namespace(model=args.model, param=args.param,
                                                     order=size + 2)).seconds
+        if limit_cycle_text(args.model) is not None:
+            from .methods import RADIUS_ORDER
+
+            derived = max(size + 2, RADIUS_ORDER)
+            return Cost(power_law(*LIMIT_CYCLE_FIT, derived)
+                        + CYCLE_CHECKS * (derived / RADIUS_ORDER) ** 2, f"order {size}",
+                        "generating the limit cycle's evaluators")
         return Cost(derivation + generate_seconds("duffing", size), f"order {size}",
                     "generating the oscillator")
     if args.model == "driven" and getattr(args, "damped", False):

@@ -47,6 +47,9 @@ def test_every_command_but_the_demo_has_an_estimate_and_the_slow_ones_a_switch()
     (["sweep", "stability", "--omega", "0.5:1.5:40000", "--force", "0.3", "--eps", "0.1",
       "--Q", "20", "--store", "map.zarr"], "a grid of 40,000 points: about"),
     (["generate", "duffing", "--order", "120", "--out", "gen"], "order 120: about"),
+    # a limit cycle's evaluators: the series to ≥ 60 and the shooting checks, growing with K
+    (["generate", "vdp", "--order", "120", "--out", "gen"],
+     "generating the limit cycle's evaluators"),
 ])
 def test_a_long_command_is_refused_at_once_and_writes_nothing(tmp_path, args, needle):
     out = run(*args, cwd=tmp_path)
