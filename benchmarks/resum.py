@@ -186,7 +186,8 @@ def mathieu_part() -> tuple[np.ndarray, dict]:
     errors = {}
     print("\nMathieu, against numerics.mathieu_refined (30 digits) on 200 points of (0, 50], "
           "relative to max(1, |a|); ns per point on [0, min(5, verified q)], best of 5:")
-    print(f"{'':<6}{'SciPy max':>10}{'at q':>7}{'verified to q':>15}{'rows':>6}{'emitted max':>13}"
+    print(f"{'':<6}{'SciPy max':>10}{'at q':>7}{'verified to q':>15}{'Padé':>8}{'rows':>6}"
+          f"{'emitted max':>13}"
           f"{'SciPy there':>13}{'ufunc ns':>10}{'_into ns':>10}{'SciPy ns':>10}{'ratio':>8}")
     with tempfile.TemporaryDirectory() as folder:
         for kind, m in MATHIEU:
@@ -206,8 +207,9 @@ def mathieu_part() -> tuple[np.ndarray, dict]:
             into = best(lambda f_into=f_into, qs=qs, out=out: f_into(out, qs), 5) / qs.size * 1e9
             small = qs[:20_000]
             scipy_ns = best(lambda m=m, small=small, g=scipy_f: g(m, small), 5) / small.size * 1e9
+            degrees = "[{}/{}]".format(*mod.DEGREES)
             print(f"{kind}_{m:<4}{es.max():>10.1e}{q[np.argmax(es)]:>7.3g}{mod.LIMIT:>15.4g}"
-                  f"{mod.ROWS:>6}{np.nanmax(er[inside]):>13.1e}{es[inside].max():>13.1e}"
+                  f"{degrees:>8}{mod.ROWS:>6}{np.nanmax(er[inside]):>13.1e}{es[inside].max():>13.1e}"
                   f"{ufunc:>10.3g}{into:>10.3g}{scipy_ns:>10.3g}{scipy_ns / ufunc:>8.1f}")
             if (kind, m) in MATHIEU_DRAWN:
                 errors[f"SciPy {kind}_{m}"] = es

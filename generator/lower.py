@@ -524,7 +524,8 @@ def lower_mathieu(r: ResummedMathieu, command: str) -> Module:
     domain = (f"NaN outside {'|q|' if r.form.power == 2 else '0 ≤ q'} ≤ {r.limit:g}, where "
               f"it was verified to {r.tolerance:g}·max(1, |{name}|) against the eigenvalues "
               "of the recurrence's matrix at 30 digits")
-    method = (f"Padé [{L}/{M}] in {var} of the exact series to order {r.order}, then "
+    method = (f"Padé [{L}/{M}] in {var} of the exact series (of the Padé of its truncations "
+              f"to order ≤ {r.order}, the one of fewest degrees verified as far), then "
               f"{r.steps} Newton step(s) on the determinant of the recurrence's {r.rows} rows")
     evaluators = (
         Evaluator(name, f"Mathieu's {r.kind}_{r.m}(q) (DLMF 28.2): {method} ({domain}).",

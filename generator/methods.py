@@ -599,6 +599,40 @@ def mathieu_rows(kind: str, m: int, q: float, a: float) -> int:
     return rows
 
 
+MATHIEU_STARTS = (1.0, 0.75, 0.5, 0.4, 0.3, 0.2)
+# NOTE: the Padé start is a measured choice, not the user's order: the near-diagonal Padé of
+# the exact series truncated at ⌊f·order⌋ for each fraction f here is verified (Padé start
+# within MATHIEU_START_TOLERANCE, refined value within the tolerance, the same grid and rule);
+# the start kept is the one of fewest Padé degrees L + M whose limit is within one grid step
+# of the longest found (a tie → the higher order).  The ufunc's time is the start's Horner
+# pair and the Newton step's rows: for a_1 at order 100 the truncation at 50 ([21/29] in q)
+# holds to q = 4.75 at 27 ns per point, the [50/50] of the whole series only to 2.625 at 93 ns
+# (benchmarks/resum.py).
+
+
+def _mathieu_verified(kind: str, m: int, form: Resummed, grid, ref, scale, tolerance: float
+                      ) -> tuple[int, int, float]:
+    """How many grid points from the first one ``form`` then the Newton step hold (the Padé
+    start within ``MATHIEU_START_TOLERANCE``, the refined value within ``tolerance``), with
+    the rows used and the largest error there (0 points: no rows, NaN)."""
+    import numpy as np
+
+    from .numerics import mathieu_newton
+
+    start = form(grid)
+    ok = np.abs(start - ref) / scale <= MATHIEU_START_TOLERANCE
+    n = int(np.argmin(ok)) if not ok.all() else len(grid)
+    if n == 0:
+        return 0, 0, float("nan")
+    rows = 1 + max(mathieu_rows(kind, m, float(q), float(a)) for q, a in zip(grid[:n], ref[:n],
+                                                                             strict=True))
+    value = mathieu_newton(kind, m, grid[:n], start[:n], rows, MATHIEU_NEWTON_STEPS)
+    error = np.abs(value - ref[:n]) / scale[:n]
+    ok = error <= tolerance
+    n = int(np.argmin(ok)) if not ok.all() else n
+    return n, rows, float(error[:n].max()) if n else float("nan")
+
+
 def resum_mathieu(kind: str, m: int, order: int, tolerance: float = MATHIEU_TOLERANCE
                   ) -> ResummedMathieu:
     """Padé of Mathieu's exact series (:func:`hill.mathieu_series`, in q², or in q when it
@@ -607,33 +641,34 @@ def resum_mathieu(kind: str, m: int, order: int, tolerance: float = MATHIEU_TOLE
     grid points), verified on a dense grid of ``(0, 50]`` against
     :func:`numerics.mathieu_refined`: ``limit`` is the last grid point before the first
     where the Padé start misses ``MATHIEU_START_TOLERANCE`` or the refined value misses
-    ``tolerance``."""
+    ``tolerance``.  The start is the series truncated at one of ``MATHIEU_STARTS`` × ``order``
+    (the rule in its NOTE)."""
     import numpy as np
 
     from .hill import mathieu_series
-    from .numerics import mathieu_newton, mathieu_refined
+    from .numerics import mathieu_refined
 
-    form = resum_series(mathieu_series(kind, m, order), MATHIEU_RANGE)
+    series = mathieu_series(kind, m, order)
     grid = np.linspace(0.0, MATHIEU_RANGE, MATHIEU_GRID + 1)[1:]
     ref = np.array([float(mathieu_refined(kind, m, float(q))) for q in grid])
     scale = np.maximum(1.0, np.abs(ref))
-    start = form(grid)
-    ok = np.abs(start - ref) / scale <= MATHIEU_START_TOLERANCE
-    n = int(np.argmin(ok)) if not ok.all() else len(grid)
-    if n == 0:
-        raise InputError(f"{kind}_{m}, order {order}: the resummed series misses "
-                         f"{MATHIEU_START_TOLERANCE:g} already at q = {grid[0]:g}; raise --order")
-    rows = 1 + max(mathieu_rows(kind, m, float(q), float(a)) for q, a in zip(grid[:n], ref[:n],
-                                                                             strict=True))
-    value = mathieu_newton(kind, m, grid[:n], start[:n], rows, MATHIEU_NEWTON_STEPS)
-    error = np.abs(value - ref[:n]) / scale[:n]
-    ok = error <= tolerance
-    n = int(np.argmin(ok)) if not ok.all() else n
-    if n == 0:
-        raise InputError(f"{kind}_{m}, order {order}: the refined value misses "
-                         f"{tolerance:g} already at q = {grid[0]:g}")
-    return ResummedMathieu(kind, m, order, form, float(grid[n - 1]), tolerance,
-                           float(error[:n].max()), rows, MATHIEU_NEWTON_STEPS)
+    found = []
+    for k in sorted({int(f * order) for f in MATHIEU_STARTS}, reverse=True):
+        try:
+            form = resum_series(series[: k + 1], MATHIEU_RANGE)
+        except InputError:
+            continue
+        n, rows, checked = _mathieu_verified(kind, m, form, grid, ref, scale, tolerance)
+        if n:
+            found.append((sum(form.approximant.degrees), -k, n, rows, checked, form))
+    if not found:
+        raise InputError(f"{kind}_{m}, order {order}: no resummed start is within "
+                         f"{MATHIEU_START_TOLERANCE:g}, refined to {tolerance:g}, already at "
+                         f"q = {grid[0]:g}; raise --order")
+    longest = max(c[2] for c in found)
+    _, _, n, rows, checked, form = min(c for c in found if c[2] >= longest - 1)
+    return ResummedMathieu(kind, m, order, form, float(grid[n - 1]), tolerance, checked, rows,
+                           MATHIEU_NEWTON_STEPS)
 
 
 def _mathieu_files(r: Request) -> tuple[str, ...]:
