@@ -450,11 +450,11 @@ def sp_text(expr) -> str:
 def _cmd_slowflow(args: argparse.Namespace) -> int:
     """``lindstedt slowflow EQUATION|NAME --order K``: the averaged equations, exact."""
     from .averaging import slow_flow
-    from .models import REGISTRY, oscillator
+    from .models import oscillator, registry_entry
 
     text, name = args.model, args.name or "oscillator"
-    if text in REGISTRY:
-        text, name = REGISTRY[text].equation, args.name or text
+    if (entry := registry_entry(text)) is not None:  # a name or its alias (vdp)
+        text, name = entry.equation, args.name or entry.name
     out = _out_folder(args.out) if args.out is not None else None
     osc = oscillator(text, _params(args.param), name)
     flow = slow_flow(osc, args.order)

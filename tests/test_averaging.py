@@ -287,6 +287,8 @@ def test_cli_json_and_bad_input(capsys):
     assert sp.sympify(data["phase"][1], locals={"r": R}).subs(R, 2) == sp.Rational(-1, 16)
     assert data["cycles"] == [{"radius": ["2", "0"], "omega": ["1", "0", "-1/16"],
                                "stable_for": "eps > 0"}]
+    assert main(["slowflow", "vdp", "--order", "2", "--json"]) == 0  # the registry's alias
+    assert json.loads(capsys.readouterr().out) == data
     for bad in (["slowflow", "q'' + q**3 = 0"], ["slowflow", "van_der_pol", "--order", "9"],
                 ["slowflow", VDP, "--param", "zz=1"]):
         assert main(bad) == 2
