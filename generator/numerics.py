@@ -438,8 +438,7 @@ def shoot_table(table: ForceTable, force: float, omega: float, guess: np.ndarray
         return ShootingFailure("RK4 overflowed on the converged orbit", False, bound)
     Mono = end[2:].reshape(2, 2).T
     lam = np.linalg.eigvals(Mono)
-    stable = bool(np.all(np.abs(lam) < 1) if table.dissipative
-                  else abs(np.trace(Mono)) < 2)
+    stable = multipliers_stable(lam, table.dissipative)
     c = np.fft.rfft(qs) / len(qs)
     odd = table.odd
     A = {n: float(2 * c[n].real) for n in range(1, harmonics + 1, 2 if odd else 1)}
