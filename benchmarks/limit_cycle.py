@@ -9,11 +9,17 @@ every ``[ε^i]`` of ``q^n`` and ``(ω q')^n`` summed term by term (i Trig produc
 the order whose amplitude arrives late made again.  Both give the same ω, amplitude and q_j
 (checked before any time is printed, at every order both run).  Medians of ``--repeat`` runs,
 wall and process (CPU) time: on a shared machine the CPU time is the steadier one.
+
+The floor: the exact q_j grow by about 0.7 j² bits (their denominators are products of the
+primes ≤ j + 1 to powers that grow with j), so q to order K holds ~K⁴ bits; column "one q²"
+is one FLINT square of that whole q, packed (``square_floor``), which any exact method that
+forms q² must at least pay; "cpu / q²" is the derivation's cost in such squares.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import statistics
 import time
@@ -116,6 +122,34 @@ def term_by_term(model, order: int) -> tuple[list, list]:
             [g.to_fraction(a) if a else Fraction(0) for a in amplitude])
 
 
+def square_floor(lc) -> tuple[float, float]:
+    """CPU seconds of one square of the whole exact q (every q_j as integers over its own
+    denominator, packed in ε and the harmonic into one FLINT polynomial) and the size of q in
+    megabytes: a lower bound for the derivation, which forms q², (q²)(ωq'), ωq' and Wq''
+    online."""
+    from flint import fmpz_poly
+
+    stride = 2 * (max(max((*c, *s), default=0) for c, s in lc.q) + 1)
+    coeffs: list[int] = []
+    bits = 0
+    for cos, sin in lc.q:
+        values = list(cos.values()) + list(sin.values())
+        den = 1
+        for v in values:
+            den = den * v.denominator // math.gcd(den, v.denominator)
+        row = [0] * stride
+        for n, v in cos.items():
+            row[2 * n] = v.numerator * (den // v.denominator)
+        for n, v in sin.items():
+            row[2 * n + 1] = v.numerator * (den // v.denominator)
+        bits += sum(abs(x).bit_length() for x in row) + den.bit_length()
+        coeffs += row + [0] * stride  # room for the product's harmonics
+    packed = fmpz_poly(coeffs)
+    start = time.process_time()
+    packed * packed
+    return time.process_time() - start, bits / 8e6
+
+
 def timed(fn, repeat: int) -> tuple[float, float, object]:
     """Medians of wall and CPU seconds over ``repeat`` calls, and the last result."""
     walls, cpus = [], []
@@ -136,12 +170,14 @@ def main() -> None:
     args = ap.parse_args()
     model = self_excited_model(oscillator(VDP, name="van_der_pol"))
     print(f"load average at start: {os.getloadavg()[0]:.2f} (2 cores)")
-    print(f"{'order':>5} {'relaxed wall':>13} {'cpu':>8} {'term-by-term wall':>18} {'cpu':>8}"
-          f" {'ratio (cpu)':>12}")
+    print(f"{'order':>5} {'relaxed wall':>13} {'cpu':>8} {'q (MB)':>7} {'one q² cpu':>11}"
+          f" {'cpu / q²':>9} {'term-by-term wall':>18} {'cpu':>8} {'ratio (cpu)':>12}")
     for order in args.orders:
         repeat = args.repeat if order <= 164 else 1
         wall, cpu, lc = timed(lambda k=order: derive_limit_cycle(model, k), repeat)
-        row = f"{order:>5} {wall:>12.2f}s {cpu:>7.2f}s"
+        floor, size = square_floor(lc)
+        row = (f"{order:>5} {wall:>12.2f}s {cpu:>7.2f}s {size:>7.1f} {floor:>10.2f}s"
+               f" {cpu / floor:>8.1f}x")
         if order <= args.baseline_to:
             b_wall, b_cpu, (omega, amplitude) = timed(lambda k=order: term_by_term(model, k),
                                                       repeat)

@@ -2,7 +2,7 @@
 # model: driven, order: 3
 # command: lindstedt generate driven --order 3
 # inputs sha256: cef33ff01dffb2211c3af2d37365f7b8bff5e57c04ba6b53bf77b6cbbf023e34
-# body sha256: 40763e1ae3db0f60e30594a2336f04e17dedc3e55e2076e9d0e71a469449f8c8
+# body sha256: 93d6019b928b330c480bb19ce3d44273a7f17d4fd163bf8d66c6ecb48daf8644
 """Driven Duffing q'' + q + eps*q**3 = f cos(omega t): μ-expansion to order 3.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -156,7 +156,12 @@ def _sin(x):
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_1(omega, eps, force, branch):
     """Coefficient of cos 1ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
-    inside = ((1) if (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
+    inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
+    omega = ((omega) if (inside == 1) else (2))
+    eps = ((eps) if (inside == 1) else (0.1))
+    force = ((force) if (inside == 1) else (0.1))
+    branch = ((branch) if (inside == 1) else (0))
+    inside = ((1) if (inside == 1) and (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
     omega = ((omega) if (inside == 1) else (2))
     eps = ((eps) if (inside == 1) else (0.1))
     force = ((force) if (inside == 1) else (0.1))
@@ -202,7 +207,12 @@ def _A_1_into(out, omega_in, eps_in, force_in, branch_in):
         eps = _at(eps_in, i)
         force = _at(force_in, i)
         branch = _at(branch_in, i)
-        inside = ((1) if (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
+        inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
+        omega = ((omega) if (inside == 1) else (2))
+        eps = ((eps) if (inside == 1) else (0.1))
+        force = ((force) if (inside == 1) else (0.1))
+        branch = ((branch) if (inside == 1) else (0))
+        inside = ((1) if (inside == 1) and (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
         omega = ((omega) if (inside == 1) else (2))
         eps = ((eps) if (inside == 1) else (0.1))
         force = ((force) if (inside == 1) else (0.1))
@@ -261,7 +271,12 @@ def A_1_into(out, omega, eps, force, branch):
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_3(omega, eps, force, branch):
     """Coefficient of cos 3ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
-    inside = ((1) if (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
+    inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
+    omega = ((omega) if (inside == 1) else (2))
+    eps = ((eps) if (inside == 1) else (0.1))
+    force = ((force) if (inside == 1) else (0.1))
+    branch = ((branch) if (inside == 1) else (0))
+    inside = ((1) if (inside == 1) and (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
     omega = ((omega) if (inside == 1) else (2))
     eps = ((eps) if (inside == 1) else (0.1))
     force = ((force) if (inside == 1) else (0.1))
@@ -301,7 +316,12 @@ def _A_3_into(out, omega_in, eps_in, force_in, branch_in):
         eps = _at(eps_in, i)
         force = _at(force_in, i)
         branch = _at(branch_in, i)
-        inside = ((1) if (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
+        inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
+        omega = ((omega) if (inside == 1) else (2))
+        eps = ((eps) if (inside == 1) else (0.1))
+        force = ((force) if (inside == 1) else (0.1))
+        branch = ((branch) if (inside == 1) else (0))
+        inside = ((1) if (inside == 1) and (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
         omega = ((omega) if (inside == 1) else (2))
         eps = ((eps) if (inside == 1) else (0.1))
         force = ((force) if (inside == 1) else (0.1))
@@ -354,7 +374,12 @@ def A_3_into(out, omega, eps, force, branch):
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_5(omega, eps, force, branch):
     """Coefficient of cos 5ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
-    inside = ((1) if (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
+    inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
+    omega = ((omega) if (inside == 1) else (2))
+    eps = ((eps) if (inside == 1) else (0.1))
+    force = ((force) if (inside == 1) else (0.1))
+    branch = ((branch) if (inside == 1) else (0))
+    inside = ((1) if (inside == 1) and (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
     omega = ((omega) if (inside == 1) else (2))
     eps = ((eps) if (inside == 1) else (0.1))
     force = ((force) if (inside == 1) else (0.1))
@@ -383,7 +408,12 @@ def _A_5_into(out, omega_in, eps_in, force_in, branch_in):
         eps = _at(eps_in, i)
         force = _at(force_in, i)
         branch = _at(branch_in, i)
-        inside = ((1) if (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
+        inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
+        omega = ((omega) if (inside == 1) else (2))
+        eps = ((eps) if (inside == 1) else (0.1))
+        force = ((force) if (inside == 1) else (0.1))
+        branch = ((branch) if (inside == 1) else (0))
+        inside = ((1) if (inside == 1) and (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
         omega = ((omega) if (inside == 1) else (2))
         eps = ((eps) if (inside == 1) else (0.1))
         force = ((force) if (inside == 1) else (0.1))
@@ -425,7 +455,12 @@ def A_5_into(out, omega, eps, force, branch):
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_7(omega, eps, force, branch):
     """Coefficient of cos 7ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
-    inside = ((1) if (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
+    inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
+    omega = ((omega) if (inside == 1) else (2))
+    eps = ((eps) if (inside == 1) else (0.1))
+    force = ((force) if (inside == 1) else (0.1))
+    branch = ((branch) if (inside == 1) else (0))
+    inside = ((1) if (inside == 1) and (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
     omega = ((omega) if (inside == 1) else (2))
     eps = ((eps) if (inside == 1) else (0.1))
     force = ((force) if (inside == 1) else (0.1))
@@ -449,7 +484,12 @@ def _A_7_into(out, omega_in, eps_in, force_in, branch_in):
         eps = _at(eps_in, i)
         force = _at(force_in, i)
         branch = _at(branch_in, i)
-        inside = ((1) if (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
+        inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
+        omega = ((omega) if (inside == 1) else (2))
+        eps = ((eps) if (inside == 1) else (0.1))
+        force = ((force) if (inside == 1) else (0.1))
+        branch = ((branch) if (inside == 1) else (0))
+        inside = ((1) if (inside == 1) and (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
         omega = ((omega) if (inside == 1) else (2))
         eps = ((eps) if (inside == 1) else (0.1))
         force = ((force) if (inside == 1) else (0.1))
@@ -486,7 +526,12 @@ def A_7_into(out, omega, eps, force, branch):
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def first_order(omega, eps, force, branch):
     """A₁ of the branch: a real root of (ω² − 1)A₁ − ¾εA₁³ + f = 0."""
-    inside = ((1) if (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
+    inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
+    omega = ((omega) if (inside == 1) else (2))
+    eps = ((eps) if (inside == 1) else (0.1))
+    force = ((force) if (inside == 1) else (0.1))
+    branch = ((branch) if (inside == 1) else (0))
+    inside = ((1) if (inside == 1) and (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
     omega = ((omega) if (inside == 1) else (2))
     eps = ((eps) if (inside == 1) else (0.1))
     force = ((force) if (inside == 1) else (0.1))
@@ -509,7 +554,12 @@ def _first_order_into(out, omega_in, eps_in, force_in, branch_in):
         eps = _at(eps_in, i)
         force = _at(force_in, i)
         branch = _at(branch_in, i)
-        inside = ((1) if (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
+        inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
+        omega = ((omega) if (inside == 1) else (2))
+        eps = ((eps) if (inside == 1) else (0.1))
+        force = ((force) if (inside == 1) else (0.1))
+        branch = ((branch) if (inside == 1) else (0))
+        inside = ((1) if (inside == 1) and (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
         omega = ((omega) if (inside == 1) else (2))
         eps = ((eps) if (inside == 1) else (0.1))
         force = ((force) if (inside == 1) else (0.1))

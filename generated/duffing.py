@@ -2,7 +2,7 @@
 # model: duffing, order: 12
 # command: lindstedt generate duffing --order 12
 # inputs sha256: 66ca4a0e4d6afa8046c93839a6f1efa563f457106a4ae4f18222a37b87ca56f2
-# body sha256: 183d576e0598b1658f3b0fa3e26940007132df5948b22c9eb27cdceb6bda6071
+# body sha256: 6a184b30eb75fbba86c6424a7a09d5eaedf88b679ca0a343db94a84ffedd4ba6
 """q'' + q + eps*q**3 = 0: L–P evaluators to order 12 in x = eps*A**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -235,8 +235,14 @@ def _sin(x):
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def omega(A, eps):
     """Frequency ω to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
+    inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
+    A = ((A) if (inside == 1) else (0.1))
+    eps = ((eps) if (inside == 1) else (0.1))
+    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) else (0))
+    A = ((A) if (inside == 1) else (0.1))
+    eps = ((eps) if (inside == 1) else (0.1))
     x = A**2*eps
-    if not ((x > -1) and (abs(x) < 1)):
+    if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
         return math.nan
     return x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + 0.011320983991026878) - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + 0.03955078125) - 0.08203125) + 0.375) + 1
 
@@ -249,8 +255,14 @@ def _omega_into(out, A_in, eps_in):
     for i in range(out.size):
         A = _at(A_in, i)
         eps = _at(eps_in, i)
+        inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
+        A = ((A) if (inside == 1) else (0.1))
+        eps = ((eps) if (inside == 1) else (0.1))
+        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) else (0))
+        A = ((A) if (inside == 1) else (0.1))
+        eps = ((eps) if (inside == 1) else (0.1))
         x = A**2*eps
-        if not ((x > -1) and (abs(x) < 1)):
+        if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
         out[i] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + 0.011320983991026878) - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + 0.03955078125) - 0.08203125) + 0.375) + 1
@@ -275,8 +287,14 @@ def omega_into(out, A, eps):
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def period(A, eps):
     """Period T = 2π Σ τ_j y^j to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
+    inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
+    A = ((A) if (inside == 1) else (0.1))
+    eps = ((eps) if (inside == 1) else (0.1))
+    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) else (0))
+    A = ((A) if (inside == 1) else (0.1))
+    eps = ((eps) if (inside == 1) else (0.1))
     x = A**2*eps
-    if not ((x > -1) and (abs(x) < 1)):
+    if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
         return math.nan
     return 2*math.pi*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) - 0.0651973094791174) + 0.07641269266605377) - 0.09219503402709961) + 0.11575698852539062) - 0.15380859375) + 0.22265625) - 0.375) + 1)
 
@@ -289,8 +307,14 @@ def _period_into(out, A_in, eps_in):
     for i in range(out.size):
         A = _at(A_in, i)
         eps = _at(eps_in, i)
+        inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
+        A = ((A) if (inside == 1) else (0.1))
+        eps = ((eps) if (inside == 1) else (0.1))
+        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) else (0))
+        A = ((A) if (inside == 1) else (0.1))
+        eps = ((eps) if (inside == 1) else (0.1))
         x = A**2*eps
-        if not ((x > -1) and (abs(x) < 1)):
+        if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
         out[i] = 2*math.pi*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) - 0.0651973094791174) + 0.07641269266605377) - 0.09219503402709961) + 0.11575698852539062) - 0.15380859375) + 0.22265625) - 0.375) + 1)
@@ -315,8 +339,16 @@ def period_into(out, A, eps):
 @vectorize(["float64(float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def q(t, A, eps):
     """q(t) with s = ωt, harmonics by the Chebyshev recurrence (NaN where no periodic orbit exists or beyond the radius of convergence)."""
+    inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(t) and not math.isinf(t)) else (0))
+    A = ((A) if (inside == 1) else (0.1))
+    eps = ((eps) if (inside == 1) else (0.1))
+    t = ((t) if (inside == 1) else (0))
+    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) and (abs(t) <= 1.0e+300) else (0))
+    A = ((A) if (inside == 1) else (0.1))
+    eps = ((eps) if (inside == 1) else (0.1))
+    t = ((t) if (inside == 1) else (0))
     x = A**2*eps
-    if not ((x > -1) and (abs(x) < 1)):
+    if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
         return math.nan
     w = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + 0.011320983991026878) - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + 0.03955078125) - 0.08203125) + 0.375) + 1
     s = t*w
@@ -347,8 +379,16 @@ def _q_into(out, t_in, A_in, eps_in):
         t = _at(t_in, i)
         A = _at(A_in, i)
         eps = _at(eps_in, i)
+        inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(t) and not math.isinf(t)) else (0))
+        A = ((A) if (inside == 1) else (0.1))
+        eps = ((eps) if (inside == 1) else (0.1))
+        t = ((t) if (inside == 1) else (0))
+        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) and (abs(t) <= 1.0e+300) else (0))
+        A = ((A) if (inside == 1) else (0.1))
+        eps = ((eps) if (inside == 1) else (0.1))
+        t = ((t) if (inside == 1) else (0))
         x = A**2*eps
-        if not ((x > -1) and (abs(x) < 1)):
+        if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
         w = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + 0.011320983991026878) - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + 0.03955078125) - 0.08203125) + 0.375) + 1
@@ -393,8 +433,16 @@ def q_into(out, t, A, eps):
 @vectorize(["float64(float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def qdot(t, A, eps):
     """dq/dt (NaN where no periodic orbit exists or beyond the radius of convergence)."""
+    inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(t) and not math.isinf(t)) else (0))
+    A = ((A) if (inside == 1) else (0.1))
+    eps = ((eps) if (inside == 1) else (0.1))
+    t = ((t) if (inside == 1) else (0))
+    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) and (abs(t) <= 1.0e+300) else (0))
+    A = ((A) if (inside == 1) else (0.1))
+    eps = ((eps) if (inside == 1) else (0.1))
+    t = ((t) if (inside == 1) else (0))
     x = A**2*eps
-    if not ((x > -1) and (abs(x) < 1)):
+    if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
         return math.nan
     w = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + 0.011320983991026878) - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + 0.03955078125) - 0.08203125) + 0.375) + 1
     s = t*w
@@ -438,8 +486,16 @@ def _qdot_into(out, t_in, A_in, eps_in):
         t = _at(t_in, i)
         A = _at(A_in, i)
         eps = _at(eps_in, i)
+        inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(t) and not math.isinf(t)) else (0))
+        A = ((A) if (inside == 1) else (0.1))
+        eps = ((eps) if (inside == 1) else (0.1))
+        t = ((t) if (inside == 1) else (0))
+        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) and (abs(t) <= 1.0e+300) else (0))
+        A = ((A) if (inside == 1) else (0.1))
+        eps = ((eps) if (inside == 1) else (0.1))
+        t = ((t) if (inside == 1) else (0))
         x = A**2*eps
-        if not ((x > -1) and (abs(x) < 1)):
+        if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
         w = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + 0.011320983991026878) - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + 0.03955078125) - 0.08203125) + 0.375) + 1
@@ -497,8 +553,14 @@ def qdot_into(out, t, A, eps):
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def error_estimate(A, eps):
     """Relative truncation error of period(), from the first omitted term |τ_{K+1} y^(K+1)| / (1 - |y|/R) over the truncated sum (inf from the radius R on: no bound there)."""
+    inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
+    A = ((A) if (inside == 1) else (0.1))
+    eps = ((eps) if (inside == 1) else (0.1))
+    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) else (0))
+    A = ((A) if (inside == 1) else (0.1))
+    eps = ((eps) if (inside == 1) else (0.1))
     x = A**2*eps
-    if not ((x > -1) and (abs(x) < 1)):
+    if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
         return math.nan
     T = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) - 0.0651973094791174) + 0.07641269266605377) - 0.09219503402709961) + 0.11575698852539062) - 0.15380859375) + 0.22265625) - 0.375) + 1
     return (((0.03473509559274875)*abs(x)**13/((1 - abs(x))*abs(T))) if (abs(x) < 1) else (math.inf))
@@ -512,8 +574,14 @@ def _error_estimate_into(out, A_in, eps_in):
     for i in range(out.size):
         A = _at(A_in, i)
         eps = _at(eps_in, i)
+        inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
+        A = ((A) if (inside == 1) else (0.1))
+        eps = ((eps) if (inside == 1) else (0.1))
+        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) else (0))
+        A = ((A) if (inside == 1) else (0.1))
+        eps = ((eps) if (inside == 1) else (0.1))
         x = A**2*eps
-        if not ((x > -1) and (abs(x) < 1)):
+        if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
         T = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) - 0.0651973094791174) + 0.07641269266605377) - 0.09219503402709961) + 0.11575698852539062) - 0.15380859375) + 0.22265625) - 0.375) + 1

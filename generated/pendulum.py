@@ -2,7 +2,7 @@
 # model: pendulum, order: 12
 # command: lindstedt generate pendulum --order 12
 # inputs sha256: 89790c3fd0e75fcdff47f37c71d07dae7a9aef7a774488dd064ce33f5d86074d
-# body sha256: 254edd658e27c3a1c80e49a84d94330d53e30d57345e7115c3798bd87d907b8b
+# body sha256: 1cd066e198870b547d93066a2934dfb3ef5281684e64a58160fd72b77a3828e0
 """theta'' + sin(theta) = 0: L–P evaluators to order 12 in theta0**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -235,8 +235,12 @@ def _sin(x):
 @vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def omega(theta0):
     """Frequency ω to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
+    inside = ((1) if (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
+    theta0 = ((theta0) if (inside == 1) else (0.1))
+    inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
+    theta0 = ((theta0) if (inside == 1) else (0.1))
     x = theta0**2
-    if not ((x < math.pi**2) and (abs(x) < math.pi**2)):
+    if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
         return math.nan
     return x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) - 9.840751922602837e-10) - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) - 3.1195746527777775e-05) + 0.0003255208333333333) - 0.0625) + 1
 
@@ -247,8 +251,12 @@ def _omega_into(out, theta0_in):
     theta0_in = _apart(theta0_in, out)
     for i in range(out.size):
         theta0 = _at(theta0_in, i)
+        inside = ((1) if (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
+        theta0 = ((theta0) if (inside == 1) else (0.1))
+        inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
+        theta0 = ((theta0) if (inside == 1) else (0.1))
         x = theta0**2
-        if not ((x < math.pi**2) and (abs(x) < math.pi**2)):
+        if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
             out[i] = math.nan
             continue
         out[i] = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) - 9.840751922602837e-10) - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) - 3.1195746527777775e-05) + 0.0003255208333333333) - 0.0625) + 1
@@ -272,8 +280,12 @@ def omega_into(out, theta0):
 @vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def period(theta0):
     """Period T = 2π Σ τ_j y^j to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
+    inside = ((1) if (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
+    theta0 = ((theta0) if (inside == 1) else (0.1))
+    inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
+    theta0 = ((theta0) if (inside == 1) else (0.1))
     x = theta0**2
-    if not ((x < math.pi**2) and (abs(x) < math.pi**2)):
+    if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
         return math.nan
     return 2*math.pi*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.225550505750492e-14)*x + 6.706433207421971e-13) + 7.286018609303663e-12) + 7.997964280393218e-11) + 8.893476960263209e-10) + 1.0054783016898737e-08) + 1.162356190273135e-07) + 1.3867625063268805e-06) + 1.735611567421565e-05) + 0.00023464626736111112) + 0.0035807291666666665) + 0.0625) + 1)
 
@@ -284,8 +296,12 @@ def _period_into(out, theta0_in):
     theta0_in = _apart(theta0_in, out)
     for i in range(out.size):
         theta0 = _at(theta0_in, i)
+        inside = ((1) if (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
+        theta0 = ((theta0) if (inside == 1) else (0.1))
+        inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
+        theta0 = ((theta0) if (inside == 1) else (0.1))
         x = theta0**2
-        if not ((x < math.pi**2) and (abs(x) < math.pi**2)):
+        if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
             out[i] = math.nan
             continue
         out[i] = 2*math.pi*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.225550505750492e-14)*x + 6.706433207421971e-13) + 7.286018609303663e-12) + 7.997964280393218e-11) + 8.893476960263209e-10) + 1.0054783016898737e-08) + 1.162356190273135e-07) + 1.3867625063268805e-06) + 1.735611567421565e-05) + 0.00023464626736111112) + 0.0035807291666666665) + 0.0625) + 1)
@@ -309,8 +325,14 @@ def period_into(out, theta0):
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def theta(t, theta0):
     """theta(t) with s = ωt, harmonics by the Chebyshev recurrence (NaN where no periodic orbit exists or beyond the radius of convergence)."""
+    inside = ((1) if (not math.isnan(t) and not math.isinf(t)) and (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
+    theta0 = ((theta0) if (inside == 1) else (0.1))
+    t = ((t) if (inside == 1) else (0))
+    inside = ((1) if (inside == 1) and (abs(t) <= 1.0e+300) and (abs(theta0) <= 1.0e+150) else (0))
+    theta0 = ((theta0) if (inside == 1) else (0.1))
+    t = ((t) if (inside == 1) else (0))
     x = theta0**2
-    if not ((x < math.pi**2) and (abs(x) < math.pi**2)):
+    if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
         return math.nan
     w = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) - 9.840751922602837e-10) - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) - 3.1195746527777775e-05) + 0.0003255208333333333) - 0.0625) + 1
     s = t*w
@@ -339,8 +361,14 @@ def _theta_into(out, t_in, theta0_in):
     for i in range(out.size):
         t = _at(t_in, i)
         theta0 = _at(theta0_in, i)
+        inside = ((1) if (not math.isnan(t) and not math.isinf(t)) and (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
+        theta0 = ((theta0) if (inside == 1) else (0.1))
+        t = ((t) if (inside == 1) else (0))
+        inside = ((1) if (inside == 1) and (abs(t) <= 1.0e+300) and (abs(theta0) <= 1.0e+150) else (0))
+        theta0 = ((theta0) if (inside == 1) else (0.1))
+        t = ((t) if (inside == 1) else (0))
         x = theta0**2
-        if not ((x < math.pi**2) and (abs(x) < math.pi**2)):
+        if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
             out[i] = math.nan
             continue
         w = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) - 9.840751922602837e-10) - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) - 3.1195746527777775e-05) + 0.0003255208333333333) - 0.0625) + 1
@@ -384,8 +412,14 @@ def theta_into(out, t, theta0):
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def thetadot(t, theta0):
     """dtheta/dt (NaN where no periodic orbit exists or beyond the radius of convergence)."""
+    inside = ((1) if (not math.isnan(t) and not math.isinf(t)) and (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
+    theta0 = ((theta0) if (inside == 1) else (0.1))
+    t = ((t) if (inside == 1) else (0))
+    inside = ((1) if (inside == 1) and (abs(t) <= 1.0e+300) and (abs(theta0) <= 1.0e+150) else (0))
+    theta0 = ((theta0) if (inside == 1) else (0.1))
+    t = ((t) if (inside == 1) else (0))
     x = theta0**2
-    if not ((x < math.pi**2) and (abs(x) < math.pi**2)):
+    if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
         return math.nan
     w = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) - 9.840751922602837e-10) - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) - 3.1195746527777775e-05) + 0.0003255208333333333) - 0.0625) + 1
     s = t*w
@@ -427,8 +461,14 @@ def _thetadot_into(out, t_in, theta0_in):
     for i in range(out.size):
         t = _at(t_in, i)
         theta0 = _at(theta0_in, i)
+        inside = ((1) if (not math.isnan(t) and not math.isinf(t)) and (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
+        theta0 = ((theta0) if (inside == 1) else (0.1))
+        t = ((t) if (inside == 1) else (0))
+        inside = ((1) if (inside == 1) and (abs(t) <= 1.0e+300) and (abs(theta0) <= 1.0e+150) else (0))
+        theta0 = ((theta0) if (inside == 1) else (0.1))
+        t = ((t) if (inside == 1) else (0))
         x = theta0**2
-        if not ((x < math.pi**2) and (abs(x) < math.pi**2)):
+        if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
             out[i] = math.nan
             continue
         w = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) - 9.840751922602837e-10) - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) - 3.1195746527777775e-05) + 0.0003255208333333333) - 0.0625) + 1
@@ -485,8 +525,12 @@ def thetadot_into(out, t, theta0):
 @vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def error_estimate(theta0):
     """Relative truncation error of period(), from the first omitted term |τ_{K+1} y^(K+1)| / (1 - |y|/R) over the truncated sum (inf from the radius R on: no bound there)."""
+    inside = ((1) if (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
+    theta0 = ((theta0) if (inside == 1) else (0.1))
+    inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
+    theta0 = ((theta0) if (inside == 1) else (0.1))
     x = theta0**2
-    if not ((x < math.pi**2) and (abs(x) < math.pi**2)):
+    if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
         return math.nan
     T = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.225550505750492e-14)*x + 6.706433207421971e-13) + 7.286018609303663e-12) + 7.997964280393218e-11) + 8.893476960263209e-10) + 1.0054783016898737e-08) + 1.162356190273135e-07) + 1.3867625063268805e-06) + 1.735611567421565e-05) + 0.00023464626736111112) + 0.0035807291666666665) + 0.0625) + 1
     return (((5.8202915552354634e-15)*abs(x)**13/((-abs(x)/math.pi**2 + 1)*abs(T))) if (abs(x) < math.pi**2) else (math.inf))
@@ -498,8 +542,12 @@ def _error_estimate_into(out, theta0_in):
     theta0_in = _apart(theta0_in, out)
     for i in range(out.size):
         theta0 = _at(theta0_in, i)
+        inside = ((1) if (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
+        theta0 = ((theta0) if (inside == 1) else (0.1))
+        inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
+        theta0 = ((theta0) if (inside == 1) else (0.1))
         x = theta0**2
-        if not ((x < math.pi**2) and (abs(x) < math.pi**2)):
+        if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
             out[i] = math.nan
             continue
         T = x*(x*(x*(x*(x*(x*(x*(x*(x*(x*(x*((6.225550505750492e-14)*x + 6.706433207421971e-13) + 7.286018609303663e-12) + 7.997964280393218e-11) + 8.893476960263209e-10) + 1.0054783016898737e-08) + 1.162356190273135e-07) + 1.3867625063268805e-06) + 1.735611567421565e-05) + 0.00023464626736111112) + 0.0035807291666666665) + 0.0625) + 1

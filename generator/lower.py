@@ -20,6 +20,7 @@ from fractions import Fraction
 
 import numpy as np
 import sympy as sp
+from sympy.logic.boolalg import BooleanFunction
 
 from . import __version__
 from .averaging import PHI as PHI_SLOW
@@ -273,12 +274,19 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     # ω₀ = 1 but for a user's linear frequency: ω = ω₀ Σ ω_j y^j, T = (2π/ω₀) Σ τ_j y^j
     omega = [m.frequency * g.to_sympy(c) for c in solution.omega[: order + 1]]
     tau = [g.to_sympy(c) / m.frequency for c in solution.period[: order + 1]]
+    params = tuple(args.values())
+    t = sp.Symbol("t")
     guard = m.orbit_condition.xreplace({sp.Symbol("Y"): x})
     radius = m.radius if m.radius is not None else estimated_radius(solution, to_args)
     if radius is not None and not allow_divergent:
         guard = sp.And(guard, sp.Abs(x) < radius)
-    prelude = ((x, y),)
-    params = tuple(args.values())
+    ranges = free_ranges(y, params)
+    flag = "inside" if "inside" not in user else "_inside"
+    entry, inside = argument_entry(ranges, flag)
+    prelude, guard_t = (*entry, (x, y)), guard
+    guard = sp.And(inside, guard)
+    entry, inside = argument_entry((*ranges, (t, sp.Abs(t) <= FREE_ARGUMENT_LIMIT, 0)), flag)
+    prelude_t, guard_t = (*entry, (x, y)), sp.And(inside, guard_t)
 
     top = max(max(qj) for qj in solution.q[: order + 1])
     harmonic = {
@@ -286,7 +294,6 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
         for n in range(top + 1)
     }
     harmonic = {n: h for n, h in harmonic.items() if h != 0}
-    t = sp.Symbol("t")
     cos_lines, cs, _ = harmonics(top, m.odd, s, sines=False)
     both_lines, _, ss = harmonics(top, m.odd, s, sines=True)
     name_of = identifier(str(m.coordinate))
@@ -307,12 +314,12 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
         Evaluator(
             name_of,
             f"{name_of}(t) with s = ωt, harmonics by the Chebyshev recurrence ({domain}).",
-            (t, *params), prelude, guard,
+            (t, *params), prelude_t, guard_t,
             ((w, horner(omega, x)), (s, w * t), *cos_lines),
             amplitude * sum(h * cs[n] for n, h in sorted(harmonic.items())),
         ),
         Evaluator(
-            f"{name_of}dot", f"d{name_of}/dt ({domain}).", (t, *params), prelude, guard,
+            f"{name_of}dot", f"d{name_of}/dt ({domain}).", (t, *params), prelude_t, guard_t,
             ((w, horner(omega, x)), (s, w * t), *both_lines),
             -amplitude * w * sum(n * h * ss[n] for n, h in sorted(harmonic.items())),
         ),
@@ -645,7 +652,12 @@ def lower_limit_cycle(lc: LimitCycle, command: str, order: int,
     if est is not None:
         radius = est.radius ** 0.5 if est.variable.endswith("**2") else est.radius
         radius = LIMIT_CYCLE_MARGIN * sp.Rational(repr(float(radius)))
-    guard = sp.Abs(eps) < radius if radius is not None else sp.true
+    # without a radius, |ε| ≤ 10^(300/(K+2)) keeps ε^(K+2) finite; q(t, ε) also needs t finite
+    within = sp.Abs(eps) < radius if radius is not None else \
+        sp.Abs(eps) <= sp.Float(10.0 ** (300 // (order + 2)))
+    entry, guard = argument_entry(((eps, within, 0),))
+    entry_t, guard_t = argument_entry(((eps, within, 0),
+                                       (t, sp.Abs(t) <= FREE_ARGUMENT_LIMIT, 0)))
     top = max(max((*cos, *sin), default=1) for cos, sin in lc.q[: order + 1])
     cos_lines, cs, ss = harmonics(top, False, s, sines=True)
 
@@ -668,17 +680,19 @@ def lower_limit_cycle(lc: LimitCycle, command: str, order: int,
     domain = ("NaN from 90 % of the estimated radius of convergence on"
               if radius is not None else "no radius estimate: no guard")
     args = (eps,)
+    entry = tuple(entry)
     evaluators = (
         Evaluator("omega", f"Frequency ω of the limit cycle to order {order} ({domain}).",
-                  args, (), guard, (), horner(omega, eps)),
-        Evaluator("period", f"Period 2π Σ τ_j ε^j to order {order} ({domain}).", args, (),
+                  args, entry, guard, (), horner(omega, eps)),
+        Evaluator("period", f"Period 2π Σ τ_j ε^j to order {order} ({domain}).", args, entry,
                   guard, (), 2 * sp.pi * horner(tau, eps)),
-        Evaluator("amplitude", f"q(0) at q̇(0) = 0, to order {order} ({domain}).", args, (),
-                  guard, (), horner(amp, eps)),
-        Evaluator("q", f"q(t) on the cycle, q̇(0) = 0, s = ωt ({domain}).", (t, eps), (),
-                  guard, ((w, horner(omega, eps)), (s, w * t), *cos_lines), q_value),
+        Evaluator("amplitude", f"q(0) at q̇(0) = 0, to order {order} ({domain}).", args,
+                  entry, guard, (), horner(amp, eps)),
+        Evaluator("q", f"q(t) on the cycle, q̇(0) = 0, s = ωt ({domain}).", (t, eps),
+                  tuple(entry_t), guard_t,
+                  ((w, horner(omega, eps)), (s, w * t), *cos_lines), q_value),
         Evaluator("error_estimate", "Relative truncation error of period(): its first two "
-                  "omitted terms over the sum.", args, (), guard,
+                  "omitted terms over the sum.", args, entry, guard,
                   ((total, horner(tau, eps)),), estimate),
     )
     m = lc.model
@@ -834,18 +848,57 @@ DAMPED_STAND_IN = (2, sp.Rational(1, 10), sp.Rational(1, 10), 1)
 # NOTE: ω, ε, f, Q far above resonance: one branch, no fold, every step finite and quiet.
 
 
-def argument_entry(arguments: tuple[tuple[sp.Symbol, sp.Basic, object], ...]
-                   ) -> tuple[list[Assign], sp.Basic]:
-    """Assignments that replace every argument by its stand-in unless every argument meets its
-    condition (false for NaN: comparisons with NaN are), and the condition the guard adds (a
-    flag ``inside``, 1 or 0): outside, the evaluator computes at the stand-in point, where
-    every step is finite, and returns NaN — no floating-point flag is raised on the way."""
-    flag = sp.Symbol("inside")
-    inside = sp.And(*(cond for _, cond, _ in arguments))
-    steps: list[Assign] = [(flag, sp.Piecewise((sp.Integer(1), inside), (sp.Integer(0), True)))]
-    for v, _, safe in arguments:
-        steps.append((v, sp.Piecewise((v, sp.Eq(flag, 1)), (safe, True))))
+FREE_ARGUMENT_LIMIT = sp.Float(1e300)
+# NOTE: a finite argument passes (NaN and ±inf fail the comparison); t = ±inf would make
+# cos(ωt) invalid, a floating-point warning from the ufunc, before the guard.
+
+
+def free_ranges(y: sp.Expr, params: tuple[sp.Symbol, ...]
+                ) -> tuple[tuple[sp.Symbol, sp.Basic, object], ...]:
+    """:func:`argument_entry`'s ranges for a free oscillator's parameters: each at most
+    ``10^(300/d)`` in magnitude, ``d`` the total degree of the expansion variable ``y`` in them
+    (ε A² → 1e100), so ``y`` cannot overflow before the guard; the stand-in is 1/10 for each."""
+    try:
+        degree = max(sp.Poly(y, *params).total_degree(), 1)
+    except sp.PolynomialError:
+        degree = 6
+    bound = sp.Float(10.0 ** (300 // degree))
+    return tuple((p, sp.Abs(p) <= bound, sp.Rational(1, 10)) for p in params)
+
+
+def argument_entry(arguments: tuple[tuple[sp.Symbol, sp.Basic, object], ...],
+                   flag: str = "inside") -> tuple[list[Assign], sp.Basic]:
+    """Assignments that replace every argument by its stand-in unless every argument is finite
+    and meets its condition, and the condition the guard adds (a flag ``inside``, 1 or 0):
+    outside, the evaluator computes at the stand-in point, where every step is finite, and
+    returns NaN — no floating-point flag is raised on the way.
+
+    Two passes: :class:`Finite` first (a quiet test), so that the conditions' ordered
+    comparisons never see a NaN — LLVM may compile them branch-free to a signalling compare,
+    which raises "invalid" for NaN even where a branch would have skipped it."""
+    flag = sp.Symbol(flag)
+    steps: list[Assign] = []
+    for inside in (sp.And(*(Finite(v) for v, _, _ in arguments)),
+                   sp.And(*(cond for _, cond, _ in arguments))):
+        if steps:
+            inside = sp.And(sp.Eq(flag, 1), inside)
+        steps.append((flag, sp.Piecewise((sp.Integer(1), inside), (sp.Integer(0), True))))
+        for v, _, safe in arguments:
+            steps.append((v, sp.Piecewise((v, sp.Eq(flag, 1)), (safe, True))))
     return steps, sp.Eq(flag, 1)
+
+
+class Finite(BooleanFunction):
+    """True for a finite number; printed as a quiet test (no "invalid" for NaN, unlike an
+    ordered comparison, nor for ±inf, unlike numba's ``math.isfinite``)."""
+
+    nargs = 1
+
+    @classmethod
+    def eval(cls, arg: sp.Expr) -> sp.Basic | None:
+        if arg.is_number:
+            return sp.true if arg.is_finite else sp.false
+        return None
 
 
 def damped_entry(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol, Q: sp.Symbol,

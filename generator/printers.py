@@ -33,6 +33,12 @@ class NumbaPrinter(PythonCodePrinter):
     def _print_Half(self, expr: sp.Rational) -> str:
         return "0.5"
 
+    def _print_Finite(self, expr: sp.Basic) -> str:
+        # lower.Finite: isnan and isinf are quiet tests; numba's isfinite computes x − x, which
+        # raises "invalid" for ±inf
+        v = self._print(expr.args[0])
+        return f"(not math.isnan({v}) and not math.isinf({v}))"
+
 
 class SimdPrinter(NumbaPrinter):
     """:class:`NumbaPrinter` with ``cos``/``sin`` as the generated module's branch-free

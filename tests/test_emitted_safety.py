@@ -388,7 +388,8 @@ def test_numba_ufunc_strided_out_stays_in_the_view():
 SPECIAL = (math.nan, math.inf, -math.inf, 0.0, -0.0, -1.0, 0.5, 3.0, 1e-300, 1e300, -1e300)
 # NOTE: NaN and ±inf, zero of either sign, a negative, a fraction and an integer past every
 # branch index, and magnitudes that overflow or underflow a square.
-DOMAIN_GOOD = {"eps": 0.1, "omega": 1.2, "force": 0.3, "Q": 20.0, "branch": 0.0, "q": 1.0}
+DOMAIN_GOOD = {"eps": 0.1, "omega": 1.2, "force": 0.3, "Q": 20.0, "branch": 0.0, "q": 1.0,
+               "A": 0.5, "theta0": 0.5, "t": 1.3}
 INFINITE_IN_DOMAIN = {("Q", math.inf)}  # the undamped oscillator
 
 
@@ -523,3 +524,25 @@ def test_undamped_driven_module_is_nan_without_a_warning_outside_its_domain():
     found = domain_findings(mod, names, frozenset({("eps", 1e-300)}))
     assert not found, "\n".join(found[:40])
     assert math.isnan(mod.A_1(0.0, 0.1, 0.3, 0)) and math.isnan(mod.A_3(1e-300, 0.1, 0.3, 0))
+
+
+def test_free_and_limit_cycle_modules_are_nan_without_a_warning(newer_modules):
+    """The committed L–P modules (Duffing, pendulum) and van der Pol's cycle: t = ±inf made
+    cos(ωt) invalid and A = 1e300 overflowed εA² before the guard; every argument now passes a
+    quiet finiteness test and a magnitude bound first, and the answer there is NaN, quietly."""
+    from lindstedt.emit import load_generated
+
+    found = []
+    for mod in (load_generated(GENERATED / "duffing.py"), load_generated(GENERATED / "pendulum.py"),
+                newer_modules["van_der_pol"]):
+        names = tuple(sorted(n[:-5] for n in vars(mod) if n.endswith("_into")
+                             and not n.startswith("_") and "resummed" not in n))
+        assert len(names) == 5, names
+        found += domain_findings(mod, names)
+    assert not found, "\n".join(found[:40])
+    duffing = load_generated(GENERATED / "duffing.py")
+    # inside, the guard leaves the values alone: ω = 1 + (3/8)x − (21/256)x² + … at x = εA²
+    x = 0.1 * 0.5**2
+    assert math.isclose(duffing.omega(0.5, 0.1), 1 + 3 / 8 * x - 21 / 256 * x**2 + 81 / 2048 * x**3,
+                        rel_tol=1e-7)
+    assert math.isnan(duffing.omega(1e101, 1e-203)) and math.isnan(duffing.q(math.inf, 0.5, 0.1))
