@@ -123,28 +123,23 @@ def term_by_term(model, order: int) -> tuple[list, list]:
 
 
 def square_floor(lc) -> tuple[float, float]:
-    """CPU seconds of one square of the whole exact q (every q_j as integers over its own
-    denominator, packed in ε and the harmonic into one FLINT polynomial) and the size of q in
-    megabytes: a lower bound for the derivation, which forms q², (q²)(ωq'), ωq' and Wq''
-    online."""
+    """CPU seconds of one square of the whole exact q and its size in megabytes: every q_j's
+    nonzero Fourier coefficients as integers over q_j's common denominator, packed in ε (a
+    stride of twice the longest q_j, room for a product) into one FLINT polynomial.  A lower
+    bound for the derivation, which forms q², (q²)(ωq'), ωq' and Wq'' online."""
     from flint import fmpz_poly
 
-    stride = 2 * (max(max((*c, *s), default=0) for c, s in lc.q) + 1)
-    coeffs: list[int] = []
-    bits = 0
+    rows, bits = [], 0
     for cos, sin in lc.q:
-        values = list(cos.values()) + list(sin.values())
+        values = [v for _, v in sorted(cos.items())] + [v for _, v in sorted(sin.items())]
         den = 1
         for v in values:
             den = den * v.denominator // math.gcd(den, v.denominator)
-        row = [0] * stride
-        for n, v in cos.items():
-            row[2 * n] = v.numerator * (den // v.denominator)
-        for n, v in sin.items():
-            row[2 * n + 1] = v.numerator * (den // v.denominator)
+        row = [v.numerator * (den // v.denominator) for v in values]
         bits += sum(abs(x).bit_length() for x in row) + den.bit_length()
-        coeffs += row + [0] * stride  # room for the product's harmonics
-    packed = fmpz_poly(coeffs)
+        rows.append(row)
+    stride = 2 * max(len(r) for r in rows)
+    packed = fmpz_poly([x for r in rows for x in r + [0] * (stride - len(r))])
     start = time.process_time()
     packed * packed
     return time.process_time() - start, bits / 8e6

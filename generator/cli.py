@@ -259,6 +259,14 @@ def _singularities(omega, variable: str, of: str = "omega", degree: int | None =
                    f"{est.radius:.6g}, angle ±{est.angle:.6g} rad, spread {est.spread:.2g}")
 
 
+def _emit_only(flags) -> None:
+    """``--emit`` writes a module and prints its path: the printing flags given beside it
+    (``flags``: pairs of a flag and whether it was given) are refused, not ignored."""
+    others = [flag for flag, given in flags if given]
+    if others:
+        raise InputError(f"--emit writes the module only: drop {', '.join(others)}")
+
+
 def _cmd_mathieu(args: argparse.Namespace) -> int:
     """``lindstedt mathieu a|b --m M --order K``: DLMF §28.6's series of a_m(q) or b_m(q)."""
     from .hill import mathieu_series
@@ -266,6 +274,7 @@ def _cmd_mathieu(args: argparse.Namespace) -> int:
     if args.emit is not None:
         from . import compiler
 
+        _emit_only((("--json", args.json), ("--singularities", args.singularities)))
         for path in compiler.generate_mathieu(args.kind, args.m, args.order,
                                               _out_folder(args.emit, "--emit"),
                                               overwrite_edited=args.overwrite_edited):
@@ -330,12 +339,9 @@ def _cmd_tongues(args: argparse.Namespace) -> int:
     if args.emit is not None:
         from . import compiler
 
-        others = [flag for flag, given in (("--at", args.at is not None), ("--tol", args.tol),
-                                           ("--damping", args.damping is not None),
-                                           ("--plot", args.plot), ("--json", args.json),
-                                           ("--singularities", args.singularities)) if given]
-        if others:
-            raise InputError(f"--emit writes the module only: drop {', '.join(others)}")
+        _emit_only((("--at", args.at is not None), ("--tol", args.tol),
+                    ("--damping", args.damping is not None), ("--plot", args.plot),
+                    ("--json", args.json), ("--singularities", args.singularities)))
         for path in compiler.generate_tongue(args.p, args.n, args.order,
                                              _out_folder(args.emit, "--emit"),
                                              overwrite_edited=args.overwrite_edited):

@@ -71,6 +71,22 @@ def test_bad_input_one_line_exit_2(args, needle):
     assert "Traceback" not in out.stderr
 
 
+@pytest.mark.parametrize("args,dropped", [
+    (["mathieu", "a", "--m", "3", "--order", "20", "--json"], "--json"),
+    (["mathieu", "a", "--m", "3", "--order", "20", "--singularities"], "--singularities"),
+    (["mathieu", "b", "--m", "1", "--json", "--singularities"], "--json, --singularities"),
+    (["tongues", "cos(t)", "--json"], "--json"),
+])
+def test_emit_refuses_printing_flags_beside_it(tmp_path, args, dropped):
+    """``--emit`` prints only the module's path: a printing flag beside it is refused in one
+    line (exit 2) before anything is derived or written, in ``mathieu`` as in ``tongues``."""
+    out = run(*args, "--emit", str(tmp_path / "new"))
+    assert out.returncode == 2 and out.stdout == ""
+    assert out.stderr.strip().splitlines() == [
+        f"lindstedt: error: --emit writes the module only: drop {dropped}"]
+    assert not (tmp_path / "new").exists()
+
+
 def test_negative_and_scientific_values_are_values_not_flags():
     """``--eps -1e-1`` and ``--drive -0.3@1.3`` are read as numbers (argparse alone calls them
     unknown flags); the result equals the one with the same value written plainly."""
