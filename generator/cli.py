@@ -2024,7 +2024,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="write DIR/tongue_<N>.py instead: numba ufuncs delta_<i>(eps) and "
                    "delta_<i>_error(eps), one per curve, Padé-resummed from the series to "
                    "--order (≥ 12), verified against the Floquet boundary |tr M| = 2 to 1e-10 "
-                   "in delta on 24 points up to 3 radii (at most eps = 10), NaN beyond")
+                   "in delta on 240 points up to 3 radii (at most eps = 10), NaN beyond")
     p.add_argument("--overwrite-edited", action="store_true",
                    help="with --emit: overwrite a file edited since it was generated")
     p.set_defaults(func=_cmd_tongues)

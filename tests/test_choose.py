@@ -550,3 +550,53 @@ def test_choose_emits_the_damped_module_for_a_finite_Q(tmp_path):
         assert abs(mod.A_1(w, 0.1, 0.3, 20.0, 0) - orbit.A[1]) <= 1e-6
         assert abs(mod.B_1(w, 0.1, 0.3, 20.0, 0) - orbit.B[1]) <= 1e-6
     del sys.modules["driven_damped"]
+
+
+def vdp_omega_by_shooting(eps: float) -> float:
+    """ω of van der Pol's cycle q'' + q = ε(1 − q²)q' by shooting in (a, T): the orbit from
+    (a, 0) is back there at T (scipy's root on DOP853 at rtol 1e-12) — not the return map and
+    secant of numerics.cycle_reference."""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import root
+
+    def rhs(t, y):
+        return [y[1], -y[0] + eps * (1 - y[0] ** 2) * y[1]]
+
+    def miss(x):
+        a, period = x
+        end = solve_ivp(rhs, (0, period), [a, 0.0], method="DOP853", rtol=1e-12,
+                        atol=1e-13).y[:, -1]
+        return [end[0] - a, end[1]]
+
+    found = root(miss, [2.0, 2 * np.pi], tol=1e-12)
+    assert np.max(np.abs(found.fun)) < 1e-11, found
+    return 2 * np.pi / found.x[1]
+
+
+def test_choose_cycle_reports_the_series_error_against_shooting(monkeypatch):
+    """``choose cycle`` on ε in [0.1, 0.5], tolerance 1e-6, the order-10 sums, 2 points: the
+    error it reports for the partial sums is theirs against an independent shooting, and it
+    picks them (the cheapest by the recorded costs) since they meet the tolerance."""
+    from lindstedt import methods
+    from lindstedt.choose import choose_limit_cycle, verification_points
+    from lindstedt.lindstedt import derive_limit_cycle
+    from lindstedt.models import series_model
+
+    # NOTE: the module's resummed ω verified on (0, 0.6] only: one shooting at generation
+    # rather than eight up to ε = 3 (~100 s), its check points all beyond this range.
+    monkeypatch.setattr(methods, "RESUM_RANGE", 0.6)
+    monkeypatch.setattr(methods, "RESUM_CHECKS", ())
+    choice = choose_limit_cycle(1e-6, 0.1, 0.5, order=12, points=2)  # the ends of the range
+    rows = {method: (order, error) for method, order, error, _, _ in choice.considered}
+    assert rows["series"][0] == 10 and choice.verified_on == 2
+    omega = derive_limit_cycle(series_model("van_der_pol", 12), 12).omega[:11]
+    errors = []
+    with mpmath.workdps(30):
+        for eps in verification_points(0.1, 0.5, 2):
+            truth = vdp_omega_by_shooting(float(eps))
+            partial = sum(mpmath.mpf(c.numerator) / c.denominator * mpmath.mpf(eps) ** k
+                          for k, c in enumerate(omega))
+            errors.append(abs(float(partial) - truth) / truth)
+    assert 1e-12 < max(errors) <= 1e-6
+    assert abs(rows["series"][1] - max(errors)) <= 1e-3 * max(errors) + 1e-12, (rows, errors)
+    assert choice.method == "series" and rows["resummed"][1] < 1e-11

@@ -159,3 +159,42 @@ def test_a_users_equation_is_estimated_by_its_degree_and_symbols():
         "q'' + q + eps*(alpha*q**2 + q**3) = 0", 30, "alpha=1/3")
     done = run("series", "q'' + q + eps*q**63 = 0", "--order", "40")
     assert done.returncode == 2 and "--allow-slow" in done.stderr and done.stdout == ""
+
+
+def test_the_cost_fit_measures_every_entry_of_the_cost_model(monkeypatch):
+    """``benchmarks/cost_model.py --fit`` measures every entry of ``choose.COST_MODEL`` (the
+    damped μ-expansion's emitted module was missed, its line fitted by hand), and ``--only``
+    just the one it names: the timings replaced by stubs that record what they are asked."""
+    import importlib.util
+    from pathlib import Path
+    from types import SimpleNamespace
+
+    from lindstedt.choose import COST_MODEL, DrivenTradeoff
+    from lindstedt.driven import Drive
+    from lindstedt.methods import methods_for
+
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / "cost_model.py"
+    spec = importlib.util.spec_from_file_location("cost_model", path)
+    fit = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(fit)
+
+    def tradeoffs(truth, eps, force, Q):
+        return [DrivenTradeoff(m.name, k, 1.0, {})
+                for m in methods_for("driven", Drive(eps, force, 1.0, Q))
+                for k in m.driven_orders]
+
+    stubs = {"candidates": lambda: [SimpleNamespace(method=m, order=1)
+                                    for m in methods_for("period")],
+             "ns_per_point": lambda c: 1.0, "_generated_q_cost": lambda k, lo, hi: 1.0,
+             "_fourier_cost": lambda n, lo, hi: 1.0, "driven_truth": lambda *a: None,
+             "driven_tradeoffs": tradeoffs,
+             "emitted_driven": lambda name, k, *a: DrivenTradeoff(f"{name}, emitted", k, 1.0,
+                                                                   {})}
+    for name, stub in stubs.items():
+        monkeypatch.setattr(fit, name, stub)
+    rows = fit.measurements()
+    assert {(q, str(m)) for q, m in rows} == {(q, m) for q, entries in COST_MODEL.items()
+                                              for m in entries}
+    entry = ("driven", "mu_expansion_damped, emitted")
+    only = fit.measurements(entry)
+    assert list(only) == [entry] and [k for k, _ in only[entry]] == [1, 2, 3, 4]

@@ -1,12 +1,12 @@
 """Emitted code cannot corrupt memory.
 
 Every emitted function of every kind of module (duffing, pendulum, driven, balance, fourier,
-chosen_period) is called with wrong shapes, views, dtypes and lengths in a child process (this
-file run as a script), so that a crash fails the test instead of killing pytest.  Each bad call
-must raise TypeError or ValueError naming the function and the argument, and leave every array
-it was given (and the array a view was cut from) exactly as it was; arguments of another real
-dtype, huge int64 values included, must give the float64 answer (to a few ulp: each argument type
-is its own compilation); the good calls still equal the ufuncs.
+chosen_period, tongue_1) is called with wrong shapes, views, dtypes and lengths in a child
+process (this file run as a script), so that a crash fails the test instead of killing pytest.
+Each bad call must raise TypeError or ValueError naming the function and the argument, and leave
+every array it was given (and the array a view was cut from) exactly as it was; arguments of
+another real dtype, huge int64 values included, must give the float64 answer (to a few ulp: each
+argument type is its own compilation); the good calls still equal the ufuncs.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 GENERATED = ROOT / "generated"
 COMMITTED = ("duffing", "pendulum", "driven", "balance")
-EMITTED = ("fourier", "chosen_period")
+EMITTED = ("fourier", "chosen_period", "tongue_1")
 FILL = -12345.678  # every array handed over is filled with this: a changed element was written
 N = 7
 GOOD = {  # float64 values of each argument name, inside the modules' domains
@@ -336,7 +336,9 @@ def test_every_emitted_function_refuses_what_it_cannot_handle(tmp_path):
     """One child process calls everything; it must exit normally, every call must behave."""
     for args in (["generate", "fourier", "--harmonics", "4", "--out", str(tmp_path)],
                  ["choose", "period", "--tol", "1e-6", "--x-min", "-0.5", "--x-max", "0.7",
-                  "--emit", str(tmp_path)]):
+                  "--emit", str(tmp_path)],
+                 ["tongues", "cos(t) + 1/2*cos(2*t)", "--n", "1", "--order", "12", "--emit",
+                  str(tmp_path)]):
         made = subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
                               text=True, check=False)
         assert made.returncode == 0, made.stderr

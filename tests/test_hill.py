@@ -107,7 +107,9 @@ TABLE_28_6_1 = {  # ρ_n^(j), n = 0 or 1: j = 1 for a_2n, 2 for b_2n+2, 3 for a_
 @pytest.mark.parametrize(("kind", "m"), sorted(TABLE_28_6_1))
 def test_radius_of_convergence_against_table_28_6_1(kind, m, capsys):
     """``mathieu --singularities`` at order 100: within 0.1 % of DLMF Table 28.6.1 (Meixner et
-    al. 1980), read in q**2 where the series lives in q² (a_2n, b_2n)."""
+    al. 1980), read in q**2 where the series lives in q² (a_2n, b_2n); the reported spread
+    covers the error against the table in that variable (for the complex pairs of a_1, b_1,
+    a_3 too, whose fits over the last orders alone spread 1.1e-3 for an error of 1.8e-3)."""
     assert main(["mathieu", kind, "--m", str(m), "--order", "100", "--singularities",
                  "--json"]) == 0
     (row,) = json.loads(capsys.readouterr().out)["singularities"]
@@ -116,7 +118,7 @@ def test_radius_of_convergence_against_table_28_6_1(kind, m, capsys):
     radius = row["radius"] ** 0.5 if row["variable"] == "q**2" else row["radius"]
     assert abs(radius / expected - 1) < 1e-3, (kind, m, radius)
     assert 0 < row["spread"] < 0.01 * row["radius"]
+    assert abs(row["radius"] - (expected**2 if m % 2 == 0 else expected)) <= row["spread"]
     if row["method"].startswith("Domb–Sykes"):  # a real branch point: the fit in 1/n of
-        # degree 3 lands within 2e-6 and its spread covers the error
+        # degree 3 lands within 2e-6
         assert abs(radius / expected - 1) < 2e-6
-        assert abs(row["radius"] - expected ** 2) <= row["spread"]

@@ -191,7 +191,8 @@ def test_nearest_singularities_from_the_exact_series(capsys):
     assert main(["series", "vdp", "--order", "100", "--singularities", "--json"]) == 0
     (vdp,) = json.loads(capsys.readouterr().out)["singularities"]
     assert vdp["variable"] == "eps**2" and vdp["method"] == "Mercer–Roberts"
-    assert abs(vdp["radius"] / 3.42 - 1) < 0.01 and vdp["spread"] < 0.01
+    assert abs(vdp["radius"] / 3.42 - 1) < 0.01 and vdp["spread"] < 0.05
+    assert abs(vdp["radius"] - 3.42) <= vdp["spread"]  # an error bar, 3.42 to its two digits
     assert 0.5 < vdp["angle"] < math.pi - 0.5  # off the real axis
     for m, where, angle in ((duffing(), 1.0, math.pi), (pendulum(40), math.pi**2, 0.0)):
         sol = derive(m, 40)

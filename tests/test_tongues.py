@@ -273,6 +273,37 @@ def test_the_emitted_curves_are_the_floquet_boundary_past_the_radius(emitted):
     assert abs(got - truth) < 2e-10
 
 
+def test_the_emitted_curves_hold_the_tolerance_between_the_grid_points(emitted):
+    """Points of (0, LIMIT_i] off the verification grid (fractions of the limit that are no
+    multiple of its spacing), just below the limit included: within the module's TOLERANCE
+    (1e-10) of the boundary found by brentq at 8192 steps."""
+    _, _, mod = emitted
+    p = harmonics(EMIT_P)
+    assert mod.TOLERANCE == 1e-10
+    for i in range(2):
+        f, limit = getattr(mod, f"delta_{i}"), getattr(mod, f"LIMIT_{i}")
+        for eps in limit * np.array([0.1234567, 0.5011, 0.7777, 0.9123, 0.9871, 0.9993]):
+            got = float(f(eps))
+            assert abs(got - boundary(p, eps, got)) < mod.TOLERANCE, (i, eps)
+
+
+def test_the_bracketed_root_is_brentqs():
+    """methods.boundary_bracket (the sign of |tr M| − 2 at δ ∓ b, the root interpolated):
+    brentq's root where one curve crosses the bracket, NaN where none or both do."""
+    from lindstedt.methods import boundary_bracket
+
+    p = harmonics(EMIT_P)
+    curves = transition_curves(EMIT_P, 1, 30).curves
+    first = boundary(p, 0.3, value(curves[0].delta, 0.3))
+    d0, d1 = (boundary(p, 1.0, value(c.delta, 1.0)) for c in curves)
+    eps = np.array([0.3, 1.0, 1.0, 1.0])
+    near = np.array([first + 4e-11, d1 - 7e-11, d0 + 3e-10, (d0 + d1) / 2])
+    bracket = np.array([1e-10, 1e-10, 1e-10, abs(d1 - d0) / 2 + 0.01])
+    got = boundary_bracket(p, eps, near, bracket, 8192)
+    assert abs(got[0] - first) < 1e-14 and abs(got[1] - d1) < 1e-14, got
+    assert np.isnan(got[2]) and np.isnan(got[3])  # outside the bracket; both curves inside
+
+
 def test_the_emitted_curves_are_nan_beyond_the_verified_eps(emitted):
     _, _, mod = emitted
     outside = np.array([-0.1, mod.LIMIT_0 * 1.001, 50.0, np.nan, np.inf, -np.inf, 1e308])
