@@ -384,9 +384,16 @@ def resummed_expression(r: Resummed, z: sp.Symbol, approximant: Pade | None = No
                              / horner([rational(c) for c in P.denominator], x))
     w = sp.Symbol("w")
     body.append((w, x / sp.sqrt(x**2 - 2 * rational(r.p) * x + rational(r.R) ** 2)))
-    ratio = horner([rational(c) for c in P.numerator], w) / horner(
-        [rational(c) for c in P.denominator], w)
-    return tuple(body), sp.sqrt((1 - w) * ratio)
+    if r.log is None:
+        ratio = horner([rational(c) for c in P.numerator], w) / horner(
+            [rational(c) for c in P.denominator], w)
+        return tuple(body), sp.sqrt((1 - w) * ratio)
+    s, v, tail = sp.symbols("s v tail")
+    body += [(s, sp.cbrt(1 - w)), (v, w / (1 + s + s**2)),  # v = 1 − s, no cancellation
+             (tail, sp.Piecewise(((1 - w) * sp.log(1 - w) / 3, w < 1), (0, True)))]  # s³ ln s
+    ratio = horner([rational(c) for c in P.numerator], v) / horner(
+        [rational(c) for c in P.denominator], v)
+    return tuple(body), sp.sqrt((1 - w) * (ratio + rational(r.log) * tail))
 
 
 @dataclass(frozen=True)
@@ -417,6 +424,11 @@ def lower_resummed_cycle(r: ResummedCycle) -> tuple[Evaluator, ...]:
               f"{r.tolerance:g} against shooting")
     form = (f"sqrt((1 - w) [{L}/{M}](w)), w = eps²/(eps⁴ - 2 eps² p + R²)^(1/2), R = {r.form.R}"
             f", p = R cos β = {r.form.p}")
+    if r.form.log is not None:
+        form = (f"sqrt((1 - w) ([{L}/{M}](v) + λ s³ ln s)), s = (1 - w)^(1/3) = 1 - v, "
+                f"λ = {float(r.form.log)!r}, two-point Padé (the series and the relaxation "
+                f"limit), w = eps²/(eps⁴ - 2 eps² p + R²)^(1/2), R = {r.form.R}, "
+                f"p = R cos β = {r.form.p}")
     return (
         Evaluator("omega_resummed", f"Frequency ω resummed: {form} ({domain}).", (eps,), (),
                   guard, body, value),
