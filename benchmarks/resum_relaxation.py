@@ -1,6 +1,6 @@
 """Van der Pol's ω(ε) to ε = 10: Padé in Andersen & Geer's w against the relaxation form.
 
-    .venv/bin/python benchmarks/resum_relaxation.py [--order 164]
+    .venv/bin/python benchmarks/resum_relaxation.py [--order 164] [--emitted-only]
 
 1. From the exact series to each order in ORDERS (one derivation, truncated): the relative
    error against DOP853 shooting (numerics.cycle_reference, rtol 1e-13, its own accuracy
@@ -80,7 +80,12 @@ def emitted(order: int) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--order", type=int, default=164)
-    order = ap.parse_args().order
+    ap.add_argument("--emitted-only", action="store_true", help="part 2 alone")
+    args = ap.parse_args()
+    order = args.order
+    if args.emitted_only:
+        emitted(order)
+        return
     t0 = time.perf_counter()
     lc = derive_limit_cycle(series_model("van_der_pol", order), order)
     print(f"derivation to order {order}: {time.perf_counter() - t0:.0f} s")

@@ -367,6 +367,12 @@ LIMIT_CYCLE_MARGIN = sp.Rational(9, 10)
 # the estimate is good to ~1 % from order 60, and near the radius the terms decay slowly.
 
 
+CUBE_ROOT_STEPS = 5
+# NOTE: (1 − w)^(1/3) of the relaxation form by Halley's iteration from 0.29 + 0.71·(1 − w):
+# within 7e-16 of numpy's cbrt for 1 − w ≥ 1e-3 (|eps| ≲ 27); `**(1/3)` calls libm's pow,
+# which kept the order-60 loop from vectorizing (85 against 20 ns per point).
+
+
 def resummed_expression(r: Resummed, z: sp.Symbol, approximant: Pade | None = None
                         ) -> tuple[tuple[Assign, ...], sp.Expr]:
     """The body and output of a :class:`resum.Resummed` at ``z``: ``x = z**power``, Andersen
@@ -388,9 +394,12 @@ def resummed_expression(r: Resummed, z: sp.Symbol, approximant: Pade | None = No
         ratio = horner([rational(c) for c in P.numerator], w) / horner(
             [rational(c) for c in P.denominator], w)
         return tuple(body), sp.sqrt((1 - w) * ratio)
-    s, v, tail = sp.symbols("s v tail")
-    body += [(s, sp.cbrt(1 - w)), (v, w / (1 + s + s**2)),  # v = 1 − s, no cancellation
-             (tail, sp.Piecewise(((1 - w) * sp.log(1 - w) / 3, w < 1), (0, True)))]  # s³ ln s
+    y, s, v, tail = sp.symbols("y s v tail")
+    body += [(y, 1 - w), (s, sp.Rational(29, 100) + sp.Rational(71, 100) * y)]
+    for _ in range(CUBE_ROOT_STEPS):  # Halley on s³ = y: no libm call, so the loop vectorizes
+        body.append((s, s * (s**3 + 2 * y) / (2 * s**3 + y)))
+    body += [(v, w / (1 + s + s**2)),  # v = 1 − s, without the cancellation near w = 0
+             (tail, y * sp.log(y) / 3)]  # s³ ln s; y > 0 for every finite eps
     ratio = horner([rational(c) for c in P.numerator], v) / horner(
         [rational(c) for c in P.denominator], v)
     return tuple(body), sp.sqrt((1 - w) * (ratio + rational(r.log) * tail))

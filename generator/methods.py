@@ -496,9 +496,18 @@ def _cycle_derive(r: Request, progress: Progress | None) -> object:
 
 
 def _cycle_lower(derived: object, r: Request) -> Unit:
+    import sys
+
     cycle, resummed = derived
-    return Unit(lower_limit_cycle(cycle, r.command, r.order, resummed),
-                (lower_cycle_derivation(cycle, r.order),))
+    # NOTE: the exact coefficients pass Python's 4300-digit int → str limit from order ~150
+    # (the module's OMEGA_EXACT, AMPLITUDE_EXACT and the LaTeX); lifted while lowering.
+    limit = sys.get_int_max_str_digits()
+    sys.set_int_max_str_digits(0)
+    try:
+        return Unit(lower_limit_cycle(cycle, r.command, r.order, resummed),
+                    (lower_cycle_derivation(cycle, r.order),))
+    finally:
+        sys.set_int_max_str_digits(limit)
 
 
 RESUM_TOLERANCE = 1e-6
