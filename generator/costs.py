@@ -194,7 +194,8 @@ CYCLE_CHECKS = 25.0
 # shoots the cycle (DOP853) at the resummed evaluators' check points (methods.resum_cycle):
 # 24 s and 26 s wall at orders 12 and 58 (load 2–3), everything but the derivation.  The
 # verified range and so the checks grow with the order (ε ≤ 2.98 from order 60, 5.18 from 128,
-# where a run took 337 s at load 7): scaled by (order/60)².
+# where a run took 337 s at load 7, with Padé in w; the relaxation form reaches 3.75 and 10):
+# scaled by (order/60)².
 
 
 def series_cost(args: argparse.Namespace) -> Cost:

@@ -88,7 +88,13 @@ from .lower import (
 )
 from .models import Model, SelfExcited, check_order, duffing
 from .numerics import cycle_reference, duffing_period_exact, shoot
-from .resum import Resummed, resum_frequency, resum_series
+from .resum import (
+    Resummed,
+    resum_frequency,
+    resum_relaxation,
+    resum_series,
+    van_der_pol_relaxation,
+)
 
 Progress = Callable[[int, int], None]
 
@@ -490,9 +496,18 @@ def _cycle_derive(r: Request, progress: Progress | None) -> object:
 
 
 def _cycle_lower(derived: object, r: Request) -> Unit:
+    import sys
+
     cycle, resummed = derived
-    return Unit(lower_limit_cycle(cycle, r.command, r.order, resummed),
-                (lower_cycle_derivation(cycle, r.order),))
+    # NOTE: the exact coefficients pass Python's 4300-digit int → str limit from order ~150
+    # (the module's OMEGA_EXACT, AMPLITUDE_EXACT and the LaTeX); lifted while lowering.
+    limit = sys.get_int_max_str_digits()
+    sys.set_int_max_str_digits(0)
+    try:
+        return Unit(lower_limit_cycle(cycle, r.command, r.order, resummed),
+                    (lower_cycle_derivation(cycle, r.order),))
+    finally:
+        sys.set_int_max_str_digits(limit)
 
 
 RESUM_TOLERANCE = 1e-6
@@ -504,13 +519,25 @@ RESUM_SPREAD_MARGIN = 10.0
 # NOTE: the neighbour spread [L/M] − [L−1/M−1] underestimates van der Pol's true error by up
 # to 7× at large ε (order 130): the dense grid asks the spread for tolerance/10, and the
 # shooting references then check it.
+RELAXATION_SPREAD_MARGIN = 1.0
+# NOTE: for the relaxation form (resum.resum_relaxation) the spread is 0.3× (order 130) to
+# 10× (order 164) van der Pol's true error at ε = 10 (benchmarks/resum_relaxation.py): the
+# grid asks it for the tolerance itself, and the shooting checks at every integer ε and at
+# the end decide (the error grows monotonically with ε on the measured grid).
 RESUM_CHECKS = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0)
+RELAXATION_TERMS = {
+    frozenset({(0, 1, 1), (2, 1, -1)}): van_der_pol_relaxation,  # van der Pol
+    frozenset({(0, 1, 1), (0, 3, Fraction(-1, 3))}): van_der_pol_relaxation,  # Rayleigh
+}
+# NOTE: the oscillators whose relaxation limit is known (Rayleigh's q̇ obeys van der Pol's
+# equation, so the two share ω(ε)); keyed by the terms q^a q̇^b c of f(q, q̇).
 
 
 def resum_cycle(lc: object, tolerance: float = RESUM_TOLERANCE) -> ResummedCycle | None:
-    """The resummed ω(ε) of a limit cycle (:func:`resum.resum_frequency`) and its amplitude
+    """The resummed ω(ε) of a limit cycle (:func:`resum.resum_relaxation` for the oscillators
+    of :data:`RELAXATION_TERMS`, else :func:`resum.resum_frequency`) and its amplitude
     q(0) (Padé in ε², :func:`resum.resum_series`), each with the |ε| up to which it is
-    verified: the neighbour spread below ``tolerance/10`` on a dense grid of ``(0, 10]``, then
+    verified: the neighbour spread below ``tolerance/margin`` on a dense grid of ``(0, 10]``, then
     DOP853 shooting (:func:`numerics.cycle_reference`) at the check points up to there and at
     its end, the domain cut at the last one passed when one fails.  None for a series with
     odd powers of ε or without a singularity estimate (the amplitude alone: None in it)."""
@@ -519,8 +546,11 @@ def resum_cycle(lc: object, tolerance: float = RESUM_TOLERANCE) -> ResummedCycle
     est = nearest_singularity(lc.omega)
     if est is None or not est.variable.endswith("**2") or est.method != "Mercer–Roberts":
         return None
+    relaxation = RELAXATION_TERMS.get(frozenset(
+        (a, b, Fraction(c)) for a, b, c in getattr(lc.model, "terms", ())))
     try:
-        form = resum_frequency(lc.omega, est.radius, est.angle)
+        form = (resum_relaxation(lc.omega, est.radius, est.angle, relaxation())
+                if relaxation else resum_frequency(lc.omega, est.radius, est.angle))
     except InputError:
         return None
     refs: dict[float, object] = {}
@@ -530,7 +560,8 @@ def resum_cycle(lc: object, tolerance: float = RESUM_TOLERANCE) -> ResummedCycle
             refs[e] = cycle_reference(lc.model, e, guess=float(lc.amplitude[0]))
         return refs[e]
 
-    omega = _verified(form, lambda e: 2 * np.pi / reference(e).period, tolerance)
+    omega = _verified(form, lambda e: 2 * np.pi / reference(e).period, tolerance,
+                      RELAXATION_SPREAD_MARGIN if form.log is not None else RESUM_SPREAD_MARGIN)
     if omega is None:
         return None
     try:
@@ -543,14 +574,15 @@ def resum_cycle(lc: object, tolerance: float = RESUM_TOLERANCE) -> ResummedCycle
                          amplitude_verified=amp if amp else (0.0, (), float("nan")))
 
 
-def _verified(form: Resummed, truth: Callable[[float], float], tolerance: float
+def _verified(form: Resummed, truth: Callable[[float], float], tolerance: float,
+              margin: float = RESUM_SPREAD_MARGIN
               ) -> tuple[float, tuple[float, ...], float] | None:
     """``(limit, points, worst)`` of :func:`resum_cycle`'s rule, None if not even its first
     check point passes."""
     import numpy as np
 
     grid = np.linspace(0.0, RESUM_RANGE, RESUM_GRID + 1)[1:]
-    ok = form.spread(grid) <= tolerance / RESUM_SPREAD_MARGIN
+    ok = form.spread(grid) <= tolerance / margin
     first_bad = int(np.argmin(ok)) if not ok.all() else len(grid)
     limit = round(float(grid[first_bad - 1]), 12) if first_bad else 0.0
     points, worst = [], 0.0
