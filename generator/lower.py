@@ -898,18 +898,21 @@ def free_ranges(y: sp.Expr, params: tuple[sp.Symbol, ...]
 
 
 def argument_entry(arguments: tuple[tuple[sp.Symbol, sp.Basic, object], ...],
-                   flag: str = "inside") -> tuple[list[Assign], sp.Basic]:
+                   flag: str = "inside", infinite: tuple[sp.Symbol, ...] = ()
+                   ) -> tuple[list[Assign], sp.Basic]:
     """Assignments that replace every argument by its stand-in unless every argument is finite
     and meets its condition, and the condition the guard adds (a flag ``inside``, 1 or 0):
     outside, the evaluator computes at the stand-in point, where every step is finite, and
     returns NaN — no floating-point flag is raised on the way.
 
-    Two passes: :class:`Finite` first (a quiet test), so that the conditions' ordered
-    comparisons never see a NaN — LLVM may compile them branch-free to a signalling compare,
-    which raises "invalid" for NaN even where a branch would have skipped it."""
+    Two passes: :class:`Finite` first (:class:`NotNaN` for the arguments ``infinite`` allows
+    at ±inf), quiet tests, so that the conditions' ordered comparisons see no NaN — LLVM may
+    compile them branch-free to a signalling compare, which raises "invalid" for NaN even where
+    a branch would have skipped it.  ``tests/test_emitted_safety.py`` checks every emitted
+    family for warnings: the code LLVM makes of a guard is not otherwise predictable."""
     flag = sp.Symbol(flag)
     steps: list[Assign] = []
-    for inside in (sp.And(*(Finite(v) for v, _, _ in arguments)),
+    for inside in (sp.And(*((NotNaN if v in infinite else Finite)(v) for v, _, _ in arguments)),
                    sp.And(*(cond for _, cond, _ in arguments))):
         if steps:
             inside = sp.And(sp.Eq(flag, 1), inside)
@@ -920,8 +923,8 @@ def argument_entry(arguments: tuple[tuple[sp.Symbol, sp.Basic, object], ...],
 
 
 class Finite(BooleanFunction):
-    """True for a finite number; printed as a quiet test (no "invalid" for NaN, unlike an
-    ordered comparison, nor for ±inf, unlike numba's ``math.isfinite``)."""
+    """True for a finite number; printed as a quiet test (numba's ``math.isfinite`` computes
+    x − x, which raises "invalid" at ±inf)."""
 
     nargs = 1
 
@@ -929,6 +932,19 @@ class Finite(BooleanFunction):
     def eval(cls, arg: sp.Expr) -> sp.Basic | None:
         if arg.is_number:
             return sp.true if arg.is_finite else sp.false
+        return None
+
+
+class NotNaN(BooleanFunction):
+    """True for a number that is not NaN (±inf included); printed as a quiet test (no
+    "invalid", unlike an ordered comparison with NaN)."""
+
+    nargs = 1
+
+    @classmethod
+    def eval(cls, arg: sp.Expr) -> sp.Basic | None:
+        if arg.is_number:
+            return sp.false if arg is sp.nan else sp.true
         return None
 
 
@@ -943,7 +959,8 @@ def damped_entry(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol, Q: sp.Symbo
         (eps, sp.And(sp.Ne(eps, 0), sp.Abs(eps) <= high), e),
         (force, sp.Abs(force) <= high, f),
         (Q, low <= Q, q),
-        (branch, sp.Or(sp.Eq(branch, 0), sp.Eq(branch, 1), sp.Eq(branch, 2)), 0)))
+        (branch, sp.Or(sp.Eq(branch, 0), sp.Eq(branch, 1), sp.Eq(branch, 2)), 0)),
+        infinite=(Q,))
 
 
 def nested_horner(expr: sp.Expr, gens: tuple[sp.Symbol, ...]) -> sp.Expr:

@@ -33,9 +33,10 @@ class NumbaPrinter(PythonCodePrinter):
     def _print_Half(self, expr: sp.Rational) -> str:
         return "0.5"
 
-    def _print_Finite(self, expr: sp.Basic) -> str:
-        # lower.Finite: isnan and isinf are quiet tests; numba's isfinite computes x − x, which
-        # raises "invalid" for ±inf
+    def _print_NotNaN(self, expr: sp.Basic) -> str:  # lower.NotNaN: isnan is a quiet test
+        return f"not math.isnan({self._print(expr.args[0])})"
+
+    def _print_Finite(self, expr: sp.Basic) -> str:  # lower.Finite: isnan, isinf are quiet
         v = self._print(expr.args[0])
         return f"(not math.isnan({v}) and not math.isinf({v}))"
 
