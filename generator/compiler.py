@@ -70,15 +70,21 @@ def generate(model: str | Model, order: int, out: Path, allow_divergent: bool = 
                           overwrite_edited=overwrite_edited, flag=flag)
 
 
-def generate_limit_cycle(model: object, order: int, out: Path, *,
+def generate_limit_cycle(model: object, order: int, out: Path, *, resum_order: int | None = None,
                          overwrite_edited: bool = False, flag: str = "--out") -> list[Path]:
-    """``lindstedt generate`` of a self-excited oscillator: its limit cycle's evaluators."""
+    """``lindstedt generate`` of a self-excited oscillator: its limit cycle's evaluators, the
+    partial sums to ``order`` and ω resummed from the exact series to ``resum_order``
+    (default :data:`methods.RADIUS_ORDER`; at least ``order + 2``)."""
     order = check_order(order)
     if order < 1:
         raise InputError(f"order {order}: a limit cycle's evaluators start at order 1")
-    command = f'lindstedt generate "{model.source}" --name {model.name} --order {order}'
-    return compile_target(LIMIT_CYCLE, Request(order, command, model), out,
-                          overwrite_edited=overwrite_edited, flag=flag)
+    if resum_order is not None and resum_order < order + 2:
+        raise InputError(f"--resum-order {resum_order}: at least the order + 2 = {order + 2} "
+                         "the evaluators' error estimate needs")
+    command = f'lindstedt generate "{model.source}" --name {model.name} --order {order}' + (
+        f" --resum-order {resum_order}" if resum_order is not None else "")
+    return compile_target(LIMIT_CYCLE, Request(order, command, model, resum_order=resum_order),
+                          out, overwrite_edited=overwrite_edited, flag=flag)
 
 
 def generate_driven(order: int, out: Path, *, damped: bool = False,

@@ -232,9 +232,9 @@ def generate_cost(args: argparse.Namespace) -> Cost:
         derivation = series_cost(argparse.Namespace(model=args.model, param=args.param,
                                                     order=size + 2)).seconds
         if limit_cycle_text(args.model) is not None:
-            from .methods import RADIUS_ORDER
+            from .methods import RADIUS_ORDER, cycle_series_order
 
-            derived = max(size + 2, RADIUS_ORDER)
+            derived = cycle_series_order(size, getattr(args, "resum_order", None))
             return Cost(power_law(*LIMIT_CYCLE_FIT, derived)
                         + CYCLE_CHECKS * (derived / RADIUS_ORDER) ** 2, f"order {size}",
                         "generating the limit cycle's evaluators")

@@ -455,6 +455,7 @@ class Request:
     verified: tuple[float, float] = (0.0, 0.0)
     mathieu: tuple[str, int] | None = None  # (kind, m) of a Mathieu characteristic value
     tongue: tuple[str, int] | None = None  # (p(t) as text, n) of a tongue's transition curves
+    resum_order: int | None = None  # a limit cycle's ω series for the radius and resummation
 
 
 @dataclass(frozen=True)
@@ -490,8 +491,15 @@ RADIUS_ORDER = 60
 # for van der Pol), whatever order its evaluators sum.
 
 
+def cycle_series_order(order: int, resum_order: int | None) -> int:
+    """The order a limit cycle's exact series is derived to when its evaluators sum
+    ``order``: ``resum_order`` when given (its radius estimate and resummed ω use every
+    term), else :data:`RADIUS_ORDER`, and never below ``order + 2``."""
+    return max(order + 2, RADIUS_ORDER if resum_order is None else resum_order)
+
+
 def _cycle_derive(r: Request, progress: Progress | None) -> object:
-    lc = derive_limit_cycle(r.model, max(r.order + 2, RADIUS_ORDER))
+    lc = derive_limit_cycle(r.model, cycle_series_order(r.order, r.resum_order))
     return lc, resum_cycle(lc)
 
 

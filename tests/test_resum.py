@@ -140,15 +140,16 @@ def test_the_shooting_reference_against_the_literature():
 
 @pytest.fixture(scope="module")
 def emitted(tmp_path_factory):
-    """The module `lindstedt generate van_der_pol --order 58` writes (ω derived to order 60:
-    the relaxation form is then verified to |ε| ≈ 3.75), with fewer shooting checks."""
+    """The module `lindstedt generate van_der_pol --order 12 --resum-order 60` writes (partial
+    sums to order 12, ω resummed from its series to order 60: the relaxation form is then
+    verified to |ε| ≈ 3.75), with fewer shooting checks."""
     from lindstedt.compiler import generate_limit_cycle
     from lindstedt.emit import load_generated
 
     out = tmp_path_factory.mktemp("vdp")
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(methods, "RESUM_CHECKS", (1.0, 2.0))
-        paths = generate_limit_cycle(series_model("van_der_pol", 60), 58, out)
+        paths = generate_limit_cycle(series_model("van_der_pol", 14), 12, out, resum_order=60)
     return load_generated(out / "van_der_pol.py"), paths
 
 
@@ -156,8 +157,11 @@ def test_emitted_resummed_frequency_against_shooting(emitted):
     """omega_resummed, period_resummed and amplitude_resummed within 1e-12 of DOP853 shooting
     for ε ≤ 1 (the series alone stops at 0.9·√3.42 = 1.66) and within 1e-6 up to the verified
     limit; NaN beyond it; the error estimate is below the tolerance there."""
-    mod, _ = emitted
+    mod, paths = emitted
     assert 3.5 < mod.RESUMMED_LIMIT < 4.5
+    # the partial sums stop at 12, the resummed form uses all 31 terms in ε² of order 60
+    assert mod.ORDER == 12 and len(mod.OMEGA_EXACT) == 13 and mod.RESUMMED_DEGREES == (17, 16)
+    assert "--order 12 --resum-order 60" in paths[0].read_text()
     vdp = series_model("van_der_pol", 4)
     for eps, tol in ((0.1, 1e-12), (1.0, 1e-12), (2.5, 1e-6), (mod.RESUMMED_LIMIT, 1e-6)):
         ref = cycle_reference(vdp, eps)
@@ -172,6 +176,26 @@ def test_emitted_resummed_frequency_against_shooting(emitted):
                                                           np.nan]))))
 
 
+def test_resum_order_is_refused_where_it_means_nothing(tmp_path, capsys):
+    """--resum-order below the order + 2 the error estimate needs, on a module without a
+    limit cycle, on an oscillator without one, negative: one line, exit 2, nothing written."""
+    from lindstedt.cli import main
+
+    for args, words in (
+            (["van_der_pol", "--order", "12", "--resum-order", "13"], "at least the order + 2"),
+            (["duffing", "--resum-order", "60"], "duffing has no limit cycle"),
+            (["driven", "--resum-order", "60"], "no limit cycle to resum"),
+            (["q'' + q + eps*q**3 = 0", "--resum-order", "60"], "has no limit cycle"),
+            (["van_der_pol", "--resum-order", "-1"], "--resum-order")):
+        try:
+            code = main(["generate", *args, "--out", str(tmp_path / "x")])
+        except SystemExit as exc:  # argparse's own refusals
+            code = exc.code
+        err = capsys.readouterr().err.strip()
+        assert code == 2 and words in err.splitlines()[-1], (args, err)
+        assert not (tmp_path / "x").exists()
+
+
 def test_generated_limit_cycle_module_is_byte_identical(emitted, tmp_path):
     """A second, independent generation writes the same bytes."""
     from lindstedt.compiler import generate_limit_cycle
@@ -179,7 +203,8 @@ def test_generated_limit_cycle_module_is_byte_identical(emitted, tmp_path):
     _, paths = emitted
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(methods, "RESUM_CHECKS", (1.0, 2.0))
-        again = generate_limit_cycle(series_model("van_der_pol", 60), 58, tmp_path)
+        again = generate_limit_cycle(series_model("van_der_pol", 14), 12, tmp_path,
+                                     resum_order=60)
     assert [p.name for p in again] == [p.name for p in paths]
     for a, b in zip(paths, again, strict=True):
         assert a.read_bytes() == b.read_bytes()
