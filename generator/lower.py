@@ -449,6 +449,8 @@ class ResummedCycle:
     tolerance: float
     amplitude: Resummed | None = None  # q(0), Padé in ε², with its (limit, points, checked)
     amplitude_verified: tuple[float, tuple[float, ...], float] = (0.0, (), float("nan"))
+    harmonics: tuple[tuple[str, int, Resummed], ...] = ()  # q(s): ("cos"|"sin", n, a_n(ε))
+    harmonics_verified: tuple[float, tuple[float, ...], float] = (0.0, (), float("nan"))
 
 
 def lower_resummed_cycle(r: ResummedCycle) -> tuple[Evaluator, ...]:
@@ -479,7 +481,37 @@ def lower_resummed_cycle(r: ResummedCycle) -> tuple[Evaluator, ...]:
                   (eps,), (), guard, (*body, (omega, value), (lower, other)),
                   sp.Abs(lower - omega) / omega),
         *_lower_resummed_amplitude(r),
+        *_lower_resummed_q(r),
     )
+
+
+def _lower_resummed_q(r: ResummedCycle) -> tuple[Evaluator, ...]:
+    """``q_resummed(t, eps)``: each harmonic's Padé in ``w`` times cos ns or sin ns with
+    ``s = omega_resummed(eps)·t``, NaN beyond the harmonics' own verified |ε|."""
+    if not r.harmonics:
+        return ()
+    eps, t, phase, w = sp.symbols("eps t phase w")
+    body, omega = resummed_expression(r.form, eps)
+    top = max(n for _, n, _ in r.harmonics)
+    lines, cs, ss = harmonics(top, False, phase, sines=True)
+
+    def rational(c: Fraction) -> sp.Rational:
+        return sp.Rational(c.numerator, c.denominator)
+
+    value = sp.Integer(0)
+    for kind, n, form in r.harmonics:
+        P = form.approximant
+        a_n = horner([rational(c) for c in P.numerator], w) / horner(
+            [rational(c) for c in P.denominator], w)
+        value += (eps * a_n if form.odd else a_n) * (cs[n] if kind == "cos" else ss[n])
+    limit, _, worst = r.harmonics_verified
+    entry, guard = argument_entry(((eps, sp.Abs(eps) <= sp.Float(limit), 0),
+                                   (t, sp.Abs(t) <= FREE_ARGUMENT_LIMIT, 0)))
+    return (Evaluator(
+        "q_resummed", f"q(t) on the cycle (q'(0) = 0), {len(r.harmonics)} Fourier coefficients "
+        f"each Padé in w, s = omega_resummed(eps)·t (NaN for |eps| > {limit:g}; "
+        f"{worst:.1e} of max |q| at its checks over one period).", (t, eps), tuple(entry),
+        guard, (*body, (phase, omega * t), *lines), value),)
 
 
 def _lower_resummed_amplitude(r: ResummedCycle) -> tuple[Evaluator, ...]:
@@ -774,7 +806,11 @@ def resummed_constants(r: ResummedCycle) -> tuple[tuple[str, object], ...]:
             ("RESUMMED_DEGREES", r.form.approximant.degrees),
             *((("AMPLITUDE_RESUMMED_LIMIT", r.amplitude_verified[0]),
                ("AMPLITUDE_RESUMMED_ERROR", r.amplitude_verified[2]))
-              if r.amplitude is not None else ()))
+              if r.amplitude is not None else ()),
+            *((("Q_RESUMMED_LIMIT", r.harmonics_verified[0]),
+               ("Q_RESUMMED_ERROR", r.harmonics_verified[2]),
+               ("Q_RESUMMED_HARMONICS", len(r.harmonics)))
+              if r.harmonics else ()))
 
 
 def cubic_branches(omega: sp.Symbol, eps: sp.Symbol, force: sp.Symbol) -> tuple[sp.Expr, ...]:

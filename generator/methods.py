@@ -91,6 +91,7 @@ from .numerics import cycle_reference, duffing_period_exact, shoot
 from .resum import (
     Resummed,
     resum_frequency,
+    resum_harmonic,
     resum_relaxation,
     resum_series,
     van_der_pol_relaxation,
@@ -577,9 +578,96 @@ def resum_cycle(lc: object, tolerance: float = RESUM_TOLERANCE) -> ResummedCycle
     except InputError:
         amplitude = None
     amp = _verified(amplitude, lambda e: reference(e).q0, tolerance) if amplitude else None
+    harmonics, q_verified = _resum_q(lc, form, tolerance, reference)
     return ResummedCycle(form, *omega, tolerance=tolerance,
                          amplitude=amplitude if amp else None,
-                         amplitude_verified=amp if amp else (0.0, (), float("nan")))
+                         amplitude_verified=amp if amp else (0.0, (), float("nan")),
+                         harmonics=harmonics, harmonics_verified=q_verified)
+
+
+HARMONIC_TAIL = 1e-3
+# NOTE: q_resummed's harmonics are resummed in increasing n until two in a row stay below
+# tolerance·HARMONIC_TAIL wherever the summed spread allows (van der Pol from order 100: ~40
+# of its 201 cos/sin series); then the smallest are dropped while their largest values on the
+# verified range add up to less than tolerance·HARMONIC_TAIL.
+Q_SAMPLES = 64
+# NOTE: q_resummed is checked against the shot cycle at this many times of one period.
+
+
+def _resum_q(lc: object, form: Resummed, tolerance: float, reference: Callable
+             ) -> tuple[tuple[tuple[str, int, Resummed], ...],
+                        tuple[float, tuple[float, ...], float]]:
+    """The Fourier coefficients of ``q(s)`` each resummed (:func:`resum.resum_harmonic`, in
+    ω's ``w``) and the |ε| up to which their sum, at ``s = form(ε)·t``, is within
+    ``tolerance`` of max |q| of the shot cycle over one period: the summed neighbour spread
+    on the grid of :func:`resum_cycle`, then the shooting checks (nothing when ω's form has
+    no ``w`` or no coefficient resums)."""
+    from .numerics import cycle_samples
+
+    none: tuple = ((), (0.0, (), float("nan")))
+    if form.R is None:
+        return none
+    table: dict[tuple[str, int], list[Fraction]] = {}
+    K = len(lc.q) - 1
+    for j, (cos, sin) in enumerate(lc.q):
+        for kind, part in (("cos", cos), ("sin", sin)):
+            for n, c in part.items():
+                table.setdefault((kind, n), [Fraction(0)] * (K + 1))[j] = Fraction(c)
+    grid = np.linspace(0.0, RESUM_RANGE, RESUM_GRID + 1)[1:]
+    spread = np.zeros_like(grid)
+    forms: list[tuple[str, int, Resummed]] = []
+    quiet = 0
+    for n in sorted({n for _, n in table}):
+        largest = 0.0
+        for kind in ("cos", "sin"):
+            if (kind, n) not in table:
+                continue
+            try:
+                f = resum_harmonic(table[kind, n], form.R, form.p)
+            except InputError:  # too few terms, or poles: left out, the checks decide
+                continue
+            forms.append((kind, n, f))
+            spread = spread + np.nan_to_num(f.spread(grid), nan=np.inf)
+            inside = grid[: _first_false(spread <= tolerance)]
+            largest = max(largest, float(np.max(np.abs(f(inside)))) if inside.size else 0.0)
+        quiet = quiet + 1 if largest <= tolerance * HARMONIC_TAIL else 0
+        if quiet == 2:
+            break
+    end = _first_false(spread <= tolerance)
+    if not forms or end == 0:
+        return none
+    inside = grid[:end]
+    sizes = sorted(((float(np.max(np.abs(f(inside)))), i) for i, (_, _, f) in enumerate(forms)))
+    dropped, total = set(), 0.0
+    for size, i in sizes:
+        if total + size > tolerance * HARMONIC_TAIL:
+            break
+        dropped.add(i)
+        total += size
+    forms = [h for i, h in enumerate(forms) if i not in dropped]
+
+    def q(t: np.ndarray, e: float) -> np.ndarray:
+        s = float(form(e)) * t
+        return sum(f(e) * (np.cos(n * s) if kind == "cos" else np.sin(n * s))
+                   for kind, n, f in forms)
+
+    limit, points, worst = float(inside[-1]), [], 0.0
+    for e in [e for e in RESUM_CHECKS if e < limit] + [limit]:
+        t, truth = cycle_samples(lc.model, e, reference(e), Q_SAMPLES)
+        error = float(np.max(np.abs(q(t, e) - truth)) / np.max(np.abs(truth)))
+        if not error <= tolerance:
+            limit = points[-1] if points else 0.0
+            break
+        points.append(e)
+        worst = max(worst, error)
+    if not points:
+        return none
+    return tuple(forms), (round(limit, 12), tuple(points), worst)
+
+
+def _first_false(ok: np.ndarray) -> int:
+    """The index of the first False in ``ok`` (its length when there is none)."""
+    return int(np.argmin(ok)) if not ok.all() else len(ok)
 
 
 def _verified(form: Resummed, truth: Callable[[float], float], tolerance: float,

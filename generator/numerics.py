@@ -993,6 +993,24 @@ def cycle_reference(model: object, eps: float, guess: float = 2.0, period: float
     return CycleReference(q0, T, abs(T - T_coarse) / T)
 
 
+def cycle_samples(model: object, eps: float, reference: CycleReference, points: int
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """``(t, q(t))`` at ``points`` equally spaced times of one period of the shot cycle
+    (:func:`cycle_reference`), from its maximum ``(q(0), 0)`` by DOP853 at its tolerance."""
+    from scipy.integrate import solve_ivp
+
+    terms = [(a, b, float(c)) for a, b, c in model.terms]
+
+    def rhs(t: float, y: np.ndarray) -> list[float]:
+        q, v = y
+        return [v, -q + eps * sum(c * q**a * v**b for a, b, c in terms)]
+
+    t = reference.period * np.arange(points) / points
+    sol = solve_ivp(rhs, (0.0, reference.period), [reference.q0, 0.0], method="DOP853",
+                    rtol=CYCLE_RTOL, atol=CYCLE_RTOL / 10, t_eval=t)
+    return t, sol.y[0]
+
+
 def mathieu_reference(kind: str, m: int, q: float, size: int | None = None,
                       dps: int | None = None) -> float:
     """Mathieu's characteristic value ``a_m(q)`` or ``b_m(q)`` (DLMF §28.2, ``y'' + (a − 2q

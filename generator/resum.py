@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 
 import flint
@@ -175,8 +175,9 @@ class Resummed:
     that falls as ``x^(−1/2)``: ``ω²/(1 − w)`` is what is approximated).  With ``log`` set (a
     relaxation oscillation, :func:`resum_relaxation`) the approximant is in
     ``v = 1 − (1 − w)^(1/3)`` and ``log · s³ ln s`` (``s = 1 − v``) is added to it before
-    the square root.  ``neighbour`` is ``[L−1/M−1]`` of the same series, for the error
-    estimate."""
+    the square root.  ``rooted`` False (a Fourier coefficient, :func:`resum_harmonic`) takes
+    ``[L/M](w)`` itself; ``odd`` multiplies the value by ``z`` (a series ``z·Σ c_k z^(2k)``).
+    ``neighbour`` is ``[L−1/M−1]`` of the same series, for the error estimate."""
 
     power: int
     approximant: Pade
@@ -184,15 +185,21 @@ class Resummed:
     R: Fraction | None = None
     p: Fraction | None = None
     log: Fraction | None = None
+    rooted: bool = True
+    odd: bool = False
 
     def _x(self, z: np.ndarray) -> np.ndarray:
         return np.asarray(z, dtype=float) ** self.power
 
     def _value(self, approximant: Pade, z: np.ndarray) -> np.ndarray:
+        if self.odd:
+            return np.asarray(z, dtype=float) * replace(self, odd=False)._value(approximant, z)
         x = self._x(z)
         if self.R is None:
             return approximant(x)
         w = w_of(x, float(self.R), float(self.p))
+        if not self.rooted:
+            return approximant(w)
         if self.log is None:
             return np.sqrt((1 - w) * approximant(w))
         s = np.cbrt(1 - w)
@@ -208,7 +215,7 @@ class Resummed:
         """``|f_[L/M] − f_[L−1/M−1]| / |f_[L/M]|``: the error estimate."""
         a, b = self._value(self.approximant, z), self._value(self.neighbour, z)
         with np.errstate(divide="ignore", invalid="ignore"):
-            return np.abs(a - b) / np.maximum(np.abs(a), 1.0 if self.R is None else 0.0)
+            return np.abs(a - b) / np.maximum(np.abs(a), 0.0 if self.rooted and self.R else 1.0)
 
 
 def in_power(coefficients: Sequence[Fraction]) -> tuple[int, list[Fraction]]:
@@ -274,6 +281,43 @@ def resum_frequency(coefficients: Sequence[Fraction], radius: float, angle: floa
     R, p = _singularity(radius, angle)
     approximant, neighbour = diagonal_pade(_over_one_minus_w(c, R, p), 0.0, 1.0, "w")
     return Resummed(2, approximant, neighbour, R, p)
+
+
+def resum_harmonic(coefficients: Sequence[Fraction], R: Fraction, p: Fraction) -> Resummed:
+    """One Fourier coefficient of a limit cycle's ``q(s)`` as a function of ε (its series even
+    in ε, or ε times an even one) as Padé in Andersen & Geer's ``w`` (``R``, ``p = R cos β``
+    of ω's singularity, :func:`resum_frequency`): the series re-expanded in ``w`` and the
+    near-diagonal ``[L/M](w)`` pole-free on ``0 ≤ w ≤ 1``, both in balls at
+    :data:`RELAXATION_PRECISION` bits (the exact route costs seconds per harmonic at order
+    100).  Measured (van der Pol, order 100, the harmonics summed against DOP853): 2.6e-8 at
+    ε = 2.5, 4.7e-6 at 3, 2e-1 at 6 where Padé in ε² has poles past ε ≈ 4."""
+    c = [Fraction(x) for x in coefficients]
+    odd = len(c) > 3 and not any(c[0::2])
+    power, c = in_power(c[1:] if odd else c)
+    if power != 2:
+        raise InputError("resum_harmonic: the series must be even in ε or ε times an even one")
+    N = len(c) - 1
+    if sum(1 for x in c if x) < 3:
+        raise InputError(f"resum_harmonic: {sum(1 for x in c if x)} nonzero terms are too few")
+    old, flint.ctx.prec = flint.ctx.prec, RELAXATION_PRECISION
+    try:
+        g = flint.arb_poly([_arb(x) for x in w_substitution(R, p, N)])
+        acc = flint.arb_poly([])
+        for x in reversed(c):  # Σ c_k x(w)^k to w^N, Horner in truncated products
+            acc = (acc * g).truncate(N + 1) + _arb(x)
+        series = [acc[k] if k < acc.length() else flint.arb(0) for k in range(N + 1)]
+    finally:
+        flint.ctx.prec = old
+    half = N // 2
+    for M in sorted(range(1, N), key=lambda m: (abs(m - half), -m)):
+        try:
+            pair = (two_point_pade(series, [], N - M, M, "w"),
+                    two_point_pade(series[:N], [], N - M - 1, M - 1, "w"))
+        except InputError:
+            continue
+        if not any(real_poles(P, 0.0, 1.0) for P in pair):
+            return Resummed(2, *pair, R, p, rooted=False, odd=odd)
+    raise InputError("Padé in w: every near-diagonal approximant has a pole on [0, 1]")
 
 
 def _singularity(radius: float, angle: float) -> tuple[Fraction, Fraction]:
