@@ -2,7 +2,7 @@
 # model: balance, order: 4
 # command: lindstedt generate balance --harmonics 4
 # inputs sha256: b5d2168261d8c00fcb65880bc8741f3c5a26a9f4dd1fe0fb56b56d98742758bc
-# body sha256: d270c85f82071e303592d96c22c2dd57465928e5b0d86145231f50bb0fdcfe0d
+# body sha256: 26d52aa1d27e02143bf258444cddc84165038a951d2d4c2fbd927bef3263e467
 """Driven Duffing q'' + damping*q' + q + eps*q**3 = force*cos(omega t): harmonic balance with 4 odd harmonics.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -109,7 +109,7 @@ def _integer_overload(v):
     return lambda v: np.int64(0)
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"})
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def _residual(x, omega, eps, force, damping):
     """The kernel behind ``residual``, which checks and converts the arguments."""
     a_1 = x[0]
@@ -254,7 +254,7 @@ def residual(x, omega, eps, force, damping):
     return _residual(v, _real(omega), _real(eps), _real(force), _real(damping))
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"})
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def _jacobian(x, omega, eps, force, damping):
     """The kernel behind ``jacobian``, which checks and converts the arguments."""
     a_1 = x[0]

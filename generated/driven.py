@@ -2,7 +2,7 @@
 # model: driven, order: 3
 # command: lindstedt generate driven --order 3
 # inputs sha256: cef33ff01dffb2211c3af2d37365f7b8bff5e57c04ba6b53bf77b6cbbf023e34
-# body sha256: 40cf5bef1e9173e820ba051658c4530c0fec78b427bd448a199c219a34769108
+# body sha256: 93d6019b928b330c480bb19ce3d44273a7f17d4fd163bf8d66c6ecb48daf8644
 """Driven Duffing q'' + q + eps*q**3 = f cos(omega t): μ-expansion to order 3.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -153,7 +153,7 @@ def _sin(x):
     return v if abs(x) < TRIG_LIMIT else math.nan
 
 
-@vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_1(omega, eps, force, branch):
     """Coefficient of cos 1ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
     inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
@@ -195,7 +195,7 @@ def A_1(omega, eps, force, branch):
     return (0.0001220703125)*A1*(8192*x_0*x_4 - 96*x_1*x_3**2*x_6*(-2*x_1 + 3*x_2 + 2)*(-x_1*x_8 - 16*x_1 + 8*x_5 + 45*x_6 + x_8 + 8) - 768*x_3**4*x_7 - 3*x_6*(66825*A1**12*eps**6 + 1024*omega**12 - x_0*x_14 - x_0*x_19 - x_0*x_20 - 20480*x_0 - 571680*x_1*x_15 - x_1*x_17 - x_1*x_18 - x_1*x_20 - x_1*x_21 - 6144*x_1 - x_10*x_11 - 6144*x_10 + x_11 + x_12*x_9 + x_12 + x_14 + x_16*x_5 + x_16 + x_17 + x_18*x_9 + x_19*x_5 + x_21*x_5 + 15360*x_5 + 421248*x_7 + 15360*x_9 + 1024))/(x_0*x_4)
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _A_1_into(out, omega_in, eps_in, force_in, branch_in):
     """The loop behind ``A_1_into``, which checks and converts the arguments."""
     omega_in = _apart(omega_in, out)
@@ -268,7 +268,7 @@ def A_1_into(out, omega, eps, force, branch):
     return _A_1_into(out, omega, eps, force, branch)
 
 
-@vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_3(omega, eps, force, branch):
     """Coefficient of cos 3ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
     inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
@@ -304,7 +304,7 @@ def A_3(omega, eps, force, branch):
     return (0.0001220703125)*A1**3*eps*(4131*A1**10*eps**5 - 256*omega**10 - x_0*x_13 - x_0*x_9 - 2560*x_0 - 33696*x_1*x_10 - x_1*x_12 - x_1*x_13 - x_1*x_14 + 8*x_1*x_3**2*(-x_1*x_15 - 32*x_1 + x_15 + 16*x_5 + 45*x_8 + 16) - 1280*x_1 + x_11*x_5 + x_11 + x_12 + x_14*x_5 + 14976*x_2*x_5 + 256*x_4*x_5 + 2560*x_5 + x_6*x_7 + 1280*x_6 + x_7 + x_9 + 256)/(x_0*x_4)
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _A_3_into(out, omega_in, eps_in, force_in, branch_in):
     """The loop behind ``A_3_into``, which checks and converts the arguments."""
     omega_in = _apart(omega_in, out)
@@ -371,7 +371,7 @@ def A_3_into(out, omega, eps, force, branch):
     return _A_3_into(out, omega, eps, force, branch)
 
 
-@vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_5(omega, eps, force, branch):
     """Coefficient of cos 5ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
     inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
@@ -396,7 +396,7 @@ def A_5(omega, eps, force, branch):
     return (2.0345052083333332e-05)*A1**5*x_0*(99*A1**4*x_0 + 32*omega**4 + 48*x_1*x_3 - x_1*x_4 - 64*x_1 + x_4 + 32)/(omega**6*x_3)
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _A_5_into(out, omega_in, eps_in, force_in, branch_in):
     """The loop behind ``A_5_into``, which checks and converts the arguments."""
     omega_in = _apart(omega_in, out)
@@ -452,7 +452,7 @@ def A_5_into(out, omega, eps, force, branch):
     return _A_5_into(out, omega, eps, force, branch)
 
 
-@vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def A_7(omega, eps, force, branch):
     """Coefficient of cos 7ωt, μ-expansion order 3, undamped (eq. 10.66–10.72)."""
     inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
@@ -472,7 +472,7 @@ def A_7(omega, eps, force, branch):
     return (3.0517578125e-05)*A1**7*eps**3/omega**6
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _A_7_into(out, omega_in, eps_in, force_in, branch_in):
     """The loop behind ``A_7_into``, which checks and converts the arguments."""
     omega_in = _apart(omega_in, out)
@@ -523,7 +523,7 @@ def A_7_into(out, omega, eps, force, branch):
     return _A_7_into(out, omega, eps, force, branch)
 
 
-@vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def first_order(omega, eps, force, branch):
     """A₁ of the branch: a real root of (ω² − 1)A₁ − ¾εA₁³ + f = 0."""
     inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
@@ -542,7 +542,7 @@ def first_order(omega, eps, force, branch):
     return A1
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _first_order_into(out, omega_in, eps_in, force_in, branch_in):
     """The loop behind ``first_order_into``, which checks and converts the arguments."""
     omega_in = _apart(omega_in, out)

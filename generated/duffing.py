@@ -2,7 +2,7 @@
 # model: duffing, order: 12
 # command: lindstedt generate duffing --order 12
 # inputs sha256: 66ca4a0e4d6afa8046c93839a6f1efa563f457106a4ae4f18222a37b87ca56f2
-# body sha256: 2ce966b0185275b600e0cb4baefc45e6666210ee23e47fc6cfa95af1b53f0237
+# body sha256: 49eb22052cb6b2663dea2e5a647255bc821e29727a276047e992af2a9cca4237
 """q'' + q + eps*q**3 = 0: L–P evaluators to order 12 in x = eps*A**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -232,7 +232,7 @@ def _sin(x):
     return v if abs(x) < TRIG_LIMIT else math.nan
 
 
-@vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def omega(A, eps):
     """Frequency ω to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
     inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
@@ -247,7 +247,7 @@ def omega(A, eps):
     return x**8*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + x**4*(x*(x*((0.011320983991026878)*x - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + x*(x*((0.03955078125)*x - 0.08203125) + 0.375) + 1
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _omega_into(out, A_in, eps_in):
     """The loop behind ``omega_into``, which checks and converts the arguments."""
     A_in = _apart(A_in, out)
@@ -284,7 +284,7 @@ def omega_into(out, A, eps):
     return _omega_into(out, A, eps)
 
 
-@vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def period(A, eps):
     """Period T = 2π Σ τ_j y^j to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
     inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
@@ -299,7 +299,7 @@ def period(A, eps):
     return 2*math.pi*(x**8*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) + x**4*(x*(x*(0.07641269266605377 - 0.0651973094791174*x) - 0.09219503402709961) + 0.11575698852539062) + x*(x*(0.22265625 - 0.15380859375*x) - 0.375) + 1)
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _period_into(out, A_in, eps_in):
     """The loop behind ``period_into``, which checks and converts the arguments."""
     A_in = _apart(A_in, out)
@@ -336,7 +336,7 @@ def period_into(out, A, eps):
     return _period_into(out, A, eps)
 
 
-@vectorize(["float64(float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def q(t, A, eps):
     """q(t) with s = ωt, harmonics by the Chebyshev recurrence (NaN where no periodic orbit exists or beyond the radius of convergence)."""
     inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(t) and not math.isinf(t)) else (0))
@@ -369,7 +369,7 @@ def q(t, A, eps):
     return A*(c_1*(x**8*(x*(x*(x*((0.003360731924809097)*x - 0.003774145272174567) + 0.004282330716637084) - 0.004917771686052674) + 0.005727690650928707) + x**4*(x*(x*(0.008187539875507355 - 0.006782188720535487*x) - 0.010108232498168945) + 0.012804031372070312) + x*(x*(0.0224609375 - 0.016693115234375*x) - 0.03125) + 1) + c_11*(x**8*(x*(x*(x*(1.3087373540998648e-06 - 1.6402637805917886e-06*x) - 9.935972045127528e-07) + 7.052073272006965e-07) - 4.550238372758031e-07) + x**5*(x*((2.543092705309391e-07)*x - 1.1175870895385742e-07) + 2.9802322387695312e-08)) + c_13*(x**8*(x*(x*(x*((8.806324998562876e-08)*x - 6.119426432249497e-08) + 3.931142966706602e-08) - 2.2646418074145913e-08) + 1.1108568287454545e-08) + x**6*(9.313225746154785e-10 - 4.190951585769653e-09*x)) + c_15*(x**8*(x*(x*(x*(2.0334603167970755e-09 - 3.4668378792734877e-09*x) - 1.057841814144922e-09) + 4.623075255949516e-10) - 1.5279510989785194e-10) + (2.9103830456733704e-11)*x**7) + c_17*x**8*(x*(x*(x*((9.932005478469064e-11)*x - 4.709566070459914e-11) + 1.8557599901214417e-11) - 5.4569682106375694e-12) + 9.094947017729282e-13) + c_19*x**9*(x*(x*(7.243650124166834e-13 - 2.01917649267358e-12*x) - 1.9184653865522705e-13) + 2.842170943040401e-14) + c_21*x**10*(x*((2.7649757483594328e-14)*x - 6.661338147750939e-15) + 8.881784197001252e-16) + c_23*x**11*(2.7755575615628914e-17 - 2.2898349882893854e-16*x) + (8.673617379884035e-19)*c_25*x**12 + c_3*(x**8*(x*(x*(x*(0.004997721172204567 - 0.004511974426832138*x) - 0.005584016058906904) + 0.006302379451256002) - 0.007197538728178188) + x**4*(x*(x*((0.008334227924933657)*x - 0.009808039292693138) + 0.011763006448745728) - 0.014420509338378906) + x*(x*((0.01812744140625)*x - 0.0234375) + 0.03125)) + c_5*(x**8*(x*(x*(x*((0.0013433685999081823)*x - 0.0014134074478067415) + 0.0014870785489202731) - 0.0015627185715061387) + 0.0016369638851756463) + x**4*(x*(x*(0.001750401221215725 - 0.001703433255897835*x) - 0.0017566680908203125) + 0.0016841888427734375) + x**2*(0.0009765625 - 0.00146484375*x)) + c_7*(x**8*(x*(x*(x*(0.00020843979529078238 - 0.00021279163061809457*x) - 0.00020168606560933) + 0.00019184533317684327) - 0.00017809568817028776) + x**4*(x*(x*((0.00015951742534525692)*x - 0.00013522803783416748) + 0.00010472536087036133) - 6.866455078125e-05) + (3.0517578125e-05)*x**3) + c_9*(x**8*(x*(x*(x*((2.2221102773139177e-05)*x - 1.9857777686205225e-05) + 1.7248184208895623e-05) - 1.4417544662137516e-05) + 1.1423947398725431e-05) + x**4*(x*(x*(5.4370611906051636e-06 - 8.373521268367767e-06*x) - 2.86102294921875e-06) + 9.5367431640625e-07)))
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _q_into(out, t_in, A_in, eps_in):
     """The loop behind ``q_into``, which checks and converts the arguments."""
     t_in = _apart(t_in, out)
@@ -430,7 +430,7 @@ def q_into(out, t, A, eps):
     return _q_into(out, t, A, eps)
 
 
-@vectorize(["float64(float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def qdot(t, A, eps):
     """dq/dt (NaN where no periodic orbit exists or beyond the radius of convergence)."""
     inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(t) and not math.isinf(t)) else (0))
@@ -476,7 +476,7 @@ def qdot(t, A, eps):
     return -A*w*(s_1*(x**8*(x*(x*(x*((0.003360731924809097)*x - 0.003774145272174567) + 0.004282330716637084) - 0.004917771686052674) + 0.005727690650928707) + x**4*(x*(x*(0.008187539875507355 - 0.006782188720535487*x) - 0.010108232498168945) + 0.012804031372070312) + x*(x*(0.0224609375 - 0.016693115234375*x) - 0.03125) + 1) + s_11*(11*x**8*(x*(x*(x*(1.3087373540998648e-06 - 1.6402637805917886e-06*x) - 9.935972045127528e-07) + 7.052073272006965e-07) - 4.550238372758031e-07) + 11*x**5*(x*((2.543092705309391e-07)*x - 1.1175870895385742e-07) + 2.9802322387695312e-08)) + s_13*(13*x**8*(x*(x*(x*((8.806324998562876e-08)*x - 6.119426432249497e-08) + 3.931142966706602e-08) - 2.2646418074145913e-08) + 1.1108568287454545e-08) + 13*x**6*(9.313225746154785e-10 - 4.190951585769653e-09*x)) + s_15*(15*x**8*(x*(x*(x*(2.0334603167970755e-09 - 3.4668378792734877e-09*x) - 1.057841814144922e-09) + 4.623075255949516e-10) - 1.5279510989785194e-10) + (4.3655745685100555e-10)*x**7) + 17*s_17*x**8*(x*(x*(x*((9.932005478469064e-11)*x - 4.709566070459914e-11) + 1.8557599901214417e-11) - 5.4569682106375694e-12) + 9.094947017729282e-13) + 19*s_19*x**9*(x*(x*(7.243650124166834e-13 - 2.01917649267358e-12*x) - 1.9184653865522705e-13) + 2.842170943040401e-14) + 21*s_21*x**10*(x*((2.7649757483594328e-14)*x - 6.661338147750939e-15) + 8.881784197001252e-16) + 23*s_23*x**11*(2.7755575615628914e-17 - 2.2898349882893854e-16*x) + (2.168404344971009e-17)*s_25*x**12 + s_3*(3*x**8*(x*(x*(x*(0.004997721172204567 - 0.004511974426832138*x) - 0.005584016058906904) + 0.006302379451256002) - 0.007197538728178188) + 3*x**4*(x*(x*((0.008334227924933657)*x - 0.009808039292693138) + 0.011763006448745728) - 0.014420509338378906) + 3*x*(x*((0.01812744140625)*x - 0.0234375) + 0.03125)) + s_5*(5*x**8*(x*(x*(x*((0.0013433685999081823)*x - 0.0014134074478067415) + 0.0014870785489202731) - 0.0015627185715061387) + 0.0016369638851756463) + 5*x**4*(x*(x*(0.001750401221215725 - 0.001703433255897835*x) - 0.0017566680908203125) + 0.0016841888427734375) + 5*x**2*(0.0009765625 - 0.00146484375*x)) + s_7*(7*x**8*(x*(x*(x*(0.00020843979529078238 - 0.00021279163061809457*x) - 0.00020168606560933) + 0.00019184533317684327) - 0.00017809568817028776) + 7*x**4*(x*(x*((0.00015951742534525692)*x - 0.00013522803783416748) + 0.00010472536087036133) - 6.866455078125e-05) + (0.000213623046875)*x**3) + s_9*(9*x**8*(x*(x*(x*((2.2221102773139177e-05)*x - 1.9857777686205225e-05) + 1.7248184208895623e-05) - 1.4417544662137516e-05) + 1.1423947398725431e-05) + 9*x**4*(x*(x*(5.4370611906051636e-06 - 8.373521268367767e-06*x) - 2.86102294921875e-06) + 9.5367431640625e-07)))
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _qdot_into(out, t_in, A_in, eps_in):
     """The loop behind ``qdot_into``, which checks and converts the arguments."""
     t_in = _apart(t_in, out)
@@ -550,7 +550,7 @@ def qdot_into(out, t, A, eps):
     return _qdot_into(out, t, A, eps)
 
 
-@vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def error_estimate(A, eps):
     """Relative truncation error of period(), from the first omitted term |τ_{K+1} y^(K+1)| / (1 - |y|/R) over the truncated sum (inf from the radius R on: no bound there)."""
     inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
@@ -566,7 +566,7 @@ def error_estimate(A, eps):
     return (((0.03473509559274875)*abs(x)**13/((1 - abs(x))*abs(T))) if (abs(x) < 1) else (math.inf))
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _error_estimate_into(out, A_in, eps_in):
     """The loop behind ``error_estimate_into``, which checks and converts the arguments."""
     A_in = _apart(A_in, out)

@@ -2,7 +2,7 @@
 # model: pendulum, order: 12
 # command: lindstedt generate pendulum --order 12
 # inputs sha256: 89790c3fd0e75fcdff47f37c71d07dae7a9aef7a774488dd064ce33f5d86074d
-# body sha256: 6b657809c2dc0f7715695e4f481341eac63f9b72a06ccbda38a788a7fbb24d4a
+# body sha256: e7f0562d76de991be43186d422b77a7467e51431e52c61ef07ac6b6c398b95fb
 """theta'' + sin(theta) = 0: L–P evaluators to order 12 in theta0**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -232,7 +232,7 @@ def _sin(x):
     return v if abs(x) < TRIG_LIMIT else math.nan
 
 
-@vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def omega(theta0):
     """Frequency ω to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
     inside = ((1) if (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
@@ -245,7 +245,7 @@ def omega(theta0):
     return x**8*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) + x**4*(x*(x*(-9.840751922602837e-10*x - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) + x*(x*(0.0003255208333333333 - 3.1195746527777775e-05*x) - 0.0625) + 1
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _omega_into(out, theta0_in):
     """The loop behind ``omega_into``, which checks and converts the arguments."""
     theta0_in = _apart(theta0_in, out)
@@ -277,7 +277,7 @@ def omega_into(out, theta0):
     return _omega_into(out, theta0)
 
 
-@vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def period(theta0):
     """Period T = 2π Σ τ_j y^j to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
     inside = ((1) if (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
@@ -290,7 +290,7 @@ def period(theta0):
     return 2*math.pi*(x**8*(x*(x*(x*((6.225550505750492e-14)*x + 6.706433207421971e-13) + 7.286018609303663e-12) + 7.997964280393218e-11) + 8.893476960263209e-10) + x**4*(x*(x*((1.0054783016898737e-08)*x + 1.162356190273135e-07) + 1.3867625063268805e-06) + 1.735611567421565e-05) + x*(x*((0.00023464626736111112)*x + 0.0035807291666666665) + 0.0625) + 1)
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _period_into(out, theta0_in):
     """The loop behind ``period_into``, which checks and converts the arguments."""
     theta0_in = _apart(theta0_in, out)
@@ -322,7 +322,7 @@ def period_into(out, theta0):
     return _period_into(out, theta0)
 
 
-@vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def theta(t, theta0):
     """theta(t) with s = ωt, harmonics by the Chebyshev recurrence (NaN where no periodic orbit exists or beyond the radius of convergence)."""
     inside = ((1) if (not math.isnan(t) and not math.isinf(t)) and (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
@@ -353,7 +353,7 @@ def theta(t, theta0):
     return theta0*(c_1*(x**8*(x*(x*(x*((3.4984411607433767e-15)*x + 3.878009202268865e-14) + 4.344735498323462e-13) + 4.930042159189056e-12) + 5.681685786745562e-11) + x**4*(x*(x*((6.675456890987455e-10)*x + 8.038170937943678e-09) + 9.996626876725855e-08) + 1.2993602315374573e-06) + x*(x*((1.800779312375992e-05)*x + 0.0002766927083333333) + 0.005208333333333333) + 1) + c_11*(x**8*(x*(x*(x*(-5.843292180984549e-17*x - 5.495788137186932e-16) - 5.0589606094380024e-15) - 4.508737103051309e-14) - 3.817531828572678e-13) + x**5*(x*(-2.9609105291051997e-12*x - 1.9402553637822468e-11) - 8.466568860140714e-11)) + c_13*(x**8*(x*(x*(x*((1.3242714775723417e-17)*x + 1.1523759602585313e-16) + 9.605128396550033e-16) + 7.497823643553173e-15) + 5.2580162446247416e-14) + x**6*((3.0316490059097606e-13)*x + 1.1193780944897579e-12)) + c_15*(x**8*(x*(x*(x*(-2.541379686761074e-18*x - 1.9877870668131858e-17) - 1.438468196213516e-16) - 9.202515293004076e-16) - 4.736951571734001e-15) - 1.5158245029548804e-14*x**7) + c_17*x**8*(x*(x*(x*((4.0160776477190643e-19)*x + 2.707522441109568e-18) + 1.5920906568409362e-17) + 7.401486830834377e-17) + 2.0898315757650005e-16) + c_19*x**9*(x*(x*(-5.0160484438354664e-20*x - 2.728575467421853e-19) - 1.1564823173178713e-18) - 2.921639538487254e-18) + c_21*x**10*(x*((4.639858255515223e-21)*x + 1.807003620809174e-20) + 4.130293990420969e-20) + c_23*x**11*(-2.8234431575143343e-22*x - 5.892403111334263e-22) + (8.470329472543004e-24)*c_25*x**12 + c_3*(x**8*(x*(x*(x*(-5.118893044260875e-15*x - 5.620645755506136e-14) - 6.231725052832063e-13) - 6.989937060661281e-12) - 7.952060396147878e-11) + x**4*(x*(x*(-9.206968606684344e-10*x - 1.0900827176280785e-08) - 1.328868867018025e-07) - 1.6848036010849832e-06) + x*(x*(-2.2549099392361112e-05*x - 0.0003255208333333333) - 0.005208333333333333)) + c_5*(x**8*(x*(x*(x*((2.188651330506572e-15)*x + 2.337087131359647e-14) + 2.510335316998842e-13) + 2.714761544988113e-12) + 2.9588948516026717e-11) + x**4*(x*(x*((3.2541503299787954e-10)*x + 3.615249074811553e-09) + 4.058004056335126e-08) + 4.5829349093967015e-07) + x**2*((5.086263020833333e-06)*x + 4.8828125e-05)) + c_7*(x**8*(x*(x*(x*(-7.435204611085893e-16*x - 7.709447897850216e-15) - 8.00000122220847e-14) - 8.300096160181626e-13) - 8.593902766479933e-12) + x**4*(x*(x*(-8.846289241408053e-11*x - 8.979378632767491e-10) - 8.81652037302653e-09) - 7.947285970052083e-08) - 5.449567522321428e-07*x**3) + c_9*(x**8*(x*(x*(x*((2.226967875757958e-16)*x + 2.216709059297162e-15) + 2.1892924835273997e-14) + 2.135816781897645e-13) + 2.042401333301554e-12) + x**4*(x*(x*((1.8871934859433606e-11)*x + 1.6362820234563614e-10) + 1.241763432820638e-09) + 6.622738308376736e-09)))
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _theta_into(out, t_in, theta0_in):
     """The loop behind ``theta_into``, which checks and converts the arguments."""
     t_in = _apart(t_in, out)
@@ -409,7 +409,7 @@ def theta_into(out, t, theta0):
     return _theta_into(out, t, theta0)
 
 
-@vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def thetadot(t, theta0):
     """dtheta/dt (NaN where no periodic orbit exists or beyond the radius of convergence)."""
     inside = ((1) if (not math.isnan(t) and not math.isinf(t)) and (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
@@ -453,7 +453,7 @@ def thetadot(t, theta0):
     return -theta0*w*(s_1*(x**8*(x*(x*(x*((3.4984411607433767e-15)*x + 3.878009202268865e-14) + 4.344735498323462e-13) + 4.930042159189056e-12) + 5.681685786745562e-11) + x**4*(x*(x*((6.675456890987455e-10)*x + 8.038170937943678e-09) + 9.996626876725855e-08) + 1.2993602315374573e-06) + x*(x*((1.800779312375992e-05)*x + 0.0002766927083333333) + 0.005208333333333333) + 1) + s_11*(11*x**8*(x*(x*(x*(-5.843292180984549e-17*x - 5.495788137186932e-16) - 5.0589606094380024e-15) - 4.508737103051309e-14) - 3.817531828572678e-13) + 11*x**5*(x*(-2.9609105291051997e-12*x - 1.9402553637822468e-11) - 8.466568860140714e-11)) + s_13*(13*x**8*(x*(x*(x*((1.3242714775723417e-17)*x + 1.1523759602585313e-16) + 9.605128396550033e-16) + 7.497823643553173e-15) + 5.2580162446247416e-14) + 13*x**6*((3.0316490059097606e-13)*x + 1.1193780944897579e-12)) + s_15*(15*x**8*(x*(x*(x*(-2.541379686761074e-18*x - 1.9877870668131858e-17) - 1.438468196213516e-16) - 9.202515293004076e-16) - 4.736951571734001e-15) - 2.2737367544323206e-13*x**7) + 17*s_17*x**8*(x*(x*(x*((4.0160776477190643e-19)*x + 2.707522441109568e-18) + 1.5920906568409362e-17) + 7.401486830834377e-17) + 2.0898315757650005e-16) + 19*s_19*x**9*(x*(x*(-5.0160484438354664e-20*x - 2.728575467421853e-19) - 1.1564823173178713e-18) - 2.921639538487254e-18) + 21*s_21*x**10*(x*((4.639858255515223e-21)*x + 1.807003620809174e-20) + 4.130293990420969e-20) + 23*s_23*x**11*(-2.8234431575143343e-22*x - 5.892403111334263e-22) + (2.117582368135751e-22)*s_25*x**12 + s_3*(3*x**8*(x*(x*(x*(-5.118893044260875e-15*x - 5.620645755506136e-14) - 6.231725052832063e-13) - 6.989937060661281e-12) - 7.952060396147878e-11) + 3*x**4*(x*(x*(-9.206968606684344e-10*x - 1.0900827176280785e-08) - 1.328868867018025e-07) - 1.6848036010849832e-06) + 3*x*(x*(-2.2549099392361112e-05*x - 0.0003255208333333333) - 0.005208333333333333)) + s_5*(5*x**8*(x*(x*(x*((2.188651330506572e-15)*x + 2.337087131359647e-14) + 2.510335316998842e-13) + 2.714761544988113e-12) + 2.9588948516026717e-11) + 5*x**4*(x*(x*((3.2541503299787954e-10)*x + 3.615249074811553e-09) + 4.058004056335126e-08) + 4.5829349093967015e-07) + 5*x**2*((5.086263020833333e-06)*x + 4.8828125e-05)) + s_7*(7*x**8*(x*(x*(x*(-7.435204611085893e-16*x - 7.709447897850216e-15) - 8.00000122220847e-14) - 8.300096160181626e-13) - 8.593902766479933e-12) + 7*x**4*(x*(x*(-8.846289241408053e-11*x - 8.979378632767491e-10) - 8.81652037302653e-09) - 7.947285970052083e-08) - 3.814697265625e-06*x**3) + s_9*(9*x**8*(x*(x*(x*((2.226967875757958e-16)*x + 2.216709059297162e-15) + 2.1892924835273997e-14) + 2.135816781897645e-13) + 2.042401333301554e-12) + 9*x**4*(x*(x*((1.8871934859433606e-11)*x + 1.6362820234563614e-10) + 1.241763432820638e-09) + 6.622738308376736e-09)))
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _thetadot_into(out, t_in, theta0_in):
     """The loop behind ``thetadot_into``, which checks and converts the arguments."""
     t_in = _apart(t_in, out)
@@ -522,7 +522,7 @@ def thetadot_into(out, t, theta0):
     return _thetadot_into(out, t, theta0)
 
 
-@vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz"})
+@vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def error_estimate(theta0):
     """Relative truncation error of period(), from the first omitted term |τ_{K+1} y^(K+1)| / (1 - |y|/R) over the truncated sum (inf from the radius R on: no bound there)."""
     inside = ((1) if (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
@@ -536,7 +536,7 @@ def error_estimate(theta0):
     return (((5.8202915552354634e-15)*abs(x)**13/((-abs(x)/math.pi**2 + 1)*abs(T))) if (abs(x) < math.pi**2) else (math.inf))
 
 
-@njit(cache=True, fastmath={"arcp", "contract", "nsz"}, error_model="numpy")
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _error_estimate_into(out, theta0_in):
     """The loop behind ``error_estimate_into``, which checks and converts the arguments."""
     theta0_in = _apart(theta0_in, out)

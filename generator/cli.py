@@ -679,7 +679,7 @@ def _demo_limit_cycle(out: Path, overwrite_edited: bool) -> None:
     from .compiler import generate_limit_cycle
     from .emit import load_generated
     from .models import series_model
-    from .numerics import cycle_reference
+    from .numerics import cycle_reference, cycle_samples
 
     model = series_model("van_der_pol", DEMO_CYCLE_ORDER + 2)
     print(f"\nvan der Pol's limit cycle, order {DEMO_CYCLE_ORDER}, ω resummed from order "
@@ -699,6 +699,12 @@ def _demo_limit_cycle(out: Path, overwrite_edited: bool) -> None:
         shot = 2 * np.pi / cycle_reference(model, float(e)).period
         error = f"{abs(resummed / shot - 1):>10.1e}" if np.isfinite(resummed) else f"{'-':>10}"
         print(f"  {e:>5g} {series:>18.15f} {resummed:>18.15f} {shot:>18.15f} {error}")
+    if hasattr(vdp, "q_resummed"):
+        e = min(2.5, vdp.Q_RESUMMED_LIMIT)
+        t, shot = cycle_samples(model, e, cycle_reference(model, e), 64)
+        print(f"  q_resummed(t, {e:g}) over one period against the shot orbit: max error "
+              f"{np.max(np.abs(vdp.q_resummed(t, e) - shot)):.1e} ({vdp.Q_RESUMMED_HARMONICS} "
+              f"harmonics, verified to |eps| <= {vdp.Q_RESUMMED_LIMIT:g}, NaN beyond)")
 
 
 def _demo_slow_flow(out: Path, figures: Path, overwrite_edited: bool) -> None:

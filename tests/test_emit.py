@@ -266,6 +266,13 @@ def test_broadcasting(duf, pend):
     assert pend.theta(tt, 0.5).shape == (5, 1)
 
 
+def _same(a: np.ndarray, b: np.ndarray) -> None:
+    """NaN at the same places, within 2 ulp elsewhere (LLVM may order the additions of a
+    polynomial's Estrin split differently in the vectorised loop: emit.FASTMATH)."""
+    assert np.array_equal(np.isnan(a), np.isnan(b))
+    np.testing.assert_array_max_ulp(a[~np.isnan(a)], b[~np.isnan(b)], maxulp=2)
+
+
 def test_into_twins_equal_the_ufuncs(duf, pend):
     """``<name>_into(out, …)``: scalars and 1-D arrays mixed, the ufunc's values and NaNs;
     its vectorised cos/sin within 2 ulp of libm's, phases beyond 2**20 through libm."""
@@ -279,10 +286,9 @@ def test_into_twins_equal_the_ufuncs(duf, pend):
     x = np.random.default_rng(11).uniform(-1e6, 1e6, 10**5)  # the phase alone: q with ε = 0
     np.testing.assert_allclose(duf.q_into(np.empty_like(x), x, 1.0, 0.0), np.cos(x), rtol=0,
                                atol=2.3e-16)
-    assert np.array_equal(duf.period_into(np.empty(101), 1.0, eps), duf.period(1.0, eps),
-                          equal_nan=True)
+    _same(duf.period_into(np.empty(101), 1.0, eps), duf.period(1.0, eps))
     th = np.linspace(0, 3.5, 101)
-    assert np.array_equal(pend.period_into(np.empty(101), th), pend.period(th), equal_nan=True)
+    _same(pend.period_into(np.empty(101), th), pend.period(th))
     with pytest.raises(ValueError, match="out's length"):
         duf.period_into(np.empty(3), 1.0, eps)
 

@@ -331,8 +331,9 @@ def test_choose_mathieu_weighs_series_pade_and_the_solver():
     assert near.method == "pade" and rows["series"] > 1e-3 and rows["pade"] <= 1e-13
     far = choose_mathieu("a", 0, 1e-13, 0.0, 45.0, order=60, points=5)
     assert far.method == "reference" and far.max_error <= 1e-14
-    with pytest.raises(InputError, match="no method meets it"):
-        choose_mathieu("a", 0, 1e-30, 0.0, 2.0, order=60, points=3)
+    with pytest.raises(InputError, match="no method meets it"):  # the Padé value is NaN past
+        # q ≈ 7 and the refined one can equal the 30-digit reference at a few points
+        choose_mathieu("a", 0, 1e-30, 0.0, 45.0, order=60, points=5)
 
 
 def test_generated_mathieu_module_is_byte_identical(tmp_path):
