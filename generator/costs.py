@@ -234,9 +234,11 @@ def generate_cost(args: argparse.Namespace) -> Cost:
         if limit_cycle_text(args.model) is not None:
             from .methods import RADIUS_ORDER, cycle_series_order
 
-            derived = cycle_series_order(size, getattr(args, "resum_order", None))
+            resum = getattr(args, "resum_order", None)
+            derived = cycle_series_order(size, resum)
             return Cost(power_law(*LIMIT_CYCLE_FIT, derived)
-                        + CYCLE_CHECKS * (derived / RADIUS_ORDER) ** 2, f"order {size}",
+                        + CYCLE_CHECKS * (derived / RADIUS_ORDER) ** 2,
+                        f"order {size}" + (f", --resum-order {resum}" if resum else ""),
                         "generating the limit cycle's evaluators")
         return Cost(derivation + generate_seconds("duffing", size), f"order {size}",
                     "generating the oscillator")
