@@ -193,6 +193,22 @@ def test_harmonic_form_recovers_functions_rational_in_w():
         resum_harmonic([F(1), F(1), F(1), F(1)], F(1), F(-1))
 
 
+def test_emitted_relaxation_form_equals_the_in_process_one(emitted):
+    """The module's omega_resummed (cube root by scaled Halley steps, ln s by the atanh series,
+    Estrin's split) against the same form evaluated with NumPy's cbrt and log1p: the same
+    function to 3e-14 (the Padé's rounding near the verified limit), its twin to 2 ulp."""
+    from lindstedt.lindstedt import derive_limit_cycle, nearest_singularity
+
+    mod, _ = emitted
+    omega = derive_limit_cycle(series_model("van_der_pol", 60), 60).omega
+    est = nearest_singularity(omega)
+    form = resum_relaxation(omega, est.radius, est.angle, van_der_pol_relaxation())
+    e = np.linspace(1e-3, mod.RESUMMED_LIMIT, 2001)
+    value = mod.omega_resummed(e)
+    np.testing.assert_allclose(value, form(e), rtol=3e-14)
+    np.testing.assert_array_max_ulp(mod.omega_resummed_into(np.empty_like(e), e), value, 2)
+
+
 def test_emitted_resummed_q_against_the_shot_orbit(emitted):
     """q_resummed(t, eps) over three periods against DOP853 from the shot cycle's maximum:
     ≤ 1e-11 at ε = 1 (where the order-12 partial sum is 4e-4 off), within the module's
