@@ -651,23 +651,33 @@ def _resum_q(lc: object, form: Resummed, tolerance: float, reference: Callable
         return sum(f(e) * (np.cos(n * s) if kind == "cos" else np.sin(n * s))
                    for kind, n, f in forms)
 
-    limit, points, worst = float(inside[-1]), [], 0.0
-    for e in [e for e in RESUM_CHECKS if e < limit] + [limit]:
+    def error(e: float) -> float:
         t, truth = cycle_samples(lc.model, e, reference(e), Q_SAMPLES)
-        error = float(np.max(np.abs(q(t, e) - truth)) / np.max(np.abs(truth)))
-        if not error <= tolerance:
-            limit = points[-1] if points else 0.0
-            break
-        points.append(e)
-        worst = max(worst, error)
-    if not points:
-        return none
-    return tuple(forms), (round(limit, 12), tuple(points), worst)
+        return float(np.max(np.abs(q(t, e) - truth)) / np.max(np.abs(truth)))
+
+    checked = _checked(round(float(inside[-1]), 12), error, tolerance)
+    return (tuple(forms), checked) if checked else none
 
 
 def _first_false(ok: np.ndarray) -> int:
     """The index of the first False in ``ok`` (its length when there is none)."""
     return int(np.argmin(ok)) if not ok.all() else len(ok)
+
+
+def _checked(limit: float, error: Callable[[float], float], tolerance: float
+             ) -> tuple[float, tuple[float, ...], float] | None:
+    """``(limit, points, worst)``: ``error`` at the check points below ``limit`` and at
+    ``limit`` itself, the domain cut at the last point passed when one misses ``tolerance``;
+    None when the first misses."""
+    points, worst = [], 0.0
+    for e in [e for e in RESUM_CHECKS if e < limit] + [limit]:  # and the end itself
+        err = error(e)
+        if not err <= tolerance:
+            limit = points[-1] if points else 0.0
+            break
+        points.append(e)
+        worst = max(worst, err)
+    return (float(limit), tuple(points), worst) if points else None
 
 
 def _verified(form: Resummed, truth: Callable[[float], float], tolerance: float,
@@ -678,23 +688,15 @@ def _verified(form: Resummed, truth: Callable[[float], float], tolerance: float,
     import numpy as np
 
     grid = np.linspace(0.0, RESUM_RANGE, RESUM_GRID + 1)[1:]
-    ok = form.spread(grid) <= tolerance / margin
-    first_bad = int(np.argmin(ok)) if not ok.all() else len(grid)
-    limit = round(float(grid[first_bad - 1]), 12) if first_bad else 0.0
-    points, worst = [], 0.0
-    if limit == 0.0:
+    end = _first_false(form.spread(grid) <= tolerance / margin)
+    if end == 0:
         return None
-    for e in [e for e in RESUM_CHECKS if e < limit] + [limit]:  # and the end itself
+
+    def error(e: float) -> float:
         value = truth(e)
-        error = abs(float(form(e)) - value) / abs(value)
-        if not error <= tolerance:
-            limit = points[-1] if points else 0.0
-            break
-        points.append(e)
-        worst = max(worst, error)
-    if not points:
-        return None
-    return float(limit), tuple(points), worst
+        return abs(float(form(e)) - value) / abs(value)
+
+    return _checked(round(float(grid[end - 1]), 12), error, tolerance)
 
 
 MATHIEU_TOLERANCE = 1e-15
