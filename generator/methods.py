@@ -87,7 +87,7 @@ from .lower import (
     x_,
 )
 from .models import Model, SelfExcited, check_order, duffing
-from .numerics import cycle_reference, duffing_period_exact, shoot
+from .numerics import cycle_reference, cycle_samples, duffing_period_exact, shoot
 from .resum import (
     Resummed,
     resum_frequency,
@@ -602,8 +602,6 @@ def _resum_q(lc: object, form: Resummed, tolerance: float, reference: Callable
     ``tolerance`` of max |q| of the shot cycle over one period: the summed neighbour spread
     on the grid of :func:`resum_cycle`, then the shooting checks (nothing when ω's form has
     no ``w`` or no coefficient resums)."""
-    from .numerics import cycle_samples
-
     none: tuple = ((), (0.0, (), float("nan")))
     if form.R is None:
         return none

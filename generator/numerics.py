@@ -959,17 +959,24 @@ def _cycle_return(rhs: Callable, a: float, rtol: float, t_max: float) -> tuple[f
     return math.nan, math.nan
 
 
+def _cycle_rhs(model: object, eps: float) -> Callable:
+    """The right-hand side ``(q̇, q̈)`` of ``q̈ + q = ε f(q, q̇)``, ``f = Σ c q^a q̇^b`` (the
+    terms of a :class:`models.SelfExcited`), for SciPy's ``solve_ivp``."""
+    terms = [(a, b, float(c)) for a, b, c in model.terms]
+
+    def rhs(t: float, y: np.ndarray) -> list[float]:
+        q, v = y
+        return [v, -q + eps * sum(c * q**a * v**b for a, b, c in terms)]
+    return rhs
+
+
 def cycle_reference(model: object, eps: float, guess: float = 2.0, period: float = 2 * np.pi,
                     rtol: float = CYCLE_RTOL) -> CycleReference:
     """The attracting limit cycle of ``q̈ + q = ε f(q, q̇)`` (a :class:`models.SelfExcited`)
     at any ``eps > 0``, relaxation oscillations included: the return map to the maximum of q
     (Poincaré section q̇ = 0), a few plain returns from ``guess`` and then the secant method
     on ``P(a) − a``; repeated at ``100 rtol`` for :attr:`CycleReference.accuracy`."""
-    terms = [(a, b, float(c)) for a, b, c in model.terms]
-
-    def rhs(t: float, y: np.ndarray) -> list[float]:
-        q, v = y
-        return [v, -q + eps * sum(c * q**a * v**b for a, b, c in terms)]
+    rhs = _cycle_rhs(model, eps)
 
     def solve(tol: float) -> tuple[float, float]:
         t_max = 4 * max(period, 2 * np.pi + 2 * eps)
@@ -999,15 +1006,9 @@ def cycle_samples(model: object, eps: float, reference: CycleReference, points: 
     (:func:`cycle_reference`), from its maximum ``(q(0), 0)`` by DOP853 at its tolerance."""
     from scipy.integrate import solve_ivp
 
-    terms = [(a, b, float(c)) for a, b, c in model.terms]
-
-    def rhs(t: float, y: np.ndarray) -> list[float]:
-        q, v = y
-        return [v, -q + eps * sum(c * q**a * v**b for a, b, c in terms)]
-
     t = reference.period * np.arange(points) / points
-    sol = solve_ivp(rhs, (0.0, reference.period), [reference.q0, 0.0], method="DOP853",
-                    rtol=CYCLE_RTOL, atol=CYCLE_RTOL / 10, t_eval=t)
+    sol = solve_ivp(_cycle_rhs(model, eps), (0.0, reference.period), [reference.q0, 0.0],
+                    method="DOP853", rtol=CYCLE_RTOL, atol=CYCLE_RTOL / 10, t_eval=t)
     return t, sol.y[0]
 
 

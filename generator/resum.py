@@ -16,7 +16,7 @@ compares with its numerical reference and fixes the verified interval.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from fractions import Fraction
 
@@ -215,7 +215,8 @@ class Resummed:
         """``|f_[L/M] − f_[L−1/M−1]| / |f_[L/M]|``: the error estimate."""
         a, b = self._value(self.approximant, z), self._value(self.neighbour, z)
         with np.errstate(divide="ignore", invalid="ignore"):
-            return np.abs(a - b) / np.maximum(np.abs(a), 0.0 if self.rooted and self.R else 1.0)
+            relative = self.rooted and self.R is not None  # a frequency; else absolute below 1
+            return np.abs(a - b) / np.maximum(np.abs(a), 0.0 if relative else 1.0)
 
 
 def in_power(coefficients: Sequence[Fraction]) -> tuple[int, list[Fraction]]:
@@ -227,19 +228,22 @@ def in_power(coefficients: Sequence[Fraction]) -> tuple[int, list[Fraction]]:
     return 1, c
 
 
-def diagonal_pade(coefficients: Sequence[Fraction], lo: float, hi: float,
-                  variable: str = "x") -> tuple[Pade, Pade]:
+def diagonal_pade(coefficients: Sequence, lo: float, hi: float, variable: str = "x",
+                  build: Callable[[Sequence, int, int, str], Pade] | None = None
+                  ) -> tuple[Pade, Pade]:
     """The pair ``[L/M]``, ``[L−1/M−1]`` with ``L + M`` = the last index and ``M`` nearest
     ``L`` (then ``L + 1``, ``L − 1``, … while one of the pair has a real pole on
-    ``[lo, hi]``): the near-diagonal approximants converge best in the cut plane."""
+    ``[lo, hi]``): the near-diagonal approximants converge best in the cut plane.  ``build``
+    makes one approximant (default :func:`pade`, exact over QQ)."""
+    build = build or pade
     N = len(coefficients) - 1
     if N < 2:
         raise InputError(f"Padé: {N + 1} coefficients are too few to resum")
     half = N // 2
     for M in sorted(range(1, N), key=lambda m: (abs(m - half), -m)):
         try:
-            pair = (pade(coefficients, N - M, M, variable),
-                    pade(coefficients, N - M - 1, M - 1, variable))
+            pair = (build(coefficients, N - M, M, variable),
+                    build(coefficients, N - M - 1, M - 1, variable))
         except InputError:
             continue
         if not any(real_poles(P, lo, hi) for P in pair):
@@ -308,16 +312,9 @@ def resum_harmonic(coefficients: Sequence[Fraction], R: Fraction, p: Fraction) -
         series = [acc[k] if k < acc.length() else flint.arb(0) for k in range(N + 1)]
     finally:
         flint.ctx.prec = old
-    half = N // 2
-    for M in sorted(range(1, N), key=lambda m: (abs(m - half), -m)):
-        try:
-            pair = (two_point_pade(series, [], N - M, M, "w"),
-                    two_point_pade(series[:N], [], N - M - 1, M - 1, "w"))
-        except InputError:
-            continue
-        if not any(real_poles(P, 0.0, 1.0) for P in pair):
-            return Resummed(2, *pair, R, p, rooted=False, odd=odd)
-    raise InputError("Padé in w: every near-diagonal approximant has a pole on [0, 1]")
+    pair = diagonal_pade(series, 0.0, 1.0, "w",
+                         lambda c, L, M, v: two_point_pade(c, [], L, M, v))  # in balls
+    return Resummed(2, *pair, R, p, rooted=False, odd=odd)
 
 
 def _singularity(radius: float, angle: float) -> tuple[Fraction, Fraction]:

@@ -220,13 +220,13 @@ def test_emitted_resummed_q_against_the_shot_orbit(emitted):
     limit = mod.Q_RESUMMED_LIMIT
     assert limit > mod.RADIUS and mod.Q_RESUMMED_ERROR <= mod.RESUMMED_TOLERANCE
     vdp = series_model("van_der_pol", 4)
-    for eps, tol in ((1.0, 1e-11), (limit, 2 * mod.RESUMMED_TOLERANCE)):
+    for eps, tol in ((1.0, 1e-11), (limit, 2 * mod.RESUMMED_TOLERANCE)):  # of max |q|
         ref = cycle_reference(vdp, eps)
         t = np.linspace(0.0, 3 * ref.period, 61)
         run = solve_ivp(lambda _t, y, e=eps: [y[1], -y[0] + e * (1 - y[0] ** 2) * y[1]],
                         (0.0, t[-1]), [ref.q0, 0.0], method="DOP853", rtol=1e-13,
                         atol=1e-14, t_eval=t)
-        assert np.max(np.abs(mod.q_resummed(t, eps) - run.y[0])) <= tol * 2.0
+        assert np.max(np.abs(mod.q_resummed(t, eps) - run.y[0])) <= tol * np.max(np.abs(run.y[0]))
     assert np.all(np.isnan(mod.q_resummed(0.0, np.array([limit + 1e-9, 10.0, np.nan]))))
 
 
