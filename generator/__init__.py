@@ -4,6 +4,8 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
 
     equation   user text through a whitelist walker over ``ast``         str -> Equation
     models     the oscillator registry, a user's Oscillator, its L–P Model  Equation, K -> Model
+    orbits     where a free oscillator's family of periodic orbits ends:  Model -> OrbitDomain
+               the first integral's separatrix, to 30 digits
     series     the one Fourier kernel: exact P(C) + S·R(C) over QQ       (FLINT fmpq_poly) and
                QQ[params] (fmpq_mpoly), the odd-cosine fast path, relaxed (online) products
                of ε-series of Trig sums, and the Laurent form in e^{is} over complex128 for the

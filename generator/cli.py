@@ -113,10 +113,26 @@ def series_json(sol) -> dict:
         "convention": sol.convention,
         "radius": None if m.radius is None else str(m.radius),
     }
+    data.update(_domain_fields(sol))
     if m.source:
         data.update(equation=m.source, omega0=str(m.frequency),
                     units="omega in units of omega0, period in units of 2*pi/omega0")
     return data
+
+
+def _domain_fields(sol) -> dict:
+    """Where the series may be used: ``orbit_limit`` (the family of periodic orbits exists
+    for lower < y < upper, 30 digits, or ``known`` false with the reason) and, where the
+    model states no radius, ``radius_estimate`` (value and spread, from the τ_j)."""
+    from .lower import estimated_radius
+    from .orbits import orbit_domain
+
+    fields = {"orbit_limit": orbit_domain(sol.model).as_json()}
+    if sol.model.radius is None and sol.ground.is_rational and sol.order >= 2:
+        found = estimated_radius(sol, {})
+        if found is not None:
+            fields["radius_estimate"] = {"value": float(found[0]), "spread": found[1]}
+    return fields
 
 
 def series_table(sol) -> str:
@@ -128,6 +144,11 @@ def series_table(sol) -> str:
     ]
     if m.frequency != 1:
         lines.append(f"omega in units of omega0 = {m.frequency}, T in units of 2*pi/omega0")
+    domain = _domain_fields(sol)["orbit_limit"]
+    y = m.variable.partition("=")[0].strip() or m.variable
+    lines.append(f"periodic orbits for {domain['lower']} < {y} < {domain['upper']} "
+                 f"({domain['how']})" if domain["known"] else
+                 f"orbit domain not computed: {domain['how']}")
     if sol.ground.is_rational:
         lines.append(f"{'j':>3}  {'omega_j':>24}  {'(T/2pi)_j':>24}  "
                      "q_j: harmonic n -> coefficient")
@@ -204,6 +225,21 @@ def _int_text(n: int) -> str:
     return str(fmpz(n))
 
 
+def _cycles_json(cycles) -> list[dict]:
+    """Every limit cycle: its first-order amplitude a₀ (exact, SymPy's str), S'(a₀) and its
+    stability, smallest amplitude first."""
+    return [{"amplitude0": str(c.amplitude), "slope": str(c.slope), "stability": c.stability,
+             "expandable": c.rational and c.slope != 0} for c in cycles]
+
+
+def _cycles_text(model, listed: list[dict]) -> str:
+    lines = [f"{model.name}: {len(listed)} limit cycle(s) of S(a), by amplitude:"]
+    for k, c in enumerate(listed, 1):
+        lines.append(f"  cycle {k}: a0 = {c['amplitude0']}, S'(a0) = {c['slope']}: "
+                     f"{c['stability']}")
+    return "\n".join(lines)
+
+
 def limit_cycle_table(lc) -> str:
     m = lc.model
     lines = [f"{m.name}: {m.title}, a limit cycle, expansion variable eps, order {lc.order}",
@@ -217,14 +253,38 @@ def limit_cycle_table(lc) -> str:
 
 
 def _cmd_series(args: argparse.Namespace) -> int:
-    from .lindstedt import derive, derive_limit_cycle
+    from .lindstedt import derive, derive_limit_cycle, limit_cycles
     from .models import SelfExcited, series_model
 
     found = series_model(args.model, args.order, _params(args.param), args.name)
+    if args.cycle is not None and not isinstance(found, SelfExcited):
+        raise InputError(f"--cycle {args.cycle}: {args.model!r} is conservative: a family of "
+                         "orbits, no limit cycles to pick from")
     if isinstance(found, SelfExcited):
-        lc = derive_limit_cycle(found, args.order)
-        data, text = limit_cycle_json(lc), limit_cycle_table(lc)
+        cycles = limit_cycles(found)
+        if args.cycle is not None and not 1 <= args.cycle <= len(cycles):
+            raise InputError(f"--cycle {args.cycle}: {found.name} has {len(cycles)} limit "
+                             f"cycle(s), numbered 1 to {len(cycles)} by amplitude")
+        listed = _cycles_json(cycles)
+        first = args.cycle if args.cycle is not None else 1
+        lc = derive_limit_cycle(found, args.order, first - 1)
+        data = {**limit_cycle_json(lc), "cycle": first, "cycles": listed}
         omega = lc.omega
+        # the table: the cycle asked for, or each in turn (one that cannot be expanded says why)
+        texts = [_cycles_text(found, listed)]
+        for k in ([first] if args.cycle is not None else range(1, len(cycles) + 1)):
+            c = cycles[k - 1]
+            if k == first:
+                texts.append(f"cycle {k}: " + limit_cycle_table(lc))
+            elif c.slope == 0:
+                texts.append(f"cycle {k}: not expanded: {c.stability}")
+            elif not c.rational:
+                texts.append(f"cycle {k}: not expanded: its amplitude {c.amplitude} is "
+                             "irrational (the exact series need a rational one)")
+            else:
+                texts.append(f"cycle {k}: " + limit_cycle_table(
+                    derive_limit_cycle(found, args.order, k - 1)))
+        text = "\n\n".join(texts)
     else:
         model = found  # series_model built it (model_from_text): parse and expand once
         progress = Progress(f"deriving {model.name} to order {args.order}", not args.json)
@@ -1977,6 +2037,10 @@ def build_parser() -> argparse.ArgumentParser:
                        "cycles (the amplitude fixed order by order).")
     _flag_oscillator(p)
     _flag_order(p, "highest order K of the series")
+    p.add_argument("--cycle", type=int, default=None, metavar="N",
+                   help="a self-excited oscillator's N-th limit cycle (by amplitude, from 1) "
+                   "to expand; default: each in turn in the table, the first in --json "
+                   "(which lists every cycle under 'cycles')")
     p.add_argument("--singularities", action="store_true",
                    help="also estimate the nearest singularities of ω from the exact series "
                    "(Domb–Sykes or Mercer–Roberts, extrapolated in 1/n; their spread over the "

@@ -615,25 +615,42 @@ class CycleOrder:
     q: tuple[dict[int, Fraction], dict[int, Fraction]]
 
 
-def limit_cycle_amplitudes(model: Any) -> list[tuple[Fraction, Fraction]]:
-    """The positive roots ``a₀`` of ``S(a) = [sin s] f(a cos s, −a sin s)`` (the first-order
-    secular condition) with ``S'(a₀)``, smallest first; an irrational root is refused (the
-    series are exact rationals)."""
+@dataclass(frozen=True)
+class Cycle:
+    """One positive root ``a₀`` of the first-order amplitude function ``S(a)`` (exact: a
+    rational or an algebraic number) and ``S'(a₀)``: the cycle attracts for ``ε S'(a₀) > 0``
+    and repels for the other sign of ε; ``S'(a₀) = 0``: semi-stable (a double root)."""
+
+    amplitude: sp.Expr
+    slope: sp.Expr
+
+    @property
+    def rational(self) -> bool:
+        return bool(self.amplitude.is_Rational)
+
+    @property
+    def stability(self) -> str:
+        if self.slope == 0:
+            return "semi-stable (a double root of S(a)): no series in eps"
+        good, bad = ("eps > 0", "eps < 0") if self.slope > 0 else ("eps < 0", "eps > 0")
+        return f"stable (attracting) for {good}, unstable (repelling) for {bad}"
+
+
+def limit_cycles(model: Any) -> tuple[Cycle, ...]:
+    """Every positive root ``a₀`` of ``S(a) = [sin s] f(a cos s, −a sin s)`` (the first-order
+    secular condition) with ``S'(a₀)``, smallest first; a one-line :class:`InputError` says
+    why when there is none (every orbit decays or grows)."""
     a = sp.Symbol("a")
     g = Ground.for_coefficients([a])
     x = Trig.from_fourier({1: g.scalar(a)}, {}, g)
     f = _force_of(model.terms, x, x.derivative(), g)
     _, sines = f.to_fourier()
     S = sp.expand(g.to_sympy(sines.get(1, g.scalar(0))))
-    found = []
+    found: list[Cycle] = []
     for root in sp.Poly(S, a).real_roots() if S.has(a) else []:
-        if root <= 0 or any(r == root for r, _ in found):
+        if root <= 0 or any(c.amplitude == root for c in found):
             continue
-        if not root.is_Rational:
-            raise InputError(f"{model.name}: the limit cycle's amplitude {root} is irrational; "
-                             "the exact series need a rational one")
-        found.append((Fraction(int(root.p), int(root.q)),
-                      _fraction(sp.diff(S, a).subs(a, root))))
+        found.append(Cycle(root, sp.nsimplify(sp.expand(sp.diff(S, a).subs(a, root)))))
     if not found:
         probe = S.subs(a, 1) if S.has(a) else S
         # NOTE: S(a) > 0 shrinks the amplitude for eps > 0 (averaged: da/dt = −ε S(a)/2)
@@ -644,7 +661,19 @@ def limit_cycle_amplitudes(model: Any) -> list[tuple[Fraction, Fraction]]:
         raise InputError(f"{model.name} ({model.source}): no limit cycle: the first-order "
                          f"amplitude function S(a) = {S} has no positive root, so no cycle "
                          f"branches from the linear oscillator at eps = 0: {fate}")
-    return found
+    return tuple(found)
+
+
+def limit_cycle_amplitudes(model: Any) -> list[tuple[Fraction, Fraction]]:
+    """The cycles of :func:`limit_cycles` as exact ``(a₀, S'(a₀))`` fractions, for the series;
+    an irrational amplitude is refused (the series are exact rationals)."""
+    out = []
+    for k, c in enumerate(limit_cycles(model)):
+        if not c.rational:
+            raise InputError(f"{model.name}: limit cycle {k + 1}'s amplitude {c.amplitude} is "
+                             "irrational; the exact series need a rational one")
+        out.append((_fraction(c.amplitude), _fraction(c.slope)))
+    return out
 
 
 def _fraction(r: sp.Expr) -> Fraction:
@@ -673,10 +702,14 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
     Σ_(i<j) W_i q''_(j−i) + W_j a₀ cos s``: every ε-product is a :class:`RelaxedProduct`."""
     order = check_order(order)
     top = order + 1  # q_K's cos s (so q(0)'s ε^K) is fixed by the secular condition of K + 1
-    cycles = limit_cycle_amplitudes(model)
+    cycles = limit_cycles(model)
     if not 0 <= cycle < len(cycles):
         raise InputError(f"cycle {cycle}: {model.name} has {len(cycles)} limit cycle(s)")
-    a0, slope = cycles[cycle]
+    if not cycles[cycle].rational:
+        raise InputError(f"{model.name}: limit cycle {cycle + 1}'s amplitude "
+                         f"{cycles[cycle].amplitude} is irrational; the exact series need a "
+                         "rational one")
+    a0, slope = _fraction(cycles[cycle].amplitude), _fraction(cycles[cycle].slope)
     if slope == 0:
         raise InputError(f"{model.name}: the cycle at amplitude {a0} is semi-stable (a double "
                          "root of the first-order amplitude function S(a), S'(a) = 0): the "

@@ -13,6 +13,7 @@ import builtins
 import hashlib
 import json
 import keyword
+import math
 import re
 import unicodedata
 from collections.abc import Callable
@@ -46,6 +47,7 @@ from .errors import InputError
 from .lindstedt import LimitCycle, SeriesSolution, nearest_singularity, order_terms
 from .models import Model
 from .numerics import mathieu_recurrence
+from .orbits import OrbitDomain, orbit_domain
 from .printers import identifier
 from .resum import Pade, Resummed
 
@@ -201,6 +203,7 @@ def harmonics(top: int, odd: bool, s: sp.Expr, sines: bool) -> tuple[list[Assign
 MODULE_NAMES = frozenset({
     "math", "np", "numba", "njit", "vectorize", "overload", "types", "TRIG_LIMIT", "SIN_KERNEL",
     "COS_KERNEL", "ORDER", "MODEL", "VARIABLE", "CONVENTION", "RADIUS", "ALLOW_DIVERGENT",
+    "RADIUS_SPREAD", "ORBIT_LIMIT", "ORBIT_LIMIT_EXACT",
     "OMEGA", "PERIOD", "Q", "OMEGA_EXACT", "PERIOD_EXACT", "omega", "period", "error_estimate",
 })
 LOCAL_NAMES = frozenset({"out", "i", "t"})
@@ -228,41 +231,82 @@ def check_emitted_names(model: Model) -> None:
                              f"{name!r}, which it uses already; rename the coordinate")
 
 
-def estimated_radius(solution: SeriesSolution, to_args: dict) -> sp.Expr | None:
-    """The radius of convergence of ``T/2π = Σ τ_j y^j`` where the model knows none: the root
-    test ``min_j |τ_j|^(−1/j)`` over the upper half of the derived orders (the emitted order K
-    and the two above it included) — a number, or an expression in the amplitude and the
-    parameters for a series in ε with coefficients in ``QQ[A, …]``.  None when every τ_j there
-    vanishes (a series that stops: no bound to state)."""
+def estimated_radius(solution: SeriesSolution, to_args: dict
+                     ) -> tuple[sp.Expr, float] | None:
+    """The radius of convergence of ``T/2π = Σ τ_j y^j`` where the model knows none, and its
+    spread (an error bar; the guard and the error estimate take the radius minus it).
+
+    Rational coefficients: the root test ``min_j |τ_j|^(−1/j)`` over the upper half of the
+    derived orders, Domb–Sykes' line of the ratios in 1/j where it fits, and from 12 nonzero
+    coefficients :func:`lindstedt.nearest_singularity` (its extrapolations' spread) — the
+    smallest of them, with the spread of the estimator used, or the distance between the
+    root test and Domb–Sykes below 12 (the range of the root tests without Domb–Sykes).
+    Coefficients in ``QQ[A, …]``: the root test as an expression, spread 0 (no number to
+    state).  None when every τ_j there vanishes (a series that stops: no bound to state)."""
     top = solution.order
     g = solution.ground
-    roots = []
-    for j in range(max(1, top // 2), top + 1):
-        c = g.to_sympy(solution.period[j]).xreplace(to_args)
-        if c != 0:
-            roots.append(sp.Abs(c) ** sp.Rational(-1, j))
+    if not g.is_rational:
+        roots = []
+        for j in range(max(1, top // 2), top + 1):
+            c = g.to_sympy(solution.period[j]).xreplace(to_args)
+            if c != 0:
+                roots.append(sp.Abs(c) ** sp.Rational(-1, j))
+        return (sp.Min(*roots), 0.0) if roots else None
+    import mpmath
+
+    fractions = [g.to_fraction(c) for c in solution.period]
+    tau = [abs(mpmath.mpf(c.numerator) / c.denominator) for c in fractions]
+    roots = [float(tau[j] ** (mpmath.mpf(-1) / j))
+             for j in range(max(1, top // 2), top + 1) if tau[j]]
     if not roots:
         return None
-    root = sp.Min(*roots)
-    if not g.is_rational:
-        return root
+    radius, spread = min(roots), max(roots) - min(roots)
     # Domb–Sykes: |τ_j/τ_(j−1)| = (1 − (1 + γ)/j)/R for a singularity on the real axis; its
     # line in 1/j finds R from ten terms where the root test is still 40 % high (Duffing: 1.0000
-    # against 1.36 at order 10) — taken when the line fits, else the root test alone
-    tau = [abs(float(g.to_fraction(c))) for c in solution.period]
+    # against 1.36 at order 10) — taken when the line fits
     js = [j for j in range(max(2, top // 2), top + 1) if tau[j] and tau[j - 1]]
     if len(js) >= 3:
-        ratios = np.array([tau[j] / tau[j - 1] for j in js])
+        ratios = np.array([float(tau[j] / tau[j - 1]) for j in js])
         design = np.vstack([np.ones(len(js)), 1.0 / np.array(js, dtype=float)]).T
         (a, b), *_ = np.linalg.lstsq(design, ratios, rcond=None)
         if a > 0 and np.max(np.abs(design @ np.array([a, b]) - ratios) / ratios) < DOMB_SYKES_FIT:
-            return sp.Min(root, sp.Float(1 / a, 17))
-    return root
+            spread = abs(radius - 1 / a)
+            radius = min(radius, 1 / a)
+    est = nearest_singularity(fractions, "y", None)
+    if est is not None:
+        r = math.sqrt(est.radius) if est.variable.endswith("**2") else est.radius
+        r_spread = est.spread / (2 * r) if est.variable.endswith("**2") else est.spread
+        if r <= radius:
+            radius, spread = r, r_spread
+    return sp.Float(radius, 17), float(spread)
 
 
 DOMB_SYKES_FIT = 0.02
 # NOTE: the largest relative misfit of the ratios' line for its R to count (a pair of complex
 # singularities makes the ratios oscillate: no line, no estimate from it)
+
+
+def _truncation_bound(solution: SeriesSolution, order: int, x: sp.Symbol,
+                      reach: sp.Expr | None, domain: OrbitDomain) -> sp.Expr:
+    """A bound on ``|Σ_(j>K) τ_j y^j|`` (in units of 2π/ω₀): the first omitted term, then a
+    geometric tail from ``τ_{K+2}`` at the ratio ``r = max(1/R, |τ_{K+2}/τ_{K+1}|)``, ``R``
+    the smaller of ``reach`` (radius less spread) and the distance to the orbits' edge — a
+    singularity of T, where the period diverges.  Ratios of a branch point's coefficients
+    rise toward 1/R (log, square root) or fall toward it (a pole of order > 1): r bounds both.
+    inf from ``r|y| = 1`` on."""
+    g, w0 = solution.ground, solution.model.frequency
+    t1 = sp.Abs(g.to_sympy(solution.period[order + 1]) / w0)
+    t2 = sp.Abs(g.to_sympy(solution.period[order + 2]) / w0)
+    edges = [sp.Float(v, 17) for v in (-domain.lower, domain.upper) if math.isfinite(v)]
+    limits = [e for e in ([reach] if reach is not None else []) + edges]
+    if not limits:  # no radius and no edge: the omitted terms alone
+        return t1 * sp.Abs(x) ** (order + 1) + t2 * sp.Abs(x) ** (order + 2)
+    R = sp.Min(*limits) if len(limits) > 1 else limits[0]
+    r = sp.Max(1 / R, t2 / t1) if t1 != 0 else 1 / R
+    c = sp.Max(t2, r * t1)
+    ax = sp.Abs(x)
+    tail = t1 * ax ** (order + 1) + c * ax ** (order + 2) / (1 - r * ax)
+    return sp.Piecewise((tail, r * ax < 1), (sp.oo, True))
 
 
 def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = False) -> Module:
@@ -292,9 +336,16 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     params = tuple(args.values())
     t = sp.Symbol("t")
     guard = m.orbit_condition.xreplace({sp.Symbol("Y"): x})
-    radius = m.radius if m.radius is not None else estimated_radius(solution, to_args)
-    if radius is not None and not allow_divergent:
-        guard = sp.And(guard, sp.Abs(x) < radius)
+    domain = orbit_domain(m)
+    lo, hi = domain.guard_bounds()
+    for bound, holds in ((lo, x > lo), (hi, x < hi)):
+        if math.isfinite(bound):
+            guard = sp.And(guard, holds)
+    found = (m.radius, 0.0) if m.radius is not None else estimated_radius(solution, to_args)
+    radius, spread = found if found is not None else (None, 0.0)
+    reach = None if radius is None else radius - sp.Float(spread, 17) if spread else radius
+    if reach is not None and not allow_divergent:
+        guard = sp.And(guard, sp.Abs(x) < reach)
     ranges = free_ranges(y, params)
     flag = "inside" if "inside" not in user else "_inside"
     entry, inside = argument_entry(ranges, flag)
@@ -312,37 +363,36 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     cos_lines, cs, _ = harmonics(top, m.odd, s, sines=False)
     both_lines, _, ss = harmonics(top, m.odd, s, sines=True)
     name_of = identifier(str(m.coordinate))
-    domain = "NaN where no periodic orbit exists" + (
-        "" if allow_divergent or radius is None else " or beyond the radius of convergence"
-        + ("" if m.radius is not None else ", estimated by the root test on its last τ_j")
-    )
-    tail = abs(g.to_sympy(solution.period[order + 1]) / m.frequency)
-    estimate = tail * sp.Abs(x) ** (order + 1) / sp.Abs(total)
-    if radius is not None:  # inf at and beyond the radius (--allow-divergent): never negative
-        estimate = sp.Piecewise((estimate / (1 - sp.Abs(x) / radius), sp.Abs(x) < radius),
-                                (sp.oo, True))
+    where = ("NaN where no periodic orbit exists" if domain.known else
+             f"NaN where no periodic orbit exists as far as known: no orbit domain ({domain.how})")
+    where += ("" if allow_divergent or radius is None else
+              " or beyond the radius of convergence"
+              + ("" if m.radius is not None else " less its spread, estimated from its τ_j"))
+    estimate = _truncation_bound(solution, order, x, reach, domain) / sp.Abs(total)
     evaluators = (
-        Evaluator("omega", f"Frequency ω to order {order} ({domain}).", params, prelude, guard,
+        Evaluator("omega", f"Frequency ω to order {order} ({where}).", params, prelude, guard,
                   (), horner(omega, x)),
-        Evaluator("period", f"Period T = 2π Σ τ_j y^j to order {order} ({domain}).", params,
+        Evaluator("period", f"Period T = 2π Σ τ_j y^j to order {order} ({where}).", params,
                   prelude, guard, (), 2 * sp.pi * horner(tau, x)),
         Evaluator(
             name_of,
-            f"{name_of}(t) with s = ωt, harmonics by the Chebyshev recurrence ({domain}).",
+            f"{name_of}(t) with s = ωt, harmonics by the Chebyshev recurrence ({where}).",
             (t, *params), prelude_t, guard_t,
             ((w, horner(omega, x)), (s, w * t), *cos_lines),
             amplitude * sum(h * cs[n] for n, h in sorted(harmonic.items())),
         ),
         Evaluator(
-            f"{name_of}dot", f"d{name_of}/dt ({domain}).", (t, *params), prelude_t, guard_t,
+            f"{name_of}dot", f"d{name_of}/dt ({where}).", (t, *params), prelude_t, guard_t,
             ((w, horner(omega, x)), (s, w * t), *both_lines),
             -amplitude * w * sum(n * h * ss[n] for n, h in sorted(harmonic.items())),
         ),
         Evaluator(
             "error_estimate",
-            "Relative truncation error of period(), from the first omitted term "
-            "|τ_{K+1} y^(K+1)| / (1 - |y|/R) over the truncated sum (inf from the radius R "
-            "on: no bound there).",
+            "Relative truncation error of period(), a bound on the omitted tail: "
+            "|τ_{K+1}| |y|^(K+1) + c |y|^(K+2) / (1 - r|y|), its terms growing at most by "
+            "r = max(1/R, |τ_{K+2}/τ_{K+1}|) an order, R the smaller of the radius less its "
+            "spread and the distance to the orbits' edge, c = max(|τ_{K+2}|, r|τ_{K+1}|); "
+            "over the truncated sum (inf from r|y| = 1 on: no bound there).",
             params, prelude, guard, ((total, horner(tau, x)),), estimate,
         ),
     )
@@ -361,6 +411,9 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
         ("CONVENTION", solution.convention),
         ("RADIUS", float(radius) if radius is not None and radius.is_number
          else float("nan")),
+        ("RADIUS_SPREAD", float(spread)),
+        ("ORBIT_LIMIT", (domain.lower, domain.upper)),
+        ("ORBIT_LIMIT_EXACT", (domain.lower_text, domain.upper_text)),
         ("ALLOW_DIVERGENT", allow_divergent),
         *numeric,
         ("OMEGA_EXACT", tuple(str(c) for c in omega)),
