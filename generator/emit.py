@@ -90,7 +90,11 @@ def banner(p: Provenance, comment: str) -> str:
 def pyliteral(value: object) -> str:
     """Deterministic Python source for a constant (floats round-trip through ``repr``)."""
     if isinstance(value, float):
-        return "math.nan" if math.isnan(value) else repr(value)
+        if math.isnan(value):
+            return "math.nan"
+        if math.isinf(value):
+            return "math.inf" if value > 0 else "-math.inf"
+        return repr(value)
     if isinstance(value, tuple):
         if value and isinstance(value[0], tuple):
             rows = ",\n    ".join(f"[{', '.join(pyliteral(v) for v in row)}]" for row in value)

@@ -176,6 +176,7 @@ class _Float:
     W: Callable
     zeros: Callable  # (side: +1 | -1) -> nearest zero of g₀ on that side, or None
     W_infinity: Callable  # the limit of W toward -inf on the negative side
+    edges: set  # the sides where zeros() met the end of the force's domain (NaN), not a zero
 
 
 def _float_at(sc: _Scaled, s: float) -> _Float:
@@ -191,7 +192,7 @@ def _float_at(sc: _Scaled, s: float) -> _Float:
             found = [r for r in roots if r * side > 0]
             return min(found, key=abs) if found else None
 
-        return _Float(g, Wp, zeros, lambda: math.inf)
+        return _Float(g, Wp, zeros, lambda: math.inf, set())
     g0_us, weight_us = sc.numeric["g0"], sc.numeric["weight"]
 
     def g0(x: float | np.ndarray) -> float | np.ndarray:
@@ -204,6 +205,8 @@ def _float_at(sc: _Scaled, s: float) -> _Float:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", IntegrationWarning)
             return quad(integrand, 0.0, x, limit=200)[0]
+
+    edges: set[int] = set()
 
     def zeros(side: int) -> float | None:
         L, n = ZERO_GRID
@@ -221,8 +224,17 @@ def _float_at(sc: _Scaled, s: float) -> _Float:
         if change.size == 0:
             return None
         i = int(change[0])
-        if bad[i + 1]:
-            return float(grid[i + 1])
+        if bad[i + 1]:  # NOTE: marked as an edge of the force's domain, not a zero
+            edges.add(side)
+            inside, outside = float(grid[i]), float(grid[i + 1])
+            for _ in range(80):  # the last finite point, by bisection
+                mid = (inside + outside) / 2
+                if mid in (inside, outside):
+                    break
+                with np.errstate(all="ignore"):
+                    finite = not math.isnan(float(g0(mid)))
+                inside, outside = (mid, outside) if finite else (inside, mid)
+            return inside
         return float(brentq(g0, grid[i], grid[i + 1], xtol=1e-15))
 
     def W_infinity() -> float:
@@ -235,7 +247,7 @@ def _float_at(sc: _Scaled, s: float) -> _Float:
                 return math.inf
         return -value if math.isfinite(value) and abs(value) < 1e200 else math.inf
 
-    return _Float(g0, W, zeros, W_infinity)
+    return _Float(g0, W, zeros, W_infinity, edges)
 
 
 def _closes(sc: _Scaled, s: float) -> tuple[bool | None, str]:
@@ -251,7 +263,7 @@ def _closes_at(sc: _Scaled, s: float) -> tuple[bool | None, str]:
     f = _float_at(sc, s)
     up = f.zeros(+1)
     if up is not None and up <= 1.0:
-        return False, "saddle above"
+        return False, "domain edge" if +1 in f.edges else "saddle above"
     if float(f.g0(1.0)) < 0:  # (an exact 0 there is an underflow: e^(−su) at large s)
         return False, "saddle above"
     down = f.zeros(-1)
@@ -262,6 +274,8 @@ def _closes_at(sc: _Scaled, s: float) -> tuple[bool | None, str]:
     if not math.isfinite(level):  # beyond what doubles hold: the scan ends here
         return None, "overflow"
     if not level < barrier:
+        if down is not None and -1 in f.edges:
+            return False, "domain edge"
         return False, "barrier" if down is not None else "barrier at infinity"
     return True, ""
 
@@ -277,7 +291,8 @@ def _domain(variable: str, sc: _Scaled) -> OrbitDomain:
             continue
         s_edge, kind = edge
         y = s_edge**sc.power
-        text = mpmath.nstr(y, DIGITS, min_fixed=-math.inf, max_fixed=math.inf)
+        digits = DIGITS if kind != "domain edge" else 16
+        text = mpmath.nstr(y, digits, min_fixed=-math.inf, max_fixed=math.inf)
         hows.append(f"{'+' if side > 0 else '-'} side: {_describe(kind)} at "
                     f"{variable.partition('=')[0].strip() or variable} = "
                     f"{mpmath.nstr(y, 12)}")
@@ -299,7 +314,9 @@ def _domain(variable: str, sc: _Scaled) -> OrbitDomain:
 def _describe(kind: str) -> str:
     return {"saddle above": "a saddle of the potential reaches the turning point",
             "barrier": "the swing reaches the saddle on the far side",
-            "barrier at infinity": "the swing escapes to infinity on the far side"}[kind]
+            "barrier at infinity": "the swing escapes to infinity on the far side",
+            "domain edge": "the swing reaches the end of the force's domain (to double "
+                           "precision)"}[kind]
 
 
 def _edge(sc: _Scaled, side: int) -> tuple[mpmath.mpf, str] | None:
@@ -331,7 +348,10 @@ def _edge(sc: _Scaled, side: int) -> tuple[mpmath.mpf, str] | None:
 
 def _refine(sc: _Scaled, s0: float, kind: str) -> mpmath.mpf:
     """The edge to :data:`DIGITS` digits: Newton/secant in mpmath on the equation that holds
-    there, from the bisection's double ``s0``."""
+    there, from the bisection's double ``s0`` (kept as it is at the end of the force's
+    domain, where the force has no value to solve with)."""
+    if kind == "domain edge":
+        return mpmath.mpf(s0)
     u, s = sc.u, sc.s
     with mpmath.workdps(DIGITS + 10):
         g0 = sp.lambdify((u, s), sc.g0, "mpmath")
