@@ -2,7 +2,7 @@
 # model: duffing, order: 12
 # command: lindstedt generate duffing --order 12
 # inputs sha256: 66ca4a0e4d6afa8046c93839a6f1efa563f457106a4ae4f18222a37b87ca56f2
-# body sha256: 49eb22052cb6b2663dea2e5a647255bc821e29727a276047e992af2a9cca4237
+# body sha256: 551f1050b8ff1093b480a0f3911d64c9bbd93f00f4973c5d9e406d5e13f8c1b9
 """q'' + q + eps*q**3 = 0: L–P evaluators to order 12 in x = eps*A**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -24,6 +24,15 @@ MODEL = 'duffing'
 VARIABLE = 'x = eps*A**2'
 CONVENTION = "q(0) = A, q'(0) = 0, so q_j(0) = 0 for j >= 1"
 RADIUS = 1.0
+RADIUS_SPREAD = 0.0
+ORBIT_LIMIT = np.array([
+    -1.0,
+    math.inf,
+])
+ORBIT_LIMIT_EXACT = (
+    '-1.0',
+    'inf',
+)
 ALLOW_DIVERGENT = False
 OMEGA = np.array([
     1.0,
@@ -242,7 +251,7 @@ def omega(A, eps):
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
     x = A**2*eps
-    if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
+    if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
         return math.nan
     return x**8*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + x**4*(x*(x*((0.011320983991026878)*x - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + x*(x*((0.03955078125)*x - 0.08203125) + 0.375) + 1
 
@@ -262,7 +271,7 @@ def _omega_into(out, A_in, eps_in):
         A = ((A) if (inside == 1) else (0.1))
         eps = ((eps) if (inside == 1) else (0.1))
         x = A**2*eps
-        if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
+        if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
         out[i] = x**8*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + x**4*(x*(x*((0.011320983991026878)*x - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + x*(x*((0.03955078125)*x - 0.08203125) + 0.375) + 1
@@ -294,7 +303,7 @@ def period(A, eps):
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
     x = A**2*eps
-    if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
+    if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
         return math.nan
     return 2*math.pi*(x**8*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) + x**4*(x*(x*(0.07641269266605377 - 0.0651973094791174*x) - 0.09219503402709961) + 0.11575698852539062) + x*(x*(0.22265625 - 0.15380859375*x) - 0.375) + 1)
 
@@ -314,7 +323,7 @@ def _period_into(out, A_in, eps_in):
         A = ((A) if (inside == 1) else (0.1))
         eps = ((eps) if (inside == 1) else (0.1))
         x = A**2*eps
-        if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
+        if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
         out[i] = 2*math.pi*(x**8*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) + x**4*(x*(x*(0.07641269266605377 - 0.0651973094791174*x) - 0.09219503402709961) + 0.11575698852539062) + x*(x*(0.22265625 - 0.15380859375*x) - 0.375) + 1)
@@ -348,7 +357,7 @@ def q(t, A, eps):
     eps = ((eps) if (inside == 1) else (0.1))
     t = ((t) if (inside == 1) else (0))
     x = A**2*eps
-    if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
+    if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
         return math.nan
     w = x**8*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + x**4*(x*(x*((0.011320983991026878)*x - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + x*(x*((0.03955078125)*x - 0.08203125) + 0.375) + 1
     s = t*w
@@ -388,7 +397,7 @@ def _q_into(out, t_in, A_in, eps_in):
         eps = ((eps) if (inside == 1) else (0.1))
         t = ((t) if (inside == 1) else (0))
         x = A**2*eps
-        if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
+        if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
         w = x**8*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + x**4*(x*(x*((0.011320983991026878)*x - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + x*(x*((0.03955078125)*x - 0.08203125) + 0.375) + 1
@@ -442,7 +451,7 @@ def qdot(t, A, eps):
     eps = ((eps) if (inside == 1) else (0.1))
     t = ((t) if (inside == 1) else (0))
     x = A**2*eps
-    if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
+    if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
         return math.nan
     w = x**8*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + x**4*(x*(x*((0.011320983991026878)*x - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + x*(x*((0.03955078125)*x - 0.08203125) + 0.375) + 1
     s = t*w
@@ -495,7 +504,7 @@ def _qdot_into(out, t_in, A_in, eps_in):
         eps = ((eps) if (inside == 1) else (0.1))
         t = ((t) if (inside == 1) else (0))
         x = A**2*eps
-        if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
+        if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
         w = x**8*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + x**4*(x*(x*((0.011320983991026878)*x - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + x*(x*((0.03955078125)*x - 0.08203125) + 0.375) + 1
@@ -552,7 +561,7 @@ def qdot_into(out, t, A, eps):
 
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def error_estimate(A, eps):
-    """Relative truncation error of period(), from the first omitted term |τ_{K+1} y^(K+1)| / (1 - |y|/R) over the truncated sum (inf from the radius R on: no bound there)."""
+    """Relative truncation error of period(), a bound on the omitted tail: |τ_{K+1}| |y|^(K+1) + c |y|^(K+2) / (1 - r|y|), its terms growing at most by r = max(1/R, |τ_{K+2}/τ_{K+1}|) an order, R the smaller of the radius less its spread and the distance to the orbits' edge, c = max(|τ_{K+2}|, r|τ_{K+1}|); over the truncated sum (inf from r|y| = 1 on: no bound there)."""
     inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
@@ -560,10 +569,10 @@ def error_estimate(A, eps):
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
     x = A**2*eps
-    if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
+    if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
         return math.nan
     T = x**8*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) + x**4*(x*(x*(0.07641269266605377 - 0.0651973094791174*x) - 0.09219503402709961) + 0.11575698852539062) + x*(x*(0.22265625 - 0.15380859375*x) - 0.375) + 1
-    return (((0.03473509559274875)*abs(x)**13/((1 - abs(x))*abs(T))) if (abs(x) < 1) else (math.inf))
+    return (((0.03473509559274875)*abs(x)**13 + 0.034735095592748752*abs(x)**14/(1 - 1.0*abs(x))) if (1.0*abs(x) < 1) else (math.inf))/abs(T)
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
@@ -581,11 +590,11 @@ def _error_estimate_into(out, A_in, eps_in):
         A = ((A) if (inside == 1) else (0.1))
         eps = ((eps) if (inside == 1) else (0.1))
         x = A**2*eps
-        if not ((inside == 1) and (x > -1) and (abs(x) < 1)):
+        if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
         T = x**8*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) + x**4*(x*(x*(0.07641269266605377 - 0.0651973094791174*x) - 0.09219503402709961) + 0.11575698852539062) + x*(x*(0.22265625 - 0.15380859375*x) - 0.375) + 1
-        out[i] = (((0.03473509559274875)*abs(x)**13/((1 - abs(x))*abs(T))) if (abs(x) < 1) else (math.inf))
+        out[i] = (((0.03473509559274875)*abs(x)**13 + 0.034735095592748752*abs(x)**14/(1 - 1.0*abs(x))) if (1.0*abs(x) < 1) else (math.inf))/abs(T)
     return out
 
 

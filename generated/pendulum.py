@@ -2,7 +2,7 @@
 # model: pendulum, order: 12
 # command: lindstedt generate pendulum --order 12
 # inputs sha256: 89790c3fd0e75fcdff47f37c71d07dae7a9aef7a774488dd064ce33f5d86074d
-# body sha256: e7f0562d76de991be43186d422b77a7467e51431e52c61ef07ac6b6c398b95fb
+# body sha256: d2c244af579cb12819f0a64e42ac3f16a2bab2efb464465d6680fe0cfffb8190
 """theta'' + sin(theta) = 0: L–P evaluators to order 12 in theta0**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -24,6 +24,15 @@ MODEL = 'pendulum'
 VARIABLE = 'theta0**2'
 CONVENTION = "q(0) = A, q'(0) = 0, so q_j(0) = 0 for j >= 1"
 RADIUS = 9.869604401089358
+RADIUS_SPREAD = 0.0
+ORBIT_LIMIT = np.array([
+    -math.inf,
+    9.869604401089358,
+])
+ORBIT_LIMIT_EXACT = (
+    '-inf',
+    '9.86960440108935861883449099988',
+)
 ALLOW_DIVERGENT = False
 OMEGA = np.array([
     1.0,
@@ -240,7 +249,7 @@ def omega(theta0):
     inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
     theta0 = ((theta0) if (inside == 1) else (0.1))
     x = theta0**2
-    if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+    if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
         return math.nan
     return x**8*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) + x**4*(x*(x*(-9.840751922602837e-10*x - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) + x*(x*(0.0003255208333333333 - 3.1195746527777775e-05*x) - 0.0625) + 1
 
@@ -256,7 +265,7 @@ def _omega_into(out, theta0_in):
         inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
         theta0 = ((theta0) if (inside == 1) else (0.1))
         x = theta0**2
-        if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+        if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
             out[i] = math.nan
             continue
         out[i] = x**8*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) + x**4*(x*(x*(-9.840751922602837e-10*x - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) + x*(x*(0.0003255208333333333 - 3.1195746527777775e-05*x) - 0.0625) + 1
@@ -285,7 +294,7 @@ def period(theta0):
     inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
     theta0 = ((theta0) if (inside == 1) else (0.1))
     x = theta0**2
-    if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+    if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
         return math.nan
     return 2*math.pi*(x**8*(x*(x*(x*((6.225550505750492e-14)*x + 6.706433207421971e-13) + 7.286018609303663e-12) + 7.997964280393218e-11) + 8.893476960263209e-10) + x**4*(x*(x*((1.0054783016898737e-08)*x + 1.162356190273135e-07) + 1.3867625063268805e-06) + 1.735611567421565e-05) + x*(x*((0.00023464626736111112)*x + 0.0035807291666666665) + 0.0625) + 1)
 
@@ -301,7 +310,7 @@ def _period_into(out, theta0_in):
         inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
         theta0 = ((theta0) if (inside == 1) else (0.1))
         x = theta0**2
-        if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+        if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
             out[i] = math.nan
             continue
         out[i] = 2*math.pi*(x**8*(x*(x*(x*((6.225550505750492e-14)*x + 6.706433207421971e-13) + 7.286018609303663e-12) + 7.997964280393218e-11) + 8.893476960263209e-10) + x**4*(x*(x*((1.0054783016898737e-08)*x + 1.162356190273135e-07) + 1.3867625063268805e-06) + 1.735611567421565e-05) + x*(x*((0.00023464626736111112)*x + 0.0035807291666666665) + 0.0625) + 1)
@@ -332,7 +341,7 @@ def theta(t, theta0):
     theta0 = ((theta0) if (inside == 1) else (0.1))
     t = ((t) if (inside == 1) else (0))
     x = theta0**2
-    if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+    if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
         return math.nan
     w = x**8*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) + x**4*(x*(x*(-9.840751922602837e-10*x - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) + x*(x*(0.0003255208333333333 - 3.1195746527777775e-05*x) - 0.0625) + 1
     s = t*w
@@ -368,7 +377,7 @@ def _theta_into(out, t_in, theta0_in):
         theta0 = ((theta0) if (inside == 1) else (0.1))
         t = ((t) if (inside == 1) else (0))
         x = theta0**2
-        if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+        if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
             out[i] = math.nan
             continue
         w = x**8*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) + x**4*(x*(x*(-9.840751922602837e-10*x - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) + x*(x*(0.0003255208333333333 - 3.1195746527777775e-05*x) - 0.0625) + 1
@@ -419,7 +428,7 @@ def thetadot(t, theta0):
     theta0 = ((theta0) if (inside == 1) else (0.1))
     t = ((t) if (inside == 1) else (0))
     x = theta0**2
-    if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+    if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
         return math.nan
     w = x**8*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) + x**4*(x*(x*(-9.840751922602837e-10*x - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) + x*(x*(0.0003255208333333333 - 3.1195746527777775e-05*x) - 0.0625) + 1
     s = t*w
@@ -468,7 +477,7 @@ def _thetadot_into(out, t_in, theta0_in):
         theta0 = ((theta0) if (inside == 1) else (0.1))
         t = ((t) if (inside == 1) else (0))
         x = theta0**2
-        if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+        if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
             out[i] = math.nan
             continue
         w = x**8*(x*(x*(x*(-5.218096898167283e-15*x - 5.76708223627214e-14) - 6.443099177531727e-13) - 7.292721445171067e-12) - 8.387246616960268e-11) + x**4*(x*(x*(-9.840751922602837e-10*x - 1.1845659117174713e-08) - 1.4752202143324326e-07) - 1.9065917484343998e-06) + x*(x*(0.0003255208333333333 - 3.1195746527777775e-05*x) - 0.0625) + 1
@@ -524,16 +533,16 @@ def thetadot_into(out, t, theta0):
 
 @vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def error_estimate(theta0):
-    """Relative truncation error of period(), from the first omitted term |τ_{K+1} y^(K+1)| / (1 - |y|/R) over the truncated sum (inf from the radius R on: no bound there)."""
+    """Relative truncation error of period(), a bound on the omitted tail: |τ_{K+1}| |y|^(K+1) + c |y|^(K+2) / (1 - r|y|), its terms growing at most by r = max(1/R, |τ_{K+2}/τ_{K+1}|) an order, R the smaller of the radius less its spread and the distance to the orbits' edge, c = max(|τ_{K+2}|, r|τ_{K+1}|); over the truncated sum (inf from r|y| = 1 on: no bound there)."""
     inside = ((1) if (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
     theta0 = ((theta0) if (inside == 1) else (0.1))
     inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
     theta0 = ((theta0) if (inside == 1) else (0.1))
     x = theta0**2
-    if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+    if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
         return math.nan
     T = x**8*(x*(x*(x*((6.225550505750492e-14)*x + 6.706433207421971e-13) + 7.286018609303663e-12) + 7.997964280393218e-11) + 8.893476960263209e-10) + x**4*(x*(x*((1.0054783016898737e-08)*x + 1.162356190273135e-07) + 1.3867625063268805e-06) + 1.735611567421565e-05) + x*(x*((0.00023464626736111112)*x + 0.0035807291666666665) + 0.0625) + 1
-    return (((5.8202915552354634e-15)*abs(x)**13/((-abs(x)/math.pi**2 + 1)*abs(T))) if (abs(x) < math.pi**2) else (math.inf))
+    return (((5.8202915552354634e-15)*abs(x)**13 + 5.8971882951996013e-16*abs(x)**14/(1 - 0.10132118364233778*abs(x))) if (0.10132118364233778*abs(x) < 1) else (math.inf))/abs(T)
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
@@ -547,11 +556,11 @@ def _error_estimate_into(out, theta0_in):
         inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
         theta0 = ((theta0) if (inside == 1) else (0.1))
         x = theta0**2
-        if not ((inside == 1) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+        if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
             out[i] = math.nan
             continue
         T = x**8*(x*(x*(x*((6.225550505750492e-14)*x + 6.706433207421971e-13) + 7.286018609303663e-12) + 7.997964280393218e-11) + 8.893476960263209e-10) + x**4*(x*(x*((1.0054783016898737e-08)*x + 1.162356190273135e-07) + 1.3867625063268805e-06) + 1.735611567421565e-05) + x*(x*((0.00023464626736111112)*x + 0.0035807291666666665) + 0.0625) + 1
-        out[i] = (((5.8202915552354634e-15)*abs(x)**13/((-abs(x)/math.pi**2 + 1)*abs(T))) if (abs(x) < math.pi**2) else (math.inf))
+        out[i] = (((5.8202915552354634e-15)*abs(x)**13 + 5.8971882951996013e-16*abs(x)**14/(1 - 0.10132118364233778*abs(x))) if (0.10132118364233778*abs(x) < 1) else (math.inf))/abs(T)
     return out
 
 

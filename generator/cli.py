@@ -1523,22 +1523,37 @@ def _mixing_table(data: dict) -> list[str]:
     return lines
 
 
-def _considered(rows: Sequence[tuple[str, int, float, float]]) -> list[dict]:
+def _considered(rows: Sequence[tuple[str, int, float, float]], quantity: str | None = None
+                ) -> list[dict]:
     """``choose``'s per-method rows as JSON records."""
-    return [{"method": m, "order": o, "max_error": e, "ns_per_point": ns} for m, o, e, ns in rows]
+    return [{"method": str(m), "order": o, "label": _label(m, o, quantity), "max_error": e,
+             "ns_per_point": ns} for m, o, e, ns in rows]
+
+
+def _label(method, order: int, quantity: str | None = None) -> str:
+    """A method at an order as tables print it: the registry record's own label (the Padé
+    approximant names itself), else "NAME order K"."""
+    label = getattr(method, "label", None)
+    if label is None and quantity is not None:
+        from .methods import methods_for
+
+        label = next((m.label for m in methods_for(quantity) if m == method), None)
+    return label(order) if callable(label) else f"{method} order {order}"
 
 
 def _print_choice(header: str, chosen: tuple[str, int, float, float],
-                  rows: Sequence[tuple[str, int, float, float]], micro: bool = False) -> None:
+                  rows: Sequence[tuple[str, int, float, float]], micro: bool = False,
+                  quantity: str | None = None) -> None:
     """The text report of every ``choose``: the header, the choice, each method considered
     (cost in ns/point, or µs when ``micro``)."""
     unit, scale = ("µs/point", 1e-3) if micro else ("ns/point", 1.0)
     print(header)
     m, o, e, ns = chosen
-    print(f"  chosen: {m} order {o}: max error {e:.1e}, {ns * scale:.2f} {unit}")
-    width = max(len(r[0]) for r in rows)
+    print(f"  chosen: {_label(m, o, quantity)}: max error {e:.1e}, {ns * scale:.2f} {unit}")
+    width = max(len(_label(r[0], r[1], quantity)) for r in rows)
     for m, o, e, ns in rows:
-        print(f"  {m:>{width}} order {o:>2}: max error {e:.1e}, {ns * scale:8.2f} {unit}")
+        print(f"  {_label(m, o, quantity):>{width}}: max error {e:.1e}, {ns * scale:8.2f} "
+              f"{unit}")
 
 
 def _cmd_choose(args: argparse.Namespace) -> int:
@@ -1583,7 +1598,7 @@ def _cmd_choose(args: argparse.Namespace) -> int:
             "modelled_ns_per_point": modelled_ns("period", choice.method, choice.order),
             "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
             "quantity": "period", "variable": variable,
-            "considered": _considered(choice.considered)}
+            "considered": _considered(choice.considered, "period")}
     if model is not None:
         data.update(equation=model.source or model.title, omega0=str(model.frequency),
                     reference="quadrature of the scaled potential (Gauss–Legendre, 256 nodes)")
@@ -1599,7 +1614,7 @@ def _cmd_choose(args: argparse.Namespace) -> int:
     _print_choice(f"period T(x), {variable} in [{args.x_min:g}, {args.x_max:g}], tolerance "
                   f"{args.tol:g} (relative, verified on {choice.verified_on} points):",
                   (choice.method, choice.order, choice.max_error, choice.ns_per_point),
-                  choice.considered)
+                  choice.considered, quantity="period")
     for path in data.get("emitted", []):
         print(f"  emitted {path}")
     return 0

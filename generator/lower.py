@@ -338,9 +338,10 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     guard = m.orbit_condition.xreplace({sp.Symbol("Y"): x})
     domain = orbit_domain(m)
     lo, hi = domain.guard_bounds()
-    for bound, holds in ((lo, x > lo), (hi, x < hi)):
-        if math.isfinite(bound):
-            guard = sp.And(guard, holds)
+    if math.isfinite(lo):
+        guard = sp.And(guard, x > sp.Float(lo, 17))
+    if math.isfinite(hi):
+        guard = sp.And(guard, x < sp.Float(hi, 17))
     found = (m.radius, 0.0) if m.radius is not None else estimated_radius(solution, to_args)
     radius, spread = found if found is not None else (None, 0.0)
     reach = None if radius is None else radius - sp.Float(spread, 17) if spread else radius

@@ -1204,6 +1204,12 @@ class Method:
     bound: int = -1  # driven: which of ``choose``'s emit bounds caps its order (-1: none)
     run_emitted: Callable[..., Emitted] | None = None  # driven: read its emitted module
     emittable: Callable[[object], str | None] = _always  # why its module cannot be emitted
+    describe: Callable[[int], str] | None = None  # its name at an order (default: "NAME order K")
+
+    def label(self, order: int) -> str:
+        """What the method is at ``order``, as tables print it ("lindstedt order 8",
+        "[12/12] Padé, 25 coefficients")."""
+        return self.describe(order) if self.describe is not None else f"{self.name} order {order}"
 
     def why_not(self, subject: object) -> str | None:
         """None when the method applies to ``subject`` (a Model or a Drive), else why not."""
@@ -1270,7 +1276,7 @@ METHODS: tuple[Method, ...] = (
            target=CHOSEN_PERIOD),
     Method("pade", "period", "diagonal Padé [k/k] of the L–P series", _PERIOD, _series_period,
            kind=2, domain=x_ > -1, orders=_pade_orders, lowered=_lower_pade,
-           target=CHOSEN_PERIOD),
+           target=CHOSEN_PERIOD, describe=lambda k: f"[{k}/{k}] Padé, {2 * k + 1} coefficients"),
     # q(t)
     Method("lindstedt", "q", "the L–P series of q(t) (generate NAME)",
            "q(t) against cn; any free oscillator's period against quadrature", _free,

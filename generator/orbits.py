@@ -132,12 +132,13 @@ def orbit_domain(model: Model) -> OrbitDomain:
 
 def _scaled(model: Model) -> _Scaled | str:
     u, P, s = sp.Symbol("u"), sp.Symbol("P"), sp.Symbol("s")
-    if model.variable == "eps":
+    if model.order_factor == 1:  # y = ε, the coefficients in QQ[A, …]
         return ("the orbits depend on eps and A separately (several powers of A): no single "
                 "edge in eps")
     if any(sp.sympify(c).free_symbols for c in model.coefficients()):
         return "the coefficients hold symbolic parameters: give them values (--param)"
-    power = 1 if not model.variable.startswith("A**") else int(model.variable[3:])
+    # y = ε·A^p: s = y; y = A^power (no ε: the amplitude is small): s = A
+    power = 1 if model.coupling != 1 else sp.Poly(model.order_factor, model.amplitude).degree()
     if model.exact_to is None:  # the model's terms are the whole force, y = s^power
         G = sp.Integer(0)
         for k, terms in enumerate(model.forcing, start=1):
@@ -290,9 +291,10 @@ def _domain(variable: str, sc: _Scaled) -> OrbitDomain:
         if edge is None:
             continue
         s_edge, kind = edge
-        y = s_edge**sc.power
         digits = DIGITS if kind != "domain edge" else 16
-        text = mpmath.nstr(y, digits, min_fixed=-math.inf, max_fixed=math.inf)
+        with mpmath.workdps(DIGITS + 10):
+            y = s_edge**sc.power
+            text = mpmath.nstr(y, digits, min_fixed=-math.inf, max_fixed=math.inf)
         hows.append(f"{'+' if side > 0 else '-'} side: {_describe(kind)} at "
                     f"{variable.partition('=')[0].strip() or variable} = "
                     f"{mpmath.nstr(y, 12)}")
