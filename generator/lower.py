@@ -355,7 +355,7 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     entry, inside = argument_entry((*ranges, (t, sp.Abs(t) <= FREE_ARGUMENT_LIMIT, 0)), flag)
     prelude_t, guard_t = (*entry, (x, y)), sp.And(inside, guard_t)
 
-    top = max(max(qj) for qj in solution.q[: order + 1])
+    top = max((max(qj) for qj in solution.q[: order + 1] if qj), default=1)
     harmonic = {
         n: horner([g.to_sympy(solution.q[j].get(n, g.scalar(0))) for j in range(order + 1)], x)
         for n in range(top + 1)

@@ -44,8 +44,9 @@ SCAN_TRANSCENDENTAL = 1e3
 # separatrix where the first of these fails; the bisection then closes in on it.  No failure:
 # no edge up to the scan's end, and the module's radius guard alone holds beyond it.
 ZERO_GRID = (64.0, 4001)
-# NOTE: zeros of a non-polynomial g₀ are looked for on |u| ≤ 64 (4001 points a side, then
-# Brent); a polynomial's come from its companion matrix, all of them.
+# NOTE: zeros of a non-polynomial g₀ are looked for on |u| ≤ 64 (4001 points a side), then on
+# 2000 points spaced geometrically to 64·10⁵, then Brent; a polynomial's come from its
+# companion matrix, all of them.
 
 
 @dataclass(frozen=True)
@@ -109,14 +110,15 @@ class _Scaled:
 
     @functools.cached_property
     def numeric(self) -> dict:
-        """Compiled once: ``g₀``'s coefficients in u as functions of s (polynomial), else
-        ``g₀(u, s)`` and the weight ``e^{2H}(u, s)`` for NumPy."""
-        if self.polynomial:
-            coefficients = sp.Poly(self.g0, self.u).all_coeffs()[::-1]
-            return {"coefficients": [sp.lambdify(self.s, c, "math") for c in coefficients]}
+        """Compiled once: ``g₀``'s coefficients in u as functions of s (where it is a
+        polynomial in u), ``g₀(u, s)`` and the weight ``e^{2H}(u, s)`` for NumPy."""
         H = sp.integrate(self.h, (self.u, 0, self.u)) if self.h != 0 else sp.Integer(0)
-        return {"g0": sp.lambdify((self.u, self.s), self.g0, "numpy"),
-                "weight": sp.lambdify((self.u, self.s), sp.exp(2 * H), "numpy")}
+        out = {"g0": sp.lambdify((self.u, self.s), self.g0, "numpy"),
+               "weight": sp.lambdify((self.u, self.s), sp.exp(2 * H), "numpy")}
+        if self.g0.is_polynomial(self.u):
+            coefficients = sp.Poly(self.g0, self.u).all_coeffs()[::-1]
+            out["coefficients"] = [sp.lambdify(self.s, c, "math") for c in coefficients]
+        return out
 
 
 def orbit_domain(model: Model) -> OrbitDomain:
@@ -181,19 +183,20 @@ class _Float:
 
 
 def _float_at(sc: _Scaled, s: float) -> _Float:
-    if sc.polynomial:
+    roots = None
+    if "coefficients" in sc.numeric:
         coeffs = [float(c(s)) for c in sc.numeric["coefficients"]]
         g = np.polynomial.Polynomial(coeffs)
-        Wp = 2 * g.integ()
         # g₀(0) = 0: the other zeros are those of g₀/u (no spurious root next to 0)
         roots = [r.real for r in np.polynomial.Polynomial(coeffs[1:]).roots()
                  if abs(r.imag) <= 1e-7 * abs(r)]
 
-        def zeros(side: int) -> float | None:
+        def polynomial_zeros(side: int) -> float | None:
             found = [r for r in roots if r * side > 0]
             return min(found, key=abs) if found else None
 
-        return _Float(g, Wp, zeros, lambda: math.inf, set())
+        if sc.polynomial:
+            return _Float(g, 2 * g.integ(), polynomial_zeros, lambda: math.inf, set())
     g0_us, weight_us = sc.numeric["g0"], sc.numeric["weight"]
 
     def g0(x: float | np.ndarray) -> float | np.ndarray:
@@ -211,7 +214,8 @@ def _float_at(sc: _Scaled, s: float) -> _Float:
 
     def zeros(side: int) -> float | None:
         L, n = ZERO_GRID
-        grid = side * np.linspace(0.0, L, n)[1:]
+        grid = side * np.concatenate([np.linspace(0.0, L, n)[1:],
+                                      np.geomspace(L, L * 1e5, n // 2)[1:]])
         with np.errstate(all="ignore"):
             values = np.asarray(g0(grid), dtype=float) * np.ones_like(grid)
         if values[0] * side <= 0:  # within the first step: g₀ ~ u there, so a zero is near
@@ -248,7 +252,7 @@ def _float_at(sc: _Scaled, s: float) -> _Float:
                 return math.inf
         return -value if math.isfinite(value) and abs(value) < 1e200 else math.inf
 
-    return _Float(g0, W, zeros, W_infinity, edges)
+    return _Float(g0, W, polynomial_zeros if roots is not None else zeros, W_infinity, edges)
 
 
 def _closes(sc: _Scaled, s: float) -> tuple[bool | None, str]:
