@@ -131,7 +131,13 @@ def orbit_domain(model: Model) -> OrbitDomain:
     scaled = _scaled(model)
     if isinstance(scaled, str):
         return unknown(model, scaled)
-    return _domain(model.variable, scaled)
+    try:
+        return _domain(model.variable, scaled)
+    except (ValueError, ArithmeticError, TypeError) as exc:
+        # NOTE: a force the numerics cannot follow (a root finder without a bracket, a
+        # quadrature that fails): no edge is stated, and the radius guard stands alone
+        return unknown(model, f"the first integral could not be followed ({type(exc).__name__}"
+                       f": {str(exc)[:80]})")
 
 
 class EdgeError(ValueError):
