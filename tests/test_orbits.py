@@ -112,7 +112,7 @@ def emitted(tmp_path_factory, text: str, order: int, name: str):
     return load_generated(out / f"{name}.py")
 
 
-EMITTED = [("q'' + q + eps*q**2 = 0", 8), ("q'' + q + eps*q**2 = 0", 30),
+EMITTED = [*(("q'' + q + eps*q**2 = 0", k) for k in (2, 4, 8, 16, 30)),
            ("q'' + q + eps*q**2*q'**2 = 0", 16), ("q'' + q - q**2/2 - q**3/2 = 0", 8),
            ("q'' + q*exp(-q) = 0", 8), ("q'' + q - eps*(q**3 + q*q'**2) = 0", 8)]
 
