@@ -78,26 +78,48 @@ class Progress:
 
 
 def _rational(c: object) -> str:
-    """Exact ``"p/q"`` (always with a denominator, so scripts can split on '/')."""
-    return f"{int(c.p)}/{int(c.q)}"
+    """Exact ``"p/q"`` (always with a denominator, so scripts can split on '/'); FLINT's
+    ``fmpq`` prints its digits itself, however long."""
+    return f"{c.p}/{c.q}"
+
+
+def _monomial(powers: tuple[tuple[str, int], ...]) -> str:
+    """SymPy's spelling of a monomial: ``"A**2*alpha"``, ``"1"`` for the constant."""
+    return "*".join(n if e == 1 else f"{n}**{e}" for n, e in powers) or "1"
 
 
 def _coefficient(sol, c: object) -> str | dict:
     """``"p/q"``, or for coefficients in ``QQ[A, params]`` an object mapping each monomial
-    (SymPy's ``str``: ``"A**2*alpha"``, ``"1"``) to its exact ``"p/q"``."""
+    (SymPy's ``str``: ``"A**2*alpha"``, ``"1"``) to its exact ``"p/q"``, formatted from
+    FLINT's terms (no SymPy on the way)."""
     if sol.ground.is_rational:
         return _rational(c)
-    import sympy as sp
+    return dict(sorted((_monomial(m), _rational(v)) for m, v in sol.ground.terms(c)))
 
-    expr = sp.expand(sol.ground.to_sympy(c))
-    terms = sp.Poly(expr, *sorted(expr.free_symbols, key=str)).terms() if expr.free_symbols \
-        else ([((), expr)] if expr != 0 else [])
-    gens = sorted(expr.free_symbols, key=str)
-    out = {}
-    for powers, value in terms:
-        key = sp.Mul(*(g**e for g, e in zip(gens, powers, strict=True)))
-        out[str(key)] = _rational(value)
-    return dict(sorted(out.items()))
+
+def _polynomial_text(sol, c: object) -> str:
+    """A coefficient in ``QQ[A, params]`` as SymPy writes it (``3*A**2*alpha/8 - A/4``, in
+    SymPy's order), formatted from FLINT's terms."""
+    names = sorted({n for powers, _ in sol.ground.terms(c) for n, _ in powers})
+
+    def order(term: tuple) -> tuple:  # SymPy's: lex on the names (sorted), descending
+        powers = dict(term[0])
+        return tuple(-powers.get(n, 0) for n in names)
+
+    terms = sorted(sol.ground.terms(c), key=order)
+    out = []
+    for powers, v in terms:
+        p, q = abs(int(v.p)), int(v.q)
+        body = _monomial(powers) if powers else ""
+        if body:
+            body = (body if p == 1 else f"{p}*{body}") + (f"/{q}" if q != 1 else "")
+        else:
+            body = f"{p}/{q}" if q != 1 else f"{p}"
+        out.append(("- " if v < 0 else "+ ") + body)
+    if not out:
+        return "0"
+    text = " ".join(out)
+    return text[2:] if text.startswith("+ ") else "-" + text[2:]
 
 
 def series_json(sol) -> dict:
@@ -157,7 +179,9 @@ def series_table(sol) -> str:
             lines.append(f"{j:>3}  {_rational(sol.omega[j]):>24}  "
                          f"{_rational(sol.period[j]):>24}  {harmonics}")
         return "\n".join(lines)
-    g = sol.ground.to_sympy
+    def g(c: object) -> str:
+        return _polynomial_text(sol, c)
+
     for j in range(sol.order + 1):  # symbolic coefficients: one block an order
         lines.append(f"j = {j}: omega_j = {g(sol.omega[j])}")
         lines.append(f"       (T/2pi)_j = {g(sol.period[j])}")
@@ -272,7 +296,9 @@ def _cmd_series(args: argparse.Namespace) -> int:
         omega = lc.omega
         # the table: the cycle asked for, or each in turn (one that cannot be expanded says why)
         texts = [_cycles_text(found, listed)]
-        for k in ([first] if args.cycle is not None else range(1, len(cycles) + 1)):
+        shown = [] if args.json else [first] if args.cycle is not None \
+            else range(1, len(cycles) + 1)
+        for k in shown:
             c = cycles[k - 1]
             if k == first:
                 texts.append(f"cycle {k}: " + limit_cycle_table(lc))
@@ -290,7 +316,8 @@ def _cmd_series(args: argparse.Namespace) -> int:
         progress = Progress(f"deriving {model.name} to order {args.order}", not args.json)
         sol = derive(model, args.order, progress)
         progress.close()
-        data, text = series_json(sol), series_table(sol)
+        data = series_json(sol)
+        text = "" if args.json else series_table(sol)  # build only what is printed
         omega = [sol.ground.to_fraction(c) for c in sol.omega] if sol.ground.is_rational \
             else None
     if args.singularities:

@@ -210,6 +210,20 @@ class Ground:
                         * sp.Mul(*(g**e for g, e in zip(gens, k[1:], strict=True)))
                         for k, v in c.to_dict().items()))
 
+    def terms(self, c: Any) -> list[tuple[tuple[tuple[str, int], ...], Any]]:
+        """The monomials of an exact coefficient straight from FLINT, without SymPy: pairs of
+        ``((name, power), …)`` (names sorted, powers ≥ 1; ``()`` for the constant) and the
+        rational (``fmpq``) multiplying it; no pair for a zero coefficient."""
+        if self.is_rational:
+            return [((), c)] if c != 0 else []
+        names = [str(g) for g in self.domain.symbols]
+        if self._flint_ring is None:
+            items = [(k, fmpq(int(v.numerator), int(v.denominator))) for k, v in c.items()]
+        else:
+            items = [(k[1:], v) for k, v in c.to_dict().items()]
+        return [(tuple(sorted((n, e) for n, e in zip(names, k, strict=True) if e)), v)
+                for k, v in items if v != 0]
+
     def to_fraction(self, c: Any) -> Fraction:
         if not self.is_rational:
             raise TypeError("coefficients with symbolic parameters have no Fraction value")
