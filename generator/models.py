@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import keyword
 import math
+import os
 import re
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -205,6 +207,9 @@ def oscillator(text: str, values: dict[str, str] | None = None, name: str = "osc
     if not NAME.fullmatch(name or "") or keyword.iskeyword(name):
         raise InputError(f"name {name!r}: letters, digits and '_' only, starting with a letter, "
                          "and no Python keyword (the module is imported by that name)")
+    if shadows_a_module(name):
+        raise InputError(f"name {name!r}: a module of that name is importable (Python's own or "
+                         "installed); the written module would shadow it: choose another name")
     eq = parse_equation(text)
     known = {str(p): p for p in eq.parameters}
     if eq.small is not None:  # a value for eps too: the amplitude is then the small quantity
@@ -243,6 +248,19 @@ def oscillator(text: str, values: dict[str, str] | None = None, name: str = "osc
 
 
 NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,31}")
+
+
+def shadows_a_module(name: str) -> bool:
+    """Whether a module ``name.py`` in the working folder would shadow one that scripts import:
+    the standard library's, or any on ``sys.path`` (site-packages: ``numpy``, ``numba``,
+    ``flint``, ``lindstedt``…); the working folder itself is not searched (a module written
+    there before may be written again)."""
+    from importlib.machinery import PathFinder
+
+    if name in sys.stdlib_module_names or name in sys.builtin_module_names or name == "lindstedt":
+        return True
+    here = {"", os.getcwd()}
+    return PathFinder.find_spec(name, [p for p in sys.path if p not in here]) is not None
 LP = "free L–P"
 
 

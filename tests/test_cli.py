@@ -71,6 +71,20 @@ def test_bad_input_one_line_exit_2(args, needle):
     assert "Traceback" not in out.stderr
 
 
+@pytest.mark.parametrize("name", ["numpy", "numba", "scipy", "math", "sys", "json", "flint",
+                                  "lindstedt"])
+def test_name_that_shadows_a_module_is_refused(tmp_path, name):
+    """``--name numpy`` would write numpy.py, which shadows NumPy for every script run from that
+    folder: one line, exit 2, nothing written."""
+    out = run("generate", "q'' + q + eps*q**2 = 0", "--name", name, "--order", "2",
+              "--out", str(tmp_path / "gen"))
+    assert out.returncode == 2 and out.stdout == ""
+    assert out.stderr.strip().splitlines() == [
+        f"lindstedt: error: name {name!r}: a module of that name is importable (Python's own "
+        "or installed); the written module would shadow it: choose another name"]
+    assert not (tmp_path / "gen").exists()
+
+
 @pytest.mark.parametrize("args,dropped", [
     (["mathieu", "a", "--m", "3", "--order", "20", "--json"], "--json"),
     (["mathieu", "a", "--m", "3", "--order", "20", "--singularities"], "--singularities"),
