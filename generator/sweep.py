@@ -656,12 +656,14 @@ def _mark_done(arrays: _Arrays, chunk: int) -> None:
 
 
 def open_sweep(store: Path | str) -> xr.Dataset:
-    """A sweep's store as a Dataset (lazily read, no dask); ``done`` says which blocks are."""
+    """A sweep's store as a Dataset (lazily read, no dask); ``done`` says which blocks are.
+    The metadata is consolidated when the store is made (blocks never change it), so
+    ``xarray.open_zarr(path)`` reads it in one file, without a warning."""
     import xarray as xr
 
     path = Path(store)
     _stored_identity(path)
-    return xr.open_zarr(str(path), consolidated=False, chunks=None)
+    return xr.open_zarr(str(path), consolidated=None, chunks=None)
 
 
 # --- running ------------------------------------------------------------------------------------
@@ -824,8 +826,12 @@ def run_sweep(kind: str, axes: Mapping[str, Sequence[float]], store: Path | str,
 
 def _initialise(path: Path, grid: Grid) -> xr.Dataset:
     """Metadata, coordinates and fill values of a new store (no block is written)."""
-    _dataset(grid, None, None).to_zarr(str(path), mode="w", compute=False, consolidated=False,
-                                       encoding=_encoding(grid))
+    import warnings
+
+    with warnings.catch_warnings():  # zarr's note that v3 does not yet specify consolidation
+        warnings.filterwarnings("ignore", "Consolidated metadata", UserWarning)
+        _dataset(grid, None, None).to_zarr(str(path), mode="w", compute=False,
+                                           consolidated=True, encoding=_encoding(grid))
     return open_sweep(path)
 
 

@@ -11,6 +11,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -75,6 +76,11 @@ def test_local_cluster_equals_serial_and_shooting(tmp_path):
 def test_every_kind_on_a_running_scheduler_equals_serial(scheduler, tmp_path, kind, axes):
     ds = run_sweep(kind, axes, tmp_path / f"{kind}.zarr", scheduler=scheduler, chunk=2)
     xr.testing.assert_identical(ds.load(), serial_sweep(kind, axes, chunk=2))
+    # consolidated metadata: xarray's own reader, with its defaults, opens it without a warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        plain = xr.open_zarr(tmp_path / f"{kind}.zarr")
+    xr.testing.assert_identical(plain.load(), serial_sweep(kind, axes, chunk=2))
 
 
 def test_response_against_shooting_and_one_harmonic():
