@@ -5,7 +5,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test tex lint bench figures generated clean
+.PHONY: demo test test-fast tex lint bench figures generated clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -25,9 +25,15 @@ tex:
 demo: $(STAMP) tex
 	$(BIN)/lindstedt demo --out out
 
+# The suite's three layers (tests/conftest.py): the exact identities first and alone, then the
+# printers and the emitted modules; each on every core.
 test: $(STAMP) tex
 	$(BIN)/ruff check generator tests benchmarks
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n auto -m exact
+	$(BIN)/python -m pytest -n auto -m "printers or emitted"
+
+test-fast: $(STAMP)
+	$(BIN)/python -m pytest -n auto -m exact
 
 lint: $(STAMP)
 	$(BIN)/ruff check generator tests benchmarks

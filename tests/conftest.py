@@ -1,0 +1,40 @@
+"""The suite's three layers, as markers, so the fast one runs first and alone:
+
+* ``exact``: exact identities and in-process numerics against independent references (series
+  against elliptic integrals, DLMF, product-to-sum, quadrature, shooting); nothing is emitted.
+* ``printers``: the command line, JSON contracts, tables, LaTeX, files, charts, the fuzzer.
+* ``emitted``: generated numba modules compiled and checked against references, the wheel in a
+  fresh venv, ``make demo``, Dask clusters.
+
+``make test`` runs ``-m exact`` first, then the other two, each on every core (pytest-xdist);
+``pytest -m exact`` alone takes a minute.  A module's layer is where its slowest test belongs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+LAYERS = {
+    "exact": ("averaging", "branches", "driven", "driven_damped", "driven_equation", "equation",
+              "hill", "layout", "lindstedt", "parametric", "response", "response_equation",
+              "series"),
+    "printers": ("charts", "cli", "costs", "emit", "files", "fuzz", "latex", "notebook",
+                 "validity"),
+    "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "orbits", "oscillator",
+                "resum", "sweep", "tongues"),
+}
+LAYER_OF = {f"test_{name}.py": layer for layer, names in LAYERS.items() for name in names}
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    for layer in LAYERS:
+        config.addinivalue_line("markers", f"{layer}: a layer of the suite (tests/conftest.py)")
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    for item in items:
+        name = Path(str(item.fspath)).name
+        if name not in LAYER_OF:
+            raise pytest.UsageError(f"{name}: give it a layer in tests/conftest.py")
+        item.add_marker(getattr(pytest.mark, LAYER_OF[name]))
