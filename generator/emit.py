@@ -183,10 +183,11 @@ def latex_context(d: Derivation) -> dict:
     y = variable.split("=")[0].strip()  # a symbol: powers y^{j} of it are valid TeX
     qs = sp.latex(d.coordinate)
     rows = [
-        {"j": j, "omega": latex_coefficient(w), "tau": latex_coefficient(tau)}
+        {"j": j, "omega": latex_coefficient(w, stack=False),
+         "tau": latex_coefficient(tau, stack=False)}
         for j, (w, tau) in enumerate(zip(d.omega, d.period, strict=True))
-    ]
-    fourier = [{"j": j, "n": n, "c": latex_coefficient(c)}
+    ]  # table cells: a number is never split; \padmath shrinks one wider than its column
+    fourier = [{"j": j, "n": n, "c": latex_coefficient(c, stack=False)}
                for j, qj in enumerate(d.q) for n, c in qj]
     period_terms = [
         _signed(d.period[j], f"{y}^{{{j}}}" if j > 1 else y, first=False)

@@ -75,10 +75,11 @@ LATEX_LINE_DIGITS = 30
 # 0.42\linewidth columns (~203pt with 2cm margins), so longer integers go on several lines.
 
 
-def latex_digits(n: int) -> str:
+def latex_digits(n: int, stack: bool = True) -> str:
     r"""A non-negative integer in groups of 3 digits (thin spaces); longer than
-    ``LATEX_LINE_DIGITS``, it is stacked in right-aligned lines broken only between groups,
-    the lines differing by at most one group.
+    ``LATEX_LINE_DIGITS`` and ``stack``, it is stacked in right-aligned lines broken only
+    between groups, the lines differing by at most one group (a table's cell never stacks:
+    its ``\padmath`` shrinks what is wider than the column, so a number reads as one).
 
     >>> latex_digits(57594037927936)
     '57\\,594\\,037\\,927\\,936'
@@ -88,7 +89,7 @@ def latex_digits(n: int) -> str:
         return text  # four digits read at a glance (siunitx's default minimum for grouping)
     head = len(text) % 3 or 3
     groups = [text[:head], *(text[i:i + 3] for i in range(head, len(text), 3))]
-    lines = math.ceil(len(groups) / (LATEX_LINE_DIGITS // 3))
+    lines = math.ceil(len(groups) / (LATEX_LINE_DIGITS // 3)) if stack else 1
     if lines == 1:
         return r"\,".join(groups)
     cuts = [i * len(groups) // lines for i in range(lines + 1)]
@@ -97,7 +98,7 @@ def latex_digits(n: int) -> str:
     return r"\begin{array}{@{}r@{}}" + r"\\".join(rows) + r"\end{array}"
 
 
-def latex_rational(r: sp.Rational) -> str:
+def latex_rational(r: sp.Rational, stack: bool = True) -> str:
     """An exact rational for LaTeX math: ``\\frac`` of grouped digits (:func:`latex_digits`).
 
     >>> latex_rational(sp.Rational(-21, 256))
@@ -105,13 +106,13 @@ def latex_rational(r: sp.Rational) -> str:
     """
     r = sp.Rational(r)
     sign = "-" if r < 0 else ""
-    p, q = latex_digits(abs(int(r.p))), latex_digits(int(r.q))
+    p, q = latex_digits(abs(int(r.p)), stack), latex_digits(int(r.q), stack)
     return sign + (p if q == "1" else rf"\frac{{{p}}}{{{q}}}")
 
 
-def latex_coefficient(c: sp.Expr) -> str:
+def latex_coefficient(c: sp.Expr, stack: bool = True) -> str:
     """:func:`latex_rational` for a number, SymPy's LaTeX for a polynomial in parameters."""
-    return latex_rational(c) if c.is_Rational else sp.latex(c)
+    return latex_rational(c, stack) if c.is_Rational else sp.latex(c)
 
 
 EPS = sp.Symbol("eps")

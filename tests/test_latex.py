@@ -108,5 +108,24 @@ def test_tex_compiles_without_overfull_lines(written, name, tmp_path):
     assert not overfull, overfull[:5]
 
 
+@pytest.mark.parametrize("name", ["order-high/duffing_tables.tex",
+                                  "order-high/pendulum_tables.tex",
+                                  *(f"generated/{p.name}"
+                                    for p in sorted(GENERATED.glob("*_tables.tex")))])
+def test_no_number_in_a_table_is_split(written, name):
+    """A table cell holds each number on one line (\\padmath shrinks a wide one to its
+    column): no stacked digits, and every cell's digits are the exact coefficient's."""
+    rows = [line for line in written[name].read_text().splitlines()
+            if not line.startswith(("%", r"\newcommand"))]
+    cells = [c for row in rows for c in re.findall(r"\\padmath\{(.*?)\}(?= &| \\\\)", row)]
+    assert len(cells) > 20
+    assert not any(LINES[0] in c for c in cells)
+    long_ones = [c for c in cells if len(ungrouped(c)) > LATEX_LINE_DIGITS]
+    if name.startswith("order-high/"):
+        assert long_ones  # order 40: numbers far longer than a stacked line
+    for cell in cells:
+        assert re.fullmatch(r"-?(\\frac\{\d+\}\{\d+\}|\d+)", ungrouped(cell)), cell
+
+
 def test_every_kind_of_tex_is_compiled(written):
     assert set(TEX_NAMES) == {n for n in written if n.startswith("order-high/")}
