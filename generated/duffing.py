@@ -2,7 +2,7 @@
 # model: duffing, order: 12
 # command: lindstedt generate duffing --order 12
 # inputs sha256: 66ca4a0e4d6afa8046c93839a6f1efa563f457106a4ae4f18222a37b87ca56f2
-# body sha256: 551f1050b8ff1093b480a0f3911d64c9bbd93f00f4973c5d9e406d5e13f8c1b9
+# body sha256: cbe1d8da5d9ec545f5b4b6eec07b6b12ac7aadd4a1c59d0c839ddd927a0a4161
 """q'' + q + eps*q**3 = 0: L–P evaluators to order 12 in x = eps*A**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -247,10 +247,12 @@ def omega(A, eps):
     inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
-    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) else (0))
+    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) else (0))
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
-    x = A**2*eps
+    x = eps
+    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
+    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
     if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
         return math.nan
     return x**8*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + x**4*(x*(x*((0.011320983991026878)*x - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + x*(x*((0.03955078125)*x - 0.08203125) + 0.375) + 1
@@ -267,10 +269,12 @@ def _omega_into(out, A_in, eps_in):
         inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
         A = ((A) if (inside == 1) else (0.1))
         eps = ((eps) if (inside == 1) else (0.1))
-        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) else (0))
+        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) else (0))
         A = ((A) if (inside == 1) else (0.1))
         eps = ((eps) if (inside == 1) else (0.1))
-        x = A**2*eps
+        x = eps
+        x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
+        x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
         if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
@@ -299,10 +303,12 @@ def period(A, eps):
     inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
-    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) else (0))
+    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) else (0))
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
-    x = A**2*eps
+    x = eps
+    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
+    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
     if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
         return math.nan
     return 2*math.pi*(x**8*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) + x**4*(x*(x*(0.07641269266605377 - 0.0651973094791174*x) - 0.09219503402709961) + 0.11575698852539062) + x*(x*(0.22265625 - 0.15380859375*x) - 0.375) + 1)
@@ -319,10 +325,12 @@ def _period_into(out, A_in, eps_in):
         inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
         A = ((A) if (inside == 1) else (0.1))
         eps = ((eps) if (inside == 1) else (0.1))
-        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) else (0))
+        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) else (0))
         A = ((A) if (inside == 1) else (0.1))
         eps = ((eps) if (inside == 1) else (0.1))
-        x = A**2*eps
+        x = eps
+        x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
+        x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
         if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
@@ -352,11 +360,13 @@ def q(t, A, eps):
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
     t = ((t) if (inside == 1) else (0))
-    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) and (abs(t) <= 1.0e+300) else (0))
+    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) and (abs(t) <= 1.0e+300) else (0))
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
     t = ((t) if (inside == 1) else (0))
-    x = A**2*eps
+    x = eps
+    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
+    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
     if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
         return math.nan
     w = x**8*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + x**4*(x*(x*((0.011320983991026878)*x - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + x*(x*((0.03955078125)*x - 0.08203125) + 0.375) + 1
@@ -392,11 +402,13 @@ def _q_into(out, t_in, A_in, eps_in):
         A = ((A) if (inside == 1) else (0.1))
         eps = ((eps) if (inside == 1) else (0.1))
         t = ((t) if (inside == 1) else (0))
-        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) and (abs(t) <= 1.0e+300) else (0))
+        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) and (abs(t) <= 1.0e+300) else (0))
         A = ((A) if (inside == 1) else (0.1))
         eps = ((eps) if (inside == 1) else (0.1))
         t = ((t) if (inside == 1) else (0))
-        x = A**2*eps
+        x = eps
+        x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
+        x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
         if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
@@ -446,11 +458,13 @@ def qdot(t, A, eps):
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
     t = ((t) if (inside == 1) else (0))
-    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) and (abs(t) <= 1.0e+300) else (0))
+    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) and (abs(t) <= 1.0e+300) else (0))
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
     t = ((t) if (inside == 1) else (0))
-    x = A**2*eps
+    x = eps
+    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
+    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
     if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
         return math.nan
     w = x**8*(x*(x*(x*(0.006237279708448895 - 0.005568128115294488*x) - 0.00706504934849761) + 0.008112444011658226) - 0.00947632974202861) + x**4*(x*(x*((0.011320983991026878)*x - 0.01395021378993988) + 0.017994403839111328) - 0.024982452392578125) + x*(x*((0.03955078125)*x - 0.08203125) + 0.375) + 1
@@ -499,11 +513,13 @@ def _qdot_into(out, t_in, A_in, eps_in):
         A = ((A) if (inside == 1) else (0.1))
         eps = ((eps) if (inside == 1) else (0.1))
         t = ((t) if (inside == 1) else (0))
-        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) and (abs(t) <= 1.0e+300) else (0))
+        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) and (abs(t) <= 1.0e+300) else (0))
         A = ((A) if (inside == 1) else (0.1))
         eps = ((eps) if (inside == 1) else (0.1))
         t = ((t) if (inside == 1) else (0))
-        x = A**2*eps
+        x = eps
+        x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
+        x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
         if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue
@@ -565,10 +581,12 @@ def error_estimate(A, eps):
     inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
-    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) else (0))
+    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) else (0))
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
-    x = A**2*eps
+    x = eps
+    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
+    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
     if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
         return math.nan
     T = x**8*(x*(x*(x*((0.037655499172602594)*x - 0.04111688992562357) + 0.045286478809785535) - 0.05040817548206178) + 0.05685099380571046) + x**4*(x*(x*(0.07641269266605377 - 0.0651973094791174*x) - 0.09219503402709961) + 0.11575698852539062) + x*(x*(0.22265625 - 0.15380859375*x) - 0.375) + 1
@@ -586,10 +604,12 @@ def _error_estimate_into(out, A_in, eps_in):
         inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
         A = ((A) if (inside == 1) else (0.1))
         eps = ((eps) if (inside == 1) else (0.1))
-        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+100) and (abs(eps) <= 1.0e+100) else (0))
+        inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) else (0))
         A = ((A) if (inside == 1) else (0.1))
         eps = ((eps) if (inside == 1) else (0.1))
-        x = A**2*eps
+        x = eps
+        x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
+        x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
         if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
             out[i] = math.nan
             continue

@@ -347,13 +347,14 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     reach = None if radius is None else radius - sp.Float(spread, 17) if spread else radius
     if reach is not None and not allow_divergent:
         guard = sp.And(guard, sp.Abs(x) < reach)
-    ranges = free_ranges(y, params)
+    scaled = scaled_variable(y, params, x)
+    steps, ranges = scaled if scaled is not None else (((x, y),), free_ranges(y, params))
     flag = "inside" if "inside" not in user else "_inside"
     entry, inside = argument_entry(ranges, flag)
-    prelude, guard_t = (*entry, (x, y)), guard
+    prelude, guard_t = (*entry, *steps), guard
     guard = sp.And(inside, guard)
     entry, inside = argument_entry((*ranges, (t, sp.Abs(t) <= FREE_ARGUMENT_LIMIT, 0)), flag)
-    prelude_t, guard_t = (*entry, (x, y)), sp.And(inside, guard_t)
+    prelude_t, guard_t = (*entry, *steps), sp.And(inside, guard_t)
 
     top = max((max(qj) for qj in solution.q[: order + 1] if qj), default=1)
     harmonic = {
@@ -1011,6 +1012,41 @@ def free_ranges(y: sp.Expr, params: tuple[sp.Symbol, ...]
         degree = 6
     bound = sp.Float(10.0 ** (300 // degree))
     return tuple((p, sp.Abs(p) <= bound, sp.Rational(1, 10)) for p in params)
+
+
+SCALED_CLAMP = sp.Float(1e8)
+# NOTE: a partial product of the expansion variable held at ±1e8 before it grows by a factor
+# |a| > 1 (|a| ≤ 1e300): at most 1e308, finite; and beyond 1e8 it is out of every orbit domain.
+
+
+def scaled_variable(y: sp.Expr, params: tuple[sp.Symbol, ...], x: sp.Symbol
+                    ) -> tuple[tuple[Assign, ...], tuple[tuple[sp.Symbol, sp.Basic, object], ...]
+                               ] | None:
+    """``x = y`` for ``y = c·p·a^k`` (ε A², ε A⁴…), computed factor by factor from ``p``: each
+    partial product ``p·a^i`` lies between ``|p|`` and ``|y|``, so an in-domain ``y`` is exact
+    however extreme ``p`` and ``a`` are (ε = 1e300, A = 1e-200; A = 1e200, ε = 0) and only an
+    out-of-domain one is clamped (:data:`SCALED_CLAMP`).  Returns the steps and
+    :func:`argument_entry`'s ranges (``p`` any finite number, ``|a| ≤ 1e300``), or None for
+    another form of ``y`` (then :func:`free_ranges` bounds each parameter)."""
+    c, factors = y.as_coeff_Mul()
+    powers: dict[sp.Symbol, int] = {}
+    for f in sp.Mul.make_args(factors):
+        base, e = f.as_base_exp()
+        if base not in params or not e.is_Integer or e < 1:
+            return None
+        powers[base] = int(e)
+    if len(powers) != 2 or 1 not in powers.values() or not c.is_Rational or c == 0:
+        return None
+    first = next(b for b, e in powers.items() if e == 1)
+    other, k = next((b, e) for b, e in powers.items() if b is not first)
+    clamped = sp.Min(sp.Max(x, -SCALED_CLAMP), SCALED_CLAMP) * other
+    steps = [(x, first)] + [(x, sp.Piecewise((clamped, sp.Abs(other) > 1), (x * other, True)))
+                            for _ in range(k)]
+    if c != 1:
+        steps.append((x, c * x))
+    ranges = tuple((p, sp.true if p is first else sp.Abs(p) <= FREE_ARGUMENT_LIMIT,
+                    sp.Rational(1, 10)) for p in params)
+    return tuple(steps), ranges
 
 
 def argument_entry(arguments: tuple[tuple[sp.Symbol, sp.Basic, object], ...],

@@ -547,4 +547,20 @@ def test_free_and_limit_cycle_modules_are_nan_without_a_warning(newer_modules):
     x = 0.1 * 0.5**2
     assert math.isclose(duffing.omega(0.5, 0.1), 1 + 3 / 8 * x - 21 / 256 * x**2 + 81 / 2048 * x**3,
                         rel_tol=1e-7)
-    assert math.isnan(duffing.omega(1e101, 1e-203)) and math.isnan(duffing.q(math.inf, 0.5, 0.1))
+    assert math.isnan(duffing.q(math.inf, 0.5, 0.1))
+    # in-domain extremes are numbers: x = εA² is formed factor by factor (ε, then ·A, ·A), so
+    # neither A² nor ε A overflows or underflows where x itself is moderate
+    for A, eps in ((1e-200, 1e300), (1e101, 1e-203), (1e200, 0.0), (1e300, -1e-600)):
+        x = (eps * A) * A
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            w = duffing.omega(A, eps)
+            q = duffing.q(1.0, A, eps)
+            wv = duffing.omega(np.array([A]), np.array([eps]))[0]
+        assert math.isclose(w, 1 + 3 / 8 * x - 21 / 256 * x**2 + 81 / 2048 * x**3,
+                            rel_tol=1e-4), (A, eps)
+        assert wv == w
+        assert math.isclose(q / A, math.cos(w) + x / 32 * (math.cos(3 * w) - math.cos(w)),
+                            rel_tol=1e-2, abs_tol=1e-3), (A, eps)
+    # beyond the domain still NaN: x = 1e100, and |A| past 1e300 (x in range only for ε = 0)
+    assert math.isnan(duffing.omega(1e200, 1e-300)) and math.isnan(duffing.q(1.0, 1e301, 0.0))
