@@ -230,7 +230,13 @@ def limit_cycle_stability(lc) -> str:
             "for both signs")
 
 
-def _fraction_text(c) -> str:
+def _fraction_text(c: object) -> str:
+    """``"p/q"`` of a Fraction; an algebraic number (a limit cycle in Q(a₀)) as SymPy's str,
+    exact (``"-3*2**(3/4)/2560"``)."""
+    if getattr(c, "is_Rational", False):  # SymPy's Rational (no import: start-up)
+        c = Fraction(int(c.p), int(c.q))
+    elif not isinstance(c, Fraction):
+        return str(c)
     return f"{_int_text(c.numerator)}/{_int_text(c.denominator)}"
 
 
@@ -253,7 +259,7 @@ def _cycles_json(cycles) -> list[dict]:
     """Every limit cycle: its first-order amplitude a₀ (exact, SymPy's str), S'(a₀) and its
     stability, smallest amplitude first."""
     return [{"amplitude0": str(c.amplitude), "slope": str(c.slope), "stability": c.stability,
-             "expandable": c.rational and c.slope != 0} for c in cycles]
+             "expandable": c.slope != 0} for c in cycles]
 
 
 def _cycles_text(model, listed: list[dict]) -> str:
@@ -304,9 +310,6 @@ def _cmd_series(args: argparse.Namespace) -> int:
                 texts.append(f"cycle {k}: " + limit_cycle_table(lc))
             elif c.slope == 0:
                 texts.append(f"cycle {k}: not expanded: {c.stability}")
-            elif not c.rational:
-                texts.append(f"cycle {k}: not expanded: its amplitude {c.amplitude} is "
-                             "irrational (the exact series need a rational one)")
             else:
                 texts.append(f"cycle {k}: " + limit_cycle_table(
                     derive_limit_cycle(found, args.order, k - 1)))

@@ -21,6 +21,7 @@ from math import factorial
 from typing import Any
 
 import sympy as sp
+from sympy.polys.domains import QQ
 
 from .display import SHOWN_ORDERS, latex_aligned, latex_sum, latex_text, more
 from .errors import InputError
@@ -705,25 +706,32 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
     cycles = limit_cycles(model)
     if not 0 <= cycle < len(cycles):
         raise InputError(f"cycle {cycle}: {model.name} has {len(cycles)} limit cycle(s)")
-    if not cycles[cycle].rational:
-        raise InputError(f"{model.name}: limit cycle {cycle + 1}'s amplitude "
-                         f"{cycles[cycle].amplitude} is irrational; the exact series need a "
-                         "rational one")
-    a0, slope = _fraction(cycles[cycle].amplitude), _fraction(cycles[cycle].slope)
+    chosen = cycles[cycle]
+    if chosen.rational:
+        g = Ground.for_coefficients([])
+        a0, slope = _fraction(chosen.amplitude), _fraction(chosen.slope)
+        exact: Callable[[Any], Any] = g.to_fraction
+    else:  # exact in the number field Q(a₀): a₀ reduced by its minimal polynomial
+        field = QQ.algebraic_field(chosen.amplitude)
+        g = Ground(field)
+        a0, slope = chosen.amplitude, chosen.slope
+
+        def exact(c: Any) -> sp.Expr:
+            return sp.radsimp(field.to_sympy(c))
     if slope == 0:
         raise InputError(f"{model.name}: the cycle at amplitude {a0} is semi-stable (a double "
                          "root of the first-order amplitude function S(a), S'(a) = 0): the "
                          "secular conditions cannot fix its amplitude order by order, and it "
                          "need not persist for eps ≠ 0; no series in eps")
-    g = Ground.for_coefficients([])
     zero = g.scalar(0)
     nothing = Trig(g.poly([]), g.poly([]), g)
+    a0_g = g.scalar(a0)
 
     def constant(c: Any) -> Trig:
         return Trig(g.poly([c]), g.poly([]), g)
 
     cos_s = Trig.from_fourier({1: g.scalar(1)}, {}, g)
-    qs = [cos_s * g.scalar(a0)]
+    qs = [cos_s * a0_g]
     W, omega = [g.scalar(1)], [g.scalar(1)]
     # the series: q, q', q'', ω, X = (ω² − 1)/ε (X_k = W_(k+1)), and the products of f
     q = TrigTerms(qs)
@@ -767,8 +775,8 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
                 total = total + constant(c)
         return total
 
-    def fourier(x: Trig) -> tuple[dict[int, Fraction], dict[int, Fraction]]:
-        return tuple({n: g.to_fraction(c) for n, c in part.items() if c}
+    def fourier(x: Trig) -> tuple[dict[int, Any], dict[int, Any]]:
+        return tuple({n: exact(c) for n, c in part.items() if c}
                      for part in x.to_fourier())
 
     documented: list[CycleOrder] = []
@@ -787,7 +795,7 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
             # F_j holds a_(j−1) linearly, through f's linearisation at q_0 and W_1 q_(j−1)''
             known = known + lin * a_prev
             kc = kc + lc_ * a_prev
-        Wj = -kc / g.scalar(a0)  # the cos s condition, kc + W_j a0 = 0 (−W_j q_0'' = W_j a0 cos s)
+        Wj = -kc / a0_g  # the cos s condition, kc + W_j a0 = 0 (−W_j q_0'' = W_j a0 cos s)
         W.append(Wj)
         S = sum((omega[a] * omega[j - a] for a in range(1, j)), zero)
         omega.append((Wj - S) * g.scalar(Fraction(1, 2)))
@@ -798,7 +806,7 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
         omegas.terms.append(constant(omega[j]))
         for node in nodes:
             node.forget(j - 1)
-        F = known + cos_s * (Wj * g.scalar(a0))
+        F = known + cos_s * (Wj * a0_g)
         p = solve_trig(F).particular
         # its cos s (a_j) waits for the next order's sin s condition; its sin s makes
         # q_j'(0) = R(1) = 0 (d/ds of S·R(C) at s = 0 is R(1); of P(C), 0): R's constant term
@@ -806,18 +814,18 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
         r_at_one = sum(r, zero)
         qs.append(Trig(p.cos_part, p.sin_part - g.poly([r_at_one]), g))
         if shown is not None:
-            documented.append(CycleOrder(j, shown, g.to_fraction(a_prev) if j >= 2 else None,
-                                         g.to_fraction(Wj), g.to_fraction(omega[j]),
-                                         fourier(qs[j])))
+            documented.append(CycleOrder(j, shown, exact(a_prev) if j >= 2 else None,
+                                         exact(Wj), exact(omega[j]), fourier(qs[j])))
     period = [g.scalar(1)]
     for j in range(1, order + 1):
         period.append(-sum((omega[a] * period[j - a] for a in range(1, j + 1)), zero))
     fourier_q = [fourier(qj) for qj in qs[: order + 1]]
     return LimitCycle(
         model=model, order=order,
-        omega=tuple(g.to_fraction(w) for w in omega[: order + 1]),
-        period=tuple(g.to_fraction(p) for p in period),
-        amplitude=tuple(sum(cos.values(), Fraction(0)) for cos, _ in fourier_q),
+        omega=tuple(exact(w) for w in omega[: order + 1]),
+        period=tuple(exact(p) for p in period),
+        amplitude=tuple(sum(cos.values(), Fraction(0)) if chosen.rational
+                        else sp.radsimp(sp.Add(*cos.values())) for cos, _ in fourier_q),
         q=tuple(fourier_q), slope=slope,
         linearisation=fourier(lin) if lin is not None else ({}, {}), orders=tuple(documented))
 
@@ -879,7 +887,8 @@ def nearest_singularity(coefficients: Sequence[Fraction], variable: str = "eps",
     c = list(coefficients)
     if len(c) > 2 and all(x == 0 for x in c[1::2]):
         c, variable = c[::2], f"{variable}**2"
-    c = [mpmath.mpf(x.numerator) / x.denominator for x in c]
+    c = [mpmath.mpf(x.numerator) / x.denominator if isinstance(x, Fraction)
+         else mpmath.mpf(sp.N(x, 40)) for x in c]  # an algebraic number: 40 digits
     while c and c[-1] == 0:
         c.pop()
     if len(c) < 12:

@@ -500,6 +500,14 @@ def cycle_series_order(order: int, resum_order: int | None) -> int:
 
 
 def _cycle_derive(r: Request, progress: Progress | None) -> object:
+    from .lindstedt import limit_cycles
+
+    first = limit_cycles(r.model)[0]
+    if not first.rational:
+        raise InputError(f"{r.model.name}: the limit cycle's amplitude {first.amplitude} is "
+                         "irrational: `lindstedt series` gives its exact series in "
+                         f"Q({first.amplitude}); the evaluators and their resummation need "
+                         "rational coefficients and are not emitted for it")
     lc = derive_limit_cycle(r.model, cycle_series_order(r.order, r.resum_order))
     return lc, resum_cycle(lc)
 

@@ -584,6 +584,13 @@ class RelaxedProduct(TrigSeries):
     def coeff(self, i: int) -> Trig:
         if i in self.cache:
             return self.cache[i]
+        a, b = self.a, self.b
+        if not a.coeff(0).ground.is_rational:  # no integer packing off QQ: the Cauchy sum
+            out = a.coeff(0) * b.coeff(i)
+            for k in range(1, i + 1):
+                out = out + a.coeff(k) * b.coeff(i - k)
+            self.cache[i] = out
+            return out
         while self.started < i:
             self.started += 1
             self._squares(self.started)

@@ -100,11 +100,46 @@ def test_rayleigh_has_van_der_pols_frequency():
         derive_limit_cycle(model(VDP), 8).omega
 
 
+IRRATIONAL = "q'' + q = eps*(q' - q**4*q')"
+# NOTE: S(a) = −a/2 + a⁵/16: the cycle at a₀ = 2^(3/4), exact in Q(2^(3/4))
+
+
+@pytest.mark.parametrize(("text", "f", "a0", "order", "tol"), [
+    (IRRATIONAL, lambda q, p: p - q**4 * p, 2**0.75, 12, (1e-10, 1e-10, 1e-6)),
+    ("q'' + q = eps*(1 - 2*q**2)*q'", lambda q, p: (1 - 2 * q**2) * p, 2**0.5, 12,
+     (1e-10, 1e-9, 1e-4)),
+])
+def test_an_irrational_amplitude_is_exact_in_its_number_field(text, f, a0, order, tol):
+    """a₀ = 2^(3/4) (and √2): the series are exact in Q(a₀), every amplitude coefficient a
+    rational multiple of a₀ and every ω_j rational; ω and q(0) against the settled cycle
+    (DOP853) at ε = 0.05, 0.2, 0.5."""
+    import sympy as sp
+
+    lc = derive_limit_cycle(model(text), order)
+    root = sp.nsimplify(a0)
+    assert lc.amplitude[0] == root
+    assert all(sp.simplify(c / root).is_Rational for c in lc.amplitude if c != 0)
+    assert all(getattr(w, "is_Rational", False) or isinstance(w, F) for w in lc.omega)
+    for eps, bound in zip((0.05, 0.2, 0.5), tol, strict=True):
+        omega = sum(float(c) * eps**j for j, c in enumerate(lc.omega))
+        amplitude = sum(float(c) * eps**j for j, c in enumerate(lc.amplitude))
+        # started at the series' q(0): the settling (≈ exp(−ε S'(a₀) t/2)) removes what is off
+        period, q_turn = numerical_cycle(f, eps, amplitude)
+        assert abs(omega - 2 * np.pi / period) < bound, eps
+        assert abs(amplitude - q_turn) < bound, eps
+
+
+def test_an_irrational_cycle_in_the_series_command(capsys):
+    assert main(["series", IRRATIONAL, "--order", "4", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["cycles"][0]["amplitude0"] == "2**(3/4)" and data["cycles"][0]["expandable"]
+    assert data["amplitude"][:3] == ["2**(3/4)", "0/1", "2**(3/4)/180"]
+    assert data["omega"][:3] == ["1/1", "0/1", "-7/48"]
+
+
 def test_refusals_name_what_is_wrong():
     with pytest.raises(InputError, match="no limit cycle"):
         derive_limit_cycle(model("q'' + q = -eps*q'"), 4)
-    with pytest.raises(InputError, match="irrational"):
-        derive_limit_cycle(model("q'' + q = eps*(1 - 2*q**2)*q'"), 4)  # a = √2
     with pytest.raises(InputError, match="conservative"):
         model("q'' + q = eps*q**3")
     with pytest.raises(InputError, match="cycle 1"):
