@@ -146,7 +146,7 @@ def _domain_fields(sol) -> dict:
     """Where the series may be used: ``orbit_limit`` (the family of periodic orbits exists
     for lower < y < upper, 30 digits, or ``known`` false with the reason) and, where the
     model states no radius, ``radius_estimate`` (value and spread, from the τ_j)."""
-    from .lower import estimated_radius
+    from .lindstedt import estimated_radius
     from .orbits import orbit_domain
 
     fields = {"orbit_limit": orbit_domain(sol.model).as_json()}

@@ -958,3 +958,60 @@ def nearest_singularity(coefficients: Sequence[Fraction], variable: str = "eps",
     if degree is None:
         method += f", degree {chosen} in 1/n"
     return Singularity(variable, radius, float(angle), float(spread), method)
+
+
+def estimated_radius(solution: SeriesSolution, to_args: dict
+                     ) -> tuple[sp.Expr, float] | None:
+    """The radius of convergence of ``T/2π = Σ τ_j y^j`` where the model knows none, and its
+    spread (an error bar; the guard and the error estimate take the radius minus it).
+
+    Rational coefficients: the root test ``min_j |τ_j|^(−1/j)`` over the upper half of the
+    derived orders, Domb–Sykes' line of the ratios in 1/j where it fits, and from 12 nonzero
+    coefficients :func:`lindstedt.nearest_singularity` (its extrapolations' spread) — the
+    smallest of them, with the spread of the estimator used, or the distance between the
+    root test and Domb–Sykes below 12 (the range of the root tests without Domb–Sykes).
+    Coefficients in ``QQ[A, …]``: the root test as an expression, spread 0 (no number to
+    state).  None when every τ_j there vanishes (a series that stops: no bound to state)."""
+    top = solution.order
+    g = solution.ground
+    if not g.is_rational:
+        roots = []
+        for j in range(max(1, top // 2), top + 1):
+            c = g.to_sympy(solution.period[j]).xreplace(to_args)
+            if c != 0:
+                roots.append(sp.Abs(c) ** sp.Rational(-1, j))
+        return (sp.Min(*roots), 0.0) if roots else None
+    import mpmath
+
+    fractions = [g.to_fraction(c) for c in solution.period]
+    tau = [abs(mpmath.mpf(c.numerator) / c.denominator) for c in fractions]
+    roots = [float(tau[j] ** (mpmath.mpf(-1) / j))
+             for j in range(max(1, top // 2), top + 1) if tau[j]]
+    if not roots:
+        return None
+    radius, spread = min(roots), max(roots) - min(roots)
+    # Domb–Sykes: |τ_j/τ_(j−1)| = (1 − (1 + γ)/j)/R for a singularity on the real axis; its
+    # line in 1/j finds R from ten terms where the root test is still 40 % high (Duffing: 1.0000
+    # against 1.36 at order 10) — taken when the line fits
+    js = [j for j in range(max(2, top // 2), top + 1) if tau[j] and tau[j - 1]]
+    if len(js) >= 3:
+        import numpy as np
+
+        ratios = np.array([float(tau[j] / tau[j - 1]) for j in js])
+        design = np.vstack([np.ones(len(js)), 1.0 / np.array(js, dtype=float)]).T
+        (a, b), *_ = np.linalg.lstsq(design, ratios, rcond=None)
+        if a > 0 and np.max(np.abs(design @ np.array([a, b]) - ratios) / ratios) < DOMB_SYKES_FIT:
+            spread = abs(radius - 1 / a)
+            radius = min(radius, 1 / a)
+    est = nearest_singularity(fractions, "y", None)
+    if est is not None:
+        r = math.sqrt(est.radius) if est.variable.endswith("**2") else est.radius
+        r_spread = est.spread / (2 * r) if est.variable.endswith("**2") else est.spread
+        if r <= radius:
+            radius, spread = r, r_spread
+    return sp.Float(radius, 17), float(spread)
+
+
+DOMB_SYKES_FIT = 0.02
+# NOTE: the largest relative misfit of the ratios' line for its R to count (a pair of complex
+# singularities makes the ratios oscillate: no line, no estimate from it)

@@ -29,8 +29,6 @@ from dataclasses import dataclass
 import mpmath
 import numpy as np
 import sympy as sp
-from scipy.integrate import IntegrationWarning, quad
-from scipy.optimize import brentq
 
 from .models import Model, oscillator
 
@@ -210,6 +208,10 @@ def _float_at(sc: _Scaled, s: float) -> _Float:
         if sc.polynomial:
             return _Float(g, 2 * g.integ(), polynomial_zeros, lambda: math.inf, set())
     g0_us, weight_us = sc.numeric["g0"], sc.numeric["weight"]
+    # NOTE: SciPy only here (a transcendental force): a polynomial's edge needs none, and
+    # `series` should not pay its import
+    from scipy.integrate import IntegrationWarning, quad
+    from scipy.optimize import brentq
 
     def g0(x: float | np.ndarray) -> float | np.ndarray:
         return g0_us(x, s)
