@@ -17,7 +17,8 @@ from collections import Counter
 import numpy as np
 from lindstedt.driven import Drive, amplitudes
 from lindstedt.numerics import multipliers_stable, orbit_hill_multipliers
-from lindstedt.response import periodic_orbits, subharmonic
+from lindstedt.response import periodic_orbits
+from lindstedt.subharmonic import subharmonic
 
 
 def _verdict(stable: bool | None, name: str, missing: str) -> str:

@@ -8,7 +8,13 @@ from __future__ import annotations
 import numpy as np
 import timing
 from lindstedt.driven import Drive, first_order_branches, harmonic_balance, mu_expansion
-from lindstedt.numerics import flow, hill_multipliers, steady_state_amplitudes, sweep
+from lindstedt.numerics import (
+    duffing_table,
+    flow,
+    hill_multipliers,
+    steady_state_amplitudes,
+    sweep,
+)
 
 
 def best(f, n: int) -> float:
@@ -27,7 +33,7 @@ def main() -> None:
         ("sweep 0.5 -> 2, 10 000 periods", lambda: sweep(0.1, 0.3, 0.05, 0.5, 2.0), 3),
         ("hill_multipliers", lambda: hill_multipliers(1.05, 0.1, 1.0, 0.0, -0.03), 10),
         ("steady_state_amplitudes, 2 drives", lambda: steady_state_amplitudes(
-            0.1, 1 / 15, [0.2, 0.1], [0.8, 1.9], [0.8, 1.9, 2.4]), 3),
+            duffing_table(0.1, 1 / 15), [0.2, 0.1], [0.8, 1.9], [0.8, 1.9, 2.4]), 3),
         ("mu_expansion order 20", lambda: mu_expansion(d, br, 20), 5),
         ("harmonic_balance N = 40", lambda: harmonic_balance(d, br, 40), 5),
     ]

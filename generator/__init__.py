@@ -25,7 +25,12 @@ The pipeline, one module per stage (input -> output); a stage imports only stage
     driven     μ-expansion with phase, harmonic balance (Duffing; and a  Drive | equation ->
                user's polynomial force by alternating frequency/time)   branches
     response   one-harmonic curves and folds, balance continuation in   Drive | equation,
-               ω or in the drive; periodic orbits, subharmonic, mixing  ω range -> folds
+               ω or in the drive; every periodic orbit at one drive     ω range -> folds
+    subharmonic  orbits of n drive periods of any polynomial force:     equation, n, ω ->
+               balance on the harmonics of ω, shooting, Floquet, onset; orbits
+               the notes' eq. 10.83 in closed form
+    mixing     combination tones of a multi-tone drive to the second    ForceTable, drives
+               order of any polynomial force, against a simulation      -> tones
     parametric  q̈ + 2ζq̇ + (1 + ε cos 2ωt)q + γq³ = 0: one-harmonic     Pump, ω range ->
                 branches, tongue, onsets, balance, full-Hill stability branches
     printers   NumbaPrinter(PythonCodePrinter), LaTeX rationals         Expr -> str

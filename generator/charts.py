@@ -29,16 +29,15 @@ from .driven import Drive
 from .emit import check_folder, check_target, write_files
 from .errors import InputError
 from .methods import candidates, reference_period
-from .numerics import steady_state_amplitudes, sweep
+from .mixing import mixing_series, tone_label
+from .numerics import ForceTable, duffing_table, steady_state_amplitudes, sweep
 from .response import (
     CONTINUATION_SECONDS,
     continue_balance,
-    mixing_tones,
     one_harmonic_curve,
     response_range,
-    subharmonic,
-    tone_label,
 )
+from .subharmonic import subharmonic, subharmonic_equation, subharmonic_orbits
 from .sweep import BALANCE_HARMONICS, MU_ORDERS, validity_errors
 
 FORMATS = (".png", ".svg", ".pdf")
@@ -210,11 +209,47 @@ def subharmonic_figure(eps: float, force: float, path: Path) -> Path:
     return _save(fig, path)
 
 
-def mixing_figure(eps: float, Q: float, drives: list[tuple[float, float]], path: Path) -> Path:
-    """Spectrum of the steady state: predicted tones (stems) and simulated amplitudes."""
+def subharmonic_orbits_figure(text: str, values: dict[str, str], omega: float | None, n: int,
+                              name: str, path: Path) -> Path:
+    """``subharmonic EQUATION --n N --plot``: q(t) over n drive periods of every orbit found
+    (solid: stable, dashed: unstable, from the shot orbit's balance) beside the primary
+    response (grey) and the drive's phase (dotted, scaled)."""
     check_plot_path(path)
-    tones = mixing_tones(eps, Q, drives)
-    sim = steady_state_amplitudes(eps, 1 / Q, [f for f, _ in drives], [w for _, w in drives],
+    found = subharmonic_orbits(subharmonic_equation(text, values, omega, n, name))
+    p = found.problem
+    t = np.linspace(0.0, p.n * 2 * np.pi / p.drive, 801)
+
+    def q(A: dict, B: dict) -> np.ndarray:
+        return sum(A[k] * np.cos(k * p.omega * t) + B.get(k, 0.0) * np.sin(k * p.omega * t)
+                   for k in A)
+
+    fig, ax = plt.subplots(figsize=(8, 4.2))
+    if found.primary is not None:
+        ax.plot(t, q(found.primary.A, found.primary.B), color="0.6", lw=1.5,
+                label="primary response (one drive period)")
+    for i, o in enumerate(found.orbits, 1):
+        style = "-" if o.stable else "--"
+        ax.plot(t, q(o.A, o.B), style, color=f"C{i - 1}", lw=1.5,
+                label=f"orbit {i}: r = {o.r:.4g}, "
+                + {True: "stable", False: "unstable", None: "not shot"}[o.stable])
+    top = max((float(np.max(np.abs(line.get_ydata()))) for line in ax.lines), default=1.0)
+    ax.plot(t, top * np.cos(p.drive * t), ":", color="k", lw=0.8, label="drive cos(nωt), scaled")
+    ax.set(xlabel="t", ylabel="q",
+           title=f"orbits of {p.n} drive periods of {text}\n(ω = {p.omega:g}, drive at "
+                 f"{p.drive:g}, f = {p.force:g})")
+    ax.legend(fontsize=8, loc="upper right")
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def mixing_figure(table: ForceTable, drives: list[tuple[float, float]], path: Path,
+                  label: str) -> Path:
+    """Spectrum of the steady state of ``q̈ + g(q, q̇) = Σ f_i cos ω_i t`` (``g`` the
+    ``table``; ``label`` names it in the title): predicted tones (stems) and simulated
+    amplitudes."""
+    check_plot_path(path)
+    tones = mixing_series(table, drives).tones
+    sim = steady_state_amplitudes(table, [f for f, _ in drives], [w for _, w in drives],
                                   [t.frequency for t in tones])
     fig, ax = plt.subplots(figsize=(8, 4.2))
     for t, s in zip(tones, sim, strict=True):
@@ -229,7 +264,7 @@ def mixing_figure(eps: float, Q: float, drives: list[tuple[float, float]], path:
     ax.set_yscale("log")
     ax.set_ylim(1e-7, 2)
     ax.set(xlabel="frequency", ylabel="amplitude",
-           title=f"frequency mixing (ε = {eps}, Q = {Q}, drives "
+           title=f"frequency mixing ({label}, drives "
                  + ", ".join(f"{f}@{w}" for f, w in drives) + ")")
     ax.legend(fontsize=8)
     fig.tight_layout()
@@ -239,7 +274,8 @@ def mixing_figure(eps: float, Q: float, drives: list[tuple[float, float]], path:
 GALLERY = (
     ("response.png", lambda path: response_figure(0.1, 0.3, 20.0, 8, path)),
     ("subharmonic.png", lambda path: subharmonic_figure(0.1, 0.5, path)),
-    ("mixing.png", lambda path: mixing_figure(0.1, 10.0, [(0.3, 1.3), (0.3, 1.7)], path)),
+    ("mixing.png", lambda path: mixing_figure(duffing_table(0.1, 0.1), [(0.3, 1.3), (0.3, 1.7)],
+                                              path, "ε = 0.1, Q = 10.0")),
     ("validity.png", lambda path: validity_figure(path)),
     ("driven_validity.png", lambda path: driven_validity_figure(path)),
 )

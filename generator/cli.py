@@ -1309,7 +1309,7 @@ def _response_equation_table(data: dict) -> list[str]:
 
 def subharmonic_json(eps: float, force: float, omega: float) -> dict:
     """The contract of ``lindstedt subharmonic … --json`` (eq. 10.83–10.87)."""
-    from .response import subharmonic
+    from .subharmonic import subharmonic
 
     exists, reason, solutions = subharmonic(eps, force, omega)
     return {
@@ -1352,27 +1352,74 @@ def _equation_args(args: argparse.Namespace, flags: Sequence[str],
 
 
 def subharmonic_equation_json(text: str, values: dict[str, str], omega: float | None,
-                              name: str = "oscillator") -> dict:
-    """:func:`subharmonic_json` of an equation of eq. 10.83's form, with ``equation``,
-    ``name`` and the ``parameters.values`` given."""
-    from .response import subharmonic_equation
+                              name: str = "oscillator", n: int = 3) -> dict:
+    """The contract of ``lindstedt subharmonic EQUATION --n N … --json``: every orbit of n
+    drive periods (balance, shooting, Floquet), the primary response and the onset.  For the
+    notes' eq. 10.83 (n = 3, ``q + εq³``, undamped) the closed form's keys of
+    :func:`subharmonic_json` as well."""
+    from .subharmonic import subharmonic_equation, subharmonic_orbits
 
-    eps, force, omega, form = subharmonic_equation(text, values, omega, name)
-    data = subharmonic_json(eps, force, omega)
-    data["parameters"]["values"] = dict(form.values)
-    return {"equation": text, "name": name, **data}
+    problem = subharmonic_equation(text, values, omega, n, name)
+    found = subharmonic_orbits(problem)
+    data = {"equation": text, "name": name, **subharmonic_orbits_json(found)}
+    data["parameters"]["values"] = dict(problem.values)
+    if problem.eps is not None:
+        notes = subharmonic_json(problem.eps, problem.force, problem.omega)
+        data = {**data, **notes, "parameters": {**data["parameters"], **notes["parameters"]}}
+    return data
+
+
+def subharmonic_orbits_json(found) -> dict:
+    """The general fields of the subharmonic's JSON (:class:`subharmonic.SubharmonicResponse`)."""
+    p = found.problem
+
+    def moduli(orbit) -> list[float]:
+        return sorted(float(abs(m)) for m in orbit.multipliers)
+
+    def orbit_json(o) -> dict:
+        return {"r": o.r, "A": _keyed(o.A), "B": _keyed(o.B), "stable": o.stable,
+                "balance_residual": o.residual,
+                "shooting": None if o.orbit is None else {
+                    "a1": o.orbit.A.get(1, 0.0), "b1": o.orbit.B.get(1, 0.0),
+                    "deviation": o.deviation, "floquet_moduli": moduli(o.orbit)}}
+
+    primary = found.primary
+    return {
+        "n": p.n,
+        "parameters": {"omega": p.omega, "drive": p.drive, "force": p.force,
+                       "harmonics": found.harmonics},
+        "exists": found.exists,
+        "reason": found.reason,
+        "orbits": [orbit_json(o) for o in found.orbits],
+        "primary": None if primary is None else {
+            "amplitude": math.hypot(primary.A.get(p.n, 0.0), primary.B.get(p.n, 0.0)),
+            "stable": primary.stable,
+            "floquet_moduli": None if primary.orbit is None else moduli(primary.orbit)},
+        "onset": None if found.onset is None else {"force": found.onset.force,
+                                                   "kind": found.onset.kind},
+        "seeds": found.seeds,
+    }
 
 
 def _cmd_subharmonic(args: argparse.Namespace) -> int:
+    n = 3 if args.n is None else args.n
     if _equation_args(args, ("eps", "force"), ("eps", "force", "omega")):
-        from .response import subharmonic_equation
+        from .subharmonic import subharmonic_equation
 
         values, name = _params(args.param), args.name or "oscillator"
-        eps, force, _, _ = subharmonic_equation(args.model, values, args.omega, name)
+        problem = subharmonic_equation(args.model, values, args.omega, n, name)
+        if problem.eps is not None:
+            draw = lambda path: _charts().subharmonic_figure(  # noqa: E731
+                problem.eps, problem.force, path)
+        else:
+            draw = lambda path: _charts().subharmonic_orbits_figure(  # noqa: E731
+                args.model, values, args.omega, n, name, path)
         return _report(args, lambda: subharmonic_equation_json(args.model, values, args.omega,
-                                                               name),
-                       lambda path: _charts().subharmonic_figure(eps, force, path),
-                       _subharmonic_table)
+                                                               name, n),
+                       draw, _subharmonic_table)
+    if n != 3:
+        raise InputError(f"--n {n}: the notes' eq. 10.83 (--eps, --force) is the 1/3 "
+                         "subharmonic; give an EQUATION for another n")
     return _report(args, lambda: subharmonic_json(args.eps, args.force, args.omega),
                    lambda path: _charts().subharmonic_figure(args.eps, args.force, path),
                    _subharmonic_table)
@@ -1380,6 +1427,8 @@ def _cmd_subharmonic(args: argparse.Namespace) -> int:
 
 def _subharmonic_table(data: dict) -> list[str]:
     p = data["parameters"]
+    if "solutions" not in data:
+        return _orbits_table(data)
     lines = [f"omega^2 q'' + q + eps q^3 = f cos 3tau: eps = {p['eps']}, f = {p['force']}, "
              f"omega = {p['omega']} (drive at {p['drive']:g})",
              ("exists: " if data["exists"] else "no subharmonic: ") + data["reason"]]
@@ -1394,6 +1443,36 @@ def _subharmonic_table(data: dict) -> list[str]:
                      + ("no balance" if full is None else
                         f"{'stable' if full['stable'] else 'unstable'} (a1 = {full['a1']:.6f})")
                      + f"; {true}")
+    if "orbits" in data:
+        lines += _orbits_table(data)[2:]
+    return lines
+
+
+def _orbits_table(data: dict) -> list[str]:
+    p, n = data["parameters"], data["n"]
+    lines = [f"{data['equation']}: orbits of {n} drive periods (the 1/{n} subharmonic), "
+             f"omega = {p['omega']:g}, drive at {p['drive']:g}, f = {p['force']:g}",
+             ("exists: " if data["exists"] else "no subharmonic: ") + data["reason"]]
+    for i, o in enumerate(data["orbits"], 1):
+        shot = o["shooting"]
+        verdict = ("shooting found no orbit" if shot is None else
+                   f"{'stable' if o['stable'] else 'unstable'} (Floquet |lambda| max "
+                   f"{max(shot['floquet_moduli']):.6g}), shooting agrees to "
+                   f"{shot['deviation']:.1e}")
+        lines.append(f"  orbit {i}: r = {o['r']:.8f} (A1 = {o['A']['1']:.8f}, "
+                     f"B1 = {o['B']['1']:.8f}); {verdict}")
+    pr = data["primary"]
+    if pr is not None:
+        lines.append(f"  primary response (one drive period): harmonic {n} amplitude "
+                     f"{pr['amplitude']:.8f}, "
+                     + ("not shot" if pr["stable"] is None else
+                        "stable" if pr["stable"] else "unstable"))
+    on = data["onset"]
+    if on is not None:
+        how = "a fold" if on["kind"] == "fold" else "a bifurcation off the primary response"
+        lines.append("  onset at this omega: " + (
+            "none: the orbits continue down to f = 0" if on["kind"] == "none" else
+            f"f = {on['force']:.8g} ({how})"))
     return lines
 
 
@@ -1488,14 +1567,36 @@ def _cmd_parametric(args: argparse.Namespace) -> int:
 
 
 def mixing_json(eps: float, Q: float, drives: list[tuple[float, float]]) -> dict:
-    """The contract of ``lindstedt mixing … --json``: predicted and simulated tones."""
-    from .response import mixing_series, simulated_fit, tone_label
+    """The contract of ``lindstedt mixing … --json``: predicted and simulated tones of the
+    notes' ``q̈ + q̇/Q + q + εq³`` (:func:`mixing_tones_json` of its table)."""
+    from .driven import Drive
+    from .numerics import duffing_table
 
-    series = mixing_series(eps, Q, drives)
-    fit = simulated_fit(eps, Q, drives, list(series.tones))
+    Drive(eps, 1.0, 1.0, Q)  # ε and Q first, then every drive's numbers
+    for f, w in drives:
+        try:
+            Drive(eps, f, w, Q)
+        except InputError as exc:
+            raise InputError(f"drive {f!r}@{w!r}: {exc}") from None
+    data = mixing_tones_json(duffing_table(eps, 1 / Q), drives)
+    data["parameters"].update(eps=eps, Q=Q)
+    return data
+
+
+def mixing_tones_json(table, drives: list[tuple[float, float]]) -> dict:
+    """Predicted (:func:`mixing.mixing_series`) and simulated tones of ``q̈ + g = Σ f_i cos
+    ω_i t``, ``g`` the :class:`numerics.ForceTable`; ``eps`` and ``Q`` among the parameters
+    when ``g`` is the notes' ``q + εq³ + q̇/Q``."""
+    from .mixing import mixing_series, simulated_fit, tone_label
+
+    series = mixing_series(table, drives)
+    fit = simulated_fit(table, drives, list(series.tones))
+    terms = table.terms
+    parameters: dict = {}
+    if set(terms) <= {(1, 0), (3, 0), (0, 1)} and terms.get((1, 0)) == 1.0:
+        parameters = {"eps": terms.get((3, 0), 0.0), "Q": 1 / terms[(0, 1)]}
     return {
-        "parameters": {"eps": eps, "Q": Q, "drives": [{"force": f, "omega": w}
-                                                      for f, w in drives]},
+        "parameters": {**parameters, "drives": [{"force": f, "omega": w} for f, w in drives]},
         "expansion_parameter": series.expansion_parameter,
         "converged": series.converged,
         "reason": series.reason,
@@ -1517,34 +1618,42 @@ def _drive(text: str) -> tuple[float, float]:
 
 
 def mixing_equation_json(text: str, values: dict[str, str], name: str = "oscillator") -> dict:
-    """:func:`mixing_json` of an equation of the mixing series' form (drives by ascending
-    frequency), with ``equation``, ``name`` and the ``parameters.values`` given."""
-    from .response import mixing_equation
+    """:func:`mixing_tones_json` of a user's equation, any polynomial force with a linear
+    stiffness and damping (drives by ascending frequency), with ``equation``, ``name`` and the
+    ``parameters.values`` given."""
+    from .mixing import mixing_equation
 
-    eps, Q, drives, form = mixing_equation(text, values, name)
-    data = mixing_json(eps, Q, drives)
-    data["parameters"]["values"] = dict(form.values)
+    table, drives, given = mixing_equation(text, values, name)
+    data = mixing_tones_json(table, drives)
+    data["parameters"]["values"] = dict(given)
     return {"equation": text, "name": name, **data}
 
 
 def _cmd_mixing(args: argparse.Namespace) -> int:
     if _equation_args(args, ("eps", "Q", "drive"), ("eps", "Q", "drive")):
-        from .response import mixing_equation
+        from .mixing import mixing_equation
 
         values, name = _params(args.param), args.name or "oscillator"
-        eps, Q, drives, _ = mixing_equation(args.model, values, name)
+        table, drives, _ = mixing_equation(args.model, values, name)
         return _report(args, lambda: mixing_equation_json(args.model, values, name),
-                       lambda path: _charts().mixing_figure(eps, Q, drives, path),
+                       lambda path: _charts().mixing_figure(table, drives, path, args.model),
                        _mixing_table)
-    return _report(args, lambda: mixing_json(args.eps, args.Q, args.drive),
-                   lambda path: _charts().mixing_figure(args.eps, args.Q, args.drive, path),
+
+    def draw(path: Path) -> Path:
+        from .numerics import duffing_table
+
+        return _charts().mixing_figure(duffing_table(args.eps, 1 / args.Q), args.drive, path,
+                                       f"ε = {args.eps}, Q = {args.Q}")
+
+    return _report(args, lambda: mixing_json(args.eps, args.Q, args.drive), draw,
                    _mixing_table)
 
 
 def _mixing_table(data: dict) -> list[str]:
     p = data["parameters"]
-    lines = [f"q'' + q'/Q + q + eps q^3 = sum f_i cos(w_i t): eps = {p['eps']}, Q = {p['Q']}, "
-             + ", ".join(f"w{i} = {d['omega']} (f = {d['force']})"
+    head = (f"{data['equation']}: " if "equation" in data else
+            f"q'' + q'/Q + q + eps q^3 = sum f_i cos(w_i t): eps = {p['eps']}, Q = {p['Q']}, ")
+    lines = [head + ", ".join(f"w{i} = {d['omega']} (f = {d['force']})"
                          for i, d in enumerate(p["drives"], 1)),
              ("" if data["converged"] else "warning: ") + data["reason"],
              f"{'tone':>12} {'frequency':>10} {'order':>6} {'predicted':>11} {'simulated':>11} "
@@ -2232,16 +2341,23 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_allow_slow(p, deprecated_force=False)
     p.set_defaults(func=_cmd_response)
 
-    p = sub.add_parser("subharmonic", help="the 1/3 subharmonic of eq. 10.83 and its stability",
-                       description="omega^2 q'' + q + eps q^3 = f cos 3τ: the 1/3 subharmonic "
-                       "(--eps, --force, --omega), or your own equation when it is of that form: "
-                       "q'' + q + eps*q**3 = f*cos(3*w*t) in any coordinate, with --param.")
-    _flag_equation(p, "\"x'' + x + eps*x**3 = f*cos(3*w*t)\" (exactly q + eps*q**3, undamped, "
-                   "omega0 = 1; the drive at 3*omega: w = --omega here, w = 3*omega in "
-                   "f*cos(w*t), or a number 3*omega without --omega)")
-    _flag_drive(p, required=False, omega="ω of eq. 10.83, the subharmonic's frequency: the "
-                "drive is at 3ω (required, unless the equation's drive frequency is a number)",
-                Q=None)
+    p = sub.add_parser("subharmonic", help="orbits of n drive periods (the 1/n subharmonic) "
+                       "and their stability",
+                       description="Your own driven oscillator q'' + g(q, q') = f cos(n w t), g "
+                       "any polynomial (damped or not): every orbit of n drive periods by "
+                       "harmonic balance on the harmonics of w, each shot for its Floquet "
+                       "stability, the primary response and the onset (the smallest drive "
+                       "amplitude with such an orbit at this w). Without EQUATION: the notes' "
+                       "omega^2 q'' + q + eps q^3 = f cos 3τ in closed form (--eps, --force, "
+                       "--omega).")
+    _flag_equation(p, "\"x'' + 0.05*x' + x + x**2 = f*cos(w*t)\" (the drive at n times the "
+                   "subharmonic's frequency ω: w = n*omega in f*cos(w*t), w = omega in "
+                   "f*cos(n*w*t), or a number n*omega without --omega)")
+    p.add_argument("--n", type=_positive, default=None, metavar="N",
+                   help="the subharmonic's order: orbits of N drive periods, 2..12 (default 3; "
+                   "1/2 needs an even power in the force, 1/3 an odd one)")
+    _flag_drive(p, required=False, omega="ω, the subharmonic's own frequency: the drive is at "
+                "n·ω (required, unless the equation's drive frequency is a number)", Q=None)
     _flag_json(p)
     _flag_plot(p)
     p.set_defaults(func=_cmd_subharmonic)
@@ -2270,12 +2386,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_parametric)
 
     p = sub.add_parser("mixing", help="combination tones of a two-tone drive",
-                       description="q'' + q'/Q + q + eps q^3 = Σ f_i cos(w_i t): "
-                       "predicted and simulated combination tones (--eps, --Q, --drive), or "
-                       "your own equation of that form with --param.")
-    _flag_equation(p, "\"x'' + x'/Q + x + eps*x**3 = f1*cos(w1*t) + f2*cos(w2*t)\" (exactly "
-                   "q + eps*q**3 + q'/Q, omega0 = 1; every frequency a number: the tones are "
-                   "numbered by ascending frequency)")
+                       description="Your own q'' + g(q, q') = Σ f_i cos(w_i t), g any "
+                       "polynomial with a linear stiffness and damping: the combination tones "
+                       "predicted to the second order of the nonlinearity, beside a simulated "
+                       "steady state; or the notes' q'' + q'/Q + q + eps q^3 (--eps, --Q, "
+                       "--drive).")
+    _flag_equation(p, "\"x'' + x'/20 + x + x**2/5 + x**3/10 = 0.3*cos(1.3*t) + "
+                   "0.3*cos(1.7*t)\" (every frequency a number: the tones are numbered by "
+                   "ascending frequency)")
     _flag_drive(p, required=False, omega=None, Q=None, force=False)
     p.add_argument("--Q", type=_quality, default=None, metavar="Q",
                    help="quality factor Q > 0 of the damping q'/Q (finite; required without "

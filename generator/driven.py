@@ -982,6 +982,8 @@ class PolynomialBalance:
     exceeds ``(degree + 1)`` times the top harmonic, so no product aliases: the projection is the
     exact Galerkin residual (as :class:`BalanceSystem`'s convolutions are for εq³).
 
+    ``drive_harmonic = n`` puts the drive on ``cos nωt`` instead: the balance of a 1/n
+    subharmonic, ω its own frequency.
     Unknowns ``x = (a_k …, b_k …)`` of ``q = Σ a_k cos kωt + b_k sin kωt`` over ``orders``:
     ``1, 3, …, 2N − 1`` for an odd force (:class:`BalanceSystem`'s layout), else
     ``0, 1, 2, …, 2N − 1`` (the constant ``a_0``, no ``b_0``).  The same interface as
@@ -989,10 +991,14 @@ class PolynomialBalance:
     amplitude ``force`` as a keyword for the continuation in it."""
 
     def __init__(self, terms: dict[tuple[int, int], float], force: float, harmonics: int,
-                 odd: bool) -> None:
+                 odd: bool, drive_harmonic: int = 1) -> None:
         check_harmonics(harmonics)
         self.terms, self.force, self.harmonics, self.odd = dict(terms), force, harmonics, odd
+        self.drive_harmonic = drive_harmonic
         top = 2 * harmonics - 1
+        if drive_harmonic > top or (odd and drive_harmonic % 2 == 0):
+            raise InputError(f"harmonic {drive_harmonic} of the drive is not among the "
+                             f"balance's orders (top {top}{', odd only' if odd else ''})")
         self.orders = np.arange(1, top + 1, 2) if odd else np.arange(0, top + 1)
         degree = max(a + b for a, b in terms)
         samples = 16
@@ -1010,7 +1016,8 @@ class PolynomialBalance:
         self.project = np.vstack([weights[:, None] * cos.T, 2.0 * sin.T]) / samples
         self.k2 = np.concatenate([k, sines]).astype(float) ** 2
         self.drive = np.zeros(len(self.k2))
-        self.drive[int(np.nonzero(k == 1)[0][0])] = 1.0  # the cos ωt component
+        # the cos(n ωt) component, n = drive_harmonic (n > 1: a 1/n subharmonic's balance)
+        self.drive[int(np.nonzero(k == drive_harmonic)[0][0])] = 1.0
         self.powers = [(a, b, c) for (a, b), c in sorted(terms.items())]
 
     @property
@@ -1119,3 +1126,91 @@ def amplitude_bound(terms: dict[tuple[int, int], float], omega: float,
         return None
     roots = H.roots()
     return 2 * float(np.max(np.abs(roots))) if roots.size else 2e-6
+
+
+@dataclass(frozen=True)
+class DrivenForm:
+    """A user's equation ``q̈ + g(q, q̇) = Σ f_i cos(ν_i t)`` once its values are given: ``g`` a
+    polynomial, ``terms`` its exact coefficients ``{(a, b): c}`` of ``c q^a q̇^b`` (the linear
+    part included); each drive ``(f, c, w)`` with ``ν = c·w``, ``c`` a positive rational and
+    ``w`` a name left free (``None``: ``ν = c``)."""
+
+    terms: dict[tuple[int, int], sp.Rational]
+    drives: tuple[tuple[float, sp.Rational, sp.Symbol | None], ...]
+    values: tuple[tuple[str, str], ...]
+
+    def floats(self) -> dict[tuple[int, int], float]:
+        """``terms`` as floats (a :class:`numerics.ForceTable`'s)."""
+        return {k: float(c) for k, c in self.terms.items() if c != 0}
+
+
+def driven_form(text: str, values: dict[str, str], name: str, method: str, why: str,
+                free_frequency: bool) -> DrivenForm:
+    """Map ``text`` onto :class:`DrivenForm` or refuse in one line naming what ``method``
+    (``why``: its ansatz) needs: a force polynomial in q and q' with rational coefficients, no
+    constant term, a linear term; the drive a sum of ``f cos(ν t)``; every parameter given,
+    except, with ``free_frequency``, one name in the drives' frequencies."""
+    from .models import oscillator
+
+    osc = oscillator(text, values, name)
+    q, v, t = osc.coordinate, osc.velocity, osc.equation.time
+    if osc.parametric != 0:
+        raise osc.refuse(method, f"{sp.sstr(osc.parametric)} depends on both t and {q}: {why}")
+    force = sp.expand(osc.force)
+    missing = sorted(str(s) for s in force.free_symbols - {q, v})
+    if missing:
+        raise osc.refuse(method, "give " + ", ".join(missing) + " a value (--param "
+                         + " --param ".join(f"{m}=..." for m in missing) + ")")
+    if not force.is_polynomial(q, v):
+        raise osc.refuse(method, f"the force {sp.sstr(force)} is not a polynomial in {q} and "
+                         f"{v}: {why}")
+    poly = sp.Poly(force, q, v)
+    if any(not c.is_Rational for c in poly.coeffs()):
+        raise osc.refuse(method, f"the force {sp.sstr(force)}: its coefficients must be "
+                         "rational numbers")
+    terms = {k: sp.Rational(c) for k, c in zip(poly.monoms(), poly.coeffs(), strict=True)}
+    if terms.get((0, 0)):
+        raise osc.refuse(method, f"the constant force {terms[(0, 0)]} moves the equilibrium "
+                         f"off {q} = 0; shift {q} to it")
+    if not terms.get((1, 0)):
+        raise osc.refuse(method, f"no linear term in {q}: q = 0 is no oscillator's "
+                         "equilibrium")
+    drive = sp.expand(osc.drive)
+    if drive == 0:
+        raise osc.refuse(method, f"no drive: write it on the right, e.g. {q}'' + ... = "
+                         "f*cos(w*t)")
+    drives = []
+    frequencies: set[sp.Symbol] = set()
+    for term in sp.Add.make_args(drive):
+        amplitude, wave = term.as_independent(t, as_Add=False)
+        if not isinstance(wave, sp.cos):
+            raise osc.refuse(method, f"the drive term {sp.sstr(term)} is not f*cos(w*t) (a "
+                             "sine or another function of t: shift t or rewrite it)")
+        c, rest = wave.args[0].as_independent(t, as_Add=False)
+        if rest != t:
+            raise osc.refuse(method, f"the drive's argument {sp.sstr(wave.args[0])} is not "
+                             "w*t")
+        number, symbols = c.as_coeff_Mul()
+        symbol = None
+        if symbols != 1:
+            if not (free_frequency and isinstance(symbols, sp.Symbol)):
+                need = ", ".join(sorted(str(s) for s in c.free_symbols))
+                raise osc.refuse(method, f"give {need} a value (--param {need}=...): the "
+                                 "drive frequencies must be numbers")
+            symbol = symbols
+            frequencies.add(symbol)
+        missing = sorted(str(s) for s in amplitude.free_symbols)
+        if missing:
+            raise osc.refuse(method, "give " + ", ".join(missing) + " a value (--param "
+                             + " --param ".join(f"{m}=..." for m in missing) + ")")
+        if not (number.is_Rational and amplitude.is_Rational):
+            raise osc.refuse(method, f"the drive term {sp.sstr(term)}: its amplitude and "
+                             "frequency must be rational numbers")
+        if not number > 0:
+            raise osc.refuse(method, f"the drive term {sp.sstr(term)}: its frequency must be "
+                             "> 0")
+        drives.append((float(amplitude), number, symbol))
+    if len(frequencies) > 1:
+        raise osc.refuse(method, "the drives' frequencies name "
+                         + ", ".join(sorted(map(str, frequencies))) + "; give them values")
+    return DrivenForm(terms, tuple(drives), tuple((str(k), str(val)) for k, val in osc.values))

@@ -653,21 +653,23 @@ class ToneFit:
     rms_residual: float
 
 
-def steady_state_amplitudes(eps: float, damping: float, forces: list[float],
+def steady_state_amplitudes(table: ForceTable, forces: list[float],
                             omegas: list[float], frequencies: list[float],
                             settle: float | None = None, window: float = 2000.0,
                             initial: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
     """The amplitudes of :func:`steady_state_fit`."""
-    return steady_state_fit(eps, damping, forces, omegas, frequencies, settle, window,
+    return steady_state_fit(table, forces, omegas, frequencies, settle, window,
                             initial).amplitudes
 
 
-def steady_state_fit(eps: float, damping: float, forces: list[float],
+def steady_state_fit(table: ForceTable, forces: list[float],
                      omegas: list[float], frequencies: list[float],
                      settle: float | None = None, window: float = 2000.0,
                      initial: tuple[float, float] = (0.0, 0.0)) -> ToneFit:
-    """Amplitudes of the simulated steady state at ``frequencies`` (least squares on cos/sin
-    over a long window after the transients, ~``20 Q`` time units, have died out), starting
+    """Amplitudes of the simulated steady state of ``q̈ + g(q, q̇) = Σ f_i cos ω_i t`` (``g``
+    the polynomial ``table``; eq. 10.60's is :func:`duffing_table`) at ``frequencies`` (least
+    squares on cos/sin over a long window after the transients, ``40/γ`` time units for the
+    linear damping ``γq̇``, have died out), starting
     from ``initial`` = (q, q̇) — which decides the attractor where several coexist — with
     their standard errors: the covariance ``σ²(XᵀX)⁻¹`` of the fit, ``σ`` the rms residual,
     carried to each amplitude ``√(c² + s²)`` (``√((var c + var s)/2)`` where it is 0).
@@ -675,6 +677,7 @@ def steady_state_fit(eps: float, damping: float, forces: list[float],
     NaN amplitudes when the simulated orbit overflows (it escapes to infinity: a softening
     spring driven over its barrier, or RK4 unstable at that amplitude).  :class:`InputError`
     when the simulation would exceed :data:`MAX_STEPS` or its fit :data:`MAX_FIT_ENTRIES`."""
+    damping = table.terms.get((0, 1), 0.0)
     if settle is None:
         if not damping > 0:
             raise InputError("damping 0 (Q inf): the transients never die out, there is no "
@@ -699,7 +702,6 @@ def steady_state_fit(eps: float, damping: float, forces: list[float],
                          f"{window:g} time units needs {entries:.2g} matrix entries; the limit is "
                          f"{MAX_FIT_ENTRIES:.0e}")
     n_keep = int(window / (h * every))
-    table = duffing_table(eps, damping)
     with np.errstate(over="ignore", invalid="ignore"):
         q = _simulate(table.q_powers, table.v_powers, table.coefficients, table.cubic,
                       np.array(forces, float), np.array(omegas, float), float(h),

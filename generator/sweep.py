@@ -66,12 +66,11 @@ from .errors import InputError
 from .response import (
     CONTINUATION_HARMONICS,
     SAME_ORBIT,
-    SUBHARMONIC_HARMONICS,
     amplitude_slope,
     periodic_orbits,
-    subharmonic,
     try_balance,
 )
+from .subharmonic import SUBHARMONIC_HARMONICS, subharmonic
 
 # --- what one point computes -------------------------------------------------------------------
 

@@ -18,7 +18,7 @@ import pytest
 LAYERS = {
     "exact": ("averaging", "branches", "driven", "driven_damped", "driven_equation", "equation",
               "hill", "layout", "lindstedt", "parametric", "response", "response_equation",
-              "series"),
+              "series", "subharmonic"),
     "printers": ("charts", "cli", "costs", "emit", "files", "fuzz", "latex", "notebook",
                  "validity"),
     "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "orbits", "oscillator",

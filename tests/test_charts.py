@@ -9,6 +9,7 @@ import pytest
 from lindstedt import charts, cli
 from lindstedt.charts import check_plot_path, mixing_figure
 from lindstedt.errors import InputError
+from lindstedt.numerics import duffing_table
 from matplotlib.colors import to_rgba
 from scipy.integrate import solve_ivp
 
@@ -39,7 +40,7 @@ def test_mixing_figure_draws_the_true_spectrum(tmp_path, monkeypatch):
     save = charts._save
     monkeypatch.setattr(charts, "_save", lambda fig, path: (drawn.append(fig), save(fig, path))[1])
     a, b = tmp_path / "a.png", tmp_path / "b.png"
-    mixing_figure(MIX_EPS, MIX_Q, MIX_DRIVES, a)
+    mixing_figure(duffing_table(MIX_EPS, 1 / MIX_Q), MIX_DRIVES, a, "eps = 0.1")
     (fig,) = drawn
     (ax,) = fig.axes
     # every combination m₁ω₁ + m₂ω₂ of 3 or 5 drive factors, in units of 0.1 (ω = 1.3, 1.7)
@@ -71,7 +72,7 @@ def test_mixing_figure_draws_the_true_spectrum(tmp_path, monkeypatch):
         assert abs(y - truth[k]) < 1e-3 * truth[k] + 5e-10, (k, y, truth[k])  # the fit
     assert ax.get_yscale() == "log"
     assert a.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    mixing_figure(MIX_EPS, MIX_Q, MIX_DRIVES, b)
+    mixing_figure(duffing_table(MIX_EPS, 1 / MIX_Q), MIX_DRIVES, b, "eps = 0.1")
     assert a.read_bytes() == b.read_bytes()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "b.png"]  # no temporaries
 
@@ -119,7 +120,7 @@ def test_subharmonic_figure_marks_the_full_hill_verdict(tmp_path, monkeypatch):
     """Small markers on each root's curve give the full Hill verdict every FULL_HILL_EVERY ω
     (dot stable, triangle unstable); where it parts from the notes' q₀ test (the line style)
     it is the true orbit's Floquet verdict (shooting from the balance orbit, RK4 monodromy)."""
-    from lindstedt.response import subharmonic
+    from lindstedt.subharmonic import subharmonic
 
     drawn = []
     save = charts._save

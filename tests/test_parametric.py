@@ -24,7 +24,8 @@ from lindstedt.parametric import (
     tongue_edges,
     trivial_orbit,
 )
-from lindstedt.response import periodic_orbits, subharmonic
+from lindstedt.response import periodic_orbits
+from lindstedt.subharmonic import subharmonic
 from scipy.optimize import brentq
 from scipy.special import mathieu_a, mathieu_b
 

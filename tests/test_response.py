@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 from lindstedt.driven import Drive
-from lindstedt.numerics import orbit_fold, shoot, sweep
+from lindstedt.numerics import duffing_table, orbit_fold, shoot, sweep
 from lindstedt.response import (
     amplitude_residual,
     amplitude_slope,
@@ -130,7 +130,7 @@ def test_curve_bad_frequency(omega):
 
 def test_subharmonic_secular_conditions_are_the_notes():
     import sympy as sp
-    from lindstedt.response import subharmonic_secular
+    from lindstedt.subharmonic import subharmonic_secular
 
     a, b, F, w, e = sp.symbols("a b F omega epsilon")
     cos_eq, sin_eq = subharmonic_secular()
@@ -152,7 +152,7 @@ def test_subharmonic_secular_conditions_are_the_notes():
 
 
 def test_subharmonic_against_true_orbit():
-    from lindstedt.response import subharmonic
+    from lindstedt.subharmonic import subharmonic
 
     exists, _, sols = subharmonic(0.1, 0.5, 1.2)
     assert exists and [s.root for s in sols] == ["+", "-"]
@@ -169,7 +169,7 @@ def test_hill_verdict_fails_for_the_negative_root_at_small_eps(monkeypatch):
     """Reported in the README: the Hill test with q₀ calls the negative root stable here, the
     true orbit's multipliers (at two step sizes) say unstable."""
     import lindstedt.numerics as numerics
-    from lindstedt.response import subharmonic
+    from lindstedt.subharmonic import subharmonic
 
     _, _, sols = subharmonic(0.05, 0.5, 1.3)
     minus = sols[1]
@@ -192,9 +192,9 @@ def test_subharmonic_does_not_exist_and_says_why():
 # --- frequency mixing -------------------------------------------------------------------------
 
 def test_cubic_mixing_makes_three_fold_combinations_not_sums():
-    from lindstedt.response import mixing_tones, tone_label
+    from lindstedt.mixing import mixing_series, tone_label
 
-    tones = mixing_tones(0.1, 10.0, [(0.3, 1.3), (0.3, 1.7)])
+    tones = mixing_series(duffing_table(0.1, 0.1), [(0.3, 1.3), (0.3, 1.7)]).tones
     first = {tone_label(t.combination) for t in tones if t.order <= 1}
     assert first == {"w1", "w2", "3w1", "3w2", "2w1-w2", "2w1+w2", "2w2-w1", "w1+2w2"}
     freqs = [t.frequency for t in tones]
@@ -230,13 +230,16 @@ def test_continuation_refuses_what_it_cannot_finish(eps, force, Q, harmonics, ne
 
 def test_mixing_bounds_and_escapes():
     from lindstedt.errors import InputError
-    from lindstedt.response import mixing_tones, simulated_tones
+    from lindstedt.mixing import mixing_series, simulated_fit
+
+    def simulated(eps, Q, drives):
+        table = duffing_table(eps, 1 / Q)
+        return simulated_fit(table, drives, list(mixing_series(table, drives).tones))
 
     with pytest.raises(InputError, match="at most 4"):
-        mixing_tones(0.1, 10.0, [(0.1, 1 + k / 10) for k in range(5)])
+        simulated(0.1, 10.0, [(0.1, 1 + k / 10) for k in range(5)])
     with pytest.raises(InputError, match="transients die out"):
-        drives = [(0.3, 1.3)]
-        simulated_tones(0.1, 1e12, drives, mixing_tones(0.1, 1e12, drives))
+        simulated(0.1, 1e12, [(0.3, 1.3)])
     drives = [(3.0, 1.0)]  # softening: driven over the barrier at |q| = 1/√0.1
     with pytest.raises(InputError, match="escapes to infinity"):
-        simulated_tones(-0.1, 10.0, drives, mixing_tones(-0.1, 10.0, drives))
+        simulated(-0.1, 10.0, drives)

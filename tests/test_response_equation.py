@@ -158,9 +158,10 @@ def test_a_softening_spring_as_text_escapes_where_the_flags_do():
 # --- subharmonic and mixing EQUATION ---------------------------------------------------------
 
 def _without_added(data):
-    data = dict(data)
-    data.pop("equation"), data.pop("name")
-    data["parameters"] = {k: v for k, v in data["parameters"].items() if k != "values"}
+    data = {k: v for k, v in data.items()
+            if k not in {"equation", "name", "n", "orbits", "primary", "onset", "seeds"}}
+    data["parameters"] = {k: v for k, v in data["parameters"].items()
+                          if k not in {"values", "harmonics"}}
     return data
 
 
@@ -186,12 +187,18 @@ def test_mixing_as_text_equals_the_flags():
 
 @pytest.mark.parametrize("argv, says", [
     (["subharmonic", "q'' + q + q**2/10 = cos(3*w*t)/2", "--omega", "1.2"],
-     "needs exactly q + eps*q**3"),
-    (["subharmonic", "q'' + q + q**3/10 + q'/20 = cos(3*w*t)/2", "--omega", "1.2"],
-     "is undamped"),
-    (["subharmonic", "q'' + 2*q + q**3/10 = cos(3*w*t)/2", "--omega", "1.2"], "omega0 = 1"),
+     "the 1/3 subharmonic needs a nonlinear term of odd degree"),
+    (["subharmonic", "q'' + q'/20 + q + q**3/10 = cos(w*t)/2", "--omega", "1", "--n", "2"],
+     "the 1/2 subharmonic needs a nonlinear term of even degree"),
+    (["subharmonic", "q'' + q + q**3/10 = cos(w*t)/2", "--omega", "1", "--n", "1"],
+     "--n 1: the subharmonic's order must be an integer in 2..12"),
+    (["subharmonic", "--eps", "0.1", "--force", "0.5", "--omega", "1.2", "--n", "2"],
+     "give an EQUATION for another n"),
+    (["subharmonic", "q'' + q + q**3/10 = cos(w*t)/2 + cos(2*w*t)", "--omega", "1"],
+     "2 drive terms"),
     (["mixing", "q'' + q'/10 + q + q**3/10 = cos(w*t)/2"], "give w a value"),
-    (["mixing", "q'' + q'/10 + q + q*q'**2/10 = cos(t)/2"], "needs exactly q + eps*q**3"),
+    (["mixing", "q'' + q + q**3/10 = cos(t)/2"], "mixing needs damping"),
+    (["mixing", "q'' + q'/10 + q**3/10 = cos(t)/2"], "no linear term"),
     (["response", "q'' + q'/Q + q + eps*q**3 = f*cos(w*t)", "--param", "eps=1/10",
       "--param", "f=3/10"], "give Q a value"),
     (["response", "q'' + q + q**3/10 = cos(w*t)/2"], "no damping"),

@@ -1,0 +1,155 @@
+"""``subharmonic EQUATION --n N`` and ``mixing EQUATION`` for any polynomial force, against
+DOP853 (SciPy): every orbit found closes after n drive periods, its Floquet multipliers are
+the monodromy's by finite differences of the DOP853 flow, the attractors a grid of
+simulations reaches are among the stable orbits, and the notes' eq. 10.83 gives the same orbits
+by its closed form; the mixing tones against the DOP853 steady state's spectrum."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from lindstedt.mixing import mixing_equation, mixing_series
+from lindstedt.subharmonic import subharmonic, subharmonic_equation, subharmonic_orbits
+from scipy.integrate import solve_ivp
+
+QUADRATIC = ("x'' + 0.05*x' + x + x**2 = f*cos(w*t)", {"f": "1/2"}, 2, 1.0)
+CUBIC = ("x'' + 0.02*x' + x + x**3/10 = f*cos(w*t)", {"f": "2"}, 3, 1.1)
+
+
+def _rhs(terms, force, drive):
+    def rhs(t, y):
+        g = sum(c * y[0] ** a * y[1] ** b for (a, b), c in terms.items())
+        return [y[1], force * math.cos(drive * t) - g]
+    return rhs
+
+
+def _flow(problem, y0, periods, rtol=1e-12):
+    T = 2 * math.pi / problem.drive
+    sol = solve_ivp(_rhs(problem.terms, problem.force, problem.drive), (0, periods * T), y0,
+                    method="DOP853", rtol=rtol, atol=1e-13)
+    return sol.y[:, -1]
+
+
+@pytest.fixture(scope="module", params=[QUADRATIC, CUBIC], ids=["1/2 of q^2", "1/3 of q^3"])
+def found(request):
+    text, values, n, omega = request.param
+    problem = subharmonic_equation(text, values, omega, n)
+    return problem, subharmonic_orbits(problem)
+
+
+def test_every_orbit_closes_after_n_drive_periods(found):
+    problem, response = found
+    assert response.exists
+    for o in response.orbits:
+        y0 = o.orbit.initial
+        end = _flow(problem, y0, problem.n)
+        assert np.max(np.abs(end - y0)) < 1e-8, (end, y0)
+        for k in range(1, problem.n):  # and not after fewer: a true subharmonic
+            assert np.max(np.abs(_flow(problem, y0, k) - y0)) > 1e-3
+        # the first harmonic of ω against the DOP853 orbit's Fourier coefficient
+        T = problem.n * 2 * math.pi / problem.drive
+        t = np.linspace(0, T, 257)[:-1]
+        sol = solve_ivp(_rhs(problem.terms, problem.force, problem.drive), (0, T), y0,
+                        method="DOP853", rtol=1e-12, atol=1e-13, t_eval=t)
+        c = np.fft.rfft(sol.y[0]) / t.size
+        assert abs(2 * abs(c[1]) - o.r) < 1e-8
+
+
+def test_floquet_multipliers_against_the_dop853_monodromy(found):
+    problem, response = found
+    for o in response.orbits:
+        y0, h = o.orbit.initial, 1e-6
+        M = np.column_stack([(_flow(problem, y0 + h * e, problem.n)
+                              - _flow(problem, y0 - h * e, problem.n)) / (2 * h)
+                             for e in np.eye(2)])
+        mine = sorted(abs(m) for m in o.orbit.multipliers)
+        assert mine == pytest.approx(sorted(abs(m) for m in np.linalg.eigvals(M)), abs=1e-5)
+        assert o.stable == bool(max(mine) < 1)
+
+
+def test_the_attractors_of_a_grid_of_simulations_are_among_the_stable_orbits(found):
+    """From 16 initial states up to 1.2 times the largest orbit's r, 250·n drive periods of
+    DOP853: each run that does not escape
+    ends on the primary response or on a drive-period shift of a stable orbit found (within
+    1e-3: what is left of the transients)."""
+    problem, response = found
+    stable = [o for o in response.orbits if o.stable]
+    T = 2 * math.pi / problem.drive
+    rhs = _rhs(problem.terms, problem.force, problem.drive)
+    shifts = [_flow(problem, o.orbit.initial, k, rtol=1e-10)
+              for o in stable for k in range(problem.n)]
+    primary = response.primary.orbit.initial
+    settled, span = 0, 1.2 * max(o.r for o in response.orbits)
+    for q0 in np.linspace(-span, span, 4):
+        for v0 in np.linspace(-span, span, 4):
+            sol = solve_ivp(rhs, (0, 250 * problem.n * T), [q0, v0], method="DOP853",
+                            rtol=1e-10, atol=1e-12)
+            y = sol.y[:, -1]
+            if not np.all(np.isfinite(y)) or np.max(np.abs(y)) > 10:
+                continue  # escaped over the barrier
+            if np.max(np.abs(y - primary)) < 1e-3:
+                continue
+            settled += 1
+            assert min(np.max(np.abs(s - y)) for s in shifts) < 1e-3, y
+    assert settled > 0
+
+
+def test_the_onset_bounds_the_orbits(found):
+    """Just above the onset force orbits exist; just below, none of the seeds finds one."""
+    problem, response = found
+    onset = response.onset
+    assert onset.kind in {"fold", "bifurcation"} and 0 < onset.force < problem.force
+    for factor, exists in ((1.02, True), (0.98, False)):
+        other = subharmonic_orbits(type(problem)(problem.terms, onset.force * factor,
+                                                 problem.omega, problem.n, problem.values),
+                                   onset=False)
+        assert other.exists is exists, factor
+
+
+def test_the_notes_subharmonic_by_both_routes():
+    """Eq. 10.83 at ε 0.1, f 1, ω 1.05: the closed form's two true orbits are the general
+    path's two (its a₁ of roots + and −, up to a drive-period shift and sign), with the same
+    stability."""
+    problem = subharmonic_equation("x'' + x + eps*x**3 = f*cos(3*w*t)",
+                                   {"eps": "1/10", "f": "1"}, 1.05)
+    assert problem.eps == 0.1
+    general = subharmonic_orbits(problem, onset=False).orbits
+    _, _, notes = subharmonic(0.1, 1.0, 1.05)
+    assert [round(o.r, 9) for o in general] == [round(abs(s.orbit.A[1]), 9) for s in notes]
+    assert [o.stable for o in general] == [s.orbit.stable for s in notes]
+
+
+def test_mixing_of_a_quadratic_and_cubic_force_against_dop853():
+    """A quadratic term makes ω₂ − ω₁ and ω₁ + ω₂, which εq³ cannot: each predicted tone within
+    its next order of the DOP853 steady state's spectrum (drives at multiples of 0.1: one FFT
+    over 2π/0.1 after the transients gives every tone exactly)."""
+    text = "x'' + x'/20 + x + x**2/5 + x**3/10 = 3/20*cos(13*t/10) + 3/20*cos(17*t/10)"
+    table, drives, _ = mixing_equation(text, {})
+    series = mixing_series(table, drives)
+    assert series.converged
+    terms = table.terms
+    rhs = _rhs(terms, 0.0, 1.0)
+
+    def full(t, y):
+        return [y[1], rhs(t, y)[1] + sum(f * math.cos(w * t) for f, w in drives)]
+
+    period, settle, samples = 2 * math.pi / 0.1, 1000.0, 4096
+    sol = solve_ivp(full, (0, settle + period), [0.0, 0.0], method="DOP853", rtol=1e-11,
+                    atol=1e-13, dense_output=True)
+    q = sol.sol(settle + np.arange(samples) * period / samples)[0]
+    truth = 2 * np.abs(np.fft.rfft(q)) / samples
+    labels = set()
+    size = sum(t.predicted for t in series.tones if t.order == 0)
+    for tone in series.tones:
+        k = round(tone.frequency * 10)
+        assert abs(tone.frequency * 10 - k) < 1e-9
+        # the first omitted order: ~rho^3 of q0 (the series' own claim), and relative 1e-3 on
+        # the drives' own tones
+        tol = series.expansion_parameter**3 * size
+        assert abs(tone.predicted - truth[k]) <= tol, (tone, truth[k], tol)
+        if tone.order == 0:
+            assert abs(tone.predicted - truth[k]) <= 1e-3 * truth[k]
+        labels.add(tone.combination)
+    assert (-1, 1) in labels and (1, 1) in labels  # ω₂ − ω₁, ω₁ + ω₂
