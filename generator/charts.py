@@ -7,6 +7,7 @@ and writes the file atomically (a temporary file in the target folder, then a re
 from __future__ import annotations
 
 import io
+import json
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -439,7 +440,6 @@ def driven_validity_figure(path: Path, eps: float = 0.1, force: float = 1.0) -> 
     return _save(fig, path)
 
 
-SWEEP_AXES = ("omega", "force", "eps", "Q")
 # NOTE: the grid axes of lindstedt.sweep (every other dimension of a field is drawn at its last
 # entry: the highest order, the last branch or root).
 SWEEP_CUTS = 5
@@ -459,7 +459,8 @@ def sweep_figure(ds: object, path: Path) -> Path:
                          "resume the sweep first")
     name = ds.attrs["headline"]
     field = ds[name]
-    extra = [d for d in field.dims if d not in SWEEP_AXES]
+    axes = list(json.loads(ds.attrs["sweep"])["axes"])  # the notes' or an equation's names
+    extra = [d for d in field.dims if d not in axes]
     picked = [f"{d} = {ds[d].values[-1]}" for d in extra if d in ds.coords]
     field = field.isel({d: -1 for d in extra})
     varying = [a for a in field.dims if field.sizes[a] > 1]
@@ -469,7 +470,7 @@ def sweep_figure(ds: object, path: Path) -> Path:
     log = name.endswith("error")
     if log:
         values = np.maximum(values, FLOOR)
-    fixed = ", ".join([*picked, *(f"{a} = {ds[a].values[0]:g}" for a in SWEEP_AXES
+    fixed = ", ".join([*picked, *(f"{a} = {ds[a].values[0]:g}" for a in axes
                                   if a in ds.dims and a not in varying[:2])])
     label = field.attrs.get("long_name", name)
 
@@ -504,7 +505,7 @@ def sweep_figure(ds: object, path: Path) -> Path:
         ticks(cuts, xa, "x")
     else:
         fig, cuts = plt.subplots(figsize=(7, 4.4))
-        xa = varying[0] if varying else next(a for a in SWEEP_AXES if a in field.dims)
+        xa = varying[0] if varying else next(a for a in axes if a in field.dims)
         x, xlog = positions(xa)
         if not varying:
             x = x[:1]

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import itertools
 import json
 import logging
@@ -48,6 +49,7 @@ import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
+from fractions import Fraction
 from numbers import Real
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -213,6 +215,8 @@ class Kind:
     points_per_chunk: int  # default block size: ~1 s of work
     headline: str  # the field a figure draws (its last entry along any extra dimension)
     settings: tuple[tuple[str, object], ...]  # constants its numbers depend on
+    builtin: bool = True  # the notes' axes (omega, force, eps, Q), checked as a Drive's
+    positive: tuple[str, ...] = ()  # an equation's axes that must be > 0 (its drive frequency)
 
     @property
     def point_seconds(self) -> float:
@@ -376,16 +380,20 @@ _PROBE = {"eps": 0.1, "force": 1.0, "omega": 1.0, "Q": math.inf}
 # NOTE: a valid drive each axis value is checked against, one field at a time.
 
 
-def _axis(name: str, values: object) -> np.ndarray:
+def _axis(name: str, values: object, builtin: bool = True) -> np.ndarray:
     """One axis as float64, each value checked by :class:`Drive`'s rules (finite, ω > 0,
-    Q > 0 or inf), no repeats."""
+    Q > 0 or inf) on a built-in kind, finite on an equation's (whose own parse checks the
+    rest, point by point), no repeats."""
     if isinstance(values, (str, bytes)) or not isinstance(values, (Sequence, np.ndarray)):
         raise InputError(f"axis {name}: give a list of values, not {values!r}")
     out = []
     for v in values:
         if isinstance(v, (bool, np.bool_)) or not isinstance(v, Real):
             raise InputError(f"axis {name}: {v!r} is not a number")
-        Drive(**{**_PROBE, name: float(v)})
+        if builtin:
+            Drive(**{**_PROBE, name: float(v)})
+        elif not math.isfinite(float(v)):
+            raise InputError(f"axis {name}: {v!r} is not finite")
         out.append(float(v))
     if not out:
         raise InputError(f"axis {name}: no values")
@@ -409,7 +417,11 @@ def make_grid(kind: str | Kind, axes: Mapping[str, Sequence[float]],
             missing and f"missing {', '.join(missing)}",
             unknown and f"unknown {', '.join(map(str, unknown))}") if part)
         raise InputError(f"sweep {kind.name}: axes {what} (it takes {', '.join(kind.axes)})")
-    values = tuple(_axis(a, axes[a]) for a in kind.axes)
+    values = tuple(_axis(a, axes[a], kind.builtin) for a in kind.axes)
+    if kind.positive:
+        for a, v in zip(kind.axes, values, strict=True):
+            if a in kind.positive and not np.all(v > 0):
+                raise InputError(f"axis {a}: the drive frequency must be > 0")
     points = kind.points_per_chunk if chunk is None else chunk
     if isinstance(points, bool) or not isinstance(points, int) or points < 1:
         raise InputError(f"chunk {chunk!r}: must be a whole number of points >= 1")
@@ -418,10 +430,11 @@ def make_grid(kind: str | Kind, axes: Mapping[str, Sequence[float]],
 
 # --- computing blocks ----------------------------------------------------------------------------
 
-def compute_block(kind_name: str, values: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
-    """Every field of ``kind_name`` on the block spanned by ``values`` (one array per axis):
-    the task each worker runs, and the serial loop's body."""
-    kind = KINDS[kind_name]
+def compute_block(kind: str | Kind, values: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
+    """Every field of ``kind`` (a :class:`Kind` or the name of a built-in one) on the block
+    spanned by ``values`` (one array per axis): the task each worker runs, and the serial
+    loop's body."""
+    kind = kind if isinstance(kind, Kind) else KINDS[kind]
     shape = tuple(v.size for v in values)
     sizes = kind.extra_sizes
     out = {f.name: np.full(shape + tuple(sizes[d] for d in f.dims), f.fill, dtype=f.dtype)
@@ -444,12 +457,12 @@ def kernel_signatures() -> dict[str, int]:
             if isinstance(f, CPUDispatcher)}
 
 
-def warm_up(kind_name: str) -> dict[str, int]:
+def warm_up(kind: str | Kind) -> dict[str, int]:
     """Run the kind's warm-up point: loads (or compiles, once, into numba's on-disk cache)
     every kernel its tasks call, so that no task pays for it. Returns
     :func:`kernel_signatures`."""
-    kind = KINDS[kind_name]
-    compute_block(kind_name, tuple(np.array([dict(kind.warm_up)[a]]) for a in kind.axes))
+    kind = kind if isinstance(kind, Kind) else KINDS[kind]
+    compute_block(kind, tuple(np.array([dict(kind.warm_up)[a]]) for a in kind.axes))
     return kernel_signatures()
 
 
@@ -457,12 +470,15 @@ class WarmUp(WorkerPlugin):
     """A worker plugin: :func:`warm_up` once on every worker, including workers that join
     later (``distributed`` runs ``setup`` when a worker starts or the plugin is registered)."""
 
-    def __init__(self, kind_name: str) -> None:
-        self.kind_name = kind_name
-        self.name = f"lindstedt-sweep-warm-up-{kind_name}"
+    def __init__(self, kind: Kind) -> None:
+        self.kind = kind
+        import hashlib
+
+        digest = hashlib.sha256(json.dumps(kind.settings, default=str).encode()).hexdigest()
+        self.name = f"lindstedt-sweep-warm-up-{kind.name}-{digest[:12]}"
 
     def setup(self, worker: object) -> None:
-        warm_up(self.kind_name)
+        warm_up(self.kind)
 
 
 # --- the dataset and its store -------------------------------------------------------------------
@@ -779,7 +795,7 @@ def _connect(scheduler: str | None, workers: int, stack: contextlib.ExitStack) -
     return stack.enter_context(client)
 
 
-def run_sweep(kind: str, axes: Mapping[str, Sequence[float]], store: Path | str,
+def run_sweep(kind: str | Kind, axes: Mapping[str, Sequence[float]], store: Path | str,
               scheduler: str | None = None, workers: int = 2, chunk: int | None = None,
               progress: Callable[[Progress], None] | None = None,
               stop_after: int | None = None) -> xr.Dataset:
@@ -818,7 +834,7 @@ def run_sweep(kind: str, axes: Mapping[str, Sequence[float]], store: Path | str,
         client = _connect(scheduler, workers, stack)
         if state.done is None:
             _initialise(path, grid)
-        client.register_plugin(WarmUp(grid.kind.name))
+        client.register_plugin(WarmUp(grid.kind))
         _gather(client, grid, path, todo, int(done.sum()), progress)
     return open_sweep(path)
 
@@ -847,7 +863,7 @@ def _gather(client: object, grid: Grid, path: Path, todo: list[int], finished: i
     arrays = _open_arrays(path, grid)
 
     def submit(chunk: int) -> object:
-        future = client.submit(compute_block, grid.kind.name, grid.block_values(chunk),
+        future = client.submit(compute_block, grid.kind, grid.block_values(chunk),
                                pure=False)
         index[future] = chunk
         return future
@@ -871,7 +887,7 @@ def _gather(client: object, grid: Grid, path: Path, todo: list[int], finished: i
             client.cancel(list(index))
 
 
-def serial_sweep(kind: str, axes: Mapping[str, Sequence[float]], chunk: int | None = None,
+def serial_sweep(kind: str | Kind, axes: Mapping[str, Sequence[float]], chunk: int | None = None,
                  progress: Callable[[Progress], None] | None = None) -> xr.Dataset:
     """The same map in this process, block by block, no dask and no store: the reference of
     :func:`run_sweep` (value for value) and its one-core baseline."""
@@ -881,9 +897,173 @@ def serial_sweep(kind: str, axes: Mapping[str, Sequence[float]], chunk: int | No
             for f in grid.kind.fields}
     start = time.perf_counter()
     for c in range(grid.chunks):
-        block = compute_block(grid.kind.name, grid.block_values(c))
+        block = compute_block(grid.kind, grid.block_values(c))
         for name, values in block.items():
             data[name][grid.region(c)] = values
         if progress is not None:
             progress(Progress(c, c + 1, grid.chunks, time.perf_counter() - start))
     return _dataset(grid, data, np.ones(grid.chunks, dtype=bool))
+
+
+# --- a user's equation: any of its parameters an axis ------------------------------------------
+
+EQUATION_BRANCHES = 5
+# NOTE: orbits stored per point, largest r first: a quadratic-and-cubic force has up to five
+# 1:1 orbits near its folds (three is the cubic's most); more are counted, not stored.
+
+
+@dataclass(frozen=True)
+class EquationSpec:
+    """What one point of an equation's map needs: the text, the values fixed for the whole
+    map, the drive frequency's name (passed as ω to the response), the subharmonic's n."""
+
+    kind: str
+    text: str
+    values: tuple[tuple[str, str], ...]
+    frequency: str
+    n: int
+    name: str
+
+
+def _exact(value: float) -> str:
+    """A float axis value as the exact rational the equation's parser takes (0.3 -> 3/10)."""
+    return str(Fraction(repr(value)))
+
+
+def _point_values(spec: EquationSpec, axis: Mapping[str, float]) -> dict[str, str]:
+    return {**dict(spec.values), **{k: _exact(v) for k, v in axis.items()}}
+
+
+def _equation_response(spec: EquationSpec, **axis: float) -> dict:
+    """Every 1:1 orbit at one point (:func:`response.equation_orbits`: the balance continued in
+    the drive amplitude, each crossing shot), largest r first, with its Floquet verdict."""
+    from .driven import driven_equation
+    from .response import equation_orbits
+
+    values = _point_values(spec, axis)
+    omega = float(Fraction(values.pop(spec.frequency)))
+    try:
+        de = driven_equation(spec.text, values, omega, spec.name)
+    except InputError:  # refused at this point (e.g. a coefficient made 0): no orbit stored
+        return {}
+    found = equation_orbits(de, ORBIT_HARMONICS, shoot_harmonics=1)
+    shot = [o.orbit for o in found.orbits if o.orbit is not None]
+    return _branches(shot, len(shot))
+
+
+def _branches(shot: list, count: int) -> dict:
+    r, stable = [math.nan] * EQUATION_BRANCHES, [-1] * EQUATION_BRANCHES
+    floquet = [math.nan] * EQUATION_BRANCHES
+    for k, orbit in enumerate(shot[:EQUATION_BRANCHES]):
+        r[k] = math.hypot(orbit.A.get(1, 0.0), orbit.B.get(1, 0.0))
+        stable[k] = int(orbit.stable)
+        floquet[k] = float(np.max(np.abs(orbit.multipliers)))
+    kept = [x for x, s in zip(r, stable, strict=True) if s == 1]
+    return {"orbits": count, "stable_orbits": sum(bool(o.stable) for o in shot), "r": r,
+            "stable": stable, "floquet": floquet, "r_stable_max": max(kept, default=math.nan),
+            "r_stable_min": min(kept, default=math.nan)}
+
+
+def _equation_subharmonic(spec: EquationSpec, **axis: float) -> dict:
+    """Every orbit of n drive periods at one point (:func:`subharmonic.subharmonic_orbits`,
+    without the onset), largest r first, with its Floquet verdict."""
+    from .subharmonic import subharmonic_equation, subharmonic_orbits
+
+    values = _point_values(spec, axis)
+    try:
+        problem = subharmonic_equation(spec.text, values, None, spec.n, spec.name)
+    except InputError:  # refused at this point (e.g. the coupling term made 0): none stored
+        return {}
+    found = subharmonic_orbits(problem, onset=False)
+    shot = [o.orbit for o in found.orbits if o.orbit is not None]
+    return {"exists": int(found.exists), **_branches(shot, len(found.orbits))}
+
+
+EQUATION_KINDS = ("response", "stability", "subharmonic")
+# NOTE: with an equation, response and stability are one map (every orbit shot, its Floquet
+# verdict); validity is the notes' μ-expansion's and takes no equation.
+
+
+def equation_kind(kind: str, text: str, values: Mapping[str, str],
+                  axes: Sequence[str], n: int = 3, name: str = "oscillator") -> Kind:
+    """The :class:`Kind` of ``sweep KIND EQUATION --axis NAME=… --param NAME=…``: the axes are
+    parameters of the equation (its drive frequency included), every other parameter has a
+    value in ``values``; refused in one line: an axis that names no parameter, a parameter
+    both an axis and a value, a parameter with neither, a kind that takes no equation."""
+    from .driven import driven_form
+    from .models import oscillator
+    from .subharmonic import check_n
+
+    if kind not in EQUATION_KINDS:
+        raise InputError(f"sweep {kind} EQUATION: the {kind} map is the notes' (μ-expansion "
+                         f"of q + eps q^3); with an equation use {', '.join(EQUATION_KINDS)}")
+    if kind == "subharmonic":
+        check_n(n)
+    if not axes:
+        raise InputError("sweep EQUATION: give at least one axis, --axis NAME=A:B:N")
+    osc = oscillator(text, {}, name)
+    names = {str(p) for p in osc.equation.parameters}
+    if osc.equation.small is not None:
+        names.add("eps")
+    both = sorted(set(axes) & set(values))
+    if both:
+        raise InputError(f"--axis {both[0]} and --param {both[0]}: a parameter is an axis or a "
+                         "value, not both")
+    unknown = sorted(set(axes) - names) + sorted(set(values) - names)
+    if unknown:
+        raise InputError(f"{unknown[0]}: not a parameter of {text!r} (its parameters: "
+                         f"{', '.join(sorted(names)) or 'none'})")
+    missing = sorted(names - set(axes) - set(values))
+    if missing:
+        raise InputError(f"{missing[0]}: give it a value (--param {missing[0]}=...) or an axis "
+                         f"(--axis {missing[0]}=A:B:N)")
+    taken = {f.name for f in (*STABILITY.fields, *SUBHARMONIC.fields)} | {"branch", "chunk",
+                                                                          "done"}
+    clash = sorted(set(axes) & taken)
+    if clash:
+        raise InputError(f"--axis {clash[0]}: the store holds a field of that name; rename the "
+                         "parameter in the equation")
+    frequency = _frequency_name(osc, text, name)
+    form = driven_form(text, {**dict(values), **{a: "1" for a in axes if a != frequency}},
+                       name, f"sweep {kind}", "a polynomial force and one drive f*cos(w*t)",
+                       True)
+    if len(form.drives) != 1:
+        raise InputError(f"{name} ({text}): sweep {kind} takes one drive f*cos(w*t), not "
+                         f"{len(form.drives)}")
+    spec = EquationSpec(kind, text, tuple(sorted(values.items())), frequency, n, name)
+    branch = ("branch", tuple(range(1, EQUATION_BRANCHES + 1)))
+    common = (
+        Field("orbits", "distinct periodic orbits found (shooting)", "int8"),
+        Field("stable_orbits", "distinct Floquet-stable orbits", "int8"),
+        Field("r", "r = sqrt(A1^2 + B1^2) of each orbit, largest first", dims=("branch",)),
+        Field("stable", "Floquet stability of each orbit", "int8", ("branch",), flag=True),
+        Field("floquet", "largest Floquet modulus of each orbit", dims=("branch",)),
+        Field("r_stable_max", "largest stable r"),
+        Field("r_stable_min", "smallest stable r"))
+    settings = (("equation", text), ("values", dict(sorted(values.items()))), ("n", n),
+                ("orbit_harmonics", ORBIT_HARMONICS))
+    warm = tuple((a, 1.0) for a in axes)
+    if kind == "subharmonic":
+        return Kind("subharmonic", f"orbits of {n} drive periods of {text}", tuple(axes),
+                    (branch,), (Field("exists", "an orbit of n drive periods was found", "int8",
+                                      flag=True), *common),
+                    functools.partial(_equation_subharmonic, spec), warm, 4, "stable_orbits",
+                    settings, builtin=False, positive=(frequency,))
+    return Kind(kind, f"every 1:1 orbit of {text} with its Floquet verdict", tuple(axes),
+                (branch,), common, functools.partial(_equation_response, spec), warm, 4,
+                "r_stable_max", settings, builtin=False, positive=(frequency,))
+
+
+def _frequency_name(osc: object, text: str, name: str) -> str:
+    """The name ``w`` of the drive's ``f*cos(w*t)`` (an axis or a value); one line where the
+    drive's argument is not a name times t."""
+    import sympy as sp
+
+    t = osc.equation.time
+    for wave in sorted(osc.drive.atoms(sp.cos), key=str):
+        c, _ = wave.args[0].as_independent(t, as_Add=False)
+        symbols = sorted(str(s) for s in c.free_symbols)
+        if len(symbols) == 1:
+            return symbols[0]
+    raise InputError(f"{name} ({text}): sweep needs the drive as f*cos(w*t) with the frequency "
+                     "a parameter w (an axis or a --param)")

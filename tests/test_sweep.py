@@ -25,6 +25,7 @@ from lindstedt.response import one_harmonic_curve
 from lindstedt.sweep import (
     MU_ORDERS,
     WarmUp,
+    equation_kind,
     estimate_bytes,
     kernel_signatures,
     local_cluster,
@@ -386,3 +387,91 @@ def test_stability_counts_every_distinct_orbit_against_dop853():
         own = reference_orbit(seed, eps, FORCE, w, 1 / Q)
         assert abs(float(point.r[0]) - own[1]) < 1e-8 and int(point.orbit_stable[0]) == 1
         assert np.isnan(point.r[1:]).all()
+
+
+# --- a user's equation: any parameter an axis ------------------------------------------------
+
+SWEPT = "q'' + 0.05*q' + q + eps*(alpha*q**2 + q**3) = f*cos(w*t)"
+
+
+def _attractor_from_rest(terms, force, omega, periods=240):
+    """DOP853 from rest over ``periods`` drive periods (40/γ of transients and more), then r
+    of the last period by FFT: the attractor a user meets."""
+    from scipy.integrate import solve_ivp
+
+    def rhs(t, y):
+        return [y[1], force * math.cos(omega * t)
+                - sum(c * y[0] ** a * y[1] ** b for (a, b), c in terms.items())]
+
+    T = 2 * math.pi / omega
+    sol = solve_ivp(rhs, (0, periods * T), [0.0, 0.0], method="DOP853", rtol=1e-10,
+                    atol=1e-12, dense_output=True)
+    q = sol.sol((periods - 1) * T + np.arange(256) * T / 256)[0]
+    return 2 * abs(np.fft.rfft(q)[1]) / 256
+
+
+def test_equation_sweep_stable_r_is_the_attractor_dop853_reaches_from_rest():
+    """``sweep response EQUATION --axis w=… --axis alpha=… --param eps=1/10 --param f=3/10``
+    (serially here): at every point the steady state DOP853 reaches from rest is one of the
+    stored stable orbits (its r within 1e-6), and a point with three orbits holds one unstable
+    between two stable (the fold's hysteresis)."""
+    kind = equation_kind("response", SWEPT, {"eps": "1/10", "f": "3/10"}, ["w", "alpha"])
+    ds = serial_sweep(kind, {"w": [0.9, 1.3, 1.5], "alpha": [0.0, 0.5]})
+    assert ds["r"].dims == ("w", "alpha", "branch")
+    for i, w in enumerate(ds["w"].values):
+        for j, alpha in enumerate(ds["alpha"].values):
+            terms = {(1, 0): 1.0, (0, 1): 0.05, (3, 0): 0.1, (2, 0): 0.1 * alpha}
+            truth = _attractor_from_rest({k: v for k, v in terms.items() if v}, 0.3, w)
+            r, stable = ds["r"].values[i, j], ds["stable"].values[i, j]
+            kept = r[stable == 1]
+            assert np.min(np.abs(kept - truth)) < 1e-6, (w, alpha, truth, r, stable)
+    three = ds["orbits"].values == 3
+    assert three.any()
+    for index in zip(*np.nonzero(three), strict=True):
+        assert list(ds["stable"].values[index][:3]) == [1, 0, 1]
+
+
+def test_equation_subharmonic_sweep_against_the_command():
+    """The subharmonic map of a quadratic force over its drive frequency: each point's orbits
+    are the ``subharmonic EQUATION --n 2`` command's at that point."""
+    from lindstedt.subharmonic import subharmonic_equation, subharmonic_orbits
+
+    text = "x'' + 0.05*x' + x + x**2 = f*cos(W*t)"
+    kind = equation_kind("subharmonic", text, {"f": "1/2"}, ["W"], n=2)
+    ds = serial_sweep(kind, {"W": [1.6, 2.0, 2.4]})
+    for i, W in enumerate(ds["W"].values):
+        found = subharmonic_orbits(subharmonic_equation(text, {"f": "1/2"}, W / 2, 2),
+                                   onset=False)
+        assert ds["exists"].values[i] == int(found.exists)
+        rs = ds["r"].values[i]
+        assert np.allclose(rs[: len(found.orbits)], [o.r for o in found.orbits], atol=1e-9)
+    assert ds["exists"].values[1] == 1
+
+
+@pytest.mark.parametrize("argv, says", [
+    (["--axis", "beta=0:1:3", "--param", "eps=1/10", "--param", "f=3/10", "--param",
+      "alpha=1"], "beta: not a parameter"),
+    (["--axis", "w=1:2:3", "--axis", "alpha=0:1:2", "--param", "alpha=1", "--param",
+      "eps=1/10", "--param", "f=3/10"], "--axis alpha and --param alpha"),
+    (["--axis", "w=1:2:3", "--param", "eps=1/10", "--param", "f=3/10"],
+     "alpha: give it a value (--param alpha=...) or an axis"),
+    (["--axis", "w=-1:2:3", "--param", "alpha=1", "--param", "eps=1/10", "--param",
+      "f=3/10"], "axis w: the drive frequency must be > 0"),
+    (["--omega", "1:2:3", "--param", "alpha=1"], "--omega: with an equation"),
+])
+def test_equation_sweep_refusals(tmp_path, capsys, argv, says):
+    from lindstedt.cli import main
+
+    store = tmp_path / "s"
+    assert main(["sweep", "response", SWEPT, *argv, "--store", str(store)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert says in err and len(err.splitlines()) == 1, err
+    assert not store.exists()
+
+
+def test_validity_takes_no_equation(tmp_path, capsys):
+    from lindstedt.cli import main
+
+    assert main(["sweep", "validity", SWEPT, "--axis", "w=1", "--store",
+                 str(tmp_path / "s")]) == 2
+    assert "the notes'" in capsys.readouterr().err
