@@ -470,7 +470,8 @@ class WarmUp(WorkerPlugin):
     """A worker plugin: :func:`warm_up` once on every worker, including workers that join
     later (``distributed`` runs ``setup`` when a worker starts or the plugin is registered)."""
 
-    def __init__(self, kind: Kind) -> None:
+    def __init__(self, kind: str | Kind) -> None:
+        kind = kind if isinstance(kind, Kind) else kind_named(kind)
         self.kind = kind
         import hashlib
 
