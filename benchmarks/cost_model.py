@@ -17,6 +17,7 @@ import time
 from collections import defaultdict
 
 import numpy as np
+from lindstedt.analysis.driven import Drive
 from lindstedt.choose import (
     COST_MODEL,
     _fourier_cost,
@@ -28,8 +29,7 @@ from lindstedt.choose import (
     modelled_ns,
     ns_per_point,
 )
-from lindstedt.driven import Drive
-from lindstedt.methods import methods_for
+from lindstedt.methods.registry import methods_for
 from scipy.optimize import nnls
 from scipy.special import ellipj
 

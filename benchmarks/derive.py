@@ -13,8 +13,8 @@ from __future__ import annotations
 import argparse
 
 import sympy as sp
-from lindstedt.lindstedt import derive
-from lindstedt.models import duffing, pendulum
+from lindstedt.derive.lindstedt import derive
+from lindstedt.derive.models import duffing, pendulum
 from sympy.simplify.fu import TR8
 from timing import best
 

@@ -10,11 +10,17 @@ import time
 from pathlib import Path
 
 import numpy as np
+from lindstedt.analysis.driven import (
+    Drive,
+    amplitudes,
+    first_order_branches,
+    harmonic_balance,
+    mu_expansion,
+)
+from lindstedt.analysis.response import continue_balance, one_harmonic_curve
 from lindstedt.compiler import generate_balance
-from lindstedt.driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
-from lindstedt.emit import load_generated
-from lindstedt.numerics import shoot, sweep
-from lindstedt.response import continue_balance, one_harmonic_curve
+from lindstedt.emit.render import load_generated
+from lindstedt.numerics.integrate import shoot, sweep
 from timing import best
 
 

@@ -11,10 +11,15 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from lindstedt.analysis.driven import (
+    Drive,
+    first_order_branches,
+    mu_expansion_damped,
+    mu_expansion_exact,
+)
 from lindstedt.compiler import generate_driven
-from lindstedt.driven import Drive, first_order_branches, mu_expansion_damped, mu_expansion_exact
-from lindstedt.emit import load_generated
-from lindstedt.numerics import shoot
+from lindstedt.emit.render import load_generated
+from lindstedt.numerics.integrate import shoot
 from timing import median
 
 DAMPED_ORDERS = range(1, 7)

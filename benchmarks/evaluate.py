@@ -25,10 +25,10 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 from lindstedt.compiler import generate
-from lindstedt.emit import load_generated
-from lindstedt.lindstedt import derive, period_series, solution_expression
-from lindstedt.lower import Evaluator, lower_free
-from lindstedt.models import A, duffing, eps, t
+from lindstedt.derive.lindstedt import derive, period_series, solution_expression
+from lindstedt.derive.models import A, duffing, eps, t
+from lindstedt.emit.render import load_generated
+from lindstedt.lower.lowering import Evaluator, lower_free
 from sympy.codegen.rewriting import create_expand_pow_optimization, optimize
 from sympy.printing.c import C99CodePrinter
 from timing import best

@@ -15,10 +15,10 @@ from __future__ import annotations
 from collections import Counter
 
 import numpy as np
-from lindstedt.driven import Drive, amplitudes
-from lindstedt.numerics import multipliers_stable, orbit_hill_multipliers
-from lindstedt.response import periodic_orbits
-from lindstedt.subharmonic import subharmonic
+from lindstedt.analysis.driven import Drive, amplitudes
+from lindstedt.analysis.response import periodic_orbits
+from lindstedt.analysis.subharmonic import subharmonic
+from lindstedt.numerics.integrate import multipliers_stable, orbit_hill_multipliers
 
 
 def _verdict(stable: bool | None, name: str, missing: str) -> str:

@@ -25,14 +25,14 @@ import statistics
 import time
 from fractions import Fraction
 
-from lindstedt.lindstedt import (
+from lindstedt.algebra.series import Ground, Trig, solve_trig
+from lindstedt.derive.lindstedt import (
     _linearisation,
     _secular_parts,
     derive_limit_cycle,
     limit_cycle_amplitudes,
 )
-from lindstedt.models import oscillator, self_excited_model
-from lindstedt.series import Ground, Trig, solve_trig
+from lindstedt.derive.models import oscillator, self_excited_model
 
 VDP = "q'' + q = eps*(1 - q**2)*q'"
 

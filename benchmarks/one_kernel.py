@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 import timing
-from lindstedt.driven import Drive, first_order_branches, harmonic_balance, mu_expansion
-from lindstedt.numerics import (
+from lindstedt.analysis.driven import Drive, first_order_branches, harmonic_balance, mu_expansion
+from lindstedt.numerics.integrate import (
     duffing_table,
     flow,
     hill_multipliers,

@@ -18,9 +18,9 @@ import time
 from pathlib import Path
 
 import sympy as sp
-from lindstedt.equation import parse_equation
-from lindstedt.lindstedt import derive
-from lindstedt.models import duffing, model_from_text, oscillator, pendulum
+from lindstedt.derive.equation import parse_equation
+from lindstedt.derive.lindstedt import derive
+from lindstedt.derive.models import duffing, model_from_text, oscillator, pendulum
 from sympy.core.cache import clear_cache
 from sympy.parsing.sympy_parser import parse_expr
 from timing import best

@@ -15,7 +15,7 @@ import math
 import statistics
 import time
 
-from lindstedt.parametric import (
+from lindstedt.analysis.parametric import (
     Pump,
     balance_point,
     one_harmonic,

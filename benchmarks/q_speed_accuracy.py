@@ -22,8 +22,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from lindstedt.compiler import generate
-from lindstedt.emit import load_generated
-from lindstedt.methods import cn_fourier
+from lindstedt.emit.render import load_generated
+from lindstedt.methods.registry import cn_fourier
 from scipy.integrate import solve_ivp
 from scipy.special import ellipj
 from timing import best

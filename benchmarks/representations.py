@@ -18,8 +18,8 @@ from unittest import mock
 
 from flint import fmpq, fmpq_poly
 from lindstedt import lindstedt
-from lindstedt.models import duffing
-from lindstedt.series import Ground
+from lindstedt.algebra.series import Ground
+from lindstedt.derive.models import duffing
 from sympy.external.gmpy import GROUND_TYPES
 from sympy.polys.domains import QQ
 

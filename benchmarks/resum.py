@@ -30,16 +30,7 @@ from pathlib import Path
 
 import numpy as np
 import sympy as sp
-from lindstedt.charts import mathieu_accuracy_figure, resummed_speed_accuracy_figure
-from lindstedt.compiler import generate_limit_cycle, generate_mathieu
-from lindstedt.emit import load_generated
-from lindstedt.errors import InputError
-from lindstedt.hill import mathieu_series
-from lindstedt.lindstedt import derive_limit_cycle, nearest_singularity
-from lindstedt.methods import RELAXATION_SPREAD_MARGIN, RESUM_TOLERANCE
-from lindstedt.models import series_model
-from lindstedt.numerics import cycle_reference, mathieu_reference, mathieu_refined
-from lindstedt.resum import (
+from lindstedt.algebra.resum import (
     compose,
     diagonal_pade,
     horner_float,
@@ -51,6 +42,15 @@ from lindstedt.resum import (
     w_of,
     w_substitution,
 )
+from lindstedt.charts import mathieu_accuracy_figure, resummed_speed_accuracy_figure
+from lindstedt.compiler import generate_limit_cycle, generate_mathieu
+from lindstedt.derive.hill import mathieu_series
+from lindstedt.derive.lindstedt import derive_limit_cycle, nearest_singularity
+from lindstedt.derive.models import series_model
+from lindstedt.emit.render import load_generated
+from lindstedt.errors import InputError
+from lindstedt.methods.registry import RELAXATION_SPREAD_MARGIN, RESUM_TOLERANCE
+from lindstedt.numerics.integrate import cycle_reference, mathieu_reference, mathieu_refined
 from scipy.special import mathieu_a, mathieu_b
 from timing import best
 

@@ -22,12 +22,12 @@ import time
 from pathlib import Path
 
 import numpy as np
+from lindstedt.algebra.resum import resum_frequency, resum_relaxation, van_der_pol_relaxation
 from lindstedt.compiler import generate_limit_cycle
-from lindstedt.emit import load_generated
-from lindstedt.lindstedt import derive_limit_cycle, nearest_singularity
-from lindstedt.models import series_model
-from lindstedt.numerics import cycle_reference
-from lindstedt.resum import resum_frequency, resum_relaxation, van_der_pol_relaxation
+from lindstedt.derive.lindstedt import derive_limit_cycle, nearest_singularity
+from lindstedt.derive.models import series_model
+from lindstedt.emit.render import load_generated
+from lindstedt.numerics.integrate import cycle_reference
 from timing import median
 
 ORDERS = (60, 100, 130, 164)

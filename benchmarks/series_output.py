@@ -19,8 +19,8 @@ import time
 
 import sympy as sp
 from lindstedt.cli import series_json
-from lindstedt.lindstedt import derive
-from lindstedt.models import series_model
+from lindstedt.derive.lindstedt import derive
+from lindstedt.derive.models import series_model
 
 EQUATIONS = ("q'' + q + eps*(alpha*q**2 + q**3) = 0", "q'' + q + eps*q**3 = 0",
              "q'' + q + eps*(q**2 + q**3) = 0")

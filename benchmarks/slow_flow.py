@@ -12,11 +12,11 @@ from pathlib import Path
 
 import numpy as np
 import sympy as sp
-from lindstedt.averaging import PHI, R, slow_flow
 from lindstedt.charts import SLOW_FLOW_EPS, slow_flow_errors
 from lindstedt.compiler import generate_slow_flow
-from lindstedt.emit import load_generated
-from lindstedt.models import oscillator
+from lindstedt.derive.averaging import PHI, R, slow_flow
+from lindstedt.derive.models import oscillator
+from lindstedt.emit.render import load_generated
 from numba import njit
 from timing import best
 

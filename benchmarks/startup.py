@@ -21,7 +21,8 @@ COMMANDS = (
     ("python -c pass (interpreter)", [sys.executable, "-c", "pass"]),
     ("import every stage (eager CLI)", [sys.executable, "-c",
                                         "import lindstedt.cli, lindstedt.charts, "
-                                        "lindstedt.choose, lindstedt.emit, lindstedt.response"]),
+                                        "lindstedt.choose, lindstedt.emit.render, "
+                                        "lindstedt.analysis.response"]),
     ("lindstedt --help", [BIN / "lindstedt", "--help"]),
     ("lindstedt driven --eps x (error)", [BIN / "lindstedt", "driven", "--eps", "x"]),
     ("lindstedt series duffing --order 2", [BIN / "lindstedt", "series", "duffing", "--order",

@@ -17,13 +17,13 @@ from pathlib import Path
 
 import numpy as np
 import sympy as sp
-from lindstedt import methods
+from lindstedt.algebra.resum import resum_series
 from lindstedt.cli import main
-from lindstedt.emit import load_generated
-from lindstedt.hill import fourier_of_text, transition_curves
-from lindstedt.lindstedt import nearest_singularity
-from lindstedt.numerics import floquet_traces
-from lindstedt.resum import resum_series
+from lindstedt.derive.hill import fourier_of_text, transition_curves
+from lindstedt.derive.lindstedt import nearest_singularity
+from lindstedt.emit.render import load_generated
+from lindstedt.methods import registry as methods
+from lindstedt.numerics.integrate import floquet_traces
 from scipy.optimize import brentq
 from timing import best, median
 

@@ -16,7 +16,7 @@ import random
 from fractions import Fraction
 
 from flint import fmpq, fmpq_poly
-from lindstedt.series import Ground, Trig
+from lindstedt.algebra.series import Ground, Trig
 from timing import best
 
 QQ = Ground.for_coefficients([])

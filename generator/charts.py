@@ -18,6 +18,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .analysis.driven import Drive
+from .analysis.mixing import mixing_series, tone_label
+from .analysis.response import (
+    CONTINUATION_SECONDS,
+    continue_balance,
+    one_harmonic_curve,
+    response_range,
+)
+from .analysis.subharmonic import subharmonic, subharmonic_equation, subharmonic_orbits
 from .choose import (
     DRIVEN_QUANTITIES,
     DrivenTradeoff,
@@ -26,19 +35,10 @@ from .choose import (
     pareto_front,
     tradeoffs,
 )
-from .driven import Drive
-from .emit import check_folder, check_target, write_files
+from .emit.render import check_folder, check_target, write_files
 from .errors import InputError
-from .methods import candidates, reference_period
-from .mixing import mixing_series, tone_label
-from .numerics import ForceTable, duffing_table, steady_state_amplitudes, sweep
-from .response import (
-    CONTINUATION_SECONDS,
-    continue_balance,
-    one_harmonic_curve,
-    response_range,
-)
-from .subharmonic import subharmonic, subharmonic_equation, subharmonic_orbits
+from .methods.registry import candidates, reference_period
+from .numerics.integrate import ForceTable, duffing_table, steady_state_amplitudes, sweep
 from .sweep import BALANCE_HARMONICS, MU_ORDERS, validity_errors
 
 FORMATS = (".png", ".svg", ".pdf")
@@ -132,7 +132,7 @@ def response_equation_figure(text: str, values: dict[str, str], harmonics: int, 
     """Response r(ω) of a user's damped driven oscillator: the one-harmonic amplitudes, the
     continued N-harmonic balance (first-harmonic amplitude), the simulated sweeps up and down
     (max |q|), its folds."""
-    from .response import equation_response
+    from .analysis.response import equation_response
 
     check_plot_path(path)
     curve = equation_response(text, values, harmonics, name, omega_min, omega_max, max_seconds)
@@ -533,9 +533,9 @@ def ince_strutt_figure(path: Path, p: str = "cos(t)", zeta: float = 0.05, grid: 
     damping ζ; the transition curves of :func:`hill.transition_curves` drawn solid where the
     Floquet boundary is within INCE_STRUTT_TOL of them (and inside their estimated radius),
     dashed elsewhere; with damping, the tongues' tips ε_min(ζ) of :func:`hill.tongue_tip`."""
-    from .hill import fourier_of_text, tongue_tip, transition_curves
-    from .lindstedt import nearest_singularity
-    from .numerics import floquet_stable, floquet_traces
+    from .derive.hill import fourier_of_text, tongue_tip, transition_curves
+    from .derive.lindstedt import nearest_singularity
+    from .numerics.integrate import floquet_stable, floquet_traces
 
     check_plot_path(path)
     harmonics = fourier_of_text(p)
@@ -622,8 +622,8 @@ def slow_flow_errors(order: int, eps_values: Sequence[float] = SLOW_FLOW_EPS,
     """Largest |r_slow − r_sim| over ``εt ≤ SLOW_FLOW_HORIZON`` of van der Pol's growth from
     ``r = SLOW_FLOW_START``, at each ε: ``r = √(q² + q̇²)`` of the slow flow at ``order`` (with
     its near-identity transformation) and of the simulation."""
-    from .averaging import simulate, slow_flow, transient
-    from .models import REGISTRY, oscillator
+    from .derive.averaging import simulate, slow_flow, transient
+    from .derive.models import REGISTRY, oscillator
 
     osc = oscillator(REGISTRY["van_der_pol"].equation, name="van_der_pol")
     flow = slow_flow(osc, order)
@@ -659,8 +659,8 @@ def slow_flow_error_figure(path: Path, orders: Sequence[int] = (1, 2, 3)) -> Pat
 def slow_flow_transient_figure(path: Path, eps: float = 0.2) -> Path:
     """r(t) of van der Pol's growth from ``r = SLOW_FLOW_START``: the simulation, the first-
     and second-order slow flows, and the second order's error."""
-    from .averaging import simulate, slow_flow, transient
-    from .models import REGISTRY, oscillator
+    from .derive.averaging import simulate, slow_flow, transient
+    from .derive.models import REGISTRY, oscillator
 
     check_plot_path(path)
     osc = oscillator(REGISTRY["van_der_pol"].equation, name="van_der_pol")
@@ -703,7 +703,7 @@ def parametric_figure(eps: float, zeta: float, gamma: float, omega_from: float,
     """Response r(ω) of ``q̈ + 2ζq̇ + (1 + ε cos 2ωt)q + γq³ = 0`` (the pump at 2ω): the
     one-harmonic branches (stable solid, unstable dashed), the harmonic balance's first harmonic
     with its full-Hill verdict (dots), shooting (o stable, x unstable), the tongue's edges."""
-    from .parametric import Pump, check_omega, onsets, response, tongue_edges
+    from .analysis.parametric import Pump, check_omega, onsets, response, tongue_edges
 
     check_plot_path(path)
     p = Pump(eps, zeta, gamma)

@@ -28,13 +28,14 @@ import mpmath
 import numpy as np
 from scipy.special import ellipj, ellipk
 
+from .analysis.driven import Drive, amplitudes, first_order_branches, harmonic_balance
 from .compiler import generate, generate_method
+from .derive.lindstedt import derive
+from .derive.models import Model, duffing, pendulum
 from .display import html_table
-from .driven import Drive, amplitudes, first_order_branches, harmonic_balance
-from .emit import load_generated
+from .emit.render import load_generated
 from .errors import InputError
-from .lindstedt import derive
-from .methods import (
+from .methods.registry import (
     DRIVEN_MAX,
     INTEGRATION_RTOLS,
     SHOOTING_STEPS,
@@ -51,8 +52,7 @@ from .methods import (
     reference_period,
     reference_q,
 )
-from .models import Model, duffing, pendulum
-from .numerics import shoot
+from .numerics.integrate import shoot
 
 Progress = Callable[[int, int], None]
 # NOTE: ``progress(done, total)`` lets the command line draw a bar over the long loops.
@@ -783,8 +783,8 @@ def choose_limit_cycle(tol: float, eps_min: float, eps_max: float, order: int | 
     shooting references at ``points`` Chebyshev points (shooting's own error: its
     two-tolerance difference there)."""
     from .compiler import generate_limit_cycle
-    from .models import series_model
-    from .numerics import cycle_reference
+    from .derive.models import series_model
+    from .numerics.integrate import cycle_reference
 
     if not (0 < eps_min <= eps_max) or not (tol > 0):
         raise InputError(f"--x-min {eps_min}, --x-max {eps_max}, --tol {tol}: need "
@@ -816,10 +816,10 @@ def choose_mathieu(kind: str, m: int, tol: float, q_min: float, q_max: float,
     (NumPy Horner), the emitted Padé evaluator and the eigenvalue solver, measured against the
     eigenvalue solver in mpmath (30 digits) at ``points`` Chebyshev points, relative to
     max(1, |a|)."""
+    from .algebra.resum import horner_float
     from .compiler import generate_mathieu
-    from .hill import mathieu_series
-    from .numerics import mathieu_reference
-    from .resum import horner_float
+    from .derive.hill import mathieu_series
+    from .numerics.integrate import mathieu_reference
 
     if not (q_min <= q_max) or not (tol > 0):
         raise InputError(f"--x-min {q_min}, --x-max {q_max}, --tol {tol}: need x-min ≤ x-max "

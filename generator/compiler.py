@@ -14,9 +14,10 @@ from collections.abc import Callable
 from functools import partial
 from pathlib import Path
 
-from .emit import check_writable, render, write_files
+from .derive.models import Model, check_order, model_by_name
+from .emit.render import check_writable, render, write_files
 from .errors import InputError
-from .methods import (
+from .methods.registry import (
     BALANCE,
     CHOSEN_PERIOD,
     FOURIER,
@@ -32,7 +33,6 @@ from .methods import (
     Request,
     Target,
 )
-from .models import Model, check_order, model_by_name
 
 Progress = Callable[[int, int], None]
 
@@ -147,7 +147,7 @@ def generate_slow_flow(osc: object, order: int, command: str, out: Path, *,
 def generate_mathieu(kind: str, m: int, order: int, out: Path, *,
                      overwrite_edited: bool = False, flag: str = "--emit") -> list[Path]:
     """``lindstedt mathieu a|b --m M --order K --emit DIR``: the resummed a_m(q) or b_m(q)."""
-    from .hill import mathieu_series
+    from .derive.hill import mathieu_series
 
     mathieu_series(kind, m, 0)  # the kind and m checked before the derivation
     order = check_order(order)
@@ -165,7 +165,7 @@ TONGUE_MIN_ORDER = 12
 def generate_tongue(p: str, n: int, order: int, out: Path, *, overwrite_edited: bool = False,
                     flag: str = "--emit") -> list[Path]:
     """``lindstedt tongues P --n N --order K --emit DIR``: the resummed transition curves."""
-    from .hill import fourier_of_text, transition_curves
+    from .derive.hill import fourier_of_text, transition_curves
 
     transition_curves(fourier_of_text(p), n, 0)  # p and n checked before the derivation
     order = check_order(order)

@@ -135,7 +135,7 @@ def oscillator_seconds(text: str, pairs: list[str] | None, order: int) -> float:
     equation is parsed here (its errors come first, as the command's own)."""
     import sympy as sp
 
-    from .equation import SMALL, parse_equation
+    from .derive.equation import SMALL, parse_equation
 
     eq = parse_equation(text)
     q, v, a = eq.derivatives
@@ -172,9 +172,9 @@ def limit_cycle_text(model: str) -> str | None:
     (the command's own parse reports it)."""
     import sympy as sp
 
-    from .equation import parse_equation
+    from .derive.equation import parse_equation
+    from .derive.models import registry_entry
     from .errors import InputError
-    from .models import registry_entry
 
     entry = registry_entry(model) if model.isidentifier() else None
     text = entry.equation if entry else model
@@ -202,7 +202,7 @@ def series_cost(args: argparse.Namespace) -> Cost:
     if args.model in SERIES_COSTS:
         seconds = power_law(*SERIES_COSTS[args.model], args.order)
     elif args.model.isidentifier():  # another registry name: its equation is known
-        from .models import registry_entry
+        from .derive.models import registry_entry
 
         entry = registry_entry(args.model)
         seconds = (oscillator_seconds(entry.equation, args.param, args.order) if entry
@@ -232,7 +232,7 @@ def generate_cost(args: argparse.Namespace) -> Cost:
         derivation = series_cost(argparse.Namespace(model=args.model, param=args.param,
                                                     order=size + 2)).seconds
         if limit_cycle_text(args.model) is not None:
-            from .methods import RADIUS_ORDER, cycle_series_order
+            from .methods.registry import RADIUS_ORDER, cycle_series_order
 
             resum = getattr(args, "resum_order", None)
             derived = cycle_series_order(size, resum)
@@ -290,8 +290,8 @@ RESPONSE_EQUATION_ENDS = 2 * 15.0
 def response_equation_cost(args: argparse.Namespace) -> Cost:
     """``response EQUATION``: the equation lowered (refused in one line before anything runs),
     its range and continuation estimated as the command will run them."""
-    from .driven import PolynomialBalance
-    from .response import equation_continuation_seconds, equation_range, response_equation
+    from .analysis.driven import PolynomialBalance
+    from .analysis.response import equation_continuation_seconds, equation_range, response_equation
 
     values: dict[str, str] = {}
     for pair in args.param or ():
@@ -316,7 +316,7 @@ def response_equation_cost(args: argparse.Namespace) -> Cost:
 
 
 def response_cost(args: argparse.Namespace) -> Cost:
-    from .response import continuation_seconds, response_range
+    from .analysis.response import continuation_seconds, response_range
 
     if getattr(args, "model", None) is not None:
         return response_equation_cost(args)
@@ -421,7 +421,7 @@ TONGUE_EMIT_SECONDS = 6.0
 
 
 def tongues_cost(args: argparse.Namespace) -> Cost:
-    from .hill import fourier_of_text
+    from .derive.hill import fourier_of_text
 
     top = max(fourier_of_text(args.p))
     seconds = power_law(*TONGUES_FIT, args.order) * top**2.5
@@ -441,7 +441,7 @@ SLOW_FLOW_FIT = (2.0, 0.95, 4, "2.2")
 
 
 def slow_flow_cost(args: argparse.Namespace) -> Cost:
-    from .averaging import MAX_ORDER
+    from .derive.averaging import MAX_ORDER
 
     # NOTE: beyond MAX_ORDER the derivation refuses at once (its own one-line message)
     order = args.order if args.order <= MAX_ORDER else 0

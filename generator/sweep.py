@@ -63,16 +63,16 @@ if TYPE_CHECKING:
 # NOTE: xarray and zarr are imported where the client uses them: every worker imports this
 # module to run its blocks and needs neither (~1.3 s of each worker's start-up, measured).
 
-from .driven import Drive, amplitudes, first_order_branches, mu_expansion
-from .errors import InputError
-from .response import (
+from .analysis.driven import Drive, amplitudes, first_order_branches, mu_expansion
+from .analysis.response import (
     CONTINUATION_HARMONICS,
     SAME_ORBIT,
     amplitude_slope,
     periodic_orbits,
     try_balance,
 )
-from .subharmonic import SUBHARMONIC_HARMONICS, subharmonic
+from .analysis.subharmonic import SUBHARMONIC_HARMONICS, subharmonic
+from .errors import InputError
 
 # --- what one point computes -------------------------------------------------------------------
 
@@ -451,7 +451,7 @@ def kernel_signatures() -> dict[str, int]:
     worker's counts stay fixed from task to task (no recompiling)."""
     from numba.core.registry import CPUDispatcher
 
-    from . import numerics
+    from .numerics import integrate as numerics
 
     return {name: len(f.signatures) for name, f in vars(numerics).items()
             if isinstance(f, CPUDispatcher)}
@@ -938,8 +938,8 @@ def _point_values(spec: EquationSpec, axis: Mapping[str, float]) -> dict[str, st
 def _equation_response(spec: EquationSpec, **axis: float) -> dict:
     """Every 1:1 orbit at one point (:func:`response.equation_orbits`: the balance continued in
     the drive amplitude, each crossing shot), largest r first, with its Floquet verdict."""
-    from .driven import driven_equation
-    from .response import equation_orbits
+    from .analysis.driven import driven_equation
+    from .analysis.response import equation_orbits
 
     values = _point_values(spec, axis)
     omega = float(Fraction(values.pop(spec.frequency)))
@@ -968,7 +968,7 @@ def _branches(shot: list, count: int) -> dict:
 def _equation_subharmonic(spec: EquationSpec, **axis: float) -> dict:
     """Every orbit of n drive periods at one point (:func:`subharmonic.subharmonic_orbits`,
     without the onset), largest r first, with its Floquet verdict."""
-    from .subharmonic import subharmonic_equation, subharmonic_orbits
+    from .analysis.subharmonic import subharmonic_equation, subharmonic_orbits
 
     values = _point_values(spec, axis)
     try:
@@ -991,9 +991,9 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
     parameters of the equation (its drive frequency included), every other parameter has a
     value in ``values``; refused in one line: an axis that names no parameter, a parameter
     both an axis and a value, a parameter with neither, a kind that takes no equation."""
-    from .driven import driven_form
-    from .models import oscillator
-    from .subharmonic import check_n
+    from .analysis.driven import driven_form
+    from .analysis.subharmonic import check_n
+    from .derive.models import oscillator
 
     if kind not in EQUATION_KINDS:
         raise InputError(f"sweep {kind} EQUATION: the {kind} map is the notes' (μ-expansion "

@@ -1,5 +1,5 @@
-"""The slow flow (lindstedt.averaging) against independent references: the literature's van der
-Pol flow, the L–P limit cycles (exact), harmonic balance for the driven Duffing, and SciPy's
+"""The slow flow (lindstedt.derive.averaging) against independent references: the literature's
+van der Pol flow, the L–P limit cycles (exact), harmonic balance for the driven Duffing, and SciPy's
 DOP853 simulation of the equation itself (the error's order in ε)."""
 
 from __future__ import annotations
@@ -9,11 +9,11 @@ import math
 import numpy as np
 import pytest
 import sympy as sp
-from lindstedt.averaging import PHI, R, cycle_series, fixed_points, slow_flow, transient
-from lindstedt.driven import Drive, harmonic_balance, one_harmonic_roots
+from lindstedt.analysis.driven import Drive, harmonic_balance, one_harmonic_roots
+from lindstedt.derive.averaging import PHI, R, cycle_series, fixed_points, slow_flow, transient
+from lindstedt.derive.lindstedt import derive_limit_cycle
+from lindstedt.derive.models import oscillator, self_excited_model
 from lindstedt.errors import InputError
-from lindstedt.lindstedt import derive_limit_cycle
-from lindstedt.models import oscillator, self_excited_model
 from scipy.integrate import solve_ivp
 
 VDP = "q'' + q = eps*(1 - q**2)*q'"
@@ -245,7 +245,7 @@ def test_emitted_right_sides(tmp_path):
     differences, the Cartesian right side against the polar one (u = r cos φ, v = −r sin φ);
     regenerating gives byte-identical files."""
     from lindstedt.cli import main
-    from lindstedt.emit import load_generated
+    from lindstedt.emit.render import load_generated
 
     args = ["slowflow", DRIVEN, "--name", "forced", "--param", "k=1/2", "--order", "2",
             "--out", str(tmp_path)]

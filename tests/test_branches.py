@@ -16,9 +16,9 @@ import math
 
 import numpy as np
 import pytest
+from lindstedt.analysis.driven import Drive
+from lindstedt.analysis.response import periodic_orbits
 from lindstedt.cli import driven_json, driven_table
-from lindstedt.driven import Drive
-from lindstedt.response import periodic_orbits
 from scipy.integrate import solve_ivp
 
 SAME = 1e-7  # two reference orbits are one when their states differ by this, relative

@@ -9,7 +9,7 @@ import pytest
 from lindstedt import charts, cli
 from lindstedt.charts import check_plot_path, mixing_figure
 from lindstedt.errors import InputError
-from lindstedt.numerics import duffing_table
+from lindstedt.numerics.integrate import duffing_table
 from matplotlib.colors import to_rgba
 from scipy.integrate import solve_ivp
 
@@ -120,7 +120,7 @@ def test_subharmonic_figure_marks_the_full_hill_verdict(tmp_path, monkeypatch):
     """Small markers on each root's curve give the full Hill verdict every FULL_HILL_EVERY ω
     (dot stable, triangle unstable); where it parts from the notes' q₀ test (the line style)
     it is the true orbit's Floquet verdict (shooting from the balance orbit, RK4 monodromy)."""
-    from lindstedt.subharmonic import subharmonic
+    from lindstedt.analysis.subharmonic import subharmonic
 
     drawn = []
     save = charts._save

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from lindstedt.choose import choose_period
 from lindstedt.errors import InputError
-from lindstedt.methods import candidates, resummed_coefficients
+from lindstedt.methods.registry import candidates, resummed_coefficients
 from reference import duffing_period
 
 
@@ -142,7 +142,7 @@ def test_driven_and_spring_scenes():
 
 
 def test_choose_emits_just_the_chosen_evaluator(tmp_path):
-    from lindstedt.emit import load_generated
+    from lindstedt.emit.render import load_generated
 
     run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "period", "--tol", "1e-8",
                           "--x-min", "0", "--x-max", "1000", "--emit", str(tmp_path), "--json"],
@@ -180,7 +180,7 @@ def test_every_method_emits_its_period(tmp_path, method, order, lo, hi, tol):
     period(A, eps) against T = 4K(m)/√(1+x) (mpmath) on the verified range, its ends
     included, and NaN just outside it (and beyond the separatrix)."""
     from lindstedt.compiler import generate_choice
-    from lindstedt.emit import load_generated
+    from lindstedt.emit.render import load_generated
 
     cand = next(c for c in candidates() if (c.method, c.order) == (method, order))
     generate_choice(cand, "test", tmp_path, (lo, hi))
@@ -201,7 +201,7 @@ def test_every_method_emits_its_period(tmp_path, method, order, lo, hi, tol):
 
 
 def test_integrated_period_reaches_its_tolerance():
-    from lindstedt.methods import integrated_period, reference_period
+    from lindstedt.methods.registry import integrated_period, reference_period
 
     for x in (0.1, 5.0, -0.5):
         ref = reference_period(np.array([x]))[0]
@@ -212,9 +212,9 @@ def test_integrated_period_reaches_its_tolerance():
 def test_modified_lindstedt_of_cheung_chen_lau():
     """ω² = (1 + 3x/4) g(α), α = 3x/(4 + 3x): by construction g = 1 + O(α²) (CCL's choice of α
     absorbs the first-order term), and the series holds out to x = 10³ and down to x = −0.9."""
-    from lindstedt.lindstedt import derive
-    from lindstedt.methods import modified_coefficients, reference_period
-    from lindstedt.models import duffing
+    from lindstedt.derive.lindstedt import derive
+    from lindstedt.derive.models import duffing
+    from lindstedt.methods.registry import modified_coefficients, reference_period
 
     sol = derive(duffing(), 40)
     g = modified_coefficients([sol.ground.to_fraction(c) for c in sol.omega])
@@ -226,7 +226,7 @@ def test_modified_lindstedt_of_cheung_chen_lau():
 
 def test_choose_amplitudes_meets_the_tolerance_against_shooting():
     from lindstedt.choose import choose_driven
-    from lindstedt.numerics import shoot
+    from lindstedt.numerics.integrate import shoot
 
     c = choose_driven("amplitudes", 1e-8, 0.1, 0.3, 20.0, 1.3)
     assert c.max_error <= 1e-8 and c.method in ("mu_expansion", "harmonic_balance", "shooting")
@@ -244,8 +244,8 @@ def test_one_harmonic_closed_form_is_mu_order_zero():
     for q = A₁ cos ωt + B₁ sin ωt (cos: (1 − ω²)A₁ + ωB₁/Q + ¾εr²A₁ = f, sin: (1 − ω²)B₁ −
     ωA₁/Q + ¾εr²B₁ = 0, r² = A₁² + B₁²: signs included) on the largest branch (numpy.roots of
     the cubic in r²), damped and undamped; and it is the μ-expansion's order 0."""
-    from lindstedt.driven import Drive, amplitudes, first_order_branches, mu_expansion
-    from lindstedt.methods import one_harmonic_amplitudes
+    from lindstedt.analysis.driven import Drive, amplitudes, first_order_branches, mu_expansion
+    from lindstedt.methods.registry import one_harmonic_amplitudes
 
     eps, f = 0.1, 0.7
     for Q in (np.inf, 20.0):
@@ -269,15 +269,15 @@ def test_one_harmonic_closed_form_is_mu_order_zero():
 def test_choose_response_over_a_range_holds_between_the_points():
     """The chosen method's r(ω) meets the tolerance at ω off the verification grid, against
     shooting started from the one-harmonic guess (not from the method's own answer)."""
-    from lindstedt.choose import choose_driven
-    from lindstedt.driven import (
+    from lindstedt.analysis.driven import (
         Drive,
         amplitudes,
         first_order_branches,
         harmonic_balance,
         mu_expansion,
     )
-    from lindstedt.numerics import shoot
+    from lindstedt.choose import choose_driven
+    from lindstedt.numerics.integrate import shoot
 
     c = choose_driven("response", 1e-6, 0.1, 0.3, 20.0, 0.5, 1.0)
     assert c.max_error <= 1e-6 and c.verified_on >= 20
@@ -304,8 +304,8 @@ def test_choose_response_over_a_range_holds_between_the_points():
 
 def test_choose_q_against_jacobi_cn():
     from lindstedt.choose import choose_solution
-    from lindstedt.lindstedt import derive
-    from lindstedt.models import duffing
+    from lindstedt.derive.lindstedt import derive
+    from lindstedt.derive.models import duffing
     from scipy.special import ellipj
 
     c = choose_solution(1e-8, 0.0, 0.3)
@@ -331,7 +331,7 @@ def test_choose_q_against_jacobi_cn():
 def test_exact_fourier_series_of_the_solution(x):
     """The nome series against mpmath's cn (any m < 1): double precision with enough
     harmonics, on a softening spring next to the separatrix too."""
-    from lindstedt.methods import cn_fourier
+    from lindstedt.methods.registry import cn_fourier
 
     t = np.linspace(0.0, 15.0, 61)
     m = x / (2 * (1 + x))
@@ -347,7 +347,7 @@ def test_choose_q_for_a_softening_spring_beyond_the_series():
     """On [−0.95, 0] the L–P series cannot reach 1e-10 and SciPy's cn does not take m < 0:
     the exact Fourier series does, and the choice holds off the verification grid."""
     from lindstedt.choose import choose_solution
-    from lindstedt.methods import cn_fourier
+    from lindstedt.methods.registry import cn_fourier
 
     c = choose_solution(1e-10, -0.95, 0.0)
     assert c.method == "fourier" and c.max_error <= 1e-10
@@ -363,7 +363,7 @@ def test_choose_q_for_a_softening_spring_beyond_the_series():
 def test_choose_q_emits_the_exact_fourier_module(tmp_path):
     """`choose q --emit` on a softening range writes fourier.py: its q and q_into match mpmath's
     cn off the grid, its omega is 2π/T with T = 4K(m)/√(1+x) (mpmath), NaN past the separatrix."""
-    from lindstedt.emit import load_generated
+    from lindstedt.emit.render import load_generated
 
     run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "q", "--tol", "1e-10",
                           "--x-min", "-0.95", "--x-max", "0", "--emit", str(tmp_path), "--json"],
@@ -389,8 +389,8 @@ def test_choose_q_emits_the_exact_fourier_module(tmp_path):
 def test_choose_emits_the_driven_module_it_verified(tmp_path):
     """With --emit only emittable methods compete, ranked by their emitted modules' measured
     cost: undamped, the compiled μ-expansion; its A₁ off the grid agrees with shooting."""
-    from lindstedt.emit import load_generated
-    from lindstedt.numerics import shoot
+    from lindstedt.emit.render import load_generated
+    from lindstedt.numerics.integrate import shoot
 
     run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "response", "--eps", "0.1",
                           "--force", "1", "--omega-min", "0.8", "--omega-max", "1.2", "--tol",
@@ -442,8 +442,8 @@ def _mp_period(potential, level_at=1):
 
 def test_quadrature_period_is_the_elliptic_period():
     """The Gauss–Legendre quadrature of the scaled potential, against mpmath's K(m)."""
-    from lindstedt.methods import quadrature_period
-    from lindstedt.models import duffing
+    from lindstedt.derive.models import duffing
+    from lindstedt.methods.registry import quadrature_period
 
     x = np.array([-0.9, -0.5, -0.1, 0.0, 0.3, 0.9, 5.0, 100.0])
     with mpmath.workdps(30):
@@ -455,7 +455,7 @@ def test_quadrature_period_is_the_elliptic_period():
 def test_choose_period_for_an_equation_against_mpmath():
     """q'' + q + εq⁵ = 0 in x = εA⁴: the chosen candidate meets the tolerance at points the
     chooser never saw, against mpmath's tanh-sinh quadrature (another rule, 30 digits)."""
-    from lindstedt.models import model_from_text
+    from lindstedt.derive.models import model_from_text
 
     model = model_from_text("q'' + q + eps*q**5 = 0", 60)
     tol = 1e-8
@@ -469,7 +469,7 @@ def test_choose_period_for_an_equation_against_mpmath():
 
 
 def test_choose_period_for_an_equation_refuses_with_a_reason():
-    from lindstedt.models import model_from_text
+    from lindstedt.derive.models import model_from_text
 
     with pytest.raises(InputError, match="no bounded periodic swing"):
         choose_period(1e-8, -3.0, 0.5, model=model_from_text("q'' + q + eps*q**5 = 0", 60))
@@ -491,9 +491,9 @@ def test_damped_mu_expansion_is_a_registered_method_for_a_finite_Q():
     """It applies to a driven oscillator with a finite Q and says why not for Q = inf (the
     undamped record's) and for a free oscillator; the undamped module says why it cannot be
     emitted for a finite Q; both records share the float μ-expansion's solve."""
-    from lindstedt.driven import Drive
-    from lindstedt.methods import MU_DAMPED, method, methods_for
-    from lindstedt.models import duffing
+    from lindstedt.analysis.driven import Drive
+    from lindstedt.derive.models import duffing
+    from lindstedt.methods.registry import MU_DAMPED, method, methods_for
 
     damped, undamped = method("driven", "mu_expansion_damped"), method("driven", "mu_expansion")
     finite, infinite = Drive(0.1, 0.3, 0.8, 20.0), Drive(0.1, 0.3, 0.8, np.inf)
@@ -510,8 +510,8 @@ def test_emitted_damped_module_is_not_verified_beside_a_fold():
     """Beside the fold of the upper branch (ε = 0.1, f = 0.3, Q = 20) the emitted damped
     module returns NaN there, so its error is NaN and ``choose`` cannot count it as meeting
     any tolerance; 0.2 below the fold it meets shooting (the truth) to 1e-4."""
+    from lindstedt.analysis.driven import one_harmonic_roots
     from lindstedt.choose import driven_truth, emitted_driven
-    from lindstedt.driven import one_harmonic_roots
 
     w = np.linspace(1.3, 1.6, 30001)
     fold = w[np.flatnonzero(np.isfinite(one_harmonic_roots(0.1, 0.3, 20.0, w)[:, 1]))[-1]]
@@ -528,9 +528,9 @@ def test_choose_emits_the_damped_module_for_a_finite_Q(tmp_path):
     """For Q = 20 with --emit the undamped module cannot compete and the damped one is the
     cheapest verified; its A₁, B₁ at ω off the verified point agree with shooting (started
     from the one-harmonic guess, not from the module's answer)."""
-    from lindstedt.driven import Drive, first_order_branches
-    from lindstedt.emit import load_generated
-    from lindstedt.numerics import shoot
+    from lindstedt.analysis.driven import Drive, first_order_branches
+    from lindstedt.emit.render import load_generated
+    from lindstedt.numerics.integrate import shoot
 
     run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "amplitudes", "--eps",
                           "0.1", "--force", "0.3", "--Q", "20", "--omega", "0.8", "--tol",
@@ -578,10 +578,10 @@ def test_choose_cycle_reports_the_series_error_against_shooting(monkeypatch):
     """``choose cycle`` on ε in [0.1, 0.5], tolerance 1e-6, the order-10 sums, 2 points: the
     error it reports for the partial sums is theirs against an independent shooting, and it
     picks them (the cheapest by the recorded costs) since they meet the tolerance."""
-    from lindstedt import methods
     from lindstedt.choose import choose_limit_cycle, verification_points
-    from lindstedt.lindstedt import derive_limit_cycle
-    from lindstedt.models import series_model
+    from lindstedt.derive.lindstedt import derive_limit_cycle
+    from lindstedt.derive.models import series_model
+    from lindstedt.methods import registry as methods
 
     # NOTE: the module's resummed ω verified on (0, 0.6] only: one shooting at generation
     # rather than eight up to ε = 3 (~100 s), its check points all beyond this range.

@@ -169,9 +169,9 @@ def test_the_cost_fit_measures_every_entry_of_the_cost_model(monkeypatch):
     from pathlib import Path
     from types import SimpleNamespace
 
+    from lindstedt.analysis.driven import Drive
     from lindstedt.choose import COST_MODEL, DrivenTradeoff
-    from lindstedt.driven import Drive
-    from lindstedt.methods import methods_for
+    from lindstedt.methods.registry import methods_for
 
     path = Path(__file__).resolve().parent.parent / "benchmarks" / "cost_model.py"
     spec = importlib.util.spec_from_file_location("cost_model", path)

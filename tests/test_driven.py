@@ -11,7 +11,7 @@ import sys
 import numpy as np
 import pytest
 import sympy as sp
-from lindstedt.driven import (
+from lindstedt.analysis.driven import (
     Drive,
     amplitudes,
     first_order_branches,
@@ -20,7 +20,7 @@ from lindstedt.driven import (
     mu_expansion,
 )
 from lindstedt.errors import InputError
-from lindstedt.numerics import shoot
+from lindstedt.numerics.integrate import shoot
 
 NOTES = Drive(eps=0.1, force=1.0, omega=1.0)
 
@@ -278,7 +278,7 @@ def reference_grid() -> list[tuple[float, float, float, np.ndarray]]:
     """Hardening and softening, damped and not, ε down to 1e-12 and 0, the force across three
     decades; ω on a grid through ω = 1 and at 1e-3, 1e-5 and 1e-7 (relative) on both sides of
     every fold."""
-    from lindstedt.response import one_harmonic_folds
+    from lindstedt.analysis.response import one_harmonic_folds
 
     base = np.concatenate([np.geomspace(0.2, 5, 41), [1.0, 1 - 1e-9, 1 + 1e-9]])
     grid = []
@@ -300,7 +300,7 @@ def test_one_harmonic_solver_finds_every_root_to_1e12():
     """Every real branch r (A₁ signed, undamped) and δ₀ of :func:`driven.one_harmonic`, the
     count right, each to 1e-12 relative (δ₀ absolute) of 30-digit roots, over both fold
     windows; and :func:`first_order_branches` the same roots."""
-    from lindstedt.driven import one_harmonic
+    from lindstedt.analysis.driven import one_harmonic
 
     checked = folds = 0
     for eps, force, Q, omega in reference_grid():

@@ -11,8 +11,7 @@ import sys
 import numpy as np
 import pytest
 import sympy as sp
-from lindstedt.compiler import generate_driven
-from lindstedt.driven import (
+from lindstedt.analysis.driven import (
     A1_,
     Delta_,
     Drive,
@@ -30,9 +29,10 @@ from lindstedt.driven import (
     one_harmonic_roots,
     x_,
 )
-from lindstedt.emit import load_generated
-from lindstedt.lower import DAMPED_TRUNCATION, lower_driven_damped
-from lindstedt.numerics import shoot
+from lindstedt.compiler import generate_driven
+from lindstedt.emit.render import load_generated
+from lindstedt.lower.lowering import DAMPED_TRUNCATION, lower_driven_damped
+from lindstedt.numerics.integrate import shoot
 
 K = 4
 SAMPLE = {x_: sp.Rational(1, 3), a_: sp.Integer(3), gamma_: sp.Rational(1, 7)}

@@ -16,9 +16,9 @@ import math
 
 import numpy as np
 import pytest
+from lindstedt.analysis.driven import Drive, driven_equation
+from lindstedt.analysis.response import equation_orbits, periodic_orbits
 from lindstedt.cli import driven_equation_json, main
-from lindstedt.driven import Drive, driven_equation
-from lindstedt.response import equation_orbits, periodic_orbits
 from scipy.integrate import solve_ivp
 
 AGREE = 1e-7  # the package's orbit against the reference's (state, relative; r)

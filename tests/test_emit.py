@@ -13,32 +13,22 @@ import mpmath
 import numpy as np
 import pytest
 import sympy as sp
-from lindstedt.cli import BALANCE_HARMONICS, DRIVEN_ORDER
-from lindstedt.compiler import generate, generate_balance, generate_driven
-from lindstedt.driven import (
+from lindstedt.analysis.driven import (
     Drive,
     amplitudes,
     first_order_branches,
     harmonic_balance,
 )
-from lindstedt.emit import (
-    environment,
-    render_cycle_derivation,
-    render_latex,
-    render_module,
-    template_folder,
-)
-from lindstedt.emit import load_generated as load
-from lindstedt.errors import InputError
-from lindstedt.lindstedt import (
+from lindstedt.cli import BALANCE_HARMONICS, DRIVEN_ORDER
+from lindstedt.compiler import generate, generate_balance, generate_driven
+from lindstedt.derive.lindstedt import (
     derive,
     derive_limit_cycle,
     omega_coefficients,
     period_series,
     solution_expression,
 )
-from lindstedt.lower import lower_cycle_derivation, lower_derivation, lower_free
-from lindstedt.models import (
+from lindstedt.derive.models import (
     A,
     duffing,
     eps,
@@ -48,7 +38,17 @@ from lindstedt.models import (
     t,
     theta0,
 )
-from lindstedt.printers import identifier, latex_rational, pycode
+from lindstedt.emit.render import (
+    environment,
+    render_cycle_derivation,
+    render_latex,
+    render_module,
+    template_folder,
+)
+from lindstedt.emit.render import load_generated as load
+from lindstedt.errors import InputError
+from lindstedt.lower.lowering import lower_cycle_derivation, lower_derivation, lower_free
+from lindstedt.lower.printers import identifier, latex_rational, pycode
 from reference import periodic_orbit
 from scipy.special import ellipj, ellipk
 

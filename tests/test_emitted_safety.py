@@ -308,7 +308,7 @@ def kernel_cases(calls: Calls, mod) -> None:
 
 def run_all(folders: dict[str, Path]) -> list[dict]:
     """The child process: load every module, make every call, return the records."""
-    from lindstedt.emit import load_generated
+    from lindstedt.emit.render import load_generated
 
     calls = Calls()
     for kind, folder in folders.items():
@@ -368,7 +368,7 @@ import sys
 import numpy as np
 import pytest
 from pathlib import Path
-from lindstedt.emit import load_generated
+from lindstedt.emit.render import load_generated
 duffing = load_generated(Path(sys.argv[1]))
 parent = np.full(14, -1.0)
 duffing.period(np.linspace(0.5, 1.4, 7), np.full(7, 0.1), out=parent[::2])
@@ -448,7 +448,7 @@ def newer_modules(tmp_path_factory):
         made = subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
                               text=True, check=False)
         assert made.returncode == 0, made.stderr
-    from lindstedt.emit import load_generated
+    from lindstedt.emit.render import load_generated
     return {name: load_generated(out / f"{name}.py")
             for name in ("driven_damped", "van_der_pol", "mathieu_a1", "vdp_slow_flow",
                          "tongue_1")}
@@ -517,7 +517,7 @@ def test_undamped_driven_module_is_nan_without_a_warning_outside_its_domain():
     """The committed undamped module: ω = 0 gave ±inf, and NaN, ±inf, 1e300 warnings; now NaN,
     quietly.  Left out: ε = 1e-300, whose closed-form cubic divides f by ε² (the module keeps
     no lower bound on ε: its roots are exact down to ε = 1e-20)."""
-    from lindstedt.emit import load_generated
+    from lindstedt.emit.render import load_generated
 
     mod = load_generated(GENERATED / "driven.py")
     names = tuple(sorted(n[:-5] for n in vars(mod) if n.endswith("_into")
@@ -532,7 +532,7 @@ def test_free_and_limit_cycle_modules_are_nan_without_a_warning(newer_modules):
     """The committed L–P modules (Duffing, pendulum) and van der Pol's cycle: t = ±inf made
     cos(ωt) invalid and A = 1e300 overflowed εA² before the guard; every argument now passes a
     quiet finiteness test and a magnitude bound first, and the answer there is NaN, quietly."""
-    from lindstedt.emit import load_generated
+    from lindstedt.emit.render import load_generated
 
     found = []
     for mod in (load_generated(GENERATED / "duffing.py"), load_generated(GENERATED / "pendulum.py"),

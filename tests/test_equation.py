@@ -20,7 +20,7 @@ import sympy as sp
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from lindstedt.cli import main
-from lindstedt.equation import parse_equation, parse_expression
+from lindstedt.derive.equation import parse_equation, parse_expression
 from lindstedt.errors import InputError
 from reference import duffing_period, reciprocal
 

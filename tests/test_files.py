@@ -16,13 +16,14 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from lindstedt import emit, methods
 from lindstedt.compiler import generate
-from lindstedt.emit import check_writable, load_generated, render_latex, render_module
+from lindstedt.derive.lindstedt import derive
+from lindstedt.derive.models import duffing
+from lindstedt.emit import render as emit
+from lindstedt.emit.render import check_writable, load_generated, render_latex, render_module
 from lindstedt.errors import InputError
-from lindstedt.lindstedt import derive
-from lindstedt.lower import lower_derivation, lower_free
-from lindstedt.models import duffing
+from lindstedt.lower.lowering import lower_derivation, lower_free
+from lindstedt.methods import registry as methods
 
 SET = ("duffing.py", "duffing_tables.tex", "duffing_derivation.tex")
 

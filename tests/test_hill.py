@@ -11,8 +11,8 @@ from fractions import Fraction as F
 import mpmath as mp
 import pytest
 from lindstedt.cli import main
+from lindstedt.derive.hill import mathieu_series
 from lindstedt.errors import InputError
-from lindstedt.hill import mathieu_series
 
 DLMF = {  # coefficients of q^0, q^1, … as far as DLMF 28.6.1–28.6.13 print them
     # (https://dlmf.nist.gov/28.6, §28.6(i); the same as Abramowitz & Stegun 20.2.25)

@@ -48,8 +48,8 @@ def venv(tmp_path_factory) -> Path:
 
 def test_import_name_is_lindstedt_and_nothing_called_generator(venv, tmp_path):
     py = venv / "bin/python"
-    out = _run([py, "-c", "import lindstedt, lindstedt.emit as e; print(lindstedt.__file__); "
-                "print(e.template_folder())"], tmp_path)
+    out = _run([py, "-c", "import lindstedt, lindstedt.emit.render as e; "
+                "print(lindstedt.__file__); print(e.template_folder())"], tmp_path)
     package, templates = out.stdout.split()
     site = Path(_run([py, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
                      tmp_path).stdout.strip())

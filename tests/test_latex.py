@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 import sympy as sp
 from lindstedt.compiler import generate, generate_driven
-from lindstedt.printers import LATEX_LINE_DIGITS, latex_digits, latex_rational
+from lindstedt.lower.printers import LATEX_LINE_DIGITS, latex_digits, latex_rational
 
 GENERATED = Path(__file__).resolve().parents[1] / "generated"
 PDFLATEX = shutil.which("pdflatex")
@@ -76,7 +76,7 @@ def written(tmp_path_factory) -> dict[str, Path]:
     generate_driven(3, out)
     generate_driven(3, out, damped=True)
     from lindstedt.compiler import generate_slow_flow
-    from lindstedt.models import oscillator
+    from lindstedt.derive.models import oscillator
 
     generate_slow_flow(oscillator("q'' + q = eps*(-k*q' - q**3 + F*cos(w*t))", name="forced"),
                        3, "cmd", out)

@@ -11,9 +11,9 @@ from functools import reduce
 import numpy as np
 import pytest
 from lindstedt.cli import main
+from lindstedt.derive.lindstedt import derive_limit_cycle, limit_cycle_amplitudes
+from lindstedt.derive.models import oscillator, self_excited_model
 from lindstedt.errors import InputError
-from lindstedt.lindstedt import derive_limit_cycle, limit_cycle_amplitudes
-from lindstedt.models import oscillator, self_excited_model
 from scipy.integrate import solve_ivp
 
 VDP = "q'' + q = eps*(1 - q**2)*q'"
@@ -157,7 +157,7 @@ def test_the_issues_command_vdp(capsys):
     """`lindstedt series vdp --order K --json` (vdp: the registry's alias of van_der_pol):
     the published first coefficients, the stability of both signs of ε, and partial sums of
     ω against the period of the cycle shot numerically (numerics.true_limit_cycle)."""
-    from lindstedt.numerics import true_limit_cycle
+    from lindstedt.numerics.integrate import true_limit_cycle
 
     assert main(["series", "vdp", "--order", "40", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
@@ -220,8 +220,8 @@ def test_nearest_singularities_from_the_exact_series(capsys):
     axis."""
     import math
 
-    from lindstedt.lindstedt import derive, nearest_singularity
-    from lindstedt.models import duffing, pendulum
+    from lindstedt.derive.lindstedt import derive, nearest_singularity
+    from lindstedt.derive.models import duffing, pendulum
 
     assert main(["series", "vdp", "--order", "100", "--singularities", "--json"]) == 0
     (vdp,) = json.loads(capsys.readouterr().out)["singularities"]
@@ -241,7 +241,7 @@ def test_true_cycle_and_its_floquet_exponent():
     classical 6.6632868593…; the exponent ln|det M|/T equals Liouville's ∮ ε ∂f/∂q̇ dt / T
     integrated along DOP853's cycle, and at small ε the averaged −ε S'(a₀)/2 (opposite signs
     for the Liénard term's two cycles)."""
-    from lindstedt.numerics import true_limit_cycle
+    from lindstedt.numerics.integrate import true_limit_cycle
 
     vdp = model(VDP)
     one = true_limit_cycle(vdp, 1.0)
@@ -267,8 +267,8 @@ def test_emitted_limit_cycle_module_against_the_true_cycle(tmp_path):
     """`lindstedt generate van_der_pol`: ω, T, q(0) and q(t) against the shot cycle and
     DOP853 from it, within the module's own error estimate; NaN from 90 % of its estimated
     radius (√3.42 in ε) on."""
-    from lindstedt.emit import load_generated
-    from lindstedt.numerics import true_limit_cycle
+    from lindstedt.emit.render import load_generated
+    from lindstedt.numerics.integrate import true_limit_cycle
 
     assert main(["generate", "van_der_pol", "--order", "16", "--out", str(tmp_path)]) == 0
     mod = load_generated(tmp_path / "van_der_pol.py")
@@ -465,7 +465,7 @@ def test_odd_harmonic_sums_round_trip_through_the_kernel():
     ∫r dC) gives back the Fourier coefficients a sum was built from (Chebyshev's route)."""
     import random
 
-    from lindstedt.series import Ground, Trig
+    from lindstedt.algebra.series import Ground, Trig
 
     g = Ground.for_coefficients([])
     rng = random.Random(3)

@@ -6,8 +6,7 @@ from fractions import Fraction
 
 import pytest
 import sympy as sp
-from lindstedt.errors import InputError
-from lindstedt.lindstedt import (
+from lindstedt.derive.lindstedt import (
     derive,
     naive_expansion,
     naive_expression,
@@ -16,7 +15,8 @@ from lindstedt.lindstedt import (
     period_series,
     q_expression,
 )
-from lindstedt.models import A, duffing, eps, pendulum, polynomial, t
+from lindstedt.derive.models import A, duffing, eps, pendulum, polynomial, t
+from lindstedt.errors import InputError
 from reference import duffing_period, pendulum_period, reciprocal
 
 
@@ -185,7 +185,7 @@ def test_a_model_too_small_for_the_order_is_refused():
     would be wrong from j = 5 on, so derive refuses.  The pendulum's sin is summed by
     recurrence, exact at every order: pendulum(4) to order 8 gives the elliptic-integral
     coefficients."""
-    from lindstedt.models import model_from_text
+    from lindstedt.derive.models import model_from_text
 
     with pytest.raises(InputError, match=r"order 8: the oscillator model holds .* to order 4"):
         derive(model_from_text("q'' + q*exp(-q**2) = 0", 4), 8)

@@ -9,12 +9,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from lindstedt.analysis.driven import (
+    Drive,
+    amplitudes,
+    first_order_branches,
+    harmonic_balance,
+    mu_expansion,
+)
 from lindstedt.choose import Choice, DrivenChoice, SolutionChoice, choose_period
+from lindstedt.derive.lindstedt import derive, order_equation
+from lindstedt.derive.models import duffing, pendulum
 from lindstedt.display import html_table
-from lindstedt.driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
-from lindstedt.lindstedt import derive, order_equation
-from lindstedt.models import duffing, pendulum
-from lindstedt.numerics import shoot
+from lindstedt.numerics.integrate import shoot
 from reference import duffing_period, pendulum_period, reciprocal
 
 NOTEBOOK = Path(__file__).resolve().parent.parent / "docs" / "example.ipynb"

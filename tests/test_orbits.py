@@ -15,9 +15,9 @@ import mpmath
 import numpy as np
 import pytest
 from lindstedt.cli import main
-from lindstedt.emit import load_generated
-from lindstedt.models import model_from_text
-from lindstedt.orbits import orbit_domain
+from lindstedt.derive.models import model_from_text
+from lindstedt.derive.orbits import orbit_domain
+from lindstedt.emit.render import load_generated
 from scipy.integrate import solve_ivp
 
 mp = mpmath.mp

@@ -25,10 +25,10 @@ import numpy as np
 import pytest
 import sympy as sp
 from lindstedt.cli import main
-from lindstedt.emit import load_generated
+from lindstedt.derive.lindstedt import derive
+from lindstedt.derive.models import model_from_text
+from lindstedt.emit.render import load_generated
 from lindstedt.errors import InputError
-from lindstedt.lindstedt import derive
-from lindstedt.models import model_from_text
 from reference import pendulum_period
 from scipy.integrate import solve_ivp
 

@@ -11,9 +11,8 @@ import sys
 
 import numpy as np
 import pytest
-from lindstedt.driven import Drive, amplitudes
-from lindstedt.numerics import multipliers_stable, orbit_hill_multipliers
-from lindstedt.parametric import (
+from lindstedt.analysis.driven import Drive, amplitudes
+from lindstedt.analysis.parametric import (
     Pump,
     balance_point,
     fold,
@@ -24,8 +23,9 @@ from lindstedt.parametric import (
     tongue_edges,
     trivial_orbit,
 )
-from lindstedt.response import periodic_orbits
-from lindstedt.subharmonic import subharmonic
+from lindstedt.analysis.response import periodic_orbits
+from lindstedt.analysis.subharmonic import subharmonic
+from lindstedt.numerics.integrate import multipliers_stable, orbit_hill_multipliers
 from scipy.optimize import brentq
 from scipy.special import mathieu_a, mathieu_b
 

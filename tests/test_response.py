@@ -8,15 +8,15 @@ import sys
 
 import numpy as np
 import pytest
-from lindstedt.driven import Drive
-from lindstedt.numerics import duffing_table, orbit_fold, shoot, sweep
-from lindstedt.response import (
+from lindstedt.analysis.driven import Drive
+from lindstedt.analysis.response import (
     amplitude_residual,
     amplitude_slope,
     continue_balance,
     one_harmonic_curve,
     one_harmonic_folds,
 )
+from lindstedt.numerics.integrate import duffing_table, orbit_fold, shoot, sweep
 
 EPS, F, Q = 0.1, 0.3, 20.0
 
@@ -130,7 +130,7 @@ def test_curve_bad_frequency(omega):
 
 def test_subharmonic_secular_conditions_are_the_notes():
     import sympy as sp
-    from lindstedt.subharmonic import subharmonic_secular
+    from lindstedt.analysis.subharmonic import subharmonic_secular
 
     a, b, F, w, e = sp.symbols("a b F omega epsilon")
     cos_eq, sin_eq = subharmonic_secular()
@@ -152,7 +152,7 @@ def test_subharmonic_secular_conditions_are_the_notes():
 
 
 def test_subharmonic_against_true_orbit():
-    from lindstedt.subharmonic import subharmonic
+    from lindstedt.analysis.subharmonic import subharmonic
 
     exists, _, sols = subharmonic(0.1, 0.5, 1.2)
     assert exists and [s.root for s in sols] == ["+", "-"]
@@ -168,8 +168,8 @@ def test_subharmonic_against_true_orbit():
 def test_hill_verdict_fails_for_the_negative_root_at_small_eps(monkeypatch):
     """Reported in the README: the Hill test with q₀ calls the negative root stable here, the
     true orbit's multipliers (at two step sizes) say unstable."""
-    import lindstedt.numerics as numerics
-    from lindstedt.subharmonic import subharmonic
+    import lindstedt.numerics.integrate as numerics
+    from lindstedt.analysis.subharmonic import subharmonic
 
     _, _, sols = subharmonic(0.05, 0.5, 1.3)
     minus = sols[1]
@@ -192,7 +192,7 @@ def test_subharmonic_does_not_exist_and_says_why():
 # --- frequency mixing -------------------------------------------------------------------------
 
 def test_cubic_mixing_makes_three_fold_combinations_not_sums():
-    from lindstedt.mixing import mixing_series, tone_label
+    from lindstedt.analysis.mixing import mixing_series, tone_label
 
     tones = mixing_series(duffing_table(0.1, 0.1), [(0.3, 1.3), (0.3, 1.7)]).tones
     first = {tone_label(t.combination) for t in tones if t.order <= 1}
@@ -229,8 +229,8 @@ def test_continuation_refuses_what_it_cannot_finish(eps, force, Q, harmonics, ne
 
 
 def test_mixing_bounds_and_escapes():
+    from lindstedt.analysis.mixing import mixing_series, simulated_fit
     from lindstedt.errors import InputError
-    from lindstedt.mixing import mixing_series, simulated_fit
 
     def simulated(eps, Q, drives):
         table = duffing_table(eps, 1 / Q)

@@ -100,9 +100,9 @@ def test_folds_of_an_asymmetric_spring_against_the_reference():
     for moduli in data["numerical"]["fold_floquet_moduli"]:
         assert abs(max(moduli) - 1) < 1e-8 and min(moduli) < 1
     for w in true:  # the reference's fold from the package's fold orbit, moved off it
-        from lindstedt.driven import driven_equation
-        from lindstedt.numerics import ForceTable
-        from lindstedt.response import orbit_fold_table
+        from lindstedt.analysis.driven import driven_equation
+        from lindstedt.analysis.response import orbit_fold_table
+        from lindstedt.numerics.integrate import ForceTable
 
         de = driven_equation(ASYMMETRIC, {}, 1.0)
         _, y0, _ = orbit_fold_table(ForceTable.of(de.terms), de.force, w, _fold_state(data, w))
@@ -119,8 +119,8 @@ def test_folds_of_an_asymmetric_spring_against_the_reference():
 
 def _fold_state(data, w):
     """The balance's state at the fold ``w`` (the package's seed for its own refinement)."""
-    from lindstedt.driven import PolynomialBalance, driven_equation
-    from lindstedt.response import continue_equation
+    from lindstedt.analysis.driven import PolynomialBalance, driven_equation
+    from lindstedt.analysis.response import continue_equation
 
     de = driven_equation(ASYMMETRIC, {}, 1.0)
     cont = continue_equation(de, 8, *data["parameters"]["omega_range"])

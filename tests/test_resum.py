@@ -10,11 +10,7 @@ from fractions import Fraction as F
 import mpmath
 import numpy as np
 import pytest
-from lindstedt import methods
-from lindstedt.errors import InputError
-from lindstedt.models import series_model
-from lindstedt.numerics import cycle_reference
-from lindstedt.resum import (
+from lindstedt.algebra.resum import (
     compose,
     pade,
     real_poles,
@@ -27,6 +23,10 @@ from lindstedt.resum import (
     w_of,
     w_substitution,
 )
+from lindstedt.derive.models import series_model
+from lindstedt.errors import InputError
+from lindstedt.methods import registry as methods
+from lindstedt.numerics.integrate import cycle_reference
 
 
 def test_pade_recovers_a_rational_function_exactly():
@@ -107,7 +107,7 @@ def test_relaxation_form_reaches_the_relaxation_regime():
     shooting (rtol 1e-9: ~1e-8) at ε = 10 and 1e-5 at ε = 5, and at ε = 10 over ten times
     closer than Padé in w of the same coefficients (resum_frequency); 1e-7 at ε = 10 needs
     order 164 (benchmarks/resum_relaxation.py; ε ≤ 1: the emitted module's test below)."""
-    from lindstedt.lindstedt import derive_limit_cycle, nearest_singularity
+    from lindstedt.derive.lindstedt import derive_limit_cycle, nearest_singularity
 
     lc = derive_limit_cycle(series_model("van_der_pol", 60), 60)
     est = nearest_singularity(lc.omega)
@@ -145,7 +145,7 @@ def emitted(tmp_path_factory):
     sums to order 12, ω resummed from its series to order 60: the relaxation form is then
     verified to |ε| ≈ 3.75), with fewer shooting checks."""
     from lindstedt.compiler import generate_limit_cycle
-    from lindstedt.emit import load_generated
+    from lindstedt.emit.render import load_generated
 
     out = tmp_path_factory.mktemp("vdp")
     with pytest.MonkeyPatch.context() as mp:
@@ -197,7 +197,7 @@ def test_emitted_relaxation_form_equals_the_in_process_one(emitted):
     """The module's omega_resummed (cube root by scaled Halley steps, ln s by the atanh series,
     Estrin's split) against the same form evaluated with NumPy's cbrt and log1p: the same
     function to 3e-14 (the Padé's rounding near the verified limit), its twin to 2 ulp."""
-    from lindstedt.lindstedt import derive_limit_cycle, nearest_singularity
+    from lindstedt.derive.lindstedt import derive_limit_cycle, nearest_singularity
 
     mod, _ = emitted
     omega = derive_limit_cycle(series_model("van_der_pol", 60), 60).omega
@@ -268,7 +268,7 @@ def test_mathieu_reference_against_dlmf_and_mpmath():
     """The eigenvalue reference at q = 1 against Abramowitz & Stegun's Table 20.1 (8 decimals:
     a_0 = −0.45513860, a_1 = 1.85910807, b_1 = −0.11024882, b_2 = 3.91702477), and float64
     against mpmath at 30 digits at q = 40."""
-    from lindstedt.numerics import mathieu_reference
+    from lindstedt.numerics.integrate import mathieu_reference
 
     for kind, m, value in (("a", 0, -0.45513860), ("a", 1, 1.85910807),
                            ("b", 1, -0.11024882), ("b", 2, 3.91702477)):
@@ -283,7 +283,11 @@ def test_mathieu_refined_and_truncation_bound_against_mpmath():
     against mpmath's own symmetric eigensolver at 40 digits (60 rows), and the truncation
     bound against the true change of the eigenvalue when the matrix is cut to N rows."""
     import mpmath
-    from lindstedt.numerics import mathieu_recurrence, mathieu_refined, mathieu_truncation_bound
+    from lindstedt.numerics.integrate import (
+        mathieu_recurrence,
+        mathieu_refined,
+        mathieu_truncation_bound,
+    )
 
     def eigsy(kind, m, q, n):
         index, diag, couplings = mathieu_recurrence(kind, m, n)
@@ -311,8 +315,8 @@ def test_emitted_mathieu_against_the_eigenvalue_reference(kind, m, past, tmp_pat
     verified q, past the series' radius (|q| ≈ 1.47 for a_0), NaN beyond (and below q = 0 for
     a series with odd powers); the error estimate (the Newton step) covers the error."""
     from lindstedt.cli import main
-    from lindstedt.emit import load_generated
-    from lindstedt.numerics import mathieu_reference
+    from lindstedt.emit.render import load_generated
+    from lindstedt.numerics.integrate import mathieu_reference
 
     assert main(["mathieu", kind, "--m", str(m), "--order", "60", "--emit",
                  str(tmp_path)]) == 0
@@ -367,9 +371,9 @@ def test_mathieu_start_is_the_cheapest_verified_as_far(tmp_path):
     mpmath (less one grid step); the ufunc is within 1e-15·max(1, |a|) of mpmath's
     eigenvalues at 30 digits up to its limit."""
     from lindstedt.compiler import generate_mathieu
-    from lindstedt.emit import load_generated
-    from lindstedt.hill import mathieu_series
-    from lindstedt.numerics import mathieu_reference, mathieu_refined
+    from lindstedt.derive.hill import mathieu_series
+    from lindstedt.emit.render import load_generated
+    from lindstedt.numerics.integrate import mathieu_reference, mathieu_refined
 
     generate_mathieu("a", 1, 100, tmp_path)
     mod = load_generated(tmp_path / "mathieu_a1.py")

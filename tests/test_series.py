@@ -6,7 +6,7 @@ from fractions import Fraction
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from lindstedt.series import (
+from lindstedt.algebra.series import (
     Basis,
     Ground,
     Trig,
@@ -178,7 +178,7 @@ def test_trig_over_symbolic_parameters():
 # The float kernel (Laurent form, complex128) against the exact one on random rational sums.
 
 import numpy as np  # noqa: E402
-from lindstedt.series import (  # noqa: E402
+from lindstedt.algebra.series import (  # noqa: E402
     laurent_derivative,
     laurent_from_fourier,
     laurent_product,

@@ -10,8 +10,8 @@ import math
 
 import numpy as np
 import pytest
-from lindstedt.mixing import mixing_equation, mixing_series
-from lindstedt.subharmonic import subharmonic, subharmonic_equation, subharmonic_orbits
+from lindstedt.analysis.mixing import mixing_equation, mixing_series
+from lindstedt.analysis.subharmonic import subharmonic, subharmonic_equation, subharmonic_orbits
 from scipy.integrate import solve_ivp
 
 QUADRATIC = ("x'' + 0.05*x' + x + x**2 = f*cos(w*t)", {"f": "1/2"}, 2, 1.0)

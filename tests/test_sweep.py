@@ -17,11 +17,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from lindstedt.analysis.driven import (
+    Drive,
+    amplitudes,
+    first_order_branches,
+    harmonic_balance,
+    mu_expansion,
+)
+from lindstedt.analysis.response import one_harmonic_curve
 from lindstedt.charts import sweep_figure
-from lindstedt.driven import Drive, amplitudes, first_order_branches, harmonic_balance, mu_expansion
 from lindstedt.errors import InputError
-from lindstedt.numerics import shoot
-from lindstedt.response import one_harmonic_curve
+from lindstedt.numerics.integrate import shoot
 from lindstedt.sweep import (
     MU_ORDERS,
     WarmUp,
@@ -366,7 +372,7 @@ def test_stability_counts_every_distinct_orbit_against_dop853():
     inside the softening spring's fold window at ω = 0.804 (ε −0.1) likewise. Each count,
     the largest Floquet modulus and the small branch's r against DOP853 + Newton on the period
     map (test_branches), started from every orbit's state and from the one-harmonic root."""
-    from lindstedt.response import periodic_orbits
+    from lindstedt.analysis.response import periodic_orbits
     from test_branches import _cubic_seeds, _distance, reference_orbit
 
     for eps, w in ((EPS, 1.491), (-0.1, 0.804)):
@@ -434,7 +440,7 @@ def test_equation_sweep_stable_r_is_the_attractor_dop853_reaches_from_rest():
 def test_equation_subharmonic_sweep_against_the_command():
     """The subharmonic map of a quadratic force over its drive frequency: each point's orbits
     are the ``subharmonic EQUATION --n 2`` command's at that point."""
-    from lindstedt.subharmonic import subharmonic_equation, subharmonic_orbits
+    from lindstedt.analysis.subharmonic import subharmonic_equation, subharmonic_orbits
 
     text = "x'' + 0.05*x' + x + x**2 = f*cos(W*t)"
     kind = equation_kind("subharmonic", text, {"f": "1/2"}, ["W"], n=2)

@@ -14,9 +14,9 @@ import mpmath as mp
 import numpy as np
 import pytest
 from lindstedt.cli import main
+from lindstedt.derive.hill import fourier_of_text, mathieu_series, tongue_tip, transition_curves
 from lindstedt.errors import InputError
-from lindstedt.hill import fourier_of_text, mathieu_series, tongue_tip, transition_curves
-from lindstedt.numerics import floquet_stable, floquet_traces
+from lindstedt.numerics.integrate import floquet_stable, floquet_traces
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 
@@ -238,7 +238,7 @@ EMIT_ARGS = ["tongues", EMIT_P, "--n", "1", "--order", "30", "--emit"]
 @pytest.fixture(scope="module")
 def emitted(tmp_path_factory):
     """``tongues P --n 1 --order 30 --emit DIR``, twice into two folders, and the module."""
-    from lindstedt.emit import load_generated
+    from lindstedt.emit.render import load_generated
 
     first, again = tmp_path_factory.mktemp("tongue"), tmp_path_factory.mktemp("again")
     assert main([*EMIT_ARGS, str(first)]) == 0 and main([*EMIT_ARGS, str(again)]) == 0
@@ -290,7 +290,7 @@ def test_the_emitted_curves_hold_the_tolerance_between_the_grid_points(emitted):
 def test_the_bracketed_root_is_brentqs():
     """methods.boundary_bracket (the sign of |tr M| − 2 at δ ∓ b, the root interpolated):
     brentq's root where one curve crosses the bracket, NaN where none or both do."""
-    from lindstedt.methods import boundary_bracket
+    from lindstedt.methods.registry import boundary_bracket
 
     p = harmonics(EMIT_P)
     curves = transition_curves(EMIT_P, 1, 30).curves
@@ -340,7 +340,7 @@ def test_emit_refuses_in_one_line(tmp_path):
 def test_an_even_curve_is_emitted_in_eps_squared(tmp_path):
     """p = cos t, n = 0 (a_0(−2ε)/4, even in ε): Padé in ε², NaN only for |ε| beyond the
     limit, and equal to the Floquet boundary at ±ε past the radius of a_0 (|q| ≈ 1.4688)."""
-    from lindstedt.emit import load_generated
+    from lindstedt.emit.render import load_generated
 
     assert main(["tongues", "cos(t)", "--n", "0", "--order", "30", "--emit", str(tmp_path)]) == 0
     mod = load_generated(tmp_path / "tongue_0.py")

@@ -93,7 +93,7 @@ def test_a_softening_spring_over_its_barrier_escapes_and_is_reported_so():
     """ε = −0.1, f = 0.3, Q = 20: sweeping up, the resonance carries |q| past the barrier
     1/√0.1 = 3.16 near ω = 0.81 and the orbit leaves the well (before: "sweep up jumps at
     0.8016" with amplitudes of 1e214). Reported as an escape, never as a jump."""
-    from lindstedt.numerics import sweep
+    from lindstedt.numerics.integrate import sweep
 
     data = json.loads(subprocess.run(
         [sys.executable, "-m", "lindstedt", "response", "--eps", "-0.1", "--force", "0.3",
@@ -219,7 +219,7 @@ def test_shooting_reports_a_trajectory_past_the_escape_bound_as_escaping():
     |ε|x³ − x − |f| = 0 (numpy.roots here); from beyond it, moving outward, DOP853 runs off
     to infinity whatever the drive's phase — and shooting from there says it escapes, where it
     used to return nothing without a reason."""
-    from lindstedt.numerics import escape_bound, shoot, shoot_explained
+    from lindstedt.numerics.integrate import escape_bound, shoot, shoot_explained
 
     eps, f, Q, w = -0.1, 0.3, 20.0, 0.8
     roots = np.roots([-eps, 0.0, -1.0, -f])
@@ -243,8 +243,8 @@ def test_an_orbit_too_unstable_for_the_coarse_balance_guess_is_found():
     """ε = −0.1, f = 0.3, Q = 20, ω = 0.3: the orbit hugging the barrier has a Floquet
     multiplier 7.7e7; from the 8-harmonic balance (1e-5 off) its trajectory escapes within the
     period, and `driven` had it as a balance without an orbit. Against multiple shooting."""
-    from lindstedt.driven import Drive
-    from lindstedt.response import periodic_orbits
+    from lindstedt.analysis.driven import Drive
+    from lindstedt.analysis.response import periodic_orbits
 
     eps, f, Q, w = -0.1, 0.3, 20.0, 0.3
     top = periodic_orbits(Drive(eps, f, w, Q)).orbits[0]

@@ -22,8 +22,8 @@ from dataclasses import dataclass
 import sympy as sp
 from sympy.polys.domains import QQ
 
-from .equation import SMALL, Equation, parse_equation, parse_expression
-from .errors import InputError
+from ..derive.equation import SMALL, Equation, parse_equation, parse_expression
+from ..errors import InputError
 
 t, eps, A, theta0 = sp.symbols("t epsilon A theta_0")
 Y = sp.Symbol("Y")  # stands for the expansion variable y in conditions
@@ -202,8 +202,9 @@ class Oscillator:
 
 def oscillator(text: str, values: dict[str, str] | None = None, name: str = "oscillator"
                ) -> Oscillator:
-    """Parse ``text`` (see :mod:`lindstedt.equation`) with parameter ``values`` (exact text such
-    as ``"1/3"``) into an :class:`Oscillator`; every value must name a parameter of the text."""
+    """Parse ``text`` (see :mod:`lindstedt.derive.equation`) with parameter ``values`` (exact
+    text such as ``"1/3"``) into an :class:`Oscillator`; every value must name a parameter of
+    the text."""
     if not NAME.fullmatch(name or "") or keyword.iskeyword(name):
         raise InputError(f"name {name!r}: letters, digits and '_' only, starting with a letter, "
                          "and no Python keyword (the module is imported by that name)")

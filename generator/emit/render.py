@@ -23,8 +23,8 @@ from types import ModuleType
 import jinja2
 import sympy as sp
 
-from .errors import InputError
-from .lower import (
+from ..errors import InputError
+from ..lower.lowering import (
     ArrayKernel,
     CycleDerivation,
     Derivation,
@@ -36,13 +36,13 @@ from .lower import (
     SlowFlowDocument,
     Unit,
 )
-from .printers import latex_coefficient, latex_expr, latex_rational, pycode
+from ..lower.printers import latex_coefficient, latex_expr, latex_rational, pycode
 
 
 def template_folder() -> Path:
     """The Jinja2 templates: ``lindstedt/templates`` in an installed wheel, the checkout's
     top-level ``templates/`` in an editable install (pyproject maps one onto the other)."""
-    here = Path(__file__).resolve().parent
+    here = Path(__file__).resolve().parent.parent  # the package: lindstedt/emit/render.py
     for folder in (here / "templates", here.parent / "templates"):
         if (folder / "module.py.j2").is_file():
             return folder

@@ -23,10 +23,7 @@ from typing import Any
 import sympy as sp
 from sympy.polys.domains import QQ
 
-from .display import SHOWN_ORDERS, latex_aligned, latex_sum, latex_text, more
-from .errors import InputError
-from .models import Model, check_order, t
-from .series import (
+from ..algebra.series import (
     Basis,
     Ground,
     RelaxedProduct,
@@ -38,6 +35,9 @@ from .series import (
     solve_trig,
     to_fourier,
 )
+from ..derive.models import Model, check_order, t
+from ..display import SHOWN_ORDERS, latex_aligned, latex_sum, latex_text, more
+from ..errors import InputError
 
 CONVENTION = "q(0) = A, q'(0) = 0, so q_j(0) = 0 for j >= 1"
 s = sp.Symbol("s")

@@ -11,9 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .driven import MAGNITUDES, driven_form
-from .errors import InputError
-from .numerics import ForceTable, ToneFit, steady_state_fit
+from ..analysis.driven import MAGNITUDES, driven_form
+from ..errors import InputError
+from ..numerics.integrate import ForceTable, ToneFit, steady_state_fit
 
 
 @dataclass(frozen=True)

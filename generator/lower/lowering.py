@@ -23,13 +23,9 @@ from fractions import Fraction
 import sympy as sp
 from sympy.logic.boolalg import BooleanFunction
 
-from . import __version__
-from .averaging import PHI as PHI_SLOW
-from .averaging import R as R_SLOW
-from .averaging import SlowFlow
-from .averaging import U as U_SLOW
-from .averaging import V as V_SLOW
-from .driven import (
+from .. import __version__
+from ..algebra.resum import Pade, Resummed
+from ..analysis.driven import (
     A1_,
     BalanceEquations,
     Delta_,
@@ -41,20 +37,24 @@ from .driven import (
     gamma_,
     omega_,
 )
-from .driven import x_ as damped_x
-from .errors import InputError
-from .lindstedt import (
+from ..analysis.driven import x_ as damped_x
+from ..derive.averaging import PHI as PHI_SLOW
+from ..derive.averaging import R as R_SLOW
+from ..derive.averaging import SlowFlow
+from ..derive.averaging import U as U_SLOW
+from ..derive.averaging import V as V_SLOW
+from ..derive.lindstedt import (
     LimitCycle,
     SeriesSolution,
     estimated_radius,
     nearest_singularity,
     order_terms,
 )
-from .models import Model
-from .numerics import mathieu_recurrence
-from .orbits import OrbitDomain, orbit_domain
-from .printers import identifier
-from .resum import Pade, Resummed
+from ..derive.models import Model
+from ..derive.orbits import OrbitDomain, orbit_domain
+from ..errors import InputError
+from ..lower.printers import identifier
+from ..numerics.integrate import mathieu_recurrence
 
 Assign = tuple[sp.Symbol, sp.Expr]
 

@@ -12,9 +12,9 @@ from numba import njit, prange
 from numpy.typing import ArrayLike
 from scipy.special import ellipj, ellipk
 
-from .display import harmonics_table
-from .errors import InputError
-from .series import laurent_from_fourier, laurent_product
+from ..algebra.series import laurent_from_fourier, laurent_product
+from ..display import harmonics_table
+from ..errors import InputError
 
 
 def duffing_period_exact(A: ArrayLike, eps: ArrayLike) -> np.ndarray:
@@ -775,7 +775,7 @@ def true_limit_cycle(model: object, eps: float, cycle: int = 0, order: int = 12
                      ) -> LimitCycleOrbit | None:
     """The true orbit of limit cycle ``cycle`` of a :class:`models.SelfExcited` oscillator at
     ``eps``, shot from its L–P series at ``order`` (q(0) and T as the seed)."""
-    from .lindstedt import derive_limit_cycle
+    from ..derive.lindstedt import derive_limit_cycle
 
     lc = derive_limit_cycle(model, order, cycle)
     table = ForceTable.of({(1, 0): 1.0, **{(a, b): -eps * float(c) for a, b, c in model.terms}})

@@ -17,9 +17,11 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from .driven import Drive, PolynomialBalance, amplitude_bound, driven_form
-from .errors import InputError
-from .numerics import (
+from ..algebra.series import trig_power
+from ..analysis.driven import Drive, PolynomialBalance, amplitude_bound, driven_form
+from ..analysis.response import SHOOTING_TOLERANCES, _corrector, _DriveFamily, _tangent
+from ..errors import InputError
+from ..numerics.integrate import (
     ForceTable,
     PeriodicOrbit,
     duffing_table,
@@ -30,8 +32,6 @@ from .numerics import (
     shoot_table,
     steady_state_amplitudes,
 )
-from .response import SHOOTING_TOLERANCES, _corrector, _DriveFamily, _tangent
-from .series import trig_power
 
 _a, _b, _F, _w1, _eps1 = sp.symbols("a b F omega epsilon")
 

@@ -23,7 +23,7 @@ from fractions import Fraction
 import flint
 import numpy as np
 
-from .errors import InputError
+from ..errors import InputError
 
 
 @dataclass(frozen=True)

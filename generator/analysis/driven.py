@@ -29,9 +29,7 @@ import numpy as np
 import sympy as sp
 from sympy.polys.domains import QQ
 
-from .display import SHOWN_ROWS, harmonics_table, html_table
-from .errors import InputError
-from .series import (
+from ..algebra.series import (
     Basis,
     Ground,
     Trig,
@@ -48,6 +46,8 @@ from .series import (
     to_fourier,
     trig_power,
 )
+from ..display import SHOWN_ROWS, harmonics_table, html_table
+from ..errors import InputError
 
 if TYPE_CHECKING:  # numerics (numba) is imported where an orbit is shot
     pass
@@ -896,13 +896,13 @@ class DrivenEquation:
 
 def driven_equation(text: str, values: dict[str, str], omega: float,
                     name: str = "oscillator") -> DrivenEquation:
-    """Lower ``text`` (see :mod:`lindstedt.equation`) to a :class:`DrivenEquation`: a polynomial
-    force and a single drive ``f cos(w t)``, every parameter but ``w`` given in ``values``
-    (exact text, ``eps`` included), ``w = omega``.  A one-line :class:`InputError` says why
+    """Lower ``text`` (see :mod:`lindstedt.derive.equation`) to a :class:`DrivenEquation`: a
+    polynomial force and a single drive ``f cos(w t)``, every parameter but ``w`` given in
+    ``values`` (exact text, ``eps`` included), ``w = omega``.  A one-line :class:`InputError` says why
     where it cannot: no drive or more than one, a drive that is not ``f cos(w t)``, a term in
     both t and q (parametric), a force that is not a polynomial in q and q', a missing value."""
-    from .equation import parse_expression
-    from .models import oscillator
+    from ..derive.equation import parse_expression
+    from ..derive.models import oscillator
 
     if isinstance(omega, bool) or not isinstance(omega, (int, float)) \
             or not math.isfinite(omega) or omega <= 0:
@@ -1150,7 +1150,7 @@ def driven_form(text: str, values: dict[str, str], name: str, method: str, why: 
     (``why``: its ansatz) needs: a force polynomial in q and q' with rational coefficients, no
     constant term, a linear term; the drive a sum of ``f cos(ν t)``; every parameter given,
     except, with ``free_frequency``, one name in the drives' frequencies."""
-    from .models import oscillator
+    from ..derive.models import oscillator
 
     osc = oscillator(text, values, name)
     q, v, t = osc.coordinate, osc.velocity, osc.equation.time

@@ -36,16 +36,16 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from .driven import MAGNITUDES, PolynomialBalance
-from .errors import InputError
-from .numerics import (
+from ..algebra.series import trig_power
+from ..analysis.driven import MAGNITUDES, PolynomialBalance
+from ..errors import InputError
+from ..numerics.integrate import (
     ForceTable,
     PeriodicOrbit,
     multipliers_stable,
     orbit_hill_multipliers,
     shoot_table,
 )
-from .series import trig_power
 
 _a, _b, _w, _e, _z, _g = sp.symbols("a b omega epsilon zeta gamma")
 

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from .driven import (
+from ..analysis.driven import (
     MAGNITUDES,
     BalanceSystem,
     Branch,
@@ -34,8 +34,8 @@ from .driven import (
     harmonic_balance,
     one_harmonic_roots,
 )
-from .errors import InputError
-from .numerics import (
+from ..errors import InputError
+from ..numerics.integrate import (
     ForceTable,
     PeriodicOrbit,
     ShootingFailure,
@@ -1218,7 +1218,7 @@ def response_equation(text: str, values: dict[str, str], name: str = "oscillator
     :class:`driven.DrivenEquation` of ``text`` (ω left free: every parameter but the drive
     frequency needs a value), refused in one line where the force depends on the drive
     frequency or has no damping (a term odd in q')."""
-    from .driven import driven_equation
+    from ..analysis.driven import driven_equation
 
     def lowered(omega: float) -> DrivenEquation:
         try:
@@ -1264,7 +1264,7 @@ def equation_response(text: str, values: dict[str, str], harmonics: int,
                       max_seconds: float = CONTINUATION_SECONDS) -> EquationCurve:
     """``response EQUATION``'s curve: the continuation over the range, then the simulated
     sweeps both ways, escapes detected past :data:`ESCAPE_FACTOR` × the largest balance."""
-    from .driven import PolynomialBalance
+    from ..analysis.driven import PolynomialBalance
 
     de = response_equation(text, values, name)
     er = equation_range(de.terms, de.force, omega_min, omega_max)

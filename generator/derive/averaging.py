@@ -39,9 +39,9 @@ import numpy as np
 import sympy as sp
 from sympy.polys.domains import QQ
 
-from .errors import InputError
-from .models import Oscillator
-from .series import Ground, MPoly, Trig
+from ..algebra.series import Ground, MPoly, Trig
+from ..derive.models import Oscillator
+from ..errors import InputError
 
 MAX_ORDER = 6
 # NOTE: order 6 of van der Pol takes about half a second, the driven Duffing's order 4 one;

@@ -12,7 +12,7 @@ import math
 import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
-from .errors import InputError
+from ..errors import InputError
 
 
 class NumbaPrinter(PythonCodePrinter):

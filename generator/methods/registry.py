@@ -43,8 +43,15 @@ from numba import njit
 from scipy.integrate import solve_ivp
 from scipy.special import ellipj
 
-from .averaging import slow_flow
-from .driven import (
+from ..algebra.resum import (
+    Resummed,
+    resum_frequency,
+    resum_harmonic,
+    resum_relaxation,
+    resum_series,
+    van_der_pol_relaxation,
+)
+from ..analysis.driven import (
     Branch,
     Drive,
     amplitudes,
@@ -57,9 +64,11 @@ from .driven import (
     mu_expansion_exact,
     one_harmonic,
 )
-from .errors import InputError
-from .lindstedt import derive, derive_limit_cycle, nearest_singularity
-from .lower import (
+from ..derive.averaging import slow_flow
+from ..derive.lindstedt import derive, derive_limit_cycle, nearest_singularity
+from ..derive.models import Model, SelfExcited, check_order, duffing
+from ..errors import InputError
+from ..lower.lowering import (
     FOURIER_AGM_STEPS,
     MuDampedDerivation,
     MuDerivation,
@@ -86,16 +95,7 @@ from .lower import (
     lower_tongue,
     x_,
 )
-from .models import Model, SelfExcited, check_order, duffing
-from .numerics import cycle_reference, cycle_samples, duffing_period_exact, shoot
-from .resum import (
-    Resummed,
-    resum_frequency,
-    resum_harmonic,
-    resum_relaxation,
-    resum_series,
-    van_der_pol_relaxation,
-)
+from ..numerics.integrate import cycle_reference, cycle_samples, duffing_period_exact, shoot
 
 Progress = Callable[[int, int], None]
 
@@ -500,7 +500,7 @@ def cycle_series_order(order: int, resum_order: int | None) -> int:
 
 
 def _cycle_derive(r: Request, progress: Progress | None) -> object:
-    from .lindstedt import limit_cycles
+    from ..derive.lindstedt import limit_cycles
 
     first = limit_cycles(r.model)[0]
     if not first.rational:
@@ -727,7 +727,7 @@ MATHIEU_GRID = 400
 def mathieu_rows(kind: str, m: int, q: float, a: float) -> int:
     """The fewest rows of the recurrence whose eigenvalue is within ``MATHIEU_TRUNCATION``
     ·max(1, |a|) of the infinite one at ``q`` (:func:`numerics.mathieu_truncation_bound`)."""
-    from .numerics import mathieu_recurrence, mathieu_truncation_bound
+    from ..numerics.integrate import mathieu_recurrence, mathieu_truncation_bound
 
     rows = mathieu_recurrence(kind, m, 1)[0] + 2
     while mathieu_truncation_bound(kind, m, q, a, rows) > MATHIEU_TRUNCATION * max(1.0, abs(a)):
@@ -753,7 +753,7 @@ def _mathieu_verified(kind: str, m: int, form: Resummed, grid, ref, scale, toler
     the rows used and the largest error there (0 points: no rows, NaN)."""
     import numpy as np
 
-    from .numerics import mathieu_newton
+    from ..numerics.integrate import mathieu_newton
 
     start = form(grid)
     ok = np.abs(start - ref) / scale <= MATHIEU_START_TOLERANCE
@@ -781,8 +781,8 @@ def resum_mathieu(kind: str, m: int, order: int, tolerance: float = MATHIEU_TOLE
     (the rule in its NOTE)."""
     import numpy as np
 
-    from .hill import mathieu_series
-    from .numerics import mathieu_refined
+    from ..derive.hill import mathieu_series
+    from ..numerics.integrate import mathieu_refined
 
     series = mathieu_series(kind, m, order)
     grid = np.linspace(0.0, MATHIEU_RANGE, MATHIEU_GRID + 1)[1:]
@@ -844,7 +844,7 @@ def boundary_bracket(p: dict[int, tuple[float, float]], eps: np.ndarray, near: n
     """The δ in ``near ± bracket`` where ``|tr M| = 2`` at each ``eps`` (the sign change of
     ``|tr M| − 2`` between the two ends of :func:`numerics.floquet_traces`, the root by linear
     interpolation), NaN where the sign does not change (no boundary or two in the bracket)."""
-    from .numerics import floquet_traces
+    from ..numerics.integrate import floquet_traces
 
     below, above = (np.abs(floquet_traces(near + s * bracket, eps, p, steps=steps)[0]) - 2
                     for s in (-1, 1))
@@ -863,7 +863,7 @@ def resum_tongue(text: str, n: int, order: int, tolerance: float = TONGUE_TOLERA
     :class:`InputError` if a curve misses at the first point."""
     import numpy as np
 
-    from .hill import fourier_of_text, transition_curves
+    from ..derive.hill import fourier_of_text, transition_curves
 
     harmonics = fourier_of_text(text)
     p = {k: (float(a), float(b)) for k, (a, b) in harmonics.items()}

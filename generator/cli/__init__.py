@@ -13,9 +13,9 @@ from collections.abc import Sequence
 from fractions import Fraction
 from pathlib import Path
 
-from . import __version__
-from .costs import COST_LIMIT_SECONDS, COSTS, DRIVEN_MAX_ORDER, emit_bounds
-from .errors import InputError
+from .. import __version__
+from ..costs import COST_LIMIT_SECONDS, COSTS, DRIVEN_MAX_ORDER, emit_bounds
+from ..errors import InputError
 
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
 # well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
@@ -146,8 +146,8 @@ def _domain_fields(sol) -> dict:
     """Where the series may be used: ``orbit_limit`` (the family of periodic orbits exists
     for lower < y < upper, 30 digits, or ``known`` false with the reason) and, where the
     model states no radius, ``radius_estimate`` (value and spread, from the τ_j)."""
-    from .lindstedt import estimated_radius
-    from .orbits import orbit_domain
+    from ..derive.lindstedt import estimated_radius
+    from ..derive.orbits import orbit_domain
 
     fields = {"orbit_limit": orbit_domain(sol.model).as_json()}
     if sol.model.radius is None and sol.ground.is_rational and sol.order >= 2:
@@ -283,8 +283,8 @@ def limit_cycle_table(lc) -> str:
 
 
 def _cmd_series(args: argparse.Namespace) -> int:
-    from .lindstedt import derive, derive_limit_cycle, limit_cycles
-    from .models import SelfExcited, series_model
+    from ..derive.lindstedt import derive, derive_limit_cycle, limit_cycles
+    from ..derive.models import SelfExcited, series_model
 
     found = series_model(args.model, args.order, _params(args.param), args.name)
     if args.cycle is not None and not isinstance(found, SelfExcited):
@@ -334,7 +334,7 @@ def _singularities(omega, variable: str, of: str = "omega", degree: int | None =
                    ) -> tuple[list[dict], str]:
     """``--singularities``: the nearest singularity of ω (or of the series ``of``) estimated
     from its exact series (``degree``: of :func:`lindstedt.nearest_singularity`)."""
-    from .lindstedt import nearest_singularity
+    from ..derive.lindstedt import nearest_singularity
 
     if omega is None:
         raise InputError("--singularities: the coefficients stay symbolic; give every "
@@ -359,10 +359,10 @@ def _emit_only(flags) -> None:
 
 def _cmd_mathieu(args: argparse.Namespace) -> int:
     """``lindstedt mathieu a|b --m M --order K``: DLMF §28.6's series of a_m(q) or b_m(q)."""
-    from .hill import mathieu_series
+    from ..derive.hill import mathieu_series
 
     if args.emit is not None:
-        from . import compiler
+        from .. import compiler
 
         _emit_only((("--json", args.json), ("--singularities", args.singularities)))
         for path in compiler.generate_mathieu(args.kind, args.m, args.order,
@@ -409,7 +409,7 @@ def _series_value(coefficients, x: float) -> tuple[float, float, int]:
 
 def _radius(coefficients) -> float:
     """The estimated radius of convergence in the series' own variable (inf if too short)."""
-    from .lindstedt import nearest_singularity
+    from ..derive.lindstedt import nearest_singularity
 
     est = nearest_singularity(coefficients, "x", None)
     if est is None:
@@ -424,10 +424,10 @@ DAMPING_PANEL = 0.05
 def _cmd_tongues(args: argparse.Namespace) -> int:
     """``lindstedt tongues P --n N --order K``: the transition curves out of tongue n of
     x'' + (δ + ε p(t))x = 0, exact; ``--damping Z``: the damped tongue's tip."""
-    from .hill import fourier_of_text, tongue_tip, transition_curves
+    from ..derive.hill import fourier_of_text, tongue_tip, transition_curves
 
     if args.emit is not None:
-        from . import compiler
+        from .. import compiler
 
         _emit_only((("--at", args.at is not None), ("--tol", args.tol),
                     ("--damping", args.damping is not None), ("--plot", args.plot),
@@ -440,7 +440,7 @@ def _cmd_tongues(args: argparse.Namespace) -> int:
     if args.tol is not None and args.at is None:
         raise InputError("--tol: give --at EPS, the eps the tolerance is asked at")
     if args.plot:
-        from .charts import check_plot_path
+        from ..charts import check_plot_path
 
         check_plot_path(Path(args.plot))  # before any work
     p = fourier_of_text(args.p)
@@ -499,7 +499,7 @@ def _cmd_tongues(args: argparse.Namespace) -> int:
         lines.append(f"at zeta = {args.damping:g}: eps_min = {eps:.12g}, delta = {delta:.12g}")
     print(json.dumps(data) if args.json else "\n".join(lines))
     if args.plot:
-        from .charts import ince_strutt_figure
+        from ..charts import ince_strutt_figure
 
         path = ince_strutt_figure(Path(args.plot), args.p, args.damping or DAMPING_PANEL,
                                   order=args.order, tongues=range(max(4, args.n + 1)))
@@ -532,7 +532,7 @@ def slow_flow_json(flow) -> dict:
 
 def _cycles(flow) -> list:
     """The limit cycles of an autonomous flow with numeric coefficients (none otherwise)."""
-    from .averaging import cycle_series
+    from ..derive.averaging import cycle_series
 
     return [] if flow.driven or flow.parameters else cycle_series(flow)
 
@@ -545,8 +545,8 @@ def sp_text(expr) -> str:
 
 def _cmd_slowflow(args: argparse.Namespace) -> int:
     """``lindstedt slowflow EQUATION|NAME --order K``: the averaged equations, exact."""
-    from .averaging import slow_flow
-    from .models import oscillator, registry_entry
+    from ..derive.averaging import slow_flow
+    from ..derive.models import oscillator, registry_entry
 
     text, name = args.model, args.name or "oscillator"
     if (entry := registry_entry(text)) is not None:  # a name or its alias (vdp)
@@ -556,7 +556,7 @@ def _cmd_slowflow(args: argparse.Namespace) -> int:
     flow = slow_flow(osc, args.order)
     written = []
     if out is not None:  # written before anything is printed: a refusal prints nothing
-        from .compiler import generate_slow_flow
+        from ..compiler import generate_slow_flow
 
         params = "".join(f" --param {k}={v}" for k, v in sorted(_params(args.param).items()))
         command = f'lindstedt slowflow "{text}" --name {name} --order {args.order}{params}'
@@ -584,7 +584,7 @@ def _cmd_slowflow(args: argparse.Namespace) -> int:
 
 
 def _cmd_models(args: argparse.Namespace) -> int:
-    from .models import ALIASES, REGISTRY
+    from ..derive.models import ALIASES, REGISTRY
 
     aliases = {e.name: sorted(a for a, name in ALIASES.items() if name == e.name)
                for e in REGISTRY.values()}
@@ -605,7 +605,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         raise InputError(f"--param/--name: the {args.model} modules take neither")
     if args.model in EMITTED and args.allow_divergent:
         raise InputError(f"--allow-divergent: the {args.model} evaluators have no radius to lift")
-    from . import compiler
+    from .. import compiler
 
     if args.model in EMITTED and args.resum_order is not None:
         raise InputError(f"--resum-order: the {args.model} modules have no limit cycle to resum")
@@ -623,8 +623,8 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         paths = compiler.generate_fourier(args.harmonics, out,
                                           overwrite_edited=args.overwrite_edited)
     else:
-        from .lower import check_emitted_names
-        from .models import SelfExcited, series_model
+        from ..derive.models import SelfExcited, series_model
+        from ..lower.lowering import check_emitted_names
 
         found = series_model(args.model, order + 2, _params(args.param), args.name)
         if isinstance(found, SelfExcited):
@@ -676,17 +676,17 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
     import numpy as np
 
-    from .charts import (
+    from ..charts import (
         check_plot_path,
         driven_speed_accuracy_figure,
         gallery,
         speed_accuracy_figure,
     )
-    from .compiler import generate, generate_balance, generate_driven
-    from .emit import check_writable, load_generated
-    from .lindstedt import derive
-    from .models import model_by_name
-    from .numerics import duffing_period_exact, pendulum_period_exact
+    from ..compiler import generate, generate_balance, generate_driven
+    from ..derive.lindstedt import derive
+    from ..derive.models import model_by_name
+    from ..emit.render import check_writable, load_generated
+    from ..numerics.integrate import duffing_period_exact, pendulum_period_exact
 
     figures = out / "figures"
     modules = ["duffing", "pendulum", "driven", "balance"]
@@ -735,7 +735,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     # (benchmarks/*speed_accuracy.py refresh the committed copies the README shows).
     print(f"  {speed_accuracy_figure(figures / 'speed_accuracy.png')}")
     print(f"  {driven_speed_accuracy_figure(figures / 'driven_speed_accuracy.png')}")
-    from .charts import ince_strutt_figure  # Hill's equation: Floquet grid and series curves
+    from ..charts import ince_strutt_figure  # Hill's equation: Floquet grid and series curves
 
     print(f"  {ince_strutt_figure(figures / 'ince_strutt.png')}")
     _demo_limit_cycle(out, args.overwrite_edited)
@@ -768,10 +768,10 @@ def _demo_limit_cycle(out: Path, overwrite_edited: bool) -> None:
     NaN beyond their verified ε) and its derivation, against the shot cycle."""
     import numpy as np
 
-    from .compiler import generate_limit_cycle
-    from .emit import load_generated
-    from .models import series_model
-    from .numerics import cycle_reference, cycle_samples
+    from ..compiler import generate_limit_cycle
+    from ..derive.models import series_model
+    from ..emit.render import load_generated
+    from ..numerics.integrate import cycle_reference, cycle_samples
 
     model = series_model("van_der_pol", DEMO_CYCLE_ORDER + 2)
     print(f"\nvan der Pol's limit cycle, order {DEMO_CYCLE_ORDER}, ω resummed from order "
@@ -806,11 +806,11 @@ def _demo_slow_flow(out: Path, figures: Path, overwrite_edited: bool) -> None:
     against simulation, and its two figures."""
     import numpy as np
 
-    from .averaging import simulate, slow_flow, transient
-    from .charts import slow_flow_figures
-    from .compiler import generate_slow_flow
-    from .emit import load_generated
-    from .models import REGISTRY, oscillator
+    from ..charts import slow_flow_figures
+    from ..compiler import generate_slow_flow
+    from ..derive.averaging import simulate, slow_flow, transient
+    from ..derive.models import REGISTRY, oscillator
+    from ..emit.render import load_generated
 
     text = REGISTRY["van_der_pol"].equation
     osc = oscillator(text, name="van_der_pol")
@@ -841,7 +841,7 @@ DEMO_SUBHARMONIC = (0.1, 0.5, 1.3)
 def _demo_parametric(figures: Path) -> None:
     """The demo's parametric block: the response figure under ``figures``, the tongue and
     onsets, and one subharmonic where the full Hill equation corrects the notes' verdict."""
-    from .charts import PARAMETRIC_FIGURE, parametric_figure
+    from ..charts import PARAMETRIC_FIGURE, parametric_figure
 
     data = parametric_json(*PARAMETRIC_FIGURE, points=2)
     print(f"  {parametric_figure(*PARAMETRIC_FIGURE, figures / 'parametric.png')}")
@@ -859,9 +859,9 @@ def driven_json(d, order: int, harmonics: int) -> dict:
     found, ``first_order`` how the root was paired with it); an orbit that no one-harmonic root
     stands for (found by continuing the balance through a fold the cubic does not have) has
     ``A1``, ``r``, ``delta0`` null and no μ-expansion, with ``mu_note`` saying why."""
-    from .driven import amplitudes, mu_expansion
-    from .numerics import multipliers_stable, orbit_hill_multipliers
-    from .response import periodic_orbits
+    from ..analysis.driven import amplitudes, mu_expansion
+    from ..analysis.response import periodic_orbits
+    from ..numerics.integrate import multipliers_stable, orbit_hill_multipliers
 
     damped = d.damping > 0
     top = max(2 * harmonics - 1, 2 * order + 1)
@@ -1013,8 +1013,8 @@ def driven_equation_json(text: str, values: dict[str, str], omega: float, harmon
     (:func:`response.equation_orbits`), largest first, each by its harmonic balance (``A``
     holds the constant ``"0"`` and even harmonics unless the force is odd) and, checked by
     shooting, the true orbit with its Floquet moduli and verdict."""
-    from .driven import driven_equation
-    from .response import equation_orbits
+    from ..analysis.driven import driven_equation
+    from ..analysis.response import equation_orbits
 
     de = driven_equation(text, values, omega, name)
     found = equation_orbits(de, harmonics)
@@ -1090,7 +1090,7 @@ DRIVE_FLAGS = ("eps", "force", "Q")
 
 
 def _cmd_driven(args: argparse.Namespace) -> int:
-    from .driven import Drive, check_steady_state
+    from ..analysis.driven import Drive, check_steady_state
 
     if args.model is not None:
         given = [f"--{k}" for k in DRIVE_FLAGS if getattr(args, k) is not None]
@@ -1121,9 +1121,9 @@ def response_json(eps: float, force: float, Q: float, harmonics: int,
     (``max_seconds``: the continuation's cost limit)."""
     import numpy as np
 
-    from .driven import BalanceSystem, Drive
-    from .numerics import orbit_fold, sweep
-    from .response import continue_balance, one_harmonic_folds, response_range
+    from ..analysis.driven import BalanceSystem, Drive
+    from ..analysis.response import continue_balance, one_harmonic_folds, response_range
+    from ..numerics.integrate import orbit_fold, sweep
 
     d = Drive(eps, force, 1.0, Q)
     if d.damping == 0:
@@ -1166,7 +1166,7 @@ def _report(args: argparse.Namespace, compute, draw, table) -> int:
 
 
 def _charts():
-    from . import charts
+    from .. import charts
 
     return charts
 
@@ -1181,7 +1181,7 @@ def response_equation_json(text: str, values: dict[str, str], harmonics: int,
     and of the true orbit (each with its Floquet moduli), the sweeps' jumps and escapes."""
     import numpy as np
 
-    from .response import equation_response, orbit_fold_table
+    from ..analysis.response import equation_response, orbit_fold_table
 
     curve = equation_response(text, values, harmonics, name, omega_min, omega_max, max_seconds)
     de, er, cont, up, down = curve.de, curve.er, curve.cont, curve.up, curve.down
@@ -1309,7 +1309,7 @@ def _response_equation_table(data: dict) -> list[str]:
 
 def subharmonic_json(eps: float, force: float, omega: float) -> dict:
     """The contract of ``lindstedt subharmonic … --json`` (eq. 10.83–10.87)."""
-    from .subharmonic import subharmonic
+    from ..analysis.subharmonic import subharmonic
 
     exists, reason, solutions = subharmonic(eps, force, omega)
     return {
@@ -1357,7 +1357,7 @@ def subharmonic_equation_json(text: str, values: dict[str, str], omega: float | 
     drive periods (balance, shooting, Floquet), the primary response and the onset.  For the
     notes' eq. 10.83 (n = 3, ``q + εq³``, undamped) the closed form's keys of
     :func:`subharmonic_json` as well."""
-    from .subharmonic import subharmonic_equation, subharmonic_orbits
+    from ..analysis.subharmonic import subharmonic_equation, subharmonic_orbits
 
     problem = subharmonic_equation(text, values, omega, n, name)
     found = subharmonic_orbits(problem)
@@ -1404,7 +1404,7 @@ def subharmonic_orbits_json(found) -> dict:
 def _cmd_subharmonic(args: argparse.Namespace) -> int:
     n = 3 if args.n is None else args.n
     if _equation_args(args, ("eps", "force"), ("eps", "force", "omega")):
-        from .subharmonic import subharmonic_equation
+        from ..analysis.subharmonic import subharmonic_equation
 
         values, name = _params(args.param), args.name or "oscillator"
         problem = subharmonic_equation(args.model, values, args.omega, n, name)
@@ -1489,7 +1489,7 @@ def parametric_json(eps: float, zeta: float, gamma: float, omega_from: float, om
     every branch point (one harmonic, balance with its full-Hill verdict, shooting)."""
     import numpy as np
 
-    from .parametric import Pump, check_omega, fold, onsets, response, tongue_edges
+    from ..analysis.parametric import Pump, check_omega, fold, onsets, response, tongue_edges
 
     p = Pump(eps, zeta, gamma)
     lo, hi = check_omega(omega_from, "--omega-from"), check_omega(omega_to, "--omega-to")
@@ -1569,8 +1569,8 @@ def _cmd_parametric(args: argparse.Namespace) -> int:
 def mixing_json(eps: float, Q: float, drives: list[tuple[float, float]]) -> dict:
     """The contract of ``lindstedt mixing … --json``: predicted and simulated tones of the
     notes' ``q̈ + q̇/Q + q + εq³`` (:func:`mixing_tones_json` of its table)."""
-    from .driven import Drive
-    from .numerics import duffing_table
+    from ..analysis.driven import Drive
+    from ..numerics.integrate import duffing_table
 
     Drive(eps, 1.0, 1.0, Q)  # ε and Q first, then every drive's numbers
     for f, w in drives:
@@ -1587,7 +1587,7 @@ def mixing_tones_json(table, drives: list[tuple[float, float]]) -> dict:
     """Predicted (:func:`mixing.mixing_series`) and simulated tones of ``q̈ + g = Σ f_i cos
     ω_i t``, ``g`` the :class:`numerics.ForceTable`; ``eps`` and ``Q`` among the parameters
     when ``g`` is the notes' ``q + εq³ + q̇/Q``."""
-    from .mixing import mixing_series, simulated_fit, tone_label
+    from ..analysis.mixing import mixing_series, simulated_fit, tone_label
 
     series = mixing_series(table, drives)
     fit = simulated_fit(table, drives, list(series.tones))
@@ -1621,7 +1621,7 @@ def mixing_equation_json(text: str, values: dict[str, str], name: str = "oscilla
     """:func:`mixing_tones_json` of a user's equation, any polynomial force with a linear
     stiffness and damping (drives by ascending frequency), with ``equation``, ``name`` and the
     ``parameters.values`` given."""
-    from .mixing import mixing_equation
+    from ..analysis.mixing import mixing_equation
 
     table, drives, given = mixing_equation(text, values, name)
     data = mixing_tones_json(table, drives)
@@ -1631,7 +1631,7 @@ def mixing_equation_json(text: str, values: dict[str, str], name: str = "oscilla
 
 def _cmd_mixing(args: argparse.Namespace) -> int:
     if _equation_args(args, ("eps", "Q", "drive"), ("eps", "Q", "drive")):
-        from .mixing import mixing_equation
+        from ..analysis.mixing import mixing_equation
 
         values, name = _params(args.param), args.name or "oscillator"
         table, drives, _ = mixing_equation(args.model, values, name)
@@ -1640,7 +1640,7 @@ def _cmd_mixing(args: argparse.Namespace) -> int:
                        _mixing_table)
 
     def draw(path: Path) -> Path:
-        from .numerics import duffing_table
+        from ..numerics.integrate import duffing_table
 
         return _charts().mixing_figure(duffing_table(args.eps, 1 / args.Q), args.drive, path,
                                        f"ε = {args.eps}, Q = {args.Q}")
@@ -1678,7 +1678,7 @@ def _label(method, order: int, quantity: str | None = None) -> str:
     approximant names itself), else "NAME order K"."""
     label = getattr(method, "label", None)
     if label is None and quantity is not None:
-        from .methods import methods_for
+        from ..methods.registry import methods_for
 
         label = next((m.label for m in methods_for(quantity) if m == method), None)
     return label(order) if callable(label) else f"{method} order {order}"
@@ -1720,13 +1720,13 @@ def _cmd_choose(args: argparse.Namespace) -> int:
         if args.emit:
             raise InputError("--emit: the chosen period module is the Duffing oscillator's; "
                              "`lindstedt generate EQUATION` emits an equation's evaluators")
-        from .methods import MAX_ORDER
-        from .models import model_from_text
+        from ..derive.models import model_from_text
+        from ..methods.registry import MAX_ORDER
 
         model = model_from_text(args.model, MAX_ORDER, _params(args.param), args.name)
-    from .choose import choose_period, modelled_ns
-    from .compiler import generate_choice
-    from .emit import check_writable
+    from ..choose import choose_period, modelled_ns
+    from ..compiler import generate_choice
+    from ..emit.render import check_writable
 
     if args.emit:
         check_writable(_out_folder(args.emit, "--emit"), ["chosen_period.py"], "--emit",
@@ -1776,7 +1776,7 @@ def _choose_resummed(args: argparse.Namespace) -> int:
     if args.emit:
         raise InputError(f"--emit: choose {args.quantity} reports; `lindstedt generate "
                          "van_der_pol` and `lindstedt mathieu … --emit DIR` write the modules")
-    from .choose import choose_limit_cycle, choose_mathieu
+    from ..choose import choose_limit_cycle, choose_mathieu
 
     if args.quantity == "cycle":
         c = choose_limit_cycle(args.tol, args.x_min, args.x_max)
@@ -1803,7 +1803,7 @@ def _choose_resummed(args: argparse.Namespace) -> int:
 
 
 def _cmd_clock(args: argparse.Namespace) -> int:
-    from .choose import appendix_thresholds
+    from ..choose import appendix_thresholds
 
     rows = [{"approximation": t.approximation, "tolerance": t.tolerance,
              "claimed_deg": t.claimed_deg, "potential_deg": t.potential_deg,
@@ -1827,7 +1827,7 @@ def _cmd_clock(args: argparse.Namespace) -> int:
 
 
 def _cmd_scene(args: argparse.Namespace) -> int:
-    from .choose import SCENES
+    from ..choose import SCENES
 
     result = SCENES[args.name]()
     if args.json:
@@ -1844,9 +1844,9 @@ def _choose_q(args: argparse.Namespace) -> int:
     for name in ("tol", "x_min", "x_max"):
         if getattr(args, name) is None:
             raise InputError(f"choose q needs --{name.replace('_', '-')}")
-    from .choose import choose_solution, modelled_ns
-    from .compiler import generate_method
-    from .emit import check_writable
+    from ..choose import choose_solution, modelled_ns
+    from ..compiler import generate_method
+    from ..emit.render import check_writable
 
     if args.emit:
         check_writable(_out_folder(args.emit, "--emit"), ["duffing.py", "duffing_tables.tex",
@@ -1888,12 +1888,12 @@ def _choose_driven(args: argparse.Namespace) -> int:
         raise InputError("give --omega or a range (--omega-min, --omega-max), not both")
     tol = args.tol or 1e-4
     lo, hi = (args.omega, None) if args.omega is not None else (args.omega_min, args.omega_max)
-    from .driven import check_steady_state
+    from ..analysis.driven import check_steady_state
 
     check_steady_state(args.eps, args.Q, lo, hi)
-    from .choose import DRIVEN_MAX, choose_driven
-    from .compiler import generate_method
-    from .emit import check_writable
+    from ..choose import DRIVEN_MAX, choose_driven
+    from ..compiler import generate_method
+    from ..emit.render import check_writable
 
     if args.emit:
         check_writable(_out_folder(args.emit, "--emit"),
@@ -1938,10 +1938,10 @@ def _choose_driven(args: argparse.Namespace) -> int:
 def _cmd_sweep(args: argparse.Namespace) -> int:
     """A map over a parameter grid on dask.distributed, into a resumable Zarr store."""
     if args.plot:
-        from .charts import check_plot_path
+        from ..charts import check_plot_path
 
         check_plot_path(Path(args.plot))
-    from .sweep import equation_kind, run_sweep
+    from ..sweep import equation_kind, run_sweep
 
     builtin = {name: getattr(args, name) for name in ("omega", "force", "eps", "Q")
                if getattr(args, name) is not None}
@@ -1965,7 +1965,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                    args.workers, args.chunk, lambda p: bar(p.finished, p.total))
     bar.close()
     if args.plot:
-        from .charts import sweep_figure
+        from ..charts import sweep_figure
 
         sweep_figure(ds, Path(args.plot))
     done = ds["done"].values

@@ -1,0 +1,1 @@
+"""Exact algebra: the one Fourier kernel (series) and Padé resummation (resum)."""

@@ -1,0 +1,1 @@
+"""Driven oscillators: μ-expansion, harmonic balance, response, subharmonic, mixing, parametric."""

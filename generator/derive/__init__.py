@@ -1,0 +1,1 @@
+"""Derivation: equations, models, L–P series, limit cycles, Hill, averaging."""

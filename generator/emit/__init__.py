@@ -1,0 +1,1 @@
+"""Rendering and writing: strict Jinja2 environments, one-unit writes."""

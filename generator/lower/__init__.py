@@ -1,0 +1,1 @@
+"""Lowering: solutions to IR records, and the printers."""

@@ -1,0 +1,1 @@
+"""The method registry: per method what it applies to, derives, evaluates, lowers."""

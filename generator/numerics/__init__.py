@@ -1,0 +1,1 @@
+"""Numerical references: the one integrator, shooting, Floquet, quadratures."""
