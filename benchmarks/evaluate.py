@@ -28,7 +28,8 @@ from lindstedt.compiler import generate
 from lindstedt.derive.lindstedt import derive, period_series, solution_expression
 from lindstedt.derive.models import A, duffing, eps, t
 from lindstedt.emit.render import load_generated
-from lindstedt.lower.lowering import Evaluator, lower_free
+from lindstedt.lower.records import Evaluator
+from lindstedt.lower.series import lower_free
 from sympy.codegen.rewriting import create_expand_pow_optimization, optimize
 from sympy.printing.c import C99CodePrinter
 from timing import best

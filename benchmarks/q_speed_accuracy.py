@@ -23,7 +23,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from lindstedt.compiler import generate
 from lindstedt.emit.render import load_generated
-from lindstedt.methods.registry import cn_fourier
+from lindstedt.methods.kernels import cn_fourier
 from scipy.integrate import solve_ivp
 from scipy.special import ellipj
 from timing import best

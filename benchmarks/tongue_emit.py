@@ -22,7 +22,7 @@ from lindstedt.cli import main
 from lindstedt.derive.hill import fourier_of_text, transition_curves
 from lindstedt.derive.lindstedt import nearest_singularity
 from lindstedt.emit.render import load_generated
-from lindstedt.methods import registry as methods
+from lindstedt.methods import verify as methods
 from lindstedt.numerics.integrate import floquet_traces
 from scipy.optimize import brentq
 from timing import best, median

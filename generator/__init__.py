@@ -41,10 +41,25 @@ order; a stage imports only stages above it::
                     one-harmonic branches, tongue, onsets, balance, full-Hill stability
     lower.printers  NumbaPrinter(PythonCodePrinter), LaTeX         Expr -> str
                     rationals
-    lower.lowering  solutions -> IR records (Module, Evaluator,    solution -> Unit
-                    Derivation, PeriodFormula); Horner, Chebyshev recurrence, AGM steps
+    lower.records   the IR records (Module, Evaluator, Derivation,  -> records
+                    PeriodFormula, Unit) a template lays out
+    lower.forms     Horner/Estrin, the Chebyshev recurrence, AGM    Expr -> Expr
+                    steps, argument guards, the scaled variable x = εA^k
+    lower.series    free oscillators, limit cycles, resummations,  solution -> Module
+                    Mathieu, tongues -> Module
+    lower.driven    the μ-expansion's branches (Cardano), damped,   orders -> Module
+                    the harmonic-balance system
+    lower.documents  derivations' LaTeX records, the AGM period,   solution -> Unit
+                    a chosen formula, the slow flow
     emit.render     strict Jinja2 environments, provenance,        Unit -> files
                     one-unit writes
+    methods.kernels  compiled period kernels (Horner, AGM, cn),     PeriodSeries -> floats
+                    the period series re-expanded, each method's coefficients
+    methods.references  the references each method is checked      x -> truth
+                    against (mpmath, quadrature, shooting, the driven modules on a grid)
+    methods.verify  resummations verified on a grid before they    series -> Resummed
+                    are emitted (limit cycles, Mathieu, Hill tongues)
+    methods.targets  what generate derives and lowers per target   Request -> Unit
     methods.registry  the method registry: per method what it      Model | Drive -> Method
                     applies to (and why not), how it derives, evaluates, lowers, its
                     reference

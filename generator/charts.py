@@ -37,7 +37,8 @@ from .choose import (
 )
 from .emit.render import check_folder, check_target, write_files
 from .errors import InputError
-from .methods.registry import candidates, reference_period
+from .methods.references import reference_period
+from .methods.registry import candidates
 from .numerics.integrate import ForceTable, duffing_table, steady_state_amplitudes, sweep
 from .sweep import BALANCE_HARMONICS, MU_ORDERS, validity_errors
 

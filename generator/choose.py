@@ -35,23 +35,18 @@ from .derive.models import Model, duffing, pendulum
 from .display import html_table
 from .emit.render import load_generated
 from .errors import InputError
-from .methods.registry import (
+from .methods.kernels import cn_fourier
+from .methods.references import (
     DRIVEN_MAX,
     INTEGRATION_RTOLS,
     SHOOTING_STEPS,
-    SIMPLEST_FIRST,
-    Candidate,
-    Method,
-    candidates,
-    cn_fourier,
     integrated_period,
-    method,
-    methods_for,
     one_harmonic_amplitudes,
     quadrature_period,
     reference_period,
     reference_q,
 )
+from .methods.registry import SIMPLEST_FIRST, Candidate, Method, candidates, method, methods_for
 from .numerics.integrate import shoot
 
 Progress = Callable[[int, int], None]

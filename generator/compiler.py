@@ -17,7 +17,8 @@ from pathlib import Path
 from .derive.models import Model, check_order, model_by_name
 from .emit.render import check_writable, render, write_files
 from .errors import InputError
-from .methods.registry import (
+from .methods.registry import Candidate, Method
+from .methods.targets import (
     BALANCE,
     CHOSEN_PERIOD,
     FOURIER,
@@ -28,8 +29,6 @@ from .methods.registry import (
     MU_DAMPED,
     SLOW_FLOW,
     TONGUE,
-    Candidate,
-    Method,
     Request,
     Target,
 )

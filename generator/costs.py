@@ -232,7 +232,7 @@ def generate_cost(args: argparse.Namespace) -> Cost:
         derivation = series_cost(argparse.Namespace(model=args.model, param=args.param,
                                                     order=size + 2)).seconds
         if limit_cycle_text(args.model) is not None:
-            from .methods.registry import RADIUS_ORDER, cycle_series_order
+            from .methods.targets import RADIUS_ORDER, cycle_series_order
 
             resum = getattr(args, "resum_order", None)
             derived = cycle_series_order(size, resum)

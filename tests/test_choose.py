@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 from lindstedt.choose import choose_period
 from lindstedt.errors import InputError
-from lindstedt.methods.registry import candidates, resummed_coefficients
+from lindstedt.methods.kernels import resummed_coefficients
+from lindstedt.methods.registry import candidates
 from reference import duffing_period
 
 
@@ -201,7 +202,7 @@ def test_every_method_emits_its_period(tmp_path, method, order, lo, hi, tol):
 
 
 def test_integrated_period_reaches_its_tolerance():
-    from lindstedt.methods.registry import integrated_period, reference_period
+    from lindstedt.methods.references import integrated_period, reference_period
 
     for x in (0.1, 5.0, -0.5):
         ref = reference_period(np.array([x]))[0]
@@ -214,7 +215,8 @@ def test_modified_lindstedt_of_cheung_chen_lau():
     absorbs the first-order term), and the series holds out to x = 10³ and down to x = −0.9."""
     from lindstedt.derive.lindstedt import derive
     from lindstedt.derive.models import duffing
-    from lindstedt.methods.registry import modified_coefficients, reference_period
+    from lindstedt.methods.kernels import modified_coefficients
+    from lindstedt.methods.references import reference_period
 
     sol = derive(duffing(), 40)
     g = modified_coefficients([sol.ground.to_fraction(c) for c in sol.omega])
@@ -245,7 +247,7 @@ def test_one_harmonic_closed_form_is_mu_order_zero():
     ωA₁/Q + ¾εr²B₁ = 0, r² = A₁² + B₁²: signs included) on the largest branch (numpy.roots of
     the cubic in r²), damped and undamped; and it is the μ-expansion's order 0."""
     from lindstedt.analysis.driven import Drive, amplitudes, first_order_branches, mu_expansion
-    from lindstedt.methods.registry import one_harmonic_amplitudes
+    from lindstedt.methods.references import one_harmonic_amplitudes
 
     eps, f = 0.1, 0.7
     for Q in (np.inf, 20.0):
@@ -331,7 +333,7 @@ def test_choose_q_against_jacobi_cn():
 def test_exact_fourier_series_of_the_solution(x):
     """The nome series against mpmath's cn (any m < 1): double precision with enough
     harmonics, on a softening spring next to the separatrix too."""
-    from lindstedt.methods.registry import cn_fourier
+    from lindstedt.methods.kernels import cn_fourier
 
     t = np.linspace(0.0, 15.0, 61)
     m = x / (2 * (1 + x))
@@ -347,7 +349,7 @@ def test_choose_q_for_a_softening_spring_beyond_the_series():
     """On [−0.95, 0] the L–P series cannot reach 1e-10 and SciPy's cn does not take m < 0:
     the exact Fourier series does, and the choice holds off the verification grid."""
     from lindstedt.choose import choose_solution
-    from lindstedt.methods.registry import cn_fourier
+    from lindstedt.methods.kernels import cn_fourier
 
     c = choose_solution(1e-10, -0.95, 0.0)
     assert c.method == "fourier" and c.max_error <= 1e-10
@@ -443,7 +445,7 @@ def _mp_period(potential, level_at=1):
 def test_quadrature_period_is_the_elliptic_period():
     """The Gauss–Legendre quadrature of the scaled potential, against mpmath's K(m)."""
     from lindstedt.derive.models import duffing
-    from lindstedt.methods.registry import quadrature_period
+    from lindstedt.methods.references import quadrature_period
 
     x = np.array([-0.9, -0.5, -0.1, 0.0, 0.3, 0.9, 5.0, 100.0])
     with mpmath.workdps(30):
@@ -493,7 +495,8 @@ def test_damped_mu_expansion_is_a_registered_method_for_a_finite_Q():
     emitted for a finite Q; both records share the float μ-expansion's solve."""
     from lindstedt.analysis.driven import Drive
     from lindstedt.derive.models import duffing
-    from lindstedt.methods.registry import MU_DAMPED, method, methods_for
+    from lindstedt.methods.registry import method, methods_for
+    from lindstedt.methods.targets import MU_DAMPED
 
     damped, undamped = method("driven", "mu_expansion_damped"), method("driven", "mu_expansion")
     finite, infinite = Drive(0.1, 0.3, 0.8, 20.0), Drive(0.1, 0.3, 0.8, np.inf)
@@ -581,7 +584,7 @@ def test_choose_cycle_reports_the_series_error_against_shooting(monkeypatch):
     from lindstedt.choose import choose_limit_cycle, verification_points
     from lindstedt.derive.lindstedt import derive_limit_cycle
     from lindstedt.derive.models import series_model
-    from lindstedt.methods import registry as methods
+    from lindstedt.methods import verify as methods
 
     # NOTE: the module's resummed ω verified on (0, 0.6] only: one shooting at generation
     # rather than eight up to ε = 3 (~100 s), its check points all beyond this range.

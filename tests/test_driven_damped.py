@@ -31,7 +31,7 @@ from lindstedt.analysis.driven import (
 )
 from lindstedt.compiler import generate_driven
 from lindstedt.emit.render import load_generated
-from lindstedt.lower.lowering import DAMPED_TRUNCATION, lower_driven_damped
+from lindstedt.lower.driven import DAMPED_TRUNCATION, lower_driven_damped
 from lindstedt.numerics.integrate import shoot
 
 K = 4

@@ -47,8 +47,9 @@ from lindstedt.emit.render import (
 )
 from lindstedt.emit.render import load_generated as load
 from lindstedt.errors import InputError
-from lindstedt.lower.lowering import lower_cycle_derivation, lower_derivation, lower_free
+from lindstedt.lower.documents import lower_cycle_derivation, lower_derivation
 from lindstedt.lower.printers import identifier, latex_rational, pycode
+from lindstedt.lower.series import lower_free
 from reference import periodic_orbit
 from scipy.special import ellipj, ellipk
 

@@ -22,8 +22,9 @@ from lindstedt.derive.models import duffing
 from lindstedt.emit import render as emit
 from lindstedt.emit.render import check_writable, load_generated, render_latex, render_module
 from lindstedt.errors import InputError
-from lindstedt.lower.lowering import lower_derivation, lower_free
-from lindstedt.methods import registry as methods
+from lindstedt.lower.documents import lower_derivation
+from lindstedt.lower.series import lower_free
+from lindstedt.methods import targets as methods
 
 SET = ("duffing.py", "duffing_tables.tex", "duffing_derivation.tex")
 

@@ -40,8 +40,13 @@ def imported(path: Path, known: set[str], where: str | None = None) -> set[str]:
     place in the package (``analysis/driven.py``), default its own."""
     place = Path(where) if where else path.relative_to(PACKAGE)
     here = list(place.with_suffix("").parts)  # a module's own name, or __init__, is last
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    typing_only = {id(n) for block in ast.walk(tree) if isinstance(block, ast.If)
+                   and ast.unparse(block.test) == "TYPE_CHECKING" for n in ast.walk(block)}
     found = set()
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+    for node in ast.walk(tree):
+        if id(node) in typing_only:  # names for annotations only: no import at run time
+            continue
         if isinstance(node, ast.ImportFrom):
             if node.level:
                 head = [*here[: len(here) - node.level],

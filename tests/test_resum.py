@@ -25,7 +25,7 @@ from lindstedt.algebra.resum import (
 )
 from lindstedt.derive.models import series_model
 from lindstedt.errors import InputError
-from lindstedt.methods import registry as methods
+from lindstedt.methods import verify as methods
 from lindstedt.numerics.integrate import cycle_reference
 
 

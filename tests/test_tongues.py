@@ -290,7 +290,7 @@ def test_the_emitted_curves_hold_the_tolerance_between_the_grid_points(emitted):
 def test_the_bracketed_root_is_brentqs():
     """methods.boundary_bracket (the sign of |tr M| − 2 at δ ∓ b, the root interpolated):
     brentq's root where one curve crosses the bracket, NaN where none or both do."""
-    from lindstedt.methods.registry import boundary_bracket
+    from lindstedt.methods.verify import boundary_bracket
 
     p = harmonics(EMIT_P)
     curves = transition_curves(EMIT_P, 1, 30).curves

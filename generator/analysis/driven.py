@@ -898,9 +898,10 @@ def driven_equation(text: str, values: dict[str, str], omega: float,
                     name: str = "oscillator") -> DrivenEquation:
     """Lower ``text`` (see :mod:`lindstedt.derive.equation`) to a :class:`DrivenEquation`: a
     polynomial force and a single drive ``f cos(w t)``, every parameter but ``w`` given in
-    ``values`` (exact text, ``eps`` included), ``w = omega``.  A one-line :class:`InputError` says why
-    where it cannot: no drive or more than one, a drive that is not ``f cos(w t)``, a term in
-    both t and q (parametric), a force that is not a polynomial in q and q', a missing value."""
+    ``values`` (exact text, ``eps`` included), ``w = omega``.  A one-line :class:`InputError`
+    says why where it cannot: no drive or more than one, a drive that is not ``f cos(w t)``, a
+    term in both t and q (parametric), a force that is not a polynomial in q and q', a missing
+    value."""
     from ..derive.equation import parse_expression
     from ..derive.models import oscillator
 

@@ -624,7 +624,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
                                           overwrite_edited=args.overwrite_edited)
     else:
         from ..derive.models import SelfExcited, series_model
-        from ..lower.lowering import check_emitted_names
+        from ..lower.forms import check_emitted_names
 
         found = series_model(args.model, order + 2, _params(args.param), args.name)
         if isinstance(found, SelfExcited):
@@ -1721,7 +1721,7 @@ def _cmd_choose(args: argparse.Namespace) -> int:
             raise InputError("--emit: the chosen period module is the Duffing oscillator's; "
                              "`lindstedt generate EQUATION` emits an equation's evaluators")
         from ..derive.models import model_from_text
-        from ..methods.registry import MAX_ORDER
+        from ..methods.kernels import MAX_ORDER
 
         model = model_from_text(args.model, MAX_ORDER, _params(args.param), args.name)
     from ..choose import choose_period, modelled_ns

@@ -24,7 +24,8 @@ import jinja2
 import sympy as sp
 
 from ..errors import InputError
-from ..lower.lowering import (
+from ..lower.printers import latex_coefficient, latex_expr, latex_rational, pycode
+from ..lower.records import (
     ArrayKernel,
     CycleDerivation,
     Derivation,
@@ -36,7 +37,6 @@ from ..lower.lowering import (
     SlowFlowDocument,
     Unit,
 )
-from ..lower.printers import latex_coefficient, latex_expr, latex_rational, pycode
 
 
 def template_folder() -> Path:

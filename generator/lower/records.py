@@ -1,0 +1,313 @@
+"""The lowering's IR records: what a template lays out (no code strings), and the
+documents' records (SymPy objects the LaTeX printer prints)."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import unicodedata
+from dataclasses import dataclass
+
+import sympy as sp
+
+from .. import __version__
+from ..algebra.resum import Resummed
+from ..analysis.driven import (
+    MuDampedOrder,
+    MuOrder,
+)
+
+Assign = tuple[sp.Symbol, sp.Expr]
+
+
+def _unsafe(ch: str) -> bool:
+    """Control, format, surrogate, private or unassigned, line or paragraph separator."""
+    category = unicodedata.category(ch)
+    return category[0] == "C" or category in ("Zl", "Zp")
+
+
+def one_line(text: str) -> str:
+    """``text`` as data on one line of a generated file: every character that could end a
+    comment line or hide text (newline, other controls, separators) becomes a visible escape.
+
+    >>> one_line("lindstedt generate\\nimport os")
+    'lindstedt generate\\\\nimport os'
+    """
+    return "".join(ch.encode("unicode_escape").decode("ascii") if _unsafe(ch) else ch
+                   for ch in str(text))
+
+
+def docstring_text(text: str) -> str:
+    """``text`` as data inside a generated ``\"\"\"`` docstring: backslashes and quotes
+    escaped (no quote can close it), lines kept, other unsafe characters escaped."""
+    text = str(text).replace("\\", "\\\\").replace('"', '\\"')
+    return "\n".join(one_line(line) for line in text.split("\n"))
+
+
+@dataclass(frozen=True)
+class Evaluator:
+    """Everything needed to emit one numba ufunc."""
+
+    name: str
+    doc: str
+    args: tuple[sp.Symbol, ...]
+    prelude: tuple[Assign, ...]
+    guard: sp.Basic  # SymPy boolean; false -> NaN
+    body: tuple[Assign, ...]
+    output: sp.Expr
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "doc", docstring_text(self.doc))
+
+
+@dataclass(frozen=True)
+class ArrayKernel:
+    """One numba ``@njit`` function returning an array: ``x`` unpacked into named symbols,
+    shared subexpressions, then ``out[index] = value`` entries."""
+
+    name: str
+    doc: str
+    unpack: tuple[sp.Symbol, ...]  # x[0], x[1], … bound to these names
+    args: tuple[sp.Symbol, ...]  # scalar arguments after x
+    shape: tuple[int, ...]
+    subexprs: tuple[Assign, ...]
+    entries: tuple[tuple[tuple[int, ...], sp.Expr], ...]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "doc", docstring_text(self.doc))
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """What a generated file says about where it came from (no timestamp: reproducible)."""
+
+    model: str
+    order: int
+    command: str
+    inputs: str  # sha256 of the canonical description of the inputs
+
+    def __post_init__(self) -> None:
+        # NOTE: the command is the caller's text: it reaches the banner only as one line of data.
+        object.__setattr__(self, "command", one_line(self.command))
+
+    @property
+    def version(self) -> str:
+        return __version__
+
+
+@dataclass(frozen=True)
+class Module:
+    """One generated Python module: constants and evaluators."""
+
+    name: str
+    doc: str
+    constants: tuple[tuple[str, object], ...]  # name -> int, float, str or tuple of them
+    evaluators: tuple[Evaluator, ...]
+    provenance: Provenance
+    kernels: tuple[ArrayKernel, ...] = ()
+    newton: bool = False  # emit newton(x0, …) driving the kernels "residual" and "jacobian"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "doc", docstring_text(self.doc))
+
+
+def provenance(model: str, order: int, command: str, **inputs: object) -> Provenance:
+    """Provenance with a hash over the canonical JSON of every input that shapes the output."""
+    payload = json.dumps(
+        {"version": __version__, "model": model, "order": order, **inputs},
+        sort_keys=True, default=str,
+    )
+    return Provenance(model, order, command, hashlib.sha256(payload.encode()).hexdigest())
+
+
+@dataclass(frozen=True)
+class ResummedCycle:
+    """A limit cycle's resummed frequency and where it was verified: ``|ε| ≤ limit``, with
+    the largest measured error ``checked`` against the numerical references at ``points``;
+    the same for its amplitude q(0) when its Padé form verified anywhere."""
+
+    form: Resummed
+    limit: float
+    points: tuple[float, ...]
+    checked: float
+    tolerance: float
+    amplitude: Resummed | None = None  # q(0), Padé in ε², with its (limit, points, checked)
+    amplitude_verified: tuple[float, tuple[float, ...], float] = (0.0, (), float("nan"))
+    harmonics: tuple[tuple[str, int, Resummed], ...] = ()  # q(s): ("cos"|"sin", n, a_n(ε))
+    harmonics_verified: tuple[float, tuple[float, ...], float] = (0.0, (), float("nan"))
+
+
+@dataclass(frozen=True)
+class ResummedMathieu:
+    """Mathieu's ``a_m(q)`` or ``b_m(q)``: the Padé of its exact series to ``order`` as the
+    start of ``steps`` Newton steps on the determinant of the recurrence truncated to ``rows``
+    rows, and where it was verified against the high-precision reference: ``0 ≤ q ≤ limit``
+    (``|q|`` when the series is even in q), the largest error ``checked`` there, relative to
+    max(1, |a|)."""
+
+    kind: str
+    m: int
+    order: int
+    form: Resummed
+    limit: float
+    tolerance: float
+    checked: float
+    rows: int
+    steps: int
+
+
+@dataclass(frozen=True)
+class ResummedCurve:
+    """One transition curve ``δ(ε)`` as the Padé of its exact series, verified against the
+    Floquet boundary on ``0 ≤ ε ≤ limit`` (``|ε|`` when the series is even in ε), with the
+    largest error ``checked`` there (absolute, in δ)."""
+
+    label: str
+    form: Resummed
+    limit: float
+    checked: float
+
+
+@dataclass(frozen=True)
+class ResummedTongue:
+    """The transition curves of tongue ``n`` of ``ẍ + (δ + ε p(t))x = 0`` (``p`` as its user
+    text, data only), each resummed and verified to ``tolerance`` in δ."""
+
+    p: str
+    n: int
+    order: int
+    tolerance: float
+    curves: tuple[ResummedCurve, ...]
+
+
+x_ = sp.Symbol("x")
+# NOTE: x = εA², the variable of every period formula (:class:`PeriodFormula`).
+
+
+@dataclass(frozen=True)
+class PeriodFormula:
+    """``T/2π`` of one verified period candidate in ``x = εA²``: assignments, then the value,
+    inside the method's domain; its coefficients as the verified doubles (provenance)."""
+
+    method: str
+    order: int
+    domain: sp.Basic  # SymPy boolean in x_
+    body: tuple[Assign, ...]
+    value: sp.Expr
+    num: tuple[float, ...]
+    den: tuple[float, ...]
+
+
+# --- documents: the LaTeX beside a module, as SymPy objects (printed by emit) ---------------
+
+@dataclass(frozen=True)
+class OrderPieces:
+    """The ``y^j`` equation of a free oscillator: its forcing, resonant part, ω_j, q_j."""
+
+    j: int
+    resonant: sp.Expr
+    omega: sp.Expr
+    forcing: tuple[tuple[int, sp.Expr], ...]
+    q: tuple[tuple[int, sp.Expr], ...]
+
+
+@dataclass(frozen=True)
+class Derivation:
+    """The tables and the order-by-order derivation of a free oscillator's series to
+    ``order`` (templates ``tables.tex.j2``, ``derivation.tex.j2``)."""
+
+    model: str
+    latex: str  # the equation of motion, as the model typesets it
+    y: sp.Expr
+    coordinate: sp.Symbol
+    amplitude: sp.Expr
+    order_factor: sp.Expr
+    coupling: sp.Expr
+    order: int
+    omega: tuple[sp.Expr, ...]
+    period: tuple[sp.Expr, ...]
+    q: tuple[tuple[tuple[int, sp.Expr], ...], ...]
+    orders: tuple[OrderPieces, ...]
+
+
+@dataclass(frozen=True)
+class NotesTable:
+    """The notes' driven table: A₁, A₃, A₅ by μ-order, harmonic balance and shooting at
+    ``(eps, force, omega)``; a cell is a number, or the notes' own printed digits."""
+
+    eps: float
+    force: float
+    omega: float
+    rows: tuple[tuple[str, tuple[tuple[int, float | str], ...]], ...]
+
+
+@dataclass(frozen=True)
+class MuDerivation:
+    """The μ-expansion's derivation to ``order`` and the notes' table (``mu_derivation.tex.j2``)."""
+
+    order: int
+    orders: tuple[MuOrder, ...]
+    table: NotesTable
+
+
+@dataclass(frozen=True)
+class MuDampedDerivation:
+    """The damped μ-expansion's derivation to ``order`` (``mu_damped_derivation.tex.j2``):
+    ``F_j``, both secular conditions, ``b_{j−1}``, ``δ_{j−1}``, ``q_j`` and ``δ_j`` per order."""
+
+    order: int
+    orders: tuple[MuDampedOrder, ...]
+    determinant: sp.Expr  # Δ in x, a, γ
+
+
+@dataclass(frozen=True)
+class CycleOrderPieces:
+    """Order j of a limit cycle's document: ``F_j = K_j + a_(j−1) L + a₀ W_j cos s``, the two
+    secular conditions and ``q_j`` (exact rationals; :class:`lindstedt.CycleOrder`)."""
+
+    j: int
+    known_cos: tuple[tuple[int, sp.Rational], ...]
+    known_sin: tuple[tuple[int, sp.Rational], ...]
+    a_prev: sp.Rational | None  # a_(j−1), from the sin s condition (None at j = 1)
+    W: sp.Rational
+    omega: sp.Rational
+    q_cos: tuple[tuple[int, sp.Rational], ...]
+    q_sin: tuple[tuple[int, sp.Rational], ...]
+
+
+@dataclass(frozen=True)
+class CycleDerivation:
+    """The order-by-order derivation of a limit cycle (``cycle_derivation.tex.j2``): the
+    amplitude equation ``S(a₀) = 0``, the linearisation ``L`` and the first orders."""
+
+    model: str
+    equation: str  # q'' + q = eps*f(q, q') as the user wrote it
+    a0: sp.Rational
+    slope: sp.Rational
+    lin_cos: tuple[tuple[int, sp.Rational], ...]
+    lin_sin: tuple[tuple[int, sp.Rational], ...]
+    orders: tuple[CycleOrderPieces, ...]
+
+
+@dataclass(frozen=True)
+class Unit:
+    """What one command writes: a module and the documents beside it."""
+
+    module: Module
+    documents: tuple[Derivation | MuDerivation | MuDampedDerivation
+                     | SlowFlowDocument | CycleDerivation, ...] = ()
+
+
+# --- the slow flow (averaging) ---------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SlowFlowDocument:
+    """The slow flow's equations for ``slow_flow.tex.j2``: ``R_k``, ``Φ_k`` by order."""
+
+    name: str
+    source: str  # the equation as the user wrote it
+    order: int
+    driven: bool
+    radial: tuple[sp.Expr, ...]
+    phase: tuple[sp.Expr, ...]

@@ -1,0 +1,570 @@
+"""Lowering the exact series: a free oscillator's ω, T and q (with the radius and orbit
+guards), limit cycles, their resummations, Mathieu's characteristic values and Hill's
+tongues."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from fractions import Fraction
+
+import sympy as sp
+
+from ..algebra.resum import Pade, Resummed
+from ..derive.lindstedt import (
+    LimitCycle,
+    SeriesSolution,
+    estimated_radius,
+    nearest_singularity,
+)
+from ..derive.orbits import OrbitDomain, orbit_domain
+from ..numerics.integrate import mathieu_recurrence
+from .forms import (
+    FREE_ARGUMENT_LIMIT,
+    _hex,
+    argument_entry,
+    check_emitted_names,
+    free_ranges,
+    harmonics,
+    horner,
+    scaled_variable,
+)
+from .printers import identifier
+from .records import (
+    Assign,
+    Evaluator,
+    Module,
+    ResummedCycle,
+    ResummedMathieu,
+    ResummedTongue,
+    one_line,
+    provenance,
+)
+
+
+def _truncation_bound(solution: SeriesSolution, order: int, x: sp.Symbol,
+                      reach: sp.Expr | None, domain: OrbitDomain) -> sp.Expr:
+    """A bound on ``|Σ_(j>K) τ_j y^j|`` (in units of 2π/ω₀): the first omitted term, then a
+    geometric tail from ``τ_{K+2}`` at the ratio ``r = max(1/R, |τ_{K+2}/τ_{K+1}|)``, ``R``
+    the smaller of ``reach`` (radius less spread) and the distance to the orbits' edge — a
+    singularity of T, where the period diverges.  Ratios of a branch point's coefficients
+    rise toward 1/R (log, square root) or fall toward it (a pole of order > 1): r bounds both.
+    inf from ``r|y| = 1`` on."""
+    g, w0 = solution.ground, solution.model.frequency
+    t1 = sp.Abs(g.to_sympy(solution.period[order + 1]) / w0)
+    t2 = sp.Abs(g.to_sympy(solution.period[order + 2]) / w0)
+    edges = [sp.Float(v, 17) for v in (-domain.lower, domain.upper) if math.isfinite(v)]
+    limits = [e for e in ([reach] if reach is not None else []) + edges]
+    if not limits:  # no radius and no edge: the omitted terms alone
+        return t1 * sp.Abs(x) ** (order + 1) + t2 * sp.Abs(x) ** (order + 2)
+    R = sp.Min(*limits) if len(limits) > 1 else limits[0]
+    r = sp.Max(1 / R, t2 / t1) if t1 != 0 else 1 / R
+    c = sp.Max(t2, r * t1)
+    ax = sp.Abs(x)
+    tail = t1 * ax ** (order + 1) + c * ax ** (order + 2) / (1 - r * ax)
+    return sp.Piecewise((tail, r * ax < 1), (sp.oo, True))
+
+
+def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = False) -> Module:
+    """Evaluators ω, T, q, q̇ and the truncation-error estimate of a free oscillator.
+
+    ``solution`` must be derived two orders above the emitted order K: ``τ_{K+1}`` feeds
+    :func:`error_estimate`.  Outside the orbit condition the ufuncs return NaN, and beyond
+    the radius of convergence too unless ``allow_divergent``.
+    """
+    m = solution.model
+    order = solution.order - 2
+    if order < 0:
+        raise ValueError("lower_free needs a solution derived to order K + 2")
+    check_emitted_names(m)
+    g = solution.ground
+    args = {name: sp.Symbol(identifier(name)) for name, _ in m.parameters}
+    to_args = {sym: args[name] for name, sym in m.parameters}
+    user = {str(m.coordinate), str(m.coordinate) + "dot", *args}
+    # a user's name keeps its meaning: an internal name it would shadow takes a leading '_'
+    # (which no user name has); the built-in models keep x, w, s, T, byte for byte
+    x, w, s, total = (sp.Symbol(n if n not in user else "_" + n) for n in ("x", "w", "s", "T"))
+    y = m.y.xreplace(to_args)
+    amplitude = m.amplitude.xreplace(to_args)
+    # ω₀ = 1 but for a user's linear frequency: ω = ω₀ Σ ω_j y^j, T = (2π/ω₀) Σ τ_j y^j
+    omega = [m.frequency * g.to_sympy(c) for c in solution.omega[: order + 1]]
+    tau = [g.to_sympy(c) / m.frequency for c in solution.period[: order + 1]]
+    params = tuple(args.values())
+    t = sp.Symbol("t")
+    guard = m.orbit_condition.xreplace({sp.Symbol("Y"): x})
+    domain = orbit_domain(m)
+    lo, hi = domain.guard_bounds()
+    if math.isfinite(lo):
+        guard = sp.And(guard, x > sp.Float(lo, 17))
+    if math.isfinite(hi):
+        guard = sp.And(guard, x < sp.Float(hi, 17))
+    found = (m.radius, 0.0) if m.radius is not None else estimated_radius(solution, to_args)
+    radius, spread = found if found is not None else (None, 0.0)
+    reach = None if radius is None else radius - sp.Float(spread, 17) if spread else radius
+    if reach is not None and not allow_divergent:
+        guard = sp.And(guard, sp.Abs(x) < reach)
+    scaled = scaled_variable(y, params, x)
+    steps, ranges = scaled if scaled is not None else (((x, y),), free_ranges(y, params))
+    flag = "inside" if "inside" not in user else "_inside"
+    entry, inside = argument_entry(ranges, flag)
+    prelude, guard_t = (*entry, *steps), guard
+    guard = sp.And(inside, guard)
+    entry, inside = argument_entry((*ranges, (t, sp.Abs(t) <= FREE_ARGUMENT_LIMIT, 0)), flag)
+    prelude_t, guard_t = (*entry, *steps), sp.And(inside, guard_t)
+
+    top = max((max(qj) for qj in solution.q[: order + 1] if qj), default=1)
+    harmonic = {
+        n: horner([g.to_sympy(solution.q[j].get(n, g.scalar(0))) for j in range(order + 1)], x)
+        for n in range(top + 1)
+    }
+    harmonic = {n: h for n, h in harmonic.items() if h != 0}
+    cos_lines, cs, _ = harmonics(top, m.odd, s, sines=False)
+    both_lines, _, ss = harmonics(top, m.odd, s, sines=True)
+    name_of = identifier(str(m.coordinate))
+    where = ("NaN where no periodic orbit exists" if domain.known else
+             f"NaN where no periodic orbit exists as far as known: no orbit domain ({domain.how})")
+    where += ("" if allow_divergent or radius is None else
+              " or beyond the radius of convergence"
+              + ("" if m.radius is not None else " less its spread, estimated from its τ_j"))
+    estimate = _truncation_bound(solution, order, x, reach, domain) / sp.Abs(total)
+    evaluators = (
+        Evaluator("omega", f"Frequency ω to order {order} ({where}).", params, prelude, guard,
+                  (), horner(omega, x)),
+        Evaluator("period", f"Period T = 2π Σ τ_j y^j to order {order} ({where}).", params,
+                  prelude, guard, (), 2 * sp.pi * horner(tau, x)),
+        Evaluator(
+            name_of,
+            f"{name_of}(t) with s = ωt, harmonics by the Chebyshev recurrence ({where}).",
+            (t, *params), prelude_t, guard_t,
+            ((w, horner(omega, x)), (s, w * t), *cos_lines),
+            amplitude * sum(h * cs[n] for n, h in sorted(harmonic.items())),
+        ),
+        Evaluator(
+            f"{name_of}dot", f"d{name_of}/dt ({where}).", (t, *params), prelude_t, guard_t,
+            ((w, horner(omega, x)), (s, w * t), *both_lines),
+            -amplitude * w * sum(n * h * ss[n] for n, h in sorted(harmonic.items())),
+        ),
+        Evaluator(
+            "error_estimate",
+            "Relative truncation error of period(), a bound on the omitted tail: "
+            "|τ_{K+1}| |y|^(K+1) + c |y|^(K+2) / (1 - r|y|), its terms growing at most by "
+            "r = max(1/R, |τ_{K+2}/τ_{K+1}|) an order, R the smaller of the radius less its "
+            "spread and the distance to the orbits' edge, c = max(|τ_{K+2}|, r|τ_{K+1}|); "
+            "over the truncated sum (inf from r|y| = 1 on: no bound there).",
+            params, prelude, guard, ((total, horner(tau, x)),), estimate,
+        ),
+    )
+    numeric = ()  # the coefficients as floats, where they are numbers (no symbolic parameter)
+    if g.is_rational:
+        Q = tuple(
+            tuple(float(g.to_sympy(solution.q[j].get(n, g.scalar(0)))) for n in range(top + 1))
+            for j in range(order + 1)
+        )
+        numeric = (("OMEGA", tuple(float(c) for c in omega)),
+                   ("PERIOD", tuple(float(c) for c in tau)), ("Q", Q))
+    constants = (
+        ("ORDER", order),
+        ("MODEL", m.name),
+        ("VARIABLE", m.variable),
+        ("CONVENTION", solution.convention),
+        ("RADIUS", float(radius) if radius is not None and radius.is_number
+         else float("nan")),
+        ("RADIUS_SPREAD", float(spread)),
+        ("ORBIT_LIMIT", (domain.lower, domain.upper)),
+        ("ORBIT_LIMIT_EXACT", (domain.lower_text, domain.upper_text)),
+        ("ALLOW_DIVERGENT", allow_divergent),
+        *numeric,
+        ("OMEGA_EXACT", tuple(str(c) for c in omega)),
+        ("PERIOD_EXACT", tuple(str(c) for c in tau)),
+    )
+    return Module(
+        name=m.name,
+        doc=f"{m.title}: L–P evaluators to order {order} in {m.variable}.",
+        constants=constants,
+        evaluators=evaluators,
+        provenance=provenance(
+            m.name, order, command, allow_divergent=allow_divergent,
+            forcing=[[(n, str(c)) for n, c in terms] for terms in m.forcing[: order + 2]],
+            **({"elementary": [(n, str(a), str(w)) for n, a, w in m.elementary]}
+               if m.elementary else {}),
+            **({"equation": m.source, "frequency": str(m.frequency), "given": m.given,
+                "velocity_forcing": [[(a, b, str(c)) for a, b, c in terms]
+                                     for terms in m.velocity_forcing[: order + 2]]}
+               if m.source else {}),
+        ),
+    )
+
+
+LIMIT_CYCLE_MARGIN = sp.Rational(9, 10)
+# NOTE: the emitted limit-cycle series answer NaN from 90 % of the estimated radius on (in ε):
+# the estimate is good to ~1 % from order 60, and near the radius the terms decay slowly.
+
+
+CUBE_ROOT_STEPS = 2
+CUBE_ROOT_START = (sp.Rational("0.338153"), sp.Rational("2.00238"), sp.Rational("1.35592"))
+# NOTE: (1 − w)^(1/3) of the relaxation form: y = 1 − w scaled by 8^k into [1/8, 1] (selects,
+# k ≤ 3: y ≥ 1/4096, |eps| ≲ 50), the start (a + b y)/(1 + c y) (minimax, 0.65 % on [1/8, 1]),
+# then Halley's iteration, cubic: 2e-7 after one step, 4.4e-16 (numpy's cbrt) after two.
+# `**(1/3)` calls libm's pow, which kept the order-60 loop from vectorizing (85 against 20 ns
+# per point); five steps from 0.29 + 0.71 y, the former start, were a chain of five divisions.
+
+
+LOG_TERMS = 16
+# NOTE: ln s of the relaxation form as 4·2 atanh(u) of s^(1/4), |u| ≤ 0.28 for 1 − w ≥ 1e-3
+# (with the cube root's range): 16 terms of the odd series leave < 1e-17 relative, and the
+# loop vectorizes (math.log, a libm call, kept it scalar: 27.5 against 13 ns per point).
+
+
+def resummed_expression(r: Resummed, z: sp.Symbol, approximant: Pade | None = None
+                        ) -> tuple[tuple[Assign, ...], sp.Expr]:
+    """The body and output of a :class:`resum.Resummed` at ``z``: ``x = z**power``, Andersen
+    & Geer's ``w`` when the form has one, numerator and denominator in Horner form (exact
+    rationals: the printer rounds each once)."""
+    P = approximant or r.approximant
+    x = sp.Symbol("x")
+    body: list[Assign] = [(x, z**r.power)]
+
+    def rational(c: Fraction) -> sp.Rational:
+        return sp.Rational(c.numerator, c.denominator)
+
+    if r.R is None:
+        return tuple(body), (horner([rational(c) for c in P.numerator], x)
+                             / horner([rational(c) for c in P.denominator], x))
+    w = sp.Symbol("w")
+    body.append((w, x / sp.sqrt(x**2 - 2 * rational(r.p) * x + rational(r.R) ** 2)))
+    if r.log is None:
+        ratio = horner([rational(c) for c in P.numerator], w) / horner(
+            [rational(c) for c in P.denominator], w)
+        return tuple(body), sp.sqrt((1 - w) * ratio)
+    y, y8, scale, s, v, tail = sp.symbols("y y8 scale s v tail")
+    a, b, c = CUBE_ROOT_START
+
+    def by_range(value: Callable[[int], sp.Rational]) -> sp.Piecewise:
+        return sp.Piecewise(*((value(k), y < sp.Rational(1, 8**k)) for k in (3, 2, 1)),
+                            (sp.Float(1.0), True))
+
+    body += [(y, 1 - w), (scale, by_range(lambda k: sp.Rational(1, 2**k))),
+             (y8, y * by_range(lambda k: sp.Integer(8**k))), (s, (a + b * y8) / (1 + c * y8))]
+    for _ in range(CUBE_ROOT_STEPS):  # Halley on s³ = y8: no libm call, so the loop vectorizes
+        body.append((s, s * (s**3 + 2 * y8) / (2 * s**3 + y8)))
+    body.append((s, s * scale))
+    half, quarter, u, u2 = sp.symbols("half quarter u u2")
+    series = horner([sp.Rational(1, 2 * k + 1) for k in range(LOG_TERMS)], u2)
+    body += [(v, w / (1 + s + s**2)),  # v = 1 − s, without the cancellation near w = 0
+             # s³ ln s = y·4 ln s^(1/4) = 8y·atanh(u), u = (s^(1/4) − 1)/(s^(1/4) + 1)
+             (half, sp.sqrt(s)), (quarter, sp.sqrt(half)), (u, (quarter - 1) / (quarter + 1)),
+             (u2, u**2), (tail, 8 * y * u * series)]
+    ratio = horner([rational(c) for c in P.numerator], v) / horner(
+        [rational(c) for c in P.denominator], v)
+    return tuple(body), sp.sqrt((1 - w) * (ratio + rational(r.log) * tail))
+
+
+def lower_resummed_cycle(r: ResummedCycle) -> tuple[Evaluator, ...]:
+    """``omega_resummed(eps)``, ``period_resummed(eps)`` and ``resummed_error(eps)`` (the
+    relative difference of the neighbouring approximants), NaN beyond the verified |ε|."""
+    eps = sp.Symbol("eps")
+    guard = sp.Abs(eps) <= sp.Rational(repr(r.limit))
+    body, value = resummed_expression(r.form, eps)
+    _, other = resummed_expression(r.form, eps, r.form.neighbour)
+    omega, lower = sp.Symbol("omega"), sp.Symbol("omega_lower")
+    L, M = r.form.approximant.degrees
+    domain = (f"NaN for |eps| > {r.limit:g}, where it was not verified to "
+              f"{r.tolerance:g} against shooting")
+    form = (f"sqrt((1 - w) [{L}/{M}](w)), w = eps²/(eps⁴ - 2 eps² p + R²)^(1/2), R = {r.form.R}"
+            f", p = R cos β = {r.form.p}")
+    if r.form.log is not None:
+        form = (f"sqrt((1 - w) ([{L}/{M}](v) + λ s³ ln s)), s = (1 - w)^(1/3) = 1 - v, "
+                f"λ = {float(r.form.log)!r}, two-point Padé (the series and the relaxation "
+                f"limit), w = eps²/(eps⁴ - 2 eps² p + R²)^(1/2), R = {r.form.R}, "
+                f"p = R cos β = {r.form.p}")
+    return (
+        Evaluator("omega_resummed", f"Frequency ω resummed: {form} ({domain}).", (eps,), (),
+                  guard, body, value),
+        Evaluator("period_resummed", f"Period 2π/ω of omega_resummed ({domain}).", (eps,), (),
+                  guard, (*body, (omega, value)), 2 * sp.pi / omega),
+        Evaluator("resummed_error", "Relative difference of omega_resummed and the next "
+                  f"lower approximant [{L - 1}/{M - 1}] (an error estimate; {domain}).",
+                  (eps,), (), guard, (*body, (omega, value), (lower, other)),
+                  sp.Abs(lower - omega) / omega),
+        *_lower_resummed_amplitude(r),
+        *_lower_resummed_q(r),
+    )
+
+
+def _lower_resummed_q(r: ResummedCycle) -> tuple[Evaluator, ...]:
+    """``q_resummed(t, eps)``: each harmonic's Padé in ``w`` times cos ns or sin ns with
+    ``s = omega_resummed(eps)·t``, NaN beyond the harmonics' own verified |ε|."""
+    if not r.harmonics:
+        return ()
+    eps, t, phase, w = sp.symbols("eps t phase w")
+    body, omega = resummed_expression(r.form, eps)
+    top = max(n for _, n, _ in r.harmonics)
+    lines, cs, ss = harmonics(top, False, phase, sines=True)
+
+    def rational(c: Fraction) -> sp.Rational:
+        return sp.Rational(c.numerator, c.denominator)
+
+    value = sp.Integer(0)
+    for kind, n, form in r.harmonics:
+        P = form.approximant
+        a_n = horner([rational(c) for c in P.numerator], w) / horner(
+            [rational(c) for c in P.denominator], w)
+        value += (eps * a_n if form.odd else a_n) * (cs[n] if kind == "cos" else ss[n])
+    limit, _, worst = r.harmonics_verified
+    entry, guard = argument_entry(((eps, sp.Abs(eps) <= sp.Float(limit), 0),
+                                   (t, sp.Abs(t) <= FREE_ARGUMENT_LIMIT, 0)))
+    return (Evaluator(
+        "q_resummed", f"q(t) on the cycle (q'(0) = 0), {len(r.harmonics)} Fourier coefficients "
+        f"each Padé in w, s = omega_resummed(eps)·t (NaN for |eps| > {limit:g}; "
+        f"{worst:.1e} of max |q| at its checks over one period).", (t, eps), tuple(entry),
+        guard, (*body, (phase, omega * t), *lines), value),)
+
+
+def _lower_resummed_amplitude(r: ResummedCycle) -> tuple[Evaluator, ...]:
+    """``amplitude_resummed(eps)``: q(0) as the Padé form in ε², NaN beyond its own verified
+    |ε| (none without a verified form)."""
+    if r.amplitude is None:
+        return ()
+    eps = sp.Symbol("eps")
+    limit, _, _ = r.amplitude_verified
+    body, value = resummed_expression(r.amplitude, eps)
+    L, M = r.amplitude.approximant.degrees
+    return (Evaluator(
+        "amplitude_resummed", f"q(0) at q̇(0) = 0, Padé [{L}/{M}] in eps² (NaN for |eps| > "
+        f"{limit:g}, where it was not verified to {r.tolerance:g} against shooting).", (eps,),
+        (), sp.Abs(eps) <= sp.Rational(repr(limit)), body, value),)
+
+
+def mathieu_newton_steps(kind: str, m: int, q: sp.Symbol, start: sp.Expr, rows: int,
+                         steps: int) -> tuple[tuple[Assign, ...], sp.Expr, sp.Expr]:
+    """The body, value and last correction of ``steps`` Newton steps on ``det(T_rows − a)``
+    from ``start``, unrolled: the leading minors ``p_j`` (rows 0…k, ``k = rows // 2``) and
+    trailing ones ``s_j`` (rows j…rows−1) with their a-derivatives, two independent chains
+    (:func:`numerics.mathieu_newton`, the same recurrences, which the verification runs)."""
+    _, diag, couplings = mathieu_recurrence(kind, m, rows)
+    qq = sp.Symbol("qq")
+    a = sp.Symbol("a_0")
+    body: list[Assign] = [(qq, q**2), (a, start)]
+    step = sp.Integer(0)
+    k = rows // 2
+
+    def c(j: int) -> sp.Expr:
+        return sp.Integer(diag[j][0]) + diag[j][1] * q - a
+
+    for n in range(1, steps + 1):
+        p_prev, dp_prev, p, dp = sp.Integer(1), sp.Integer(0), c(0), sp.Integer(-1)
+        s_next, ds_next, s, ds = sp.Integer(1), sp.Integer(0), c(rows - 1), sp.Integer(-1)
+        forward = list(range(1, k + 1))
+        backward = list(range(rows - 2, k, -1))
+        for i in range(max(len(forward), len(backward))):  # the two chains interleaved
+            if i < len(forward):
+                j = forward[i]
+                pj, dpj = sp.symbols(f"p{n}_{j} dp{n}_{j}")
+                e2 = couplings[j - 1] * qq
+                body += [(pj, c(j) * p - e2 * p_prev), (dpj, c(j) * dp - p - e2 * dp_prev)]
+                p, p_prev, dp, dp_prev = pj, p, dpj, dp
+            if i < len(backward):
+                j = backward[i]
+                sj, dsj = sp.symbols(f"s{n}_{j} ds{n}_{j}")
+                e2 = couplings[j] * qq
+                body += [(sj, c(j) * s - e2 * s_next), (dsj, c(j) * ds - s - e2 * ds_next)]
+                s, s_next, ds, ds_next = sj, s, dsj, ds
+        e2 = couplings[k] * qq
+        det, ddet = sp.symbols(f"det_{n} ddet_{n}")
+        step, a_next = sp.Symbol(f"step_{n}"), sp.Symbol(f"a_{n}")
+        body += [(det, p * s - e2 * p_prev * s_next),
+                 (ddet, dp * s + p * ds - e2 * (dp_prev * s_next + p_prev * ds_next)),
+                 (step, det / ddet), (a_next, a - step)]
+        a = a_next
+    return tuple(body), a, step
+
+
+def lower_mathieu(r: ResummedMathieu, command: str) -> Module:
+    """``{kind}{m}(q)`` (say ``a0``): the Padé value refined by Newton on the recurrence's
+    determinant, and ``{kind}{m}_error(q)`` (the relative size of the last Newton step, the
+    error of the value it corrects), NaN outside the verified q."""
+    q = sp.Symbol("q")
+    name = f"{r.kind}{r.m}"
+    bound = sp.Rational(repr(r.limit))
+    guard = sp.Abs(q) <= bound if r.form.power == 2 else sp.And(q >= 0, q <= bound)
+    pade, start = resummed_expression(r.form, q)
+    newton, value, step = mathieu_newton_steps(r.kind, r.m, q, start, r.rows, r.steps)
+    body = (*pade, *newton)
+    L, M = r.form.approximant.degrees
+    var = "q²" if r.form.power == 2 else "q"
+    domain = (f"NaN outside {'|q|' if r.form.power == 2 else '0 ≤ q'} ≤ {r.limit:g}, where "
+              f"it was verified to {r.tolerance:g}·max(1, |{name}|) against the eigenvalues "
+              "of the recurrence's matrix at 30 digits")
+    method = (f"Padé [{L}/{M}] in {var} of the exact series (of the Padé of its truncations "
+              f"to order ≤ {r.order}, the one of fewest degrees verified as far), then "
+              f"{r.steps} Newton step(s) on the determinant of the recurrence's {r.rows} rows")
+    evaluators = (
+        Evaluator(name, f"Mathieu's {r.kind}_{r.m}(q) (DLMF 28.2): {method} ({domain}).",
+                  (q,), (), guard, body, value),
+        Evaluator(f"{name}_error", f"|last Newton step| / max(1, |{name}|): the error of the "
+                  f"value the step corrects, an upper estimate ({domain}).", (q,), (), guard,
+                  body, sp.Abs(step) / sp.Max(1, sp.Abs(value))),
+    )
+    constants = (
+        ("ORDER", r.order), ("MODEL", f"mathieu_{name}"), ("VARIABLE", "q"),
+        ("LIMIT", r.limit), ("TOLERANCE", r.tolerance), ("CHECKED_ERROR", r.checked),
+        ("DEGREES", (L, M)), ("SYMMETRIC", r.form.power == 2), ("ROWS", r.rows),
+        ("NEWTON_STEPS", r.steps),
+    )
+    return Module(
+        name=f"mathieu_{name}",
+        doc=f"Mathieu's characteristic value {r.kind}_{r.m}(q) of y'' + (a - 2q cos 2z) y = 0, "
+            "resummed past the radius of its series and refined by Newton.",
+        constants=constants, evaluators=evaluators,
+        provenance=provenance(f"mathieu_{name}", r.order, command,
+                              numerator=[_hex(c) for c in r.form.approximant.numerator],
+                              denominator=[_hex(c) for c in r.form.approximant.denominator],
+                              limit=r.limit, rows=r.rows, steps=r.steps),
+    )
+
+
+def lower_tongue(r: ResummedTongue, command: str) -> Module:
+    """``delta_<i>(eps)`` for curve i of the tongue (the Padé of its series), and
+    ``delta_<i>_error(eps)`` (|difference to the next lower approximant|, an estimate), NaN
+    outside the verified ε."""
+    eps = sp.Symbol("eps")
+    evaluators: list[Evaluator] = []
+    constants: list[tuple[str, object]] = [("ORDER", r.order), ("MODEL", f"tongue_{r.n}"),
+                                           ("VARIABLE", "eps"), ("TOLERANCE", r.tolerance)]
+    for i, c in enumerate(r.curves):
+        bound = sp.Rational(repr(c.limit))
+        guard = sp.Abs(eps) <= bound if c.form.power == 2 else sp.And(eps >= 0, eps <= bound)
+        body, value = resummed_expression(c.form, eps)
+        _, other = resummed_expression(c.form, eps, c.form.neighbour)
+        L, M = c.form.approximant.degrees
+        var = "eps²" if c.form.power == 2 else "eps"
+        domain = (f"NaN outside {'|eps|' if c.form.power == 2 else '0 ≤ eps'} ≤ {c.limit:g}, "
+                  f"where it was verified to {r.tolerance:g} in delta against the Floquet "
+                  "boundary |tr M| = 2")
+        delta, lower = sp.Symbol("delta"), sp.Symbol("delta_lower")
+        name = f"delta_{i}"
+        evaluators += [
+            Evaluator(name, f"Transition curve {c.label} of tongue {r.n}: Padé [{L}/{M}] in "
+                      f"{var} of the exact series to order {r.order} ({domain}).", (eps,), (),
+                      guard, body, value),
+            Evaluator(f"{name}_error", f"|{name} − Padé [{L - 1}/{M - 1}]|: an error estimate "
+                      f"in delta ({domain}).", (eps,), (), guard,
+                      (*body, (delta, value), (lower, other)), sp.Abs(delta - lower)),
+        ]
+        constants += [(f"LABEL_{i}", one_line(c.label)), (f"LIMIT_{i}", c.limit),
+                      (f"CHECKED_ERROR_{i}", c.checked), (f"DEGREES_{i}", (L, M)),
+                      (f"SYMMETRIC_{i}", c.form.power == 2)]
+    return Module(
+        name=f"tongue_{r.n}",
+        doc=f"Transition curves delta(eps) out of tongue n = {r.n} (delta = n²/4) of "
+            f"x'' + (delta + eps p(t)) x = 0, p(t) = {r.p}, resummed past the radius of "
+            "their series.",
+        constants=tuple(constants), evaluators=tuple(evaluators),
+        provenance=provenance(f"tongue_{r.n}", r.order, command, p=r.p, n=r.n, curves=[
+            {"numerator": [_hex(x) for x in c.form.approximant.numerator],
+             "denominator": [_hex(x) for x in c.form.approximant.denominator],
+             "limit": c.limit} for c in r.curves]),
+    )
+
+
+def lower_limit_cycle(lc: LimitCycle, command: str, order: int,
+                      resummed: ResummedCycle | None = None) -> Module:
+    """Evaluators ``omega(eps)``, ``period(eps)``, ``amplitude(eps)`` (q(0), at q̇(0) = 0),
+    ``q(t, eps)`` and ``error_estimate(eps)`` of a limit cycle's L–P series to ``order``
+    (``lc`` derived further: K + 2 for the estimate, and far enough for the radius), NaN where
+    |ε| is beyond 90 % of the radius :func:`lindstedt.nearest_singularity` estimates from ω's
+    exact coefficients."""
+    if not 1 <= order <= lc.order - 2:
+        raise ValueError(f"order {order}: the cycle is derived to {lc.order}, not K + 2")
+    eps, t, w, s, total = sp.symbols("eps t w s T")
+    rational = [sp.Rational(c.numerator, c.denominator) for c in lc.omega]
+    omega = rational[: order + 1]
+    tau = [sp.Rational(c.numerator, c.denominator) for c in lc.period[: order + 1]]
+    amp = [sp.Rational(c.numerator, c.denominator) for c in lc.amplitude[: order + 1]]
+    est = nearest_singularity(lc.omega)
+    radius = None
+    if est is not None:
+        radius = est.radius ** 0.5 if est.variable.endswith("**2") else est.radius
+        radius = LIMIT_CYCLE_MARGIN * sp.Rational(repr(float(radius)))
+    # without a radius, |ε| ≤ 10^(300/(K+2)) keeps ε^(K+2) finite; q(t, ε) also needs t finite
+    within = sp.Abs(eps) < radius if radius is not None else \
+        sp.Abs(eps) <= sp.Float(10.0 ** (300 // (order + 2)))
+    entry, guard = argument_entry(((eps, within, 0),))
+    entry_t, guard_t = argument_entry(((eps, within, 0),
+                                       (t, sp.Abs(t) <= FREE_ARGUMENT_LIMIT, 0)))
+    top = max(max((*cos, *sin), default=1) for cos, sin in lc.q[: order + 1])
+    cos_lines, cs, ss = harmonics(top, False, s, sines=True)
+
+    def in_eps(table: dict) -> sp.Expr:
+        return horner([table.get(j, sp.Integer(0)) for j in range(order + 1)], eps)
+
+    cos_h: dict[int, dict] = {}
+    sin_h: dict[int, dict] = {}
+    for j, (cos, sin) in enumerate(lc.q[: order + 1]):
+        for n, c in cos.items():
+            cos_h.setdefault(n, {})[j] = sp.Rational(c.numerator, c.denominator)
+        for n, c in sin.items():
+            sin_h.setdefault(n, {})[j] = sp.Rational(c.numerator, c.denominator)
+    q_value = sum((in_eps(h) * cs[n] for n, h in sorted(cos_h.items())), sp.Integer(0)) + sum(
+        (in_eps(h) * ss[n] for n, h in sorted(sin_h.items())), sp.Integer(0))
+    tail = abs(sp.Rational(lc.period[order + 1].numerator, lc.period[order + 1].denominator))
+    tail2 = abs(sp.Rational(lc.period[order + 2].numerator, lc.period[order + 2].denominator))
+    estimate = (tail * sp.Abs(eps) ** (order + 1) + tail2 * sp.Abs(eps) ** (order + 2)) \
+        / sp.Abs(total)
+    domain = ("NaN from 90 % of the estimated radius of convergence on"
+              if radius is not None else "no radius estimate: no guard")
+    args = (eps,)
+    entry = tuple(entry)
+    evaluators = (
+        Evaluator("omega", f"Frequency ω of the limit cycle to order {order} ({domain}).",
+                  args, entry, guard, (), horner(omega, eps)),
+        Evaluator("period", f"Period 2π Σ τ_j ε^j to order {order} ({domain}).", args, entry,
+                  guard, (), 2 * sp.pi * horner(tau, eps)),
+        Evaluator("amplitude", f"q(0) at q̇(0) = 0, to order {order} ({domain}).", args,
+                  entry, guard, (), horner(amp, eps)),
+        Evaluator("q", f"q(t) on the cycle, q̇(0) = 0, s = ωt ({domain}).", (t, eps),
+                  tuple(entry_t), guard_t,
+                  ((w, horner(omega, eps)), (s, w * t), *cos_lines), q_value),
+        Evaluator("error_estimate", "Relative truncation error of period(): its first two "
+                  "omitted terms over the sum.", args, entry, guard,
+                  ((total, horner(tau, eps)),), estimate),
+    )
+    m = lc.model
+    constants = (
+        ("ORDER", order),
+        ("MODEL", m.name),
+        ("VARIABLE", "eps"),
+        ("CONVENTION", "q'(0) = 0; q(0) = amplitude(eps)"),
+        ("RADIUS", float(radius) if radius is not None else float("nan")),
+        ("OMEGA_EXACT", tuple(str(c) for c in omega)),
+        ("PERIOD_EXACT", tuple(str(c) for c in tau)),
+        ("AMPLITUDE_EXACT", tuple(str(c) for c in amp)),
+    )
+    if resummed is not None:
+        evaluators = (*evaluators, *lower_resummed_cycle(resummed))
+        constants = (*constants, *resummed_constants(resummed))
+    return Module(
+        name=m.name,
+        doc=f"{m.title}: its limit cycle's L–P evaluators to order {order} in eps.",
+        constants=constants,
+        evaluators=evaluators,
+        provenance=provenance(m.name, order, command, equation=m.source,
+                              terms=[(a, b, str(c)) for a, b, c in m.terms],
+                              **({"resummed": resummed_constants(resummed)}
+                                 if resummed is not None else {})),
+    )
+
+
+def resummed_constants(r: ResummedCycle) -> tuple[tuple[str, object], ...]:
+    """What the module states about its resummed evaluators: the verified |ε|, the
+    tolerance, the largest error measured at the reference points, the degrees."""
+    return (("RESUMMED_LIMIT", r.limit), ("RESUMMED_TOLERANCE", r.tolerance),
+            ("RESUMMED_CHECKED", tuple(r.points)), ("RESUMMED_ERROR", r.checked),
+            ("RESUMMED_DEGREES", r.form.approximant.degrees),
+            *((("AMPLITUDE_RESUMMED_LIMIT", r.amplitude_verified[0]),
+               ("AMPLITUDE_RESUMMED_ERROR", r.amplitude_verified[2]))
+              if r.amplitude is not None else ()),
+            *((("Q_RESUMMED_LIMIT", r.harmonics_verified[0]),
+               ("Q_RESUMMED_ERROR", r.harmonics_verified[2]),
+               ("Q_RESUMMED_HARMONICS", len(r.harmonics)))
+              if r.harmonics else ()))

@@ -1,0 +1,254 @@
+"""What ``generate`` derives and lowers, per target: its files, its derivation and its
+lowering (:class:`Target`), from one :class:`Request`."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..analysis.driven import (
+    Drive,
+    amplitudes,
+    balance_equations,
+    damped_determinant,
+    first_order_branches,
+    harmonic_balance,
+    mu_expansion,
+    mu_expansion_damped,
+    mu_expansion_exact,
+)
+from ..derive.averaging import slow_flow
+from ..derive.lindstedt import derive, derive_limit_cycle
+from ..derive.models import Model, SelfExcited
+from ..errors import InputError
+from ..lower.documents import (
+    lower_choice,
+    lower_cycle_derivation,
+    lower_derivation,
+    lower_fourier,
+    lower_slow_flow,
+)
+from ..lower.driven import lower_balance, lower_driven, lower_driven_damped
+from ..lower.records import (
+    MuDampedDerivation,
+    MuDerivation,
+    NotesTable,
+    Unit,
+)
+from ..lower.series import lower_free, lower_limit_cycle, lower_mathieu, lower_tongue
+from ..numerics.integrate import shoot
+from .verify import resum_cycle, resum_mathieu, resum_tongue
+
+if TYPE_CHECKING:
+    from .registry import Candidate
+
+
+Progress = Callable[[int, int], None]
+
+# --- emission: what `generate` derives and lowers ------------------------------------------------
+
+@dataclass(frozen=True)
+class Request:
+    """One emission asked for: its order (or harmonics), the command that asked, and what the
+    target needs besides (the free oscillator, the verified candidate and range)."""
+
+    order: int
+    command: str
+    model: Model | SelfExcited | None = None
+    allow_divergent: bool = False
+    candidate: Candidate | None = None
+    verified: tuple[float, float] = (0.0, 0.0)
+    mathieu: tuple[str, int] | None = None  # (kind, m) of a Mathieu characteristic value
+    tongue: tuple[str, int] | None = None  # (p(t) as text, n) of a tongue's transition curves
+    resum_order: int | None = None  # a limit cycle's ω series for the radius and resummation
+
+
+@dataclass(frozen=True)
+class Target:
+    """What a method emits: its files, and its derive and lower stages (the compiler calls
+    each once, in order, then renders and writes)."""
+
+    files: Callable[[Request], tuple[str, ...]]
+    derive: Callable[[Request, Progress | None], object]
+    lower: Callable[[object, Request], Unit]
+
+
+def _free_files(r: Request) -> tuple[str, ...]:
+    name = r.model.name
+    return (f"{name}.py", f"{name}_tables.tex", f"{name}_derivation.tex")
+
+
+def _free_derive(r: Request, progress: Progress | None) -> object:
+    return derive(r.model, r.order + 2, progress)
+
+
+def _free_lower(solution: object, r: Request) -> Unit:
+    module = lower_free(solution, r.command, r.allow_divergent)
+    return Unit(module, (lower_derivation(solution, r.order),))
+
+
+def _cycle_files(r: Request) -> tuple[str, ...]:
+    return (f"{r.model.name}.py", f"{r.model.name}_derivation.tex")
+
+
+RADIUS_ORDER = 60
+# NOTE: a limit cycle's radius is estimated from ω to at least this order (1 % from order 60
+# for van der Pol), whatever order its evaluators sum.
+
+
+def cycle_series_order(order: int, resum_order: int | None) -> int:
+    """The order a limit cycle's exact series is derived to when its evaluators sum
+    ``order``: ``resum_order`` when given (its radius estimate and resummed ω use every
+    term), else :data:`RADIUS_ORDER`, and never below ``order + 2``."""
+    return max(order + 2, RADIUS_ORDER if resum_order is None else resum_order)
+
+
+def _cycle_derive(r: Request, progress: Progress | None) -> object:
+    from ..derive.lindstedt import limit_cycles
+
+    first = limit_cycles(r.model)[0]
+    if not first.rational:
+        raise InputError(f"{r.model.name}: the limit cycle's amplitude {first.amplitude} is "
+                         "irrational: `lindstedt series` gives its exact series in "
+                         f"Q({first.amplitude}); the evaluators and their resummation need "
+                         "rational coefficients and are not emitted for it")
+    lc = derive_limit_cycle(r.model, cycle_series_order(r.order, r.resum_order))
+    return lc, resum_cycle(lc)
+
+
+def _cycle_lower(derived: object, r: Request) -> Unit:
+    import sys
+
+    cycle, resummed = derived
+    # NOTE: the exact coefficients pass Python's 4300-digit int → str limit from order ~150
+    # (the module's OMEGA_EXACT, AMPLITUDE_EXACT and the LaTeX); lifted while lowering.
+    limit = sys.get_int_max_str_digits()
+    sys.set_int_max_str_digits(0)
+    try:
+        return Unit(lower_limit_cycle(cycle, r.command, r.order, resummed),
+                    (lower_cycle_derivation(cycle, r.order),))
+    finally:
+        sys.set_int_max_str_digits(limit)
+
+
+def _mathieu_files(r: Request) -> tuple[str, ...]:
+    kind, m = r.mathieu
+    return (f"mathieu_{kind}{m}.py",)
+
+
+def _mathieu_derive(r: Request, progress: Progress | None) -> object:
+    kind, m = r.mathieu
+    return resum_mathieu(kind, m, r.order)
+
+
+def _mathieu_lower(derived: object, r: Request) -> Unit:
+    return Unit(lower_mathieu(derived, r.command))
+
+
+def _tongue_derive(r: Request, progress: Progress | None) -> object:
+    text, n = r.tongue
+    return resum_tongue(text, n, r.order)
+
+
+def _tongue_lower(derived: object, r: Request) -> Unit:
+    return Unit(lower_tongue(derived, r.command))
+
+
+NOTES_DRIVE = (0.1, 1.0, 1.0)
+# NOTE: ε, f, ω of the notes' table (§10.4, undamped), reproduced in every driven derivation.
+NOTES_TABLE_ORDERS = 6
+
+
+def notes_table() -> NotesTable:
+    """The notes' table: A₁, A₃, A₅ by μ-order, harmonic balance and shooting."""
+    eps, force, omega = NOTES_DRIVE
+    d = Drive(eps, force, omega)
+    (branch,) = first_order_branches(d)
+    mu = mu_expansion(d, branch, NOTES_TABLE_ORDERS)
+
+    def cells(A: dict) -> tuple[tuple[int, float | str], ...]:
+        return tuple((n, A[n] if A.get(n) else "") for n in (1, 3, 5))
+
+    rows = [(f"$\\mu$-expansion, order {j}", cells(amplitudes(*mu.partial(j), 2 * j + 1)[0]))
+            for j in range(NOTES_TABLE_ORDERS + 1)]
+    hb = harmonic_balance(d, branch, 8)
+    A, _ = amplitudes(hb.coefficients, 0.0, 15)
+    rows.append(("harmonic balance, $N = 8$", cells(A)))
+    orbit = shoot(eps, force, omega, 0.0, np.array([sum(A.values()), 0.0]))
+    rows.append(("numerical (shooting)", cells(orbit.A)))
+    rows.append(("notes: numerical", ((1, "2.356"), (3, "0.0456"), (5, "0.0008"))))
+    return NotesTable(eps, force, omega, tuple(rows))
+
+
+def _mu_derive(r: Request, progress: Progress | None) -> object:
+    return mu_expansion_exact(r.order), notes_table()
+
+
+def _mu_lower(derived: object, r: Request) -> Unit:
+    orders, table = derived
+    return Unit(lower_driven(orders, r.command), (MuDerivation(r.order, orders, table),))
+
+
+def _balance_derive(r: Request, progress: Progress | None) -> object:
+    return balance_equations(r.order)
+
+
+def _balance_lower(eqs: object, r: Request) -> Unit:
+    return Unit(lower_balance(eqs, r.command))
+
+
+def _fourier_derive(r: Request, progress: Progress | None) -> object:
+    harmonics = r.order
+    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 60:
+        raise InputError(f"harmonics {harmonics!r}: must be an integer in 1..60")
+    return harmonics  # closed form: nothing to derive but the count
+
+
+def _fourier_lower(harmonics: object, r: Request) -> Unit:
+    return Unit(lower_fourier(harmonics, r.command))
+
+
+def _choice_derive(r: Request, progress: Progress | None) -> object:
+    return r.candidate  # derived and verified by choose
+
+
+def _choice_lower(c: object, r: Request) -> Unit:
+    return Unit(lower_choice(c.method.formula(c), r.command, r.verified))
+
+
+FREE = Target(_free_files, _free_derive, _free_lower)
+LIMIT_CYCLE = Target(_cycle_files, _cycle_derive, _cycle_lower)
+MU = Target(lambda r: ("driven.py", "driven_derivation.tex"), _mu_derive, _mu_lower)
+BALANCE = Target(lambda r: ("balance.py",), _balance_derive, _balance_lower)
+
+
+DAMPED_MAX = 11
+# NOTE: the damped μ-expansion is emitted at orders 1..11 (its derivation's bound, one order
+# more estimates the truncation error); interpreted, it is the float μ-expansion's solve.
+
+
+def _mu_damped_derive(r: Request, progress: Progress | None) -> object:
+    if isinstance(r.order, bool) or not isinstance(r.order, int) or not 1 <= r.order <= DAMPED_MAX:
+        raise InputError(f"order {r.order!r}: the damped μ-expansion is emitted at orders "
+                         f"1..{DAMPED_MAX}")
+    return mu_expansion_damped(r.order + 1)  # one order more: the truncation error's estimate
+
+
+def _mu_damped_lower(orders: object, r: Request) -> Unit:
+    return Unit(lower_driven_damped(orders, r.command),
+                (MuDampedDerivation(r.order, orders[: r.order], damped_determinant()),))
+
+
+MU_DAMPED = Target(lambda r: ("driven_damped.py", "driven_damped_derivation.tex"),
+                   _mu_damped_derive, _mu_damped_lower)
+FOURIER = Target(lambda r: ("fourier.py",), _fourier_derive, _fourier_lower)
+CHOSEN_PERIOD = Target(lambda r: ("chosen_period.py",), _choice_derive, _choice_lower)
+SLOW_FLOW = Target(lambda r: (f"{r.model.name}_slow_flow.py", f"{r.model.name}_slow_flow.tex"),
+                   lambda r, progress: slow_flow(r.model, r.order),
+                   lambda flow, r: lower_slow_flow(flow, r.command))
+# NOTE: the slow flow's request carries the user's models.Oscillator as its model.
+MATHIEU = Target(_mathieu_files, _mathieu_derive, _mathieu_lower)
+TONGUE = Target(lambda r: (f"tongue_{r.tongue[1]}.py",), _tongue_derive, _tongue_lower)
