@@ -20,7 +20,8 @@ from lindstedt.analysis.driven import (
 from lindstedt.analysis.response import continue_balance, one_harmonic_curve
 from lindstedt.compiler import generate_balance
 from lindstedt.emit.render import load_generated
-from lindstedt.numerics.integrate import shoot, sweep
+from lindstedt.numerics.integrate import sweep
+from lindstedt.numerics.shooting import shoot
 from timing import best
 
 

@@ -11,15 +11,11 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from lindstedt.analysis.driven import (
-    Drive,
-    first_order_branches,
-    mu_expansion_damped,
-    mu_expansion_exact,
-)
+from lindstedt.analysis.driven import Drive, first_order_branches
+from lindstedt.analysis.mu_exact import mu_expansion_damped, mu_expansion_exact
 from lindstedt.compiler import generate_driven
 from lindstedt.emit.render import load_generated
-from lindstedt.numerics.integrate import shoot
+from lindstedt.numerics.shooting import shoot
 from timing import median
 
 DAMPED_ORDERS = range(1, 7)

@@ -18,7 +18,7 @@ import numpy as np
 from lindstedt.analysis.driven import Drive, amplitudes
 from lindstedt.analysis.response import periodic_orbits
 from lindstedt.analysis.subharmonic import subharmonic
-from lindstedt.numerics.integrate import multipliers_stable, orbit_hill_multipliers
+from lindstedt.numerics.floquet import multipliers_stable, orbit_hill_multipliers
 
 
 def _verdict(stable: bool | None, name: str, missing: str) -> str:

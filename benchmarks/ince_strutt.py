@@ -23,7 +23,7 @@ import time
 import numpy as np
 from lindstedt.derive.hill import mathieu_series, tongue_tip, transition_curves
 from lindstedt.derive.lindstedt import nearest_singularity
-from lindstedt.numerics.integrate import floquet_stable, floquet_traces
+from lindstedt.numerics.floquet import floquet_stable, floquet_traces
 from scipy.integrate import solve_ivp
 
 GRID = 400

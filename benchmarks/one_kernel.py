@@ -8,13 +8,8 @@ from __future__ import annotations
 import numpy as np
 import timing
 from lindstedt.analysis.driven import Drive, first_order_branches, harmonic_balance, mu_expansion
-from lindstedt.numerics.integrate import (
-    duffing_table,
-    flow,
-    hill_multipliers,
-    steady_state_amplitudes,
-    sweep,
-)
+from lindstedt.numerics.floquet import hill_multipliers
+from lindstedt.numerics.integrate import duffing_table, flow, steady_state_amplitudes, sweep
 
 
 def best(f, n: int) -> float:

@@ -17,8 +17,8 @@ import time
 from unittest import mock
 
 from flint import fmpq, fmpq_poly
-from lindstedt import lindstedt
 from lindstedt.algebra.series import Ground
+from lindstedt.derive import lindstedt
 from lindstedt.derive.models import duffing
 from sympy.external.gmpy import GROUND_TYPES
 from sympy.polys.domains import QQ

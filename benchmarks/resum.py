@@ -50,7 +50,7 @@ from lindstedt.derive.models import series_model
 from lindstedt.emit.render import load_generated
 from lindstedt.errors import InputError
 from lindstedt.methods.verify import RELAXATION_SPREAD_MARGIN, RESUM_TOLERANCE
-from lindstedt.numerics.integrate import cycle_reference, mathieu_reference, mathieu_refined
+from lindstedt.numerics.references import cycle_reference, mathieu_reference, mathieu_refined
 from scipy.special import mathieu_a, mathieu_b
 from timing import best
 

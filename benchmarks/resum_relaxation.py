@@ -27,7 +27,7 @@ from lindstedt.compiler import generate_limit_cycle
 from lindstedt.derive.lindstedt import derive_limit_cycle, nearest_singularity
 from lindstedt.derive.models import series_model
 from lindstedt.emit.render import load_generated
-from lindstedt.numerics.integrate import cycle_reference
+from lindstedt.numerics.references import cycle_reference
 from timing import median
 
 ORDERS = (60, 100, 130, 164)

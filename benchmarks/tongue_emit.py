@@ -23,7 +23,7 @@ from lindstedt.derive.hill import fourier_of_text, transition_curves
 from lindstedt.derive.lindstedt import nearest_singularity
 from lindstedt.emit.render import load_generated
 from lindstedt.methods import verify as methods
-from lindstedt.numerics.integrate import floquet_traces
+from lindstedt.numerics.floquet import floquet_traces
 from scipy.optimize import brentq
 from timing import best, median
 

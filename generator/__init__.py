@@ -23,12 +23,20 @@ order; a stage imports only stages above it::
     derive.averaging  the slow flow of q'' + q = ε f (+ ε F cos   Oscillator, K -> SlowFlow
                     ωt): near-identity averaging to any order in van der Pol's variables,
                     exact (R_k, Φ_k of dr/dt, dφ/dt)
-    numerics.integrate  references: elliptic periods, Jacobi cn; one RK4 step for any
-                    polynomial force table: shooting + Floquet, sweeps, true folds,
-                    simulations
-    analysis.driven  μ-expansion with phase, harmonic balance      Drive | equation ->
-                    (Duffing; and a user's polynomial force by      branches
-                    alternating frequency/time)
+    numerics.integrate  the one integrator: RK4 of any polynomial  ForceTable -> flows
+                    force table, compiled; flows, sweeps with their jumps, simulations
+    numerics.floquet  Floquet multipliers: Hill about q₀, a damped  orbit -> multipliers
+                    pump over a grid, the full Hill equation, the verdict
+    numerics.shooting  periodic orbits by Newton on the flow map,  guess -> PeriodicOrbit
+                    true folds, true limit cycles
+    numerics.references  elliptic periods, cn, the pendulum, a     x -> truth
+                    cycle by DOP853, Mathieu by the Hill matrix and mpmath
+    analysis.driven  the notes' driven Duffing: one harmonic,      Drive -> branches
+                    μ-expansion with phase, harmonic balance
+    analysis.mu_exact  the μ-expansion (undamped, damped) and the  K -> exact orders
+                    balance equations, exactly, for LaTeX and emission
+    analysis.polynomial  a user's driven equation lowered to data, text -> DrivenEquation
+                    the Galerkin balance of any polynomial force, an amplitude bound
     analysis.response  one-harmonic curves and folds, balance      Drive | equation,
                     continuation in ω or in the drive; every        ω range -> folds
                     periodic orbit at one drive

@@ -536,7 +536,7 @@ def ince_strutt_figure(path: Path, p: str = "cos(t)", zeta: float = 0.05, grid: 
     dashed elsewhere; with damping, the tongues' tips ε_min(ζ) of :func:`hill.tongue_tip`."""
     from .derive.hill import fourier_of_text, tongue_tip, transition_curves
     from .derive.lindstedt import nearest_singularity
-    from .numerics.integrate import floquet_stable, floquet_traces
+    from .numerics.floquet import floquet_stable, floquet_traces
 
     check_plot_path(path)
     harmonics = fourier_of_text(p)

@@ -47,7 +47,7 @@ from .methods.references import (
     reference_q,
 )
 from .methods.registry import SIMPLEST_FIRST, Candidate, Method, candidates, method, methods_for
-from .numerics.integrate import shoot
+from .numerics.shooting import shoot
 
 Progress = Callable[[int, int], None]
 # NOTE: ``progress(done, total)`` lets the command line draw a bar over the long loops.
@@ -779,7 +779,7 @@ def choose_limit_cycle(tol: float, eps_min: float, eps_max: float, order: int | 
     two-tolerance difference there)."""
     from .compiler import generate_limit_cycle
     from .derive.models import series_model
-    from .numerics.integrate import cycle_reference
+    from .numerics.references import cycle_reference
 
     if not (0 < eps_min <= eps_max) or not (tol > 0):
         raise InputError(f"--x-min {eps_min}, --x-max {eps_max}, --tol {tol}: need "
@@ -814,7 +814,7 @@ def choose_mathieu(kind: str, m: int, tol: float, q_min: float, q_max: float,
     from .algebra.resum import horner_float
     from .compiler import generate_mathieu
     from .derive.hill import mathieu_series
-    from .numerics.integrate import mathieu_reference
+    from .numerics.references import mathieu_reference
 
     if not (q_min <= q_max) or not (tol > 0):
         raise InputError(f"--x-min {q_min}, --x-max {q_max}, --tol {tol}: need x-min ≤ x-max "

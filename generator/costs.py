@@ -290,7 +290,7 @@ RESPONSE_EQUATION_ENDS = 2 * 15.0
 def response_equation_cost(args: argparse.Namespace) -> Cost:
     """``response EQUATION``: the equation lowered (refused in one line before anything runs),
     its range and continuation estimated as the command will run them."""
-    from .analysis.driven import PolynomialBalance
+    from .analysis.polynomial import PolynomialBalance
     from .analysis.response import equation_continuation_seconds, equation_range, response_equation
 
     values: dict[str, str] = {}

@@ -451,10 +451,10 @@ def kernel_signatures() -> dict[str, int]:
     worker's counts stay fixed from task to task (no recompiling)."""
     from numba.core.registry import CPUDispatcher
 
-    from .numerics import integrate as numerics
+    from .numerics import floquet, integrate, shooting
 
-    return {name: len(f.signatures) for name, f in vars(numerics).items()
-            if isinstance(f, CPUDispatcher)}
+    return {name: len(f.signatures) for module in (integrate, floquet, shooting)
+            for name, f in vars(module).items() if isinstance(f, CPUDispatcher)}
 
 
 def warm_up(kind: str | Kind) -> dict[str, int]:
@@ -938,7 +938,7 @@ def _point_values(spec: EquationSpec, axis: Mapping[str, float]) -> dict[str, st
 def _equation_response(spec: EquationSpec, **axis: float) -> dict:
     """Every 1:1 orbit at one point (:func:`response.equation_orbits`: the balance continued in
     the drive amplitude, each crossing shot), largest r first, with its Floquet verdict."""
-    from .analysis.driven import driven_equation
+    from .analysis.polynomial import driven_equation
     from .analysis.response import equation_orbits
 
     values = _point_values(spec, axis)
@@ -991,7 +991,7 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
     parameters of the equation (its drive frequency included), every other parameter has a
     value in ``values``; refused in one line: an axis that names no parameter, a parameter
     both an axis and a value, a parameter with neither, a kind that takes no equation."""
-    from .analysis.driven import driven_form
+    from .analysis.polynomial import driven_form
     from .analysis.subharmonic import check_n
     from .derive.models import oscillator
 

@@ -228,7 +228,7 @@ def test_modified_lindstedt_of_cheung_chen_lau():
 
 def test_choose_amplitudes_meets_the_tolerance_against_shooting():
     from lindstedt.choose import choose_driven
-    from lindstedt.numerics.integrate import shoot
+    from lindstedt.numerics.shooting import shoot
 
     c = choose_driven("amplitudes", 1e-8, 0.1, 0.3, 20.0, 1.3)
     assert c.max_error <= 1e-8 and c.method in ("mu_expansion", "harmonic_balance", "shooting")
@@ -279,7 +279,7 @@ def test_choose_response_over_a_range_holds_between_the_points():
         mu_expansion,
     )
     from lindstedt.choose import choose_driven
-    from lindstedt.numerics.integrate import shoot
+    from lindstedt.numerics.shooting import shoot
 
     c = choose_driven("response", 1e-6, 0.1, 0.3, 20.0, 0.5, 1.0)
     assert c.max_error <= 1e-6 and c.verified_on >= 20
@@ -392,7 +392,7 @@ def test_choose_emits_the_driven_module_it_verified(tmp_path):
     """With --emit only emittable methods compete, ranked by their emitted modules' measured
     cost: undamped, the compiled μ-expansion; its A₁ off the grid agrees with shooting."""
     from lindstedt.emit.render import load_generated
-    from lindstedt.numerics.integrate import shoot
+    from lindstedt.numerics.shooting import shoot
 
     run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "response", "--eps", "0.1",
                           "--force", "1", "--omega-min", "0.8", "--omega-max", "1.2", "--tol",
@@ -533,7 +533,7 @@ def test_choose_emits_the_damped_module_for_a_finite_Q(tmp_path):
     from the one-harmonic guess, not from the module's answer)."""
     from lindstedt.analysis.driven import Drive, first_order_branches
     from lindstedt.emit.render import load_generated
-    from lindstedt.numerics.integrate import shoot
+    from lindstedt.numerics.shooting import shoot
 
     run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "amplitudes", "--eps",
                           "0.1", "--force", "0.3", "--Q", "20", "--omega", "0.8", "--tol",

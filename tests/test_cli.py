@@ -120,8 +120,9 @@ def test_force_in_series_is_the_old_spelling_of_allow_slow():
 
 def test_light_constants_match_the_stages():
     """The parser's choices are restated in cli (no SymPy at start-up): they must agree."""
-    from lindstedt import choose, cli, models
+    from lindstedt import choose, cli
     from lindstedt.analysis import driven
+    from lindstedt.derive import models
 
     assert cli.FREE_MODELS == models.MODELS
     assert cli.MAX_HARMONICS == driven.MAX_HARMONICS

@@ -15,12 +15,12 @@ from lindstedt.analysis.driven import (
     Drive,
     amplitudes,
     first_order_branches,
-    first_order_secular,
     harmonic_balance,
     mu_expansion,
 )
+from lindstedt.analysis.mu_exact import first_order_secular
 from lindstedt.errors import InputError
-from lindstedt.numerics.integrate import shoot
+from lindstedt.numerics.shooting import shoot
 
 NOTES = Drive(eps=0.1, force=1.0, omega=1.0)
 

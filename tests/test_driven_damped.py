@@ -12,27 +12,29 @@ import numpy as np
 import pytest
 import sympy as sp
 from lindstedt.analysis.driven import (
-    A1_,
-    Delta_,
     Drive,
-    a_,
     amplitudes,
-    damped_determinant,
-    eps_,
     first_order_branches,
-    gamma_,
     harmonic_balance,
     mu_expansion,
+    one_harmonic_roots,
+)
+from lindstedt.analysis.mu_exact import (
+    A1_,
+    Delta_,
+    a_,
+    damped_determinant,
+    eps_,
+    gamma_,
     mu_expansion_damped,
     mu_expansion_exact,
     omega_,
-    one_harmonic_roots,
     x_,
 )
 from lindstedt.compiler import generate_driven
 from lindstedt.emit.render import load_generated
 from lindstedt.lower.driven import DAMPED_TRUNCATION, lower_driven_damped
-from lindstedt.numerics.integrate import shoot
+from lindstedt.numerics.shooting import shoot
 
 K = 4
 SAMPLE = {x_: sp.Rational(1, 3), a_: sp.Integer(3), gamma_: sp.Rational(1, 7)}

@@ -157,7 +157,7 @@ def test_the_issues_command_vdp(capsys):
     """`lindstedt series vdp --order K --json` (vdp: the registry's alias of van_der_pol):
     the published first coefficients, the stability of both signs of ε, and partial sums of
     ω against the period of the cycle shot numerically (numerics.true_limit_cycle)."""
-    from lindstedt.numerics.integrate import true_limit_cycle
+    from lindstedt.numerics.shooting import true_limit_cycle
 
     assert main(["series", "vdp", "--order", "40", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
@@ -241,7 +241,7 @@ def test_true_cycle_and_its_floquet_exponent():
     classical 6.6632868593…; the exponent ln|det M|/T equals Liouville's ∮ ε ∂f/∂q̇ dt / T
     integrated along DOP853's cycle, and at small ε the averaged −ε S'(a₀)/2 (opposite signs
     for the Liénard term's two cycles)."""
-    from lindstedt.numerics.integrate import true_limit_cycle
+    from lindstedt.numerics.shooting import true_limit_cycle
 
     vdp = model(VDP)
     one = true_limit_cycle(vdp, 1.0)
@@ -268,7 +268,7 @@ def test_emitted_limit_cycle_module_against_the_true_cycle(tmp_path):
     DOP853 from it, within the module's own error estimate; NaN from 90 % of its estimated
     radius (√3.42 in ε) on."""
     from lindstedt.emit.render import load_generated
-    from lindstedt.numerics.integrate import true_limit_cycle
+    from lindstedt.numerics.shooting import true_limit_cycle
 
     assert main(["generate", "van_der_pol", "--order", "16", "--out", str(tmp_path)]) == 0
     mod = load_generated(tmp_path / "van_der_pol.py")

@@ -20,7 +20,7 @@ from lindstedt.choose import Choice, DrivenChoice, SolutionChoice, choose_period
 from lindstedt.derive.lindstedt import derive, order_equation
 from lindstedt.derive.models import duffing, pendulum
 from lindstedt.display import html_table
-from lindstedt.numerics.integrate import shoot
+from lindstedt.numerics.shooting import shoot
 from reference import duffing_period, pendulum_period, reciprocal
 
 NOTEBOOK = Path(__file__).resolve().parent.parent / "docs" / "example.ipynb"

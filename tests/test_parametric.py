@@ -25,7 +25,7 @@ from lindstedt.analysis.parametric import (
 )
 from lindstedt.analysis.response import periodic_orbits
 from lindstedt.analysis.subharmonic import subharmonic
-from lindstedt.numerics.integrate import multipliers_stable, orbit_hill_multipliers
+from lindstedt.numerics.floquet import multipliers_stable, orbit_hill_multipliers
 from scipy.optimize import brentq
 from scipy.special import mathieu_a, mathieu_b
 

@@ -16,7 +16,8 @@ from lindstedt.analysis.response import (
     one_harmonic_curve,
     one_harmonic_folds,
 )
-from lindstedt.numerics.integrate import duffing_table, orbit_fold, shoot, sweep
+from lindstedt.numerics.integrate import duffing_table, sweep
+from lindstedt.numerics.shooting import orbit_fold, shoot
 
 EPS, F, Q = 0.1, 0.3, 20.0
 
@@ -168,13 +169,15 @@ def test_subharmonic_against_true_orbit():
 def test_hill_verdict_fails_for_the_negative_root_at_small_eps(monkeypatch):
     """Reported in the README: the Hill test with q₀ calls the negative root stable here, the
     true orbit's multipliers (at two step sizes) say unstable."""
-    import lindstedt.numerics.integrate as numerics
+    import lindstedt.numerics.integrate as integrate
+    import lindstedt.numerics.shooting as shooting
     from lindstedt.analysis.subharmonic import subharmonic
 
     _, _, sols = subharmonic(0.05, 0.5, 1.3)
     minus = sols[1]
     assert minus.root == "-" and minus.hill_stable and not minus.orbit.stable
-    monkeypatch.setattr(numerics, "STEPS_PER_PERIOD", 2 * numerics.STEPS_PER_PERIOD)
+    for module in (integrate, shooting):  # the flow's steps and the samples they carry
+        monkeypatch.setattr(module, "STEPS_PER_PERIOD", 2 * integrate.STEPS_PER_PERIOD)
     _, _, again = subharmonic(0.05, 0.5, 1.3)
     assert not again[1].orbit.stable
     np.testing.assert_allclose(sorted(abs(again[1].orbit.multipliers)),

@@ -100,7 +100,7 @@ def test_folds_of_an_asymmetric_spring_against_the_reference():
     for moduli in data["numerical"]["fold_floquet_moduli"]:
         assert abs(max(moduli) - 1) < 1e-8 and min(moduli) < 1
     for w in true:  # the reference's fold from the package's fold orbit, moved off it
-        from lindstedt.analysis.driven import driven_equation
+        from lindstedt.analysis.polynomial import driven_equation
         from lindstedt.analysis.response import orbit_fold_table
         from lindstedt.numerics.integrate import ForceTable
 
@@ -119,7 +119,7 @@ def test_folds_of_an_asymmetric_spring_against_the_reference():
 
 def _fold_state(data, w):
     """The balance's state at the fold ``w`` (the package's seed for its own refinement)."""
-    from lindstedt.analysis.driven import PolynomialBalance, driven_equation
+    from lindstedt.analysis.polynomial import PolynomialBalance, driven_equation
     from lindstedt.analysis.response import continue_equation
 
     de = driven_equation(ASYMMETRIC, {}, 1.0)

@@ -26,7 +26,7 @@ from lindstedt.algebra.resum import (
 from lindstedt.derive.models import series_model
 from lindstedt.errors import InputError
 from lindstedt.methods import verify as methods
-from lindstedt.numerics.integrate import cycle_reference
+from lindstedt.numerics.references import cycle_reference
 
 
 def test_pade_recovers_a_rational_function_exactly():
@@ -268,7 +268,7 @@ def test_mathieu_reference_against_dlmf_and_mpmath():
     """The eigenvalue reference at q = 1 against Abramowitz & Stegun's Table 20.1 (8 decimals:
     a_0 = −0.45513860, a_1 = 1.85910807, b_1 = −0.11024882, b_2 = 3.91702477), and float64
     against mpmath at 30 digits at q = 40."""
-    from lindstedt.numerics.integrate import mathieu_reference
+    from lindstedt.numerics.references import mathieu_reference
 
     for kind, m, value in (("a", 0, -0.45513860), ("a", 1, 1.85910807),
                            ("b", 1, -0.11024882), ("b", 2, 3.91702477)):
@@ -283,7 +283,7 @@ def test_mathieu_refined_and_truncation_bound_against_mpmath():
     against mpmath's own symmetric eigensolver at 40 digits (60 rows), and the truncation
     bound against the true change of the eigenvalue when the matrix is cut to N rows."""
     import mpmath
-    from lindstedt.numerics.integrate import (
+    from lindstedt.numerics.references import (
         mathieu_recurrence,
         mathieu_refined,
         mathieu_truncation_bound,
@@ -316,7 +316,7 @@ def test_emitted_mathieu_against_the_eigenvalue_reference(kind, m, past, tmp_pat
     a series with odd powers); the error estimate (the Newton step) covers the error."""
     from lindstedt.cli import main
     from lindstedt.emit.render import load_generated
-    from lindstedt.numerics.integrate import mathieu_reference
+    from lindstedt.numerics.references import mathieu_reference
 
     assert main(["mathieu", kind, "--m", str(m), "--order", "60", "--emit",
                  str(tmp_path)]) == 0
@@ -373,7 +373,7 @@ def test_mathieu_start_is_the_cheapest_verified_as_far(tmp_path):
     from lindstedt.compiler import generate_mathieu
     from lindstedt.derive.hill import mathieu_series
     from lindstedt.emit.render import load_generated
-    from lindstedt.numerics.integrate import mathieu_reference, mathieu_refined
+    from lindstedt.numerics.references import mathieu_reference, mathieu_refined
 
     generate_mathieu("a", 1, 100, tmp_path)
     mod = load_generated(tmp_path / "mathieu_a1.py")

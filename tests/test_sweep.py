@@ -27,7 +27,7 @@ from lindstedt.analysis.driven import (
 from lindstedt.analysis.response import one_harmonic_curve
 from lindstedt.charts import sweep_figure
 from lindstedt.errors import InputError
-from lindstedt.numerics.integrate import shoot
+from lindstedt.numerics.shooting import shoot
 from lindstedt.sweep import (
     MU_ORDERS,
     WarmUp,

@@ -16,7 +16,7 @@ import pytest
 from lindstedt.cli import main
 from lindstedt.derive.hill import fourier_of_text, mathieu_series, tongue_tip, transition_curves
 from lindstedt.errors import InputError
-from lindstedt.numerics.integrate import floquet_stable, floquet_traces
+from lindstedt.numerics.floquet import floquet_stable, floquet_traces
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 

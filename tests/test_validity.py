@@ -219,7 +219,8 @@ def test_shooting_reports_a_trajectory_past_the_escape_bound_as_escaping():
     |ε|x³ − x − |f| = 0 (numpy.roots here); from beyond it, moving outward, DOP853 runs off
     to infinity whatever the drive's phase — and shooting from there says it escapes, where it
     used to return nothing without a reason."""
-    from lindstedt.numerics.integrate import escape_bound, shoot, shoot_explained
+    from lindstedt.numerics.integrate import escape_bound
+    from lindstedt.numerics.shooting import shoot, shoot_explained
 
     eps, f, Q, w = -0.1, 0.3, 20.0, 0.8
     roots = np.roots([-eps, 0.0, -1.0, -f])

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.driven import MAGNITUDES, driven_form
+from ..analysis.driven import MAGNITUDES
+from ..analysis.polynomial import driven_form
 from ..errors import InputError
 from ..numerics.integrate import ForceTable, ToneFit, steady_state_fit
 

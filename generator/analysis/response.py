@@ -22,10 +22,7 @@ from ..analysis.driven import (
     BalanceSystem,
     Branch,
     Drive,
-    DrivenEquation,
     HarmonicBalance,
-    PolynomialBalance,
-    amplitude_bound,
     amplitude_residual,
     amplitude_slope,
     amplitudes,
@@ -34,17 +31,10 @@ from ..analysis.driven import (
     harmonic_balance,
     one_harmonic_roots,
 )
+from ..analysis.polynomial import DrivenEquation, PolynomialBalance, amplitude_bound
 from ..errors import InputError
-from ..numerics.integrate import (
-    ForceTable,
-    PeriodicOrbit,
-    ShootingFailure,
-    Sweep,
-    flow_table,
-    shoot_explained,
-    shoot_table,
-    sweep_table,
-)
+from ..numerics.integrate import ForceTable, Sweep, flow_table, sweep_table
+from ..numerics.shooting import PeriodicOrbit, ShootingFailure, shoot_explained, shoot_table
 
 _u, _w, _e, _f, _g = sp.symbols("u w e f g")  # u = r², w = ω², g = 1/Q
 _G = _u * ((1 - _w + sp.Rational(3, 4) * _e * _u) ** 2 + _w * _g**2) - _f**2
@@ -1218,7 +1208,7 @@ def response_equation(text: str, values: dict[str, str], name: str = "oscillator
     :class:`driven.DrivenEquation` of ``text`` (ω left free: every parameter but the drive
     frequency needs a value), refused in one line where the force depends on the drive
     frequency or has no damping (a term odd in q')."""
-    from ..analysis.driven import driven_equation
+    from ..analysis.polynomial import driven_equation
 
     def lowered(omega: float) -> DrivenEquation:
         try:
@@ -1264,7 +1254,7 @@ def equation_response(text: str, values: dict[str, str], harmonics: int,
                       max_seconds: float = CONTINUATION_SECONDS) -> EquationCurve:
     """``response EQUATION``'s curve: the continuation over the range, then the simulated
     sweeps both ways, escapes detected past :data:`ESCAPE_FACTOR` × the largest balance."""
-    from ..analysis.driven import PolynomialBalance
+    from ..analysis.polynomial import PolynomialBalance
 
     de = response_equation(text, values, name)
     er = equation_range(de.terms, de.force, omega_min, omega_max)

@@ -18,20 +18,13 @@ import numpy as np
 import sympy as sp
 
 from ..algebra.series import trig_power
-from ..analysis.driven import Drive, PolynomialBalance, amplitude_bound, driven_form
+from ..analysis.driven import Drive
+from ..analysis.polynomial import PolynomialBalance, amplitude_bound, driven_form
 from ..analysis.response import SHOOTING_TOLERANCES, _corrector, _DriveFamily, _tangent
 from ..errors import InputError
-from ..numerics.integrate import (
-    ForceTable,
-    PeriodicOrbit,
-    duffing_table,
-    hill_multipliers,
-    multipliers_stable,
-    orbit_hill_multipliers,
-    shoot,
-    shoot_table,
-    steady_state_amplitudes,
-)
+from ..numerics.floquet import hill_multipliers, multipliers_stable, orbit_hill_multipliers
+from ..numerics.integrate import ForceTable, duffing_table, steady_state_amplitudes
+from ..numerics.shooting import PeriodicOrbit, shoot, shoot_table
 
 _a, _b, _F, _w1, _eps1 = sp.symbols("a b F omega epsilon")
 

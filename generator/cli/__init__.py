@@ -686,7 +686,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from ..derive.lindstedt import derive
     from ..derive.models import model_by_name
     from ..emit.render import check_writable, load_generated
-    from ..numerics.integrate import duffing_period_exact, pendulum_period_exact
+    from ..numerics.references import duffing_period_exact, pendulum_period_exact
 
     figures = out / "figures"
     modules = ["duffing", "pendulum", "driven", "balance"]
@@ -771,7 +771,7 @@ def _demo_limit_cycle(out: Path, overwrite_edited: bool) -> None:
     from ..compiler import generate_limit_cycle
     from ..derive.models import series_model
     from ..emit.render import load_generated
-    from ..numerics.integrate import cycle_reference, cycle_samples
+    from ..numerics.references import cycle_reference, cycle_samples
 
     model = series_model("van_der_pol", DEMO_CYCLE_ORDER + 2)
     print(f"\nvan der Pol's limit cycle, order {DEMO_CYCLE_ORDER}, ω resummed from order "
@@ -861,7 +861,7 @@ def driven_json(d, order: int, harmonics: int) -> dict:
     ``A1``, ``r``, ``delta0`` null and no μ-expansion, with ``mu_note`` saying why."""
     from ..analysis.driven import amplitudes, mu_expansion
     from ..analysis.response import periodic_orbits
-    from ..numerics.integrate import multipliers_stable, orbit_hill_multipliers
+    from ..numerics.floquet import multipliers_stable, orbit_hill_multipliers
 
     damped = d.damping > 0
     top = max(2 * harmonics - 1, 2 * order + 1)
@@ -1013,7 +1013,7 @@ def driven_equation_json(text: str, values: dict[str, str], omega: float, harmon
     (:func:`response.equation_orbits`), largest first, each by its harmonic balance (``A``
     holds the constant ``"0"`` and even harmonics unless the force is odd) and, checked by
     shooting, the true orbit with its Floquet moduli and verdict."""
-    from ..analysis.driven import driven_equation
+    from ..analysis.polynomial import driven_equation
     from ..analysis.response import equation_orbits
 
     de = driven_equation(text, values, omega, name)
@@ -1123,7 +1123,8 @@ def response_json(eps: float, force: float, Q: float, harmonics: int,
 
     from ..analysis.driven import BalanceSystem, Drive
     from ..analysis.response import continue_balance, one_harmonic_folds, response_range
-    from ..numerics.integrate import orbit_fold, sweep
+    from ..numerics.integrate import sweep
+    from ..numerics.shooting import orbit_fold
 
     d = Drive(eps, force, 1.0, Q)
     if d.damping == 0:

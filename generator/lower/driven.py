@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..analysis.driven import (
+from ..analysis.mu_exact import (
     A1_,
     BalanceEquations,
     Delta_,
@@ -17,7 +17,7 @@ from ..analysis.driven import (
     gamma_,
     omega_,
 )
-from ..analysis.driven import x_ as damped_x
+from ..analysis.mu_exact import x_ as damped_x
 from .forms import argument_entry, nested_horner
 from .records import ArrayKernel, Assign, Evaluator, Module, provenance
 

@@ -12,10 +12,7 @@ import sympy as sp
 
 from .. import __version__
 from ..algebra.resum import Resummed
-from ..analysis.driven import (
-    MuDampedOrder,
-    MuOrder,
-)
+from ..analysis.mu_exact import MuDampedOrder, MuOrder
 
 Assign = tuple[sp.Symbol, sp.Expr]
 

@@ -18,7 +18,7 @@ from ..derive.lindstedt import (
     nearest_singularity,
 )
 from ..derive.orbits import OrbitDomain, orbit_domain
-from ..numerics.integrate import mathieu_recurrence
+from ..numerics.references import mathieu_recurrence
 from .forms import (
     FREE_ARGUMENT_LIMIT,
     _hex,

@@ -21,7 +21,7 @@ from ..analysis.driven import (
     one_harmonic,
 )
 from ..derive.models import Model
-from ..numerics.integrate import shoot
+from ..numerics.shooting import shoot
 
 if TYPE_CHECKING:
     from .registry import Emitted, Solved

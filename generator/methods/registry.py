@@ -39,17 +39,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 import sympy as sp
 
-from ..analysis.driven import (
-    Branch,
-    Drive,
-)
+from ..analysis.driven import Branch, Drive
 from ..derive.lindstedt import derive
 from ..derive.models import Model, check_order, duffing
 from ..lower.records import (
     PeriodFormula,
     x_,
 )
-from ..numerics.integrate import duffing_period_exact
+from ..numerics.references import duffing_period_exact
 from .kernels import (
     MAX_ORDER,
     Coefficients,

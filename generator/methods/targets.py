@@ -12,11 +12,13 @@ import numpy as np
 from ..analysis.driven import (
     Drive,
     amplitudes,
-    balance_equations,
-    damped_determinant,
     first_order_branches,
     harmonic_balance,
     mu_expansion,
+)
+from ..analysis.mu_exact import (
+    balance_equations,
+    damped_determinant,
     mu_expansion_damped,
     mu_expansion_exact,
 )
@@ -39,7 +41,7 @@ from ..lower.records import (
     Unit,
 )
 from ..lower.series import lower_free, lower_limit_cycle, lower_mathieu, lower_tongue
-from ..numerics.integrate import shoot
+from ..numerics.shooting import shoot
 from .verify import resum_cycle, resum_mathieu, resum_tongue
 
 if TYPE_CHECKING:

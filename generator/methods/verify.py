@@ -26,7 +26,7 @@ from ..lower.records import (
     ResummedMathieu,
     ResummedTongue,
 )
-from ..numerics.integrate import cycle_reference, cycle_samples
+from ..numerics.references import cycle_reference, cycle_samples
 
 RESUM_TOLERANCE = 1e-6
 # NOTE: the relative error the resummed limit-cycle evaluators are verified to (issue #13's
@@ -228,7 +228,7 @@ MATHIEU_GRID = 400
 def mathieu_rows(kind: str, m: int, q: float, a: float) -> int:
     """The fewest rows of the recurrence whose eigenvalue is within ``MATHIEU_TRUNCATION``
     ·max(1, |a|) of the infinite one at ``q`` (:func:`numerics.mathieu_truncation_bound`)."""
-    from ..numerics.integrate import mathieu_recurrence, mathieu_truncation_bound
+    from ..numerics.references import mathieu_recurrence, mathieu_truncation_bound
 
     rows = mathieu_recurrence(kind, m, 1)[0] + 2
     while mathieu_truncation_bound(kind, m, q, a, rows) > MATHIEU_TRUNCATION * max(1.0, abs(a)):
@@ -254,7 +254,7 @@ def _mathieu_verified(kind: str, m: int, form: Resummed, grid, ref, scale, toler
     the rows used and the largest error there (0 points: no rows, NaN)."""
     import numpy as np
 
-    from ..numerics.integrate import mathieu_newton
+    from ..numerics.references import mathieu_newton
 
     start = form(grid)
     ok = np.abs(start - ref) / scale <= MATHIEU_START_TOLERANCE
@@ -283,7 +283,7 @@ def resum_mathieu(kind: str, m: int, order: int, tolerance: float = MATHIEU_TOLE
     import numpy as np
 
     from ..derive.hill import mathieu_series
-    from ..numerics.integrate import mathieu_refined
+    from ..numerics.references import mathieu_refined
 
     series = mathieu_series(kind, m, order)
     grid = np.linspace(0.0, MATHIEU_RANGE, MATHIEU_GRID + 1)[1:]
@@ -331,7 +331,7 @@ def boundary_bracket(p: dict[int, tuple[float, float]], eps: np.ndarray, near: n
     """The δ in ``near ± bracket`` where ``|tr M| = 2`` at each ``eps`` (the sign change of
     ``|tr M| − 2`` between the two ends of :func:`numerics.floquet_traces`, the root by linear
     interpolation), NaN where the sign does not change (no boundary or two in the bracket)."""
-    from ..numerics.integrate import floquet_traces
+    from ..numerics.floquet import floquet_traces
 
     below, above = (np.abs(floquet_traces(near + s * bracket, eps, p, steps=steps)[0]) - 2
                     for s in (-1, 1))

@@ -1,0 +1,373 @@
+"""A user's driven oscillator ``q̈ + g(q, q̇) = Σ f_i cos ν_i t``, ``g`` a polynomial: its
+equation lowered to data (:class:`DrivenEquation`, :class:`DrivenForm`), the Galerkin
+balance of any polynomial force by alternating frequency and time (:class:`PolynomialBalance`)
+and a bound on its orbits' amplitude."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from ..errors import InputError
+from .driven import MAGNITUDES, check_harmonics
+
+# --- a user's driven oscillator: q'' + g(q, q') = f cos(w t), g a polynomial -----------------
+
+DRIVEN = "driven"
+
+
+@dataclass(frozen=True)
+class DrivenEquation:
+    """A user's equation lowered to data: ``q̈ + Σ c q^a q̇^b = f cos ωt`` at one ω.
+
+    ``terms`` maps ``(a, b)`` to the float ``c`` (the linear part included); ``force`` is the
+    drive amplitude ``f``, ``omega`` the drive frequency (the value of ``frequency``, the
+    symbol in the cosine's argument), ``values`` the parameter values as given (text)."""
+
+    name: str
+    text: str
+    terms: dict[tuple[int, int], float]
+    force: float
+    omega: float
+    frequency: str
+    values: tuple[tuple[str, str], ...]
+
+    @property
+    def odd(self) -> bool:
+        """``g(−q, −q̇) = −g(q, q̇)``: the response holds odd harmonics only."""
+        return all((a + b) % 2 == 1 for a, b in self.terms)
+
+    @property
+    def dissipative(self) -> bool:
+        """A term odd in ``q̇``: stability asks every Floquet multiplier inside the unit circle."""
+        return any(b % 2 == 1 for _, b in self.terms)
+
+    @property
+    def degree(self) -> int:
+        return max(a + b for a, b in self.terms)
+
+
+def driven_equation(text: str, values: dict[str, str], omega: float,
+                    name: str = "oscillator") -> DrivenEquation:
+    """Lower ``text`` (see :mod:`lindstedt.derive.equation`) to a :class:`DrivenEquation`: a
+    polynomial force and a single drive ``f cos(w t)``, every parameter but ``w`` given in
+    ``values`` (exact text, ``eps`` included), ``w = omega``.  A one-line :class:`InputError`
+    says why where it cannot: no drive or more than one, a drive that is not ``f cos(w t)``, a
+    term in both t and q (parametric), a force that is not a polynomial in q and q', a missing
+    value."""
+    from ..derive.equation import parse_expression
+    from ..derive.models import oscillator
+
+    if isinstance(omega, bool) or not isinstance(omega, (int, float)) \
+            or not math.isfinite(omega) or omega <= 0:
+        raise InputError(f"--omega {omega!r}: the drive frequency must be finite and > 0")
+    values = dict(values)
+    small = values.pop("eps", None)
+    osc = oscillator(text, values, name)
+    q, v, t = osc.coordinate, osc.velocity, osc.equation.time
+    subs: dict[sp.Symbol, sp.Expr] = {}
+    if small is not None:
+        if osc.equation.small is None:
+            raise InputError(f"--param eps: not a parameter of {text!r}")
+        number = parse_expression(small, "--param eps")
+        if not number.is_Rational:
+            raise InputError(f"--param eps={small}: not a rational number")
+        subs[osc.equation.small] = number
+    if osc.parametric != 0:
+        raise osc.refuse(DRIVEN, f"{sp.sstr(osc.parametric)} depends on both t and {q} "
+                         "(parametric excitation); give a drive in t alone")
+    drive = osc.drive.xreplace(subs)
+    if drive == 0:
+        raise osc.refuse(DRIVEN, f"no drive: write it on the right, e.g. {q}'' + ... = "
+                         "f*cos(w*t)")
+    terms = sp.Add.make_args(sp.expand(drive))
+    if len(terms) > 1:
+        raise osc.refuse(DRIVEN, f"the drive {sp.sstr(drive)} has {len(terms)} terms; it takes "
+                         "one, f*cos(w*t) (several tones: `lindstedt mixing`)")
+    amplitude, wave = drive.as_independent(t, as_Add=False)
+    if not isinstance(wave, sp.cos):
+        raise osc.refuse(DRIVEN, f"the drive {sp.sstr(drive)} is not f*cos(w*t) (a sine or "
+                         "another function of t: shift t or rewrite it as f*cos(w*t))")
+    w, rest = wave.args[0].as_independent(t, as_Add=False)
+    if rest != t or not isinstance(w, sp.Symbol):
+        raise osc.refuse(DRIVEN, f"the drive's argument {sp.sstr(wave.args[0])} is not w*t "
+                         "with the frequency a name w (its value is --omega)")
+    if str(w) in values:
+        raise InputError(f"--param {w}: {w} is the drive frequency; give it with --omega")
+    subs[w] = sp.Rational(str(float(omega)))
+    force_expr = sp.expand(osc.force.xreplace(subs))
+    amplitude = amplitude.xreplace(subs)
+    missing = sorted(str(s) for s in (force_expr.free_symbols | amplitude.free_symbols)
+                     - {q, v})
+    if missing:
+        raise osc.refuse(DRIVEN, "give " + ", ".join(missing) + " a value (--param "
+                         + " --param ".join(f"{m}=..." for m in missing) + ")")
+    if not force_expr.is_polynomial(q, v):
+        raise osc.refuse(DRIVEN, f"the force {sp.sstr(osc.force)} is not a polynomial in {q} "
+                         f"and {v} (expand it: driven evaluates polynomial forces)")
+    poly = sp.Poly(force_expr, q, v)
+    table: dict[tuple[int, int], float] = {}
+    for (a, b), c in zip(poly.monoms(), poly.coeffs(), strict=True):
+        value = float(c)
+        if not math.isfinite(value) or (value != 0 and not MAGNITUDES[0] <= abs(value)
+                                        <= MAGNITUDES[1]):
+            raise osc.refuse(DRIVEN, f"the coefficient {c} of {sp.sstr(q**a * v**b)} is "
+                             f"outside {MAGNITUDES[0]:g}..{MAGNITUDES[1]:g}")
+        if value != 0:
+            table[(a, b)] = value
+    if table.get((0, 0)):
+        raise osc.refuse(DRIVEN, f"the constant force {table[(0, 0)]:g} moves the equilibrium "
+                         f"off {q} = 0; shift {q} to it")
+    if not any(a + b == 1 for a, b in table) and (1, 0) not in table:
+        raise osc.refuse(DRIVEN, f"no linear term in {q}: q = 0 is no oscillator's equilibrium")
+    f = float(amplitude)
+    if f == 0 or not math.isfinite(f) or not MAGNITUDES[0] <= abs(f) <= MAGNITUDES[1]:
+        raise osc.refuse(DRIVEN, f"the drive amplitude {amplitude} must be nonzero, within "
+                         f"{MAGNITUDES[0]:g}..{MAGNITUDES[1]:g}")
+    given = [(k, str(val)) for k, val in sorted({**values, **({"eps": small} if small
+                                                               else {})}.items())]
+    return DrivenEquation(name, text, table, f, float(omega), str(w), tuple(given))
+
+
+class PolynomialBalance:
+    """The Galerkin residual of ``q̈ + g(q, q̇) = f cos ωt`` for a polynomial ``g`` (a
+    :class:`DrivenEquation`'s terms), by alternating frequency and time: ``q`` and ``q̇`` sampled
+    on ``S`` points of a period, ``g`` evaluated there, projected back on the harmonics.  ``S``
+    exceeds ``(degree + 1)`` times the top harmonic, so no product aliases: the projection is the
+    exact Galerkin residual (as :class:`BalanceSystem`'s convolutions are for εq³).
+
+    ``drive_harmonic = n`` puts the drive on ``cos nωt`` instead: the balance of a 1/n
+    subharmonic, ω its own frequency.
+    Unknowns ``x = (a_k …, b_k …)`` of ``q = Σ a_k cos kωt + b_k sin kωt`` over ``orders``:
+    ``1, 3, …, 2N − 1`` for an odd force (:class:`BalanceSystem`'s layout), else
+    ``0, 1, 2, …, 2N − 1`` (the constant ``a_0``, no ``b_0``).  The same interface as
+    :class:`BalanceSystem` (``residual``, ``jacobian``, ``d_omega`` in ``(x, ω)``), with the drive
+    amplitude ``force`` as a keyword for the continuation in it."""
+
+    def __init__(self, terms: dict[tuple[int, int], float], force: float, harmonics: int,
+                 odd: bool, drive_harmonic: int = 1) -> None:
+        check_harmonics(harmonics)
+        self.terms, self.force, self.harmonics, self.odd = dict(terms), force, harmonics, odd
+        self.drive_harmonic = drive_harmonic
+        top = 2 * harmonics - 1
+        if drive_harmonic > top or (odd and drive_harmonic % 2 == 0):
+            raise InputError(f"harmonic {drive_harmonic} of the drive is not among the "
+                             f"balance's orders (top {top}{', odd only' if odd else ''})")
+        self.orders = np.arange(1, top + 1, 2) if odd else np.arange(0, top + 1)
+        degree = max(a + b for a, b in terms)
+        samples = 16
+        while samples <= (degree + 1) * top:
+            samples *= 2
+        theta = 2 * np.pi * np.arange(samples) / samples
+        k = self.orders
+        sines = k[k > 0]
+        self.n_cos = len(k)
+        cos, sin = np.cos(np.outer(theta, k)), np.sin(np.outer(theta, sines))
+        self.basis = np.hstack([cos, sin])  # (S, m): q = basis @ x
+        self.d_basis = np.hstack([-k * np.sin(np.outer(theta, k)),
+                                  sines * np.cos(np.outer(theta, sines))])  # d/dθ
+        weights = np.where(k == 0, 1.0, 2.0)
+        self.project = np.vstack([weights[:, None] * cos.T, 2.0 * sin.T]) / samples
+        self.k2 = np.concatenate([k, sines]).astype(float) ** 2
+        self.drive = np.zeros(len(self.k2))
+        # the cos(n ωt) component, n = drive_harmonic (n > 1: a 1/n subharmonic's balance)
+        self.drive[int(np.nonzero(k == drive_harmonic)[0][0])] = 1.0
+        self.powers = [(a, b, c) for (a, b), c in sorted(terms.items())]
+
+    @property
+    def size(self) -> int:
+        return len(self.k2)
+
+    def _force(self, x: np.ndarray, omega: float) -> tuple[np.ndarray, ...]:
+        """``g``, ``∂g/∂q``, ``∂g/∂q̇`` on the sample points."""
+        q, v = self.basis @ x, omega * (self.d_basis @ x)
+        g, gq, gv = np.zeros_like(q), np.zeros_like(q), np.zeros_like(q)
+        for a, b, c in self.powers:
+            qa, vb = q**a, v**b
+            g += c * qa * vb
+            if a:
+                gq += c * a * q ** (a - 1) * vb
+            if b:
+                gv += c * b * qa * v ** (b - 1)
+        return g, gq, gv
+
+    def residual(self, x: np.ndarray, omega: float, force: float | None = None) -> np.ndarray:
+        g, _, _ = self._force(x, omega)
+        f = self.force if force is None else force
+        return -omega**2 * self.k2 * x + self.project @ g - f * self.drive
+
+    def jacobian(self, x: np.ndarray, omega: float, force: float | None = None) -> np.ndarray:
+        _, gq, gv = self._force(x, omega)
+        J = self.project @ (gq[:, None] * self.basis + omega * gv[:, None] * self.d_basis)
+        return J - np.diag(omega**2 * self.k2)
+
+    def d_omega(self, x: np.ndarray, omega: float, force: float | None = None) -> np.ndarray:
+        _, _, gv = self._force(x, omega)
+        return -2 * omega * self.k2 * x + self.project @ (gv * (self.d_basis @ x))
+
+    def amplitudes(self, x: np.ndarray) -> tuple[dict[int, float], dict[int, float]]:
+        """``A_k``, ``B_k`` of ``x`` (``A_0`` the mean, when the orders hold it)."""
+        A = {int(k): float(a) for k, a in zip(self.orders, x[: self.n_cos], strict=True)}
+        B = {int(k): float(b) for k, b in zip(self.orders[self.orders > 0], x[self.n_cos:],
+                                              strict=True)}
+        return A, B
+
+    def vector(self, A: dict[int, float], B: dict[int, float]) -> np.ndarray:
+        """The unknowns of ``A``, ``B`` (harmonics beyond the orders dropped, missing ones 0)."""
+        return np.array([A.get(int(k), 0.0) for k in self.orders]
+                        + [B.get(int(k), 0.0) for k in self.orders if k > 0])
+
+    def state(self, x: np.ndarray, omega: float) -> np.ndarray:
+        """``(q(0), q̇(0))`` of a balance solution: a shooting guess."""
+        A, B = self.amplitudes(x)
+        return np.array([sum(A.values()), omega * sum(k * b for k, b in B.items())])
+
+    def solve(self, x: np.ndarray, omega: float, tol: float = 1e-13,
+              max_iter: int = 50) -> tuple[np.ndarray, bool, float]:
+        """Newton's method from ``x``: the solution, whether it converged, its residual."""
+        x = np.array(x, dtype=float)
+        converged = False
+        with np.errstate(over="ignore", invalid="ignore"):
+            for _ in range(max_iter):
+                try:
+                    step = np.linalg.solve(self.jacobian(x, omega), -self.residual(x, omega))
+                except np.linalg.LinAlgError:  # singular: exactly at a fold
+                    break
+                if not np.all(np.isfinite(step)):
+                    break
+                x = x + step
+                if np.max(np.abs(step)) <= tol * (1 + np.max(np.abs(x))):
+                    converged = True
+                    break
+            residual = float(np.max(np.abs(self.residual(x, omega))))
+        return x, converged and math.isfinite(residual), residual
+
+
+def amplitude_bound(terms: dict[tuple[int, int], float], omega: float,
+                    force: float) -> float | None:
+    """A first-harmonic amplitude ``r`` beyond which ``q = r cos(ωt + φ)`` balances no drive of
+    amplitude ``force``, doubled: ``None`` where none exists (the top degree even, or its
+    terms not dominating: the response may grow without end).
+
+    On ``q = r cos θ`` the first harmonic of ``q̈ + g`` is exactly
+    ``P = (Σ_a κ_a c_a0 r^a − ω² r, −Σ_b κ_b c_0b (ωr)^b)`` over the odd pure powers
+    (``κ_n = C(n, (n−1)/2)/2^(n−1)``, ¾ for n = 3; even pure powers have no first harmonic),
+    plus at most ``2|c| r^a (ωr)^b`` from each mixed term ``c q^a q̇^b``: no orbit where
+    ``|P| > force + Σ 2|c| r^a (ωr)^b``, i.e. beyond every root of the polynomial
+    ``|P|² − (force + Σ …)²``; the largest modulus of its roots, complex ones included (a
+    window where the two nearly touch counts).  The distortion of a true orbit by its higher
+    harmonics is what the factor 2 leaves room for (a one-harmonic bound, not a proof)."""
+    d = max(a + b for a, b in terms)
+    if d % 2 == 0 or d < 3:
+        return None
+
+    def kappa(n: int) -> float:
+        return math.comb(n, (n - 1) // 2) / 2 ** (n - 1)
+
+    cos = [(a, kappa(a) * c) for (a, b), c in terms.items() if b == 0 and a % 2]
+    sin = [(b, -kappa(b) * c * omega**b) for (a, b), c in terms.items() if a == 0 and b % 2]
+    mixed = [(a + b, 2 * abs(c) * omega**b) for (a, b), c in terms.items() if a and b]
+    P = np.polynomial.Polynomial
+    pc, ps, pm = P([0.0, -omega**2]), P([0.0]), P([abs(force)])
+    for n, c in cos:
+        pc = pc + P([0.0] * n + [c])
+    for n, c in sin:
+        ps = ps + P([0.0] * n + [c])
+    for n, c in mixed:
+        pm = pm + P([0.0] * n + [c])
+    H = (pc * pc + ps * ps - pm * pm).trim()
+    if H.degree() < 2 * d or not H.coef[-1] > 0:
+        return None
+    roots = H.roots()
+    return 2 * float(np.max(np.abs(roots))) if roots.size else 2e-6
+
+
+@dataclass(frozen=True)
+class DrivenForm:
+    """A user's equation ``q̈ + g(q, q̇) = Σ f_i cos(ν_i t)`` once its values are given: ``g`` a
+    polynomial, ``terms`` its exact coefficients ``{(a, b): c}`` of ``c q^a q̇^b`` (the linear
+    part included); each drive ``(f, c, w)`` with ``ν = c·w``, ``c`` a positive rational and
+    ``w`` a name left free (``None``: ``ν = c``)."""
+
+    terms: dict[tuple[int, int], sp.Rational]
+    drives: tuple[tuple[float, sp.Rational, sp.Symbol | None], ...]
+    values: tuple[tuple[str, str], ...]
+
+    def floats(self) -> dict[tuple[int, int], float]:
+        """``terms`` as floats (a :class:`numerics.ForceTable`'s)."""
+        return {k: float(c) for k, c in self.terms.items() if c != 0}
+
+
+def driven_form(text: str, values: dict[str, str], name: str, method: str, why: str,
+                free_frequency: bool) -> DrivenForm:
+    """Map ``text`` onto :class:`DrivenForm` or refuse in one line naming what ``method``
+    (``why``: its ansatz) needs: a force polynomial in q and q' with rational coefficients, no
+    constant term, a linear term; the drive a sum of ``f cos(ν t)``; every parameter given,
+    except, with ``free_frequency``, one name in the drives' frequencies."""
+    from ..derive.models import oscillator
+
+    osc = oscillator(text, values, name)
+    q, v, t = osc.coordinate, osc.velocity, osc.equation.time
+    if osc.parametric != 0:
+        raise osc.refuse(method, f"{sp.sstr(osc.parametric)} depends on both t and {q}: {why}")
+    force = sp.expand(osc.force)
+    missing = sorted(str(s) for s in force.free_symbols - {q, v})
+    if missing:
+        raise osc.refuse(method, "give " + ", ".join(missing) + " a value (--param "
+                         + " --param ".join(f"{m}=..." for m in missing) + ")")
+    if not force.is_polynomial(q, v):
+        raise osc.refuse(method, f"the force {sp.sstr(force)} is not a polynomial in {q} and "
+                         f"{v}: {why}")
+    poly = sp.Poly(force, q, v)
+    if any(not c.is_Rational for c in poly.coeffs()):
+        raise osc.refuse(method, f"the force {sp.sstr(force)}: its coefficients must be "
+                         "rational numbers")
+    terms = {k: sp.Rational(c) for k, c in zip(poly.monoms(), poly.coeffs(), strict=True)}
+    if terms.get((0, 0)):
+        raise osc.refuse(method, f"the constant force {terms[(0, 0)]} moves the equilibrium "
+                         f"off {q} = 0; shift {q} to it")
+    if not terms.get((1, 0)):
+        raise osc.refuse(method, f"no linear term in {q}: q = 0 is no oscillator's "
+                         "equilibrium")
+    drive = sp.expand(osc.drive)
+    if drive == 0:
+        raise osc.refuse(method, f"no drive: write it on the right, e.g. {q}'' + ... = "
+                         "f*cos(w*t)")
+    drives = []
+    frequencies: set[sp.Symbol] = set()
+    for term in sp.Add.make_args(drive):
+        amplitude, wave = term.as_independent(t, as_Add=False)
+        if not isinstance(wave, sp.cos):
+            raise osc.refuse(method, f"the drive term {sp.sstr(term)} is not f*cos(w*t) (a "
+                             "sine or another function of t: shift t or rewrite it)")
+        c, rest = wave.args[0].as_independent(t, as_Add=False)
+        if rest != t:
+            raise osc.refuse(method, f"the drive's argument {sp.sstr(wave.args[0])} is not "
+                             "w*t")
+        number, symbols = c.as_coeff_Mul()
+        symbol = None
+        if symbols != 1:
+            if not (free_frequency and isinstance(symbols, sp.Symbol)):
+                need = ", ".join(sorted(str(s) for s in c.free_symbols))
+                raise osc.refuse(method, f"give {need} a value (--param {need}=...): the "
+                                 "drive frequencies must be numbers")
+            symbol = symbols
+            frequencies.add(symbol)
+        missing = sorted(str(s) for s in amplitude.free_symbols)
+        if missing:
+            raise osc.refuse(method, "give " + ", ".join(missing) + " a value (--param "
+                             + " --param ".join(f"{m}=..." for m in missing) + ")")
+        if not (number.is_Rational and amplitude.is_Rational):
+            raise osc.refuse(method, f"the drive term {sp.sstr(term)}: its amplitude and "
+                             "frequency must be rational numbers")
+        if not number > 0:
+            raise osc.refuse(method, f"the drive term {sp.sstr(term)}: its frequency must be "
+                             "> 0")
+        drives.append((float(amplitude), number, symbol))
+    if len(frequencies) > 1:
+        raise osc.refuse(method, "the drives' frequencies name "
+                         + ", ".join(sorted(map(str, frequencies))) + "; give them values")
+    return DrivenForm(terms, tuple(drives), tuple((str(k), str(val)) for k, val in osc.values))

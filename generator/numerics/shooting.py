@@ -1,0 +1,260 @@
+"""Shooting: Newton's method on the flow map for a periodic orbit of one or several drive
+periods with its monodromy matrix, the true fold by a bordered Newton, and the true limit
+cycle of a self-excited oscillator."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..display import harmonics_table
+from ..errors import InputError
+from .floquet import multipliers_stable
+from .integrate import (
+    NO_TERMS,
+    STEPS_PER_PERIOD,
+    ForceTable,
+    _table_force,
+    duffing_table,
+    escape_bound,
+    flow,
+    flow_table,
+)
+
+
+@dataclass(frozen=True)
+class PeriodicOrbit:
+    """A periodic orbit of period ``2π/ω`` found by shooting, with its Floquet multipliers."""
+
+    initial: np.ndarray  # (q(0), q̇(0))
+    A: dict[int, float]  # cos nωt coefficients
+    B: dict[int, float]  # sin nωt coefficients
+    multipliers: np.ndarray
+    stable: bool
+    residual: float
+
+    def _repr_html_(self) -> str:
+        moduli = ", ".join(f"{abs(m):.6g}" for m in self.multipliers)
+        return harmonics_table(
+            f"periodic orbit by shooting: q(0) = {self.initial[0]:.6g}, "
+            f"q̇(0) = {self.initial[1]:.6g}", self.A, self.B,
+            f"Floquet |λ| = {moduli}: {'stable' if self.stable else 'unstable'}; "
+            f"residual {self.residual:.1e}")
+
+
+SAMPLES = 64
+# NOTE: q is sampled 64 times per orbit for its harmonics (up to 31); more harmonics take the
+# next power of two above twice their number, a divisor of the RK4 step count.
+
+
+def _samples(harmonics: int, steps: int) -> int:
+    """Samples of q per orbit that resolve ``harmonics`` (FFT bins 0..samples/2) and divide
+    ``steps``; :class:`InputError` when the steps cannot carry that many."""
+    if isinstance(harmonics, bool) or not isinstance(harmonics, (int, np.integer)) \
+            or harmonics < 1:
+        raise InputError(f"harmonics {harmonics!r}: must be an integer ≥ 1")
+    samples = SAMPLES
+    while samples // 2 <= harmonics:
+        samples *= 2
+    if samples > steps or steps % samples:
+        raise InputError(f"harmonics {harmonics}: shooting with {steps} RK4 steps per orbit "
+                         f"resolves at most harmonic {steps // 2 - 1}")
+    return samples
+
+
+@dataclass(frozen=True)
+class ShootingFailure:
+    """Why shooting found no orbit.  ``escaped``: the trajectory from the guess itself left the
+    well (:func:`escape_bound`): a state there runs off to infinity, no orbit passes through
+    it; an orbit near it, if any, is too unstable for single shooting to reach."""
+
+    reason: str
+    escaped: bool
+    bound: float  # the escape bound |q| of these parameters (inf: no well to leave)
+
+
+def shoot(eps: float, force: float, omega: float, damping: float, guess: np.ndarray,
+          harmonics: int = 9, tol: float = 1e-12, max_iter: int = 30,
+          periods: int = 1, steps: int | None = None) -> PeriodicOrbit | None:
+    """The orbit of :func:`shoot_explained`, or ``None`` where it found none."""
+    found = shoot_explained(eps, force, omega, damping, guess, harmonics, tol, max_iter,
+                            periods, steps)
+    return found if isinstance(found, PeriodicOrbit) else None
+
+
+def shoot_explained(eps: float, force: float, omega: float, damping: float, guess: np.ndarray,
+                    harmonics: int = 9, tol: float = 1e-12, max_iter: int = 30,
+                    periods: int = 1, steps: int | None = None
+                    ) -> PeriodicOrbit | ShootingFailure:
+    """:func:`shoot_table` on eq. 10.60 (``q + εq³ + q̇/Q``), with the escape bound of a
+    softening spring's well (:func:`escape_bound`)."""
+    return shoot_table(duffing_table(eps, damping), force, omega, guess, harmonics, tol,
+                       max_iter, periods, steps, escape_bound(eps, force))
+
+
+def shoot_table(table: ForceTable, force: float, omega: float, guess: np.ndarray,
+                harmonics: int = 9, tol: float = 1e-12, max_iter: int = 30,
+                periods: int = 1, steps: int | None = None, bound: float = math.inf,
+                extra: np.ndarray = NO_TERMS) -> PeriodicOrbit | ShootingFailure:
+    """Newton's method on ``φ_T(y₀) − y₀ = 0`` for ``q̈ + g(q, q̇) = f cos ωt`` (``g`` the
+    polynomial ``table``); the monodromy matrix is its Jacobian + I.
+
+    Stability from the Floquet multipliers: dissipative (a term odd in q̇, e.g. q̇/Q), stable
+    when all ``|λ| < 1``; otherwise (area-preserving, ``det M = 1``), linearly stable when the
+    pair lies on the unit circle, i.e. ``|tr M| < 2`` (a real pair ``λ, 1/λ`` with
+    ``|tr M| > 2`` is unstable).  ``A``, ``B``: the odd harmonics for an odd force, else every
+    harmonic up to ``harmonics`` with the mean as ``A[0]``.
+    ``periods = p`` looks for an orbit of p drive periods; its ``A``, ``B`` are then the
+    coefficients of ``cos(nωt/p)``, ``sin(nωt/p)``.  ``steps``: plain RK4 with that many
+    steps per orbit instead of the Richardson pair (cheaper, less accurate).  Where Newton's
+    method finds no orbit, a :class:`ShootingFailure` says why: a trajectory that escapes
+    past ``bound`` (a softening spring's well: ``|q|`` past :func:`escape_bound` moving
+    outward, from the guess or from a Newton iterate), RK4 overflowing, a singular ``M − I``,
+    or no convergence.  ``extra``: the time-dependent rows of :func:`_field` (a pump
+    ``c q cos(νt + φ)``, further drives), of a period dividing the orbit's.
+    """
+    T = periods * 2 * np.pi / omega  # periods = 3: the 1/3 subharmonic (eq. 10.83)
+    samples = _samples(harmonics, STEPS_PER_PERIOD if steps is None else steps)
+    y = np.array(guess, dtype=float)
+
+    def escape(k: int | None, y: np.ndarray, at: float) -> ShootingFailure:
+        where = ("the trajectory from the guess" if k == 0 else "the converged trajectory"
+                 if k is None else f"the trajectory from Newton's iterate {k}")
+        return ShootingFailure(
+            f"{where} (q, q') = ({y[0]:.6g}, {y[1]:.6g}) escapes the well at t = {at:.4g} "
+            f"(of a period {T:.4g}): |q| passes {bound:.6g} moving outward, past which no "
+            "trajectory returns and no periodic orbit reaches"
+            + ("; an orbit near this state, if any, is too unstable for single shooting"
+               if k == 0 else ""), k == 0, bound)
+
+    step = np.full(2, np.nan)
+    for k in range(max_iter):
+        end, _, at = flow_table(table, force, omega, y, T, steps=steps, bound=bound,
+                                extra=extra)
+        if at >= 0:
+            return escape(k, y, at)
+        if not np.all(np.isfinite(end)):  # RK4 overflowed: h is too big for the amplitude
+            return ShootingFailure(
+                f"RK4 overflowed from (q, q') = ({y[0]:.6g}, {y[1]:.6g})"
+                + (f" (Newton's iterate {k})" if k else "") + ": its step is too large for "
+                "this amplitude", False, bound)
+        Mono = end[2:].reshape(2, 2).T
+        r = end[:2] - y
+        try:
+            step = np.linalg.solve(Mono - np.eye(2), -r)
+        except np.linalg.LinAlgError:
+            return ShootingFailure(f"M - I is singular at Newton's iterate {k} (a Floquet "
+                                   "multiplier +1: a fold)", False, bound)
+        y = y + step
+        if np.max(np.abs(step)) < tol * (1 + np.max(np.abs(y))):
+            break
+    else:
+        return ShootingFailure(f"Newton's method did not converge in {max_iter} iterations "
+                               f"(last step {np.max(np.abs(step)):.1e}, tolerance {tol:g})",
+                               False, bound)
+    end, qs, at = flow_table(table, force, omega, y, T, samples=samples, steps=steps,
+                             bound=bound, extra=extra)
+    if at >= 0:
+        return escape(None, y, at)
+    if not (np.all(np.isfinite(end)) and np.all(np.isfinite(qs))):
+        return ShootingFailure("RK4 overflowed on the converged orbit", False, bound)
+    Mono = end[2:].reshape(2, 2).T
+    lam = np.linalg.eigvals(Mono)
+    stable = multipliers_stable(lam, table.dissipative)
+    c = np.fft.rfft(qs) / len(qs)
+    odd = table.odd
+    A = {n: float(2 * c[n].real) for n in range(1, harmonics + 1, 2 if odd else 1)}
+    B = {n: float(-2 * c[n].imag) for n in range(1, harmonics + 1, 2 if odd else 1)}
+    if not odd:
+        A = {0: float(c[0].real), **A}
+    return PeriodicOrbit(y, A, B, lam, stable, float(np.max(np.abs(end[:2] - y))))
+
+
+def orbit_fold(eps: float, force: float, damping: float, omega: float, y0: np.ndarray,
+               tol: float = 1e-11) -> tuple[float, np.ndarray] | None:
+    """A fold of the true periodic orbit: ``φ_T(y₀) = y₀`` with a Floquet multiplier ``+1``
+    (``det(M − I) = 0``), by Newton's method in ``(y₀, ω)`` with a difference Jacobian."""
+    def F(z: np.ndarray) -> np.ndarray:
+        end, _ = flow(z[:2], 2 * np.pi / z[2], eps, force, z[2], damping, samples=1)
+        Mono = end[2:].reshape(2, 2).T
+        return np.array([*(end[:2] - z[:2]), np.linalg.det(Mono - np.eye(2))])
+
+    z = np.array([*y0, omega], dtype=float)
+    for _ in range(30):
+        if not z[2] > 0:  # Newton left the frequencies: no fold near this guess
+            return None
+        f0 = F(z)
+        J = np.empty((3, 3))
+        for k in range(3):
+            h = 1e-7 * (1 + abs(z[k]))
+            e = np.zeros(3)
+            e[k] = h
+            J[:, k] = (F(z + e) - F(z - e)) / (2 * h)
+        if not (np.all(np.isfinite(J)) and np.all(np.isfinite(f0))):
+            return None  # RK4 overflowed: no orbit near this guess
+        try:
+            dz = np.linalg.solve(J, -f0)
+        except np.linalg.LinAlgError:  # singular: no isolated fold here
+            return None
+        z = z + dz
+        if np.max(np.abs(dz)) < tol * (1 + np.max(np.abs(z))):
+            return float(z[2]), z[:2]
+    return None
+
+
+@dataclass(frozen=True)
+class LimitCycleOrbit:
+    """A limit cycle of the autonomous ``q̈ + g(q, q̇) = 0`` found by shooting: ``q(0)`` at the
+    turn ``q̇(0) = 0``, its period, and its Floquet multipliers (one is 1, the phase; the other
+    ``det M``) with the exponent ``ln|det M| / T`` (< 0: the cycle attracts)."""
+
+    q0: float
+    period: float
+    multipliers: tuple[complex, complex]
+    exponent: float
+
+
+def limit_cycle_orbit(table: ForceTable, q0: float, period: float, tol: float = 1e-12,
+                      max_iter: int = 30) -> LimitCycleOrbit | None:
+    """Newton's method on ``φ_T(q₀, 0) − (q₀, 0) = 0`` in ``(q₀, T)`` (the phase fixed by
+    ``q̇(0) = 0``): the Jacobian is ``[M e₁ − e₁, ẏ(T)]`` with the monodromy ``M`` from the one
+    compiled RK4 step (Richardson pair).  None when Newton does not converge."""
+    q, T = float(q0), float(period)
+    for _ in range(max_iter):
+        if not (np.isfinite(q) and np.isfinite(T) and T > 0):
+            return None
+        end, _, escaped = flow_table(table, 0.0, 2 * np.pi / T, np.array([q, 0.0]), T)
+        if escaped >= 0 or not np.all(np.isfinite(end)):
+            return None
+        residual = end[:2] - np.array([q, 0.0])
+        M = end[2:].reshape(2, 2, order="F")
+        g, _, _ = _table_force(end[0], end[1], table.q_powers, table.v_powers,
+                               table.coefficients)
+        jacobian = np.column_stack([M[:, 0] - np.array([1.0, 0.0]), [end[1], -g]])
+        try:
+            step = np.linalg.solve(jacobian, -residual)
+        except np.linalg.LinAlgError:
+            return None
+        q, T = q + step[0], T + step[1]
+        if np.max(np.abs(step)) < tol * max(1.0, abs(q), T):
+            end, _, _ = flow_table(table, 0.0, 2 * np.pi / T, np.array([q, 0.0]), T)
+            M = end[2:].reshape(2, 2, order="F")
+            mu = np.linalg.eigvals(M)
+            mu = tuple(sorted((complex(m) for m in mu), key=lambda m: abs(abs(m) - 1)))
+            return LimitCycleOrbit(q, T, mu, float(np.log(abs(np.linalg.det(M))) / T))
+    return None
+
+
+def true_limit_cycle(model: object, eps: float, cycle: int = 0, order: int = 12
+                     ) -> LimitCycleOrbit | None:
+    """The true orbit of limit cycle ``cycle`` of a :class:`models.SelfExcited` oscillator at
+    ``eps``, shot from its L–P series at ``order`` (q(0) and T as the seed)."""
+    from ..derive.lindstedt import derive_limit_cycle
+
+    lc = derive_limit_cycle(model, order, cycle)
+    table = ForceTable.of({(1, 0): 1.0, **{(a, b): -eps * float(c) for a, b, c in model.terms}})
+    q0 = sum(float(c) * eps**j for j, c in enumerate(lc.amplitude))
+    T = 2 * np.pi * sum(float(c) * eps**j for j, c in enumerate(lc.period))
+    return limit_cycle_orbit(table, q0, T)
