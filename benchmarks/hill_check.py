@@ -16,7 +16,7 @@ from collections import Counter
 
 import numpy as np
 from lindstedt.analysis.driven import Drive, amplitudes
-from lindstedt.analysis.response import periodic_orbits
+from lindstedt.analysis.periodic import periodic_orbits
 from lindstedt.analysis.subharmonic import subharmonic
 from lindstedt.numerics.floquet import multipliers_stable, orbit_hill_multipliers
 

@@ -37,9 +37,13 @@ order; a stage imports only stages above it::
                     balance equations, exactly, for LaTeX and emission
     analysis.polynomial  a user's driven equation lowered to data, text -> DrivenEquation
                     the Galerkin balance of any polynomial force, an amplitude bound
-    analysis.response  one-harmonic curves and folds, balance      Drive | equation,
-                    continuation in ω or in the drive; every        ω range -> folds
-                    periodic orbit at one drive
+    analysis.continuation  pseudo-arclength through folds, in ω    system -> curve
+                    or in the drive amplitude from rest; crossings of a level
+    analysis.response  one-harmonic curves and folds, the balance  Drive | equation,
+                    continued over an ω range (the notes' and any    ω range -> folds
+                    polynomial force)
+    analysis.periodic  every distinct periodic orbit at one drive:  Drive | equation ->
+                    seeds, balance, shooting, Floquet; the true fold  orbits
     analysis.subharmonic  orbits of n drive periods of any         equation, n, ω -> orbits
                     polynomial force: balance on the harmonics of ω, shooting, Floquet,
                     onset; the notes' eq. 10.83 in closed form

@@ -18,14 +18,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .analysis.continuation import CONTINUATION_SECONDS
 from .analysis.driven import Drive
 from .analysis.mixing import mixing_series, tone_label
-from .analysis.response import (
-    CONTINUATION_SECONDS,
-    continue_balance,
-    one_harmonic_curve,
-    response_range,
-)
+from .analysis.response import continue_balance, one_harmonic_curve, response_range
 from .analysis.subharmonic import subharmonic, subharmonic_equation, subharmonic_orbits
 from .choose import (
     DRIVEN_QUANTITIES,

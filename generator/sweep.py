@@ -63,14 +63,9 @@ if TYPE_CHECKING:
 # NOTE: xarray and zarr are imported where the client uses them: every worker imports this
 # module to run its blocks and needs neither (~1.3 s of each worker's start-up, measured).
 
-from .analysis.driven import Drive, amplitudes, first_order_branches, mu_expansion
-from .analysis.response import (
-    CONTINUATION_HARMONICS,
-    SAME_ORBIT,
-    amplitude_slope,
-    periodic_orbits,
-    try_balance,
-)
+from .analysis.continuation import CONTINUATION_HARMONICS
+from .analysis.driven import Drive, amplitude_slope, amplitudes, first_order_branches, mu_expansion
+from .analysis.periodic import SAME_ORBIT, periodic_orbits, try_balance
 from .analysis.subharmonic import SUBHARMONIC_HARMONICS, subharmonic
 from .errors import InputError
 
@@ -938,8 +933,8 @@ def _point_values(spec: EquationSpec, axis: Mapping[str, float]) -> dict[str, st
 def _equation_response(spec: EquationSpec, **axis: float) -> dict:
     """Every 1:1 orbit at one point (:func:`response.equation_orbits`: the balance continued in
     the drive amplitude, each crossing shot), largest r first, with its Floquet verdict."""
+    from .analysis.periodic import equation_orbits
     from .analysis.polynomial import driven_equation
-    from .analysis.response import equation_orbits
 
     values = _point_values(spec, axis)
     omega = float(Fraction(values.pop(spec.frequency)))

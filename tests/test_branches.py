@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 from lindstedt.analysis.driven import Drive
-from lindstedt.analysis.response import periodic_orbits
+from lindstedt.analysis.periodic import periodic_orbits
 from lindstedt.cli import driven_json, driven_table
 from scipy.integrate import solve_ivp
 

@@ -17,8 +17,8 @@ import math
 import numpy as np
 import pytest
 from lindstedt.analysis.driven import Drive
+from lindstedt.analysis.periodic import equation_orbits, periodic_orbits
 from lindstedt.analysis.polynomial import driven_equation
-from lindstedt.analysis.response import equation_orbits, periodic_orbits
 from lindstedt.cli import driven_equation_json, main
 from scipy.integrate import solve_ivp
 

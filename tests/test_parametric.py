@@ -23,7 +23,7 @@ from lindstedt.analysis.parametric import (
     tongue_edges,
     trivial_orbit,
 )
-from lindstedt.analysis.response import periodic_orbits
+from lindstedt.analysis.periodic import periodic_orbits
 from lindstedt.analysis.subharmonic import subharmonic
 from lindstedt.numerics.floquet import multipliers_stable, orbit_hill_multipliers
 from scipy.optimize import brentq

@@ -8,14 +8,8 @@ import sys
 
 import numpy as np
 import pytest
-from lindstedt.analysis.driven import Drive
-from lindstedt.analysis.response import (
-    amplitude_residual,
-    amplitude_slope,
-    continue_balance,
-    one_harmonic_curve,
-    one_harmonic_folds,
-)
+from lindstedt.analysis.driven import Drive, amplitude_residual, amplitude_slope
+from lindstedt.analysis.response import continue_balance, one_harmonic_curve, one_harmonic_folds
 from lindstedt.numerics.integrate import duffing_table, sweep
 from lindstedt.numerics.shooting import orbit_fold, shoot
 

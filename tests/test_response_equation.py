@@ -100,8 +100,8 @@ def test_folds_of_an_asymmetric_spring_against_the_reference():
     for moduli in data["numerical"]["fold_floquet_moduli"]:
         assert abs(max(moduli) - 1) < 1e-8 and min(moduli) < 1
     for w in true:  # the reference's fold from the package's fold orbit, moved off it
+        from lindstedt.analysis.periodic import orbit_fold_table
         from lindstedt.analysis.polynomial import driven_equation
-        from lindstedt.analysis.response import orbit_fold_table
         from lindstedt.numerics.integrate import ForceTable
 
         de = driven_equation(ASYMMETRIC, {}, 1.0)

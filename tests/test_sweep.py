@@ -372,7 +372,7 @@ def test_stability_counts_every_distinct_orbit_against_dop853():
     inside the softening spring's fold window at ω = 0.804 (ε −0.1) likewise. Each count,
     the largest Floquet modulus and the small branch's r against DOP853 + Newton on the period
     map (test_branches), started from every orbit's state and from the one-harmonic root."""
-    from lindstedt.analysis.response import periodic_orbits
+    from lindstedt.analysis.periodic import periodic_orbits
     from test_branches import _cubic_seeds, _distance, reference_orbit
 
     for eps, w in ((EPS, 1.491), (-0.1, 0.804)):

@@ -245,7 +245,7 @@ def test_an_orbit_too_unstable_for_the_coarse_balance_guess_is_found():
     multiplier 7.7e7; from the 8-harmonic balance (1e-5 off) its trajectory escapes within the
     period, and `driven` had it as a balance without an orbit. Against multiple shooting."""
     from lindstedt.analysis.driven import Drive
-    from lindstedt.analysis.response import periodic_orbits
+    from lindstedt.analysis.periodic import periodic_orbits
 
     eps, f, Q, w = -0.1, 0.3, 20.0, 0.3
     top = periodic_orbits(Drive(eps, f, w, Q)).orbits[0]

@@ -11,10 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.driven import MAGNITUDES
-from ..analysis.polynomial import driven_form
 from ..errors import InputError
 from ..numerics.integrate import ForceTable, ToneFit, steady_state_fit
+from .driven import MAGNITUDES
+from .polynomial import driven_form
 
 
 @dataclass(frozen=True)

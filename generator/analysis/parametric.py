@@ -37,12 +37,12 @@ import numpy as np
 import sympy as sp
 
 from ..algebra.series import trig_power
-from ..analysis.driven import MAGNITUDES
-from ..analysis.polynomial import PolynomialBalance
 from ..errors import InputError
 from ..numerics.floquet import multipliers_stable, orbit_hill_multipliers
 from ..numerics.integrate import ForceTable
 from ..numerics.shooting import PeriodicOrbit, shoot_table
+from .driven import MAGNITUDES
+from .polynomial import PolynomialBalance
 
 _a, _b, _w, _e, _z, _g = sp.symbols("a b omega epsilon zeta gamma")
 

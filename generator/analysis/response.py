@@ -9,32 +9,41 @@ negative, between the folds); the folds solve ``G = ∂G/∂u = 0``.  N harmonic
 from __future__ import annotations
 
 import functools
-import itertools
 import math
-import time
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import sympy as sp
 
-from ..analysis.driven import (
-    MAGNITUDES,
+from ..errors import InputError
+from ..numerics.integrate import ForceTable, Sweep, sweep_table
+from .continuation import (
+    CONTINUATION_HARMONICS,
+    CONTINUATION_SECONDS,
+    MAX_POINTS,
+    MAX_Q,
+    _balance_r,
+    _continue,
+    _crossings,
+    _half_period,
+    _newton_fixed_omega,
+    continue_in_drive,
+)
+from .driven import (
     BalanceSystem,
-    Branch,
     Drive,
-    HarmonicBalance,
     amplitude_residual,
     amplitude_slope,
-    amplitudes,
     check_harmonics,
     first_order_branches,
-    harmonic_balance,
     one_harmonic_roots,
 )
-from ..analysis.polynomial import DrivenEquation, PolynomialBalance, amplitude_bound
-from ..errors import InputError
-from ..numerics.integrate import ForceTable, Sweep, flow_table, sweep_table
-from ..numerics.shooting import PeriodicOrbit, ShootingFailure, shoot_explained, shoot_table
+from .polynomial import DrivenEquation, PolynomialBalance, amplitude_bound
+
+if TYPE_CHECKING:
+    from .continuation import Continuation
+
 
 _u, _w, _e, _f, _g = sp.symbols("u w e f g")  # u = r², w = ω², g = 1/Q
 _G = _u * ((1 - _w + sp.Rational(3, 4) * _e * _u) ** 2 + _w * _g**2) - _f**2
@@ -116,37 +125,6 @@ def one_harmonic_folds(eps: float, force: float, Q: float) -> list[float]:
         if u > 0 and abs(amplitude_residual(u, omega, d)) < 1e-9 * (1 + force**2):
             folds.append(float(omega))
     return sorted({float(w) for w in folds})
-
-
-@dataclass(frozen=True)
-class Continuation:
-    """The N-harmonic balance traced in ω by pseudo-arclength: one or more pieces, each a
-    curve from one end of the range to an end (``pieces``: the index of each piece's first
-    point; consecutive points of different pieces are not neighbours on the curve)."""
-
-    omega: np.ndarray
-    x: np.ndarray  # (points, 2N): a_1, a_3, …, b_1, b_3, …
-    folds: list[float]  # where dω/ds changes sign, refined
-    pieces: tuple[int, ...] = (0,)
-    complete: bool = True  # every one-harmonic root at both ends lies on a traced piece
-
-    def piece_slices(self) -> list[slice]:
-        """The points of each piece."""
-        ends = [*self.pieces[1:], len(self.omega)]
-        return [slice(a, b) for a, b in zip(self.pieces, ends, strict=True)]
-
-
-MAX_POINTS = 20000
-CONTINUATION_SECONDS = 60.0
-# NOTE: the continuation refuses a curve it estimates at more than 20000 steps or a minute of
-# work (its max_seconds: the CLI's cost limit, lifted by --allow-slow) instead of running for
-# ten minutes: `response --force 1e30 --harmonics 60` once ran 590 s and stopped short of the
-# range, reporting a partial curve.
-MAX_Q = 1e12
-# NOTE: near the resonance x(ω) changes by ~Q·2e-16 relative between neighbouring doubles in ω:
-# the corrector's 1e-13 then needs Q ≲ 1e3 (above, some steps take all 30 iterations: slower,
-# still right); by Q ~ 1e16 the peak is narrower than the doubles around ω = 1 and the
-# continuation wanders for good.  Below 1e12 it is only slower.
 
 
 def point_seconds(harmonics: int) -> float:
@@ -233,75 +211,6 @@ def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_s
                      point_seconds(harmonics), max_points, where)
 
 
-def _continue(sysm: BalanceSystem | PolynomialBalance, end_solutions, omega_start: float,
-              omega_stop: float, step: float, estimate: float, seconds: float,
-              per_point: float, max_points: int, where: str) -> Continuation:
-    """The pseudo-arclength loop of :func:`continue_balance` on any balance with ``residual``,
-    ``jacobian`` and ``d_omega`` in ``(x, ω)``: from each of ``end_solutions()`` (``(ω, x,
-    direction into the range)`` at the two ends, the first at ``omega_start``, and whether
-    they are complete) not reached yet, until ω leaves the range; ``estimate`` points of
-    ``per_point`` seconds, ``seconds`` in all, bound its steps and its time."""
-    lo, hi = sorted((omega_start, omega_stop))
-    limit = min(max_points, int(2 * max(seconds, CONTINUATION_SECONDS) / per_point))
-    allowed = 2 * max(seconds, CONTINUATION_SECONDS)
-    deadline = time.monotonic() + allowed
-    points: list[np.ndarray] = []
-    starts: list[int] = []
-    folds: list[float] = []
-    y = None
-    try:
-        with np.errstate(over="ignore", invalid="ignore"):
-            ends, complete = end_solutions()
-            visited = [False] * len(ends)
-            while not all(visited):
-                k = visited.index(False)
-                visited[k] = True
-                omega0, x0, direction = ends[k]
-                y = np.append(x0, omega0)
-                t = _tangent(sysm, y, None)
-                if t[-1] * direction < 0:
-                    t = -t
-                starts.append(len(points))
-                points.append(y)
-                y_old = None
-                while y_old is None or lo <= y[-1] <= hi:
-                    if len(points) - len(starts) >= limit:
-                        raise InputError(f"{where}: the continuation did not leave ω in "
-                                         f"[{lo:.3g}, {hi:.3g}] within {limit} steps of "
-                                         f"{step:g} (the estimate was {estimate:.0f}); the "
-                                         "curve is longer than it looks")
-                    if time.monotonic() > deadline:
-                        raise InputError(f"{where}: the continuation gave up after "
-                                         f"{allowed:.0f} s at ω = {y[-1]:.6g}, "
-                                         f"{len(points)} points in (its estimate: "
-                                         f"{estimate:.0f}): the corrector does not converge "
-                                         "there")
-                    y_new = _corrector(sysm, y + step * t, t)
-                    t_new = _tangent(sysm, y_new, t)
-                    if not (np.all(np.isfinite(y_new)) and np.all(np.isfinite(t_new))):
-                        raise np.linalg.LinAlgError("the balance overflowed")
-                    if t_new[-1] * t[-1] < 0:
-                        folds.append(_refine_fold(sysm, y, t, step))
-                    y_old, y, t = y, y_new, t_new
-                    points.append(y)
-                # the end it left by: the nearest solution there is reached
-                edge = lo if y[-1] < lo else hi
-                s_edge = (edge - y_old[-1]) / (y[-1] - y_old[-1])
-                x_edge = y_old[:-1] + s_edge * (y[:-1] - y_old[:-1])
-                at_edge = [j for j, e in enumerate(ends) if e[0] == edge]
-                if at_edge:
-                    nearest = min(at_edge, key=lambda j: np.linalg.norm(ends[j][1] - x_edge))
-                    if np.linalg.norm(ends[nearest][1] - x_edge) \
-                            <= 1e-2 * (1 + np.linalg.norm(x_edge)):
-                        visited[nearest] = True
-    except np.linalg.LinAlgError as exc:
-        at = "" if y is None else f" at ω = {y[-1]:.4g}"
-        raise InputError(f"{where}: the harmonic-balance continuation failed{at} ({exc}): "
-                         "its Jacobian is singular or the balance overflowed") from None
-    arr = np.array(points)
-    return Continuation(arr[:, -1], arr[:, :-1], sorted(folds), tuple(starts), complete)
-
-
 def _end_solutions(sysm: BalanceSystem, d: Drive, omega_start: float, omega_stop: float
                    ) -> tuple[list[tuple[float, np.ndarray, float]], bool]:
     """The balance solutions from every one-harmonic root at both ends, as ``(ω, x, the
@@ -335,63 +244,6 @@ def _end_solutions(sysm: BalanceSystem, d: Drive, omega_start: float, omega_stop
     return out, complete
 
 
-def _newton_fixed_omega(sysm: BalanceSystem, x: np.ndarray, omega: float) -> np.ndarray:
-    for _ in range(50):
-        dx = np.linalg.solve(sysm.jacobian(x, omega), -sysm.residual(x, omega))
-        x = x + dx
-        if np.max(np.abs(dx)) < 1e-14 * (1 + np.max(np.abs(x))):
-            break
-    return x
-
-
-def _extended_jacobian(sysm: BalanceSystem, y: np.ndarray) -> np.ndarray:
-    x, omega = y[:-1], y[-1]
-    return np.column_stack([sysm.jacobian(x, omega), sysm.d_omega(x, omega)])
-
-
-def _tangent(sysm: BalanceSystem, y: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
-    """Unit null vector of ``[R_x | R_ω]``, oriented along ``previous``."""
-    _, _, vt = np.linalg.svd(_extended_jacobian(sysm, y))
-    t = vt[-1]
-    if previous is not None and t @ previous < 0:
-        t = -t
-    return t
-
-
-def _corrector(sysm: BalanceSystem, y: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Newton on ``R(y) = 0`` with ``t·(y − y_pred) = 0``."""
-    y_pred = y.copy()
-    for _ in range(30):
-        x, omega = y[:-1], y[-1]
-        F = np.append(sysm.residual(x, omega), t @ (y - y_pred))
-        J = np.vstack([_extended_jacobian(sysm, y), t])
-        dy = np.linalg.solve(J, -F)
-        y = y + dy
-        if np.max(np.abs(dy)) < 1e-13 * (1 + np.max(np.abs(y))):
-            break
-    return y
-
-
-def _refine_fold(sysm: BalanceSystem, y: np.ndarray, t: np.ndarray, step: float) -> float:
-    """Secant on the step length for ``t_ω = 0`` between two continuation points."""
-    def t_omega(h: float) -> tuple[float, np.ndarray]:
-        z = _corrector(sysm, y + h * t, t)
-        return _tangent(sysm, z, t)[-1], z
-
-    h0, h1 = 0.0, step
-    f0, f1 = t[-1], t_omega(step)[0]
-    z = y
-    for _ in range(40):
-        if f1 == f0:
-            break
-        h2 = h1 - f1 * (h1 - h0) / (f1 - f0)
-        f2, z = t_omega(h2)
-        h0, f0, h1, f1 = h1, f1, h2, f2
-        if abs(f2) < 1e-13:
-            break
-    return float(z[-1])
-
-
 # --- the 1/3 subharmonic (eq. 10.83–10.87) ---------------------------------------------------
 
 _a, _b, _F, _w1, _eps1 = sp.symbols("a b F omega epsilon")
@@ -399,510 +251,6 @@ _a, _b, _F, _w1, _eps1 = sp.symbols("a b F omega epsilon")
 
 # --- every distinct periodic orbit at one ω: seeds, shooting, deduplication -----------------
 # (here, after the continuation: its crossings with ω are the seeds the one-harmonic cubic lacks)
-
-SAME_ORBIT = 1e-8
-# NOTE: two shot orbits are one when their states (q(0), q̇(0)/ω) differ by at most 1e-8 of the
-# larger state's norm (≈ the orbit's first-harmonic amplitude r).  Shooting converges to ~1e-12
-# (near a fold, with its multiplier near +1, to ~1e-10); two distinct orbits a distance Δω from
-# a fold differ by ~r·√Δω, so only orbits within ~1e-16 of a fold (one orbit, in double
-# precision) are merged.
-SHOOTING_TOLERANCES = (1e-12, 1e-10)
-# NOTE: near a fold a Floquet multiplier nears +1, M − I is nearly singular and amplifies the
-# integrator's ~1e-13 into Newton steps that never fall below 1e-12 (shooting gave up 2e-6 from
-# the fold at ω = 1.49323, ε 0.1, f 0.3, Q 20): each seed is tried again at 1e-10.
-BALANCE_NEAR = 1e-3
-# NOTE: a converged balance is the orbit's own when its (q(0), q̇(0)) lies within 1e-3 (relative,
-# as SAME_ORBIT) of the orbit's (8 harmonics: ~1e-10; the other orbits lie O(1) away, or
-# ~√(distance to the fold) near one); a seed whose balance converged onto another orbit and
-# whose shooting did not follow it is shown with the balance of a seed that did.
-CONTINUATION_HARMONICS = 8
-# NOTE: the continuation that seeds the orbits carries at most 8 harmonics (2 ms a point; its
-# crossings are then polished at the harmonics asked): a seed, not an answer.
-REFINED_HARMONICS = 32
-# NOTE: where shooting from a balance fails, the balance is solved again with 32 harmonics and
-# shot once more: an orbit near the barrier of a softening spring can be so unstable (Floquet
-# multiplier 7.7e7 at ε −0.1, f 0.3, Q 20, ω 0.3) that the 8-harmonic balance's 1e-5 error
-# carries its trajectory out of the well within the period; 32 harmonics bring it to ~1e-16.
-CONTINUATION_BUDGET = 15.0
-# NOTE: seconds the seeding continuation may take (its own estimate, checked before it starts);
-# above, the seeds are the one-harmonic roots only and the result says it may be incomplete.
-
-
-@dataclass(frozen=True)
-class Orbit:
-    """One distinct periodic orbit of period ``2π/ω`` with how it was found.
-
-    ``seed``: ``"one_harmonic"`` when shooting from a one-harmonic root reached it,
-    ``"continuation"`` when only a crossing of the continued harmonic balance did.
-    ``branch``: the one-harmonic root that stands for it at first order (the root whose shooting
-    reached it, the nearest when several did; or, when as many roots as orbits are left over,
-    the one of the same rank in amplitude), ``None`` when no root does.
-    ``balance``: the harmonic balance whose solution led to the orbit.  ``orbit`` is ``None``
-    for a root whose balance converged but whose shooting did not (at the corners of the
-    domain): then the branch is that balance alone (``paired = "balance"``)."""
-
-    orbit: PeriodicOrbit | None  # None: shooting found no orbit (see periodic_orbits)
-    balance: HarmonicBalance | None
-    branch: Branch | None
-    seed: str
-    paired: str | None  # "shot" (its shooting reached it), "rank", "balance", None (no root)
-    failure: ShootingFailure | None = None  # orbit None: why shooting from the balance failed
-
-    @property
-    def r(self) -> float:
-        """The first-harmonic amplitude ``√(A₁² + B₁²)`` of the true orbit (of the balance
-        where shooting found none)."""
-        return _amplitude({"orbit": self.orbit, "balance": self.balance})
-
-
-@dataclass(frozen=True)
-class Orbits:
-    """Every distinct orbit found at one drive, largest first, and the one-harmonic roots."""
-
-    orbits: tuple[Orbit, ...]
-    roots: tuple[tuple[Branch, int | None], ...]  # each root, the index of the orbit it stands for
-    complete: bool  # whether the seeds cover the whole response curve (balance_crossings)
-    note: str  # how the seeds were found
-    failures: tuple[ShootingFailure | None, ...] = ()  # per root: why its shooting found none
-
-
-def _guess(hb: HarmonicBalance, omega: float) -> np.ndarray:
-    """``(q(0), q̇(0)) = (Σ A_n, ω Σ n B_n)`` of a balance solution."""
-    A, B = amplitudes(hb.coefficients, 0.0, 2 * hb.harmonics - 1)
-    return np.array([sum(A.values()), omega * sum(n * b for n, b in B.items())])
-
-
-def _state_distance(a: np.ndarray, b: np.ndarray, omega: float) -> float:
-    """``|Δ(q, q̇/ω)|`` relative to the larger of the two states' norms (see SAME_ORBIT)."""
-    u, v = np.array([a[0], a[1] / omega]), np.array([b[0], b[1] / omega])
-    size = max(float(np.linalg.norm(u)), float(np.linalg.norm(v)))
-    return float(np.linalg.norm(u - v)) / size if size > 0 else 0.0
-
-
-def _first_harmonic_gap(br: Branch, found: dict) -> float:
-    """Distance of a root's ``(A₁ cos δ₀, A₁ sin δ₀)`` from an orbit's ``(A₁, B₁)`` (its
-    balance's, where shooting found none)."""
-    if found["orbit"] is None:
-        A, B = amplitudes(found["balance"].coefficients, 0.0, 1)
-    else:
-        A, B = found["orbit"].A, found["orbit"].B
-    return math.hypot(br.A1 * math.cos(br.delta0) - A[1], br.A1 * math.sin(br.delta0) - B[1])
-
-
-def _amplitude(found: dict) -> float:
-    """r of a found orbit, or of its balance when shooting found none."""
-    if found["orbit"] is None:
-        A, B = amplitudes(found["balance"].coefficients, 0.0, 1)
-        return math.hypot(A[1], B[1])
-    return math.hypot(found["orbit"].A[1], found["orbit"].B[1])
-
-
-def try_balance(d: Drive, start: Branch | np.ndarray, harmonics: int,
-                converged: bool = False) -> HarmonicBalance | None:
-    """:func:`driven.harmonic_balance` from ``start``, or ``None`` where its Newton meets a
-    singular Jacobian (exactly at a fold) — and, with ``converged``, where it does not
-    converge."""
-    try:
-        hb = harmonic_balance(d, start, harmonics)
-    except np.linalg.LinAlgError:
-        return None
-    return hb if hb.converged or not converged else None
-
-
-def _balance_vector(hb: HarmonicBalance) -> np.ndarray:
-    """``x = (a_1, a_3, …, b_1, b_3, …)`` of a balance solution."""
-    A, B = amplitudes(hb.coefficients, 0.0, 2 * hb.harmonics - 1)
-    return np.array([*A.values(), *B.values()])
-
-
-@functools.lru_cache(maxsize=16)
-def _traced(eps: float, force: float, Q: float, harmonics: int, lo: float,
-            hi: float) -> tuple[object, str]:
-    """The continued balance on ``[lo, hi]`` (cached: one curve serves every ω on it), or
-    ``None`` and the reason it was refused."""
-    try:
-        return continue_balance(eps, force, Q, harmonics, lo, hi,
-                                max_seconds=CONTINUATION_BUDGET), ""
-    except InputError as exc:
-        return None, str(exc)
-
-
-def balance_crossings(d: Drive, harmonics: int = CONTINUATION_HARMONICS
-                      ) -> tuple[list[np.ndarray], str, bool]:
-    """Every point of the continued harmonic-balance curve at ``d.omega`` (damped only), as
-    balance vectors ``x`` with ``harmonics`` harmonics, interpolated between continuation
-    points (linearly; quadratically around each turn of ω, where both crossings near a fold
-    may lie between two points): seeds, not solutions.  With how they were found, and whether
-    they are complete: every piece of the curve that reaches an end of the range traced (a
-    softening spring's two, see :func:`continue_balance`), or none needed (linear, one orbit;
-    ω above the range, where ``response`` has one branch too).  ``False``: undamped (no
-    continuation), refused, or a root at an end whose balance did not converge."""
-    if d.damping == 0:
-        return [], "undamped: no continuation (the response curve needs damping)", False
-    if d.eps == 0:  # linear: one orbit, the root's (and the curve, up to r = fQ, is long)
-        return [], "linear (eps 0): one orbit, no continuation needed", True
-    lo, hi = response_range(d.eps, d.force, d.Q)
-    if d.omega > hi:
-        return [], (f"omega above the response curve's range (up to {hi:.6g}, 1.25 x its "
-                    "highest one-harmonic fold): no continuation"), True
-    lo = min(lo, max(0.98 * d.omega, MAGNITUDES[0]))
-    cont, why = _traced(d.eps, d.force, d.Q, harmonics, lo, hi)
-    if cont is None:
-        return [], f"continuation refused ({why})", False
-    seeds = []
-    for piece in cont.piece_slices():
-        seeds += _crossings(cont.omega[piece] - d.omega, cont.x[piece])
-    note = f"continued harmonic balance (N = {harmonics}) on [{lo:.6g}, {hi:.6g}]"
-    if not cont.complete:  # a root at an end whose balance did not converge: not traced
-        return seeds, (f"{note}: the balance from a one-harmonic root at an end of the range "
-                       "did not converge, its piece of the curve is missing"), False
-    return seeds, note, True
-
-
-def _crossings(w: np.ndarray, x: np.ndarray) -> list[np.ndarray]:
-    """Where one piece of the continued curve meets ``w = 0`` (``w``: its ω minus the drive's),
-    interpolated (see :func:`balance_crossings`)."""
-    seeds = []
-    for i in range(len(w) - 1):
-        if w[i] * w[i + 1] <= 0 and w[i] != w[i + 1]:
-            t = w[i] / (w[i] - w[i + 1])
-            seeds.append(x[i] + t * (x[i + 1] - x[i]))
-    for i in range(1, len(w) - 1):
-        if (w[i] - w[i - 1]) * (w[i + 1] - w[i]) >= 0:
-            continue
-        # w(s) = w_i + b s + c s² through s = −1, 0, 1 (equal arclength steps), w(s) = 0
-        b, c = (w[i + 1] - w[i - 1]) / 2, (w[i + 1] - 2 * w[i] + w[i - 1]) / 2
-        disc = b * b - 4 * c * w[i]
-        if c == 0 or disc < 0:
-            continue
-        for s in ((-b - math.sqrt(disc)) / (2 * c), (-b + math.sqrt(disc)) / (2 * c)):
-            if abs(s) <= 1:
-                seeds.append(x[i] + s * (x[i + 1] - x[i - 1]) / 2
-                             + s * s * (x[i + 1] - 2 * x[i] + x[i - 1]) / 2)
-    return seeds
-
-
-def periodic_orbits(d: Drive, harmonics: int = 8, shoot_harmonics: int = 9) -> Orbits:
-    """Every distinct periodic orbit of period ``2π/ω`` that the seeds reach, largest ``r``
-    first, each once, with its Floquet multipliers (:func:`numerics.shoot`).
-
-    Seeds: every real root of the one-harmonic equation (through its harmonic balance with
-    ``harmonics`` harmonics, or the root itself where that balance does not converge) and,
-    damped, every crossing of the continued harmonic-balance curve with this ω
-    (:func:`balance_crossings`, polished at ``harmonics``): the true folds are not the
-    one-harmonic ones, so near a fold the cubic has too few roots or too many.  Orbits are
-    one when their states differ by at most SAME_ORBIT.  Undamped there is no continuation:
-    the one-harmonic seeds only, deduplicated."""
-    check_harmonics(harmonics)
-    roots = first_order_branches(d)
-    seeds: list[tuple[int | None, list[np.ndarray], HarmonicBalance | None]] = []
-    for k, br in enumerate(roots):
-        hb = try_balance(d, br, harmonics)
-        first = br.A1 * np.array([math.cos(br.delta0), d.omega * math.sin(br.delta0)])
-        guesses = [_guess(hb, d.omega), first] if hb is not None and hb.converged else [first]
-        seeds.append((k, guesses, hb))
-    crossings, note, complete = balance_crossings(d, min(harmonics, CONTINUATION_HARMONICS))
-    for x in crossings:
-        hb = try_balance(d, x, harmonics)
-        h = len(x) // 2
-        raw = np.array([x[:h].sum(), d.omega * np.sum(np.arange(1, 2 * h, 2) * x[h:])])
-        seeds.append((None, [_guess(hb, d.omega), raw] if hb is not None and hb.converged
-                      else [raw], hb))
-    found: list[dict] = []  # orbit, balance, whether that balance is the orbit's, seed
-    reached: dict[int, int] = {}  # root index -> orbit index
-    failures: dict[int, ShootingFailure] = {}  # root index -> why its shooting found none
-    for k, guesses, hb in seeds:
-        orbit, failure = _shoot_seed(d, guesses, hb, shoot_harmonics)
-        if orbit is None:
-            if k is not None:
-                failures[k] = failure
-            continue
-        j = next((j for j, f in enumerate(found) if _state_distance(
-            f["orbit"].initial, orbit.initial, d.omega) <= SAME_ORBIT), None)
-        # the balance shown beside the orbit: one that converged onto it, if any seed's did
-        own = hb is not None and hb.converged and _state_distance(
-            _guess(hb, d.omega), orbit.initial, d.omega) <= BALANCE_NEAR
-        if j is None:
-            j = len(found)
-            found.append({"orbit": orbit, "balance": hb, "own": own,
-                          "seed": "one_harmonic" if k is not None else "continuation"})
-        elif own and not found[j]["own"]:
-            found[j].update(balance=hb, own=True)
-        if k is not None:
-            reached[k] = j
-    # a root whose shooting failed but whose balance converged elsewhere than every orbit found
-    # (the corners of the domain, where RK4 cannot follow the scales): its balance, no orbit
-    for k, _, hb in seeds:
-        if k is None or k in reached or hb is None or not hb.converged:
-            continue
-        state = _guess(hb, d.omega)
-        if all(_state_distance(state, f["orbit"].initial if f["orbit"] is not None
-                               else _guess(f["balance"], d.omega), d.omega)
-               > (BALANCE_NEAR if f["orbit"] is not None else SAME_ORBIT) for f in found):
-            reached[k] = len(found)
-            found.append({"orbit": None, "balance": hb, "own": True, "seed": "one_harmonic",
-                          "failure": failures.get(k)})
-    rank = sorted(range(len(found)), key=lambda j: -_amplitude(found[j]))
-    found = [found[j] for j in rank]
-    new_index = {old: new for new, old in enumerate(rank)}
-    # the first-order root standing for each orbit: the nearest root whose shooting reached it
-    owner: dict[int, int] = {}  # orbit index -> root index
-    for k, old in reached.items():
-        j = new_index[old]
-        if j not in owner or _first_harmonic_gap(roots[k], found[j]) \
-                < _first_harmonic_gap(roots[owner[j]], found[j]):
-            owner[j] = k
-    # ... then, when as many roots as orbits are left over, the leftovers by rank in amplitude
-    free_roots = [k for k in range(len(roots)) if k not in owner.values()]
-    free_orbits = [j for j in range(len(found)) if j not in owner]
-    paired = {j: "shot" if found[j]["orbit"] is not None else "balance" for j in owner}
-    if len(free_roots) == len(free_orbits):
-        owner.update(zip(free_orbits, sorted(free_roots, key=lambda k: -abs(roots[k].A1)),
-                         strict=True))
-        paired.update(dict.fromkeys(free_orbits, "rank"))
-    stands = {k: j for j, k in owner.items()}
-    orbits = tuple(Orbit(f["orbit"], f["balance"], roots[owner[j]] if j in owner else None,
-                         f["seed"], paired.get(j), f.get("failure"))
-                   for j, f in enumerate(found))
-    return Orbits(orbits, tuple((br, stands.get(k)) for k, br in enumerate(roots)),
-                  complete, note, tuple(failures.get(k) for k in range(len(roots))))
-
-
-def _shoot_seed(d: Drive, guesses: list[np.ndarray], hb: HarmonicBalance | None,
-                shoot_harmonics: int) -> tuple[PeriodicOrbit | None, ShootingFailure | None]:
-    """Shooting from each guess at each of SHOOTING_TOLERANCES, then (a converged balance)
-    from the balance solved again with REFINED_HARMONICS; the orbit, or why the first guess
-    found none."""
-    first = None
-    for tol, guess in itertools.product(SHOOTING_TOLERANCES, guesses):
-        found = shoot_explained(d.eps, d.force, d.omega, d.damping, guess,
-                                harmonics=shoot_harmonics, tol=tol)
-        if isinstance(found, PeriodicOrbit):
-            return found, None
-        first = first or found
-    if hb is not None and hb.converged and hb.harmonics < REFINED_HARMONICS:
-        fine = try_balance(d, _balance_vector(hb), REFINED_HARMONICS, converged=True)
-        if fine is not None:
-            for tol in SHOOTING_TOLERANCES:
-                found = shoot_explained(d.eps, d.force, d.omega, d.damping,
-                                        _guess(fine, d.omega), harmonics=shoot_harmonics,
-                                        tol=tol)
-                if isinstance(found, PeriodicOrbit):
-                    return found, None
-    return None, first
-
-
-# --- a user's driven oscillator: every orbit at one ω, from a continuation in the drive -------
-
-class _DriveFamily:
-    """A :class:`driven.PolynomialBalance` at fixed ω as a family in the drive amplitude f:
-    the interface :func:`_tangent` and :func:`_corrector` take, with f in ω's place."""
-
-    def __init__(self, system: PolynomialBalance, omega: float) -> None:
-        self.system, self.omega = system, omega
-
-    def residual(self, x: np.ndarray, f: float) -> np.ndarray:
-        return self.system.residual(x, self.omega, force=f)
-
-    def jacobian(self, x: np.ndarray, f: float) -> np.ndarray:
-        return self.system.jacobian(x, self.omega)
-
-    def d_omega(self, x: np.ndarray, f: float) -> np.ndarray:
-        return -self.system.drive
-
-
-@dataclass(frozen=True)
-class DriveContinuation:
-    """The balance traced in the drive amplitude from rest (``f = 0``, ``q = 0``) at one ω."""
-
-    force: np.ndarray  # f at each point
-    x: np.ndarray  # (points, unknowns)
-    complete: bool  # it reached the amplitude bound, past which no orbit lies
-    note: str
-
-
-MAX_DRIVE_POINTS = 4000
-# NOTE: the continuation in f stops after 4000 points (~5 s at 31 unknowns) and says its seeds
-# may be incomplete; a curve up to an amplitude bound of a few hundred takes far fewer.
-
-
-def continue_in_drive(system: PolynomialBalance, omega: float, bound: float | None,
-                      max_points: int = MAX_DRIVE_POINTS,
-                      max_seconds: float = CONTINUATION_BUDGET) -> DriveContinuation:
-    """Trace the balance from ``f = 0``, ``x = 0`` by pseudo-arclength in ``(x, f)`` until the
-    first harmonic exceeds ``bound`` (:func:`driven.amplitude_bound`; then every orbit at the
-    drive lies on the traced part, up to isolated branches the curve does not pass) or the
-    budget ends.  The step adapts: halved where the corrector fails or the tangent turns by
-    more than ~25°, grown by 1.5 where it does not, up to 1 % of the curve's scale and, near
-    ``±f``, to half the distance from it (down to 1e-4 of the scale)."""
-    fam = _DriveFamily(system, omega)
-    m = system.size
-    k1 = int(np.nonzero(system.orders == 1)[0][0])
-    sin1 = system.n_cos + int(np.nonzero(system.orders[system.orders > 0] == 1)[0][0])
-    scale = abs(system.force) + (bound if bound is not None else 10.0)
-    h_max, h_floor, h_min = scale / 100, scale * 1e-4, scale * 1e-9
-    h = h_max / 4
-    y = np.zeros(m + 1)
-    deadline = time.monotonic() + max_seconds
-    with np.errstate(over="ignore", invalid="ignore"):
-        t = _tangent(fam, y, None)
-        if t[-1] < 0:
-            t = -t
-        if abs(t[-1]) < 1e-8:  # ω at a linear resonance, undamped: q = 0 is degenerate
-            t = _first_direction(fam, y, h, k1, sin1)
-        points = [y]
-        while True:
-            r = math.hypot(y[k1], y[sin1])
-            if bound is not None and r > bound:
-                return _drive_curve(points, True, f"continued in the drive amplitude from 0 "
-                                    f"up to the amplitude bound r = {bound:.4g}")
-            if len(points) >= max_points or time.monotonic() > deadline:
-                return _drive_curve(points, False, f"the continuation in the drive stopped at "
-                                    f"r = {r:.4g} after {len(points)} points"
-                                    + ("" if bound is None else f" (bound {bound:.4g})"))
-            try:
-                y_new = _corrector(fam, y + h * t, t)
-                t_new = _tangent(fam, y_new, t)
-            except np.linalg.LinAlgError:
-                y_new = t_new = None
-            good = (y_new is not None and np.all(np.isfinite(y_new))
-                    and np.all(np.isfinite(t_new))
-                    and np.max(np.abs(fam.residual(y_new[:-1], y_new[-1])))
-                    <= 1e-9 * (1 + np.max(np.abs(y_new)))
-                    and np.linalg.norm(y_new - y) <= 2 * h and t_new @ t > 0.9)
-            if not good:
-                h /= 2
-                if h < h_min:
-                    return _drive_curve(points, False, f"the continuation in the drive failed "
-                                        f"at r = {r:.4g}, f = {y[-1]:.4g} (no step converges)")
-                continue
-            y, t = y_new, t_new
-            points.append(y)
-            # near ±f the steps shrink with the distance to it, so that a fold of the curve
-            # just beyond ±f (two crossings close together) leaves points on both sides
-            near = min(abs(y[-1] - system.force), abs(y[-1] + system.force))
-            h = min(1.5 * h, h_max, max(h_floor, 0.5 * near))
-
-
-def _first_direction(fam: _DriveFamily, y: np.ndarray, h: float, k1: int,
-                     sin1: int) -> np.ndarray:
-    """Where ``[J | −e₁]`` is singular at rest (an undamped harmonic at its linear resonance,
-    the response growing like ``f^(1/3)``), the curve's first direction: the first of ±cos ωt,
-    ±sin ωt whose pseudo-arclength step converges; its tangent there, pointing away from rest.
-    """
-    for k, sign in itertools.product((k1, sin1), (1.0, -1.0)):
-        t = np.zeros_like(y)
-        t[k] = sign
-        try:
-            z = _corrector(fam, y + h * t, t)
-            if np.max(np.abs(fam.residual(z[:-1], z[-1]))) <= 1e-9 * (1 + np.max(np.abs(z))):
-                t = _tangent(fam, z, z - y)
-                return t
-        except np.linalg.LinAlgError:
-            continue
-    raise InputError("the balance at rest is singular (a harmonic at its linear resonance) and "
-                     "no first step from it converges")
-
-
-def _drive_curve(points: list[np.ndarray], complete: bool, note: str) -> DriveContinuation:
-    arr = np.array(points)
-    return DriveContinuation(arr[:, -1], arr[:, :-1], complete, note)
-
-
-@dataclass(frozen=True)
-class EquationOrbit:
-    """One distinct periodic orbit of a user's driven oscillator: its balance and, where
-    shooting found it, the true orbit with its Floquet multipliers."""
-
-    orbit: PeriodicOrbit | None
-    balance: np.ndarray | None  # x of the balance solution that led to it
-    converged: bool  # that balance's Newton converged
-    residual: float | None
-    failure: ShootingFailure | None = None
-
-    @property
-    def r(self) -> float:
-        """The first-harmonic amplitude of the true orbit (of the balance where none)."""
-        if self.orbit is not None:
-            return math.hypot(self.orbit.A.get(1, 0.0), self.orbit.B.get(1, 0.0))
-        return float("nan")
-
-
-@dataclass(frozen=True)
-class EquationOrbits:
-    orbits: tuple[EquationOrbit, ...]
-    system: PolynomialBalance
-    complete: bool
-    note: str
-    seeds: int
-
-
-def _half_period(system: PolynomialBalance, x: np.ndarray) -> np.ndarray:
-    """``q(t + T/2)``: harmonic k times ``(−1)^k``; it answers ``−f cos ωt`` where ``q`` answers
-    ``f cos ωt`` (the force is autonomous)."""
-    sign = (-1.0) ** np.concatenate([system.orders, system.orders[system.orders > 0]])
-    return sign * x
-
-
-def equation_orbits(de: DrivenEquation, harmonics: int = 8,
-                    shoot_harmonics: int | None = None) -> EquationOrbits:
-    """Every distinct periodic orbit of period ``2π/ω`` of a :class:`driven.DrivenEquation`
-    that the seeds reach, largest ``r`` first, each once, checked by shooting with its Floquet
-    multipliers (:func:`numerics.shoot_table`).
-
-    Seeds: where the balance (at most CONTINUATION_HARMONICS harmonics), continued in the drive
-    amplitude from rest (:func:`continue_in_drive`), crosses ``f`` — and ``−f``, shifted by half
-    a period — (:func:`_crossings`, quadratic around the folds); each is polished by Newton's
-    method at ``harmonics`` and shot from; orbits within SAME_ORBIT are one."""
-    check_harmonics(harmonics)
-    top = 2 * harmonics - 1
-    shoot_harmonics = top if shoot_harmonics is None else shoot_harmonics
-    omega, f = de.omega, de.force
-    coarse = PolynomialBalance(de.terms, f, min(harmonics, CONTINUATION_HARMONICS), de.odd)
-    fine = PolynomialBalance(de.terms, f, harmonics, de.odd)
-    bound = amplitude_bound(de.terms, omega, abs(f))
-    curve = continue_in_drive(coarse, omega, bound)
-    seeds = _crossings(curve.force - f, curve.x)
-    seeds += [_half_period(coarse, x) for x in _crossings(curve.force + f, curve.x)]
-    table = ForceTable.of(de.terms)
-    found: list[EquationOrbit] = []
-    for x in seeds:
-        A, B = coarse.amplitudes(x)
-        start = fine.vector(A, B)
-        xb, converged, residual = fine.solve(start, omega)
-        guesses = [fine.state(xb, omega)] if converged else []
-        guesses.append(coarse.state(x, omega))
-        orbit, failure = None, None
-        for tol, guess in itertools.product(SHOOTING_TOLERANCES, guesses):
-            shot = shoot_table(table, f, omega, guess, harmonics=shoot_harmonics, tol=tol)
-            if isinstance(shot, PeriodicOrbit):
-                orbit, failure = shot, None
-                break
-            failure = failure or shot
-        if orbit is None:
-            if converged and all(o.orbit is not None or _state_distance(
-                    fine.state(o.balance, omega), fine.state(xb, omega), omega) > SAME_ORBIT
-                    for o in found):
-                found.append(EquationOrbit(None, xb, converged, residual, failure))
-            continue
-        j = next((j for j, o in enumerate(found) if o.orbit is not None and _state_distance(
-            o.orbit.initial, orbit.initial, omega) <= SAME_ORBIT), None)
-        own = converged and _state_distance(fine.state(xb, omega), orbit.initial,
-                                            omega) <= BALANCE_NEAR
-        if j is None:
-            found.append(EquationOrbit(orbit, xb if converged else None, converged and own,
-                                       residual if converged else None))
-        elif own and not found[j].converged:
-            found[j] = EquationOrbit(orbit, xb, True, residual)
-    found.sort(key=lambda o: -(o.r if o.orbit is not None else _balance_r(fine, o.balance)))
-    note = curve.note + f"; {len(seeds)} crossings of the drive amplitude"
-    return EquationOrbits(tuple(found), fine, curve.complete, note, len(seeds))
-
-
-def _balance_r(system: PolynomialBalance, x: np.ndarray) -> float:
-    A, B = system.amplitudes(x)
-    return math.hypot(A.get(1, 0.0), B.get(1, 0.0))
-
 
 # --- a user's driven oscillator: the response curve in ω -------------------------------------
 
@@ -1159,40 +507,6 @@ def _equation_ends(de: DrivenEquation, fine: PolynomialBalance, omega_start: flo
     return out, complete
 
 
-def orbit_fold_table(table: ForceTable, force: float, omega: float, y0: np.ndarray,
-                     tol: float = 1e-11) -> tuple[float, np.ndarray, np.ndarray] | None:
-    """:func:`numerics.orbit_fold` for ``q̈ + g(q, q̇) = f cos ωt`` (``g`` the table): the true
-    orbit with a Floquet multiplier ``+1`` by Newton's method in ``(y₀, ω)`` on
-    ``(φ_T(y₀) − y₀, det(M − I))``; ``(ω, y₀, multipliers)`` or ``None``."""
-    def F(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        end, _, _ = flow_table(table, force, z[2], z[:2], 2 * np.pi / z[2], samples=1)
-        mono = end[2:].reshape(2, 2).T
-        return np.array([*(end[:2] - z[:2]), np.linalg.det(mono - np.eye(2))]), mono
-
-    z = np.array([*y0, omega], dtype=float)
-    with np.errstate(over="ignore", invalid="ignore"):
-        for _ in range(30):
-            if not z[2] > 0:
-                return None
-            f0, _ = F(z)
-            J = np.empty((3, 3))
-            for k in range(3):
-                e = np.zeros(3)
-                e[k] = 1e-7 * (1 + abs(z[k]))
-                J[:, k] = (F(z + e)[0] - F(z - e)[0]) / (2 * e[k])
-            if not (np.all(np.isfinite(J)) and np.all(np.isfinite(f0))):
-                return None
-            try:
-                dz = np.linalg.solve(J, -f0)
-            except np.linalg.LinAlgError:
-                return None
-            z = z + dz
-            if np.max(np.abs(dz)) < tol * (1 + np.max(np.abs(z))):
-                _, mono = F(z)
-                return float(z[2]), z[:2], np.linalg.eigvals(mono)
-    return None
-
-
 ESCAPE_FACTOR = 10.0
 # NOTE: a user's equation has no barrier in closed form: a sweep whose |q| passes 10× the largest
 # |q| of any balance solution on the range (Σ|a_k| + |b_k| over the continued curve), moving
@@ -1208,7 +522,7 @@ def response_equation(text: str, values: dict[str, str], name: str = "oscillator
     :class:`driven.DrivenEquation` of ``text`` (ω left free: every parameter but the drive
     frequency needs a value), refused in one line where the force depends on the drive
     frequency or has no damping (a term odd in q')."""
-    from ..analysis.polynomial import driven_equation
+    from .polynomial import driven_equation
 
     def lowered(omega: float) -> DrivenEquation:
         try:
@@ -1254,7 +568,7 @@ def equation_response(text: str, values: dict[str, str], harmonics: int,
                       max_seconds: float = CONTINUATION_SECONDS) -> EquationCurve:
     """``response EQUATION``'s curve: the continuation over the range, then the simulated
     sweeps both ways, escapes detected past :data:`ESCAPE_FACTOR` × the largest balance."""
-    from ..analysis.polynomial import PolynomialBalance
+    from .polynomial import PolynomialBalance
 
     de = response_equation(text, values, name)
     er = equation_range(de.terms, de.force, omega_min, omega_max)

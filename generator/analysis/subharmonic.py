@@ -18,13 +18,14 @@ import numpy as np
 import sympy as sp
 
 from ..algebra.series import trig_power
-from ..analysis.driven import Drive
-from ..analysis.polynomial import PolynomialBalance, amplitude_bound, driven_form
-from ..analysis.response import SHOOTING_TOLERANCES, _corrector, _DriveFamily, _tangent
 from ..errors import InputError
 from ..numerics.floquet import hill_multipliers, multipliers_stable, orbit_hill_multipliers
 from ..numerics.integrate import ForceTable, duffing_table, steady_state_amplitudes
 from ..numerics.shooting import PeriodicOrbit, shoot, shoot_table
+from .continuation import _corrector, _DriveFamily, _tangent
+from .driven import Drive
+from .periodic import SHOOTING_TOLERANCES
+from .polynomial import PolynomialBalance, amplitude_bound, driven_form
 
 _a, _b, _F, _w1, _eps1 = sp.symbols("a b F omega epsilon")
 

@@ -860,7 +860,7 @@ def driven_json(d, order: int, harmonics: int) -> dict:
     stands for (found by continuing the balance through a fold the cubic does not have) has
     ``A1``, ``r``, ``delta0`` null and no μ-expansion, with ``mu_note`` saying why."""
     from ..analysis.driven import amplitudes, mu_expansion
-    from ..analysis.response import periodic_orbits
+    from ..analysis.periodic import periodic_orbits
     from ..numerics.floquet import multipliers_stable, orbit_hill_multipliers
 
     damped = d.damping > 0
@@ -1013,8 +1013,8 @@ def driven_equation_json(text: str, values: dict[str, str], omega: float, harmon
     (:func:`response.equation_orbits`), largest first, each by its harmonic balance (``A``
     holds the constant ``"0"`` and even harmonics unless the force is odd) and, checked by
     shooting, the true orbit with its Floquet moduli and verdict."""
+    from ..analysis.periodic import equation_orbits
     from ..analysis.polynomial import driven_equation
-    from ..analysis.response import equation_orbits
 
     de = driven_equation(text, values, omega, name)
     found = equation_orbits(de, harmonics)
@@ -1182,7 +1182,8 @@ def response_equation_json(text: str, values: dict[str, str], harmonics: int,
     and of the true orbit (each with its Floquet moduli), the sweeps' jumps and escapes."""
     import numpy as np
 
-    from ..analysis.response import equation_response, orbit_fold_table
+    from ..analysis.periodic import orbit_fold_table
+    from ..analysis.response import equation_response
 
     curve = equation_response(text, values, harmonics, name, omega_min, omega_max, max_seconds)
     de, er, cont, up, down = curve.de, curve.er, curve.cont, curve.up, curve.down

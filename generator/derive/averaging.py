@@ -40,8 +40,8 @@ import sympy as sp
 from sympy.polys.domains import QQ
 
 from ..algebra.series import Ground, MPoly, Trig
-from ..derive.models import Oscillator
 from ..errors import InputError
+from .models import Oscillator
 
 MAX_ORDER = 6
 # NOTE: order 6 of van der Pol takes about half a second, the driven Duffing's order 4 one;

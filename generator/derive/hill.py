@@ -20,9 +20,9 @@ import flint
 import sympy as sp
 from flint import fmpq, fmpq_poly, fmpq_series
 
-from ..derive.equation import TIME, parse_expression
-from ..derive.models import check_order
 from ..errors import InputError
+from .equation import TIME, parse_expression
+from .models import check_order
 
 KINDS = ("a", "b")
 MAX_M = 100

@@ -35,9 +35,9 @@ from ..algebra.series import (
     solve_trig,
     to_fourier,
 )
-from ..derive.models import Model, check_order, t
 from ..display import SHOWN_ORDERS, latex_aligned, latex_sum, latex_text, more
 from ..errors import InputError
+from .models import Model, check_order, t
 
 CONVENTION = "q(0) = A, q'(0) = 0, so q_j(0) = 0 for j >= 1"
 s = sp.Symbol("s")

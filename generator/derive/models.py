@@ -22,8 +22,8 @@ from dataclasses import dataclass
 import sympy as sp
 from sympy.polys.domains import QQ
 
-from ..derive.equation import SMALL, Equation, parse_equation, parse_expression
 from ..errors import InputError
+from .equation import SMALL, Equation, parse_equation, parse_expression
 
 t, eps, A, theta0 = sp.symbols("t epsilon A theta_0")
 Y = sp.Symbol("Y")  # stands for the expansion variable y in conditions

@@ -30,7 +30,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from ..derive.models import Model, oscillator
+from .models import Model, oscillator
 
 DIGITS = 30
 # NOTE: the edge is stated to 30 significant digits (mpmath works at 40).

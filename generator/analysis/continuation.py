@@ -1,0 +1,335 @@
+"""Pseudo-arclength continuation of a balance system, through its folds: in the drive
+frequency ω (a curve in ω with its pieces) or in the drive amplitude f from rest at one ω
+(the seeds of every orbit), and the crossings of a traced curve with a level."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from .driven import (
+    BalanceSystem,
+)
+from .polynomial import PolynomialBalance
+
+
+@dataclass(frozen=True)
+class Continuation:
+    """The N-harmonic balance traced in ω by pseudo-arclength: one or more pieces, each a
+    curve from one end of the range to an end (``pieces``: the index of each piece's first
+    point; consecutive points of different pieces are not neighbours on the curve)."""
+
+    omega: np.ndarray
+    x: np.ndarray  # (points, 2N): a_1, a_3, …, b_1, b_3, …
+    folds: list[float]  # where dω/ds changes sign, refined
+    pieces: tuple[int, ...] = (0,)
+    complete: bool = True  # every one-harmonic root at both ends lies on a traced piece
+
+    def piece_slices(self) -> list[slice]:
+        """The points of each piece."""
+        ends = [*self.pieces[1:], len(self.omega)]
+        return [slice(a, b) for a, b in zip(self.pieces, ends, strict=True)]
+
+
+MAX_POINTS = 20000
+CONTINUATION_SECONDS = 60.0
+# NOTE: the continuation refuses a curve it estimates at more than 20000 steps or a minute of
+# work (its max_seconds: the CLI's cost limit, lifted by --allow-slow) instead of running for
+# ten minutes: `response --force 1e30 --harmonics 60` once ran 590 s and stopped short of the
+# range, reporting a partial curve.
+MAX_Q = 1e12
+# NOTE: near the resonance x(ω) changes by ~Q·2e-16 relative between neighbouring doubles in ω:
+# the corrector's 1e-13 then needs Q ≲ 1e3 (above, some steps take all 30 iterations: slower,
+# still right); by Q ~ 1e16 the peak is narrower than the doubles around ω = 1 and the
+# continuation wanders for good.  Below 1e12 it is only slower.
+
+
+def _continue(sysm: BalanceSystem | PolynomialBalance, end_solutions, omega_start: float,
+              omega_stop: float, step: float, estimate: float, seconds: float,
+              per_point: float, max_points: int, where: str) -> Continuation:
+    """The pseudo-arclength loop of :func:`continue_balance` on any balance with ``residual``,
+    ``jacobian`` and ``d_omega`` in ``(x, ω)``: from each of ``end_solutions()`` (``(ω, x,
+    direction into the range)`` at the two ends, the first at ``omega_start``, and whether
+    they are complete) not reached yet, until ω leaves the range; ``estimate`` points of
+    ``per_point`` seconds, ``seconds`` in all, bound its steps and its time."""
+    lo, hi = sorted((omega_start, omega_stop))
+    limit = min(max_points, int(2 * max(seconds, CONTINUATION_SECONDS) / per_point))
+    allowed = 2 * max(seconds, CONTINUATION_SECONDS)
+    deadline = time.monotonic() + allowed
+    points: list[np.ndarray] = []
+    starts: list[int] = []
+    folds: list[float] = []
+    y = None
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):
+            ends, complete = end_solutions()
+            visited = [False] * len(ends)
+            while not all(visited):
+                k = visited.index(False)
+                visited[k] = True
+                omega0, x0, direction = ends[k]
+                y = np.append(x0, omega0)
+                t = _tangent(sysm, y, None)
+                if t[-1] * direction < 0:
+                    t = -t
+                starts.append(len(points))
+                points.append(y)
+                y_old = None
+                while y_old is None or lo <= y[-1] <= hi:
+                    if len(points) - len(starts) >= limit:
+                        raise InputError(f"{where}: the continuation did not leave ω in "
+                                         f"[{lo:.3g}, {hi:.3g}] within {limit} steps of "
+                                         f"{step:g} (the estimate was {estimate:.0f}); the "
+                                         "curve is longer than it looks")
+                    if time.monotonic() > deadline:
+                        raise InputError(f"{where}: the continuation gave up after "
+                                         f"{allowed:.0f} s at ω = {y[-1]:.6g}, "
+                                         f"{len(points)} points in (its estimate: "
+                                         f"{estimate:.0f}): the corrector does not converge "
+                                         "there")
+                    y_new = _corrector(sysm, y + step * t, t)
+                    t_new = _tangent(sysm, y_new, t)
+                    if not (np.all(np.isfinite(y_new)) and np.all(np.isfinite(t_new))):
+                        raise np.linalg.LinAlgError("the balance overflowed")
+                    if t_new[-1] * t[-1] < 0:
+                        folds.append(_refine_fold(sysm, y, t, step))
+                    y_old, y, t = y, y_new, t_new
+                    points.append(y)
+                # the end it left by: the nearest solution there is reached
+                edge = lo if y[-1] < lo else hi
+                s_edge = (edge - y_old[-1]) / (y[-1] - y_old[-1])
+                x_edge = y_old[:-1] + s_edge * (y[:-1] - y_old[:-1])
+                at_edge = [j for j, e in enumerate(ends) if e[0] == edge]
+                if at_edge:
+                    nearest = min(at_edge, key=lambda j: np.linalg.norm(ends[j][1] - x_edge))
+                    if np.linalg.norm(ends[nearest][1] - x_edge) \
+                            <= 1e-2 * (1 + np.linalg.norm(x_edge)):
+                        visited[nearest] = True
+    except np.linalg.LinAlgError as exc:
+        at = "" if y is None else f" at ω = {y[-1]:.4g}"
+        raise InputError(f"{where}: the harmonic-balance continuation failed{at} ({exc}): "
+                         "its Jacobian is singular or the balance overflowed") from None
+    arr = np.array(points)
+    return Continuation(arr[:, -1], arr[:, :-1], sorted(folds), tuple(starts), complete)
+
+
+def _newton_fixed_omega(sysm: BalanceSystem, x: np.ndarray, omega: float) -> np.ndarray:
+    for _ in range(50):
+        dx = np.linalg.solve(sysm.jacobian(x, omega), -sysm.residual(x, omega))
+        x = x + dx
+        if np.max(np.abs(dx)) < 1e-14 * (1 + np.max(np.abs(x))):
+            break
+    return x
+
+
+def _extended_jacobian(sysm: BalanceSystem, y: np.ndarray) -> np.ndarray:
+    x, omega = y[:-1], y[-1]
+    return np.column_stack([sysm.jacobian(x, omega), sysm.d_omega(x, omega)])
+
+
+def _tangent(sysm: BalanceSystem, y: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
+    """Unit null vector of ``[R_x | R_ω]``, oriented along ``previous``."""
+    _, _, vt = np.linalg.svd(_extended_jacobian(sysm, y))
+    t = vt[-1]
+    if previous is not None and t @ previous < 0:
+        t = -t
+    return t
+
+
+def _corrector(sysm: BalanceSystem, y: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Newton on ``R(y) = 0`` with ``t·(y − y_pred) = 0``."""
+    y_pred = y.copy()
+    for _ in range(30):
+        x, omega = y[:-1], y[-1]
+        F = np.append(sysm.residual(x, omega), t @ (y - y_pred))
+        J = np.vstack([_extended_jacobian(sysm, y), t])
+        dy = np.linalg.solve(J, -F)
+        y = y + dy
+        if np.max(np.abs(dy)) < 1e-13 * (1 + np.max(np.abs(y))):
+            break
+    return y
+
+
+def _refine_fold(sysm: BalanceSystem, y: np.ndarray, t: np.ndarray, step: float) -> float:
+    """Secant on the step length for ``t_ω = 0`` between two continuation points."""
+    def t_omega(h: float) -> tuple[float, np.ndarray]:
+        z = _corrector(sysm, y + h * t, t)
+        return _tangent(sysm, z, t)[-1], z
+
+    h0, h1 = 0.0, step
+    f0, f1 = t[-1], t_omega(step)[0]
+    z = y
+    for _ in range(40):
+        if f1 == f0:
+            break
+        h2 = h1 - f1 * (h1 - h0) / (f1 - f0)
+        f2, z = t_omega(h2)
+        h0, f0, h1, f1 = h1, f1, h2, f2
+        if abs(f2) < 1e-13:
+            break
+    return float(z[-1])
+
+
+CONTINUATION_HARMONICS = 8
+# NOTE: the continuation that seeds the orbits carries at most 8 harmonics (2 ms a point; its
+# crossings are then polished at the harmonics asked): a seed, not an answer.
+CONTINUATION_BUDGET = 15.0
+# NOTE: seconds the seeding continuation may take (its own estimate, checked before it starts);
+# above, the seeds are the one-harmonic roots only and the result says it may be incomplete.
+
+
+def _crossings(w: np.ndarray, x: np.ndarray) -> list[np.ndarray]:
+    """Where one piece of the continued curve meets ``w = 0`` (``w``: its ω minus the drive's),
+    interpolated (see :func:`balance_crossings`)."""
+    seeds = []
+    for i in range(len(w) - 1):
+        if w[i] * w[i + 1] <= 0 and w[i] != w[i + 1]:
+            t = w[i] / (w[i] - w[i + 1])
+            seeds.append(x[i] + t * (x[i + 1] - x[i]))
+    for i in range(1, len(w) - 1):
+        if (w[i] - w[i - 1]) * (w[i + 1] - w[i]) >= 0:
+            continue
+        # w(s) = w_i + b s + c s² through s = −1, 0, 1 (equal arclength steps), w(s) = 0
+        b, c = (w[i + 1] - w[i - 1]) / 2, (w[i + 1] - 2 * w[i] + w[i - 1]) / 2
+        disc = b * b - 4 * c * w[i]
+        if c == 0 or disc < 0:
+            continue
+        for s in ((-b - math.sqrt(disc)) / (2 * c), (-b + math.sqrt(disc)) / (2 * c)):
+            if abs(s) <= 1:
+                seeds.append(x[i] + s * (x[i + 1] - x[i - 1]) / 2
+                             + s * s * (x[i + 1] - 2 * x[i] + x[i - 1]) / 2)
+    return seeds
+
+
+# --- a user's driven oscillator: every orbit at one ω, from a continuation in the drive -------
+
+class _DriveFamily:
+    """A :class:`driven.PolynomialBalance` at fixed ω as a family in the drive amplitude f:
+    the interface :func:`_tangent` and :func:`_corrector` take, with f in ω's place."""
+
+    def __init__(self, system: PolynomialBalance, omega: float) -> None:
+        self.system, self.omega = system, omega
+
+    def residual(self, x: np.ndarray, f: float) -> np.ndarray:
+        return self.system.residual(x, self.omega, force=f)
+
+    def jacobian(self, x: np.ndarray, f: float) -> np.ndarray:
+        return self.system.jacobian(x, self.omega)
+
+    def d_omega(self, x: np.ndarray, f: float) -> np.ndarray:
+        return -self.system.drive
+
+
+@dataclass(frozen=True)
+class DriveContinuation:
+    """The balance traced in the drive amplitude from rest (``f = 0``, ``q = 0``) at one ω."""
+
+    force: np.ndarray  # f at each point
+    x: np.ndarray  # (points, unknowns)
+    complete: bool  # it reached the amplitude bound, past which no orbit lies
+    note: str
+
+
+MAX_DRIVE_POINTS = 4000
+# NOTE: the continuation in f stops after 4000 points (~5 s at 31 unknowns) and says its seeds
+# may be incomplete; a curve up to an amplitude bound of a few hundred takes far fewer.
+
+
+def continue_in_drive(system: PolynomialBalance, omega: float, bound: float | None,
+                      max_points: int = MAX_DRIVE_POINTS,
+                      max_seconds: float = CONTINUATION_BUDGET) -> DriveContinuation:
+    """Trace the balance from ``f = 0``, ``x = 0`` by pseudo-arclength in ``(x, f)`` until the
+    first harmonic exceeds ``bound`` (:func:`driven.amplitude_bound`; then every orbit at the
+    drive lies on the traced part, up to isolated branches the curve does not pass) or the
+    budget ends.  The step adapts: halved where the corrector fails or the tangent turns by
+    more than ~25°, grown by 1.5 where it does not, up to 1 % of the curve's scale and, near
+    ``±f``, to half the distance from it (down to 1e-4 of the scale)."""
+    fam = _DriveFamily(system, omega)
+    m = system.size
+    k1 = int(np.nonzero(system.orders == 1)[0][0])
+    sin1 = system.n_cos + int(np.nonzero(system.orders[system.orders > 0] == 1)[0][0])
+    scale = abs(system.force) + (bound if bound is not None else 10.0)
+    h_max, h_floor, h_min = scale / 100, scale * 1e-4, scale * 1e-9
+    h = h_max / 4
+    y = np.zeros(m + 1)
+    deadline = time.monotonic() + max_seconds
+    with np.errstate(over="ignore", invalid="ignore"):
+        t = _tangent(fam, y, None)
+        if t[-1] < 0:
+            t = -t
+        if abs(t[-1]) < 1e-8:  # ω at a linear resonance, undamped: q = 0 is degenerate
+            t = _first_direction(fam, y, h, k1, sin1)
+        points = [y]
+        while True:
+            r = math.hypot(y[k1], y[sin1])
+            if bound is not None and r > bound:
+                return _drive_curve(points, True, f"continued in the drive amplitude from 0 "
+                                    f"up to the amplitude bound r = {bound:.4g}")
+            if len(points) >= max_points or time.monotonic() > deadline:
+                return _drive_curve(points, False, f"the continuation in the drive stopped at "
+                                    f"r = {r:.4g} after {len(points)} points"
+                                    + ("" if bound is None else f" (bound {bound:.4g})"))
+            try:
+                y_new = _corrector(fam, y + h * t, t)
+                t_new = _tangent(fam, y_new, t)
+            except np.linalg.LinAlgError:
+                y_new = t_new = None
+            good = (y_new is not None and np.all(np.isfinite(y_new))
+                    and np.all(np.isfinite(t_new))
+                    and np.max(np.abs(fam.residual(y_new[:-1], y_new[-1])))
+                    <= 1e-9 * (1 + np.max(np.abs(y_new)))
+                    and np.linalg.norm(y_new - y) <= 2 * h and t_new @ t > 0.9)
+            if not good:
+                h /= 2
+                if h < h_min:
+                    return _drive_curve(points, False, f"the continuation in the drive failed "
+                                        f"at r = {r:.4g}, f = {y[-1]:.4g} (no step converges)")
+                continue
+            y, t = y_new, t_new
+            points.append(y)
+            # near ±f the steps shrink with the distance to it, so that a fold of the curve
+            # just beyond ±f (two crossings close together) leaves points on both sides
+            near = min(abs(y[-1] - system.force), abs(y[-1] + system.force))
+            h = min(1.5 * h, h_max, max(h_floor, 0.5 * near))
+
+
+def _first_direction(fam: _DriveFamily, y: np.ndarray, h: float, k1: int,
+                     sin1: int) -> np.ndarray:
+    """Where ``[J | −e₁]`` is singular at rest (an undamped harmonic at its linear resonance,
+    the response growing like ``f^(1/3)``), the curve's first direction: the first of ±cos ωt,
+    ±sin ωt whose pseudo-arclength step converges; its tangent there, pointing away from rest.
+    """
+    for k, sign in itertools.product((k1, sin1), (1.0, -1.0)):
+        t = np.zeros_like(y)
+        t[k] = sign
+        try:
+            z = _corrector(fam, y + h * t, t)
+            if np.max(np.abs(fam.residual(z[:-1], z[-1]))) <= 1e-9 * (1 + np.max(np.abs(z))):
+                t = _tangent(fam, z, z - y)
+                return t
+        except np.linalg.LinAlgError:
+            continue
+    raise InputError("the balance at rest is singular (a harmonic at its linear resonance) and "
+                     "no first step from it converges")
+
+
+def _drive_curve(points: list[np.ndarray], complete: bool, note: str) -> DriveContinuation:
+    arr = np.array(points)
+    return DriveContinuation(arr[:, -1], arr[:, :-1], complete, note)
+
+
+def _half_period(system: PolynomialBalance, x: np.ndarray) -> np.ndarray:
+    """``q(t + T/2)``: harmonic k times ``(−1)^k``; it answers ``−f cos ωt`` where ``q`` answers
+    ``f cos ωt`` (the force is autonomous)."""
+    sign = (-1.0) ** np.concatenate([system.orders, system.orders[system.orders > 0]])
+    return sign * x
+
+
+def _balance_r(system: PolynomialBalance, x: np.ndarray) -> float:
+    A, B = system.amplitudes(x)
+    return math.hypot(A.get(1, 0.0), B.get(1, 0.0))
