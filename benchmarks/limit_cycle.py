@@ -26,7 +26,7 @@ import time
 from fractions import Fraction
 
 from lindstedt.algebra.series import Ground, Trig, solve_trig
-from lindstedt.derive.lindstedt import (
+from lindstedt.derive.cycles import (
     _linearisation,
     _secular_parts,
     derive_limit_cycle,

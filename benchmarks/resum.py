@@ -44,8 +44,9 @@ from lindstedt.algebra.resum import (
 )
 from lindstedt.charts import mathieu_accuracy_figure, resummed_speed_accuracy_figure
 from lindstedt.compiler import generate_limit_cycle, generate_mathieu
+from lindstedt.derive.cycles import derive_limit_cycle
 from lindstedt.derive.hill import mathieu_series
-from lindstedt.derive.lindstedt import derive_limit_cycle, nearest_singularity
+from lindstedt.derive.lindstedt import nearest_singularity
 from lindstedt.derive.models import series_model
 from lindstedt.emit.render import load_generated
 from lindstedt.errors import InputError

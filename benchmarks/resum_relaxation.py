@@ -24,7 +24,8 @@ from pathlib import Path
 import numpy as np
 from lindstedt.algebra.resum import resum_frequency, resum_relaxation, van_der_pol_relaxation
 from lindstedt.compiler import generate_limit_cycle
-from lindstedt.derive.lindstedt import derive_limit_cycle, nearest_singularity
+from lindstedt.derive.cycles import derive_limit_cycle
+from lindstedt.derive.lindstedt import nearest_singularity
 from lindstedt.derive.models import series_model
 from lindstedt.emit.render import load_generated
 from lindstedt.numerics.references import cycle_reference

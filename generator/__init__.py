@@ -15,8 +15,9 @@ order; a stage imports only stages above it::
     derive.orbits   where a free oscillator's family of periodic   Model -> OrbitDomain
                     orbits ends: the first integral's separatrix, to 30 digits
     derive.lindstedt  L–P series, order-by-order equations, naive  Model, K -> SeriesSolution
-                    expansion, and the limit cycles of             SelfExcited, K -> LimitCycle
-                    q'' + q = ε f(q, q')
+                    expansion; the nearest singularity and the radius of a series
+    derive.cycles   the limit cycles of q'' + q = ε f(q, q'), each  SelfExcited, K -> LimitCycle
+                    with its stability, exact in Q or Q(a₀)
     derive.hill     Hill's equation x'' + (δ + ε p(t))x = 0:       p(t), n, K -> curves
                     transition curves out of each tongue, a damped tongue's tip, and
                     Mathieu's a_m(q), b_m(q), exact (L–P about cos nτ, sin nτ)

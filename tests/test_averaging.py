@@ -11,7 +11,7 @@ import pytest
 import sympy as sp
 from lindstedt.analysis.driven import Drive, harmonic_balance, one_harmonic_roots
 from lindstedt.derive.averaging import PHI, R, cycle_series, fixed_points, slow_flow, transient
-from lindstedt.derive.lindstedt import derive_limit_cycle
+from lindstedt.derive.cycles import derive_limit_cycle
 from lindstedt.derive.models import oscillator, self_excited_model
 from lindstedt.errors import InputError
 from scipy.integrate import solve_ivp

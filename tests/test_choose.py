@@ -582,7 +582,7 @@ def test_choose_cycle_reports_the_series_error_against_shooting(monkeypatch):
     error it reports for the partial sums is theirs against an independent shooting, and it
     picks them (the cheapest by the recorded costs) since they meet the tolerance."""
     from lindstedt.choose import choose_limit_cycle, verification_points
-    from lindstedt.derive.lindstedt import derive_limit_cycle
+    from lindstedt.derive.cycles import derive_limit_cycle
     from lindstedt.derive.models import series_model
     from lindstedt.methods import verify as methods
 

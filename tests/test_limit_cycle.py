@@ -11,7 +11,7 @@ from functools import reduce
 import numpy as np
 import pytest
 from lindstedt.cli import main
-from lindstedt.derive.lindstedt import derive_limit_cycle, limit_cycle_amplitudes
+from lindstedt.derive.cycles import derive_limit_cycle, limit_cycle_amplitudes
 from lindstedt.derive.models import oscillator, self_excited_model
 from lindstedt.errors import InputError
 from scipy.integrate import solve_ivp

@@ -107,7 +107,8 @@ def test_relaxation_form_reaches_the_relaxation_regime():
     shooting (rtol 1e-9: ~1e-8) at ε = 10 and 1e-5 at ε = 5, and at ε = 10 over ten times
     closer than Padé in w of the same coefficients (resum_frequency); 1e-7 at ε = 10 needs
     order 164 (benchmarks/resum_relaxation.py; ε ≤ 1: the emitted module's test below)."""
-    from lindstedt.derive.lindstedt import derive_limit_cycle, nearest_singularity
+    from lindstedt.derive.cycles import derive_limit_cycle
+    from lindstedt.derive.lindstedt import nearest_singularity
 
     lc = derive_limit_cycle(series_model("van_der_pol", 60), 60)
     est = nearest_singularity(lc.omega)
@@ -197,7 +198,8 @@ def test_emitted_relaxation_form_equals_the_in_process_one(emitted):
     """The module's omega_resummed (cube root by scaled Halley steps, ln s by the atanh series,
     Estrin's split) against the same form evaluated with NumPy's cbrt and log1p: the same
     function to 3e-14 (the Padé's rounding near the verified limit), its twin to 2 ulp."""
-    from lindstedt.derive.lindstedt import derive_limit_cycle, nearest_singularity
+    from lindstedt.derive.cycles import derive_limit_cycle
+    from lindstedt.derive.lindstedt import nearest_singularity
 
     mod, _ = emitted
     omega = derive_limit_cycle(series_model("van_der_pol", 60), 60).omega

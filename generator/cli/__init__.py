@@ -283,7 +283,8 @@ def limit_cycle_table(lc) -> str:
 
 
 def _cmd_series(args: argparse.Namespace) -> int:
-    from ..derive.lindstedt import derive, derive_limit_cycle, limit_cycles
+    from ..derive.cycles import derive_limit_cycle, limit_cycles
+    from ..derive.lindstedt import derive
     from ..derive.models import SelfExcited, series_model
 
     found = series_model(args.model, args.order, _params(args.param), args.name)

@@ -14,11 +14,8 @@ from ..derive.averaging import R as R_SLOW
 from ..derive.averaging import SlowFlow
 from ..derive.averaging import U as U_SLOW
 from ..derive.averaging import V as V_SLOW
-from ..derive.lindstedt import (
-    LimitCycle,
-    SeriesSolution,
-    order_terms,
-)
+from ..derive.cycles import LimitCycle
+from ..derive.lindstedt import SeriesSolution, order_terms
 from ..errors import InputError
 from .forms import _LOCAL, LOCAL_NAMES, MODULE_NAMES, agm_steps, harmonics
 from .records import (

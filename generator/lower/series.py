@@ -11,12 +11,8 @@ from fractions import Fraction
 import sympy as sp
 
 from ..algebra.resum import Pade, Resummed
-from ..derive.lindstedt import (
-    LimitCycle,
-    SeriesSolution,
-    estimated_radius,
-    nearest_singularity,
-)
+from ..derive.cycles import LimitCycle
+from ..derive.lindstedt import SeriesSolution, estimated_radius, nearest_singularity
 from ..derive.orbits import OrbitDomain, orbit_domain
 from ..numerics.references import mathieu_recurrence
 from .forms import (

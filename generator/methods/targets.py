@@ -23,7 +23,8 @@ from ..analysis.mu_exact import (
     mu_expansion_exact,
 )
 from ..derive.averaging import slow_flow
-from ..derive.lindstedt import derive, derive_limit_cycle
+from ..derive.cycles import derive_limit_cycle
+from ..derive.lindstedt import derive
 from ..derive.models import Model, SelfExcited
 from ..errors import InputError
 from ..lower.documents import (
@@ -109,7 +110,7 @@ def cycle_series_order(order: int, resum_order: int | None) -> int:
 
 
 def _cycle_derive(r: Request, progress: Progress | None) -> object:
-    from ..derive.lindstedt import limit_cycles
+    from ..derive.cycles import limit_cycles
 
     first = limit_cycles(r.model)[0]
     if not first.rational:

@@ -251,7 +251,7 @@ def true_limit_cycle(model: object, eps: float, cycle: int = 0, order: int = 12
                      ) -> LimitCycleOrbit | None:
     """The true orbit of limit cycle ``cycle`` of a :class:`models.SelfExcited` oscillator at
     ``eps``, shot from its L–P series at ``order`` (q(0) and T as the seed)."""
-    from ..derive.lindstedt import derive_limit_cycle
+    from ..derive.cycles import derive_limit_cycle
 
     lc = derive_limit_cycle(model, order, cycle)
     table = ForceTable.of({(1, 0): 1.0, **{(a, b): -eps * float(c) for a, b, c in model.terms}})
