@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 from distributed import Client
-from lindstedt.sweep import WarmUp, local_cluster, make_grid, run_sweep, serial_sweep, warm_up
+from lindstedt.sweep.kinds import WarmUp, warm_up
+from lindstedt.sweep.store import local_cluster, make_grid, run_sweep, serial_sweep
 
 KIND = "stability"
 SPEED_UP_TARGET = 1.7

@@ -79,8 +79,10 @@ order; a stage imports only stages above it::
     compiler        derive -> lower -> render -> write, each once  Target, Request -> files
     choose          methods × orders, verified error, recorded     tol, range -> Choice
                     cost model
-    sweep           driven maps over grids on dask.distributed,    kind, axes -> Dataset
-                    into Zarr (the notes' axes, or any parameters of an equation)
+    sweep.kinds     what one point of a map computes: the notes'   point -> fields
+                    kinds, and any equation's parameters as axes
+    sweep.store     grids in blocks on dask.distributed, into a    kind, axes -> Dataset
+                    resumable Zarr store
     charts          matplotlib figures                             results -> PNG/SVG/PDF
     costs           each command's estimated wall time and bounds  arguments -> Cost
     cli             the command line (each command imports its stages itself)

@@ -28,18 +28,20 @@ from lindstedt.analysis.response import one_harmonic_curve
 from lindstedt.charts import sweep_figure
 from lindstedt.errors import InputError
 from lindstedt.numerics.shooting import shoot
-from lindstedt.sweep import (
+from lindstedt.sweep.kinds import (
     MU_ORDERS,
     WarmUp,
     equation_kind,
-    estimate_bytes,
     kernel_signatures,
+    validity_errors,
+)
+from lindstedt.sweep.store import (
+    estimate_bytes,
     local_cluster,
     make_grid,
     open_sweep,
     run_sweep,
     serial_sweep,
-    validity_errors,
 )
 
 EPS, FORCE, Q = 0.1, 0.3, 20.0
@@ -211,7 +213,7 @@ def test_stopped_sweep_resumes_without_recomputing(scheduler, tmp_path):
 
 KILLED = """
 import json, os, signal, sys
-import lindstedt.sweep as sweep
+import lindstedt.sweep.store as sweep
 kind, axes, store, address = json.loads(sys.argv[1])
 marked = []
 write_flag = sweep._mark_done

@@ -1944,7 +1944,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         from ..charts import check_plot_path
 
         check_plot_path(Path(args.plot))
-    from ..sweep import equation_kind, run_sweep
+    from ..kinds import equation_kind
+    from ..store import run_sweep
 
     builtin = {name: getattr(args, name) for name in ("omega", "force", "eps", "Q")
                if getattr(args, name) is not None}

@@ -1,0 +1,2 @@
+"""Maps over parameter grids: what one point computes (kinds) and the resumable store on
+dask.distributed (store)."""

@@ -1,0 +1,509 @@
+"""Maps of the driven oscillator ``q̈ + q̇/Q + q + εq³ = f cos ωt`` over parameter grids.
+
+A grid is a few named axes (``omega``, ``force``, ``eps``, ``Q``), each a list of values; a
+*kind* of map (:data:`KINDS`) says which axes it takes, what it computes at one point and
+what it stores:
+
+* ``response``: the steady amplitude ``r = √(A₁² + B₁²)`` of every 1:1 branch (harmonic
+  balance with 10 harmonics from each first-order root), its one-harmonic stability
+  (``∂G/∂u > 0``), and the largest and smallest stable amplitude;
+* ``stability``: every distinct periodic orbit (:func:`response.periodic_orbits`: shooting
+  from each branch's balance solution and from the crossings of the continued balance, which
+  find the orbits the one-harmonic roots miss near a fold), how many are Floquet-stable, their
+  largest Floquet modulus, and the orbit each first-order branch stands for;
+* ``subharmonic``: the 1/3 subharmonic (eq. 10.87, undamped; ``omega`` is its frequency, the
+  drive is at ``3ω``): whether it exists, both roots, Hill and true-orbit stability, and the
+  full Hill verdict (about the harmonic-balance orbit, :func:`numerics.orbit_hill_multipliers`)
+  with its largest multiplier modulus;
+* ``validity``: the μ-expansion's and low-order harmonic balance's error in ``A₁`` against
+  harmonic balance with 10 harmonics on the largest branch (the driven validity chart).
+
+Every point is computed by the existing solvers of :mod:`driven`, :mod:`response` and
+:mod:`numerics`; nothing here solves anything itself.
+
+A user's equation (:func:`equation_kind`) makes a kind of its own: any of its parameters an
+axis, every orbit stored with its r and Floquet verdict.
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+import json
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import TYPE_CHECKING
+
+import numpy as np
+from distributed import WorkerPlugin
+
+from .analysis.continuation import CONTINUATION_HARMONICS
+from .analysis.driven import Drive, amplitude_slope, amplitudes, first_order_branches, mu_expansion
+from .analysis.periodic import SAME_ORBIT, periodic_orbits, try_balance
+from .analysis.subharmonic import SUBHARMONIC_HARMONICS, subharmonic
+from .errors import InputError
+
+if TYPE_CHECKING:
+    pass
+
+# NOTE: xarray and zarr are imported where the client uses them: every worker imports this
+# module to run its blocks and needs neither (~1.3 s of each worker's start-up, measured).
+
+
+
+# --- what one point computes -------------------------------------------------------------------
+
+BRANCHES = 3
+# NOTE: the first-order amplitude equation is a cubic in r²: at most three 1:1 branches.
+RESPONSE_HARMONICS = 10
+# NOTE: harmonic balance with 10 odd harmonics equals the true orbit to ~1e-10 at the notes'
+# parameters (the judge of the validity chart), at ~1 ms a branch.
+ORBIT_HARMONICS = 8
+# NOTE: the balance each orbit is shot from (response.periodic_orbits' default).
+MU_ORDERS = (1, 2, 4, 6, 10)
+BALANCE_HARMONICS = (2, 4)
+JUDGE_HARMONICS = 10
+# NOTE: the methods and the judge of charts.driven_validity_figure (its VALIDITY_METHODS).
+
+
+def _response(omega: float, force: float, eps: float, Q: float) -> dict:
+    d = Drive(eps, force, omega, Q)
+    branches = first_order_branches(d)[:BRANCHES]
+    r, stable = [math.nan] * BRANCHES, [-1] * BRANCHES
+    for k, br in enumerate(branches):
+        stable[k] = int(amplitude_slope(br.A1**2, omega, d) > 0)
+        hb = try_balance(d, br, RESPONSE_HARMONICS, converged=True)
+        if hb is not None:
+            A, B = amplitudes(hb.coefficients, 0.0, 1)
+            r[k] = math.hypot(A[1], B[1])
+    kept = [r[k] for k in range(len(branches)) if stable[k] == 1 and math.isfinite(r[k])]
+    return {"branches": len(branches), "r": r, "stable": stable,
+            "r_stable_max": max(kept, default=math.nan),
+            "r_stable_min": min(kept, default=math.nan)}
+
+
+def _stability(omega: float, force: float, eps: float, Q: float) -> dict:
+    """Every distinct 1:1 orbit (:func:`response.periodic_orbits`: the one-harmonic roots and,
+    damped, the crossings of the continued balance, shot and deduplicated); per first-order
+    branch, the orbit it stands for (NaN / −1 where it stands for none)."""
+    found = periodic_orbits(Drive(eps, force, omega, Q), ORBIT_HARMONICS, shoot_harmonics=1)
+    shot = [o.orbit for o in found.orbits if o.orbit is not None]
+    r, floquet, stable = [math.nan] * BRANCHES, [math.nan] * BRANCHES, [-1] * BRANCHES
+    for k, (_, j) in enumerate(found.roots[:BRANCHES]):
+        orbit = None if j is None else found.orbits[j].orbit
+        if orbit is not None:
+            r[k] = math.hypot(orbit.A[1], orbit.B[1])
+            floquet[k] = float(np.max(np.abs(orbit.multipliers)))
+            stable[k] = int(orbit.stable)
+    return {"branches": min(len(found.roots), BRANCHES), "orbits": len(shot),
+            "stable_orbits": sum(o.stable for o in shot),
+            "max_floquet": max((float(np.max(np.abs(o.multipliers))) for o in shot),
+                               default=math.nan),
+            "r": r, "floquet": floquet, "orbit_stable": stable}
+
+
+def _subharmonic(omega: float, force: float, eps: float) -> dict:
+    exists, _, solutions = subharmonic(eps, force, omega)
+    out = {"exists": int(exists), "F": solutions[0].F if solutions else math.nan,
+           "a": [math.nan] * 2, "hill_stable": [-1] * 2, "orbit_a1": [math.nan] * 2,
+           "orbit_floquet": [math.nan] * 2, "orbit_stable": [-1] * 2, "locked": [-1] * 2,
+           "full_hill_stable": [-1] * 2, "full_hill_modulus": [math.nan] * 2}
+    for s in solutions:
+        k = 0 if s.root == "+" else 1
+        out["a"][k], out["hill_stable"][k] = s.a, int(s.hill_stable)
+        if s.full_hill_stable is not None:  # None: the balance did not converge to this root
+            out["full_hill_stable"][k] = int(s.full_hill_stable)
+            out["full_hill_modulus"][k] = float(np.max(np.abs(s.full_hill_multipliers)))
+        if s.orbit is not None:
+            out["orbit_a1"][k] = s.orbit.A[1]
+            out["orbit_floquet"][k] = float(np.max(np.abs(s.orbit.multipliers)))
+            out["orbit_stable"][k] = int(s.orbit.stable)
+            out["locked"][k] = int(bool(s.locked))
+    out["stable_roots"] = sum(v == 1 for v in out["orbit_stable"])
+    return out
+
+
+def validity_errors(d: Drive) -> tuple[np.ndarray, np.ndarray, int]:
+    """``|A₁ − A₁(balance, N = 10)|`` on the largest branch for the μ-expansion at
+    :data:`MU_ORDERS` and harmonic balance with :data:`BALANCE_HARMONICS` harmonics (NaN where a
+    method refuses: a fold, a diverging μ-series, a balance that does not converge — and
+    everywhere when the judge itself does not converge), and the branch count.
+
+    The measure of ``charts._validity_errors``, with the judge's convergence checked."""
+    mu_err = np.full(len(MU_ORDERS), np.nan)
+    hb_err = np.full(len(BALANCE_HARMONICS), np.nan)
+    branches = first_order_branches(d)
+    judge = try_balance(d, branches[0], JUDGE_HARMONICS, converged=True) if branches else None
+    if judge is None:
+        return mu_err, hb_err, len(branches)
+    truth = amplitudes(judge.coefficients, 0.0, 1)[0][1]
+    for k, order in enumerate(MU_ORDERS):
+        mu = mu_expansion(d, branches[0], order)
+        if len(mu.coefficients) > order and mu.converged:
+            mu_err[k] = abs(amplitudes(*mu.partial(order), 1)[0][1] - truth)
+    for k, harmonics in enumerate(BALANCE_HARMONICS):
+        hb = try_balance(d, branches[0], harmonics, converged=True)
+        if hb is not None:
+            hb_err[k] = abs(amplitudes(hb.coefficients, 0.0, 1)[0][1] - truth)
+    return mu_err, hb_err, len(branches)
+
+
+def _validity(omega: float, force: float, eps: float, Q: float) -> dict:
+    mu_err, hb_err, count = validity_errors(Drive(eps, force, omega, Q))
+    return {"mu_error": mu_err, "balance_error": hb_err, "branches": count}
+
+
+# --- the kinds of map ----------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Field:
+    """One stored variable: ``float64`` (NaN = none) or an ``int8`` count or flag (−1 = none)."""
+
+    name: str
+    long_name: str
+    dtype: str = "float64"
+    dims: tuple[str, ...] = ()  # beyond the grid's axes
+    flag: bool = False  # int8 verdict: 1 yes, 0 no, −1 none
+
+    @property
+    def fill(self) -> float | int:
+        return math.nan if self.dtype == "float64" else -1
+
+    def attrs(self) -> dict:
+        out: dict = {"long_name": self.long_name}
+        if self.flag:
+            out |= {"flag_values": [-1, 0, 1], "flag_meanings": "none no yes"}
+        elif self.dtype == "int8":
+            out["comment"] = "-1: not computed"
+        return out
+
+
+@dataclass(frozen=True)
+class Kind:
+    """A kind of map: its axes, the dimensions its fields add, what one point computes."""
+
+    name: str
+    description: str
+    axes: tuple[str, ...]
+    extra: tuple[tuple[str, tuple[int, ...]], ...]  # dimension -> coordinate values
+    fields: tuple[Field, ...]
+    point: Callable[..., dict]  # axis values (floats, by name) -> field values
+    warm_up: tuple[tuple[str, float], ...]  # a point that runs every compiled kernel it uses
+    points_per_chunk: int  # default block size: ~1 s of work
+    headline: str  # the field a figure draws (its last entry along any extra dimension)
+    settings: tuple[tuple[str, object], ...]  # constants its numbers depend on
+    builtin: bool = True  # the notes' axes (omega, force, eps, Q), checked as a Drive's
+    positive: tuple[str, ...] = ()  # an equation's axes that must be > 0 (its drive frequency)
+
+    @property
+    def point_seconds(self) -> float:
+        """The wall time of one point on one worker: a default block is ~1 s of work."""
+        return 1.0 / self.points_per_chunk
+
+    @property
+    def extra_sizes(self) -> dict[str, int]:
+        return {dim: len(values) for dim, values in self.extra}
+
+
+AXES = ("omega", "force", "eps", "Q")
+# NOTE: the order of every grid's dimensions. Blocks take whole trailing axes, so the axes that
+# usually have few values (ε, Q) come last and ω, the one swept finely, first.
+BRANCH = ("branch", (1, 2, 3))
+# NOTE: branches are numbered by first-order amplitude, largest first (first_order_branches).
+
+RESPONSE = Kind(
+    "response", "steady 1:1 amplitude r of every branch (harmonic balance, N = 10) and its "
+    "one-harmonic stability", AXES, (BRANCH,),
+    (Field("branches", "number of first-order 1:1 branches", "int8"),
+     Field("r", "r = sqrt(A1^2 + B1^2), harmonic balance N = 10", dims=("branch",)),
+     Field("stable", "one-harmonic stability dG/du > 0", "int8", ("branch",), flag=True),
+     Field("r_stable_max", "largest stable r"),
+     Field("r_stable_min", "smallest stable r")),
+    _response, (("omega", 1.2), ("force", 0.3), ("eps", 0.1), ("Q", 20.0)),
+    256, "r_stable_max", (("harmonics", RESPONSE_HARMONICS),))
+# NOTE: 256 points: ~3 ms a point (balance on up to three branches), ~1 s a task.
+
+STABILITY = Kind(
+    "stability", "Floquet stability of every distinct 1:1 orbit (shooting from every branch "
+    "and from the continued harmonic balance)",
+    AXES, (BRANCH,),
+    (Field("branches", "number of first-order 1:1 branches", "int8"),
+     Field("orbits", "distinct periodic orbits found by shooting", "int8"),
+     Field("stable_orbits", "distinct Floquet-stable orbits", "int8"),
+     Field("max_floquet", "largest Floquet modulus over the orbits"),
+     Field("r", "r = sqrt(A1^2 + B1^2) of the orbit the branch stands for", dims=("branch",)),
+     Field("floquet", "largest Floquet modulus of the orbit the branch stands for",
+           dims=("branch",)),
+     Field("orbit_stable", "Floquet stability of the orbit the branch stands for", "int8",
+           ("branch",), flag=True)),
+    _stability, (("omega", 1.2), ("force", 0.3), ("eps", 0.1), ("Q", 20.0)),
+    48, "stable_orbits",
+    (("orbit_harmonics", ORBIT_HARMONICS), ("continuation_harmonics", CONTINUATION_HARMONICS),
+     ("same_orbit", SAME_ORBIT)))
+# NOTE: 48 points: ~25 ms a point damped (up to six seeds shot; the continuation, ~0.7 s, once
+# per worker and (ε, f, Q), 11 ms a point of a 64-point ω line), 10 ms undamped; ~1 s a task.
+
+SUBHARMONIC = Kind(
+    "subharmonic", "the 1/3 subharmonic of the undamped oscillator (eq. 10.87), omega its "
+    "frequency, the drive at 3 omega", ("omega", "force", "eps"), (("root", (1, -1)),),
+    (Field("exists", "eq. 10.87 has real amplitudes", "int8", flag=True),
+     Field("F", "F = f/(1 - 9 omega^2), the cos 3tau amplitude"),
+     Field("a", "a(f), the first harmonic of root +/-", dims=("root",)),
+     Field("hill_stable", "Hill-equation stability", "int8", ("root",), flag=True),
+     Field("orbit_a1", "first harmonic of the true orbit (shooting, 3 drive periods)",
+           dims=("root",)),
+     Field("orbit_floquet", "largest Floquet modulus of the true orbit", dims=("root",)),
+     Field("orbit_stable", "Floquet stability of the true orbit", "int8", ("root",),
+           flag=True),
+     Field("locked", "a simulation 1 % off the true orbit stays on it", "int8", ("root",),
+           flag=True),
+     Field("stable_roots", "roots whose true orbit is stable", "int8"),
+     Field("full_hill_stable", "full Hill stability: the variational equation about the "
+           "harmonic-balance orbit, not the notes' q0 = a cos tau + F cos 3tau", "int8",
+           ("root",), flag=True),
+     Field("full_hill_modulus", "largest multiplier modulus of the full Hill equation",
+           dims=("root",))),
+    _subharmonic, (("omega", 1.5), ("force", 0.1), ("eps", 0.1)),
+    8, "stable_roots", (("full_hill_harmonics", SUBHARMONIC_HARMONICS),))
+# NOTE: 8 points: ~0.12 s a point (Hill, shooting over 3 periods, a locking simulation).
+
+VALIDITY = Kind(
+    "validity", "error in A1 of the mu-expansion and of low-order harmonic balance against "
+    "harmonic balance N = 10, largest branch", AXES,
+    (("mu_order", MU_ORDERS), ("harmonics", BALANCE_HARMONICS)),
+    (Field("mu_error", "|A1 - A1(balance N = 10)|, mu-expansion", dims=("mu_order",)),
+     Field("balance_error", "|A1 - A1(balance N = 10)|, harmonic balance",
+           dims=("harmonics",)),
+     Field("branches", "number of first-order 1:1 branches", "int8")),
+    _validity, (("omega", 0.6), ("force", 1.0), ("eps", 0.1), ("Q", math.inf)),
+    32, "mu_error", (("judge_harmonics", JUDGE_HARMONICS),))
+# NOTE: 32 points: ~25 ms a point (μ-expansion to order 10 five times, three balances).
+
+KINDS: Mapping[str, Kind] = {k.name: k for k in (RESPONSE, STABILITY, SUBHARMONIC, VALIDITY)}
+
+
+def kind_named(name: str) -> Kind:
+    """The :class:`Kind` called ``name``, or :class:`InputError` listing the kinds."""
+    if name not in KINDS:
+        raise InputError(f"sweep kind {name!r}: use one of {', '.join(KINDS)}")
+    return KINDS[name]
+
+
+# --- computing blocks ----------------------------------------------------------------------------
+
+def compute_block(kind: str | Kind, values: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
+    """Every field of ``kind`` (a :class:`Kind` or the name of a built-in one) on the block
+    spanned by ``values`` (one array per axis): the task each worker runs, and the serial
+    loop's body."""
+    kind = kind if isinstance(kind, Kind) else KINDS[kind]
+    shape = tuple(v.size for v in values)
+    sizes = kind.extra_sizes
+    out = {f.name: np.full(shape + tuple(sizes[d] for d in f.dims), f.fill, dtype=f.dtype)
+           for f in kind.fields}
+    for index in itertools.product(*(range(n) for n in shape)):
+        point = {a: float(v[i]) for a, v, i in zip(kind.axes, values, index, strict=True)}
+        for name, value in kind.point(**point).items():
+            out[name][index] = value
+    return out
+
+
+def kernel_signatures() -> dict[str, int]:
+    """Compiled signatures of each numba kernel in :mod:`numerics` in this process: a warm
+    worker's counts stay fixed from task to task (no recompiling)."""
+    from numba.core.registry import CPUDispatcher
+
+    from .numerics import floquet, integrate, shooting
+
+    return {name: len(f.signatures) for module in (integrate, floquet, shooting)
+            for name, f in vars(module).items() if isinstance(f, CPUDispatcher)}
+
+
+def warm_up(kind: str | Kind) -> dict[str, int]:
+    """Run the kind's warm-up point: loads (or compiles, once, into numba's on-disk cache)
+    every kernel its tasks call, so that no task pays for it. Returns
+    :func:`kernel_signatures`."""
+    kind = kind if isinstance(kind, Kind) else KINDS[kind]
+    compute_block(kind, tuple(np.array([dict(kind.warm_up)[a]]) for a in kind.axes))
+    return kernel_signatures()
+
+
+class WarmUp(WorkerPlugin):
+    """A worker plugin: :func:`warm_up` once on every worker, including workers that join
+    later (``distributed`` runs ``setup`` when a worker starts or the plugin is registered)."""
+
+    def __init__(self, kind: str | Kind) -> None:
+        kind = kind if isinstance(kind, Kind) else kind_named(kind)
+        self.kind = kind
+        import hashlib
+
+        digest = hashlib.sha256(json.dumps(kind.settings, default=str).encode()).hexdigest()
+        self.name = f"lindstedt-sweep-warm-up-{kind.name}-{digest[:12]}"
+
+    def setup(self, worker: object) -> None:
+        warm_up(self.kind)
+
+
+# --- a user's equation: any of its parameters an axis ------------------------------------------
+
+EQUATION_BRANCHES = 5
+# NOTE: orbits stored per point, largest r first: a quadratic-and-cubic force has up to five
+# 1:1 orbits near its folds (three is the cubic's most); more are counted, not stored.
+
+
+@dataclass(frozen=True)
+class EquationSpec:
+    """What one point of an equation's map needs: the text, the values fixed for the whole
+    map, the drive frequency's name (passed as ω to the response), the subharmonic's n."""
+
+    kind: str
+    text: str
+    values: tuple[tuple[str, str], ...]
+    frequency: str
+    n: int
+    name: str
+
+
+def _exact(value: float) -> str:
+    """A float axis value as the exact rational the equation's parser takes (0.3 -> 3/10)."""
+    return str(Fraction(repr(value)))
+
+
+def _point_values(spec: EquationSpec, axis: Mapping[str, float]) -> dict[str, str]:
+    return {**dict(spec.values), **{k: _exact(v) for k, v in axis.items()}}
+
+
+def _equation_response(spec: EquationSpec, **axis: float) -> dict:
+    """Every 1:1 orbit at one point (:func:`response.equation_orbits`: the balance continued in
+    the drive amplitude, each crossing shot), largest r first, with its Floquet verdict."""
+    from .analysis.periodic import equation_orbits
+    from .analysis.polynomial import driven_equation
+
+    values = _point_values(spec, axis)
+    omega = float(Fraction(values.pop(spec.frequency)))
+    try:
+        de = driven_equation(spec.text, values, omega, spec.name)
+    except InputError:  # refused at this point (e.g. a coefficient made 0): no orbit stored
+        return {}
+    found = equation_orbits(de, ORBIT_HARMONICS, shoot_harmonics=1)
+    shot = [o.orbit for o in found.orbits if o.orbit is not None]
+    return _branches(shot, len(shot))
+
+
+def _branches(shot: list, count: int) -> dict:
+    r, stable = [math.nan] * EQUATION_BRANCHES, [-1] * EQUATION_BRANCHES
+    floquet = [math.nan] * EQUATION_BRANCHES
+    for k, orbit in enumerate(shot[:EQUATION_BRANCHES]):
+        r[k] = math.hypot(orbit.A.get(1, 0.0), orbit.B.get(1, 0.0))
+        stable[k] = int(orbit.stable)
+        floquet[k] = float(np.max(np.abs(orbit.multipliers)))
+    kept = [x for x, s in zip(r, stable, strict=True) if s == 1]
+    return {"orbits": count, "stable_orbits": sum(bool(o.stable) for o in shot), "r": r,
+            "stable": stable, "floquet": floquet, "r_stable_max": max(kept, default=math.nan),
+            "r_stable_min": min(kept, default=math.nan)}
+
+
+def _equation_subharmonic(spec: EquationSpec, **axis: float) -> dict:
+    """Every orbit of n drive periods at one point (:func:`subharmonic.subharmonic_orbits`,
+    without the onset), largest r first, with its Floquet verdict."""
+    from .analysis.subharmonic import subharmonic_equation, subharmonic_orbits
+
+    values = _point_values(spec, axis)
+    try:
+        problem = subharmonic_equation(spec.text, values, None, spec.n, spec.name)
+    except InputError:  # refused at this point (e.g. the coupling term made 0): none stored
+        return {}
+    found = subharmonic_orbits(problem, onset=False)
+    shot = [o.orbit for o in found.orbits if o.orbit is not None]
+    return {"exists": int(found.exists), **_branches(shot, len(found.orbits))}
+
+
+EQUATION_KINDS = ("response", "stability", "subharmonic")
+# NOTE: with an equation, response and stability are one map (every orbit shot, its Floquet
+# verdict); validity is the notes' μ-expansion's and takes no equation.
+
+
+def equation_kind(kind: str, text: str, values: Mapping[str, str],
+                  axes: Sequence[str], n: int = 3, name: str = "oscillator") -> Kind:
+    """The :class:`Kind` of ``sweep KIND EQUATION --axis NAME=… --param NAME=…``: the axes are
+    parameters of the equation (its drive frequency included), every other parameter has a
+    value in ``values``; refused in one line: an axis that names no parameter, a parameter
+    both an axis and a value, a parameter with neither, a kind that takes no equation."""
+    from .analysis.polynomial import driven_form
+    from .analysis.subharmonic import check_n
+    from .derive.models import oscillator
+
+    if kind not in EQUATION_KINDS:
+        raise InputError(f"sweep {kind} EQUATION: the {kind} map is the notes' (μ-expansion "
+                         f"of q + eps q^3); with an equation use {', '.join(EQUATION_KINDS)}")
+    if kind == "subharmonic":
+        check_n(n)
+    if not axes:
+        raise InputError("sweep EQUATION: give at least one axis, --axis NAME=A:B:N")
+    osc = oscillator(text, {}, name)
+    names = {str(p) for p in osc.equation.parameters}
+    if osc.equation.small is not None:
+        names.add("eps")
+    both = sorted(set(axes) & set(values))
+    if both:
+        raise InputError(f"--axis {both[0]} and --param {both[0]}: a parameter is an axis or a "
+                         "value, not both")
+    unknown = sorted(set(axes) - names) + sorted(set(values) - names)
+    if unknown:
+        raise InputError(f"{unknown[0]}: not a parameter of {text!r} (its parameters: "
+                         f"{', '.join(sorted(names)) or 'none'})")
+    missing = sorted(names - set(axes) - set(values))
+    if missing:
+        raise InputError(f"{missing[0]}: give it a value (--param {missing[0]}=...) or an axis "
+                         f"(--axis {missing[0]}=A:B:N)")
+    taken = {f.name for f in (*STABILITY.fields, *SUBHARMONIC.fields)} | {"branch", "chunk",
+                                                                          "done"}
+    clash = sorted(set(axes) & taken)
+    if clash:
+        raise InputError(f"--axis {clash[0]}: the store holds a field of that name; rename the "
+                         "parameter in the equation")
+    frequency = _frequency_name(osc, text, name)
+    form = driven_form(text, {**dict(values), **{a: "1" for a in axes if a != frequency}},
+                       name, f"sweep {kind}", "a polynomial force and one drive f*cos(w*t)",
+                       True)
+    if len(form.drives) != 1:
+        raise InputError(f"{name} ({text}): sweep {kind} takes one drive f*cos(w*t), not "
+                         f"{len(form.drives)}")
+    spec = EquationSpec(kind, text, tuple(sorted(values.items())), frequency, n, name)
+    branch = ("branch", tuple(range(1, EQUATION_BRANCHES + 1)))
+    common = (
+        Field("orbits", "distinct periodic orbits found (shooting)", "int8"),
+        Field("stable_orbits", "distinct Floquet-stable orbits", "int8"),
+        Field("r", "r = sqrt(A1^2 + B1^2) of each orbit, largest first", dims=("branch",)),
+        Field("stable", "Floquet stability of each orbit", "int8", ("branch",), flag=True),
+        Field("floquet", "largest Floquet modulus of each orbit", dims=("branch",)),
+        Field("r_stable_max", "largest stable r"),
+        Field("r_stable_min", "smallest stable r"))
+    settings = (("equation", text), ("values", dict(sorted(values.items()))), ("n", n),
+                ("orbit_harmonics", ORBIT_HARMONICS))
+    warm = tuple((a, 1.0) for a in axes)
+    if kind == "subharmonic":
+        return Kind("subharmonic", f"orbits of {n} drive periods of {text}", tuple(axes),
+                    (branch,), (Field("exists", "an orbit of n drive periods was found", "int8",
+                                      flag=True), *common),
+                    functools.partial(_equation_subharmonic, spec), warm, 4, "stable_orbits",
+                    settings, builtin=False, positive=(frequency,))
+    return Kind(kind, f"every 1:1 orbit of {text} with its Floquet verdict", tuple(axes),
+                (branch,), common, functools.partial(_equation_response, spec), warm, 4,
+                "r_stable_max", settings, builtin=False, positive=(frequency,))
+
+
+def _frequency_name(osc: object, text: str, name: str) -> str:
+    """The name ``w`` of the drive's ``f*cos(w*t)`` (an axis or a value); one line where the
+    drive's argument is not a name times t."""
+    import sympy as sp
+
+    t = osc.equation.time
+    for wave in sorted(osc.drive.atoms(sp.cos), key=str):
+        c, _ = wave.args[0].as_independent(t, as_Add=False)
+        symbols = sorted(str(s) for s in c.free_symbols)
+        if len(symbols) == 1:
+            return symbols[0]
+    raise InputError(f"{name} ({text}): sweep needs the drive as f*cos(w*t) with the frequency "
+                     "a parameter w (an axis or a --param)")
