@@ -9,7 +9,8 @@ import os
 import re
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
 
@@ -2216,15 +2217,8 @@ def _flag_drive(p: argparse.ArgumentParser, required: bool, omega: str | None,
                        help="quality factor Q > 0 of the damping q'/Q (default inf: undamped)")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(
-        prog="lindstedt",
-        description="Exact Lindstedt–Poincaré series for nonlinear oscillators, "
-        "emitted as numba evaluators and LaTeX.",
-    )
-    parser.add_argument("--version", action="version", version=f"lindstedt {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-
+def _args_series(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt series``'s arguments."""
     p = sub.add_parser("series", help="the L–P series of a free oscillator, or of its limit "
                        "cycles", description="Derive ω_j, (T/2π)_j and q_j of the L–P series "
                        "exactly; for q'' + q = eps*f(q, q') with f odd in q', of its limit "
@@ -2241,8 +2235,11 @@ def build_parser() -> argparse.ArgumentParser:
                    "last orders); with --json a key 'singularities'")
     _flag_json(p)
     _flag_allow_slow(p)
-    p.set_defaults(func=_cmd_series)
+    return p
 
+
+def _args_mathieu(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt mathieu``'s arguments."""
     p = sub.add_parser("mathieu", help="Mathieu's characteristic values a_m(q), b_m(q) as "
                        "exact series", description="The series of a_m(q) (even solutions "
                        "ce_m) or b_m(q) (odd, se_m) of y'' + (a - 2q cos 2z) y = 0 in DLMF's "
@@ -2264,8 +2261,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also estimate the nearest singularity (radius of convergence) from "
                    "the exact series, with its spread; in q**2 for a_2n, b_2n; with --json a "
                    "key 'singularities'")
-    p.set_defaults(func=_cmd_mathieu)
+    return p
 
+
+def _args_tongues(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt tongues``'s arguments."""
     p = sub.add_parser("tongues", help="transition curves of Hill's equation x'' + (delta + "
                        "eps p(t)) x = 0 out of a tongue", description="Both transition curves "
                        "delta(eps) out of the tongue delta = n^2/4 of x'' + (delta + eps p(t))"
@@ -2302,14 +2302,20 @@ def build_parser() -> argparse.ArgumentParser:
                    "in delta on 240 points up to 3 radii (at most eps = 10), NaN beyond")
     p.add_argument("--overwrite-edited", action="store_true",
                    help="with --emit: overwrite a file edited since it was generated")
-    p.set_defaults(func=_cmd_tongues)
+    return p
 
+
+def _args_models(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt models``'s arguments."""
     p = sub.add_parser("models", help="list the named oscillators",
                        description="The named oscillators: each is an equation (any equation "
                        "of the family can be given instead of a name).")
     _flag_json(p, "the list as JSON")
-    p.set_defaults(func=_cmd_models)
+    return p
 
+
+def _args_generate(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt generate``'s arguments."""
     p = sub.add_parser(
         "generate", help="write a numba evaluator module and LaTeX tables and derivation",
         description="Write a numba evaluator module (and for duffing, pendulum, driven its "
@@ -2331,8 +2337,11 @@ def build_parser() -> argparse.ArgumentParser:
                    "Pol's omega_resummed verified to eps ≈ 3.75; 164: to eps = 10)")
     _flag_allow_slow(p)
     _flag_overwrite_edited(p)
-    p.set_defaults(func=_cmd_generate)
+    return p
 
+
+def _args_driven(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt driven``'s arguments."""
     p = sub.add_parser("driven", help="steady 1:1 response of a driven oscillator",
                        description="q'' + q'/Q + q + eps q^3 = f cos(w t) (--eps, --force, --Q): "
                        "every 1:1 branch by the μ-expansion, harmonic balance and shooting; or "
@@ -2349,8 +2358,11 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_harmonics(p, "odd harmonics N of harmonic balance")
     _flag_json(p)
     _flag_allow_slow(p, deprecated_force=False)
-    p.set_defaults(func=_cmd_driven)
+    return p
 
+
+def _args_response(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt response``'s arguments."""
     p = sub.add_parser("response", help="folds and hysteresis of the damped driven oscillator",
                        description="Response curve over ω: folds three ways, sweep jumps. "
                        "q'' + q'/Q + q + eps q^3 = f cos(w t) (--eps, --force, --Q), or your "
@@ -2375,8 +2387,11 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_json(p)
     _flag_plot(p)
     _flag_allow_slow(p, deprecated_force=False)
-    p.set_defaults(func=_cmd_response)
+    return p
 
+
+def _args_subharmonic(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt subharmonic``'s arguments."""
     p = sub.add_parser("subharmonic", help="orbits of n drive periods (the 1/n subharmonic) "
                        "and their stability",
                        description="Your own driven oscillator q'' + g(q, q') = f cos(n w t), g "
@@ -2396,8 +2411,11 @@ def build_parser() -> argparse.ArgumentParser:
                 "n·ω (required, unless the equation's drive frequency is a number)", Q=None)
     _flag_json(p)
     _flag_plot(p)
-    p.set_defaults(func=_cmd_subharmonic)
+    return p
 
+
+def _args_parametric(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt parametric``'s arguments."""
     p = sub.add_parser("parametric", help="the parametrically driven oscillator's response "
                        "in its first tongue",
                        description="q'' + 2 zeta q' + (1 + eps cos 2wt) q + gamma q^3 = 0: the "
@@ -2419,8 +2437,11 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_harmonics(p, "odd harmonics of the balance (1, 3, …, 2N − 1)")
     _flag_json(p)
     _flag_plot(p)
-    p.set_defaults(func=_cmd_parametric)
+    return p
 
+
+def _args_mixing(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt mixing``'s arguments."""
     p = sub.add_parser("mixing", help="combination tones of a two-tone drive",
                        description="Your own q'' + g(q, q') = Σ f_i cos(w_i t), g any "
                        "polynomial with a linear stiffness and damping: the combination tones "
@@ -2440,8 +2461,11 @@ def build_parser() -> argparse.ArgumentParser:
                    "EQUATION)")
     _flag_json(p)
     _flag_plot(p)
-    p.set_defaults(func=_cmd_mixing)
+    return p
 
+
+def _args_choose(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt choose``'s arguments."""
     p = sub.add_parser("choose", help="the cheapest verified method for a tolerance and a range",
                        description="Time and verify every method, report the cheapest that "
                        "meets the tolerance on the range.")
@@ -2477,8 +2501,11 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_json(p)
     _flag_overwrite_edited(p)
     _flag_allow_slow(p, deprecated_force=False)
-    p.set_defaults(func=_cmd_choose)
+    return p
 
+
+def _args_sweep(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt sweep``'s arguments."""
     p = sub.add_parser("sweep", help="maps over parameter grids on a Dask cluster, resumable",
                        description="Map a driven oscillator over a grid of parameters on "
                        "dask.distributed (a LocalCluster here by default), block by block into "
@@ -2526,17 +2553,26 @@ def build_parser() -> argparse.ArgumentParser:
     _flag_json(p, "a JSON summary")
     _flag_plot(p)
     _flag_allow_slow(p, deprecated_force=False)
-    p.set_defaults(func=_cmd_sweep)
+    return p
 
+
+def _args_clock(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt clock``'s arguments."""
     p = sub.add_parser("clock", help="the notes' grandfather's-clock accuracy claims, checked")
     _flag_json(p, "JSON")
-    p.set_defaults(func=_cmd_clock)
+    return p
 
+
+def _args_scene(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt scene``'s arguments."""
     p = sub.add_parser("scene", help="named scenes: the smallest model that meets each")
     p.add_argument("name", choices=SCENE_NAMES, help="the scene")
     _flag_json(p, "JSON")
-    p.set_defaults(func=_cmd_scene)
+    return p
 
+
+def _args_slowflow(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt slowflow``'s arguments."""
     p = sub.add_parser("slowflow", help="the slow flow (averaging) of q'' + q = eps*f, free, "
                        "self-excited or driven", description="Average q'' + q = eps*f(q, q') "
                        "(+ eps*F*cos(w*t), w = 1 + eps*sigma) to order K: dr/dt and dphi/dt "
@@ -2551,22 +2587,73 @@ def build_parser() -> argparse.ArgumentParser:
                    "slow_flow, slow_flow_jacobian, slow_flow_cartesian) and "
                    "<name>_slow_flow.tex into DIR")
     _flag_overwrite_edited(p)
-    p.set_defaults(func=_cmd_slowflow)
+    return p
 
+
+def _args_demo(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt demo``'s arguments."""
     p = sub.add_parser("demo", help="derive, emit, evaluate and typeset the built-in defaults",
                        description="The main job on the built-in defaults; writes only under "
                        "--out.")
     p.add_argument("--out", default="out", metavar="DIR",
                    help="output folder for evaluators, LaTeX, PDFs and figures/ (default out/)")
     _flag_overwrite_edited(p)
-    p.set_defaults(func=_cmd_demo)
+    return p
+
+
+@dataclass(frozen=True)
+class Command:
+    """One command: its name, the function that adds its arguments (a subparser), the one that
+    runs it, and its cost estimate (:data:`costs.COSTS`, checked before it runs; ``None``: a
+    command too quick to estimate).  The parser, the cost guard and ``--help`` loop over
+    :data:`COMMANDS`."""
+
+    name: str
+    arguments: Callable[[argparse._SubParsersAction], argparse.ArgumentParser]
+    run: Callable[[argparse.Namespace], int]
+    cost: Callable[[argparse.Namespace], object] | None
+
+
+COMMANDS: tuple[Command, ...] = tuple(
+    Command(name, arguments, run, COSTS.get(name)) for name, arguments, run in (
+    ("series", _args_series, _cmd_series),
+    ("mathieu", _args_mathieu, _cmd_mathieu),
+    ("tongues", _args_tongues, _cmd_tongues),
+    ("models", _args_models, _cmd_models),
+    ("generate", _args_generate, _cmd_generate),
+    ("driven", _args_driven, _cmd_driven),
+    ("response", _args_response, _cmd_response),
+    ("subharmonic", _args_subharmonic, _cmd_subharmonic),
+    ("parametric", _args_parametric, _cmd_parametric),
+    ("mixing", _args_mixing, _cmd_mixing),
+    ("choose", _args_choose, _cmd_choose),
+    ("sweep", _args_sweep, _cmd_sweep),
+    ("clock", _args_clock, _cmd_clock),
+    ("scene", _args_scene, _cmd_scene),
+    ("slowflow", _args_slowflow, _cmd_slowflow),
+    ("demo", _args_demo, _cmd_demo),
+))
+COMMAND = {c.name: c for c in COMMANDS}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The parser: one subparser per :data:`COMMANDS` entry, in its order."""
+    parser = _Parser(
+        prog="lindstedt",
+        description="Exact Lindstedt–Poincaré series for nonlinear oscillators, "
+        "emitted as numba evaluators and LaTeX.",
+    )
+    parser.add_argument("--version", action="version", version=f"lindstedt {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for command in COMMANDS:
+        command.arguments(sub).set_defaults(func=command.run)
     return parser
 
 
 def check_cost(args: argparse.Namespace) -> None:
     """Every command's estimate (lindstedt.costs.COSTS) before it runs: bounds that no switch
     lifts, then a refusal above COST_LIMIT_SECONDS without --allow-slow."""
-    estimate = COSTS.get(args.command)
+    estimate = COMMAND[args.command].cost
     if estimate is None:
         return
     cost = estimate(args)
