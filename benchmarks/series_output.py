@@ -18,7 +18,7 @@ import sys
 import time
 
 import sympy as sp
-from lindstedt.cli import series_json
+from lindstedt.cli.series import series_json
 from lindstedt.derive.lindstedt import derive
 from lindstedt.derive.models import series_model
 

@@ -85,7 +85,17 @@ order; a stage imports only stages above it::
                     resumable Zarr store
     charts          matplotlib figures                             results -> PNG/SVG/PDF
     costs           each command's estimated wall time and bounds  arguments -> Cost
-    cli             the command line (each command imports its stages itself)
+    cli.common      what every command shares: light constants,   argv -> Namespace
+                    argument types and flags, the report shape
+    cli.series      series, mathieu, tongues, slowflow, models,     records -> JSON, tables
+                    generate
+    cli.driven      driven, response, subharmonic, parametric,      records -> JSON, tables
+                    mixing
+    cli.choose      choose, clock, scene                            Choice -> JSON, tables
+    cli.sweep       sweep                                          Dataset -> summary
+    cli.demo        the demo                                       -> out/
+    cli             the COMMANDS table: parser, cost guard, --help  argv -> exit status
+                    (each command imports its stages itself)
 
 Each folder's ``__init__`` holds its docstring only.  Beside the stages: ``errors`` (the
 one-line InputError) and ``display`` (Jupyter's LaTeX and HTML reprs), which import no stage.

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from lindstedt.analysis.driven import Drive
 from lindstedt.analysis.periodic import periodic_orbits
-from lindstedt.cli import driven_json, driven_table
+from lindstedt.cli.driven import driven_json, driven_table
 from scipy.integrate import solve_ivp
 
 SAME = 1e-7  # two reference orbits are one when their states differ by this, relative
@@ -241,7 +241,7 @@ def test_softening_folds_and_seeding_against_the_reference():
     reported none: the continuation began on the resonant branch over the barrier and left the
     range without meeting it) and `driven`'s seeding is complete; the fold against the
     reference fold, and its side of the one-harmonic fold (numpy.roots' branch count)."""
-    from lindstedt.cli import response_json
+    from lindstedt.cli.driven import response_json
 
     eps, force, Q = -0.1, 0.3, 20.0
     fold = reference_fold(eps, force, Q, 0.8, -1)

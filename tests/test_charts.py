@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from lindstedt import charts, cli
 from lindstedt.charts import check_plot_path, mixing_figure
+from lindstedt.cli import driven as cli_driven
 from lindstedt.errors import InputError
 from lindstedt.numerics.integrate import duffing_table
 from matplotlib.colors import to_rgba
@@ -102,7 +103,7 @@ def test_cli_refuses_bad_plot_path_before_computing(tmp_path, monkeypatch, capsy
         calls.append(a)
         raise Computed
 
-    monkeypatch.setattr(cli, compute, stand_in)
+    monkeypatch.setattr(cli_driven, compute, stand_in)
     with pytest.raises(Computed):  # a writable figure path: the command computes
         cli.main([*args, "--plot", str(tmp_path / "ok.png")])
     assert len(calls) == 1

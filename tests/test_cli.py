@@ -120,8 +120,9 @@ def test_force_in_series_is_the_old_spelling_of_allow_slow():
 
 def test_light_constants_match_the_stages():
     """The parser's choices are restated in cli (no SymPy at start-up): they must agree."""
-    from lindstedt import choose, cli
+    from lindstedt import choose
     from lindstedt.analysis import driven
+    from lindstedt.cli import common as cli
     from lindstedt.derive import models
 
     assert cli.FREE_MODELS == models.MODELS
@@ -161,7 +162,7 @@ def test_every_flag_has_help_and_states_its_default():
 def test_progress_bar_only_on_a_terminal_and_never_with_json(monkeypatch):
     import io
 
-    from lindstedt import cli
+    from lindstedt.cli import common as cli
 
     class Terminal(io.StringIO):
         def isatty(self) -> bool:

@@ -19,7 +19,8 @@ import pytest
 from lindstedt.analysis.driven import Drive
 from lindstedt.analysis.periodic import equation_orbits, periodic_orbits
 from lindstedt.analysis.polynomial import driven_equation
-from lindstedt.cli import driven_equation_json, main
+from lindstedt.cli import main
+from lindstedt.cli.driven import driven_equation_json
 from scipy.integrate import solve_ivp
 
 AGREE = 1e-7  # the package's orbit against the reference's (state, relative; r)

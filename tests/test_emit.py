@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import sympy as sp
 from lindstedt.analysis.driven import Drive, amplitudes, first_order_branches, harmonic_balance
-from lindstedt.cli import BALANCE_HARMONICS, DRIVEN_ORDER
+from lindstedt.cli.demo import BALANCE_HARMONICS, DRIVEN_ORDER
 from lindstedt.compiler import generate, generate_balance, generate_driven
 from lindstedt.derive.cycles import derive_limit_cycle
 from lindstedt.derive.lindstedt import (

@@ -447,7 +447,7 @@ def test_the_derivation_document(tmp_path):
 def test_coefficients_of_any_length_are_printed():
     """Van der Pol's coefficients pass Python's 4300-digit str() limit near order 150; the
     series JSON and table print them whole (digits checked by arithmetic, not by str())."""
-    from lindstedt.cli import _fraction_text
+    from lindstedt.cli.common import _fraction_text
 
     for value in (F(7**6000 + 1, 3**12000), F(-(10**5000) - 3, 1), F(-17, 3072)):
         num, den = _fraction_text(value).split("/")

@@ -15,8 +15,8 @@ import time
 
 import numpy as np
 import pytest
-from lindstedt.cli import (
-    main,
+from lindstedt.cli import main
+from lindstedt.cli.driven import (
     mixing_equation_json,
     mixing_json,
     response_equation_json,

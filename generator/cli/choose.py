@@ -1,0 +1,352 @@
+"""``choose``, ``clock`` and ``scene``: the cheapest verified method, and the notes' claims."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections.abc import Sequence
+from pathlib import Path
+
+from ..costs import emit_bounds
+from ..errors import InputError
+
+# NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
+# well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
+from .common import (
+    DRIVEN_QUANTITIES,
+    SCENE_NAMES,
+    Progress,
+    _flag_allow_slow,
+    _flag_drive,
+    _flag_equation,
+    _flag_json,
+    _flag_overwrite_edited,
+    _order,
+    _out_folder,
+    _params,
+    _real,
+)
+
+
+def _considered(rows: Sequence[tuple[str, int, float, float]], quantity: str | None = None
+                ) -> list[dict]:
+    """``choose``'s per-method rows as JSON records."""
+    return [{"method": str(m), "order": o, "label": _label(m, o, quantity), "max_error": e,
+             "ns_per_point": ns} for m, o, e, ns in rows]
+
+
+def _label(method, order: int, quantity: str | None = None) -> str:
+    """A method at an order as tables print it: the registry record's own label (the Padé
+    approximant names itself), else "NAME order K"."""
+    label = getattr(method, "label", None)
+    if label is None and quantity is not None:
+        from ..methods.registry import methods_for
+
+        label = next((m.label for m in methods_for(quantity) if m == method), None)
+    return label(order) if callable(label) else f"{method} order {order}"
+
+
+def _print_choice(header: str, chosen: tuple[str, int, float, float],
+                  rows: Sequence[tuple[str, int, float, float]], micro: bool = False,
+                  quantity: str | None = None) -> None:
+    """The text report of every ``choose``: the header, the choice, each method considered
+    (cost in ns/point, or µs when ``micro``)."""
+    unit, scale = ("µs/point", 1e-3) if micro else ("ns/point", 1.0)
+    print(header)
+    m, o, e, ns = chosen
+    print(f"  chosen: {_label(m, o, quantity)}: max error {e:.1e}, {ns * scale:.2f} {unit}")
+    width = max(len(_label(r[0], r[1], quantity)) for r in rows)
+    for m, o, e, ns in rows:
+        print(f"  {_label(m, o, quantity):>{width}}: max error {e:.1e}, {ns * scale:8.2f} "
+              f"{unit}")
+
+
+def run_choose(args: argparse.Namespace) -> int:
+    if args.model is None and (args.param or args.name):
+        raise InputError("--param/--name: give an EQUATION (choose period EQUATION …)")
+    if args.model is not None and args.quantity != "period":
+        raise InputError(f"choose {args.quantity} EQUATION: only the period is chosen for an "
+                         "equation (q, amplitudes and response are the notes' Duffing "
+                         "oscillator's)")
+    if args.quantity in RESUMMED_QUANTITIES:
+        return _choose_resummed(args)
+    if args.quantity in DRIVEN_QUANTITIES:
+        return _choose_driven(args)
+    if args.quantity == "q":
+        return _choose_q(args)
+    for name in ("tol", "x_min", "x_max"):
+        if getattr(args, name) is None:
+            raise InputError(f"choose period needs --{name.replace('_', '-')}")
+    model = None
+    if args.model is not None:
+        if args.emit:
+            raise InputError("--emit: the chosen period module is the Duffing oscillator's; "
+                             "`lindstedt generate EQUATION` emits an equation's evaluators")
+        from ..derive.models import model_from_text
+        from ..methods.kernels import MAX_ORDER
+
+        model = model_from_text(args.model, MAX_ORDER, _params(args.param), args.name)
+    from ..choose import choose_period, modelled_ns
+    from ..compiler import generate_choice
+    from ..emit.render import check_writable
+
+    if args.emit:
+        check_writable(_out_folder(args.emit, "--emit"), ["chosen_period.py"], "--emit",
+                       args.overwrite_edited)
+    progress = Progress("timing the verified methods", not args.json)
+    choice = choose_period(args.tol, args.x_min, args.x_max, progress, model=model)
+    progress.close()
+    variable = "x = eps*A**2" if model is None else model.variable
+    data = {"method": choice.method.name, "order": choice.order,
+            "max_error": choice.max_error,
+            "ns_per_point": choice.ns_per_point, "verified_on": choice.verified_on,
+            "modelled_ns_per_point": modelled_ns("period", choice.method, choice.order),
+            "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
+            "quantity": "period", "variable": variable,
+            "considered": _considered(choice.considered, "period")}
+    if model is not None:
+        data.update(equation=model.source or model.title, omega0=str(model.frequency),
+                    reference="quadrature of the scaled potential (Gauss–Legendre, 256 nodes)")
+    if args.emit:
+        command = (f"lindstedt choose period --tol {args.tol!r} --x-min {args.x_min!r} "
+                   f"--x-max {args.x_max!r}")
+        data["emitted"] = [str(p) for p in generate_choice(
+            choice.candidate, command, Path(args.emit), (args.x_min, args.x_max),
+            overwrite_edited=args.overwrite_edited)]
+    if args.json:
+        print(json.dumps(data))
+        return 0
+    _print_choice(f"period T(x), {variable} in [{args.x_min:g}, {args.x_max:g}], tolerance "
+                  f"{args.tol:g} (relative, verified on {choice.verified_on} points):",
+                  (choice.method, choice.order, choice.max_error, choice.ns_per_point),
+                  choice.considered, quantity="period")
+    for path in data.get("emitted", []):
+        print(f"  emitted {path}")
+    return 0
+
+
+RESUMMED_QUANTITIES = ("cycle", "mathieu")
+# NOTE: choose's quantities past the radius: van der Pol's limit-cycle ω(ε) and Mathieu's
+# a_m(q), b_m(q) (partial sums, resummed evaluator, numerical reference).
+
+
+def _choose_resummed(args: argparse.Namespace) -> int:
+    """``choose cycle`` (ε in [x-min, x-max]) and ``choose mathieu --kind K --m M`` (q)."""
+    for name in ("tol", "x_min", "x_max"):
+        if getattr(args, name) is None:
+            raise InputError(f"choose {args.quantity} needs --{name.replace('_', '-')}")
+    if args.emit:
+        raise InputError(f"--emit: choose {args.quantity} reports; `lindstedt generate "
+                         "van_der_pol` and `lindstedt mathieu … --emit DIR` write the modules")
+    from ..choose import choose_limit_cycle, choose_mathieu
+
+    if args.quantity == "cycle":
+        c = choose_limit_cycle(args.tol, args.x_min, args.x_max)
+        what = f"van der Pol's limit-cycle ω(ε), ε in [{args.x_min:g}, {args.x_max:g}]"
+    else:
+        kind, m = args.kind or "a", args.m if args.m is not None else 0
+        c = choose_mathieu(kind, m, args.tol, args.x_min, args.x_max)
+        what = f"Mathieu's {kind}_{m}(q), q in [{args.x_min:g}, {args.x_max:g}]"
+    rows = [{"method": m, "order": o, "max_error": e, "recorded_ns_per_point": r,
+             "ns_per_point": ns} for m, o, e, r, ns in c.considered]
+    if args.json:
+        print(json.dumps({"quantity": args.quantity, "method": c.method, "order": c.order,
+                          "max_error": c.max_error, "ns_per_point": c.ns_per_point,
+                          "verified_on": c.verified_on, "considered": rows,
+                          "decided_by": "recorded costs (lindstedt.choose.RESUMMED_COSTS)"}))
+        return 0
+    print(f"{what}, tolerance {args.tol:g} (relative, {c.verified_on} points): {c.method}"
+          + (f" (order {c.order})" if c.order else ""))
+    for r in rows:
+        print(f"  {r['method']:<10} order {r['order']:>4}  max error {r['max_error']:8.1e}  "
+              f"{r['recorded_ns_per_point']:10.3g} ns/point recorded, "
+              f"{r['ns_per_point']:10.3g} this run")
+    return 0
+
+
+def run_clock(args: argparse.Namespace) -> int:
+    from ..choose import appendix_thresholds
+
+    rows = [{"approximation": t.approximation, "tolerance": t.tolerance,
+             "claimed_deg": t.claimed_deg, "potential_deg": t.potential_deg,
+             "period_deg": t.period_deg, "holds_for_potential": t.potential_deg >= t.claimed_deg,
+             "holds_for_period": t.period_deg >= t.claimed_deg} for t in appendix_thresholds()]
+    if args.json:
+        print(json.dumps({"claims": rows}))
+        return 0
+    print("The notes' appendix: 1 - cos(theta) approximated, accurate to a tolerance "
+          "up to an angle")
+    print(f"{'approximation':>24} {'tol':>7} {'claimed':>8} {'potential':>10} {'period':>8}"
+          "  holds?")
+    for r in rows:
+        verdict = {(True, True): "yes", (False, False): "no"}.get(
+            (r["holds_for_potential"], r["holds_for_period"]),
+            "potential " + ("yes" if r["holds_for_potential"] else "no") + ", period "
+            + ("yes" if r["holds_for_period"] else "no"))
+        print(f"{r['approximation']:>24} {r['tolerance']:>7.0e} {r['claimed_deg']:>7.1f}° "
+              f"{r['potential_deg']:>9.2f}° {r['period_deg']:>7.2f}°  {verdict}")
+    return 0
+
+
+def run_scene(args: argparse.Namespace) -> int:
+    from ..choose import SCENES
+
+    result = SCENES[args.name]()
+    if args.json:
+        print(json.dumps({"scene": result.scene, "question": result.question,
+                          "answer": result.answer, **result.details}))
+    else:
+        print(f"{result.question}: {result.answer}")
+        for key, value in result.details.items():
+            print(f"  {key}: {value}")
+    return 0
+
+
+def _choose_q(args: argparse.Namespace) -> int:
+    for name in ("tol", "x_min", "x_max"):
+        if getattr(args, name) is None:
+            raise InputError(f"choose q needs --{name.replace('_', '-')}")
+    from ..choose import choose_solution, modelled_ns
+    from ..compiler import generate_method
+    from ..emit.render import check_writable
+
+    if args.emit:
+        check_writable(_out_folder(args.emit, "--emit"), ["duffing.py", "duffing_tables.tex",
+                                         "duffing_derivation.tex", "fourier.py"], "--emit")
+    progress = Progress("verifying the L–P orders", not args.json)
+    c = choose_solution(args.tol, args.x_min, args.x_max, args.t_max,
+                        emittable=bool(args.emit), progress=progress)
+    progress.close()
+    data = {"quantity": "q", "method": c.method.name, "order": c.order,
+            "max_error": c.max_error,
+            "ns_per_point": c.ns_per_point, "verified_on": c.verified_on,
+            "modelled_ns_per_point": modelled_ns("q", c.method, c.order),
+            "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
+            "considered": _considered(c.considered)}
+    if args.emit:
+        data["emitted"] = [str(p) for p in generate_method(
+            c.method, c.order, Path(args.emit), overwrite_edited=args.overwrite_edited)]
+    if args.json:
+        print(json.dumps(data))
+        return 0
+    _print_choice(f"q(t)/A to {args.tol:g} for x in [{args.x_min:g}, {args.x_max:g}], t in "
+                  f"[0, {args.t_max:g}] (verified on {c.verified_on} points):",
+                  (c.method, c.order, c.max_error, c.ns_per_point), c.considered)
+    if c.method == "lindstedt" and not args.emit:
+        print(f"  (`lindstedt generate duffing --order {c.order}` or --emit DIR writes it)")
+    for path in data.get("emitted", []):
+        print(f"  emitted {path}")
+    return 0
+
+
+def _choose_driven(args: argparse.Namespace) -> int:
+    """``choose amplitudes`` and ``choose response``: one ω or a range of ω."""
+    for name in ("eps", "force"):
+        if getattr(args, name) is None:
+            raise InputError(f"choose {args.quantity} needs --{name}")
+    if args.omega is None and (args.omega_min is None or args.omega_max is None):
+        raise InputError(f"choose {args.quantity} needs --omega, or --omega-min and --omega-max")
+    if args.omega is not None and (args.omega_min is not None or args.omega_max is not None):
+        raise InputError("give --omega or a range (--omega-min, --omega-max), not both")
+    tol = args.tol or 1e-4
+    lo, hi = (args.omega, None) if args.omega is not None else (args.omega_min, args.omega_max)
+    from ..analysis.driven import check_steady_state
+
+    check_steady_state(args.eps, args.Q, lo, hi)
+    from ..choose import DRIVEN_MAX, choose_driven
+    from ..compiler import generate_method
+    from ..emit.render import check_writable
+
+    if args.emit:
+        check_writable(_out_folder(args.emit, "--emit"),
+                       ["driven.py", "driven_derivation.tex", "balance.py", "driven_damped.py",
+                        "driven_damped_derivation.tex"], "--emit")
+    progress = Progress("shooting the true orbits", not args.json)
+    c = choose_driven(args.quantity, tol, args.eps, args.force, args.Q, lo, hi,
+                      emit=(emit_bounds(args.allow_slow, DRIVEN_MAX, args.quantity)
+                            if args.emit else None),
+                      progress=progress)
+    progress.close()
+    data = {"quantity": args.quantity, "method": c.method.name, "order": c.order,
+            "max_error": c.max_error, "ns_per_point": c.ns_per_point,
+            "verified_on": c.verified_on, "seconds": c.ns_per_point * 1e-9,
+            "modelled_ns_per_point": c.modelled_ns_per_point,
+            "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
+            "alternatives": {m: {"order": o, "max_error": e, "seconds": ns * 1e-9}
+                             for m, o, e, ns in c.considered if m != c.method},
+            "considered": _considered(c.considered),
+            "truth_by_omega": [{"omega": float(w), "A": a.tolist(), "B": b.tolist()}
+                               for w, a, b in zip(c.truth.omega, c.truth.A, c.truth.B,
+                                                  strict=True)]}
+    if args.omega is not None:
+        data["truth"] = c.truth.A[0].tolist()
+    if args.emit:
+        data["emitted"] = [str(p) for p in generate_method(
+            c.method, c.order, Path(args.emit), overwrite_edited=args.overwrite_edited)]
+    if args.json:
+        print(json.dumps(data))
+        return 0
+    what = {"amplitudes": "A1, A3, A5 (and B_n)", "response": "r = sqrt(A1^2 + B1^2)"}
+    where = f"omega = {lo:g}" if hi is None else f"omega in [{lo:g}, {hi:g}]"
+    _print_choice(f"{what[args.quantity]} to {tol:g} (absolute, largest branch, {where}, "
+                  f"verified on {c.verified_on} point{'s' * (c.verified_on > 1)} against "
+                  "shooting):", (c.method, c.order, c.max_error, c.ns_per_point), c.considered,
+                  micro=True)
+    for path in data.get("emitted", []):
+        print(f"  emitted {path}")
+    return 0
+
+
+def arguments_choose(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt choose``'s arguments."""
+    p = sub.add_parser("choose", help="the cheapest verified method for a tolerance and a range",
+                       description="Time and verify every method, report the cheapest that "
+                       "meets the tolerance on the range.")
+    p.add_argument("quantity", choices=("period", "q", *DRIVEN_QUANTITIES,
+                                        *RESUMMED_QUANTITIES),
+                   help="period T(x); q(t); amplitudes A_n, B_n; response r(ω); cycle: van der "
+                   "Pol's limit-cycle ω(ε), ε in [x-min, x-max]; mathieu: a_m(q) or b_m(q) "
+                   "(--kind, --m), q in [x-min, x-max]")
+    p.add_argument("--kind", choices=("a", "b"), default=None,
+                   help="mathieu: a (even solutions, default) or b (odd)")
+    p.add_argument("--m", type=_order, default=None, metavar="M",
+                   help="mathieu: the index m (default 0)")
+    _flag_equation(p, "\"q'' + q + eps*q**5 = 0\" (period only: a free oscillator with a "
+                   "polynomial force, judged by quadrature; x is then its expansion variable)")
+    p.add_argument("--tol", type=_real, metavar="TOL",
+                   help="tolerance > 0 (period, q: relative, required; amplitudes, response: "
+                   "absolute, default 1e-4)")
+    p.add_argument("--x-min", type=_real, metavar="X",
+                   help="period, q: smallest x = εA² of the range (required)")
+    p.add_argument("--x-max", type=_real, metavar="X",
+                   help="period, q: largest x = εA² of the range (required)")
+    p.add_argument("--t-max", type=_real, default=20.0, metavar="T",
+                   help="q: times 0..T, in units of 1/(linear natural frequency) (default 20)")
+    _flag_drive(p, required=False, omega="amplitudes, response: one drive frequency ω")
+    p.add_argument("--omega-min", type=_real, metavar="W",
+                   help="amplitudes, response: lowest ω of a range (instead of --omega)")
+    p.add_argument("--omega-max", type=_real, metavar="W",
+                   help="amplitudes, response: highest ω of a range (instead of --omega)")
+    p.add_argument("--emit", metavar="DIR", help="write just the chosen evaluator into DIR "
+                   "(period: chosen_period.py; q: duffing.py or fourier.py; amplitudes, "
+                   "response: driven.py or balance.py, only emittable methods compete; "
+                   "default: write nothing)")
+    _flag_json(p)
+    _flag_overwrite_edited(p)
+    _flag_allow_slow(p, deprecated_force=False)
+    return p
+
+
+def arguments_clock(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt clock``'s arguments."""
+    p = sub.add_parser("clock", help="the notes' grandfather's-clock accuracy claims, checked")
+    _flag_json(p, "JSON")
+    return p
+
+
+def arguments_scene(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt scene``'s arguments."""
+    p = sub.add_parser("scene", help="named scenes: the smallest model that meets each")
+    p.add_argument("name", choices=SCENE_NAMES, help="the scene")
+    _flag_json(p, "JSON")
+    return p

@@ -1,0 +1,363 @@
+"""What every command shares: the light constants (restated so that parsing needs no
+SymPy), the progress bar, argument types and flags, the one-line parser, the report shape."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import re
+import sys
+import time
+from collections.abc import Sequence
+from fractions import Fraction
+from pathlib import Path
+
+from ..costs import COST_LIMIT_SECONDS
+from ..errors import InputError
+
+# NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
+# well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
+
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+# NOTE: before NumPy is imported: the continuation's and the fits' matrices (≤ 200 × 200) run
+# twice as fast on one BLAS thread as on OpenBLAS's pool on a busy machine (`response
+# --harmonics 40`: 8.7 s against 17.3 s), and the cost estimates assume one thread.
+
+FREE_MODELS = ("duffing", "pendulum", "helmholtz_duffing", "quintic", "cubic_quintic",
+               "velocity_squared", "sinh_spring", "van_der_pol", "rayleigh")
+# NOTE: models.MODELS, restated so that parsing arguments needs no SymPy (a test keeps them equal).
+EMITTED = ("driven", "balance", "fourier")
+# NOTE: generate's names for the driven oscillator's modules (not free oscillators).
+SCENE_NAMES = ("clock", "hard-spring", "notes-driven")
+# NOTE: choose.SCENES's keys, likewise.
+DRIVEN_QUANTITIES = ("amplitudes", "response")
+# NOTE: choose.DRIVEN_QUANTITIES, likewise.
+SWEEP_KINDS = ("response", "stability", "subharmonic", "validity")
+# NOTE: sweep.KINDS's keys, likewise.
+DEFAULT_ORDER = 4
+# NOTE: one default for every --order: it works for every command (`generate driven` at order 4
+# takes ~13 s, at 6 about 4 min) and keeps T(A) within 1e-4 for |εA²| ≤ 0.3; ask for more.
+DEFAULT_HARMONICS = 8
+# NOTE: one default for every --harmonics: 8 odd harmonics put the response's folds on the true
+# orbit's to 12 digits at the notes' parameters (`generate balance` compiles them in ~20 s).
+MAX_HARMONICS = 100
+# NOTE: driven.MAX_HARMONICS, restated (a test keeps them equal): one bound for every
+# --harmonics.  The numerical balance and shooting's sampling take up to 100; the emitted
+# modules stop earlier (balance 12, fourier 60) and say so; the response's continuation
+# refuses what it estimates at over a minute.
+PROGRESS_AFTER_SECONDS = 2.0
+# NOTE: work shorter than this shows no progress bar (it would only flicker).
+
+
+class Progress:
+    """A one-line progress bar on stderr, drawn only when stderr is a terminal and the output is
+    not JSON, and only once the work has taken ``PROGRESS_AFTER_SECONDS``; call it as
+    ``progress(done, total)``, then ``progress.close()``."""
+
+    def __init__(self, label: str, enabled: bool = True) -> None:
+        self.label = label
+        self.enabled = enabled and sys.stderr.isatty()
+        self.start = time.monotonic()
+        self.drawn = False
+
+    def __call__(self, done: int, total: int) -> None:
+        if not self.enabled or time.monotonic() - self.start < PROGRESS_AFTER_SECONDS:
+            return
+        width = 30
+        filled = width * done // max(total, 1)
+        sys.stderr.write(f"\r{self.label} [{'#' * filled}{'.' * (width - filled)}] "
+                         f"{done}/{total}")
+        sys.stderr.flush()
+        self.drawn = True
+
+    def close(self) -> None:
+        if self.drawn:
+            sys.stderr.write("\r\033[K")
+            sys.stderr.flush()
+
+
+def _rational(c: object) -> str:
+    """Exact ``"p/q"`` (always with a denominator, so scripts can split on '/'); FLINT's
+    ``fmpq`` prints its digits itself, however long."""
+    return f"{c.p}/{c.q}"
+
+
+def _params(pairs: Sequence[str] | None) -> dict[str, str]:
+    """``--param NAME=VALUE`` pairs, each name once."""
+    values: dict[str, str] = {}
+    for pair in pairs or ():
+        name, sep, value = pair.partition("=")
+        name = name.strip()
+        if not sep or not name or not value.strip():
+            raise InputError(f"--param {pair!r}: write NAME=VALUE, e.g. alpha=1/3")
+        if name in values:
+            raise InputError(f"--param {name}: given twice")
+        values[name] = value.strip()
+    return values
+
+
+def _fraction_text(c: object) -> str:
+    """``"p/q"`` of a Fraction; an algebraic number (a limit cycle in Q(a₀)) as SymPy's str,
+    exact (``"-3*2**(3/4)/2560"``)."""
+    if getattr(c, "is_Rational", False):  # SymPy's Rational (no import: start-up)
+        c = Fraction(int(c.p), int(c.q))
+    elif not isinstance(c, Fraction):
+        return str(c)
+    return f"{_int_text(c.numerator)}/{_int_text(c.denominator)}"
+
+
+INT_TEXT_BITS = 14_000
+# NOTE: below 4300 digits, Python's own str(); beyond it Python refuses (a guard against slow
+# parsing of untrusted text), and van der Pol's coefficients pass it near order 150.
+
+
+def _int_text(n: int) -> str:
+    """The decimal digits of an exact integer, however long (FLINT's conversion beyond
+    :data:`INT_TEXT_BITS`)."""
+    if n.bit_length() < INT_TEXT_BITS:
+        return str(n)
+    from flint import fmpz
+
+    return str(fmpz(n))
+
+
+def sp_text(expr) -> str:
+    import sympy as sp
+
+    return sp.sstr(expr, order="lex")
+
+
+def _out_folder(text: str, flag: str = "--out") -> Path:
+    if not text.strip():
+        raise InputError(f"{flag} {text!r}: empty; name a folder")
+    return Path(text)
+
+
+def _keyed(values: dict) -> dict:
+    return {str(n): float(v) for n, v in sorted(values.items())}
+
+
+def _first_harmonic(A: dict, B: dict) -> float:
+    """r = √(A₁² + B₁²), the amplitude of the first harmonic whatever its phase."""
+    return float(math.hypot(A.get(1, 0.0), B.get(1, 0.0)))
+
+
+def _report(args: argparse.Namespace, compute, draw, table) -> int:
+    """The shape of every effect command: check the plot path first (nothing is computed for
+    a figure that cannot be written), compute, draw, print JSON or the table.  matplotlib
+    is imported only for --plot (a refused input answers without it)."""
+    plot = _charts().check_plot_path(Path(args.plot)) if args.plot else None
+    data = compute()
+    if plot is not None:
+        draw(plot)
+    print(json.dumps(data) if args.json else "\n".join(table(data)))
+    return 0
+
+
+def _charts():
+    from .. import charts
+
+    return charts
+
+
+def _equation_args(args: argparse.Namespace, flags: Sequence[str],
+                   required: Sequence[str]) -> bool:
+    """Whether an EQUATION was given; refuses in one line the flags it replaces beside it, its
+    own flags without it, and a missing required flag without it."""
+    if args.model is not None:
+        given = [f"--{k}" for k in flags if getattr(args, k) is not None]
+        if given:
+            raise InputError(f"{', '.join(given)}: with an equation give its parameters with "
+                             "--param (e.g. --param eps=1/10) and the drive in the equation")
+        return True
+    if args.param or args.name:
+        raise InputError("--param/--name: give an equation (EQUATION) to take them")
+    missing = [f"--{k}" for k in required if getattr(args, k) is None]
+    if missing:
+        raise InputError(f"the following arguments are required: {', '.join(missing)}")
+    return False
+
+
+def _order(text: str) -> int:
+    """An order K (or an index such as mathieu's m): a non-negative integer."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: not an integer") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{value}: must be ≥ 0")
+    return value
+
+
+def _positive(text: str) -> int:
+    """A positive integer (workers, points per task)."""
+    value = _order(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value}: must be ≥ 1")
+    return value
+
+
+def _count(text: str) -> int:
+    """A number of harmonics: an integer in 1..MAX_HARMONICS."""
+    value = _positive(text)
+    if value > MAX_HARMONICS:
+        raise argparse.ArgumentTypeError(f"{value}: must be in 1..{MAX_HARMONICS}")
+    return value
+
+
+def _number(text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: not a number") from None
+
+
+def _real(text: str) -> float:
+    """A finite real number (scientific notation and a leading minus welcome)."""
+    value = _number(text)
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r}: not finite")
+    return value
+
+
+def _nonnegative(text: str) -> float:
+    """A finite real number ≥ 0 (a damping ratio)."""
+    value = _real(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be ≥ 0")
+    return value
+
+
+def _positive_real(text: str) -> float:
+    """A finite real number > 0 (a tolerance)."""
+    value = _real(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be > 0")
+    return value
+
+
+def _quality(text: str) -> float:
+    """A quality factor Q > 0; ``inf`` means undamped."""
+    if not _number(text) > 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be > 0 (inf: undamped)")
+    return float(text)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with the project's one-line errors (no usage dump), exit status 2, and any token
+    that starts like a number (``-1e-8``, ``-.5``, ``-0.3@1.3``) taken as a value, not a flag."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        # one prefix for every error, a subcommand's argparse ones included
+        self.exit(2, f"lindstedt: error: {self.prog.removeprefix('lindstedt ')}: {message}\n"
+                  if self.prog != "lindstedt" else f"lindstedt: error: {message}\n")
+
+
+class _DeprecatedForce(argparse.Action):
+    """``--force`` in series/generate: the old spelling of ``--allow-slow`` (one release)."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str, **kwargs) -> None:
+        super().__init__(option_strings, dest, nargs=0, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        print("lindstedt: note: --force here is deprecated, use --allow-slow (--force F is the "
+              "drive amplitude in driven, response, subharmonic, mixing, choose)", file=sys.stderr)
+        namespace.allow_slow = True
+
+
+# One definition per flag: the same name means the same thing, with one help text and one
+# default, in every command.
+
+def _flag_oscillator(p: argparse.ArgumentParser, emitted: bool = False) -> None:
+    """The oscillator: a name of `lindstedt models` or an equation, with --param and --name."""
+    extra = ("; or driven: μ-expansion A_n(ω), balance: harmonic-balance Newton solver, "
+             "fourier: exact Fourier series of Duffing") if emitted else ""
+    p.add_argument("model", metavar="EQUATION|NAME",
+                   help="an equation such as \"q'' + q + eps*(alpha*q**2 + q**3) = 0\" (q' and "
+                   "q'' are the derivatives, eps the small parameter, other names parameters) "
+                   f"or a name: {', '.join(FREE_MODELS)}{extra}")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="give a parameter an exact value, e.g. alpha=1/3 (repeatable; "
+                   "default: parameters stay symbolic)")
+    p.add_argument("--name", metavar="NAME",
+                   help="the oscillator's name in output and file names (default: oscillator)")
+
+
+def _flag_equation(p: argparse.ArgumentParser, example: str,
+                   default: str = "the notes' equation with the flags",
+                   which: str = "every parameter needs one") -> None:
+    """An optional EQUATION of the command's own form, with --param and --name."""
+    p.add_argument("model", metavar="EQUATION", nargs="?", default=None,
+                   help=f"an equation such as {example}; default: {default}")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="with EQUATION: an exact value for each of its parameters, e.g. "
+                   f"eps=1/10 (repeatable; {which})")
+    p.add_argument("--name", metavar="NAME",
+                   help="with EQUATION: the oscillator's name in messages (default: oscillator)")
+
+
+def _flag_order(p: argparse.ArgumentParser, what: str) -> None:
+    p.add_argument("--order", type=_order, default=DEFAULT_ORDER, metavar="K",
+                   help=f"{what}, an integer ≥ 0 (default {DEFAULT_ORDER})")
+
+
+def _flag_harmonics(p: argparse.ArgumentParser, what: str) -> None:
+    p.add_argument("--harmonics", type=_count, default=DEFAULT_HARMONICS, metavar="N",
+                   help=f"{what}, an integer in 1..{MAX_HARMONICS} (default {DEFAULT_HARMONICS})")
+
+
+def _flag_allow_slow(p: argparse.ArgumentParser, deprecated_force: bool = True) -> None:
+    """--allow-slow (and in series/generate its old spelling --force, which elsewhere is the
+    drive amplitude)."""
+    p.add_argument("--allow-slow", action="store_true",
+                   help=f"run even when the estimate exceeds {COST_LIMIT_SECONDS:.0f} s "
+                   "(default: refuse)")
+    if deprecated_force:
+        p.add_argument("--force", action=_DeprecatedForce, dest="allow_slow",
+                       help="deprecated spelling of --allow-slow")
+
+
+def _flag_overwrite_edited(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--overwrite-edited", action="store_true",
+                   help="replace generated files even when they were edited by hand since "
+                   "(default: refuse, so an edit is never lost silently)")
+
+
+def _flag_json(p: argparse.ArgumentParser, what: str = "the JSON contract") -> None:
+    p.add_argument("--json", action="store_true",
+                   help=f"print {what} on stdout instead of the table (no progress bar)")
+
+
+def _flag_plot(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--plot", metavar="FILE",
+                   help="also draw the figure into FILE (.png, .svg or .pdf; default: none)")
+
+
+def _flag_drive(p: argparse.ArgumentParser, required: bool, omega: str | None,
+                Q: str | None = "optional", force: bool = True) -> None:
+    """--eps, --force, --omega, --Q of q'' + q'/Q + q + eps q^3 = f cos(w t) (``omega``: its
+    meaning, None for none; ``Q``: "optional", "required" or None for none)."""
+    need = " (required)" if required else ""
+    p.add_argument("--eps", type=_real, required=required, metavar="EPS",
+                   help=f"ε, the cubic stiffness coefficient (dimensionless; > 0 hardens, "
+                   f"< 0 softens){need}")
+    if force:
+        p.add_argument("--force", type=_real, required=required, metavar="F",
+                       help=f"f, the drive amplitude, in units of the linear stiffness × length "
+                       f"(q is dimensionless){need}")
+    if omega is not None:
+        p.add_argument("--omega", type=_real, required=required, metavar="W",
+                       help=f"{omega}, in units of the linear natural frequency{need}")
+    if Q == "required":
+        p.add_argument("--Q", type=_quality, required=True, metavar="Q",
+                       help="quality factor Q > 0 of the damping q'/Q (finite; required)")
+    elif Q == "optional":
+        p.add_argument("--Q", type=_quality, default=math.inf, metavar="Q",
+                       help="quality factor Q > 0 of the damping q'/Q (default inf: undamped)")

@@ -1,0 +1,701 @@
+"""The series commands: ``series``, ``mathieu``, ``tongues``, ``slowflow``, ``models`` and
+``generate``: their arguments, JSON contracts and tables."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from fractions import Fraction
+from pathlib import Path
+
+from ..costs import DRIVEN_MAX_ORDER
+from ..errors import InputError
+
+# NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
+# well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
+from .common import (
+    EMITTED,
+    Progress,
+    _flag_allow_slow,
+    _flag_harmonics,
+    _flag_json,
+    _flag_order,
+    _flag_oscillator,
+    _flag_overwrite_edited,
+    _fraction_text,
+    _nonnegative,
+    _order,
+    _out_folder,
+    _params,
+    _positive_real,
+    _rational,
+    _real,
+    sp_text,
+)
+
+
+def _monomial(powers: tuple[tuple[str, int], ...]) -> str:
+    """SymPy's spelling of a monomial: ``"A**2*alpha"``, ``"1"`` for the constant."""
+    return "*".join(n if e == 1 else f"{n}**{e}" for n, e in powers) or "1"
+
+
+def _coefficient(sol, c: object) -> str | dict:
+    """``"p/q"``, or for coefficients in ``QQ[A, params]`` an object mapping each monomial
+    (SymPy's ``str``: ``"A**2*alpha"``, ``"1"``) to its exact ``"p/q"``, formatted from
+    FLINT's terms (no SymPy on the way)."""
+    if sol.ground.is_rational:
+        return _rational(c)
+    return dict(sorted((_monomial(m), _rational(v)) for m, v in sol.ground.terms(c)))
+
+
+def _polynomial_text(sol, c: object) -> str:
+    """A coefficient in ``QQ[A, params]`` as SymPy writes it (``3*A**2*alpha/8 - A/4``, in
+    SymPy's order), formatted from FLINT's terms."""
+    names = sorted({n for powers, _ in sol.ground.terms(c) for n, _ in powers})
+
+    def order(term: tuple) -> tuple:  # SymPy's: lex on the names (sorted), descending
+        powers = dict(term[0])
+        return tuple(-powers.get(n, 0) for n in names)
+
+    terms = sorted(sol.ground.terms(c), key=order)
+    out = []
+    for powers, v in terms:
+        p, q = abs(int(v.p)), int(v.q)
+        body = _monomial(powers) if powers else ""
+        if body:
+            body = (body if p == 1 else f"{p}*{body}") + (f"/{q}" if q != 1 else "")
+        else:
+            body = f"{p}/{q}" if q != 1 else f"{p}"
+        out.append(("- " if v < 0 else "+ ") + body)
+    if not out:
+        return "0"
+    text = " ".join(out)
+    return text[2:] if text.startswith("+ ") else "-" + text[2:]
+
+
+def series_json(sol) -> dict:
+    """The contract of ``lindstedt series MODEL --order K --json`` (keys are stable)."""
+    m = sol.model
+    data = {
+        "model": m.name,
+        "order": sol.order,
+        "variable": m.variable,
+        "omega": [_coefficient(sol, c) for c in sol.omega],
+        "period": [_coefficient(sol, c) for c in sol.period],
+        "q": [{str(n): _coefficient(sol, c) for n, c in sorted(qj.items())} for qj in sol.q],
+        "convention": sol.convention,
+        "radius": None if m.radius is None else str(m.radius),
+    }
+    data.update(_domain_fields(sol))
+    if m.source:
+        data.update(equation=m.source, omega0=str(m.frequency),
+                    units="omega in units of omega0, period in units of 2*pi/omega0")
+    return data
+
+
+def _domain_fields(sol) -> dict:
+    """Where the series may be used: ``orbit_limit`` (the family of periodic orbits exists
+    for lower < y < upper, 30 digits, or ``known`` false with the reason) and, where the
+    model states no radius, ``radius_estimate`` (value and spread, from the τ_j)."""
+    from ..derive.lindstedt import estimated_radius
+    from ..derive.orbits import orbit_domain
+
+    fields = {"orbit_limit": orbit_domain(sol.model).as_json()}
+    if sol.model.radius is None and sol.ground.is_rational and sol.order >= 2:
+        found = estimated_radius(sol, {})
+        if found is not None:
+            fields["radius_estimate"] = {"value": float(found[0]), "spread": found[1]}
+    return fields
+
+
+def series_table(sol) -> str:
+    """Readable table: ω_j, T_j/2π and the harmonics of q_j per order."""
+    m = sol.model
+    lines = [
+        f"{m.name}: {m.title}, expansion variable {m.variable}, order {sol.order}",
+        f"convention: {sol.convention}",
+    ]
+    if m.frequency != 1:
+        lines.append(f"omega in units of omega0 = {m.frequency}, T in units of 2*pi/omega0")
+    domain = _domain_fields(sol)["orbit_limit"]
+    y = m.variable.partition("=")[0].strip() or m.variable
+    lines.append(f"periodic orbits for {domain['lower']} < {y} < {domain['upper']} "
+                 f"({domain['how']})" if domain["known"] else
+                 f"orbit domain not computed: {domain['how']}")
+    if sol.ground.is_rational:
+        lines.append(f"{'j':>3}  {'omega_j':>24}  {'(T/2pi)_j':>24}  "
+                     "q_j: harmonic n -> coefficient")
+        for j in range(sol.order + 1):
+            harmonics = ", ".join(f"{n}: {_rational(c)}" for n, c in sorted(sol.q[j].items()))
+            lines.append(f"{j:>3}  {_rational(sol.omega[j]):>24}  "
+                         f"{_rational(sol.period[j]):>24}  {harmonics}")
+        return "\n".join(lines)
+    def g(c: object) -> str:
+        return _polynomial_text(sol, c)
+
+    for j in range(sol.order + 1):  # symbolic coefficients: one block an order
+        lines.append(f"j = {j}: omega_j = {g(sol.omega[j])}")
+        lines.append(f"       (T/2pi)_j = {g(sol.period[j])}")
+        for n, c in sorted(sol.q[j].items()):
+            lines.append(f"       q_j[cos {n}s] = {g(c)}")
+    return "\n".join(lines)
+
+
+def limit_cycle_json(lc) -> dict:
+    """``lindstedt series`` of a self-excited oscillator: ω, T/2π and q(0) as exact "p/q" in
+    ε, each q_j's cos and sin coefficients, the first-order amplitude slope and the verdict."""
+    m = lc.model
+    frac = _fraction_text
+    return {
+        "model": m.name, "order": lc.order, "variable": "eps",
+        "omega": [frac(c) for c in lc.omega], "period": [frac(c) for c in lc.period],
+        "amplitude": [frac(c) for c in lc.amplitude],
+        "q": [{"cos": {str(n): frac(c) for n, c in sorted(cos.items())},
+               "sin": {str(n): frac(c) for n, c in sorted(sin.items())}} for cos, sin in lc.q],
+        "convention": "q'(0) = 0; q(0) = sum_j amplitude[j] eps^j, s = omega t",
+        "equation": m.source, "slope": frac(lc.slope),
+        "stable_for": "eps > 0" if lc.slope > 0 else "eps < 0",
+        "stability": limit_cycle_stability(lc),
+    }
+
+
+def limit_cycle_stability(lc) -> str:
+    """The cycle attracts for ``ε S'(a₀) > 0`` and repels for the other sign of ε, where the
+    same series holds (time reversed: t → −t, ε → −ε)."""
+    good, bad = ("eps > 0", "eps < 0") if lc.slope > 0 else ("eps < 0", "eps > 0")
+    return (f"stable (attracting) for {good}, unstable (repelling) for {bad}; the series holds "
+            "for both signs")
+
+
+def _cycles_json(cycles) -> list[dict]:
+    """Every limit cycle: its first-order amplitude a₀ (exact, SymPy's str), S'(a₀) and its
+    stability, smallest amplitude first."""
+    return [{"amplitude0": str(c.amplitude), "slope": str(c.slope), "stability": c.stability,
+             "expandable": c.slope != 0} for c in cycles]
+
+
+def _cycles_text(model, listed: list[dict]) -> str:
+    lines = [f"{model.name}: {len(listed)} limit cycle(s) of S(a), by amplitude:"]
+    for k, c in enumerate(listed, 1):
+        lines.append(f"  cycle {k}: a0 = {c['amplitude0']}, S'(a0) = {c['slope']}: "
+                     f"{c['stability']}")
+    return "\n".join(lines)
+
+
+def limit_cycle_table(lc) -> str:
+    m = lc.model
+    lines = [f"{m.name}: {m.title}, a limit cycle, expansion variable eps, order {lc.order}",
+             "convention: q'(0) = 0, q(0) = sum_j amplitude_j eps^j",
+             f"stability: {limit_cycle_stability(lc)}",
+             f"{'j':>3}  {'omega_j':>22}  {'(T/2pi)_j':>22}  {'amplitude_j':>22}"]
+    for j in range(lc.order + 1):
+        lines.append(f"{j:>3}  {_fraction_text(lc.omega[j]):>22}  "
+                     f"{_fraction_text(lc.period[j]):>22}  {_fraction_text(lc.amplitude[j]):>22}")
+    return "\n".join(lines)
+
+
+def run_series(args: argparse.Namespace) -> int:
+    from ..derive.cycles import derive_limit_cycle, limit_cycles
+    from ..derive.lindstedt import derive
+    from ..derive.models import SelfExcited, series_model
+
+    found = series_model(args.model, args.order, _params(args.param), args.name)
+    if args.cycle is not None and not isinstance(found, SelfExcited):
+        raise InputError(f"--cycle {args.cycle}: {args.model!r} is conservative: a family of "
+                         "orbits, no limit cycles to pick from")
+    if isinstance(found, SelfExcited):
+        cycles = limit_cycles(found)
+        if args.cycle is not None and not 1 <= args.cycle <= len(cycles):
+            raise InputError(f"--cycle {args.cycle}: {found.name} has {len(cycles)} limit "
+                             f"cycle(s), numbered 1 to {len(cycles)} by amplitude")
+        listed = _cycles_json(cycles)
+        first = args.cycle if args.cycle is not None else 1
+        lc = derive_limit_cycle(found, args.order, first - 1)
+        data = {**limit_cycle_json(lc), "cycle": first, "cycles": listed}
+        omega = lc.omega
+        # the table: the cycle asked for, or each in turn (one that cannot be expanded says why)
+        texts = [_cycles_text(found, listed)]
+        shown = [] if args.json else [first] if args.cycle is not None \
+            else range(1, len(cycles) + 1)
+        for k in shown:
+            c = cycles[k - 1]
+            if k == first:
+                texts.append(f"cycle {k}: " + limit_cycle_table(lc))
+            elif c.slope == 0:
+                texts.append(f"cycle {k}: not expanded: {c.stability}")
+            else:
+                texts.append(f"cycle {k}: " + limit_cycle_table(
+                    derive_limit_cycle(found, args.order, k - 1)))
+        text = "\n\n".join(texts)
+    else:
+        model = found  # series_model built it (model_from_text): parse and expand once
+        progress = Progress(f"deriving {model.name} to order {args.order}", not args.json)
+        sol = derive(model, args.order, progress)
+        progress.close()
+        data = series_json(sol)
+        text = "" if args.json else series_table(sol)  # build only what is printed
+        omega = [sol.ground.to_fraction(c) for c in sol.omega] if sol.ground.is_rational \
+            else None
+    if args.singularities:
+        data["singularities"], line = _singularities(omega, data["variable"])
+        text += "\n" + line
+    print(json.dumps(data) if args.json else text)
+    return 0
+
+
+def _singularities(omega, variable: str, of: str = "omega", degree: int | None = 1
+                   ) -> tuple[list[dict], str]:
+    """``--singularities``: the nearest singularity of ω (or of the series ``of``) estimated
+    from its exact series (``degree``: of :func:`lindstedt.nearest_singularity`)."""
+    from ..derive.lindstedt import nearest_singularity
+
+    if omega is None:
+        raise InputError("--singularities: the coefficients stay symbolic; give every "
+                         "parameter a value (--param)")
+    name = variable.partition("=")[0].strip() or variable
+    est = nearest_singularity(omega, name, degree)
+    if est is None:
+        return [], "singularities: too few nonzero coefficients for an estimate (raise --order)"
+    row = {"variable": est.variable, "radius": est.radius, "angle": est.angle,
+           "spread": est.spread, "method": est.method}
+    return [row], (f"nearest singularity of {of} ({est.method}): |{est.variable}| = "
+                   f"{est.radius:.6g}, angle ±{est.angle:.6g} rad, spread {est.spread:.2g}")
+
+
+def _emit_only(flags) -> None:
+    """``--emit`` writes a module and prints its path: the printing flags given beside it
+    (``flags``: pairs of a flag and whether it was given) are refused, not ignored."""
+    others = [flag for flag, given in flags if given]
+    if others:
+        raise InputError(f"--emit writes the module only: drop {', '.join(others)}")
+
+
+def run_mathieu(args: argparse.Namespace) -> int:
+    """``lindstedt mathieu a|b --m M --order K``: DLMF §28.6's series of a_m(q) or b_m(q)."""
+    from ..derive.hill import mathieu_series
+
+    if args.emit is not None:
+        from .. import compiler
+
+        _emit_only((("--json", args.json), ("--singularities", args.singularities)))
+        for path in compiler.generate_mathieu(args.kind, args.m, args.order,
+                                              _out_folder(args.emit, "--emit"),
+                                              overwrite_edited=args.overwrite_edited):
+            print(path)
+        return 0
+    series = mathieu_series(args.kind, args.m, args.order)
+    data = {"kind": args.kind, "m": args.m, "variable": "q",
+            "series": [_fraction_text(c) for c in series]}
+    line = ""
+    if args.singularities:  # a_2n, b_2n live in q²: the estimate names q**2
+        data["singularities"], line = _singularities(series, "q", f"{args.kind}_{args.m}", None)
+        if data["singularities"] and data["singularities"][0]["variable"] == "q**2":
+            row = data["singularities"][0]
+            line += f" (|q| = {math.sqrt(row['radius']):.6g})"
+    if args.json:
+        print(json.dumps(data))
+        return 0
+    print(f"{args.kind}_{args.m}(q) of y'' + (a - 2q cos 2z) y = 0 (DLMF 28.2.1), order "
+          f"{args.order}: coefficient of q^k")
+    for k, c in enumerate(series):
+        print(f"{k:>4}  {_fraction_text(c)}")
+    if line:
+        print(line)
+    return 0
+
+
+def _series_value(coefficients, x: float) -> tuple[float, float, int]:
+    """The partial sum at ``x``, its change over the last two nonzero terms (the truncation
+    error estimate) and the order K of the smallest such change (the best reachable)."""
+    total, last, changes = 0.0, [], []
+    for k, c in enumerate(coefficients):
+        term = float(c) * x**k
+        total += term
+        if c:
+            last.append(abs(term))
+            changes.append((sum(last[-2:]), k))
+    if len(changes) < 2:
+        return total, 0.0, len(coefficients) - 1
+    best = min(changes[1:])
+    return total, changes[-1][0], best[1]
+
+
+def _radius(coefficients) -> float:
+    """The estimated radius of convergence in the series' own variable (inf if too short)."""
+    from ..derive.lindstedt import nearest_singularity
+
+    est = nearest_singularity(coefficients, "x", None)
+    if est is None:
+        return math.inf
+    return math.sqrt(est.radius) if est.variable == "x**2" else est.radius
+
+
+DAMPING_PANEL = 0.05
+# NOTE: the damped panel of `tongues --plot` without --damping: the tongues visibly lift.
+
+
+def run_tongues(args: argparse.Namespace) -> int:
+    """``lindstedt tongues P --n N --order K``: the transition curves out of tongue n of
+    x'' + (δ + ε p(t))x = 0, exact; ``--damping Z``: the damped tongue's tip."""
+    from ..derive.hill import fourier_of_text, tongue_tip, transition_curves
+
+    if args.emit is not None:
+        from .. import compiler
+
+        _emit_only((("--at", args.at is not None), ("--tol", args.tol),
+                    ("--damping", args.damping is not None), ("--plot", args.plot),
+                    ("--json", args.json), ("--singularities", args.singularities)))
+        for path in compiler.generate_tongue(args.p, args.n, args.order,
+                                             _out_folder(args.emit, "--emit"),
+                                             overwrite_edited=args.overwrite_edited):
+            print(path)
+        return 0
+    if args.tol is not None and args.at is None:
+        raise InputError("--tol: give --at EPS, the eps the tolerance is asked at")
+    if args.plot:
+        from ..charts import check_plot_path
+
+        check_plot_path(Path(args.plot))  # before any work
+    p = fourier_of_text(args.p)
+    tongue = transition_curves(p, args.n, args.order)
+    period = "2*pi" if args.n % 2 == 0 else "4*pi"
+    data: dict = {
+        "p": args.p, "n": args.n, "variable": "eps",
+        "delta0": _fraction_text(Fraction(args.n * args.n, 4)),
+        "harmonics": {str(k): [_fraction_text(a), _fraction_text(b)] for k, (a, b) in p.items()},
+        "time_origin": "pi/2" if tongue.shift else "0", "period": period,
+        "solution_variable": "tau = (t - time_origin)/2", "curves": []}
+    lines = [f"tongue n = {args.n} of x'' + (delta + eps p(t)) x = 0, p(t) = {args.p}: "
+             f"delta = {data['delta0']} + sum_k delta_k eps^k, order {args.order}; "
+             f"periodic solutions of period {period}"
+             + (" (in t - pi/2: p is even about t = pi/2)" if tongue.shift else "")]
+    for curve in tongue.curves:
+        row = {"label": curve.label, "series": [_fraction_text(c) for c in curve.delta],
+               "solution": [{"cos": {str(j): _fraction_text(c) for (kind, j), c in x.items()
+                                     if kind == 0},
+                             "sin": {str(j): _fraction_text(c) for (kind, j), c in x.items()
+                                     if kind == 1}} for x in curve.solution]}
+        lines.append(f"curve {curve.label}: k, delta_k")
+        lines += [f"{k:>4}  {_fraction_text(c)}" for k, c in enumerate(curve.delta)]
+        if args.singularities:
+            row["singularities"], line = _singularities(list(curve.delta), "eps",
+                                                        f"delta ({curve.label})", None)
+            lines.append(line)
+        if args.at is not None:
+            value, error, best = _series_value(curve.delta, args.at)
+            radius = _radius(curve.delta)
+            if abs(args.at) >= radius:  # outside the disc of convergence: no value
+                value, error = math.nan, math.inf
+            if args.tol is not None and not error <= args.tol:
+                _, best_error, _ = _series_value(curve.delta[:best + 1], args.at)
+                raise InputError(f"--tol {args.tol:g}: not reached at eps = {args.at:g} by order "
+                                 f"{args.order} (estimate {error:.2g}); the best reachable is "
+                                 f"{best_error:.2g} at order {best}")
+            row["at"] = {"eps": args.at, "delta": value, "error": error, "radius": radius}
+            lines.append(f"at eps = {args.at:g}: delta = {value:.15g} (truncation ~{error:.2g}"
+                         f"; radius of convergence ~{radius:.4g})")
+        data["curves"].append(row)
+    if args.damping is not None:
+        tip = tongue_tip(p, args.n, args.order)
+        eps, _, _ = _series_value(tip.eps_min, args.damping)
+        delta, err, _ = _series_value(tip.delta, args.damping)
+        data["damping"] = {
+            "variable": "zeta", "equation": "x'' + 2 zeta x' + (delta + eps p(t)) x = 0",
+            "eps_min": [_fraction_text(c) for c in tip.eps_min],
+            "delta_at_min": [_fraction_text(c) for c in tip.delta],
+            "mu_max": [_fraction_text(c) for c in tip.mu],
+            "at": {"zeta": args.damping, "eps_min": eps, "delta": delta, "error": err}}
+        lines.append("damped tongue tip: eps_min(zeta) = sum_k e_k zeta^k at delta = sum_k "
+                     "d_k zeta^k (k, e_k, d_k)")
+        lines += [f"{k:>4}  {_fraction_text(e):>24}  {_fraction_text(d)}"
+                  for k, (e, d) in enumerate(zip(tip.eps_min, tip.delta, strict=True))]
+        lines.append(f"at zeta = {args.damping:g}: eps_min = {eps:.12g}, delta = {delta:.12g}")
+    print(json.dumps(data) if args.json else "\n".join(lines))
+    if args.plot:
+        from ..charts import ince_strutt_figure
+
+        path = ince_strutt_figure(Path(args.plot), args.p, args.damping or DAMPING_PANEL,
+                                  order=args.order, tongues=range(max(4, args.n + 1)))
+        if not args.json:
+            print(f"Ince–Strutt chart: {path}")
+    return 0
+
+
+def slow_flow_json(flow) -> dict:
+    """The contract of ``lindstedt slowflow … --json``: ``radial[k-1]`` and ``phase[k-1]`` are
+    R_k and Φ_k of dr/dt = Σ eps^k R_k, dphi/dt = Σ eps^k Φ_k (SymPy text in r, phi and the
+    parameters), for q = r cos(t + phi) (a drive: q = r cos(w t + phi), w = 1 + eps*sigma);
+    ``cycles``: each limit cycle (a root of dr/dt) of an autonomous flow without symbolic
+    parameters, its radius r* (to eps^(K-1)) and frequency ω (to eps^K) as series in eps."""
+    return {
+        "equation": flow.source, "name": flow.name, "order": flow.order, "variable": "eps",
+        "parameters": [str(p) for p in flow.parameters], "driven": flow.driven,
+        "convention": ("q = r cos(w t + phi), q' = -r w sin(w t + phi) + O(eps), "
+                       "w = 1 + eps*sigma" if flow.driven else
+                       "q = r cos(t + phi), q' = -r sin(t + phi) + O(eps)")
+        + "; mean-free near-identity transformation",
+        "radial": [sp_text(e) for e in flow.radial],
+        "phase": [sp_text(e) for e in flow.phase],
+        "cycles": [{"radius": [sp_text(c) for c in cyc.radius],
+                    "omega": [sp_text(c) for c in cyc.omega],
+                    "stable_for": "eps > 0" if cyc.slope < 0 else "eps < 0"}
+                   for cyc in _cycles(flow)],
+    }
+
+
+def _cycles(flow) -> list:
+    """The limit cycles of an autonomous flow with numeric coefficients (none otherwise)."""
+    from ..derive.averaging import cycle_series
+
+    return [] if flow.driven or flow.parameters else cycle_series(flow)
+
+
+def run_slowflow(args: argparse.Namespace) -> int:
+    """``lindstedt slowflow EQUATION|NAME --order K``: the averaged equations, exact."""
+    from ..derive.averaging import slow_flow
+    from ..derive.models import oscillator, registry_entry
+
+    text, name = args.model, args.name or "oscillator"
+    if (entry := registry_entry(text)) is not None:  # a name or its alias (vdp)
+        text, name = entry.equation, args.name or entry.name
+    out = _out_folder(args.out) if args.out is not None else None
+    osc = oscillator(text, _params(args.param), name)
+    flow = slow_flow(osc, args.order)
+    written = []
+    if out is not None:  # written before anything is printed: a refusal prints nothing
+        from ..compiler import generate_slow_flow
+
+        params = "".join(f" --param {k}={v}" for k, v in sorted(_params(args.param).items()))
+        command = f'lindstedt slowflow "{text}" --name {name} --order {args.order}{params}'
+        written = generate_slow_flow(osc, args.order, command, out,
+                                     overwrite_edited=args.overwrite_edited)
+    if args.json:
+        print(json.dumps(slow_flow_json(flow)))
+    else:
+        frame = "q = r cos(w t + phi), w = 1 + eps*sigma" if flow.driven else \
+            "q = r cos(t + phi)"
+        print(f"{flow.name}: {flow.source}, the slow flow to order {flow.order} ({frame})")
+        print("dr/dt = sum_k eps^k R_k, dphi/dt = sum_k eps^k Phi_k")
+        for k in range(flow.order):
+            print(f"R_{k + 1}   = {sp_text(flow.radial[k])}")
+            print(f"Phi_{k + 1} = {sp_text(flow.phase[k])}")
+        for cyc in _cycles(flow):
+            print(f"limit cycle (dr/dt = 0, attracting for "
+                  f"{'eps > 0' if cyc.slope < 0 else 'eps < 0'}): r = sum_j eps^j r_j, "
+                  "omega = sum_j eps^j omega_j")
+            print("  r_j:     " + ", ".join(sp_text(c) for c in cyc.radius))
+            print("  omega_j: " + ", ".join(sp_text(c) for c in cyc.omega))
+    for path in written:
+        print(f"  {path}", file=sys.stderr if args.json else sys.stdout)
+    return 0
+
+
+def run_models(args: argparse.Namespace) -> int:
+    from ..derive.models import ALIASES, REGISTRY
+
+    aliases = {e.name: sorted(a for a, name in ALIASES.items() if name == e.name)
+               for e in REGISTRY.values()}
+    if args.json:
+        print(json.dumps([{"name": e.name, "equation": e.equation, "about": e.about,
+                           "aliases": aliases[e.name]} for e in REGISTRY.values()]))
+        return 0
+    width = max(len(name) for name in REGISTRY)
+    for e in REGISTRY.values():
+        also = f" (also: {', '.join(aliases[e.name])})" if aliases[e.name] else ""
+        print(f"{e.name:<{width}}  {e.equation:<44}  {e.about}{also}")
+    return 0
+
+
+def run_generate(args: argparse.Namespace) -> int:
+    order = args.order
+    if args.model in EMITTED and (args.param or args.name):
+        raise InputError(f"--param/--name: the {args.model} modules take neither")
+    if args.model in EMITTED and args.allow_divergent:
+        raise InputError(f"--allow-divergent: the {args.model} evaluators have no radius to lift")
+    from .. import compiler
+
+    if args.model in EMITTED and args.resum_order is not None:
+        raise InputError(f"--resum-order: the {args.model} modules have no limit cycle to resum")
+    if args.damped and args.model != "driven":
+        raise InputError(f"--damped: only `generate driven` has a damped variant, not "
+                         f"{args.model}")
+    out = _out_folder(args.out)
+    if args.model == "driven":
+        paths = compiler.generate_driven(order, out, damped=args.damped,
+                                         overwrite_edited=args.overwrite_edited)
+    elif args.model == "balance":
+        paths = compiler.generate_balance(args.harmonics, out,
+                                          overwrite_edited=args.overwrite_edited)
+    elif args.model == "fourier":
+        paths = compiler.generate_fourier(args.harmonics, out,
+                                          overwrite_edited=args.overwrite_edited)
+    else:
+        from ..derive.models import SelfExcited, series_model
+        from ..lower.forms import check_emitted_names
+
+        found = series_model(args.model, order + 2, _params(args.param), args.name)
+        if isinstance(found, SelfExcited):
+            if args.allow_divergent:
+                raise InputError("--allow-divergent: a limit cycle's evaluators stop at their "
+                                 "estimated radius")
+            for path in compiler.generate_limit_cycle(found, order, out,
+                                                      resum_order=args.resum_order,
+                                                      overwrite_edited=args.overwrite_edited):
+                print(path)
+            return 0
+        model = found
+        if args.resum_order is not None:
+            raise InputError(f"--resum-order: {model.name} has no limit cycle; only a limit "
+                             "cycle's frequency is resummed from a longer series")
+        check_emitted_names(model)  # before the derivation: a clash is known at once
+        progress = Progress(f"deriving {model.name} to order {order + 2}")
+        paths = compiler.generate(model, order, out, args.allow_divergent, progress,
+                                  overwrite_edited=args.overwrite_edited)
+        progress.close()
+    for path in paths:
+        print(path)
+    return 0
+
+
+def arguments_series(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt series``'s arguments."""
+    p = sub.add_parser("series", help="the L–P series of a free oscillator, or of its limit "
+                       "cycles", description="Derive ω_j, (T/2π)_j and q_j of the L–P series "
+                       "exactly; for q'' + q = eps*f(q, q') with f odd in q', of its limit "
+                       "cycles (the amplitude fixed order by order).")
+    _flag_oscillator(p)
+    _flag_order(p, "highest order K of the series")
+    p.add_argument("--cycle", type=int, default=None, metavar="N",
+                   help="a self-excited oscillator's N-th limit cycle (by amplitude, from 1) "
+                   "to expand; default: each in turn in the table, the first in --json "
+                   "(which lists every cycle under 'cycles')")
+    p.add_argument("--singularities", action="store_true",
+                   help="also estimate the nearest singularities of ω from the exact series "
+                   "(Domb–Sykes or Mercer–Roberts, extrapolated in 1/n; their spread over the "
+                   "last orders); with --json a key 'singularities'")
+    _flag_json(p)
+    _flag_allow_slow(p)
+    return p
+
+
+def arguments_mathieu(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt mathieu``'s arguments."""
+    p = sub.add_parser("mathieu", help="Mathieu's characteristic values a_m(q), b_m(q) as "
+                       "exact series", description="The series of a_m(q) (even solutions "
+                       "ce_m) or b_m(q) (odd, se_m) of y'' + (a - 2q cos 2z) y = 0 in DLMF's "
+                       "normalisation, exact rationals, by L–P about cos mz or sin mz.")
+    p.add_argument("kind", choices=("a", "b"), help="a: even solutions; b: odd ones")
+    p.add_argument("--m", type=_order, default=0, metavar="M",
+                   help="the index m, an integer ≥ 0 (≥ 1 for b; default 0)")
+    _flag_order(p, "highest power K of q")
+    _flag_json(p, "the contract {kind, m, variable, series}")
+    _flag_allow_slow(p, deprecated_force=False)
+    p.add_argument("--emit", metavar="DIR", default=None,
+                   help="write DIR/mathieu_<kind><m>.py instead: a numba ufunc of the value, "
+                   "Padé-resummed from the series to --order and refined by a Newton step on "
+                   "the recurrence's determinant, verified against the eigenvalues at 30 digits "
+                   "on a grid of q up to 50 and NaN beyond where it was verified")
+    p.add_argument("--overwrite-edited", action="store_true",
+                   help="with --emit: overwrite a file edited since it was generated")
+    p.add_argument("--singularities", action="store_true",
+                   help="also estimate the nearest singularity (radius of convergence) from "
+                   "the exact series, with its spread; in q**2 for a_2n, b_2n; with --json a "
+                   "key 'singularities'")
+    return p
+
+
+def arguments_tongues(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt tongues``'s arguments."""
+    p = sub.add_parser("tongues", help="transition curves of Hill's equation x'' + (delta + "
+                       "eps p(t)) x = 0 out of a tongue", description="Both transition curves "
+                       "delta(eps) out of the tongue delta = n^2/4 of x'' + (delta + eps p(t))"
+                       " x = 0 as exact series, with the periodic solution on each (period 2pi "
+                       "for n even, 4pi for n odd); p(t) a finite sum of cos(k*t), sin(k*t) "
+                       "with rational coefficients.  Mathieu's a_m, b_m: p = cos(t), "
+                       "delta = a/4, eps = -q/2.")
+    p.add_argument("p", help="p(t), e.g. 'cos(t)' or 'cos(t) + 1/2*cos(2*t)'")
+    p.add_argument("--n", type=_order, default=1, metavar="N",
+                   help="the tongue delta = N^2/4, an integer ≥ 0 (default 1)")
+    _flag_order(p, "highest power K of eps")
+    p.add_argument("--damping", type=_nonnegative, metavar="Z",
+                   help="also the tip of the tongue of x'' + 2Z x' + (delta + eps p) x = 0: "
+                   "eps_min and its delta as series in zeta, and their values at Z")
+    p.add_argument("--at", type=_real, metavar="EPS",
+                   help="also evaluate each curve at eps = EPS with its truncation estimate")
+    p.add_argument("--tol", type=_positive_real, metavar="TOL",
+                   help="with --at: refuse unless the truncation estimate is ≤ TOL (naming "
+                   "the best reachable)")
+    p.add_argument("--singularities", action="store_true",
+                   help="also estimate each curve's nearest singularity in eps (radius of "
+                   "convergence) with its spread")
+    p.add_argument("--plot", metavar="FILE",
+                   help="also draw the Ince–Strutt chart of this p into FILE (.png, .svg or "
+                   ".pdf): Floquet multipliers on a 400 x 400 grid, undamped and with damping "
+                   f"Z (default {DAMPING_PANEL}), the series curves of tongues 0..max(3, N)")
+    _flag_json(p, "the curves as JSON {p, n, variable, delta0, harmonics, time_origin, period, "
+               "solution_variable, curves: [{label, series, solution}], damping}")
+    _flag_allow_slow(p, deprecated_force=False)
+    p.add_argument("--emit", metavar="DIR", default=None,
+                   help="write DIR/tongue_<N>.py instead: numba ufuncs delta_<i>(eps) and "
+                   "delta_<i>_error(eps), one per curve, Padé-resummed from the series to "
+                   "--order (≥ 12), verified against the Floquet boundary |tr M| = 2 to 1e-10 "
+                   "in delta on 240 points up to 3 radii (at most eps = 10), NaN beyond")
+    p.add_argument("--overwrite-edited", action="store_true",
+                   help="with --emit: overwrite a file edited since it was generated")
+    return p
+
+
+def arguments_models(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt models``'s arguments."""
+    p = sub.add_parser("models", help="list the named oscillators",
+                       description="The named oscillators: each is an equation (any equation "
+                       "of the family can be given instead of a name).")
+    _flag_json(p, "the list as JSON")
+    return p
+
+
+def arguments_generate(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt generate``'s arguments."""
+    p = sub.add_parser(
+        "generate", help="write a numba evaluator module and LaTeX tables and derivation",
+        description="Write a numba evaluator module (and for duffing, pendulum, driven its "
+        "LaTeX tables and derivation) into --out.")
+    _flag_oscillator(p, emitted=True)
+    _flag_order(p, f"highest order K (duffing, pendulum; driven up to {DRIVEN_MAX_ORDER})")
+    p.add_argument("--out", default="out", metavar="DIR",
+                   help="output folder, created if missing (default out/)")
+    _flag_harmonics(p, "balance (up to 12), fourier (up to 60): odd harmonics N")
+    p.add_argument("--allow-divergent", action="store_true",
+                   help="evaluate beyond the radius of convergence instead of returning NaN "
+                   "(default: NaN)")
+    p.add_argument("--damped", action="store_true",
+                   help="driven only: the μ-expansion with damping 1/Q, A_n and B_n (n = 1, 3, "
+                   "5) of Q < inf (driven_damped.py, driven_damped_derivation.tex)")
+    p.add_argument("--resum-order", type=_order, default=None, metavar="N",
+                   help="limit cycles only: derive ω's exact series to order N (at least K + 2) "
+                   "for the radius estimate and the resummed evaluators (default 60: van der "
+                   "Pol's omega_resummed verified to eps ≈ 3.75; 164: to eps = 10)")
+    _flag_allow_slow(p)
+    _flag_overwrite_edited(p)
+    return p
+
+
+def arguments_slowflow(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt slowflow``'s arguments."""
+    p = sub.add_parser("slowflow", help="the slow flow (averaging) of q'' + q = eps*f, free, "
+                       "self-excited or driven", description="Average q'' + q = eps*f(q, q') "
+                       "(+ eps*F*cos(w*t), w = 1 + eps*sigma) to order K: dr/dt and dphi/dt "
+                       "exactly, for q = r cos(t + phi); with --out the compiled right sides and "
+                       "the LaTeX of the flow.")
+    _flag_oscillator(p)
+    p.add_argument("--order", type=_order, default=2, metavar="K",
+                   help="the order in eps, 1..6 (default 2)")
+    _flag_json(p, "the contract {equation, name, order, variable, parameters, driven, "
+               "convention, radial, phase, cycles}")
+    p.add_argument("--out", metavar="DIR", help="also write <name>_slow_flow.py (numba "
+                   "slow_flow, slow_flow_jacobian, slow_flow_cartesian) and "
+                   "<name>_slow_flow.tex into DIR")
+    _flag_overwrite_edited(p)
+    return p
