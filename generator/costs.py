@@ -331,7 +331,7 @@ def response_cost(args: argparse.Namespace) -> Cost:
 def sweep_cost(args: argparse.Namespace) -> Cost:
     """The grid's points times its kind's cost per point, over the local workers (a running
     scheduler's workers are not known before connecting: its estimate is the CPU time)."""
-    from .kinds import kind_named
+    from .sweep.kinds import kind_named
 
     kind = kind_named(args.kind)
     points = math.prod(len(getattr(args, a) or [0]) for a in kind.axes)

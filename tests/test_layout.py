@@ -99,6 +99,23 @@ def test_every_import_follows_the_stage_list():
     assert not wrong, "; ".join(wrong)
 
 
+def test_every_relative_import_names_a_module_of_the_package():
+    """A function-level import that names no module (``from .kinds import`` where the module
+    is ``sweep.kinds``) fails only when that function runs: caught here, for every one."""
+    known = set(modules())
+    wrong = []
+    for me, path in sorted(modules().items()):
+        here = list(path.relative_to(PACKAGE).with_suffix("").parts)
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.level:
+                head = [*here[: len(here) - node.level],
+                        *(node.module.split(".") if node.module else [])]
+                name = ".".join(head)
+                if name and name not in known and name != "__init__":
+                    wrong.append(f"{me}: from {'.' * node.level}{node.module or ''}")
+    assert not wrong, "; ".join(wrong)
+
+
 def test_no_module_is_over_the_limit():
     long = {name: n for name, path in modules().items()
             if (n := len(path.read_text(encoding="utf-8").splitlines())) > LIMIT}

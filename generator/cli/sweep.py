@@ -30,8 +30,8 @@ def run_sweep(args: argparse.Namespace) -> int:
         from ..charts import check_plot_path
 
         check_plot_path(Path(args.plot))
-    from ..kinds import equation_kind
-    from ..store import run_sweep
+    from ..sweep.kinds import equation_kind
+    from ..sweep.store import run_sweep
 
     builtin = {name: getattr(args, name) for name in ("omega", "force", "eps", "Q")
                if getattr(args, name) is not None}

@@ -39,11 +39,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 from distributed import WorkerPlugin
 
-from .analysis.continuation import CONTINUATION_HARMONICS
-from .analysis.driven import Drive, amplitude_slope, amplitudes, first_order_branches, mu_expansion
-from .analysis.periodic import SAME_ORBIT, periodic_orbits, try_balance
-from .analysis.subharmonic import SUBHARMONIC_HARMONICS, subharmonic
-from .errors import InputError
+from ..analysis.continuation import CONTINUATION_HARMONICS
+from ..analysis.driven import Drive, amplitude_slope, amplitudes, first_order_branches, mu_expansion
+from ..analysis.periodic import SAME_ORBIT, periodic_orbits, try_balance
+from ..analysis.subharmonic import SUBHARMONIC_HARMONICS, subharmonic
+from ..errors import InputError
 
 if TYPE_CHECKING:
     pass
@@ -314,7 +314,7 @@ def kernel_signatures() -> dict[str, int]:
     worker's counts stay fixed from task to task (no recompiling)."""
     from numba.core.registry import CPUDispatcher
 
-    from .numerics import floquet, integrate, shooting
+    from ..numerics import floquet, integrate, shooting
 
     return {name: len(f.signatures) for module in (integrate, floquet, shooting)
             for name, f in vars(module).items() if isinstance(f, CPUDispatcher)}
@@ -377,8 +377,8 @@ def _point_values(spec: EquationSpec, axis: Mapping[str, float]) -> dict[str, st
 def _equation_response(spec: EquationSpec, **axis: float) -> dict:
     """Every 1:1 orbit at one point (:func:`response.equation_orbits`: the balance continued in
     the drive amplitude, each crossing shot), largest r first, with its Floquet verdict."""
-    from .analysis.periodic import equation_orbits
-    from .analysis.polynomial import driven_equation
+    from ..analysis.periodic import equation_orbits
+    from ..analysis.polynomial import driven_equation
 
     values = _point_values(spec, axis)
     omega = float(Fraction(values.pop(spec.frequency)))
@@ -407,7 +407,7 @@ def _branches(shot: list, count: int) -> dict:
 def _equation_subharmonic(spec: EquationSpec, **axis: float) -> dict:
     """Every orbit of n drive periods at one point (:func:`subharmonic.subharmonic_orbits`,
     without the onset), largest r first, with its Floquet verdict."""
-    from .analysis.subharmonic import subharmonic_equation, subharmonic_orbits
+    from ..analysis.subharmonic import subharmonic_equation, subharmonic_orbits
 
     values = _point_values(spec, axis)
     try:
@@ -430,9 +430,9 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
     parameters of the equation (its drive frequency included), every other parameter has a
     value in ``values``; refused in one line: an axis that names no parameter, a parameter
     both an axis and a value, a parameter with neither, a kind that takes no equation."""
-    from .analysis.polynomial import driven_form
-    from .analysis.subharmonic import check_n
-    from .derive.models import oscillator
+    from ..analysis.polynomial import driven_form
+    from ..analysis.subharmonic import check_n
+    from ..derive.models import oscillator
 
     if kind not in EQUATION_KINDS:
         raise InputError(f"sweep {kind} EQUATION: the {kind} map is the notes' (μ-expansion "

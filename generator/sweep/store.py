@@ -33,8 +33,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .analysis.driven import Drive
-from .errors import InputError
+from ..analysis.driven import Drive
+from ..errors import InputError
 
 if TYPE_CHECKING:
     import xarray as xr
