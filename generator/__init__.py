@@ -98,7 +98,8 @@ order; a stage imports only stages above it::
                     (each command imports its stages itself)
 
 Each folder's ``__init__`` holds its docstring only.  Beside the stages: ``errors`` (the
-one-line InputError) and ``display`` (Jupyter's LaTeX and HTML reprs), which import no stage.
+one-line InputError), ``limits`` (every bound, and the one integer-range check) and
+``display`` (Jupyter's LaTeX and HTML reprs), which import no stage.
 """
 
 __version__ = "0.1.0"

@@ -47,9 +47,9 @@ from .methods.references import (
     reference_q,
 )
 from .methods.registry import SIMPLEST_FIRST, Candidate, Method, candidates, method, methods_for
+from .methods.targets import Progress
 from .numerics.shooting import shoot
 
-Progress = Callable[[int, int], None]
 # NOTE: ``progress(done, total)`` lets the command line draw a bar over the long loops.
 
 

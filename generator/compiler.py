@@ -10,7 +10,6 @@ starts.
 from __future__ import annotations
 
 import shlex
-from collections.abc import Callable
 from functools import partial
 from pathlib import Path
 
@@ -29,11 +28,10 @@ from .methods.targets import (
     MU_DAMPED,
     SLOW_FLOW,
     TONGUE,
+    Progress,
     Request,
     Target,
 )
-
-Progress = Callable[[int, int], None]
 
 
 def compile_target(target: Target, request: Request, out: Path,

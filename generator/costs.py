@@ -17,15 +17,13 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 from .errors import InputError
-
-COST_LIMIT_SECONDS = 60.0
-# NOTE: above this estimate the CLI asks for --allow-slow instead of running for minutes or hours.
-GENERATE_MAX_ORDER = 130
-# NOTE: SymPy's printer recurses once per level of a Horner form: duffing at order 140 exceeds
-# Python's recursion limit (130 prints), so generate stops there, whatever --allow-slow says.
-DRIVEN_MAX_ORDER = 6
-# NOTE: the exact μ-expansion's rational functions grow fast: `generate driven` at order 6 takes
-# about 3 minutes, at 7 it would take about 20.
+from .limits import (
+    COST_LIMIT_SECONDS,
+    DRIVEN_MAX_ORDER,
+    GENERATE_MAX_ORDER,
+    PERIOD_SERIES_ORDER,
+    SLOW_FLOW_MAX_ORDER,
+)
 
 
 @dataclass(frozen=True)
@@ -370,15 +368,13 @@ def choose_cost(args: argparse.Namespace) -> Cost:
     fixed = FIXED_COSTS[f"choose {args.quantity}"]
     seconds = fixed
     if getattr(args, "model", None) is not None:  # its series to order 60, its quadrature
-        seconds += power_law(*SERIES_COSTS["oscillator"], CHOOSE_ORDER) + QUADRATURE_SECONDS
+        seconds += power_law(*SERIES_COSTS["oscillator"], PERIOD_SERIES_ORDER) + QUADRATURE_SECONDS
     if args.emit and args.quantity in ("amplitudes", "response"):
         mu, harmonics = emit_bounds(args.allow_slow, EMIT_MAX_HARMONICS, args.quantity)
         seconds += max(emission_seconds("driven", mu), emission_seconds("balance", harmonics))
     return Cost(seconds, f"choose {args.quantity}", "verifying the candidates")
 
 
-CHOOSE_ORDER = 60
-# NOTE: methods.MAX_ORDER, restated: `choose period EQUATION` derives its series that far.
 QUADRATURE_SECONDS = 2.0
 # NOTE: the quadrature reference on 401 points (0.7 s measured, 1.6 s under load).
 
@@ -441,10 +437,8 @@ SLOW_FLOW_FIT = (2.0, 0.95, 4, "2.2")
 
 
 def slow_flow_cost(args: argparse.Namespace) -> Cost:
-    from .derive.averaging import MAX_ORDER
-
-    # NOTE: beyond MAX_ORDER the derivation refuses at once (its own one-line message)
-    order = args.order if args.order <= MAX_ORDER else 0
+    # NOTE: beyond the bound the derivation refuses at once (its own one-line message)
+    order = args.order if args.order <= SLOW_FLOW_MAX_ORDER else 0
     return Cost(power_law(*SLOW_FLOW_FIT, order), f"order {args.order}", "the slow flow")
 
 

@@ -121,12 +121,10 @@ def test_force_in_series_is_the_old_spelling_of_allow_slow():
 def test_light_constants_match_the_stages():
     """The parser's choices are restated in cli (no SymPy at start-up): they must agree."""
     from lindstedt import choose
-    from lindstedt.analysis import driven
     from lindstedt.cli import common as cli
     from lindstedt.derive import models
 
     assert cli.FREE_MODELS == models.MODELS
-    assert cli.MAX_HARMONICS == driven.MAX_HARMONICS
     assert tuple(choose.SCENES) == cli.SCENE_NAMES
     assert cli.DRIVEN_QUANTITIES == choose.DRIVEN_QUANTITIES
 
@@ -172,7 +170,7 @@ def test_progress_bar_only_on_a_terminal_and_never_with_json(monkeypatch):
     for stream, enabled, drawn in ((Terminal(), True, True), (Terminal(), False, False),
                                    (io.StringIO(), True, False)):
         monkeypatch.setattr(sys, "stderr", stream)
-        bar = cli.Progress("work", enabled)
+        bar = cli.ProgressBar("work", enabled)
         for done in range(1, 5):
             bar(done, 4)
         bar.close()

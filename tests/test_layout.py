@@ -11,7 +11,7 @@ from pathlib import Path
 import lindstedt
 
 PACKAGE = Path(lindstedt.__file__).resolve().parent
-BESIDE = {"errors", "display"}
+BESIDE = {"errors", "limits", "display"}
 # NOTE: beside the stages (the docstring says so): they import no stage, and any stage may
 # import them.
 LIMIT = 1000

@@ -36,12 +36,7 @@ from ..algebra.series import (
 )
 from ..display import SHOWN_ROWS, harmonics_table, html_table
 from ..errors import InputError
-
-MAGNITUDES = (1e-16, 1e16)
-# NOTE: every nonzero |ε|, |f|, ω and finite Q lies in this window.  The closed-form cubic in
-# u = r² raises (1 − ω²)/ε to the sixth power, shooting cubes amplitudes up to fQ: within
-# 1e±16 every such combination stays inside double precision (1e±288), beyond it some overflow.
-# (Only εf² matters for the shape: q → λq maps ε, f to ελ², f/λ — rescale rather than widen.)
+from ..limits import MAGNITUDES, MAX_HARMONICS, MU_MAX_ORDER, check_int
 
 
 @dataclass(frozen=True)
@@ -369,8 +364,7 @@ JUDGED_FROM = 3
 def mu_expansion(d: Drive, branch: Branch, order: int) -> MuExpansion:
     """The μ-expansion (eq. 10.66–10.72) to ``order`` on ``branch``, numerically (float64),
     judged by the size of its terms up to ``max(order, 3)``."""
-    if isinstance(order, bool) or not isinstance(order, int) or not 0 <= order <= 200:
-        raise InputError(f"order {order!r}: must be an integer in 0..200")
+    check_int(order, 0, MU_MAX_ORDER, f"order {order!r}: must be an integer in 0..{MU_MAX_ORDER}")
     top = max(order, JUDGED_FROM)
     M = 2 * top + 5
     q = [laurent_cos(M, branch.A1)]
@@ -505,16 +499,12 @@ class BalanceSystem:
                              * self.coefficients(x))
 
 
-MAX_HARMONICS = 100
-# NOTE: the numerical balance's bound (200 unknowns, dense 200×200 Newton steps): the CLI's
-# --harmonics takes the same range in every command.
 
 
 def check_harmonics(harmonics: object) -> None:
     """:class:`InputError` unless ``harmonics`` is an integer in 1..MAX_HARMONICS."""
-    if isinstance(harmonics, bool) or not isinstance(harmonics, (int, np.integer)) \
-            or not 1 <= harmonics <= MAX_HARMONICS:
-        raise InputError(f"harmonics {harmonics!r}: must be an integer in 1..{MAX_HARMONICS}")
+    check_int(harmonics, 1, MAX_HARMONICS,
+              f"harmonics {harmonics!r}: must be an integer in 1..{MAX_HARMONICS}")
 
 
 def harmonic_balance(d: Drive, start: Branch | np.ndarray, harmonics: int, tol: float = 1e-13,

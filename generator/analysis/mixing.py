@@ -12,8 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+from ..limits import MAGNITUDES, MAX_DRIVES
 from ..numerics.integrate import ForceTable, ToneFit, steady_state_fit
-from .driven import MAGNITUDES
 from .polynomial import driven_form
 
 
@@ -55,12 +55,9 @@ def _power(x: dict, n: int, one: dict) -> dict:
     return out
 
 
-MAX_DRIVES = 4
 MIN_DRIVE_OMEGA = 2 * np.pi / 2000
 # NOTE: numerics.steady_state_fit fits the tones over a 2000-unit window: a drive must
 # complete a period in it (slower tones, which near-commensurate drives make, fit poorly).
-# NOTE: four drives make at most 228 tones to second order with a cubic force, fitted in ~3 s;
-# the count grows like (2k)^5 combinations before the equal frequencies merge.
 MAX_PRODUCTS = 20_000_000
 # NOTE: phasor products of the second order (|q₁| · |q₀|^(degree − 1) terms): a quintic force
 # with four drives stays under it (~1 s); a degree-9 force with four drives does not.

@@ -20,7 +20,7 @@ from ..algebra.series import (
     to_fourier,
     trig_power,
 )
-from ..errors import InputError
+from ..limits import MU_EXACT_MAX_ORDER, check_int
 
 # --- the first-order secular conditions, symbolically (display, tests) -----------------------
 
@@ -66,8 +66,8 @@ def mu_expansion_exact(order: int) -> tuple[MuOrder, ...]:
     ``j + 1`` the secular condition is affine in ``b_j``: ``s₀ + D b_j = 0`` with
     ``D = 1 − 1/ω² − 9εA₁²/(4ω²)``, which vanishes at a fold.
     """
-    if isinstance(order, bool) or not isinstance(order, int) or not 1 <= order <= 12:
-        raise InputError(f"order {order!r}: the exact μ-expansion takes 1..12")
+    check_int(order, 1, MU_EXACT_MAX_ORDER,
+              f"order {order!r}: the exact μ-expansion takes 1..{MU_EXACT_MAX_ORDER}")
     ground = Ground(QQ.frac_field(A1_, omega_, eps_))
     basis = Basis(odd=True)
     lin = ground.scalar(1 - 1 / omega_**2)
@@ -189,8 +189,8 @@ def mu_expansion_damped(order: int) -> tuple[MuDampedOrder, ...]:
     gcds).  Convention: ``q_j`` (``j ≥ 1``) has no ``sin τ`` component (that is ``δ_j``'s) and
     its ``cos τ`` component is ``b_j``; at ``γ = 0`` these are :func:`mu_expansion_exact`'s
     orders."""
-    if isinstance(order, bool) or not isinstance(order, int) or not 1 <= order <= 12:
-        raise InputError(f"order {order!r}: the exact damped μ-expansion takes 1..12")
+    check_int(order, 1, MU_EXACT_MAX_ORDER,
+              f"order {order!r}: the exact damped μ-expansion takes 1..{MU_EXACT_MAX_ORDER}")
     ground = Ground(QQ.poly_ring(x_, a_, gamma_))
     s = ground.scalar
     zero, one = s(0), s(1)
@@ -297,8 +297,8 @@ class BalanceEquations:
 
 def balance_equations(harmonics: int) -> BalanceEquations:
     """``−(kω)² q_k + kω/Q q̃_k + q_k + ε[q³]_k − f δ_k1`` for every odd ``k ≤ 2N − 1``."""
-    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 12:
-        raise InputError(f"harmonics {harmonics!r}: the symbolic balance takes 1..12")
+    check_int(harmonics, 1, MU_EXACT_MAX_ORDER,
+              f"harmonics {harmonics!r}: the symbolic balance takes 1..{MU_EXACT_MAX_ORDER}")
     odd = range(1, 2 * harmonics, 2)
     a = [sp.Symbol(f"a_{k}") for k in odd]
     b = [sp.Symbol(f"b_{k}") for k in odd]

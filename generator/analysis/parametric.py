@@ -38,10 +38,10 @@ import sympy as sp
 
 from ..algebra.series import trig_power
 from ..errors import InputError
+from ..limits import MAGNITUDES
 from ..numerics.floquet import multipliers_stable, orbit_hill_multipliers
 from ..numerics.integrate import ForceTable
 from ..numerics.shooting import PeriodicOrbit, shoot_table
-from .driven import MAGNITUDES
 from .polynomial import PolynomialBalance
 
 _a, _b, _w, _e, _z, _g = sp.symbols("a b omega epsilon zeta gamma")

@@ -12,7 +12,8 @@ import numpy as np
 import sympy as sp
 
 from ..errors import InputError
-from .driven import MAGNITUDES, check_harmonics
+from ..limits import MAGNITUDES
+from .driven import check_harmonics
 
 # --- a user's driven oscillator: q'' + g(q, q') = f cos(w t), g a polynomial -----------------
 

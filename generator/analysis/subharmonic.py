@@ -19,6 +19,8 @@ import sympy as sp
 
 from ..algebra.series import trig_power
 from ..errors import InputError
+from ..limits import SUBHARMONIC_MAX_N as MAX_N
+from ..limits import check_int
 from ..numerics.floquet import hill_multipliers, multipliers_stable, orbit_hill_multipliers
 from ..numerics.integrate import ForceTable, duffing_table, steady_state_amplitudes
 from ..numerics.shooting import PeriodicOrbit, shoot, shoot_table
@@ -192,16 +194,12 @@ def subharmonic_equation(text: str, values: dict[str, str], omega: float | None,
 
 # --- any polynomial force, any n: balance, shooting, onset ------------------------------------
 
-MAX_N = 12
-# NOTE: the 1/n orbit spans n drive periods; at n = 12 shooting integrates 12 periods with
-# 4096 RK4 steps each and the balance carries harmonics up to 2n + 1 of ω.
 
 
 def check_n(n: object) -> None:
     """``n`` an integer in 2..MAX_N (1 is the drive's own period: ``response``)."""
-    if isinstance(n, bool) or not isinstance(n, int) or not 2 <= n <= MAX_N:
-        raise InputError(f"--n {n!r}: the subharmonic's order must be an integer in 2..{MAX_N} "
-                         "(the orbit of n drive periods; n = 1 is `lindstedt response`)")
+    check_int(n, 2, MAX_N, f"--n {n!r}: the subharmonic's order must be an integer in 2..{MAX_N} "
+              "(the orbit of n drive periods; n = 1 is `lindstedt response`)")
 
 
 def check_coupling(terms: dict[tuple[int, int], float], n: int, where: str = "") -> None:

@@ -13,8 +13,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from .. import __version__
-from ..costs import COST_LIMIT_SECONDS, COSTS
+from ..costs import COSTS
 from ..errors import InputError
+from ..limits import COST_LIMIT_SECONDS
 from .choose import (
     arguments_choose,
     arguments_clock,

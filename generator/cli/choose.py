@@ -15,7 +15,7 @@ from ..errors import InputError
 from .common import (
     DRIVEN_QUANTITIES,
     SCENE_NAMES,
-    Progress,
+    ProgressBar,
     _flag_allow_slow,
     _flag_drive,
     _flag_equation,
@@ -93,7 +93,7 @@ def run_choose(args: argparse.Namespace) -> int:
     if args.emit:
         check_writable(_out_folder(args.emit, "--emit"), ["chosen_period.py"], "--emit",
                        args.overwrite_edited)
-    progress = Progress("timing the verified methods", not args.json)
+    progress = ProgressBar("timing the verified methods", not args.json)
     choice = choose_period(args.tol, args.x_min, args.x_max, progress, model=model)
     progress.close()
     variable = "x = eps*A**2" if model is None else model.variable
@@ -213,7 +213,7 @@ def _choose_q(args: argparse.Namespace) -> int:
     if args.emit:
         check_writable(_out_folder(args.emit, "--emit"), ["duffing.py", "duffing_tables.tex",
                                          "duffing_derivation.tex", "fourier.py"], "--emit")
-    progress = Progress("verifying the L–P orders", not args.json)
+    progress = ProgressBar("verifying the L–P orders", not args.json)
     c = choose_solution(args.tol, args.x_min, args.x_max, args.t_max,
                         emittable=bool(args.emit), progress=progress)
     progress.close()
@@ -261,7 +261,7 @@ def _choose_driven(args: argparse.Namespace) -> int:
         check_writable(_out_folder(args.emit, "--emit"),
                        ["driven.py", "driven_derivation.tex", "balance.py", "driven_damped.py",
                         "driven_damped_derivation.tex"], "--emit")
-    progress = Progress("shooting the true orbits", not args.json)
+    progress = ProgressBar("shooting the true orbits", not args.json)
     c = choose_driven(args.quantity, tol, args.eps, args.force, args.Q, lo, hi,
                       emit=(emit_bounds(args.allow_slow, DRIVEN_MAX, args.quantity)
                             if args.emit else None),

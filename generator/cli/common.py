@@ -14,8 +14,8 @@ from collections.abc import Sequence
 from fractions import Fraction
 from pathlib import Path
 
-from ..costs import COST_LIMIT_SECONDS
 from ..errors import InputError
+from ..limits import COST_LIMIT_SECONDS, MAX_HARMONICS
 
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
 # well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
@@ -43,16 +43,11 @@ DEFAULT_ORDER = 4
 DEFAULT_HARMONICS = 8
 # NOTE: one default for every --harmonics: 8 odd harmonics put the response's folds on the true
 # orbit's to 12 digits at the notes' parameters (`generate balance` compiles them in ~20 s).
-MAX_HARMONICS = 100
-# NOTE: driven.MAX_HARMONICS, restated (a test keeps them equal): one bound for every
-# --harmonics.  The numerical balance and shooting's sampling take up to 100; the emitted
-# modules stop earlier (balance 12, fourier 60) and say so; the response's continuation
-# refuses what it estimates at over a minute.
 PROGRESS_AFTER_SECONDS = 2.0
 # NOTE: work shorter than this shows no progress bar (it would only flicker).
 
 
-class Progress:
+class ProgressBar:
     """A one-line progress bar on stderr, drawn only when stderr is a terminal and the output is
     not JSON, and only once the work has taken ``PROGRESS_AFTER_SECONDS``; call it as
     ``progress(done, total)``, then ``progress.close()``."""

@@ -8,8 +8,8 @@ import json
 import math
 from pathlib import Path
 
-from ..costs import COST_LIMIT_SECONDS
 from ..errors import InputError
+from ..limits import COST_LIMIT_SECONDS
 
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
 # well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.

@@ -10,14 +10,14 @@ import sys
 from fractions import Fraction
 from pathlib import Path
 
-from ..costs import DRIVEN_MAX_ORDER
 from ..errors import InputError
+from ..limits import DRIVEN_MAX_ORDER
 
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
 # well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
 from .common import (
     EMITTED,
-    Progress,
+    ProgressBar,
     _flag_allow_slow,
     _flag_harmonics,
     _flag_json,
@@ -231,7 +231,7 @@ def run_series(args: argparse.Namespace) -> int:
         text = "\n\n".join(texts)
     else:
         model = found  # series_model built it (model_from_text): parse and expand once
-        progress = Progress(f"deriving {model.name} to order {args.order}", not args.json)
+        progress = ProgressBar(f"deriving {model.name} to order {args.order}", not args.json)
         sol = derive(model, args.order, progress)
         progress.close()
         data = series_json(sol)
@@ -550,7 +550,7 @@ def run_generate(args: argparse.Namespace) -> int:
             raise InputError(f"--resum-order: {model.name} has no limit cycle; only a limit "
                              "cycle's frequency is resummed from a longer series")
         check_emitted_names(model)  # before the derivation: a clash is known at once
-        progress = Progress(f"deriving {model.name} to order {order + 2}")
+        progress = ProgressBar(f"deriving {model.name} to order {order + 2}")
         paths = compiler.generate(model, order, out, args.allow_divergent, progress,
                                   overwrite_edited=args.overwrite_edited)
         progress.close()

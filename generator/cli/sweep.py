@@ -9,12 +9,13 @@ from fractions import Fraction
 from pathlib import Path
 
 from ..errors import InputError
+from ..limits import SWEEP_MAX_VALUES
 
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
 # well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
 from .common import (
     SWEEP_KINDS,
-    Progress,
+    ProgressBar,
     _flag_allow_slow,
     _flag_json,
     _flag_plot,
@@ -50,7 +51,7 @@ def run_sweep(args: argparse.Namespace) -> int:
             raise InputError("--axis/--param/--name/--n: give an equation (EQUATION) to take "
                              "them; the notes' map takes --omega, --force, --eps, --Q")
         axes = builtin
-    bar = Progress(f"sweep {args.kind}", not args.json)
+    bar = ProgressBar(f"sweep {args.kind}", not args.json)
     ds = run_sweep(kind, axes, _out_folder(args.store, "--store"), args.scheduler,
                    args.workers, args.chunk, lambda p: bar(p.finished, p.total))
     bar.close()
@@ -80,9 +81,6 @@ def run_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
-SWEEP_MAX_VALUES = 100_000
-# NOTE: values per axis: a bound against typos in A:B:N; the store's size is checked against
-# the free disk before any work.
 
 
 def _axis_values(text: str) -> list[float]:

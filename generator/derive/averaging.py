@@ -41,11 +41,10 @@ from sympy.polys.domains import QQ
 
 from ..algebra.series import Ground, MPoly, Trig
 from ..errors import InputError
+from ..limits import SLOW_FLOW_MAX_ORDER as MAX_ORDER
+from ..limits import check_int
 from .models import Oscillator
 
-MAX_ORDER = 6
-# NOTE: order 6 of van der Pol takes about half a second, the driven Duffing's order 4 one;
-# each order costs 2–4× the one before (docs/benchmarks.md, "The slow flow").
 U, V = sp.Symbol("_u"), sp.Symbol("_v")  # van der Pol's variables ("_": no user name clashes)
 R, PHI = sp.Symbol("r", positive=True), sp.Symbol("phi")
 SIGMA = sp.Symbol("sigma")  # the detuning of a drive, ω = 1 + ε σ
@@ -86,8 +85,8 @@ class SlowFlow:
 def slow_flow(osc: Oscillator, order: int) -> SlowFlow:
     """The slow flow of ``osc`` (``q'' + q = eps*f(q, q')``, optionally ``+ eps*F*cos(w*t)``) to
     order ``order``, or a one-line :class:`InputError` naming what does not fit."""
-    if isinstance(order, bool) or not isinstance(order, int) or not 1 <= order <= MAX_ORDER:
-        raise InputError(f"order {order!r}: the slow flow is derived to orders 1 … {MAX_ORDER}")
+    check_int(order, 1, MAX_ORDER,
+              f"order {order!r}: the slow flow is derived to orders 1 … {MAX_ORDER}")
     g, params, driven = _right_side(osc, order)
     symbols = (U, V, *params)
     ground = _ground(symbols)

@@ -21,12 +21,12 @@ import sympy as sp
 from flint import fmpq, fmpq_poly, fmpq_series
 
 from ..errors import InputError
+from ..limits import HILL_MAX_INDEX as MAX_M
+from ..limits import check_int
 from .equation import TIME, parse_expression
 from .models import check_order
 
 KINDS = ("a", "b")
-MAX_M = 100
-# NOTE: m indexes the tongue δ = m²/4 of ẍ + (δ + ε cos t)x = 0; far above any use.
 
 
 def mathieu_series(kind: str, m: int, order: int) -> list[Fraction]:
@@ -34,11 +34,9 @@ def mathieu_series(kind: str, m: int, order: int) -> list[Fraction]:
     m ≥ 1) ``= Σ c_k q^k``, DLMF's normalisation ``y'' + (a − 2q cos 2z) y = 0``."""
     if kind not in KINDS:
         raise InputError(f"kind {kind!r}: a (even solutions ce_m) or b (odd, se_m)")
-    if isinstance(m, bool) or not isinstance(m, int) or not (0 if kind == "a" else 1) <= m \
-            <= MAX_M:
-        lowest = 0 if kind == "a" else 1
-        raise InputError(f"--m {m!r}: an integer {lowest}..{MAX_M} for {kind}_m (b_0 does not "
-                         "exist)" if kind == "b" else f"--m {m!r}: an integer 0..{MAX_M}")
+    check_int(m, 0 if kind == "a" else 1, MAX_M,
+              f"--m {m!r}: an integer 1..{MAX_M} for b_m (b_0 does not exist)" if kind == "b"
+              else f"--m {m!r}: an integer 0..{MAX_M}")
     order = check_order(order)
     # NOTE: y(z) = x(t) with t = 2z: ẍ + (δ + ε cos t)x = 0 with δ = a/4, ε = −q/2 — the named
     # case of transition_curves: cos mz ↔ its first curve, sin mz ↔ its second.
@@ -188,8 +186,7 @@ def transition_curves(p: Harmonics | str, n: int, order: int) -> Tongue:
     higher order."""
     if isinstance(p, str):
         p = fourier_of_text(p)
-    if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= MAX_M:
-        raise InputError(f"--n {n!r}: the tongue index, an integer 0..{MAX_M} (δ = n²/4)")
+    check_int(n, 0, MAX_M, f"--n {n!r}: the tongue index, an integer 0..{MAX_M} (δ = n²/4)")
     order = check_order(order)
     shift = next((s for s in (0, 1) if all(b == 0 for _, b in _shifted(p, s).values())), None)
     q = _shifted(p, shift or 0)
@@ -336,8 +333,7 @@ def tongue_tip(p: Harmonics | str, n: int, order: int) -> TongueTip:
     ``w``-part of ``φ_(k−1)``.  Then ``ε_min(ζ)`` is the reversion of ``ζ = μ̃(ε)/2``."""
     if isinstance(p, str):
         p = fourier_of_text(p)
-    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_M:
-        raise InputError(f"--n {n!r}: the damped tongue's index, an integer 1..{MAX_M}")
+    check_int(n, 1, MAX_M, f"--n {n!r}: the damped tongue's index, an integer 1..{MAX_M}")
     wanted = check_order(order)
     order = max(wanted, 1)  # ζ = μ̃(ε)/2 starts at ε¹: its reversion needs that term
     shift = next((s for s in (0, 1) if all(b == 0 for _, b in _shifted(p, s).values())), None)

@@ -23,6 +23,7 @@ import sympy as sp
 from sympy.polys.domains import QQ
 
 from ..errors import InputError
+from ..limits import SERIES_MAX_ORDER, check_int
 from .equation import SMALL, Equation, parse_equation, parse_expression
 
 t, eps, A, theta0 = sp.symbols("t epsilon A theta_0")
@@ -133,8 +134,7 @@ def polynomial(coefficients: dict[int, object]) -> Model:
         raise InputError("polynomial force: give at least one power n ≥ 2 with its coefficient")
     terms = []
     for n, c in sorted(coefficients.items()):
-        if isinstance(n, bool) or not isinstance(n, int) or n < 2:
-            raise InputError(f"polynomial force: power {n!r} is not an integer ≥ 2")
+        check_int(n, 2, None, f"polynomial force: power {n!r} is not an integer ≥ 2")
         value = _finite(c, f"coefficient of q^{n}")
         if value != 0:
             terms.append((n, value))
@@ -601,8 +601,6 @@ def model_from_text(text: str, order: int, values: dict[str, str] | None = None,
     return free_model(oscillator(text, values, name or "oscillator"), order)
 
 
-MAX_ORDER = 100_000
-# NOTE: a hard sanity bound only; the CLI asks for --allow-slow far below it (cost estimate).
 
 
 def check_order(order: object) -> int:
@@ -611,8 +609,8 @@ def check_order(order: object) -> int:
         raise InputError(f"order {order!r}: not an integer")
     if order < 0:
         raise InputError(f"order {order}: must be ≥ 0")
-    if order > MAX_ORDER:
-        raise InputError(f"order {order}: above the limit {MAX_ORDER}")
+    if order > SERIES_MAX_ORDER:
+        raise InputError(f"order {order}: above the limit {SERIES_MAX_ORDER}")
     return order
 
 

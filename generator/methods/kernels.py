@@ -29,8 +29,6 @@ if TYPE_CHECKING:
 Coefficients = tuple[np.ndarray, np.ndarray]
 _m = sp.Symbol("m")  # the resummed variable of the lowered period forms
 
-MAX_ORDER = 60
-# NOTE: order 60 of the exact series takes ~0.1 s and reaches 1e-16 wherever |x| ≤ 0.5.
 AGM_STEPS = 8
 # NOTE: each AGM step squares the relative gap of a and b: 3 steps reach 1e-16 for all
 # x ∈ [−0.5, 10³]; 6 reach it down to x = −1 + 1e-12, next to the separatrix.

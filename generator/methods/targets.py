@@ -27,6 +27,7 @@ from ..derive.cycles import derive_limit_cycle
 from ..derive.lindstedt import derive
 from ..derive.models import Model, SelfExcited
 from ..errors import InputError
+from ..limits import FOURIER_MAX_HARMONICS, check_int
 from ..lower.documents import (
     lower_choice,
     lower_cycle_derivation,
@@ -50,6 +51,8 @@ if TYPE_CHECKING:
 
 
 Progress = Callable[[int, int], None]
+# NOTE: the one progress callback (done, total) every long derivation takes; the command line
+# draws it (cli.common.ProgressBar).
 
 # --- emission: what `generate` derives and lowers ------------------------------------------------
 
@@ -205,9 +208,8 @@ def _balance_lower(eqs: object, r: Request) -> Unit:
 
 def _fourier_derive(r: Request, progress: Progress | None) -> object:
     harmonics = r.order
-    if isinstance(harmonics, bool) or not isinstance(harmonics, int) or not 1 <= harmonics <= 60:
-        raise InputError(f"harmonics {harmonics!r}: must be an integer in 1..60")
-    return harmonics  # closed form: nothing to derive but the count
+    return check_int(harmonics, 1, FOURIER_MAX_HARMONICS,
+                     f"harmonics {harmonics!r}: must be an integer in 1..{FOURIER_MAX_HARMONICS}")
 
 
 def _fourier_lower(harmonics: object, r: Request) -> Unit:

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..display import harmonics_table
 from ..errors import InputError
+from ..limits import check_int
 from .floquet import multipliers_stable
 from .integrate import (
     NO_TERMS,
@@ -52,9 +53,7 @@ SAMPLES = 64
 def _samples(harmonics: int, steps: int) -> int:
     """Samples of q per orbit that resolve ``harmonics`` (FFT bins 0..samples/2) and divide
     ``steps``; :class:`InputError` when the steps cannot carry that many."""
-    if isinstance(harmonics, bool) or not isinstance(harmonics, (int, np.integer)) \
-            or harmonics < 1:
-        raise InputError(f"harmonics {harmonics!r}: must be an integer ≥ 1")
+    check_int(harmonics, 1, None, f"harmonics {harmonics!r}: must be an integer ≥ 1")
     samples = SAMPLES
     while samples // 2 <= harmonics:
         samples *= 2

@@ -35,6 +35,7 @@ import numpy as np
 
 from ..analysis.driven import Drive
 from ..errors import InputError
+from ..limits import MAX_WORKERS, check_int
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -155,8 +156,7 @@ def make_grid(kind: str | Kind, axes: Mapping[str, Sequence[float]],
             if a in kind.positive and not np.all(v > 0):
                 raise InputError(f"axis {a}: the drive frequency must be > 0")
     points = kind.points_per_chunk if chunk is None else chunk
-    if isinstance(points, bool) or not isinstance(points, int) or points < 1:
-        raise InputError(f"chunk {chunk!r}: must be a whole number of points >= 1")
+    check_int(points, 1, None, f"chunk {chunk!r}: must be a whole number of points >= 1")
     return Grid(kind, values, block_shape([v.size for v in values], points))
 
 
@@ -363,7 +363,7 @@ def open_sweep(store: Path | str) -> xr.Dataset:
 # --- running ------------------------------------------------------------------------------------
 
 @dataclass(frozen=True)
-class Progress:
+class SweepProgress:
     """Reported after each block is written: which, and how many of all are done."""
 
     chunk: int
@@ -375,8 +375,6 @@ class Progress:
 SCHEDULER_TIMEOUT = 4.0
 # NOTE: a live scheduler answers a TCP connect in milliseconds and the handshake in well under
 # a second; two such waits (connect, then the client's handshake) stay inside 10 s.
-MAX_WORKERS = 64
-# NOTE: a bound against typos (workers=1000 on a laptop), far above this machine's 2 cores.
 
 
 def _first_line(e: BaseException) -> str:
@@ -476,7 +474,7 @@ def _connect(scheduler: str | None, workers: int, stack: contextlib.ExitStack) -
 
 def run_sweep(kind: str | Kind, axes: Mapping[str, Sequence[float]], store: Path | str,
               scheduler: str | None = None, workers: int = 2, chunk: int | None = None,
-              progress: Callable[[Progress], None] | None = None,
+              progress: Callable[[SweepProgress], None] | None = None,
               stop_after: int | None = None) -> xr.Dataset:
     """Map ``kind`` over the grid ``axes`` on dask.distributed into the Zarr store ``store``.
 
@@ -493,12 +491,11 @@ def run_sweep(kind: str | Kind, axes: Mapping[str, Sequence[float]], store: Path
     not answer (within ~2 × :data:`SCHEDULER_TIMEOUT`). Returns :func:`open_sweep` of the store.
     """
     grid = make_grid(kind, axes, chunk)
-    if scheduler is None and (isinstance(workers, bool) or not isinstance(workers, int)
-                              or not 1 <= workers <= MAX_WORKERS):
-        raise InputError(f"workers {workers!r}: must be a whole number in 1..{MAX_WORKERS}")
-    if stop_after is not None and (isinstance(stop_after, bool)
-                                   or not isinstance(stop_after, int) or stop_after < 0):
-        raise InputError(f"stop_after {stop_after!r}: must be a whole number >= 0")
+    if scheduler is None:
+        check_int(workers, 1, MAX_WORKERS,
+                  f"workers {workers!r}: must be a whole number in 1..{MAX_WORKERS}")
+    if stop_after is not None:
+        check_int(stop_after, 0, None, f"stop_after {stop_after!r}: must be a whole number >= 0")
     if chunk is None:  # resuming without chunk: the store's blocks
         grid = _adopt_block(Path(store), grid)
     state = check_store(store, grid)
@@ -530,7 +527,7 @@ def _initialise(path: Path, grid: Grid) -> xr.Dataset:
 
 
 def _gather(client: object, grid: Grid, path: Path, todo: list[int], finished: int,
-            progress: Callable[[Progress], None] | None) -> None:
+            progress: Callable[[SweepProgress], None] | None) -> None:
     """Keep every worker busy with one block running and one queued; write each block (then
     its flag) as it arrives; cancel what is left if stopped early or on an error."""
     from distributed import as_completed
@@ -557,7 +554,7 @@ def _gather(client: object, grid: Grid, path: Path, todo: list[int], finished: i
             _mark_done(arrays, chunk)
             finished += 1
             if progress is not None:
-                progress(Progress(chunk, finished, grid.chunks, time.perf_counter() - start))
+                progress(SweepProgress(chunk, finished, grid.chunks, time.perf_counter() - start))
             following = next(queue, None)
             if following is not None:
                 running.add(submit(following))
@@ -567,7 +564,7 @@ def _gather(client: object, grid: Grid, path: Path, todo: list[int], finished: i
 
 
 def serial_sweep(kind: str | Kind, axes: Mapping[str, Sequence[float]], chunk: int | None = None,
-                 progress: Callable[[Progress], None] | None = None) -> xr.Dataset:
+                 progress: Callable[[SweepProgress], None] | None = None) -> xr.Dataset:
     """The same map in this process, block by block, no dask and no store: the reference of
     :func:`run_sweep` (value for value) and its one-core baseline."""
     grid = make_grid(kind, axes, chunk)
@@ -580,5 +577,5 @@ def serial_sweep(kind: str | Kind, axes: Mapping[str, Sequence[float]], chunk: i
         for name, values in block.items():
             data[name][grid.region(c)] = values
         if progress is not None:
-            progress(Progress(c, c + 1, grid.chunks, time.perf_counter() - start))
+            progress(SweepProgress(c, c + 1, grid.chunks, time.perf_counter() - start))
     return _dataset(grid, data, np.ones(grid.chunks, dtype=bool))

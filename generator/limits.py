@@ -1,0 +1,79 @@
+"""Every bound of the package, in one place, and the one integer-range check.
+
+It imports nothing of the package (and nothing heavy): the command line reads these bounds
+while it parses its arguments, before SymPy or numba is loaded."""
+
+from __future__ import annotations
+
+from .errors import InputError
+
+# --- orders ---------------------------------------------------------------------------------
+
+SERIES_MAX_ORDER = 100_000
+# NOTE: a hard sanity bound on any L–P order only; the CLI asks for --allow-slow far below it
+# (cost estimate).
+GENERATE_MAX_ORDER = 130
+# NOTE: SymPy's printer recurses once per level of a Horner form: duffing at order 140 exceeds
+# Python's recursion limit (130 prints), so generate stops there, whatever --allow-slow says.
+PERIOD_SERIES_ORDER = 60
+# NOTE: the order of the exact series every period method of `choose period` is built from:
+# order 60 takes ~0.1 s and reaches 1e-16 wherever |x| ≤ 0.5.
+SLOW_FLOW_MAX_ORDER = 6
+# NOTE: the slow flow (averaging): order 6 of van der Pol takes about half a second, the driven
+# Duffing's order 4 one; each order costs 2–4× the one before (docs/benchmarks.md, "The slow
+# flow").
+DRIVEN_MAX_ORDER = 6
+# NOTE: the exact μ-expansion's rational functions grow fast: `generate driven` at order 6 takes
+# about 3 minutes, at 7 it would take about 20.
+MU_EXACT_MAX_ORDER = 12
+# NOTE: the exact μ-expansion (undamped, damped) and the symbolic balance take 1..12.
+MU_MAX_ORDER = 200
+# NOTE: the numeric μ-expansion at one ω: far above where it stops converging.
+HILL_MAX_INDEX = 100
+# NOTE: m indexes the tongue δ = m²/4 of ẍ + (δ + ε cos t)x = 0; far above any use.
+
+# --- harmonics, drives, subharmonics --------------------------------------------------------
+
+MAX_HARMONICS = 100
+# NOTE: one bound for every --harmonics.  The numerical balance (200 unknowns, dense 200×200
+# Newton steps) and shooting's sampling take up to 100; the emitted modules stop earlier
+# (balance 12, fourier 60) and say so; the response's continuation refuses what it estimates
+# at over a minute.
+FOURIER_MAX_HARMONICS = 60
+# NOTE: the emitted Fourier (AGM) evaluator of cn: 60 terms of the nome series.
+MAX_DRIVES = 4
+# NOTE: four drives make at most 228 tones to second order with a cubic force, fitted in ~3 s;
+# the count grows like (2k)^5 combinations before the equal frequencies merge.
+SUBHARMONIC_MAX_N = 12
+# NOTE: the 1/n orbit spans n drive periods; at n = 12 shooting integrates 12 periods with
+# 4096 RK4 steps each and the balance carries harmonics up to 2n + 1 of ω.
+MAGNITUDES = (1e-16, 1e16)
+# NOTE: every nonzero |ε|, |f|, ω and finite Q lies in this window.  The closed-form cubic in
+# u = r² raises (1 − ω²)/ε to the sixth power, shooting cubes amplitudes up to fQ: within
+# 1e±16 every such combination stays inside double precision (1e±288), beyond it some overflow.
+# (Only εf² matters for the shape: q → λq maps ε, f to ελ², f/λ — rescale rather than widen.)
+
+# --- work -------------------------------------------------------------------------------------
+
+COST_LIMIT_SECONDS = 60.0
+# NOTE: above this estimate the CLI asks for --allow-slow instead of running for minutes or hours.
+MAX_WORKERS = 64
+# NOTE: a bound against typos (workers=1000 on a laptop), far above this machine's 2 cores.
+SWEEP_MAX_VALUES = 100_000
+# NOTE: values per sweep axis: a bound against typos in A:B:N; the store's size is checked
+# against the free disk before any work.
+
+
+def check_int(value: object, lo: int, hi: int | None = None, message: str | None = None
+              ) -> int:
+    """``value`` when it is an integer (``bool`` is not) in ``lo..hi`` (no upper bound for
+    ``hi = None``); else :class:`InputError` with ``message`` (default: ``"{value!r}: must be
+    an integer in lo..hi"``)."""
+    import numbers
+
+    ok = (not isinstance(value, bool) and isinstance(value, numbers.Integral)
+          and lo <= value and (hi is None or value <= hi))
+    if not ok:
+        bound = f"an integer ≥ {lo}" if hi is None else f"an integer in {lo}..{hi}"
+        raise InputError(message or f"{value!r}: must be {bound}")
+    return int(value)
