@@ -26,6 +26,7 @@ order; a stage imports only stages above it::
                     exact (R_k, Φ_k of dr/dt, dφ/dt)
     numerics.integrate  the one integrator: RK4 of any polynomial  ForceTable -> flows
                     force table, compiled; flows, sweeps with their jumps, simulations
+    numerics.newton  the one Newton's method for R(x) = 0          R, J, x -> root
     numerics.floquet  Floquet multipliers: Hill about q₀, a damped  orbit -> multipliers
                     pump over a grid, the full Hill equation, the verdict
     numerics.shooting  periodic orbits by Newton on the flow map,  guess -> PeriodicOrbit

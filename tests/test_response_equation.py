@@ -100,9 +100,9 @@ def test_folds_of_an_asymmetric_spring_against_the_reference():
     for moduli in data["numerical"]["fold_floquet_moduli"]:
         assert abs(max(moduli) - 1) < 1e-8 and min(moduli) < 1
     for w in true:  # the reference's fold from the package's fold orbit, moved off it
-        from lindstedt.analysis.periodic import orbit_fold_table
         from lindstedt.analysis.polynomial import driven_equation
         from lindstedt.numerics.integrate import ForceTable
+        from lindstedt.numerics.shooting import orbit_fold_table
 
         de = driven_equation(ASYMMETRIC, {}, 1.0)
         _, y0, _ = orbit_fold_table(ForceTable.of(de.terms), de.force, w, _fold_state(data, w))

@@ -118,15 +118,6 @@ def _continue(sysm: BalanceSystem | PolynomialBalance, end_solutions, omega_star
     return Continuation(arr[:, -1], arr[:, :-1], sorted(folds), tuple(starts), complete)
 
 
-def _newton_fixed_omega(sysm: BalanceSystem, x: np.ndarray, omega: float) -> np.ndarray:
-    for _ in range(50):
-        dx = np.linalg.solve(sysm.jacobian(x, omega), -sysm.residual(x, omega))
-        x = x + dx
-        if np.max(np.abs(dx)) < 1e-14 * (1 + np.max(np.abs(x))):
-            break
-    return x
-
-
 def _extended_jacobian(sysm: BalanceSystem, y: np.ndarray) -> np.ndarray:
     x, omega = y[:-1], y[-1]
     return np.column_stack([sysm.jacobian(x, omega), sysm.d_omega(x, omega)])

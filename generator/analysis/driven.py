@@ -37,6 +37,7 @@ from ..algebra.series import (
 from ..display import SHOWN_ROWS, harmonics_table, html_table
 from ..errors import InputError
 from ..limits import MAGNITUDES, MAX_HARMONICS, MU_MAX_ORDER, check_int
+from ..numerics.newton import newton
 
 
 @dataclass(frozen=True)
@@ -522,19 +523,6 @@ def harmonic_balance(d: Drive, start: Branch | np.ndarray, harmonics: int, tol: 
         given = np.asarray(start, dtype=float)
         k = min(len(given) // 2, harmonics)
         x[:k], x[harmonics : harmonics + k] = given[:k], given[len(given) // 2 :][:k]
-    converged = False
-    with np.errstate(over="ignore", invalid="ignore"):
-        for _ in range(max_iter):
-            try:
-                step = np.linalg.solve(system.jacobian(x, d.omega),
-                                       -system.residual(x, d.omega))
-            except np.linalg.LinAlgError:  # a singular Jacobian: a fold, Newton cannot go on
-                break
-            if not np.all(np.isfinite(step)):  # Newton diverged (overflow)
-                break
-            x = x + step
-            if np.max(np.abs(step)) <= tol * (1 + np.max(np.abs(x))):
-                converged = True
-                break
-        residual = float(np.max(np.abs(system.residual(x, d.omega))))
+    x, converged, residual = newton(lambda z: system.residual(z, d.omega),
+                                    lambda z: system.jacobian(z, d.omega), x, tol, max_iter)
     return HarmonicBalance(harmonics, system.coefficients(x), residual, converged)

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from ..numerics.integrate import ForceTable, flow_table
+from ..numerics.integrate import ForceTable
 from ..numerics.shooting import PeriodicOrbit, ShootingFailure, shoot_explained, shoot_table
 from .continuation import (
     CONTINUATION_BUDGET,
@@ -377,37 +377,3 @@ def equation_orbits(de: DrivenEquation, harmonics: int = 8,
     found.sort(key=lambda o: -(o.r if o.orbit is not None else _balance_r(fine, o.balance)))
     note = curve.note + f"; {len(seeds)} crossings of the drive amplitude"
     return EquationOrbits(tuple(found), fine, curve.complete, note, len(seeds))
-
-
-def orbit_fold_table(table: ForceTable, force: float, omega: float, y0: np.ndarray,
-                     tol: float = 1e-11) -> tuple[float, np.ndarray, np.ndarray] | None:
-    """:func:`numerics.orbit_fold` for ``q̈ + g(q, q̇) = f cos ωt`` (``g`` the table): the true
-    orbit with a Floquet multiplier ``+1`` by Newton's method in ``(y₀, ω)`` on
-    ``(φ_T(y₀) − y₀, det(M − I))``; ``(ω, y₀, multipliers)`` or ``None``."""
-    def F(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        end, _, _ = flow_table(table, force, z[2], z[:2], 2 * np.pi / z[2], samples=1)
-        mono = end[2:].reshape(2, 2).T
-        return np.array([*(end[:2] - z[:2]), np.linalg.det(mono - np.eye(2))]), mono
-
-    z = np.array([*y0, omega], dtype=float)
-    with np.errstate(over="ignore", invalid="ignore"):
-        for _ in range(30):
-            if not z[2] > 0:
-                return None
-            f0, _ = F(z)
-            J = np.empty((3, 3))
-            for k in range(3):
-                e = np.zeros(3)
-                e[k] = 1e-7 * (1 + abs(z[k]))
-                J[:, k] = (F(z + e)[0] - F(z - e)[0]) / (2 * e[k])
-            if not (np.all(np.isfinite(J)) and np.all(np.isfinite(f0))):
-                return None
-            try:
-                dz = np.linalg.solve(J, -f0)
-            except np.linalg.LinAlgError:
-                return None
-            z = z + dz
-            if np.max(np.abs(dz)) < tol * (1 + np.max(np.abs(z))):
-                _, mono = F(z)
-                return float(z[2]), z[:2], np.linalg.eigvals(mono)
-    return None

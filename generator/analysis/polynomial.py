@@ -13,6 +13,7 @@ import sympy as sp
 
 from ..errors import InputError
 from ..limits import MAGNITUDES
+from ..numerics.newton import newton
 from .driven import check_harmonics
 
 # --- a user's driven oscillator: q'' + g(q, q') = f cos(w t), g a polynomial -----------------
@@ -229,22 +230,8 @@ class PolynomialBalance:
     def solve(self, x: np.ndarray, omega: float, tol: float = 1e-13,
               max_iter: int = 50) -> tuple[np.ndarray, bool, float]:
         """Newton's method from ``x``: the solution, whether it converged, its residual."""
-        x = np.array(x, dtype=float)
-        converged = False
-        with np.errstate(over="ignore", invalid="ignore"):
-            for _ in range(max_iter):
-                try:
-                    step = np.linalg.solve(self.jacobian(x, omega), -self.residual(x, omega))
-                except np.linalg.LinAlgError:  # singular: exactly at a fold
-                    break
-                if not np.all(np.isfinite(step)):
-                    break
-                x = x + step
-                if np.max(np.abs(step)) <= tol * (1 + np.max(np.abs(x))):
-                    converged = True
-                    break
-            residual = float(np.max(np.abs(self.residual(x, omega))))
-        return x, converged and math.isfinite(residual), residual
+        return newton(lambda z: self.residual(z, omega), lambda z: self.jacobian(z, omega), x,
+                      tol, max_iter)
 
 
 def amplitude_bound(terms: dict[tuple[int, int], float], omega: float,

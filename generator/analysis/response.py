@@ -18,6 +18,7 @@ import sympy as sp
 
 from ..errors import InputError
 from ..numerics.integrate import ForceTable, Sweep, sweep_table
+from ..numerics.newton import newton
 from .continuation import (
     CONTINUATION_HARMONICS,
     CONTINUATION_SECONDS,
@@ -27,7 +28,6 @@ from .continuation import (
     _continue,
     _crossings,
     _half_period,
-    _newton_fixed_omega,
     continue_in_drive,
 )
 from .driven import (
@@ -226,10 +226,8 @@ def _end_solutions(sysm: BalanceSystem, d: Drive, omega_start: float, omega_stop
         for br in sorted(roots, key=lambda b: abs(b.A1)):
             x = np.zeros(2 * h)
             x[0], x[h] = br.A1 * np.cos(br.delta0), br.A1 * np.sin(br.delta0)
-            try:
-                x = _newton_fixed_omega(sysm, x, omega)
-            except np.linalg.LinAlgError:
-                x = np.full(2 * h, np.nan)
+            x, _, _ = newton(lambda z, w=omega: sysm.residual(z, w),
+                             lambda z, w=omega: sysm.jacobian(z, w), x, 1e-14)
             size = np.max(np.abs(x))
             residual = np.max(np.abs(sysm.residual(x, omega)))
             if not residual <= 1e-9 * (abs(d.force) + (1 + omega**2) * size

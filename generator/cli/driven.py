@@ -338,8 +338,8 @@ def response_equation_json(text: str, values: dict[str, str], harmonics: int,
     and of the true orbit (each with its Floquet moduli), the sweeps' jumps and escapes."""
     import numpy as np
 
-    from ..analysis.periodic import orbit_fold_table
     from ..analysis.response import equation_response
+    from ..numerics.shooting import orbit_fold_table
 
     curve = equation_response(text, values, harmonics, name, omega_min, omega_max, max_seconds)
     de, er, cont, up, down = curve.de, curve.er, curve.cont, curve.up, curve.down

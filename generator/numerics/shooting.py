@@ -20,7 +20,6 @@ from .integrate import (
     _table_force,
     duffing_table,
     escape_bound,
-    flow,
     flow_table,
 )
 
@@ -173,33 +172,48 @@ def shoot_table(table: ForceTable, force: float, omega: float, guess: np.ndarray
 
 def orbit_fold(eps: float, force: float, damping: float, omega: float, y0: np.ndarray,
                tol: float = 1e-11) -> tuple[float, np.ndarray] | None:
-    """A fold of the true periodic orbit: ``φ_T(y₀) = y₀`` with a Floquet multiplier ``+1``
-    (``det(M − I) = 0``), by Newton's method in ``(y₀, ω)`` with a difference Jacobian."""
-    def F(z: np.ndarray) -> np.ndarray:
-        end, _ = flow(z[:2], 2 * np.pi / z[2], eps, force, z[2], damping, samples=1)
-        Mono = end[2:].reshape(2, 2).T
-        return np.array([*(end[:2] - z[:2]), np.linalg.det(Mono - np.eye(2))])
+    """:func:`orbit_fold_table` on eq. 10.60 (``q + εq³ + q̇/Q``), with the escape bound of a
+    softening spring's well: ``(ω, y₀)`` or ``None``."""
+    found = orbit_fold_table(duffing_table(eps, damping), force, omega, y0, tol,
+                             escape_bound(eps, force))
+    return None if found is None else found[:2]
+
+
+def orbit_fold_table(table: ForceTable, force: float, omega: float, y0: np.ndarray,
+                     tol: float = 1e-11, bound: float = math.inf
+                     ) -> tuple[float, np.ndarray, np.ndarray] | None:
+    """A fold of the true periodic orbit of ``q̈ + g(q, q̇) = f cos ωt`` (``g`` the table):
+    ``φ_T(y₀) = y₀`` with a Floquet multiplier ``+1`` (``det(M − I) = 0``), by Newton's method
+    in ``(y₀, ω)`` with a central-difference Jacobian; ``(ω, y₀, multipliers)``, or ``None``
+    where Newton leaves the frequencies, the flow overflows or escapes past ``bound``, or the
+    Jacobian is singular (no isolated fold near the guess)."""
+    def F(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        end, _, _ = flow_table(table, force, z[2], z[:2], 2 * np.pi / z[2], samples=1,
+                               bound=bound)
+        mono = end[2:].reshape(2, 2).T
+        return np.array([*(end[:2] - z[:2]), np.linalg.det(mono - np.eye(2))]), mono
 
     z = np.array([*y0, omega], dtype=float)
-    for _ in range(30):
-        if not z[2] > 0:  # Newton left the frequencies: no fold near this guess
-            return None
-        f0 = F(z)
-        J = np.empty((3, 3))
-        for k in range(3):
-            h = 1e-7 * (1 + abs(z[k]))
-            e = np.zeros(3)
-            e[k] = h
-            J[:, k] = (F(z + e) - F(z - e)) / (2 * h)
-        if not (np.all(np.isfinite(J)) and np.all(np.isfinite(f0))):
-            return None  # RK4 overflowed: no orbit near this guess
-        try:
-            dz = np.linalg.solve(J, -f0)
-        except np.linalg.LinAlgError:  # singular: no isolated fold here
-            return None
-        z = z + dz
-        if np.max(np.abs(dz)) < tol * (1 + np.max(np.abs(z))):
-            return float(z[2]), z[:2]
+    with np.errstate(over="ignore", invalid="ignore"):
+        for _ in range(30):
+            if not z[2] > 0:  # Newton left the frequencies: no fold near this guess
+                return None
+            f0, _ = F(z)
+            J = np.empty((3, 3))
+            for k in range(3):
+                e = np.zeros(3)
+                e[k] = 1e-7 * (1 + abs(z[k]))
+                J[:, k] = (F(z + e)[0] - F(z - e)[0]) / (2 * e[k])
+            if not (np.all(np.isfinite(J)) and np.all(np.isfinite(f0))):
+                return None  # RK4 overflowed or escaped: no orbit near this guess
+            try:
+                dz = np.linalg.solve(J, -f0)
+            except np.linalg.LinAlgError:  # singular: no isolated fold here
+                return None
+            z = z + dz
+            if np.max(np.abs(dz)) < tol * (1 + np.max(np.abs(z))):
+                _, mono = F(z)
+                return float(z[2]), z[:2], np.linalg.eigvals(mono)
     return None
 
 
