@@ -8,11 +8,11 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import TYPE_CHECKING
 
-import mpmath
 import numpy as np
 import sympy as sp
 from numba import njit
 
+from ..algebra.resum import pade
 from ..errors import InputError
 from ..lower.documents import (
     FOURIER_AGM_STEPS,
@@ -213,10 +213,11 @@ def modified_coefficients(omega: list[Fraction]) -> list[Fraction]:
 
 
 def _pade(tau: list[Fraction], k: int) -> tuple[np.ndarray, np.ndarray]:
-    with mpmath.workdps(60):
-        p, q = mpmath.pade([mpmath.mpf(t.numerator) / t.denominator for t in tau[: 2 * k + 1]],
-                           k, k)
-        return np.array([float(c) for c in p]), np.array([float(c) for c in q])
+    """The diagonal ``[k/k]`` of the period series, exact (:func:`algebra.resum.pade`), its
+    coefficients rounded once to doubles for the compiled kernel."""
+    approximant = pade(tau[: 2 * k + 1], k, k)
+    return (np.array([float(c) for c in approximant.numerator]),
+            np.array([float(c) for c in approximant.denominator]))
 
 
 @dataclass(frozen=True)
@@ -254,7 +255,7 @@ def _pade_orders(s: PeriodSeries, top: int) -> list[tuple[int, Coefficients]]:
     for k in range(1, min(top // 2, PADE_MAX) + 1):
         try:
             found.append((k, _pade(s.tau, k)))
-        except ZeroDivisionError:  # no [k/k] approximant (e.g. a series in A with gaps)
+        except InputError:  # no [k/k] approximant (a singular block, e.g. a series with gaps)
             continue
     return found
 
