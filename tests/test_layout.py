@@ -116,6 +116,17 @@ def test_every_relative_import_names_a_module_of_the_package():
     assert not wrong, "; ".join(wrong)
 
 
+def test_every_folder_is_a_package_of_the_wheel():
+    """pyproject lists the packages a wheel carries: each folder of the source, or a plain
+    ``pip install .`` lacks it (the editable install would not notice)."""
+    import tomllib
+
+    listed = set(tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text())["tool"]
+                 ["setuptools"]["packages"])
+    folders = {"lindstedt." + p.parent.name for p in PACKAGE.glob("*/__init__.py")}
+    assert folders | {"lindstedt", "lindstedt.templates"} == listed
+
+
 def test_no_module_is_over_the_limit():
     long = {name: n for name, path in modules().items()
             if (n := len(path.read_text(encoding="utf-8").splitlines())) > LIMIT}
