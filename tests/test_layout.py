@@ -116,6 +116,30 @@ def test_every_relative_import_names_a_module_of_the_package():
     assert not wrong, "; ".join(wrong)
 
 
+def test_every_name_imported_inside_the_package_exists():
+    """Every ``from .x import y`` in the package, at any depth (a command's imports run only
+    when it does), names a module that imports and a name it holds."""
+    import importlib
+
+    wrong = []
+    for me, path in sorted(modules().items()):
+        here = list(path.relative_to(PACKAGE).with_suffix("").parts)
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not (isinstance(node, ast.ImportFrom) and node.level):
+                continue
+            head = [*here[: len(here) - node.level],
+                    *(node.module.split(".") if node.module else [])]
+            name = ".".join(["lindstedt", *head])
+            module = importlib.import_module(name)
+            for alias in node.names:
+                if not hasattr(module, alias.name):
+                    try:
+                        importlib.import_module(f"{name}.{alias.name}")
+                    except ImportError:
+                        wrong.append(f"{me}: {alias.name} from {name}")
+    assert not wrong, "; ".join(wrong)
+
+
 def test_every_folder_is_a_package_of_the_wheel():
     """pyproject lists the packages a wheel carries: each folder of the source, or a plain
     ``pip install .`` lacks it (the editable install would not notice)."""

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from ..costs import emit_bounds
 from ..errors import InputError
+from ..limits import PERIOD_SERIES_ORDER
 
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
 # well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
@@ -83,9 +84,8 @@ def run_choose(args: argparse.Namespace) -> int:
             raise InputError("--emit: the chosen period module is the Duffing oscillator's; "
                              "`lindstedt generate EQUATION` emits an equation's evaluators")
         from ..derive.models import model_from_text
-        from ..methods.kernels import MAX_ORDER
 
-        model = model_from_text(args.model, MAX_ORDER, _params(args.param), args.name)
+        model = model_from_text(args.model, PERIOD_SERIES_ORDER, _params(args.param), args.name)
     from ..choose import choose_period, modelled_ns
     from ..compiler import generate_choice
     from ..emit.render import check_writable

@@ -42,13 +42,13 @@ import sympy as sp
 from ..analysis.driven import Branch, Drive
 from ..derive.lindstedt import derive
 from ..derive.models import Model, check_order, duffing
+from ..limits import PERIOD_SERIES_ORDER
 from ..lower.records import (
     PeriodFormula,
     x_,
 )
 from ..numerics.references import duffing_period_exact
 from .kernels import (
-    MAX_ORDER,
     Coefficients,
     PeriodSeries,
     _agm_orders,
@@ -316,7 +316,7 @@ def period_series(max_order: int, model: Model | None = None) -> PeriodSeries:
 
 
 @functools.cache
-def candidates(max_order: int = MAX_ORDER, model: Model | None = None
+def candidates(max_order: int = PERIOD_SERIES_ORDER, model: Model | None = None
                ) -> tuple[Candidate, ...]:
     """Every period method at every order up to ``max_order`` (Padé up to [12/12]) for
     ``model`` (the free Duffing oscillator by default), derived once: the fixed-order ones

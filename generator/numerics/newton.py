@@ -30,4 +30,4 @@ def newton(residual: Callable[[np.ndarray], np.ndarray],
                 converged = True
                 break
         size = float(np.max(np.abs(residual(x))))
-    return x, converged and np.isfinite(size), size
+    return x, bool(converged and np.isfinite(size)), size
