@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+from ..numerics.floquet import orbit_hill_multipliers
 from ..numerics.integrate import ForceTable
 from ..numerics.shooting import PeriodicOrbit, ShootingFailure, shoot_explained, shoot_table
 from .continuation import (
@@ -27,10 +28,12 @@ from .driven import (
     Branch,
     Drive,
     HarmonicBalance,
+    MuExpansion,
     amplitudes,
     check_harmonics,
     first_order_branches,
     harmonic_balance,
+    mu_expansion,
 )
 from .polynomial import DrivenEquation, PolynomialBalance, amplitude_bound
 from .response import continue_balance, response_range
@@ -377,3 +380,47 @@ def equation_orbits(de: DrivenEquation, harmonics: int = 8,
     found.sort(key=lambda o: -(o.r if o.orbit is not None else _balance_r(fine, o.balance)))
     note = curve.note + f"; {len(seeds)} crossings of the drive amplitude"
     return EquationOrbits(tuple(found), fine, curve.complete, note, len(seeds))
+
+
+@dataclass(frozen=True)
+class BranchReport:
+    """One orbit of ``driven``'s report, three ways where it can be: the μ-expansion on the
+    first-order root that stands for it (``None``: no root does), its harmonic balance (in
+    :class:`Orbit`) with the full Hill equation's multipliers about it (``None``: no balance),
+    and the true orbit shot (in :class:`Orbit`)."""
+
+    orbit: Orbit
+    mu: MuExpansion | None
+    balance_amplitudes: tuple[dict[int, float], dict[int, float]] | None
+    full_hill: np.ndarray | None
+
+
+@dataclass(frozen=True)
+class DrivenReport:
+    """Everything ``lindstedt driven`` prints for the notes' damped driven Duffing at one ω:
+    every distinct orbit (:func:`periodic_orbits`), largest first, each with its μ-expansion
+    to ``order`` and its balance with ``harmonics`` harmonics; the one-harmonic roots."""
+
+    drive: Drive
+    order: int
+    harmonics: int
+    found: Orbits
+    branches: tuple[BranchReport, ...]
+
+
+def driven_report(d: Drive, order: int, harmonics: int) -> DrivenReport:
+    """The :class:`DrivenReport` at ``d``: shooting resolves ``max(2N − 1, 2K + 1)``
+    harmonics, the balance's full Hill multipliers are the variational equation's about it
+    (no shooting)."""
+    top = max(2 * harmonics - 1, 2 * order + 1)
+    found = periodic_orbits(d, harmonics, shoot_harmonics=top)
+    table = {(1, 0): 1.0, (3, 0): d.eps, (0, 1): d.damping}
+    branches = []
+    for orb in found.orbits:
+        mu = None if orb.branch is None else mu_expansion(d, orb.branch, order)
+        balance = hill = None
+        if orb.balance is not None:
+            balance = amplitudes(orb.balance.coefficients, 0.0, 2 * harmonics - 1)
+            hill = orbit_hill_multipliers(table, *balance, d.omega)
+        branches.append(BranchReport(orb, mu, balance, hill))
+    return DrivenReport(d, order, harmonics, found, tuple(branches))

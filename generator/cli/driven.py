@@ -35,26 +35,32 @@ from .common import (
 
 
 def driven_json(d, order: int, harmonics: int) -> dict:
-    """The contract of ``lindstedt driven … --json``: every distinct 1:1 orbit found
-    (:func:`response.periodic_orbits`), largest first, each three ways where it can be.
+    """The contract of ``lindstedt driven … --json``: :func:`driven_report_json` of
+    :func:`analysis.periodic.driven_report`."""
+    from ..analysis.periodic import driven_report
+
+    return driven_report_json(driven_report(d, order, harmonics))
+
+
+def driven_report_json(report) -> dict:
+    """The JSON of a :class:`analysis.periodic.DrivenReport`, a pure function of it: every
+    distinct 1:1 orbit, largest first, each three ways where it can be.
 
     A branch carries the first-order root that stands for it (``seed`` says how the orbit was
     found, ``first_order`` how the root was paired with it); an orbit that no one-harmonic root
     stands for (found by continuing the balance through a fold the cubic does not have) has
     ``A1``, ``r``, ``delta0`` null and no μ-expansion, with ``mu_note`` saying why."""
-    from ..analysis.driven import amplitudes, mu_expansion
-    from ..analysis.periodic import periodic_orbits
-    from ..numerics.floquet import multipliers_stable, orbit_hill_multipliers
+    from ..analysis.driven import amplitudes
+    from ..numerics.floquet import multipliers_stable
 
+    d, order, harmonics, found = report.drive, report.order, report.harmonics, report.found
     damped = d.damping > 0
-    top = max(2 * harmonics - 1, 2 * order + 1)
-    found = periodic_orbits(d, harmonics, shoot_harmonics=top)
     branches = []
-    for orb in found.orbits:
-        br, orbit, hb = orb.branch, orb.orbit, orb.balance
+    for b in report.branches:
+        orb = b.orbit
+        br, orbit, hb, mu = orb.branch, orb.orbit, orb.balance, b.mu
         orders: list[dict] = []
-        if br is not None:
-            mu = mu_expansion(d, br, order)
+        if mu is not None:
             for j in range(len(mu.coefficients)):
                 c, phase = mu.partial(j)
                 A, B = amplitudes(c, phase, 2 * j + 1)
@@ -69,16 +75,13 @@ def driven_json(d, order: int, harmonics: int) -> dict:
                        "harmonic balance through a fold the one-harmonic cubic does not have "
                        "at this omega): no first-order data, no mu-expansion")
         if hb is not None:
-            A, B = amplitudes(hb.coefficients, 0.0, 2 * harmonics - 1)
+            A, B = b.balance_amplitudes
             hb_json = {"harmonics": harmonics, "A": _keyed(A), "residual": hb.residual,
                        "converged": hb.converged, "r": _first_harmonic(A, B)}
             if damped:
                 hb_json["B"] = _keyed(B)
-            # the full Hill equation about this balance orbit (no shooting)
-            lam = orbit_hill_multipliers({(1, 0): 1.0, (3, 0): d.eps, (0, 1): d.damping}, A,
-                                         B, d.omega)
-            hb_json["full_hill_stable"] = multipliers_stable(lam, damped)
-            hb_json["full_hill_moduli"] = sorted(float(abs(m)) for m in lam)
+            hb_json["full_hill_stable"] = multipliers_stable(b.full_hill, damped)
+            hb_json["full_hill_moduli"] = sorted(float(abs(m)) for m in b.full_hill)
         else:
             hb_json = {"harmonics": harmonics, "A": {}, "residual": None, "converged": False,
                        "r": None}
