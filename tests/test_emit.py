@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import sympy as sp
 from lindstedt.analysis.driven import Drive, amplitudes, first_order_branches, harmonic_balance
-from lindstedt.cli.demo import BALANCE_HARMONICS, DRIVEN_ORDER
+from lindstedt.cli.demo import DEMO_BALANCE_HARMONICS, DRIVEN_ORDER
 from lindstedt.compiler import generate, generate_balance, generate_driven
 from lindstedt.derive.cycles import derive_limit_cycle
 from lindstedt.derive.lindstedt import (
@@ -136,7 +136,7 @@ def test_generated_is_fresh(tmp_path):
     for model, order in DEFAULTS:
         generate(model, order, tmp_path)
     generate_driven(DRIVEN_ORDER, tmp_path)
-    generate_balance(BALANCE_HARMONICS, tmp_path)
+    generate_balance(DEMO_BALANCE_HARMONICS, tmp_path)
     fresh = sorted(p.name for p in tmp_path.iterdir())
     committed = sorted(p.name for p in GENERATED.iterdir() if p.is_file())
     assert fresh == committed

@@ -226,7 +226,7 @@ class ParametricBalance(PolynomialBalance):
                                                                    * self.basis)
 
 
-BALANCE_HARMONICS = 8
+PARAMETRIC_HARMONICS = 8
 # NOTE: odd harmonics 1 … 15, the command line's default: the balance's first harmonic within
 # 4e-14 (relative) of shooting at ε ≤ 0.4 (benchmarks/parametric.py; the harmonics fall like
 # (γr²/32)^k).
@@ -251,7 +251,7 @@ class BalancePoint:
 
 
 def balance_point(p: Pump, point: OneHarmonicPoint,
-                  harmonics: int = BALANCE_HARMONICS) -> BalancePoint | None:
+                  harmonics: int = PARAMETRIC_HARMONICS) -> BalancePoint | None:
     """Newton's method on :class:`ParametricBalance` from a nontrivial one-harmonic point;
     ``None`` when it does not converge or falls onto the trivial solution."""
     system = ParametricBalance(p, harmonics)
@@ -291,7 +291,7 @@ class ResponseRow:
     orbit: PeriodicOrbit | None
 
 
-def response(p: Pump, omegas: np.ndarray, harmonics: int = BALANCE_HARMONICS,
+def response(p: Pump, omegas: np.ndarray, harmonics: int = PARAMETRIC_HARMONICS,
              shoot_every: int = 0) -> list[ResponseRow]:
     """Every branch at every ``ω`` of ``omegas``; nontrivial points refined by the balance;
     every ``shoot_every``-th ω (0: none) also shot (the trivial branch by the Floquet

@@ -17,7 +17,7 @@ DEMO_ORDER = 12
 DRIVEN_ORDER = 3
 # NOTE: the exact μ-expansion's rational functions grow fast; order 3 keeps the derivation
 # readable and the emitted A_n(ω) within 1e-5 of the true orbit at the notes' parameters.
-BALANCE_HARMONICS = 4
+DEMO_BALANCE_HARMONICS = 4
 # NOTE: the demo's balance module: 4 odd harmonics reach 1e-7 at the notes' parameters and
 # compile in seconds.
 
@@ -58,8 +58,9 @@ def run_demo(args: argparse.Namespace) -> int:
     for name in ("duffing", "pendulum"):
         for path in generate(name, DEMO_ORDER, out, overwrite_edited=args.overwrite_edited):
             print(f"  {path}")
-    for path in [*generate_driven(DRIVEN_ORDER, out, overwrite_edited=args.overwrite_edited),
-                 *generate_balance(BALANCE_HARMONICS, out, overwrite_edited=args.overwrite_edited)]:
+    edited = args.overwrite_edited
+    for path in [*generate_driven(DRIVEN_ORDER, out, overwrite_edited=edited),
+                 *generate_balance(DEMO_BALANCE_HARMONICS, out, overwrite_edited=edited)]:
         print(f"  {path}")
     duf = load_generated(out / "duffing.py")
     x = np.array([-0.9, -0.5, -0.1, 0.1, 0.5, 0.9])

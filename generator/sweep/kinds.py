@@ -63,7 +63,7 @@ RESPONSE_HARMONICS = 10
 ORBIT_HARMONICS = 8
 # NOTE: the balance each orbit is shot from (response.periodic_orbits' default).
 MU_ORDERS = (1, 2, 4, 6, 10)
-BALANCE_HARMONICS = (2, 4)
+VALIDITY_BALANCE_HARMONICS = (2, 4)
 JUDGE_HARMONICS = 10
 # NOTE: the methods and the judge of charts.driven_validity_figure (its VALIDITY_METHODS).
 
@@ -127,13 +127,13 @@ def _subharmonic(omega: float, force: float, eps: float) -> dict:
 
 def validity_errors(d: Drive) -> tuple[np.ndarray, np.ndarray, int]:
     """``|A₁ − A₁(balance, N = 10)|`` on the largest branch for the μ-expansion at
-    :data:`MU_ORDERS` and harmonic balance with :data:`BALANCE_HARMONICS` harmonics (NaN where a
-    method refuses: a fold, a diverging μ-series, a balance that does not converge — and
-    everywhere when the judge itself does not converge), and the branch count.
+    :data:`MU_ORDERS` and harmonic balance with :data:`VALIDITY_BALANCE_HARMONICS` harmonics
+    (NaN where a method refuses: a fold, a diverging μ-series, a balance that does not
+    converge — and everywhere when the judge itself does not converge), and the branch count.
 
     The measure of ``charts._validity_errors``, with the judge's convergence checked."""
     mu_err = np.full(len(MU_ORDERS), np.nan)
-    hb_err = np.full(len(BALANCE_HARMONICS), np.nan)
+    hb_err = np.full(len(VALIDITY_BALANCE_HARMONICS), np.nan)
     branches = first_order_branches(d)
     judge = try_balance(d, branches[0], JUDGE_HARMONICS, converged=True) if branches else None
     if judge is None:
@@ -143,7 +143,7 @@ def validity_errors(d: Drive) -> tuple[np.ndarray, np.ndarray, int]:
         mu = mu_expansion(d, branches[0], order)
         if len(mu.coefficients) > order and mu.converged:
             mu_err[k] = abs(amplitudes(*mu.partial(order), 1)[0][1] - truth)
-    for k, harmonics in enumerate(BALANCE_HARMONICS):
+    for k, harmonics in enumerate(VALIDITY_BALANCE_HARMONICS):
         hb = try_balance(d, branches[0], harmonics, converged=True)
         if hb is not None:
             hb_err[k] = abs(amplitudes(hb.coefficients, 0.0, 1)[0][1] - truth)
@@ -272,7 +272,7 @@ SUBHARMONIC = Kind(
 VALIDITY = Kind(
     "validity", "error in A1 of the mu-expansion and of low-order harmonic balance against "
     "harmonic balance N = 10, largest branch", AXES,
-    (("mu_order", MU_ORDERS), ("harmonics", BALANCE_HARMONICS)),
+    (("mu_order", MU_ORDERS), ("harmonics", VALIDITY_BALANCE_HARMONICS)),
     (Field("mu_error", "|A1 - A1(balance N = 10)|, mu-expansion", dims=("mu_order",)),
      Field("balance_error", "|A1 - A1(balance N = 10)|, harmonic balance",
            dims=("harmonics",)),
