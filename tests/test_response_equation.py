@@ -197,7 +197,7 @@ def test_mixing_as_text_equals_the_flags():
     (["subharmonic", "q'' + q + q**3/10 = cos(w*t)/2 + cos(2*w*t)", "--omega", "1"],
      "2 drive terms"),
     (["mixing", "q'' + q'/10 + q + q**3/10 = cos(w*t)/2"], "give w a value"),
-    (["mixing", "q'' + q + q**3/10 = cos(t)/2"], "mixing needs damping"),
+    (["mixing", "q'' + q + q**3/10 = cos(t)/2"], "mixing needs a linear damping term"),
     (["mixing", "q'' + q'/10 + q**3/10 = cos(t)/2"], "no linear term"),
     (["response", "q'' + q'/Q + q + eps*q**3 = f*cos(w*t)", "--param", "eps=1/10",
       "--param", "f=3/10"], "give Q a value"),

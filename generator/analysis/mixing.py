@@ -118,9 +118,9 @@ def mixing_series(table: ForceTable, drives: list[tuple[float, float]]) -> Mixin
         raise InputError(f"the linear stiffness {k:g} must be > 0: the mixing series expands "
                          "about the linear response of a stable equilibrium")
     if not gamma > 0:
-        raise InputError("Q inf: mixing needs damping (finite Q) for a steady state"
-                         if gamma == 0 else f"the linear damping {gamma:g} < 0: no steady "
-                         "state")
+        raise InputError("no damping (Q inf): mixing needs a linear damping term (such as "
+                         "q'/Q, finite Q) for a steady state" if gamma == 0 else
+                         f"the linear damping {gamma:g} < 0: no steady state")
     nonlinear = [(a, b, c) for (a, b), c in sorted(terms.items()) if a + b >= 2]
     n = len(drives)
     omegas = np.array([w for _, w in drives])

@@ -180,8 +180,9 @@ def subharmonic_equation(text: str, values: dict[str, str], omega: float | None,
                              f"f*cos({n}*w*t)")
         omega = float(c / n)
     elif omega is None:
-        raise InputError("--omega: the subharmonic's frequency is required (the drive "
-                         f"{c}*{symbol} is at {n}*omega)")
+        frequency = str(symbol) if c == 1 else f"{c}*{symbol}"
+        raise InputError("--omega: the subharmonic's frequency is required (the drive's "
+                         f"frequency {frequency} is {n}*omega)")
     if not (math.isfinite(omega) and omega > 0):
         raise InputError(f"--omega {omega!r}: must be finite and > 0")
     terms = form.floats()

@@ -336,17 +336,19 @@ def _flag_plot(p: argparse.ArgumentParser) -> None:
 
 
 def _flag_drive(p: argparse.ArgumentParser, required: bool, omega: str | None,
-                Q: str | None = "optional", force: bool = True) -> None:
+                Q: str | None = "optional", force: bool = True, notes: bool = False) -> None:
     """--eps, --force, --omega, --Q of q'' + q'/Q + q + eps q^3 = f cos(w t) (``omega``: its
-    meaning, None for none; ``Q``: "optional", "required" or None for none)."""
+    meaning, None for none; ``Q``: "optional", "required" or None for none; ``notes``: the
+    command also takes an EQUATION, and --eps, --force belong to the notes' equation)."""
     need = " (required)" if required else ""
+    whose = "the notes' equation, without EQUATION: " if notes else ""
     p.add_argument("--eps", type=_real, required=required, metavar="EPS",
-                   help=f"ε, the cubic stiffness coefficient (dimensionless; > 0 hardens, "
-                   f"< 0 softens){need}")
+                   help=f"{whose}ε, the cubic stiffness coefficient (dimensionless; > 0 "
+                   f"hardens, < 0 softens){need}")
     if force:
         p.add_argument("--force", type=_real, required=required, metavar="F",
-                       help=f"f, the drive amplitude, in units of the linear stiffness × length "
-                       f"(q is dimensionless){need}")
+                       help=f"{whose}f, the drive amplitude, in units of the linear stiffness "
+                       f"× length (q is dimensionless){need}")
     if omega is not None:
         p.add_argument("--omega", type=_real, required=required, metavar="W",
                        help=f"{omega}, in units of the linear natural frequency{need}")

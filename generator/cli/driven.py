@@ -820,7 +820,8 @@ def arguments_driven(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
     _flag_equation(p, "\"q'' + q + eps*q**3 + gamma*q'**3 = f*cos(w*t)\" (a polynomial "
                    "force, one drive f*cos(w*t) whose w is --omega)",
                    "eq. 10.60 with --eps, --force, --Q", "every parameter but w needs one")
-    _flag_drive(p, required=False, omega="ω, the drive frequency (required)", Q="none")
+    _flag_drive(p, required=False, omega="ω, the drive frequency (required)", Q="none",
+                notes=True)
     p.add_argument("--Q", type=_quality, default=None, metavar="Q",
                    help="quality factor Q > 0 of the damping q'/Q (default: inf, undamped)")
     _flag_order(p, "μ-expansion order K")
@@ -841,7 +842,7 @@ def arguments_response(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
                    "polynomial force with damping, one drive f*cos(w*t) whose w the curve "
                    "varies)", "eq. 10.60 with --eps, --force, --Q", "every parameter but w "
                    "needs one")
-    _flag_drive(p, required=False, omega=None, Q=None)
+    _flag_drive(p, required=False, omega=None, Q=None, notes=True)
     p.add_argument("--Q", type=_quality, default=None, metavar="Q",
                    help="quality factor Q > 0 of the damping q'/Q (finite; required without "
                    "EQUATION)")
@@ -877,7 +878,8 @@ def arguments_subharmonic(sub: argparse._SubParsersAction) -> argparse.ArgumentP
                    help="the subharmonic's order: orbits of N drive periods, 2..12 (default 3; "
                    "1/2 needs an even power in the force, 1/3 an odd one)")
     _flag_drive(p, required=False, omega="ω, the subharmonic's own frequency: the drive is at "
-                "n·ω (required, unless the equation's drive frequency is a number)", Q=None)
+                "n·ω (required, unless the equation's drive frequency is a number)", Q=None,
+                notes=True)
     _flag_json(p)
     _flag_plot(p)
     return p
@@ -911,16 +913,16 @@ def arguments_parametric(sub: argparse._SubParsersAction) -> argparse.ArgumentPa
 
 def arguments_mixing(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """``lindstedt mixing``'s arguments."""
-    p = sub.add_parser("mixing", help="combination tones of a two-tone drive",
+    p = sub.add_parser("mixing", help="combination tones of a drive of up to four tones",
                        description="Your own q'' + g(q, q') = Σ f_i cos(w_i t), g any "
                        "polynomial with a linear stiffness and damping: the combination tones "
                        "predicted to the second order of the nonlinearity, beside a simulated "
                        "steady state; or the notes' q'' + q'/Q + q + eps q^3 (--eps, --Q, "
                        "--drive).")
-    _flag_equation(p, "\"x'' + x'/20 + x + x**2/5 + x**3/10 = 0.3*cos(1.3*t) + "
-                   "0.3*cos(1.7*t)\" (every frequency a number: the tones are numbered by "
-                   "ascending frequency)")
-    _flag_drive(p, required=False, omega=None, Q=None, force=False)
+    _flag_equation(p, "\"x'' + x'/20 + x + x**2/5 + x**3/10 = 3/20*cos(13*t/10) + "
+                   "3/20*cos(17*t/10)\" (every frequency a number or a name given with "
+                   "--param: the tones are numbered by ascending frequency)")
+    _flag_drive(p, required=False, omega=None, Q=None, force=False, notes=True)
     p.add_argument("--Q", type=_quality, default=None, metavar="Q",
                    help="quality factor Q > 0 of the damping q'/Q (finite; required without "
                    "EQUATION)")

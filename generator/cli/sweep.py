@@ -125,7 +125,9 @@ def arguments_sweep(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                        "a Zarr store; run the same command again to resume an interrupted "
                        "sweep. Your own equation: any of its parameters (the drive frequency "
                        "included) an --axis, the rest --param; without EQUATION the notes' "
-                       "q'' + q'/Q + q + eps q^3 = f cos(wt) over --omega, --force, --eps, --Q.")
+                       "q'' + q'/Q + q + eps q^3 = f cos(wt) over --omega, --force, --eps, --Q "
+                       "(A:B:N is N values from A to B; response, stability and validity take "
+                       "all four, subharmonic omega, force and eps).")
     p.add_argument("kind", choices=SWEEP_KINDS,
                    help="response: r of every branch; stability: Floquet verdicts of the true "
                    "orbits (with an EQUATION both: every orbit shot, r and its verdict); "
@@ -150,9 +152,7 @@ def arguments_sweep(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                           ("force", "f, drive amplitude"), ("eps", "ε, cubic stiffness"),
                           ("Q", "quality factor (inf: undamped)")):
         p.add_argument(f"--{name}", type=_axis_values, metavar="VALUES",
-                       help=f"the notes' equation: {meaning}: A:B:N (N values from A to B), "
-                       "v1,v2,… or one value (each axis the kind takes is required: response, "
-                       "stability, validity take all four, subharmonic omega, force, eps)")
+                       help=f"the notes' equation: {meaning}: A:B:N, v1,v2,… or one value")
     p.add_argument("--store", required=True, metavar="PATH",
                    help="the Zarr store (a folder) the map is written into, block by block "
                    "(required; an existing store of the same sweep resumes)")

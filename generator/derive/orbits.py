@@ -307,11 +307,13 @@ def _closes_at(sc: _Scaled, s: float) -> tuple[bool | None, str]:
 def _domain(variable: str, sc: _Scaled) -> OrbitDomain:
     lo, hi, hows = -math.inf, math.inf, []
     lo_text, hi_text = "-inf", "inf"
+    name = variable.partition("=")[0].strip() or variable
     for side in ((+1, -1) if sc.both_sides else (+1,)):
+        where = f"{name} {'>' if side > 0 else '<'} 0"
         try:
             edge = _edge(sc, side)
         except EdgeError as exc:  # a doubles' artefact that 40 digits do not confirm
-            hows.append(f"{'+' if side > 0 else '-'} side: none stated ({exc})")
+            hows.append(f"{where}: none stated ({exc})")
             continue
         if edge is None:
             continue
@@ -320,15 +322,13 @@ def _domain(variable: str, sc: _Scaled) -> OrbitDomain:
         with mpmath.workdps(DIGITS + 10):
             y = s_edge**sc.power
             text = mpmath.nstr(y, digits, min_fixed=-math.inf, max_fixed=math.inf)
-        hows.append(f"{'+' if side > 0 else '-'} side: {_describe(kind)} at "
-                    f"{variable.partition('=')[0].strip() or variable} = "
-                    f"{mpmath.nstr(y, 12)}")
+        hows.append(f"{where}: {_describe(kind)} at {name} = {mpmath.nstr(y, 12)}")
         if side > 0:
             hi, hi_text = float(y), text
         else:
             lo, lo_text = float(y), text
     if len(hows) < (2 if sc.both_sides else 1):
-        reach = (f"|y| = {SCAN[1]:g}" if sc.g0.is_polynomial(sc.u, sc.s) else
+        reach = (f"|{name}| = {SCAN[1]:g}" if sc.g0.is_polynomial(sc.u, sc.s) else
                  f"A = {SCAN_TRANSCENDENTAL:g} or where doubles overflow")
         hows.append(f"no edge {'on the other side ' if hows else ''}out to {reach}")
     how = "; ".join(hows)
