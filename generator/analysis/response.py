@@ -17,8 +17,9 @@ import numpy as np
 import sympy as sp
 
 from ..errors import InputError
-from ..numerics.integrate import ForceTable, Sweep, sweep_table
+from ..numerics.integrate import ForceTable, Sweep, sweep, sweep_table
 from ..numerics.newton import newton
+from ..numerics.shooting import orbit_fold, orbit_fold_table
 from .continuation import (
     CONTINUATION_HARMONICS,
     CONTINUATION_SECONDS,
@@ -558,6 +559,7 @@ class EquationCurve:
     bound: float
     up: Sweep
     down: Sweep
+    true_folds: tuple[tuple[float, tuple[float, ...]], ...]  # (ω, sorted |Floquet multipliers|)
 
 
 def equation_response(text: str, values: dict[str, str], harmonics: int,
@@ -574,7 +576,56 @@ def equation_response(text: str, values: dict[str, str], harmonics: int,
     cont = continue_equation(de, harmonics, lo, hi, max_seconds=max_seconds)
     table = ForceTable.of(de.terms)
     bound = ESCAPE_FACTOR * float(np.max(np.sum(np.abs(cont.x), axis=1)))
+    fine = PolynomialBalance(de.terms, de.force, harmonics, de.odd)
+    true_folds = []
+    for w in cont.folds:  # the true orbit's fold near each of the balance's
+        x = cont.x[int(np.argmin(np.abs(cont.omega - w)))]
+        found = orbit_fold_table(table, de.force, w, fine.state(x, w))
+        if found is not None:
+            true_folds.append((found[0], tuple(sorted(float(abs(m)) for m in found[2]))))
     return EquationCurve(
-        de, er, cont, PolynomialBalance(de.terms, de.force, harmonics, de.odd), table, bound,
+        de, er, cont, fine, table, bound,
         sweep_table(table, de.force, lo, hi, barrier=bound, bound=bound),
-        sweep_table(table, de.force, hi, lo, barrier=bound, bound=bound))
+        sweep_table(table, de.force, hi, lo, barrier=bound, bound=bound), tuple(sorted(true_folds)))
+
+
+@dataclass(frozen=True)
+class ResponseReport:
+    """Everything ``lindstedt response`` prints for the notes' damped Duffing: its folds three
+    ways (one harmonic, the continued balance, the true orbit's) and the simulated sweeps'
+    jumps over the range."""
+
+    eps: float
+    force: float
+    Q: float
+    harmonics: int
+    omega_range: tuple[float, float]
+    one_harmonic_folds: tuple[float, ...]
+    cont: Continuation
+    true_folds: tuple[float, ...]
+    up: Sweep
+    down: Sweep
+
+
+def duffing_response(eps: float, force: float, Q: float, harmonics: int,
+                     max_seconds: float = CONTINUATION_SECONDS) -> ResponseReport:
+    """The :class:`ResponseReport` of eq. 10.60: the continuation over
+    :func:`response_range`, each balance fold polished into the true orbit's
+    (:func:`numerics.shooting.orbit_fold`), the sweeps both ways."""
+    d = Drive(eps, force, 1.0, Q)
+    if d.damping == 0:
+        raise InputError("Q inf: a response curve needs damping (finite Q) for a steady state")
+    folds1 = one_harmonic_folds(eps, force, Q)
+    lo, hi = response_range(eps, force, Q)
+    cont = continue_balance(eps, force, Q, harmonics, lo, hi, max_seconds=max_seconds)
+    odd = BalanceSystem(eps, force, d.damping, harmonics).odd
+    true_folds = []
+    for w in cont.folds:
+        x = cont.x[int(np.argmin(np.abs(cont.omega - w)))]
+        y0 = np.array([x[:harmonics].sum(), w * np.sum(odd * x[harmonics:])])
+        found = orbit_fold(eps, force, d.damping, w, y0)
+        if found is not None:
+            true_folds.append(found[0])
+    return ResponseReport(eps, force, Q, harmonics, (lo, hi), tuple(float(w) for w in folds1),
+                          cont, tuple(sorted(true_folds)), sweep(eps, force, d.damping, lo, hi),
+                          sweep(eps, force, d.damping, hi, lo))

@@ -295,39 +295,21 @@ def run_driven(args: argparse.Namespace) -> int:
 def response_json(eps: float, force: float, Q: float, harmonics: int,
                   max_seconds: float = COST_LIMIT_SECONDS) -> dict:
     """The contract of ``lindstedt response … --json``: folds three ways, sweep jumps
-    (``max_seconds``: the continuation's cost limit)."""
-    import numpy as np
+    (``max_seconds``: the continuation's cost limit), formatted from
+    :func:`analysis.response.duffing_response`."""
+    from ..analysis.response import duffing_response
 
-    from ..analysis.driven import BalanceSystem, Drive
-    from ..analysis.response import continue_balance, one_harmonic_folds, response_range
-    from ..numerics.integrate import sweep
-    from ..numerics.shooting import orbit_fold
-
-    d = Drive(eps, force, 1.0, Q)
-    if d.damping == 0:
-        raise InputError("Q inf: a response curve needs damping (finite Q) for a steady state")
-    folds1 = one_harmonic_folds(eps, force, Q)
-    lo, hi = response_range(eps, force, Q)
-    cont = continue_balance(eps, force, Q, harmonics, lo, hi, max_seconds=max_seconds)
-    system = BalanceSystem(eps, force, d.damping, harmonics)
-    odd = system.odd
-    true_folds = []
-    for w in cont.folds:
-        x = cont.x[int(np.argmin(np.abs(cont.omega - w)))]
-        y0 = np.array([x[:harmonics].sum(), w * np.sum(odd * x[harmonics:])])
-        found = orbit_fold(eps, force, d.damping, w, y0)
-        if found is not None:
-            true_folds.append(found[0])
-    up = sweep(eps, force, d.damping, lo, hi)
-    down = sweep(eps, force, d.damping, hi, lo)
+    r = duffing_response(eps, force, Q, harmonics, max_seconds=max_seconds)
+    lo, hi = r.omega_range
     return {
         "parameters": {"eps": eps, "force": force, "Q": Q, "harmonics": harmonics,
                        "omega_range": [lo, hi]},
-        "one_harmonic": {"folds": [float(w) for w in folds1]},
-        "harmonic_balance": {"harmonics": harmonics, "folds": [float(w) for w in cont.folds]},
-        "numerical": {"folds": sorted(true_folds), "sweep_up_jump": up.jump,
-                      "sweep_down_jump": down.jump, "sweep_resolution": up.resolution,
-                      "sweep_up_escape": up.escape, "sweep_down_escape": down.escape},
+        "one_harmonic": {"folds": list(r.one_harmonic_folds)},
+        "harmonic_balance": {"harmonics": harmonics,
+                             "folds": [float(w) for w in r.cont.folds]},
+        "numerical": {"folds": list(r.true_folds), "sweep_up_jump": r.up.jump,
+                      "sweep_down_jump": r.down.jump, "sweep_resolution": r.up.resolution,
+                      "sweep_up_escape": r.up.escape, "sweep_down_escape": r.down.escape},
     }
 
 
@@ -339,21 +321,12 @@ def response_equation_json(text: str, values: dict[str, str], harmonics: int,
     :func:`response_json` (``parameters`` as ``driven EQUATION``'s, with ``omega_range``),
     with the folds of the general one-harmonic balance, of the continued N-harmonic balance,
     and of the true orbit (each with its Floquet moduli), the sweeps' jumps and escapes."""
-    import numpy as np
-
     from ..analysis.response import equation_response
-    from ..numerics.shooting import orbit_fold_table
 
     curve = equation_response(text, values, harmonics, name, omega_min, omega_max, max_seconds)
     de, er, cont, up, down = curve.de, curve.er, curve.cont, curve.up, curve.down
     lo, hi = er.omega_range
-    true_folds = []
-    for w in cont.folds:
-        x = cont.x[int(np.argmin(np.abs(cont.omega - w)))]
-        found = orbit_fold_table(curve.table, de.force, w, curve.fine.state(x, w))
-        if found is not None:
-            true_folds.append((found[0], sorted(float(abs(m)) for m in found[2])))
-    true_folds.sort()
+    true_folds = [(w, list(m)) for w, m in curve.true_folds]
     bound = curve.bound
     return {
         "equation": text,
