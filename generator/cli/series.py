@@ -306,32 +306,6 @@ def run_mathieu(args: argparse.Namespace) -> int:
     return 0
 
 
-def _series_value(coefficients, x: float) -> tuple[float, float, int]:
-    """The partial sum at ``x``, its change over the last two nonzero terms (the truncation
-    error estimate) and the order K of the smallest such change (the best reachable)."""
-    total, last, changes = 0.0, [], []
-    for k, c in enumerate(coefficients):
-        term = float(c) * x**k
-        total += term
-        if c:
-            last.append(abs(term))
-            changes.append((sum(last[-2:]), k))
-    if len(changes) < 2:
-        return total, 0.0, len(coefficients) - 1
-    best = min(changes[1:])
-    return total, changes[-1][0], best[1]
-
-
-def _radius(coefficients) -> float:
-    """The estimated radius of convergence in the series' own variable (inf if too short)."""
-    from ..derive.lindstedt import nearest_singularity
-
-    est = nearest_singularity(coefficients, "x", None)
-    if est is None:
-        return math.inf
-    return math.sqrt(est.radius) if est.variable == "x**2" else est.radius
-
-
 DAMPING_PANEL = 0.05
 # NOTE: the damped panel of `tongues --plot` without --damping: the tongues visibly lift.
 
@@ -340,6 +314,7 @@ def run_tongues(args: argparse.Namespace) -> int:
     """``lindstedt tongues P --n N --order K``: the transition curves out of tongue n of
     x'' + (δ + ε p(t))x = 0, exact; ``--damping Z``: the damped tongue's tip."""
     from ..derive.hill import fourier_of_text, tongue_tip, transition_curves
+    from ..derive.lindstedt import partial_sum, series_radius
 
     if args.emit is not None:
         from .. import compiler
@@ -384,12 +359,12 @@ def run_tongues(args: argparse.Namespace) -> int:
                                                         f"delta ({curve.label})", None)
             lines.append(line)
         if args.at is not None:
-            value, error, best = _series_value(curve.delta, args.at)
-            radius = _radius(curve.delta)
+            value, error, best = partial_sum(curve.delta, args.at)
+            radius = series_radius(curve.delta)
             if abs(args.at) >= radius:  # outside the disc of convergence: no value
                 value, error = math.nan, math.inf
             if args.tol is not None and not error <= args.tol:
-                _, best_error, _ = _series_value(curve.delta[:best + 1], args.at)
+                _, best_error, _ = partial_sum(curve.delta[:best + 1], args.at)
                 raise InputError(f"--tol {args.tol:g}: not reached at eps = {args.at:g} by order "
                                  f"{args.order} (estimate {error:.2g}); the best reachable is "
                                  f"{best_error:.2g} at order {best}")
@@ -399,8 +374,8 @@ def run_tongues(args: argparse.Namespace) -> int:
         data["curves"].append(row)
     if args.damping is not None:
         tip = tongue_tip(p, args.n, args.order)
-        eps, _, _ = _series_value(tip.eps_min, args.damping)
-        delta, err, _ = _series_value(tip.delta, args.damping)
+        eps, _, _ = partial_sum(tip.eps_min, args.damping)
+        delta, err, _ = partial_sum(tip.delta, args.damping)
         data["damping"] = {
             "variable": "zeta", "equation": "x'' + 2 zeta x' + (delta + eps p(t)) x = 0",
             "eps_min": [_fraction_text(c) for c in tip.eps_min],

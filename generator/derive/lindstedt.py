@@ -668,6 +668,30 @@ def nearest_singularity(coefficients: Sequence[Fraction], variable: str = "eps",
     return Singularity(variable, radius, float(angle), float(spread), method)
 
 
+def partial_sum(coefficients: Sequence, x: float) -> tuple[float, float, int]:
+    """The partial sum at ``x``, its change over the last two nonzero terms (the truncation
+    error estimate) and the order K of the smallest such change (the best reachable)."""
+    total, last, changes = 0.0, [], []
+    for k, c in enumerate(coefficients):
+        term = float(c) * x**k
+        total += term
+        if c:
+            last.append(abs(term))
+            changes.append((sum(last[-2:]), k))
+    if len(changes) < 2:
+        return total, 0.0, len(coefficients) - 1
+    best = min(changes[1:])
+    return total, changes[-1][0], best[1]
+
+
+def series_radius(coefficients: Sequence) -> float:
+    """The estimated radius of convergence in the series' own variable (inf if too short)."""
+    est = nearest_singularity(coefficients, "x", None)
+    if est is None:
+        return math.inf
+    return math.sqrt(est.radius) if est.variable == "x**2" else est.radius
+
+
 def estimated_radius(solution: SeriesSolution, to_args: dict
                      ) -> tuple[sp.Expr, float] | None:
     """The radius of convergence of ``T/2π = Σ τ_j y^j`` where the model knows none, and its
