@@ -353,7 +353,7 @@ def clock_scene(swing_deg: float = 10.0, seconds_per_day: float = 0.1) -> SceneR
         sol = derive(pendulum(k), k)
         coeffs = np.array([float(sol.ground.to_fraction(c)) * np.pi ** (2 * j)
                            for j, c in enumerate(sol.period)])
-        cand = Candidate(method("period", "lindstedt"), k, coeffs, np.ones(1))
+        cand = Candidate(k, coeffs, np.ones(1), method("period", "lindstedt"))
         err = float(np.max(np.abs(cand(t) / exact - 1)))
         if err <= tol:
             return SceneResult(

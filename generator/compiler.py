@@ -117,7 +117,8 @@ def generate_choice(candidate: Candidate, command: str, out: Path,
                     flag: str = "--emit") -> list[Path]:
     """``lindstedt choose period … --emit DIR``: just the chosen evaluator, NaN outside the
     range ``verified`` of x = εA² it was verified on."""
-    request = Request(candidate.order, command, candidate=candidate, verified=verified)
+    request = Request(candidate.order, command, formula=candidate.method.formula(candidate),
+                      verified=verified)
     return compile_target(CHOSEN_PERIOD, request, out, overwrite_edited=overwrite_edited,
                           flag=flag)
 

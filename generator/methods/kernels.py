@@ -6,7 +6,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import TYPE_CHECKING
 
 import numpy as np
 import sympy as sp
@@ -21,10 +20,6 @@ from ..lower.forms import agm_steps, horner
 from ..lower.records import (
     x_,
 )
-
-if TYPE_CHECKING:
-    from .registry import Candidate
-
 
 Coefficients = tuple[np.ndarray, np.ndarray]
 _m = sp.Symbol("m")  # the resummed variable of the lowered period forms
@@ -273,28 +268,38 @@ def _rationals(values: np.ndarray) -> list[sp.Expr]:
     return [sp.Rational(float(v)) for v in values]
 
 
-def _lower_lp(c: Candidate) -> tuple[tuple, sp.Expr]:
+@dataclass(frozen=True)
+class PeriodTerms:
+    """A period method's coefficients at one order, as verified doubles: what it evaluates
+    and lowers (a registry :class:`Candidate` is one, with its method)."""
+
+    order: int
+    num: np.ndarray
+    den: np.ndarray
+
+
+def _lower_lp(c: PeriodTerms) -> tuple[tuple, sp.Expr]:
     return (), horner(_rationals(c.num), x_)
 
 
-def _lower_resummed(c: Candidate) -> tuple[tuple, sp.Expr]:
+def _lower_resummed(c: PeriodTerms) -> tuple[tuple, sp.Expr]:
     return ((_m, x_ / (2 + 2 * x_)),), sp.sqrt(1 - 2 * _m) * horner(_rationals(c.num), _m)
 
 
-def _lower_modified(c: Candidate) -> tuple[tuple, sp.Expr]:
+def _lower_modified(c: PeriodTerms) -> tuple[tuple, sp.Expr]:
     return (((_m, 3 * x_ / (4 + 3 * x_)),),
             1 / sp.sqrt((1 + sp.Rational(3, 4) * x_) * horner(_rationals(c.num), _m)))
 
 
-def _lower_pade(c: Candidate) -> tuple[tuple, sp.Expr]:
+def _lower_pade(c: PeriodTerms) -> tuple[tuple, sp.Expr]:
     return (), horner(_rationals(c.num), x_) / horner(_rationals(c.den), x_)
 
 
-def _lower_agm(c: Candidate) -> tuple[tuple, sp.Expr]:
+def _lower_agm(c: PeriodTerms) -> tuple[tuple, sp.Expr]:
     lines, mean = agm_steps(sp.sqrt(1 + x_), sp.sqrt(1 + x_ / 2), c.order, "")
     return tuple(lines), 1 / mean
 
 
-def _not_lowered(c: Candidate) -> tuple[tuple, sp.Expr]:
+def _not_lowered(c: PeriodTerms) -> tuple[tuple, sp.Expr]:
     raise InputError("the exact period (SciPy's ellipk) has no compiled evaluator to emit; "
                      "loosen the tolerance or narrow the range")

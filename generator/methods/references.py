@@ -4,8 +4,8 @@ emitted modules run on a grid."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from types import ModuleType
-from typing import TYPE_CHECKING
 
 import mpmath
 import numpy as np
@@ -23,8 +23,10 @@ from ..analysis.driven import (
 from ..derive.models import Model
 from ..numerics.shooting import shoot
 
-if TYPE_CHECKING:
-    from .registry import Emitted, Solved
+Solved = tuple[bool, tuple[dict, dict]]
+# NOTE: a driven method at one ω and order: (converged, (A, B)).
+Emitted = tuple[np.ndarray, np.ndarray, Callable[[], object], int]
+# NOTE: a driven method's emitted module run on a grid: (A, B, the module's call, its order).
 
 
 def _solve_mu(d: Drive, branch: Branch, order: int) -> Solved:

@@ -34,7 +34,6 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 import sympy as sp
@@ -51,6 +50,7 @@ from ..numerics.references import duffing_period_exact
 from .kernels import (
     Coefficients,
     PeriodSeries,
+    PeriodTerms,
     _agm_orders,
     _evaluate,
     _exact_orders,
@@ -68,6 +68,8 @@ from .kernels import (
 from .references import (
     DRIVEN_MAX,
     SHOOTING_STEPS,
+    Emitted,
+    Solved,
     _run_balance_module,
     _run_mu_damped_module,
     _run_mu_module,
@@ -75,11 +77,16 @@ from .references import (
     _solve_mu,
     _solve_shooting,
 )
-from .targets import BALANCE, CHOSEN_PERIOD, DAMPED_MAX, FOURIER, FREE, MU, MU_DAMPED
-
-if TYPE_CHECKING:
-    from .targets import Target
-
+from .targets import (
+    BALANCE,
+    CHOSEN_PERIOD,
+    DAMPED_MAX,
+    FOURIER,
+    FREE,
+    MU,
+    MU_DAMPED,
+    Target,
+)
 
 # --- what a method applies to ------------------------------------------------------------------
 
@@ -145,14 +152,6 @@ def _always(subject: object) -> str | None:
     return None
 
 
-# --- driven: one method at one order at one ω ---------------------------------------------------
-
-Solved = tuple[bool, tuple[dict, dict]]
-
-
-Emitted = tuple[np.ndarray, np.ndarray, Callable[[], object], int]
-
-
 # --- the records ---------------------------------------------------------------------------------
 
 Lowered = tuple[tuple, sp.Expr]
@@ -172,7 +171,7 @@ class Method:
     steps: bool = False  # period: the order counts steps, not terms (listed first)
     domain: sp.Basic = sp.true  # period: where the formula holds, in x_
     orders: Callable[[PeriodSeries, int], list[tuple[int, Coefficients]]] | None = None
-    lowered: Callable[[Candidate], Lowered] = _not_lowered
+    lowered: Callable[[PeriodTerms], Lowered] = _not_lowered
     solve: Callable[[Drive, Branch, int], Solved] | None = None  # driven: one ω, one order
     driven_orders: tuple[int, ...] = ()
     target: Target | None = None  # what `generate` / `--emit` writes for it
@@ -295,13 +294,10 @@ def methods_for(quantity: str, subject: object | None = None) -> tuple[Method, .
 # --- period candidates: every method at every order ----------------------------------------------
 
 @dataclass(frozen=True)
-class Candidate:
+class Candidate(PeriodTerms):
     """One period method at one order with its coefficients (as verified doubles)."""
 
-    method: Method
-    order: int
-    num: np.ndarray
-    den: np.ndarray
+    method: Method | None = None
     masked: bool = True  # NaN outside the free Duffing oscillator's domain (see _evaluate)
 
     def __call__(self, x: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
@@ -328,6 +324,6 @@ def candidates(max_order: int = PERIOD_SERIES_ORDER, model: Model | None = None
     for rank, m in enumerate(methods_for("period", subject)):
         for order, (num, den) in m.orders(series, max_order):
             found.append(((not m.steps, 0 if m.steps else order, rank),
-                          Candidate(m, order, num, den, masked)))
+                          Candidate(order, num, den, m, masked)))
     found.sort(key=lambda item: item[0])
     return tuple(c for _, c in found)

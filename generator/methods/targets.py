@@ -5,7 +5,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -40,15 +39,12 @@ from ..lower.records import (
     MuDampedDerivation,
     MuDerivation,
     NotesTable,
+    PeriodFormula,
     Unit,
 )
 from ..lower.series import lower_free, lower_limit_cycle, lower_mathieu, lower_tongue
 from ..numerics.shooting import shoot
 from .verify import resum_cycle, resum_mathieu, resum_tongue
-
-if TYPE_CHECKING:
-    from .registry import Candidate
-
 
 Progress = Callable[[int, int], None]
 # NOTE: the one progress callback (done, total) every long derivation takes; the command line
@@ -65,7 +61,7 @@ class Request:
     command: str
     model: Model | SelfExcited | None = None
     allow_divergent: bool = False
-    candidate: Candidate | None = None
+    formula: PeriodFormula | None = None  # choose --emit: the chosen period formula
     verified: tuple[float, float] = (0.0, 0.0)
     mathieu: tuple[str, int] | None = None  # (kind, m) of a Mathieu characteristic value
     tongue: tuple[str, int] | None = None  # (p(t) as text, n) of a tongue's transition curves
@@ -217,11 +213,11 @@ def _fourier_lower(harmonics: object, r: Request) -> Unit:
 
 
 def _choice_derive(r: Request, progress: Progress | None) -> object:
-    return r.candidate  # derived and verified by choose
+    return r.formula  # derived and verified by choose
 
 
-def _choice_lower(c: object, r: Request) -> Unit:
-    return Unit(lower_choice(c.method.formula(c), r.command, r.verified))
+def _choice_lower(formula: object, r: Request) -> Unit:
+    return Unit(lower_choice(formula, r.command, r.verified))
 
 
 FREE = Target(_free_files, _free_derive, _free_lower)
