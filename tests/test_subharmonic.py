@@ -153,3 +153,57 @@ def test_mixing_of_a_quadratic_and_cubic_force_against_dop853():
             assert abs(tone.predicted - truth[k]) <= 1e-3 * truth[k]
         labels.add(tone.combination)
     assert (-1, 1) in labels and (1, 1) in labels  # ω₂ − ω₁, ω₁ + ω₂
+
+
+def _primary_multipliers(problem, force, y0):
+    """The primary response's Floquet multipliers over one drive period by DOP853: Newton on
+    its period map from ``y0``, the monodromy by central differences."""
+    T = 2 * math.pi / problem.drive
+    rhs = _rhs(problem.terms, force, problem.drive)
+
+    def flow(y):
+        return solve_ivp(rhs, (0, T), y, method="DOP853", rtol=1e-12, atol=1e-13).y[:, -1]
+
+    def monodromy(y, h=1e-6):
+        return np.column_stack([(flow(y + h * e) - flow(y - h * e)) / (2 * h)
+                                for e in np.eye(2)])
+
+    y = np.array(y0, dtype=float)
+    for _ in range(20):
+        step = np.linalg.solve(monodromy(y) - np.eye(2), -(flow(y) - y))
+        y = y + step
+        if np.max(np.abs(step)) < 1e-11:
+            break
+    return np.linalg.eigvals(monodromy(y))
+
+
+def test_a_branch_point_onset_is_the_primary_period_doubling():
+    """The 1/2 orbit of q² grows out of the primary response: its onset is where the primary's
+    Floquet multiplier (one drive period, by DOP853) passes −1 — inside (−1, 0) 1e-5 below
+    it, below −1 1e-5 above; and it says so ("bifurcation")."""
+    text, values, n, omega = QUADRATIC
+    problem = subharmonic_equation(text, values, omega, n)
+    onset = subharmonic_orbits(problem).onset
+    assert onset.kind == "bifurcation"
+    start = subharmonic_orbits(problem, onset=False).primary.orbit.initial
+    below = _primary_multipliers(problem, onset.force * (1 - 1e-5), start)
+    above = _primary_multipliers(problem, onset.force * (1 + 1e-5), start)
+    assert min(below.real) > -1 > min(above.real)
+    assert np.all(np.abs(below.imag) < 1e-9) and np.all(np.abs(above.imag) < 1e-9)
+
+
+def test_an_odd_force_breaks_its_symmetry_into_a_half_subharmonic():
+    """q³ alone does not feed the 1/2 subharmonic at first order (a note says so), yet at a
+    strong drive its symmetry breaks: orbits of 2 drive periods with even harmonics, which
+    DOP853 closes after two drive periods and not after one."""
+    weak = subharmonic_orbits(subharmonic_equation("x'' + 0.1*x' + x + x**3 = f*cos(w*t)",
+                                                   {"f": "1/2"}, 1.0, 2), onset=False)
+    assert not weak.exists and "no nonlinear term of even degree" in weak.note
+    problem = subharmonic_equation("x'' + 0.1*x' + x + x**3 = f*cos(w*t)", {"f": "10"}, 2.0, 2)
+    found = subharmonic_orbits(problem, onset=False)
+    stable = [o for o in found.orbits if o.stable]
+    assert stable and all(abs(o.A.get(0, 0.0)) > 0.1 for o in stable)  # a mean: even terms
+    for o in stable:
+        y0 = o.orbit.initial
+        assert np.max(np.abs(_flow(problem, y0, 2) - y0)) < 1e-8
+        assert np.max(np.abs(_flow(problem, y0, 1) - y0)) > 1e-2

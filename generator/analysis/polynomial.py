@@ -322,6 +322,9 @@ def driven_form(text: str, values: dict[str, str], name: str, method: str, why: 
                          "equilibrium")
     drive = sp.expand(osc.drive)
     if drive == 0:
+        if values and oscillator(text, {}, name).drive != 0:
+            raise osc.refuse(method, "the drive vanishes with the values given (a zero "
+                             "amplitude): give it a nonzero one")
         raise osc.refuse(method, f"no drive: write it on the right, e.g. {q}'' + ... = "
                          "f*cos(w*t)")
     drives = []

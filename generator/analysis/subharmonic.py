@@ -23,6 +23,7 @@ from ..limits import SUBHARMONIC_MAX_N as MAX_N
 from ..limits import check_int
 from ..numerics.floquet import hill_multipliers, multipliers_stable, orbit_hill_multipliers
 from ..numerics.integrate import ForceTable, duffing_table, steady_state_amplitudes
+from ..numerics.newton import newton
 from ..numerics.shooting import PeriodicOrbit, shoot, shoot_table
 from .continuation import _corrector, _DriveFamily, _tangent
 from .driven import Drive
@@ -186,7 +187,8 @@ def subharmonic_equation(text: str, values: dict[str, str], omega: float | None,
     if not (math.isfinite(omega) and omega > 0):
         raise InputError(f"--omega {omega!r}: must be finite and > 0")
     terms = form.floats()
-    check_coupling(terms, n, where)
+    if not any(a + b >= 2 for a, b in terms):
+        raise InputError(where + "a linear force has no subharmonic (give a nonlinear term)")
     notes = n == 3 and set(terms) <= {(1, 0), (3, 0)} and terms.get((1, 0)) == 1.0 \
         and terms.get((3, 0), 0.0) != 0
     return SubharmonicProblem(terms, force, float(omega), n, form.values,
@@ -203,17 +205,22 @@ def check_n(n: object) -> None:
               "(the orbit of n drive periods; n = 1 is `lindstedt response`)")
 
 
-def check_coupling(terms: dict[tuple[int, int], float], n: int, where: str = "") -> None:
-    """Refuse a force that cannot feed the 1/n subharmonic: the drive's harmonic n reaches the
-    first through a term of degree d ≡ n (mod 2) (``q̄₁^(d−1)·q_n`` and its like); an odd force
-    (every degree odd) keeps only odd harmonics, so 1/2 needs an even term, 1/3 an odd one."""
+def coupling_note(terms: dict[tuple[int, int], float], n: int) -> str | None:
+    """Why the 1/n subharmonic may be weak or absent, or ``None``: at first order the drive's
+    harmonic n reaches the first only through a term of degree d ≡ n (mod 2)
+    (``q̄₁^(d−1)·q_n`` and its like).  Without one it is not fed at first order — it can still
+    appear at larger drives (symmetry breaking of an odd force, whose 1/2 orbits carry even
+    harmonics) or through higher orders (a quadratic force's 1/3 at second order)."""
     degrees = sorted({a + b for a, b in terms if a + b >= 2})
-    if not any(d % 2 == n % 2 for d in degrees):
-        kind = "an even power such as q**2" if n % 2 == 0 else "an odd power such as q**3"
-        have = ", ".join(map(str, degrees)) if degrees else "none (a linear force)"
-        raise InputError(where + f"the 1/{n} subharmonic needs a nonlinear term of "
-                         f"{'even' if n % 2 == 0 else 'odd'} degree ({kind}); the force's "
-                         f"nonlinear degrees: {have}")
+    if not degrees:
+        return "a linear force has no subharmonic"
+    if any(d % 2 == n % 2 for d in degrees):
+        return None
+    kind = "even" if n % 2 == 0 else "odd"
+    return (f"the force has no nonlinear term of {kind} degree (its degrees: "
+            f"{', '.join(map(str, degrees))}): the 1/{n} subharmonic is not fed at first "
+            "order; it can still appear at a larger drive (symmetry breaking) or through "
+            "higher orders")
 
 
 @dataclass(frozen=True)
@@ -278,6 +285,7 @@ class SubharmonicResponse:
     primary: SubharmonicOrbit | None
     onset: Onset | None
     seeds: int
+    note: str | None = None  # coupling_note: why the orbits may be weak or absent
 
     @property
     def exists(self) -> bool:
@@ -361,16 +369,15 @@ def subharmonic_orbits(problem: SubharmonicProblem, harmonics: int = 12,
     the onset of the first (largest) one (:func:`subharmonic_onset`)."""
     p = problem
     check_n(p.n)
-    check_coupling(p.terms, p.n)
-    odd = all((a + b) % 2 == 1 for a, b in p.terms)
+    # odd harmonics only where both the force and n are odd: an odd force's 1/2 orbits break
+    # its symmetry and carry the even harmonics too
+    odd = p.n % 2 == 1 and all((a + b) % 2 == 1 for a, b in p.terms)
     harmonics = max(harmonics, p.n + 1)
     system = PolynomialBalance(p.terms, p.force, harmonics, odd, drive_harmonic=p.n)
     coarse = PolynomialBalance(p.terms, p.force, min(harmonics, p.n + 2), odd,
                                drive_harmonic=p.n)
     omega = p.omega
-    x_primary, ok, _ = system.solve(np.zeros(system.size), omega)
-    primary_x = x_primary if ok and _first(system, x_primary) < 1e-9 * (
-        1 + np.max(np.abs(x_primary))) else None
+    primary_x = _primary(system, p, p.force)
     scale = _scale(p.terms, omega, p.force)
     base = np.zeros(coarse.size) if primary_x is None else coarse.vector(
         *system.amplitudes(primary_x))
@@ -398,7 +405,27 @@ def subharmonic_orbits(problem: SubharmonicProblem, harmonics: int = 12,
     primary = None if primary_x is None else _shot(system, table, p, primary_x, periods=1)
     start = onset and orbits
     return SubharmonicResponse(p, harmonics, tuple(orbits), primary,
-                               subharmonic_onset(system, p, found) if start else None, count)
+                               subharmonic_onset(system, p, found) if start else None, count,
+                               coupling_note(p.terms, p.n))
+
+
+def _primary(system: PolynomialBalance, p: SubharmonicProblem, force: float,
+             start: np.ndarray | None = None) -> np.ndarray | None:
+    """The primary response (harmonics n, 2n, … of ω only) at drive amplitude ``force``:
+    Newton from ``start``, or from the linear response ``f/(k − (nω)²)`` on cos nωt, then from
+    rest; ``None`` where neither converges."""
+    k = p.terms.get((1, 0), 1.0)
+    linear = np.zeros(system.size)
+    index = int(np.nonzero(system.orders == p.n)[0][0])
+    gap = k - (p.n * p.omega) ** 2
+    if gap:
+        linear[index] = force / gap
+    for x0 in ([start] if start is not None else []) + [linear, np.zeros(system.size)]:
+        x, ok, _ = newton(lambda z: system.residual(z, p.omega, force),
+                          lambda z: system.jacobian(z, p.omega), x0)
+        if ok and _first(system, x) < 1e-9 * (1 + np.max(np.abs(x))):
+            return x
+    return None
 
 
 def _shot(system: PolynomialBalance, table: ForceTable, p: SubharmonicProblem, x: np.ndarray,
@@ -422,24 +449,33 @@ def _shot(system: PolynomialBalance, table: ForceTable, p: SubharmonicProblem, x
     return SubharmonicOrbit(A, B, residual, None, None)
 
 
+BRANCH_SHARE = 0.25
+# NOTE: where f turns back with the first harmonic below a quarter of the orbit's, the path
+# went through the primary response: a branch point (period doubling for n = 2), not a fold;
+# at a fold both orbits keep a first harmonic of the orbit's size.
+
+
 def subharmonic_onset(system: PolynomialBalance, p: SubharmonicProblem,
                       starts: list[np.ndarray]) -> Onset:
     """Continue each orbit in the drive amplitude (pseudo-arclength, f decreasing) to where it
-    ends: a fold (f turns back), the primary response (the first harmonic falls to 0), or
+    ends: a fold (f turns back; refined by the secant on the tangent's f-component), a branch
+    point off the primary response (f turns back where the first harmonic passes 0; refined
+    by bisection on the sign of the balance Jacobian's determinant along the primary), or
     f = 0; the smallest such f over the orbits."""
     fam = _DriveFamily(system, p.omega)
     best = Onset(math.inf, "none")
     for x in starts:
         y = np.append(x, p.force)
+        r_start = _first(system, x)
         size = 1 + float(np.max(np.abs(x))) + abs(p.force)
         h = size / 200
+        low = None
         with np.errstate(all="ignore"):
             try:
                 t = _tangent(fam, y, None)
             except np.linalg.LinAlgError:
                 continue
             t = -t if t[-1] > 0 else t  # toward smaller f
-            low = Onset(p.force, "fold")
             for _ in range(ONSET_POINTS):
                 try:
                     y_new = _corrector(fam, y + h * t, t)
@@ -455,15 +491,77 @@ def subharmonic_onset(system: PolynomialBalance, p: SubharmonicProblem,
                 if y_new[-1] <= 0:
                     low = Onset(0.0, "none")
                     break
-                if _first(system, y_new[:-1]) < 1e-6 * size:
-                    low = Onset(float(y_new[-1]), "bifurcation")
-                    break
-                if t_new[-1] > 0 and t[-1] <= 0:  # f turned back: the fold lies between
-                    low = Onset(float(min(y[-1], y_new[-1])), "fold")
+                if t_new[-1] > 0 and t[-1] <= 0:  # f turned back between y and y_new
+                    low = _turn(system, fam, p, y, t, y_new, r_start)
                     break
                 y, t = y_new, t_new
-                low = Onset(float(y[-1]), "fold")
                 h = min(1.5 * h, size / 50)
-        if low.force < best.force:
+        if low is not None and low.force < best.force:
             best = low
     return best
+
+
+def _turn(system: PolynomialBalance, fam: _DriveFamily, p: SubharmonicProblem, y: np.ndarray,
+          t: np.ndarray, y_new: np.ndarray, r_start: float) -> Onset:
+    """The onset where the continuation turned back between ``y`` and ``y_new``: the point
+    where the tangent's f-component vanishes (secant on the step), a branch point when the
+    first harmonic there has fallen below :data:`BRANCH_SHARE` of the orbit's (its drive
+    amplitude then polished on the primary response), a fold otherwise."""
+    step = float(np.linalg.norm(y_new - y))
+    z = None
+    try:
+        h0, h1 = 0.0, step
+        f0, f1 = t[-1], _tangent(fam, _corrector(fam, y + step * t, t), t)[-1]
+        for _ in range(40):
+            if f1 == f0:
+                break
+            h2 = h1 - f1 * (h1 - h0) / (f1 - f0)
+            z = _corrector(fam, y + h2 * t, t)
+            f2 = _tangent(fam, z, t)[-1]
+            h0, f0, h1, f1 = h1, f1, h2, f2
+            if abs(f2) < 1e-13:
+                break
+    except np.linalg.LinAlgError:
+        z = None
+    lo, hi = min(y[-1], y_new[-1]), max(y[-1], y_new[-1])
+    if z is None or not np.all(np.isfinite(z)) or not lo - step <= z[-1] <= hi + step:
+        z = y_new if y_new[-1] < y[-1] else y
+    r_turn = min(_first(system, z[:-1]), _first(system, y[:-1]), _first(system, y_new[:-1]))
+    if r_turn < BRANCH_SHARE * r_start:
+        f = _branch_point(system, p, min(lo, z[-1]), max(hi, z[-1]))
+        return Onset(float(z[-1]) if f is None else f, "bifurcation")
+    return Onset(float(z[-1]), "fold")
+
+
+def _branch_point(system: PolynomialBalance, p: SubharmonicProblem, lo: float,
+                  hi: float) -> float | None:
+    """The drive amplitude in about ``[lo, hi]`` where the primary response's balance Jacobian
+    is singular (the 1/n orbits leave it there), by bisection on the sign of its determinant
+    (the bracket widened until the sign changes); ``None`` where no change is found."""
+    def sign(f: float, start: np.ndarray | None) -> tuple[float, np.ndarray | None]:
+        x = _primary(system, p, f, start)
+        if x is None:
+            return 0.0, None
+        return float(np.linalg.slogdet(system.jacobian(x, p.omega))[0]), x
+
+    width = max(hi - lo, 1e-9 * (1 + abs(hi)))
+    for _ in range(20):
+        s_lo, x_lo = sign(lo, None)
+        s_hi, _ = sign(hi, x_lo)
+        if s_lo and s_hi and s_lo != s_hi:
+            break
+        lo, hi, width = max(lo - width, 0.0), hi + width, 2 * width
+    else:
+        return None
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        s_mid, x_mid = sign(mid, x_lo)
+        if not s_mid:
+            return None
+        if s_mid == s_lo:
+            lo, x_lo = mid, x_mid
+        else:
+            hi = mid
+        if hi - lo <= 1e-13 * (1 + abs(hi)):
+            break
+    return 0.5 * (lo + hi)

@@ -514,6 +514,7 @@ def subharmonic_orbits_json(found) -> dict:
         "onset": None if found.onset is None else {"force": found.onset.force,
                                                    "kind": found.onset.kind},
         "seeds": found.seeds,
+        "note": found.note,
     }
 
 
@@ -578,11 +579,16 @@ def _orbits_table(data: dict) -> list[str]:
         lines.append(f"  orbit {i}: r = {o['r']:.8f} (A1 = {o['A']['1']:.8f}, "
                      f"B1 = {o['B']['1']:.8f}); {verdict}")
     pr = data["primary"]
-    if pr is not None:
+    if pr is None:
+        lines.append("  primary response (one drive period): not found (Newton from the linear "
+                     "response and from rest did not converge)")
+    else:
         lines.append(f"  primary response (one drive period): harmonic {n} amplitude "
                      f"{pr['amplitude']:.8f}, "
                      + ("not shot" if pr["stable"] is None else
                         "stable" if pr["stable"] else "unstable"))
+    if data.get("note"):
+        lines.append(f"  note: {data['note']}")
     on = data["onset"]
     if on is not None:
         how = "a fold" if on["kind"] == "fold" else "a bifurcation off the primary response"
