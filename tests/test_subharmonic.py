@@ -153,6 +153,9 @@ def test_mixing_of_a_quadratic_and_cubic_force_against_dop853():
             assert abs(tone.predicted - truth[k]) <= 1e-3 * truth[k]
         labels.add(tone.combination)
     assert (-1, 1) in labels and (1, 1) in labels  # ω₂ − ω₁, ω₁ + ω₂
+    mean = np.mean(q)  # the quadratic term's offset, against the series' constant part
+    assert abs(series.mean - mean) <= series.expansion_parameter**3 * size
+    assert abs(series.mean - mean) <= 0.05 * abs(mean)
 
 
 def _primary_multipliers(problem, force, y0):

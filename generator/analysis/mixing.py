@@ -76,6 +76,7 @@ class MixingSeries:
     """The combination tones to second order and the verdict on the expansion."""
 
     tones: tuple[Tone, ...]
+    mean: float  # the response's constant part (an even force's offset; 0 for an odd one)
     expansion_parameter: float  # ρ = max(‖q₁‖/‖q₀‖, ‖q₂‖/‖q₁‖)
     converged: bool  # ρ ≤ MIXING_CONVERGED
     reason: str
@@ -169,6 +170,7 @@ def mixing_series(table: ForceTable, drives: list[tuple[float, float]]) -> Mixin
         raise InputError(f"drives {' '.join(f'{f:g}@{w:g}' for f, w in drives)}: the linear "
                          f"response {2 * size:.3g} makes the second-order tones overflow; the "
                          "expansion needs the nonlinear force small beside the linear one")
+    mean = float(sum(part.get(zero, 0) for part in (q0, q1, q2)).real)
     tones: dict = {}
     for order, part in ((0, q0), (1, q1), (2, q2)):
         for c, v in part.items():
@@ -192,7 +194,7 @@ def mixing_series(table: ForceTable, drives: list[tuple[float, float]]) -> Mixin
     ordered = sorted((Tone(c, nu, float(2 * abs(v)), order)
                       for nu, (c, v, order) in tones.items()),
                      key=lambda tone: (tone.order, tone.frequency))
-    return MixingSeries(tuple(ordered), rho, converged, reason)
+    return MixingSeries(tuple(ordered), mean, rho, converged, reason)
 
 
 def simulated_fit(table: ForceTable, drives: list[tuple[float, float]],

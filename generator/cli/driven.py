@@ -723,6 +723,7 @@ def mixing_tones_json(table, drives: list[tuple[float, float]]) -> dict:
         "converged": series.converged,
         "reason": series.reason,
         "simulated_rms_residual": fit.rms_residual,
+        "mean": {"predicted": series.mean, "simulated": fit.mean},
         "tones": [{"frequency": t.frequency, "combination": tone_label(t.combination),
                    "order": t.order, "predicted": t.predicted, "simulated": float(a),
                    "simulated_uncertainty": float(u), "resolved": bool(a > 3 * u)}
@@ -777,9 +778,13 @@ def _mixing_table(data: dict) -> list[str]:
             f"q'' + q'/Q + q + eps q^3 = sum f_i cos(w_i t): eps = {p['eps']}, Q = {p['Q']}, ")
     lines = [head + ", ".join(f"w{i} = {d['omega']} (f = {d['force']})"
                          for i, d in enumerate(p["drives"], 1)),
-             ("" if data["converged"] else "warning: ") + data["reason"],
-             f"{'tone':>12} {'frequency':>10} {'order':>6} {'predicted':>11} {'simulated':>11} "
-             f"{'+/-':>9}"]
+             ("" if data["converged"] else "warning: ") + data["reason"]]
+    mean = data["mean"]
+    if mean["predicted"] != 0:  # an even term's offset (an odd force has none)
+        lines.append(f"mean (offset): predicted {mean['predicted']:.3e}, simulated "
+                     f"{mean['simulated']:.3e}")
+    lines.append(f"{'tone':>12} {'frequency':>10} {'order':>6} {'predicted':>11} "
+                 f"{'simulated':>11} {'+/-':>9}")
     for t in data["tones"]:
         lines.append(f"{t['combination']:>12} {t['frequency']:>10.4f} {t['order']:>6} "
                      f"{t['predicted']:>11.3e} {t['simulated']:>11.3e} "

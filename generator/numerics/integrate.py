@@ -409,6 +409,7 @@ class ToneFit:
     amplitudes: np.ndarray
     uncertainty: np.ndarray
     rms_residual: float
+    mean: float = math.nan  # the steady state's mean (the constant of the fit)
 
 
 def steady_state_amplitudes(table: ForceTable, forces: list[float],
@@ -483,4 +484,4 @@ def steady_state_fit(table: ForceTable, forces: list[float],
     with np.errstate(invalid="ignore", divide="ignore"):
         var = np.where(amp > 0, (c * c * var_c + s * s * var_s + 2 * c * s * cov_cs)
                        / np.where(amp > 0, amp * amp, 1.0), (var_c + var_s) / 2)
-    return ToneFit(amp, np.sqrt(np.maximum(var, 0.0)), math.sqrt(sigma2))
+    return ToneFit(amp, np.sqrt(np.maximum(var, 0.0)), math.sqrt(sigma2), float(coef[0]))
