@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Generic, TypeVar
 
 import numpy as np
 
@@ -16,14 +17,17 @@ from ..analysis.driven import (
     mu_expansion,
 )
 from ..analysis.mu_exact import (
+    BalanceEquations,
+    MuDampedOrder,
+    MuOrder,
     balance_equations,
     damped_determinant,
     mu_expansion_damped,
     mu_expansion_exact,
 )
-from ..derive.averaging import slow_flow
-from ..derive.cycles import derive_limit_cycle
-from ..derive.lindstedt import derive
+from ..derive.averaging import SlowFlow, slow_flow
+from ..derive.cycles import LimitCycle, derive_limit_cycle
+from ..derive.lindstedt import SeriesSolution, derive
 from ..derive.models import Model, SelfExcited
 from ..errors import InputError
 from ..limits import FOURIER_MAX_HARMONICS, check_int
@@ -40,6 +44,9 @@ from ..lower.records import (
     MuDerivation,
     NotesTable,
     PeriodFormula,
+    ResummedCycle,
+    ResummedMathieu,
+    ResummedTongue,
     Unit,
 )
 from ..lower.series import lower_free, lower_limit_cycle, lower_mathieu, lower_tongue
@@ -68,14 +75,18 @@ class Request:
     resum_order: int | None = None  # a limit cycle's ω series for the radius and resummation
 
 
+Derived = TypeVar("Derived")
+
+
 @dataclass(frozen=True)
-class Target:
+class Target(Generic[Derived]):
     """What a method emits: its files, and its derive and lower stages (the compiler calls
-    each once, in order, then renders and writes)."""
+    each once, in order, then renders and writes), typed in what the derivation hands the
+    lowering (``Target[SeriesSolution]``, ``Target[ResummedMathieu]``, …)."""
 
     files: Callable[[Request], tuple[str, ...]]
-    derive: Callable[[Request, Progress | None], object]
-    lower: Callable[[object, Request], Unit]
+    derive: Callable[[Request, Progress | None], Derived]
+    lower: Callable[[Derived, Request], Unit]
 
 
 def _free_files(r: Request) -> tuple[str, ...]:
@@ -83,11 +94,11 @@ def _free_files(r: Request) -> tuple[str, ...]:
     return (f"{name}.py", f"{name}_tables.tex", f"{name}_derivation.tex")
 
 
-def _free_derive(r: Request, progress: Progress | None) -> object:
+def _free_derive(r: Request, progress: Progress | None) -> SeriesSolution:
     return derive(r.model, r.order + 2, progress)
 
 
-def _free_lower(solution: object, r: Request) -> Unit:
+def _free_lower(solution: SeriesSolution, r: Request) -> Unit:
     module = lower_free(solution, r.command, r.allow_divergent)
     return Unit(module, (lower_derivation(solution, r.order),))
 
@@ -108,7 +119,8 @@ def cycle_series_order(order: int, resum_order: int | None) -> int:
     return max(order + 2, RADIUS_ORDER if resum_order is None else resum_order)
 
 
-def _cycle_derive(r: Request, progress: Progress | None) -> object:
+def _cycle_derive(r: Request, progress: Progress | None
+                  ) -> tuple[LimitCycle, ResummedCycle | None]:
     from ..derive.cycles import limit_cycles
 
     first = limit_cycles(r.model)[0]
@@ -121,7 +133,7 @@ def _cycle_derive(r: Request, progress: Progress | None) -> object:
     return lc, resum_cycle(lc)
 
 
-def _cycle_lower(derived: object, r: Request) -> Unit:
+def _cycle_lower(derived: tuple[LimitCycle, ResummedCycle | None], r: Request) -> Unit:
     import sys
 
     cycle, resummed = derived
@@ -141,21 +153,21 @@ def _mathieu_files(r: Request) -> tuple[str, ...]:
     return (f"mathieu_{kind}{m}.py",)
 
 
-def _mathieu_derive(r: Request, progress: Progress | None) -> object:
+def _mathieu_derive(r: Request, progress: Progress | None) -> ResummedMathieu:
     kind, m = r.mathieu
     return resum_mathieu(kind, m, r.order)
 
 
-def _mathieu_lower(derived: object, r: Request) -> Unit:
+def _mathieu_lower(derived: ResummedMathieu, r: Request) -> Unit:
     return Unit(lower_mathieu(derived, r.command))
 
 
-def _tongue_derive(r: Request, progress: Progress | None) -> object:
+def _tongue_derive(r: Request, progress: Progress | None) -> ResummedTongue:
     text, n = r.tongue
     return resum_tongue(text, n, r.order)
 
 
-def _tongue_lower(derived: object, r: Request) -> Unit:
+def _tongue_lower(derived: ResummedTongue, r: Request) -> Unit:
     return Unit(lower_tongue(derived, r.command))
 
 
@@ -185,45 +197,51 @@ def notes_table() -> NotesTable:
     return NotesTable(eps, force, omega, tuple(rows))
 
 
-def _mu_derive(r: Request, progress: Progress | None) -> object:
+def _mu_derive(r: Request, progress: Progress | None
+               ) -> tuple[tuple[MuOrder, ...], NotesTable]:
     return mu_expansion_exact(r.order), notes_table()
 
 
-def _mu_lower(derived: object, r: Request) -> Unit:
+def _mu_lower(derived: tuple[tuple[MuOrder, ...], NotesTable], r: Request) -> Unit:
     orders, table = derived
     return Unit(lower_driven(orders, r.command), (MuDerivation(r.order, orders, table),))
 
 
-def _balance_derive(r: Request, progress: Progress | None) -> object:
+def _balance_derive(r: Request, progress: Progress | None) -> BalanceEquations:
     return balance_equations(r.order)
 
 
-def _balance_lower(eqs: object, r: Request) -> Unit:
+def _balance_lower(eqs: BalanceEquations, r: Request) -> Unit:
     return Unit(lower_balance(eqs, r.command))
 
 
-def _fourier_derive(r: Request, progress: Progress | None) -> object:
+def _fourier_derive(r: Request, progress: Progress | None) -> int:
     harmonics = r.order
     return check_int(harmonics, 1, FOURIER_MAX_HARMONICS,
                      f"harmonics {harmonics!r}: must be an integer in 1..{FOURIER_MAX_HARMONICS}")
 
 
-def _fourier_lower(harmonics: object, r: Request) -> Unit:
+def _fourier_lower(harmonics: int, r: Request) -> Unit:
     return Unit(lower_fourier(harmonics, r.command))
 
 
-def _choice_derive(r: Request, progress: Progress | None) -> object:
+def _choice_derive(r: Request, progress: Progress | None) -> PeriodFormula:
+    if r.formula is None:
+        raise InputError("choose --emit: no period formula was chosen to emit")
     return r.formula  # derived and verified by choose
 
 
-def _choice_lower(formula: object, r: Request) -> Unit:
+def _choice_lower(formula: PeriodFormula, r: Request) -> Unit:
     return Unit(lower_choice(formula, r.command, r.verified))
 
 
-FREE = Target(_free_files, _free_derive, _free_lower)
-LIMIT_CYCLE = Target(_cycle_files, _cycle_derive, _cycle_lower)
-MU = Target(lambda r: ("driven.py", "driven_derivation.tex"), _mu_derive, _mu_lower)
-BALANCE = Target(lambda r: ("balance.py",), _balance_derive, _balance_lower)
+FREE: Target[SeriesSolution] = Target(_free_files, _free_derive, _free_lower)
+LIMIT_CYCLE: Target[tuple[LimitCycle, ResummedCycle | None]] = Target(
+    _cycle_files, _cycle_derive, _cycle_lower)
+MU: Target[tuple[tuple[MuOrder, ...], NotesTable]] = Target(
+    lambda r: ("driven.py", "driven_derivation.tex"), _mu_derive, _mu_lower)
+BALANCE: Target[BalanceEquations] = Target(
+    lambda r: ("balance.py",), _balance_derive, _balance_lower)
 
 
 DAMPED_MAX = 11
@@ -231,25 +249,28 @@ DAMPED_MAX = 11
 # more estimates the truncation error); interpreted, it is the float μ-expansion's solve.
 
 
-def _mu_damped_derive(r: Request, progress: Progress | None) -> object:
-    if isinstance(r.order, bool) or not isinstance(r.order, int) or not 1 <= r.order <= DAMPED_MAX:
-        raise InputError(f"order {r.order!r}: the damped μ-expansion is emitted at orders "
-                         f"1..{DAMPED_MAX}")
+def _mu_damped_derive(r: Request, progress: Progress | None) -> tuple[MuDampedOrder, ...]:
+    check_int(r.order, 1, DAMPED_MAX, f"order {r.order!r}: the damped μ-expansion is emitted "
+              f"at orders 1..{DAMPED_MAX}")
     return mu_expansion_damped(r.order + 1)  # one order more: the truncation error's estimate
 
 
-def _mu_damped_lower(orders: object, r: Request) -> Unit:
+def _mu_damped_lower(orders: tuple[MuDampedOrder, ...], r: Request) -> Unit:
     return Unit(lower_driven_damped(orders, r.command),
                 (MuDampedDerivation(r.order, orders[: r.order], damped_determinant()),))
 
 
-MU_DAMPED = Target(lambda r: ("driven_damped.py", "driven_damped_derivation.tex"),
-                   _mu_damped_derive, _mu_damped_lower)
-FOURIER = Target(lambda r: ("fourier.py",), _fourier_derive, _fourier_lower)
-CHOSEN_PERIOD = Target(lambda r: ("chosen_period.py",), _choice_derive, _choice_lower)
-SLOW_FLOW = Target(lambda r: (f"{r.model.name}_slow_flow.py", f"{r.model.name}_slow_flow.tex"),
-                   lambda r, progress: slow_flow(r.model, r.order),
-                   lambda flow, r: lower_slow_flow(flow, r.command))
+MU_DAMPED: Target[tuple[MuDampedOrder, ...]] = Target(
+    lambda r: ("driven_damped.py", "driven_damped_derivation.tex"), _mu_damped_derive,
+    _mu_damped_lower)
+FOURIER: Target[int] = Target(lambda r: ("fourier.py",), _fourier_derive, _fourier_lower)
+CHOSEN_PERIOD: Target[PeriodFormula] = Target(
+    lambda r: ("chosen_period.py",), _choice_derive, _choice_lower)
+SLOW_FLOW: Target[SlowFlow] = Target(
+    lambda r: (f"{r.model.name}_slow_flow.py", f"{r.model.name}_slow_flow.tex"),
+    lambda r, progress: slow_flow(r.model, r.order),
+    lambda flow, r: lower_slow_flow(flow, r.command))
 # NOTE: the slow flow's request carries the user's models.Oscillator as its model.
-MATHIEU = Target(_mathieu_files, _mathieu_derive, _mathieu_lower)
-TONGUE = Target(lambda r: (f"tongue_{r.tongue[1]}.py",), _tongue_derive, _tongue_lower)
+MATHIEU: Target[ResummedMathieu] = Target(_mathieu_files, _mathieu_derive, _mathieu_lower)
+TONGUE: Target[ResummedTongue] = Target(
+    lambda r: (f"tongue_{r.tongue[1]}.py",), _tongue_derive, _tongue_lower)
