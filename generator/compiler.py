@@ -28,9 +28,16 @@ from .methods.targets import (
     MU_DAMPED,
     SLOW_FLOW,
     TONGUE,
+    ChoiceRequest,
+    CycleRequest,
+    FreeRequest,
+    HarmonicsRequest,
+    MathieuRequest,
     Progress,
     Request,
+    SlowFlowRequest,
     Target,
+    TongueRequest,
 )
 
 
@@ -63,7 +70,7 @@ def generate(model: str | Model, order: int, out: Path, allow_divergent: bool = 
         f" --param {k}={v}" for k, v in m.given)
     command = f"lindstedt generate {source} --order {order}" + (
         " --allow-divergent" if allow_divergent else "")
-    return compile_target(FREE, Request(order, command, m, allow_divergent), out, progress,
+    return compile_target(FREE, FreeRequest(order, command, m, allow_divergent), out, progress,
                           overwrite_edited=overwrite_edited, flag=flag)
 
 
@@ -80,7 +87,7 @@ def generate_limit_cycle(model: object, order: int, out: Path, *, resum_order: i
                          "the evaluators' error estimate needs")
     command = f'lindstedt generate "{model.source}" --name {model.name} --order {order}' + (
         f" --resum-order {resum_order}" if resum_order is not None else "")
-    return compile_target(LIMIT_CYCLE, Request(order, command, model, resum_order=resum_order),
+    return compile_target(LIMIT_CYCLE, CycleRequest(order, command, model, resum_order),
                           out, overwrite_edited=overwrite_edited, flag=flag)
 
 
@@ -100,7 +107,7 @@ def generate_balance(harmonics: int, out: Path, *, overwrite_edited: bool = Fals
                      flag: str = "--out") -> list[Path]:
     """``lindstedt generate balance``: compiled harmonic-balance residual, Jacobian, Newton."""
     command = f"lindstedt generate balance --harmonics {harmonics}"
-    return compile_target(BALANCE, Request(harmonics, command), out,
+    return compile_target(BALANCE, HarmonicsRequest(harmonics, command), out,
                           overwrite_edited=overwrite_edited, flag=flag)
 
 
@@ -108,7 +115,7 @@ def generate_fourier(harmonics: int, out: Path, *, overwrite_edited: bool = Fals
                      flag: str = "--out") -> list[Path]:
     """``lindstedt generate fourier``: the exact Fourier series of the free Duffing solution."""
     command = f"lindstedt generate fourier --harmonics {harmonics}"
-    return compile_target(FOURIER, Request(harmonics, command), out,
+    return compile_target(FOURIER, HarmonicsRequest(harmonics, command), out,
                           overwrite_edited=overwrite_edited, flag=flag)
 
 
@@ -117,8 +124,8 @@ def generate_choice(candidate: Candidate, command: str, out: Path,
                     flag: str = "--emit") -> list[Path]:
     """``lindstedt choose period … --emit DIR``: just the chosen evaluator, NaN outside the
     range ``verified`` of x = εA² it was verified on."""
-    request = Request(candidate.order, command, formula=candidate.method.formula(candidate),
-                      verified=verified)
+    request = ChoiceRequest(candidate.order, command, candidate.method.formula(candidate),
+                            verified)
     return compile_target(CHOSEN_PERIOD, request, out, overwrite_edited=overwrite_edited,
                           flag=flag)
 
@@ -138,7 +145,7 @@ def generate_slow_flow(osc: object, order: int, command: str, out: Path, *,
                        overwrite_edited: bool = False, flag: str = "--out") -> list[Path]:
     """``lindstedt slowflow … --out DIR``: the compiled slow-flow right sides of the
     :class:`models.Oscillator` ``osc`` to ``order`` and the LaTeX of the flow."""
-    return compile_target(SLOW_FLOW, Request(order, command, osc), out,
+    return compile_target(SLOW_FLOW, SlowFlowRequest(order, command, osc), out,
                           overwrite_edited=overwrite_edited, flag=flag)
 
 
@@ -152,7 +159,7 @@ def generate_mathieu(kind: str, m: int, order: int, out: Path, *,
     if order < 4:
         raise InputError(f"order {order}: a resummed Mathieu evaluator needs order ≥ 4")
     command = f"lindstedt mathieu {kind} --m {m} --order {order} --emit DIR"
-    return compile_target(MATHIEU, Request(order, command, mathieu=(kind, m)), out,
+    return compile_target(MATHIEU, MathieuRequest(order, command, kind, m), out,
                           overwrite_edited=overwrite_edited, flag=flag)
 
 
@@ -171,5 +178,5 @@ def generate_tongue(p: str, n: int, order: int, out: Path, *, overwrite_edited: 
         raise InputError(f"order {order}: resummed transition curves need order ≥ "
                          f"{TONGUE_MIN_ORDER}")
     command = f"lindstedt tongues {shlex.quote(p)} --n {n} --order {order} --emit DIR"
-    return compile_target(TONGUE, Request(order, command, tongue=(p, n)), out,
+    return compile_target(TONGUE, TongueRequest(order, command, p, n), out,
                           overwrite_edited=overwrite_edited, flag=flag)

@@ -28,7 +28,7 @@ from ..analysis.mu_exact import (
 from ..derive.averaging import SlowFlow, slow_flow
 from ..derive.cycles import LimitCycle, derive_limit_cycle
 from ..derive.lindstedt import SeriesSolution, derive
-from ..derive.models import Model, SelfExcited
+from ..derive.models import Model, Oscillator, SelfExcited
 from ..errors import InputError
 from ..limits import FOURIER_MAX_HARMONICS, check_int
 from ..lower.documents import (
@@ -61,49 +61,101 @@ Progress = Callable[[int, int], None]
 
 @dataclass(frozen=True)
 class Request:
-    """One emission asked for: its order (or harmonics), the command that asked, and what the
-    target needs besides (the free oscillator, the verified candidate and range)."""
+    """One emission asked for: the order of the series (or the count a target is sized by)
+    and the command that asked; each target's own request adds what it needs."""
 
     order: int
     command: str
-    model: Model | SelfExcited | None = None
+
+
+@dataclass(frozen=True)
+class FreeRequest(Request):
+    """A free oscillator's module: its model, and whether a divergent series may be emitted."""
+
+    model: Model
     allow_divergent: bool = False
-    formula: PeriodFormula | None = None  # choose --emit: the chosen period formula
-    verified: tuple[float, float] = (0.0, 0.0)
-    mathieu: tuple[str, int] | None = None  # (kind, m) of a Mathieu characteristic value
-    tongue: tuple[str, int] | None = None  # (p(t) as text, n) of a tongue's transition curves
-    resum_order: int | None = None  # a limit cycle's ω series for the radius and resummation
 
 
+@dataclass(frozen=True)
+class CycleRequest(Request):
+    """A limit cycle's module: its self-excited model and the order of the ω series that the
+    radius and the resummation use (``None``: :data:`RADIUS_ORDER`)."""
+
+    model: SelfExcited
+    resum_order: int | None = None
+
+
+@dataclass(frozen=True)
+class HarmonicsRequest(Request):
+    """A module sized by its harmonics (the balance, the Fourier period): ``order`` is the
+    number of harmonics."""
+
+    @property
+    def harmonics(self) -> int:
+        return self.order
+
+
+@dataclass(frozen=True)
+class ChoiceRequest(Request):
+    """``choose --emit``: the chosen period formula and the range it was verified on."""
+
+    formula: PeriodFormula
+    verified: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class SlowFlowRequest(Request):
+    """The slow flow of a user's oscillator (an :class:`Oscillator`, driven or not)."""
+
+    model: Oscillator
+
+
+@dataclass(frozen=True)
+class MathieuRequest(Request):
+    """Mathieu's ``a_m`` (kind "a") or ``b_m`` (kind "b") resummed."""
+
+    kind: str
+    m: int
+
+
+@dataclass(frozen=True)
+class TongueRequest(Request):
+    """The transition curves of tongue ``n`` of Hill's equation with ``p(t)`` (text)."""
+
+    p: str
+    n: int
+
+
+Asked = TypeVar("Asked", bound=Request)
 Derived = TypeVar("Derived")
 
 
 @dataclass(frozen=True)
-class Target(Generic[Derived]):
+class Target(Generic[Asked, Derived]):
     """What a method emits: its files, and its derive and lower stages (the compiler calls
-    each once, in order, then renders and writes), typed in what the derivation hands the
-    lowering (``Target[SeriesSolution]``, ``Target[ResummedMathieu]``, …)."""
+    each once, in order, then renders and writes), typed in its request and in what the
+    derivation hands the lowering (``Target[FreeRequest, SeriesSolution]``, …)."""
 
-    files: Callable[[Request], tuple[str, ...]]
-    derive: Callable[[Request, Progress | None], Derived]
-    lower: Callable[[Derived, Request], Unit]
+    files: Callable[[Asked], tuple[str, ...]]
+    derive: Callable[[Asked, Progress | None], Derived]
+    lower: Callable[[Derived, Asked], Unit]
 
 
-def _free_files(r: Request) -> tuple[str, ...]:
+def _free_files(r: FreeRequest) -> tuple[str, ...]:
     name = r.model.name
     return (f"{name}.py", f"{name}_tables.tex", f"{name}_derivation.tex")
 
 
-def _free_derive(r: Request, progress: Progress | None) -> SeriesSolution:
+def _free_derive(r: FreeRequest, progress: Progress | None) -> SeriesSolution:
     return derive(r.model, r.order + 2, progress)
 
 
-def _free_lower(solution: SeriesSolution, r: Request) -> Unit:
+def _free_lower(solution: SeriesSolution, r: FreeRequest) -> Unit:
     module = lower_free(solution, r.command, r.allow_divergent)
     return Unit(module, (lower_derivation(solution, r.order),))
 
 
-def _cycle_files(r: Request) -> tuple[str, ...]:
+def _cycle_files(r: CycleRequest) -> tuple[str, ...]:
     return (f"{r.model.name}.py", f"{r.model.name}_derivation.tex")
 
 
@@ -119,7 +171,7 @@ def cycle_series_order(order: int, resum_order: int | None) -> int:
     return max(order + 2, RADIUS_ORDER if resum_order is None else resum_order)
 
 
-def _cycle_derive(r: Request, progress: Progress | None
+def _cycle_derive(r: CycleRequest, progress: Progress | None
                   ) -> tuple[LimitCycle, ResummedCycle | None]:
     from ..derive.cycles import limit_cycles
 
@@ -133,7 +185,7 @@ def _cycle_derive(r: Request, progress: Progress | None
     return lc, resum_cycle(lc)
 
 
-def _cycle_lower(derived: tuple[LimitCycle, ResummedCycle | None], r: Request) -> Unit:
+def _cycle_lower(derived: tuple[LimitCycle, ResummedCycle | None], r: CycleRequest) -> Unit:
     import sys
 
     cycle, resummed = derived
@@ -148,26 +200,23 @@ def _cycle_lower(derived: tuple[LimitCycle, ResummedCycle | None], r: Request) -
         sys.set_int_max_str_digits(limit)
 
 
-def _mathieu_files(r: Request) -> tuple[str, ...]:
-    kind, m = r.mathieu
-    return (f"mathieu_{kind}{m}.py",)
+def _mathieu_files(r: MathieuRequest) -> tuple[str, ...]:
+    return (f"mathieu_{r.kind}{r.m}.py",)
 
 
-def _mathieu_derive(r: Request, progress: Progress | None) -> ResummedMathieu:
-    kind, m = r.mathieu
-    return resum_mathieu(kind, m, r.order)
+def _mathieu_derive(r: MathieuRequest, progress: Progress | None) -> ResummedMathieu:
+    return resum_mathieu(r.kind, r.m, r.order)
 
 
-def _mathieu_lower(derived: ResummedMathieu, r: Request) -> Unit:
+def _mathieu_lower(derived: ResummedMathieu, r: MathieuRequest) -> Unit:
     return Unit(lower_mathieu(derived, r.command))
 
 
-def _tongue_derive(r: Request, progress: Progress | None) -> ResummedTongue:
-    text, n = r.tongue
-    return resum_tongue(text, n, r.order)
+def _tongue_derive(r: TongueRequest, progress: Progress | None) -> ResummedTongue:
+    return resum_tongue(r.p, r.n, r.order)
 
 
-def _tongue_lower(derived: ResummedTongue, r: Request) -> Unit:
+def _tongue_lower(derived: ResummedTongue, r: TongueRequest) -> Unit:
     return Unit(lower_tongue(derived, r.command))
 
 
@@ -207,40 +256,38 @@ def _mu_lower(derived: tuple[tuple[MuOrder, ...], NotesTable], r: Request) -> Un
     return Unit(lower_driven(orders, r.command), (MuDerivation(r.order, orders, table),))
 
 
-def _balance_derive(r: Request, progress: Progress | None) -> BalanceEquations:
-    return balance_equations(r.order)
+def _balance_derive(r: HarmonicsRequest, progress: Progress | None) -> BalanceEquations:
+    return balance_equations(r.harmonics)
 
 
-def _balance_lower(eqs: BalanceEquations, r: Request) -> Unit:
+def _balance_lower(eqs: BalanceEquations, r: HarmonicsRequest) -> Unit:
     return Unit(lower_balance(eqs, r.command))
 
 
-def _fourier_derive(r: Request, progress: Progress | None) -> int:
-    harmonics = r.order
+def _fourier_derive(r: HarmonicsRequest, progress: Progress | None) -> int:
+    harmonics = r.harmonics
     return check_int(harmonics, 1, FOURIER_MAX_HARMONICS,
                      f"harmonics {harmonics!r}: must be an integer in 1..{FOURIER_MAX_HARMONICS}")
 
 
-def _fourier_lower(harmonics: int, r: Request) -> Unit:
+def _fourier_lower(harmonics: int, r: HarmonicsRequest) -> Unit:
     return Unit(lower_fourier(harmonics, r.command))
 
 
-def _choice_derive(r: Request, progress: Progress | None) -> PeriodFormula:
-    if r.formula is None:
-        raise InputError("choose --emit: no period formula was chosen to emit")
+def _choice_derive(r: ChoiceRequest, progress: Progress | None) -> PeriodFormula:
     return r.formula  # derived and verified by choose
 
 
-def _choice_lower(formula: PeriodFormula, r: Request) -> Unit:
+def _choice_lower(formula: PeriodFormula, r: ChoiceRequest) -> Unit:
     return Unit(lower_choice(formula, r.command, r.verified))
 
 
-FREE: Target[SeriesSolution] = Target(_free_files, _free_derive, _free_lower)
-LIMIT_CYCLE: Target[tuple[LimitCycle, ResummedCycle | None]] = Target(
+FREE: Target[FreeRequest, SeriesSolution] = Target(_free_files, _free_derive, _free_lower)
+LIMIT_CYCLE: Target[CycleRequest, tuple[LimitCycle, ResummedCycle | None]] = Target(
     _cycle_files, _cycle_derive, _cycle_lower)
-MU: Target[tuple[tuple[MuOrder, ...], NotesTable]] = Target(
+MU: Target[Request, tuple[tuple[MuOrder, ...], NotesTable]] = Target(
     lambda r: ("driven.py", "driven_derivation.tex"), _mu_derive, _mu_lower)
-BALANCE: Target[BalanceEquations] = Target(
+BALANCE: Target[HarmonicsRequest, BalanceEquations] = Target(
     lambda r: ("balance.py",), _balance_derive, _balance_lower)
 
 
@@ -260,17 +307,18 @@ def _mu_damped_lower(orders: tuple[MuDampedOrder, ...], r: Request) -> Unit:
                 (MuDampedDerivation(r.order, orders[: r.order], damped_determinant()),))
 
 
-MU_DAMPED: Target[tuple[MuDampedOrder, ...]] = Target(
+MU_DAMPED: Target[Request, tuple[MuDampedOrder, ...]] = Target(
     lambda r: ("driven_damped.py", "driven_damped_derivation.tex"), _mu_damped_derive,
     _mu_damped_lower)
-FOURIER: Target[int] = Target(lambda r: ("fourier.py",), _fourier_derive, _fourier_lower)
-CHOSEN_PERIOD: Target[PeriodFormula] = Target(
+FOURIER: Target[HarmonicsRequest, int] = Target(
+    lambda r: ("fourier.py",), _fourier_derive, _fourier_lower)
+CHOSEN_PERIOD: Target[ChoiceRequest, PeriodFormula] = Target(
     lambda r: ("chosen_period.py",), _choice_derive, _choice_lower)
-SLOW_FLOW: Target[SlowFlow] = Target(
+SLOW_FLOW: Target[SlowFlowRequest, SlowFlow] = Target(
     lambda r: (f"{r.model.name}_slow_flow.py", f"{r.model.name}_slow_flow.tex"),
     lambda r, progress: slow_flow(r.model, r.order),
     lambda flow, r: lower_slow_flow(flow, r.command))
-# NOTE: the slow flow's request carries the user's models.Oscillator as its model.
-MATHIEU: Target[ResummedMathieu] = Target(_mathieu_files, _mathieu_derive, _mathieu_lower)
-TONGUE: Target[ResummedTongue] = Target(
-    lambda r: (f"tongue_{r.tongue[1]}.py",), _tongue_derive, _tongue_lower)
+MATHIEU: Target[MathieuRequest, ResummedMathieu] = Target(
+    _mathieu_files, _mathieu_derive, _mathieu_lower)
+TONGUE: Target[TongueRequest, ResummedTongue] = Target(
+    lambda r: (f"tongue_{r.n}.py",), _tongue_derive, _tongue_lower)
