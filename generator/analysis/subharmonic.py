@@ -197,8 +197,6 @@ def subharmonic_equation(text: str, values: dict[str, str], omega: float | None,
 
 # --- any polynomial force, any n: balance, shooting, onset ------------------------------------
 
-
-
 def check_n(n: object) -> None:
     """``n`` an integer in 2..MAX_N (1 is the drive's own period: ``response``)."""
     check_int(n, 2, MAX_N, f"--n {n!r}: the subharmonic's order must be an integer in 2..{MAX_N} "
@@ -309,10 +307,12 @@ SUBHARMONIC_SEEDS = (24, 12)
 # unstable orbit draws 4 % of a uniform polar grid of starts (the stable one 26 %, the primary
 # response the rest): 288 starts in a third of the plane put ~12 on it.
 SAME_SUBHARMONIC = 1e-6
-# NOTE: two balance solutions are one orbit when their canonical harmonics (a drive-period shift
-# puts the first harmonic's phase in [0, 2π/n)) differ by 1e-6 of their norm; Newton converges
-# to ~1e-13, distinct orbits lie O(1) apart except within ~1e-12 of a fold.
+# NOTE: two balance solutions are one orbit when one equals a drive-period shift of the other
+# (_shifts) to 1e-6 of its norm; Newton converges to ~1e-13, distinct orbits lie O(1) apart
+# except within ~1e-12 of a fold.
 ONSET_POINTS = 4000
+# NOTE: continuation steps toward the onset, at most 1/50 of the orbit's size each: the onsets
+# of the tests are reached in under 200; a branch that wanders past 4000 gives no onset.
 
 
 def _shifts(system: PolynomialBalance, x: np.ndarray, n: int) -> list[np.ndarray]:
