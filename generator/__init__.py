@@ -34,12 +34,12 @@ order; a stage imports only stages above it::
                             cycles [guess -> PeriodicOrbit]
     numerics.references     elliptic periods, cn, the pendulum, a cycle by DOP853, Mathieu by
                             the Hill matrix and mpmath [x -> truth]
+    analysis.polynomial     a user's driven equation lowered to data, the Galerkin balance of
+                            any polynomial force, an amplitude bound [text -> DrivenEquation]
     analysis.driven         the notes' driven Duffing: one harmonic, μ-expansion with phase,
                             harmonic balance [Drive -> branches]
     analysis.mu_exact       the μ-expansion (undamped, damped) and the balance equations,
                             exactly, for LaTeX and emission [K -> exact orders]
-    analysis.polynomial     a user's driven equation lowered to data, the Galerkin balance of
-                            any polynomial force, an amplitude bound [text -> DrivenEquation]
     analysis.continuation   pseudo-arclength through folds, in ω or in the drive amplitude from
                             rest; crossings of a level [system -> curve]
     analysis.response       one-harmonic curves and folds, the balance continued over an ω range

@@ -21,7 +21,7 @@ import numpy as np
 from .analysis.continuation import CONTINUATION_SECONDS
 from .analysis.driven import Drive
 from .analysis.mixing import mixing_series, tone_label
-from .analysis.response import continue_balance, one_harmonic_curve, response_range
+from .analysis.response import ResponseReport, one_harmonic_curve
 from .analysis.subharmonic import subharmonic, subharmonic_equation, subharmonic_orbits
 from .choose import (
     DRIVEN_QUANTITIES,
@@ -35,7 +35,7 @@ from .emit.render import check_folder, check_target, write_files
 from .errors import InputError
 from .methods.references import reference_period
 from .methods.registry import candidates
-from .numerics.integrate import ForceTable, duffing_table, steady_state_amplitudes, sweep
+from .numerics.integrate import ForceTable, duffing_table, steady_state_amplitudes
 from .sweep.kinds import MU_ORDERS, VALIDITY_BALANCE_HARMONICS, validity_errors
 
 FORMATS = (".png", ".svg", ".pdf")
@@ -81,17 +81,34 @@ def _save(fig: plt.Figure, path: Path) -> Path:
     return path
 
 
+def _response_panel(ax: plt.Axes, r: ResponseReport, title: str) -> None:
+    """The continued N-harmonic balance (its first-harmonic amplitude, each piece), the
+    simulated sweeps up and down (max |q|) and the balance's folds of a
+    :class:`analysis.response.ResponseReport`."""
+    amp = np.array([_first(r.fine, x) for x in r.cont.x])
+    for k, piece in enumerate(r.cont.piece_slices()):  # a softening spring's: two pieces
+        ax.plot(r.cont.omega[piece], amp[piece], "k-", lw=0.7,
+                label=f"harmonic balance N = {r.fine.harmonics}" if k == 0 else None)
+    ax.plot(r.up.omega, r.up.amplitude, "C3.", ms=1.5, label="sweep up (max |q|)")
+    ax.plot(r.down.omega, r.down.amplitude, "C2.", ms=1.5, label="sweep down (max |q|)")
+    for w in r.cont.folds:
+        ax.axvline(w, color="grey", ls=":", lw=1)
+    ax.set(xlabel=f"drive frequency {r.de.frequency}", ylabel="amplitude", title=title)
+    ax.legend(fontsize=8, loc="upper left")
+
+
 def response_figure(eps: float, force: float, Q: float, harmonics: int, path: Path,
                     max_seconds: float = CONTINUATION_SECONDS) -> Path:
-    """Response r(ω): one-harmonic branches (stable solid, unstable dashed), N-harmonic
-    continuation, simulated sweeps up and down, folds; and the linear curves of Fig. 1
-    (``max_seconds``: the continuation's cost limit)."""
+    """Response r(ω) of eq. 10.60 (:func:`analysis.response.duffing_response`): the cubic's
+    one-harmonic branches (stable solid, unstable dashed) beside :func:`_response_panel`; and
+    the linear curves of Fig. 1 (``max_seconds``: the continuation's cost limit)."""
+    from .analysis.response import duffing_response
+
     check_plot_path(path)
-    lo, hi = response_range(eps, force, Q)
+    report = duffing_response(eps, force, Q, harmonics, max_seconds)
+    lo, hi = report.er.omega_range
     omega = np.linspace(lo, hi, 2000)
     curve = one_harmonic_curve(eps, force, Q, omega)
-    cont = continue_balance(eps, force, Q, harmonics, lo, hi, max_seconds=max_seconds)
-    up, down = sweep(eps, force, 1 / Q, lo, hi), sweep(eps, force, 1 / Q, hi, lo)
     fig, (ax, lin) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [3, 2]})
     count = np.isfinite(curve.r).sum(axis=1)
     jumps = np.concatenate([[False], count[1:] != count[:-1]])  # branches appear/vanish here
@@ -101,17 +118,8 @@ def response_figure(eps: float, force: float, Q: float, harmonics: int, path: Pa
                 label="one harmonic, stable" if k == 0 else None)
         ax.plot(omega, np.where(~curve.stable[:, k], r, np.nan), "C0--", lw=1.5,
                 label="one harmonic, unstable" if k == 1 else None)
-    amp = np.hypot(cont.x[:, 0], cont.x[:, harmonics])
-    for k, piece in enumerate(cont.piece_slices()):  # a softening spring's curve: two pieces
-        ax.plot(cont.omega[piece], amp[piece], "k-", lw=0.7,
-                label=f"harmonic balance N = {harmonics}" if k == 0 else None)
-    ax.plot(up.omega, up.amplitude, "C3.", ms=1.5, label="sweep up (max |q|)")
-    ax.plot(down.omega, down.amplitude, "C2.", ms=1.5, label="sweep down (max |q|)")
-    for w in cont.folds:
-        ax.axvline(w, color="grey", ls=":", lw=1)
-    ax.set(xlabel="drive frequency ω", ylabel="amplitude",
-           title=f"q̈ + q̇/Q + q + εq³ = f cos ωt  (ε = {eps}, f = {force}, Q = {Q})")
-    ax.legend(fontsize=8, loc="upper left")
+    _response_panel(ax, report, f"q̈ + q̇/Q + q + εq³ = f cos ωt  (ε = {eps}, f = {force}, "
+                    f"Q = {Q})")
     w = np.linspace(0.5, 1.5, 1000)
     for i, q in enumerate((2, 5, 10)):
         lin.plot(w, 1 / np.sqrt((1 - w**2) ** 2 + w**2 / q**2), f"C{i}-", label=f"Q = {q} (3.79)")
@@ -126,31 +134,21 @@ def response_equation_figure(text: str, values: dict[str, str], harmonics: int, 
                              name: str = "oscillator", omega_min: float | None = None,
                              omega_max: float | None = None,
                              max_seconds: float = CONTINUATION_SECONDS) -> Path:
-    """Response r(ω) of a user's damped driven oscillator: the one-harmonic amplitudes, the
-    continued N-harmonic balance (first-harmonic amplitude), the simulated sweeps up and down
-    (max |q|), its folds."""
+    """Response r(ω) of a user's damped driven oscillator
+    (:func:`analysis.response.equation_response`): the one-harmonic amplitudes beside
+    :func:`_response_panel`."""
     from .analysis.response import equation_response
 
     check_plot_path(path)
-    curve = equation_response(text, values, harmonics, name, omega_min, omega_max, max_seconds)
-    de, er, cont, fine, up, down = (curve.de, curve.er, curve.cont, curve.fine, curve.up,
-                                    curve.down)
-    lo, hi = er.omega_range
+    report = equation_response(text, values, harmonics, name, omega_min, omega_max,
+                               max_seconds)
+    lo, hi = report.er.omega_range
     fig, ax = plt.subplots(figsize=(8, 4.2))
     omega = np.linspace(lo, hi, 600)
-    one = [(w, r) for w in omega for r in er.one_harmonic.amplitudes(float(w))]
+    one = [(w, r) for w in omega for r in report.er.one_harmonic.amplitudes(float(w))]
     if one:
         ax.plot(*np.array(one).T, "C0.", ms=1.5, label="one harmonic")
-    amp = np.array([_first(fine, x) for x in cont.x])
-    for k, piece in enumerate(cont.piece_slices()):
-        ax.plot(cont.omega[piece], amp[piece], "k-", lw=0.7,
-                label=f"harmonic balance N = {harmonics}" if k == 0 else None)
-    ax.plot(up.omega, up.amplitude, "C3.", ms=1.5, label="sweep up (max |q|)")
-    ax.plot(down.omega, down.amplitude, "C2.", ms=1.5, label="sweep down (max |q|)")
-    for w in cont.folds:
-        ax.axvline(w, color="grey", ls=":", lw=1)
-    ax.set(xlabel=f"drive frequency {de.frequency}", ylabel="amplitude", title=text)
-    ax.legend(fontsize=8, loc="upper left")
+    _response_panel(ax, report, text)
     fig.tight_layout()
     return _save(fig, path)
 

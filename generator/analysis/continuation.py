@@ -12,9 +12,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from .driven import (
-    BalanceSystem,
-)
 from .polynomial import PolynomialBalance
 
 
@@ -49,7 +46,7 @@ MAX_Q = 1e12
 # continuation wanders for good.  Below 1e12 it is only slower.
 
 
-def _continue(sysm: BalanceSystem | PolynomialBalance, end_solutions, omega_start: float,
+def _continue(sysm: PolynomialBalance, end_solutions, omega_start: float,
               omega_stop: float, step: float, estimate: float, seconds: float,
               per_point: float, max_points: int, where: str) -> Continuation:
     """The pseudo-arclength loop of :func:`continue_balance` on any balance with ``residual``,
@@ -118,12 +115,12 @@ def _continue(sysm: BalanceSystem | PolynomialBalance, end_solutions, omega_star
     return Continuation(arr[:, -1], arr[:, :-1], sorted(folds), tuple(starts), complete)
 
 
-def _extended_jacobian(sysm: BalanceSystem, y: np.ndarray) -> np.ndarray:
+def _extended_jacobian(sysm: PolynomialBalance, y: np.ndarray) -> np.ndarray:
     x, omega = y[:-1], y[-1]
     return np.column_stack([sysm.jacobian(x, omega), sysm.d_omega(x, omega)])
 
 
-def _tangent(sysm: BalanceSystem, y: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
+def _tangent(sysm: PolynomialBalance, y: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
     """Unit null vector of ``[R_x | R_ω]``, oriented along ``previous``."""
     _, _, vt = np.linalg.svd(_extended_jacobian(sysm, y))
     t = vt[-1]
@@ -132,7 +129,7 @@ def _tangent(sysm: BalanceSystem, y: np.ndarray, previous: np.ndarray | None) ->
     return t
 
 
-def _corrector(sysm: BalanceSystem, y: np.ndarray, t: np.ndarray) -> np.ndarray:
+def _corrector(sysm: PolynomialBalance, y: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Newton on ``R(y) = 0`` with ``t·(y − y_pred) = 0``."""
     y_pred = y.copy()
     for _ in range(30):
@@ -146,7 +143,7 @@ def _corrector(sysm: BalanceSystem, y: np.ndarray, t: np.ndarray) -> np.ndarray:
     return y
 
 
-def _refine_fold(sysm: BalanceSystem, y: np.ndarray, t: np.ndarray, step: float) -> float:
+def _refine_fold(sysm: PolynomialBalance, y: np.ndarray, t: np.ndarray, step: float) -> float:
     """Secant on the step length for ``t_ω = 0`` between two continuation points."""
     def t_omega(h: float) -> tuple[float, np.ndarray]:
         z = _corrector(sysm, y + h * t, t)

@@ -28,7 +28,6 @@ from ..algebra.series import (
     laurent_cos,
     laurent_derivative,
     laurent_from_fourier,
-    laurent_harmonics,
     laurent_product,
     laurent_secular,
     laurent_solve,
@@ -36,8 +35,10 @@ from ..algebra.series import (
 )
 from ..display import SHOWN_ROWS, harmonics_table, html_table
 from ..errors import InputError
-from ..limits import MAGNITUDES, MAX_HARMONICS, MU_MAX_ORDER, check_int
-from ..numerics.newton import newton
+from ..limits import MAGNITUDES, MU_MAX_ORDER, check_int
+from .polynomial import DrivenEquation, PolynomialBalance
+
+DUFFING_TEXT = "q'' + q'/Q + q + eps*q**3 = f*cos(w*t)"
 
 
 @dataclass(frozen=True)
@@ -69,6 +70,26 @@ class Drive:
             if value != 0 and not math.isinf(value) and not low <= abs(value) <= high:
                 raise InputError(f"{name} {value!r}: |{name}| outside {low:g}..{high:g}{also}; "
                                  "the methods square and cube it, which must stay normal doubles")
+
+    @property
+    def terms(self) -> dict[tuple[int, int], float]:
+        """The force ``q + εq³ + q̇/Q`` as a table ``(power of q, power of q̇) -> c`` (the
+        terms that vanish left out): eq. 10.60 as any polynomial oscillator."""
+        table = {(1, 0): 1.0, (3, 0): float(self.eps), (0, 1): self.damping}
+        return {k: c for k, c in table.items() if c != 0 or k == (1, 0)}
+
+    @property
+    def equation(self) -> DrivenEquation:
+        """Eq. 10.60 at these parameters as a user's :class:`DrivenEquation`: every analysis of
+        a polynomial oscillator takes it."""
+        values = (("Q", repr(float(self.Q))), ("eps", repr(float(self.eps))),
+                  ("f", repr(float(self.force))))
+        return DrivenEquation("duffing", DUFFING_TEXT, self.terms, float(self.force),
+                              float(self.omega), "w", values)
+
+    def balance(self, harmonics: int) -> PolynomialBalance:
+        """The Galerkin balance of eq. 10.60 with odd harmonics ``1, 3, …, 2N − 1``."""
+        return PolynomialBalance(self.terms, float(self.force), harmonics, odd=True)
 
     @property
     def damping(self) -> float:
@@ -446,75 +467,13 @@ class HarmonicBalance:
                                f"{'converged' if self.converged else 'NOT converged'}")
 
 
-@dataclass(frozen=True)
-class BalanceSystem:
-    """The Galerkin residual of eq. 10.60 in ``x = (a_1, a_3, …, b_1, b_3, …)`` and ``ω``
-    (exact: products are convolutions, no aliasing), with its derivatives."""
-
-    eps: float
-    force: float
-    damping: float
-    harmonics: int
-
-    @property
-    def odd(self) -> np.ndarray:
-        return np.arange(1, 2 * self.harmonics, 2)
-
-    @property
-    def M(self) -> int:
-        return 3 * (2 * self.harmonics - 1)
-
-    def coefficients(self, x: np.ndarray) -> np.ndarray:
-        """``c_n`` of ``e^{inωt}`` for ``q = Σ a_k cos kωt + b_k sin kωt``."""
-        h = self.harmonics
-        return laurent_from_fourier(self.M, self.odd, x[:h], x[h:])
-
-    def _project(self, R: np.ndarray) -> np.ndarray:
-        return np.concatenate(laurent_to_fourier(R, self.odd))
-
-    def _linear(self, omega: float) -> np.ndarray:
-        n = laurent_harmonics(self.M)
-        return -(n * omega) ** 2 + 1j * n * omega * self.damping + 1
-
-    def residual(self, x: np.ndarray, omega: float) -> np.ndarray:
-        c = self.coefficients(x)
-        return self._project(self._linear(omega) * c
-                             + self.eps * laurent_product(c, laurent_product(c, c))
-                             - laurent_cos(self.M, self.force))
-
-    def jacobian(self, x: np.ndarray, omega: float) -> np.ndarray:
-        """``∂R/∂x``: ``dR_n/dc_m = lin_n δ_nm + 3ε (q²)_{n−m}``, ``c_{±m} = (a_m ∓ i b_m)/2``."""
-        odd, M = self.odd, self.M
-        c = self.coefficients(x)
-        q2 = laurent_product(c, c)
-        K_plus = np.diag(self._linear(omega)[M + odd]) + 3 * self.eps * q2[M + odd[:, None]
-                                                                           - odd[None, :]]
-        K_minus = 3 * self.eps * q2[M + odd[:, None] + odd[None, :]]
-        dR_da, dR_db = (K_plus + K_minus) / 2, -1j * (K_plus - K_minus) / 2
-        return np.block([[2 * dR_da.real, 2 * dR_db.real], [-2 * dR_da.imag, -2 * dR_db.imag]])
-
-    def d_omega(self, x: np.ndarray, omega: float) -> np.ndarray:
-        """``∂R/∂ω``: only the linear part depends on ω."""
-        n = laurent_harmonics(self.M)
-        return self._project((-2 * n * n * omega + 1j * n * self.damping)
-                             * self.coefficients(x))
-
-
-
-
-def check_harmonics(harmonics: object) -> None:
-    """:class:`InputError` unless ``harmonics`` is an integer in 1..MAX_HARMONICS."""
-    check_int(harmonics, 1, MAX_HARMONICS,
-              f"harmonics {harmonics!r}: must be an integer in 1..{MAX_HARMONICS}")
-
-
 def harmonic_balance(d: Drive, start: Branch | np.ndarray, harmonics: int, tol: float = 1e-13,
                      max_iter: int = 50) -> HarmonicBalance:
-    """Newton's method on :class:`BalanceSystem`, started from a one-harmonic root, or from a
-    balance ``x = (a_1, a_3, …, b_1, b_3, …)`` with any number of harmonics (cut to, or padded
-    with zeros up to, ``harmonics``)."""
-    check_harmonics(harmonics)
-    system = BalanceSystem(d.eps, d.force, d.damping, harmonics)
+    """Newton's method on the balance of eq. 10.60 (:meth:`Drive.balance`, odd harmonics
+    ``1, 3, …, 2N − 1``), started from a one-harmonic root, or from a balance
+    ``x = (a_1, a_3, …, b_1, b_3, …)`` with any number of harmonics (cut to, or padded with
+    zeros up to, ``harmonics``)."""
+    system = d.balance(harmonics)
     x = np.zeros(2 * harmonics)
     if isinstance(start, Branch):
         x[0] = start.A1 * math.cos(start.delta0)
@@ -523,6 +482,7 @@ def harmonic_balance(d: Drive, start: Branch | np.ndarray, harmonics: int, tol: 
         given = np.asarray(start, dtype=float)
         k = min(len(given) // 2, harmonics)
         x[:k], x[harmonics : harmonics + k] = given[:k], given[len(given) // 2 :][:k]
-    x, converged, residual = newton(lambda z: system.residual(z, d.omega),
-                                    lambda z: system.jacobian(z, d.omega), x, tol, max_iter)
-    return HarmonicBalance(harmonics, system.coefficients(x), residual, converged)
+    x, converged, residual = system.solve(x, d.omega, tol, max_iter)
+    coefficients = laurent_from_fourier(3 * (2 * harmonics - 1), system.orders,
+                                        x[:harmonics], x[harmonics:])
+    return HarmonicBalance(harmonics, coefficients, residual, converged)

@@ -30,12 +30,11 @@ from .driven import (
     HarmonicBalance,
     MuExpansion,
     amplitudes,
-    check_harmonics,
     first_order_branches,
     harmonic_balance,
     mu_expansion,
 )
-from .polynomial import DrivenEquation, PolynomialBalance, amplitude_bound
+from .polynomial import DrivenEquation, PolynomialBalance, amplitude_bound, check_harmonics
 from .response import continue_balance, response_range
 
 SAME_ORBIT = 1e-8

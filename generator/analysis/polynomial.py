@@ -12,13 +12,18 @@ import numpy as np
 import sympy as sp
 
 from ..errors import InputError
-from ..limits import MAGNITUDES
+from ..limits import MAGNITUDES, MAX_HARMONICS, check_int
 from ..numerics.newton import newton
-from .driven import check_harmonics
 
 # --- a user's driven oscillator: q'' + g(q, q') = f cos(w t), g a polynomial -----------------
 
 DRIVEN = "driven"
+
+
+def check_harmonics(harmonics: object) -> None:
+    """:class:`InputError` unless ``harmonics`` is an integer in 1..MAX_HARMONICS."""
+    check_int(harmonics, 1, MAX_HARMONICS,
+              f"harmonics {harmonics!r}: must be an integer in 1..{MAX_HARMONICS}")
 
 
 @dataclass(frozen=True)

@@ -17,9 +17,8 @@ import numpy as np
 import sympy as sp
 
 from ..errors import InputError
-from ..numerics.integrate import ForceTable, Sweep, sweep, sweep_table
-from ..numerics.newton import newton
-from ..numerics.shooting import orbit_fold, orbit_fold_table
+from ..numerics.integrate import ForceTable, Sweep, escape_bound, sweep_table
+from ..numerics.shooting import orbit_fold_table
 from .continuation import (
     CONTINUATION_HARMONICS,
     CONTINUATION_SECONDS,
@@ -32,15 +31,12 @@ from .continuation import (
     continue_in_drive,
 )
 from .driven import (
-    BalanceSystem,
     Drive,
     amplitude_residual,
     amplitude_slope,
-    check_harmonics,
-    first_order_branches,
     one_harmonic_roots,
 )
-from .polynomial import DrivenEquation, PolynomialBalance, amplitude_bound
+from .polynomial import DrivenEquation, PolynomialBalance, amplitude_bound, check_harmonics
 
 if TYPE_CHECKING:
     from .continuation import Continuation
@@ -128,130 +124,12 @@ def one_harmonic_folds(eps: float, force: float, Q: float) -> list[float]:
     return sorted({float(w) for w in folds})
 
 
-def point_seconds(harmonics: int) -> float:
-    """Seconds per continuation point (predictor, corrector, two SVDs) on this 2-core machine,
-    single-threaded BLAS: 2 ms at N = 8, 42 ms at N = 100."""
-    return 1.5e-3 + 4e-6 * harmonics**2
-
-
-def _curve_extent(eps: float, force: float, Q: float, lo: float, hi: float) -> float:
-    """The largest one-harmonic amplitude on ``[lo, hi]`` (a grid, ω = 1 and the folds)."""
-    folds = [w for w in one_harmonic_folds(eps, force, Q) if lo <= w <= hi]
-    omega = np.unique(np.concatenate([np.linspace(lo, hi, 2001), [1.0] if lo <= 1 <= hi else [],
-                                      folds, np.nextafter(folds, -np.inf)]))
-    with np.errstate(divide="ignore"):  # undamped and linear at ω = 1: r = ∞, said as such
-        r = one_harmonic_curve(eps, force, Q, omega).r
-    return float(np.nanmax(r)) if np.any(~np.isnan(r)) else 0.0
-
-
-def continuation_points(eps: float, force: float, Q: float, lo: float, hi: float,
-                        step: float = 0.02, max_points: int = MAX_POINTS) -> float:
-    """About how many continuation steps the response curve on ``[lo, hi]`` takes — its length
-    in (a, b, ω) is about ``(hi − lo) + π r_max`` (see :func:`continue_balance`) —, or
-    :class:`InputError` above ``max_points``."""
-    r_max = _curve_extent(eps, force, Q, lo, hi)
-    estimate = ((hi - lo) + np.pi * r_max) / step
-    if not estimate <= max_points:
-        raise InputError(f"force {force:g} (eps {eps:g}, Q {Q:g}): the response curve spans ω "
-                         f"in [{lo:.3g}, {hi:.3g}] with amplitudes up to {r_max:.3g}, about "
-                         f"{estimate:.2g} continuation steps of {step:g}; the limit is "
-                         f"{max_points}")
-    return estimate
-
-
-def continuation_seconds(eps: float, force: float, Q: float, harmonics: int, lo: float,
-                         hi: float) -> float:
-    """The estimated wall time of :func:`continue_balance` (points × :func:`point_seconds`);
-    :class:`InputError` for a curve over MAX_POINTS steps."""
-    return continuation_points(eps, force, Q, lo, hi) * point_seconds(harmonics)
-
-
 def response_range(eps: float, force: float, Q: float) -> tuple[float, float]:
     """The ω range a response curve is drawn on: half the lowest to 1.25 × the highest of
     ω = 1 and the one-harmonic folds."""
     folds = one_harmonic_folds(eps, force, Q)
     return 0.5 * min([1.0, *folds]), 1.25 * max([1.0, *folds])
 
-
-def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_start: float,
-                     omega_stop: float, step: float = 0.02, max_points: int = MAX_POINTS,
-                     max_seconds: float = CONTINUATION_SECONDS) -> Continuation:
-    """Trace the harmonic-balance curve on ``[lo, hi]`` (the two ends) through any number of
-    folds: first from the smallest one-harmonic root at ``omega_start`` (the in-well branch
-    of a softening spring, the only one below the resonance of a hardening one), until ω leaves
-    the range; then from every root at either end that no traced piece has reached, each until
-    it leaves the range.  A softening spring's curve is two pieces: the small-amplitude branch
-    up to its fold and back down the middle branch, and the resonant branch, which leaves the
-    range at its low end over the barrier.
-
-    Refuses (:class:`InputError`) a curve too long to trace: its length in (a, b, ω) is about
-    ``(hi − lo) + π r_max`` (up the resonant branch to its peak r_max and back down while the
-    phase turns through π; within a factor 0.4–1.4 of the traced length from ε = −0.1 to 1,
-    f = 0.05 to 10, Q = 5 to 1000), so ``length/step`` points at
-    :func:`point_seconds` each must stay within ``max_points`` and ``max_seconds``;
-    and a continuation whose linear algebra fails or that does not leave the range."""
-    check_harmonics(harmonics)
-    d = Drive(eps, force, omega_start, Q)
-    Drive(eps, force, omega_stop, Q)
-    sysm = BalanceSystem(eps, force, d.damping, harmonics)
-    lo, hi = sorted((omega_start, omega_stop))
-    where = f"force {force:g} (eps {eps:g}, Q {Q:g})"
-    if np.isfinite(Q) and Q > MAX_Q:
-        raise InputError(f"Q {Q:g}: the resonance is {1 / Q:.0e} wide in ω, too narrow for the "
-                         f"continuation to follow in double precision; Q up to {MAX_Q:.0e}")
-    estimate = continuation_points(eps, force, Q, lo, hi, step, max_points)
-    seconds = estimate * point_seconds(harmonics)
-    if seconds > max_seconds:
-        raise InputError(f"harmonics {harmonics}: about {seconds:.0f} s of continuation "
-                         f"({estimate:.0f} points × {1e3 * point_seconds(harmonics):.0f} ms) for "
-                         f"{where}; the limit is {max_seconds:.0f} s, ask for fewer")
-    if not first_order_branches(d):
-        raise InputError(f"{where}: no one-harmonic branch at ω = {omega_start:g} to start from")
-    return _continue(sysm, lambda: _end_solutions(sysm, d, omega_start, omega_stop),
-                     omega_start, omega_stop, step, estimate, seconds,
-                     point_seconds(harmonics), max_points, where)
-
-
-def _end_solutions(sysm: BalanceSystem, d: Drive, omega_start: float, omega_stop: float
-                   ) -> tuple[list[tuple[float, np.ndarray, float]], bool]:
-    """The balance solutions from every one-harmonic root at both ends, as ``(ω, x, the
-    direction into the range)``: the smallest root at ``omega_start`` first, then the others
-    there and those at ``omega_stop``, each by amplitude (distinct solutions only); and
-    whether every root's balance converged."""
-    out: list[tuple[float, np.ndarray, float]] = []
-    complete = True
-    h = sysm.harmonics
-    for omega, direction in ((omega_start, np.sign(omega_stop - omega_start)),
-                             (omega_stop, np.sign(omega_start - omega_stop))):
-        roots = first_order_branches(Drive(d.eps, d.force, omega, d.Q))
-        for br in sorted(roots, key=lambda b: abs(b.A1)):
-            x = np.zeros(2 * h)
-            x[0], x[h] = br.A1 * np.cos(br.delta0), br.A1 * np.sin(br.delta0)
-            x, _, _ = newton(lambda z, w=omega: sysm.residual(z, w),
-                             lambda z, w=omega: sysm.jacobian(z, w), x, 1e-14)
-            size = np.max(np.abs(x))
-            residual = np.max(np.abs(sysm.residual(x, omega)))
-            if not residual <= 1e-9 * (abs(d.force) + (1 + omega**2) * size
-                                       + abs(d.eps) * size**3):
-                complete = False
-                continue
-            if all(e[0] != omega or np.linalg.norm(e[1] - x) > 1e-6 * (1 + np.linalg.norm(x))
-                   for e in out):
-                out.append((omega, x, float(direction)))
-    if not out or out[0][0] != omega_start:
-        raise np.linalg.LinAlgError(f"no balance converged at ω = {omega_start:.4g}")
-    return out, complete
-
-
-# --- the 1/3 subharmonic (eq. 10.83–10.87) ---------------------------------------------------
-
-_a, _b, _F, _w1, _eps1 = sp.symbols("a b F omega epsilon")
-
-
-# --- every distinct periodic orbit at one ω: seeds, shooting, deduplication -----------------
-# (here, after the continuation: its crossings with ω are the seeds the one-harmonic cubic lacks)
-
-# --- a user's driven oscillator: the response curve in ω -------------------------------------
 
 _poly = np.polynomial.polynomial
 
@@ -438,7 +316,13 @@ def continue_equation(de: DrivenEquation, harmonics: int, omega_start: float,
     check_harmonics(harmonics)
     fine = PolynomialBalance(de.terms, de.force, harmonics, de.odd)
     lo, hi = sorted((omega_start, omega_stop))
-    where = f"{de.name} ({de.text})"
+    given = ", ".join(f"{k} = {v}" for k, v in de.values)
+    where = f"{de.name} ({de.text}{'; ' if given else ''}{given})"
+    damping = abs(de.terms.get((0, 1), 0.0))
+    if 0 < damping < 1 / MAX_Q:
+        raise InputError(f"{where}: the damping {damping:.0e}*q' makes the resonance "
+                         f"{damping:.0e} wide in ω, too narrow for the continuation to follow "
+                         f"in double precision; at least {1 / MAX_Q:.0e} (Q up to {MAX_Q:.0e})")
     estimate, seconds = equation_continuation_seconds(de.terms, de.force, harmonics, de.odd,
                                                       lo, hi, step, max_points)
     if seconds > max_seconds:
@@ -448,6 +332,28 @@ def continue_equation(de: DrivenEquation, harmonics: int, omega_start: float,
     return _continue(fine, lambda: _equation_ends(de, fine, omega_start, omega_stop),
                      omega_start, omega_stop, step, estimate, seconds,
                      equation_point_seconds(fine.size), max_points, where)
+
+
+def continuation_seconds(eps: float, force: float, Q: float, harmonics: int, lo: float,
+                         hi: float) -> float:
+    """The estimated wall time of :func:`continue_balance`: :func:`equation_continuation_seconds`
+    of eq. 10.60; :class:`InputError` for a curve over MAX_POINTS steps."""
+    d = Drive(eps, force, lo, Q)
+    return equation_continuation_seconds(d.terms, force, harmonics, True, lo, hi)[1]
+
+
+def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_start: float,
+                     omega_stop: float, step: float = 0.02, max_points: int = MAX_POINTS,
+                     max_seconds: float = CONTINUATION_SECONDS) -> Continuation:
+    """:func:`continue_equation` on eq. 10.60 (:attr:`driven.Drive.equation`): the balance with
+    odd harmonics ``1, 3, …, 2N − 1`` traced over ``[omega_start, omega_stop]`` through any
+    number of folds.  A softening spring's curve is two pieces: the small-amplitude branch up
+    to its fold and back down the middle branch, and the resonant branch, which leaves the
+    range at its low end over the barrier."""
+    d = Drive(eps, force, omega_start, Q)
+    Drive(eps, force, omega_stop, Q)
+    return continue_equation(d.equation, harmonics, omega_start, omega_stop, step, max_points,
+                             max_seconds)
 
 
 def equation_solutions(de: DrivenEquation, fine: PolynomialBalance, omega: float
@@ -546,86 +452,82 @@ def response_equation(text: str, values: dict[str, str], name: str = "oscillator
 
 
 @dataclass(frozen=True)
-class EquationCurve:
-    """A user's response curve, computed once for the JSON, the table and the figure: the
-    equation, its range, the continued balance, the sweeps up and down and their escape
-    bound."""
+class ResponseReport:
+    """A response curve, computed once for the JSON, the table and the figure: the equation
+    (eq. 10.60 is one, :attr:`driven.Drive.equation`), its range and one-harmonic folds, the
+    continued balance, the true orbit's folds, the simulated sweeps up and down.
+
+    ``barrier``: the ``|q|`` past which a sweep has left every steady state — the potential's
+    maximum ``1/√−ε`` of a softening eq. 10.60, else :data:`ESCAPE_FACTOR` × the largest balance
+    solution on the range; ``bound`` the escape bound of the sweeps and the shooting (the
+    notes': :func:`numerics.integrate.escape_bound`); ``notes``: eq. 10.60's parameters as
+    numbers, ``()`` for a user's equation."""
 
     de: DrivenEquation
     er: EquationResponse
     cont: Continuation
     fine: PolynomialBalance
     table: ForceTable
+    barrier: float
     bound: float
     up: Sweep
     down: Sweep
     true_folds: tuple[tuple[float, tuple[float, ...]], ...]  # (ω, sorted |Floquet multipliers|)
+    notes: tuple[tuple[str, float], ...] = ()
+
+
+def response_report(de: DrivenEquation, er: EquationResponse, harmonics: int,
+                    max_seconds: float = CONTINUATION_SECONDS, barrier: float | None = None,
+                    bound: float | None = None,
+                    notes: tuple[tuple[str, float], ...] = ()) -> ResponseReport:
+    """The :class:`ResponseReport` of ``de`` over ``er``'s range: the continuation
+    (:func:`continue_equation`), each balance fold polished into the true orbit's
+    (:func:`numerics.shooting.orbit_fold_table`), the simulated sweeps both ways, escapes
+    detected past ``barrier`` (default :data:`ESCAPE_FACTOR` × the largest balance)."""
+    lo, hi = er.omega_range
+    cont = continue_equation(de, harmonics, lo, hi, max_seconds=max_seconds)
+    table = ForceTable.of(de.terms)
+    if barrier is None:
+        barrier = ESCAPE_FACTOR * float(np.max(np.sum(np.abs(cont.x), axis=1)))
+    bound = barrier if bound is None else bound
+    fine = PolynomialBalance(de.terms, de.force, harmonics, de.odd)
+    true_folds = []
+    for w in cont.folds:  # the true orbit's fold near each of the balance's
+        x = cont.x[int(np.argmin(np.abs(cont.omega - w)))]
+        found = orbit_fold_table(table, de.force, w, fine.state(x, w), bound=bound)
+        if found is not None:
+            true_folds.append((found[0], tuple(sorted(float(abs(m)) for m in found[2]))))
+    return ResponseReport(
+        de, er, cont, fine, table, barrier, bound,
+        sweep_table(table, de.force, lo, hi, barrier=barrier, bound=bound),
+        sweep_table(table, de.force, hi, lo, barrier=barrier, bound=bound),
+        tuple(sorted(true_folds)), notes)
 
 
 def equation_response(text: str, values: dict[str, str], harmonics: int,
                       name: str = "oscillator", omega_min: float | None = None,
                       omega_max: float | None = None,
-                      max_seconds: float = CONTINUATION_SECONDS) -> EquationCurve:
-    """``response EQUATION``'s curve: the continuation over the range, then the simulated
-    sweeps both ways, escapes detected past :data:`ESCAPE_FACTOR` × the largest balance."""
-    from .polynomial import PolynomialBalance
-
+                      max_seconds: float = CONTINUATION_SECONDS) -> ResponseReport:
+    """``response EQUATION``'s :class:`ResponseReport` over :func:`equation_range`."""
     de = response_equation(text, values, name)
     er = equation_range(de.terms, de.force, omega_min, omega_max)
-    lo, hi = er.omega_range
-    cont = continue_equation(de, harmonics, lo, hi, max_seconds=max_seconds)
-    table = ForceTable.of(de.terms)
-    bound = ESCAPE_FACTOR * float(np.max(np.sum(np.abs(cont.x), axis=1)))
-    fine = PolynomialBalance(de.terms, de.force, harmonics, de.odd)
-    true_folds = []
-    for w in cont.folds:  # the true orbit's fold near each of the balance's
-        x = cont.x[int(np.argmin(np.abs(cont.omega - w)))]
-        found = orbit_fold_table(table, de.force, w, fine.state(x, w))
-        if found is not None:
-            true_folds.append((found[0], tuple(sorted(float(abs(m)) for m in found[2]))))
-    return EquationCurve(
-        de, er, cont, fine, table, bound,
-        sweep_table(table, de.force, lo, hi, barrier=bound, bound=bound),
-        sweep_table(table, de.force, hi, lo, barrier=bound, bound=bound), tuple(sorted(true_folds)))
-
-
-@dataclass(frozen=True)
-class ResponseReport:
-    """Everything ``lindstedt response`` prints for the notes' damped Duffing: its folds three
-    ways (one harmonic, the continued balance, the true orbit's) and the simulated sweeps'
-    jumps over the range."""
-
-    eps: float
-    force: float
-    Q: float
-    harmonics: int
-    omega_range: tuple[float, float]
-    one_harmonic_folds: tuple[float, ...]
-    cont: Continuation
-    true_folds: tuple[float, ...]
-    up: Sweep
-    down: Sweep
+    return response_report(de, er, harmonics, max_seconds)
 
 
 def duffing_response(eps: float, force: float, Q: float, harmonics: int,
                      max_seconds: float = CONTINUATION_SECONDS) -> ResponseReport:
-    """The :class:`ResponseReport` of eq. 10.60: the continuation over
-    :func:`response_range`, each balance fold polished into the true orbit's
-    (:func:`numerics.shooting.orbit_fold`), the sweeps both ways."""
+    """The :class:`ResponseReport` of eq. 10.60: its closed forms where they are the method —
+    the one-harmonic folds of the cubic (:func:`one_harmonic_folds`), the range
+    (:func:`response_range`), the well's barrier and escape bound — and the general path for
+    the rest."""
     d = Drive(eps, force, 1.0, Q)
     if d.damping == 0:
         raise InputError("Q inf: a response curve needs damping (finite Q) for a steady state")
-    folds1 = one_harmonic_folds(eps, force, Q)
+    folds = one_harmonic_folds(eps, force, Q)
     lo, hi = response_range(eps, force, Q)
-    cont = continue_balance(eps, force, Q, harmonics, lo, hi, max_seconds=max_seconds)
-    odd = BalanceSystem(eps, force, d.damping, harmonics).odd
-    true_folds = []
-    for w in cont.folds:
-        x = cont.x[int(np.argmin(np.abs(cont.omega - w)))]
-        y0 = np.array([x[:harmonics].sum(), w * np.sum(odd * x[harmonics:])])
-        found = orbit_fold(eps, force, d.damping, w, y0)
-        if found is not None:
-            true_folds.append(found[0])
-    return ResponseReport(eps, force, Q, harmonics, (lo, hi), tuple(float(w) for w in folds1),
-                          cont, tuple(sorted(true_folds)), sweep(eps, force, d.damping, lo, hi),
-                          sweep(eps, force, d.damping, hi, lo))
+    er = EquationResponse(OneHarmonic(d.terms, float(force)), (lo, hi),
+                          [w for w in folds if lo <= w <= hi], 1.0)
+    barrier = 1 / math.sqrt(-eps) if eps < 0 else math.inf  # the potential's maxima
+    return response_report(d.equation, er, harmonics, max_seconds, barrier,
+                           escape_bound(eps, force),
+                           (("eps", float(eps)), ("force", float(force)), ("Q", float(Q))))

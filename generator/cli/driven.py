@@ -292,59 +292,57 @@ def run_driven(args: argparse.Namespace) -> int:
     return 0
 
 
+def response_report_json(r) -> dict:
+    """The contract of ``lindstedt response … --json``, a pure function of a
+    :class:`analysis.response.ResponseReport`: the equation and its force table, the folds
+    three ways (one harmonic, the continued N-harmonic balance, the true orbit's with its
+    Floquet moduli), the sweeps' jumps and escapes; eq. 10.60's ``parameters`` also hold
+    ``eps``, ``force`` and ``Q`` as numbers."""
+    de, er, cont, up, down = r.de, r.er, r.cont, r.up, r.down
+    lo, hi = er.omega_range
+    true_folds = [(w, list(m)) for w, m in r.true_folds]
+    return {
+        "equation": de.text,
+        "name": de.name,
+        "parameters": {**dict(r.notes), "harmonics": r.fine.harmonics,
+                       "omega_range": [lo, hi], "values": dict(de.values),
+                       "linear_frequency": er.linear_frequency,
+                       "drive": {"amplitude": de.force, "frequency": de.frequency}},
+        "force": [{"q": a, "dq": b, "c": c} for (a, b), c in sorted(de.terms.items())],
+        "odd": de.odd,
+        "one_harmonic": {"folds": [float(w) for w in er.one_harmonic_folds]},
+        "harmonic_balance": {"harmonics": r.fine.harmonics,
+                             "folds": [float(w) for w in cont.folds],
+                             "complete": cont.complete},
+        "numerical": {"folds": [w for w, _ in true_folds],
+                      "fold_floquet_moduli": [m for _, m in true_folds],
+                      "sweep_up_jump": up.jump, "sweep_down_jump": down.jump,
+                      "sweep_resolution": up.resolution, "sweep_up_escape": up.escape,
+                      "sweep_down_escape": down.escape,
+                      "escape_bound": r.barrier if math.isfinite(r.barrier) else None},
+    }
+
+
 def response_json(eps: float, force: float, Q: float, harmonics: int,
                   max_seconds: float = COST_LIMIT_SECONDS) -> dict:
-    """The contract of ``lindstedt response … --json``: folds three ways, sweep jumps
-    (``max_seconds``: the continuation's cost limit), formatted from
-    :func:`analysis.response.duffing_response`."""
+    """``response --eps --force --Q --json``: :func:`response_report_json` of
+    :func:`analysis.response.duffing_response` (``max_seconds``: the continuation's cost
+    limit)."""
     from ..analysis.response import duffing_response
 
-    r = duffing_response(eps, force, Q, harmonics, max_seconds=max_seconds)
-    lo, hi = r.omega_range
-    return {
-        "parameters": {"eps": eps, "force": force, "Q": Q, "harmonics": harmonics,
-                       "omega_range": [lo, hi]},
-        "one_harmonic": {"folds": list(r.one_harmonic_folds)},
-        "harmonic_balance": {"harmonics": harmonics,
-                             "folds": [float(w) for w in r.cont.folds]},
-        "numerical": {"folds": list(r.true_folds), "sweep_up_jump": r.up.jump,
-                      "sweep_down_jump": r.down.jump, "sweep_resolution": r.up.resolution,
-                      "sweep_up_escape": r.up.escape, "sweep_down_escape": r.down.escape},
-    }
+    return response_report_json(duffing_response(eps, force, Q, harmonics, max_seconds))
 
 
 def response_equation_json(text: str, values: dict[str, str], harmonics: int,
                            name: str = "oscillator", omega_min: float | None = None,
                            omega_max: float | None = None,
                            max_seconds: float = COST_LIMIT_SECONDS) -> dict:
-    """The contract of ``lindstedt response EQUATION … --json``: the keys of
-    :func:`response_json` (``parameters`` as ``driven EQUATION``'s, with ``omega_range``),
-    with the folds of the general one-harmonic balance, of the continued N-harmonic balance,
-    and of the true orbit (each with its Floquet moduli), the sweeps' jumps and escapes."""
+    """``response EQUATION --json``: :func:`response_report_json` of
+    :func:`analysis.response.equation_response`."""
     from ..analysis.response import equation_response
 
-    curve = equation_response(text, values, harmonics, name, omega_min, omega_max, max_seconds)
-    de, er, cont, up, down = curve.de, curve.er, curve.cont, curve.up, curve.down
-    lo, hi = er.omega_range
-    true_folds = [(w, list(m)) for w, m in curve.true_folds]
-    bound = curve.bound
-    return {
-        "equation": text,
-        "name": name,
-        "parameters": {"harmonics": harmonics, "omega_range": [lo, hi],
-                       "values": dict(de.values), "linear_frequency": er.linear_frequency,
-                       "drive": {"amplitude": de.force, "frequency": de.frequency}},
-        "force": [{"q": a, "dq": b, "c": c} for (a, b), c in sorted(de.terms.items())],
-        "odd": de.odd,
-        "one_harmonic": {"folds": [float(w) for w in er.one_harmonic_folds]},
-        "harmonic_balance": {"harmonics": harmonics, "folds": [float(w) for w in cont.folds],
-                             "complete": cont.complete},
-        "numerical": {"folds": [w for w, _ in true_folds],
-                      "fold_floquet_moduli": [m for _, m in true_folds],
-                      "sweep_up_jump": up.jump, "sweep_down_jump": down.jump,
-                      "sweep_resolution": up.resolution, "sweep_up_escape": up.escape,
-                      "sweep_down_escape": down.escape, "escape_bound": bound},
-    }
+    return response_report_json(equation_response(text, values, harmonics, name, omega_min,
+                                                  omega_max, max_seconds))
 
 
 RESPONSE_EQUATION_ONLY = ("omega_min", "omega_max")
@@ -379,7 +377,7 @@ def run_response(args: argparse.Namespace) -> int:
             lambda path: _charts().response_equation_figure(
                 args.model, values, args.harmonics, path, name, args.omega_min,
                 args.omega_max, limit),
-            _response_equation_table)
+            _response_table)
     return _report(
         args, lambda: response_json(args.eps, args.force, args.Q, args.harmonics,
                                     math.inf if args.allow_slow else COST_LIMIT_SECONDS),
@@ -390,30 +388,7 @@ def run_response(args: argparse.Namespace) -> int:
 
 
 def _response_table(data: dict) -> list[str]:
-    p = data["parameters"]
-    harmonics = data["harmonic_balance"]["harmonics"]
-    lines = []
-    lines.append(f"q'' + q'/Q + q + eps q^3 = f cos(w t): eps = {p['eps']}, f = {p['force']}, "
-                 f"Q = {p['Q']}; w in [{p['omega_range'][0]:.4g}, {p['omega_range'][1]:.4g}]")
-    for label, folds in (("one harmonic", data["one_harmonic"]["folds"]),
-                         (f"harmonic balance N={harmonics}", data["harmonic_balance"]["folds"]),
-                         ("true orbit (Floquet +1)", data["numerical"]["folds"])):
-        lines.append(f"{label:>26}: folds " + (", ".join(f"{w:.12f}" for w in folds) or "none"))
-    num = data["numerical"]
-    for way in ("up", "down"):
-        value, escape = num[f"sweep_{way}_jump"], num[f"sweep_{way}_escape"]
-        if escape is not None:
-            text = (f"escapes the well at {escape:.4f} (over the barrier |q| = "
-                    f"{1 / math.sqrt(-p['eps']):.3g}: no steady state beyond)")
-        elif value is not None:
-            text = f"jumps at {value:.4f} (sweep step {num['sweep_resolution']:.1e} per period)"
-        else:
-            text = "no jump"
-        lines.append(f"{'sweep ' + way:>26}: {text}")
-    return lines
-
-
-def _response_equation_table(data: dict) -> list[str]:
+    """The table of ``response``, from its JSON."""
     p = data["parameters"]
     given = ", ".join(f"{k} = {v}" for k, v in p["values"].items())
     harmonics = data["harmonic_balance"]["harmonics"]
@@ -427,7 +402,10 @@ def _response_equation_table(data: dict) -> list[str]:
         lines.append(f"{label:>26}: folds " + (", ".join(f"{w:.12f}" for w in folds) or "none"))
     for way in ("up", "down"):
         value, escape = num[f"sweep_{way}_jump"], num[f"sweep_{way}_escape"]
-        if escape is not None:
+        if escape is not None and "eps" in p:
+            text = (f"escapes the well at {escape:.4f} (over the barrier |q| = "
+                    f"{num['escape_bound']:.3g}: no steady state beyond)")
+        elif escape is not None:
             text = (f"escapes at {escape:.4f} (|q| past {num['escape_bound']:.3g}, 10 times "
                     "every balance solution's: no steady state beyond)")
         elif value is not None:
