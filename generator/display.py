@@ -99,6 +99,13 @@ def harmonics_table(caption: str, A: dict[int, float], B: dict[int, float],
     """``A_n``, ``B_n`` of ``q = Σ A_n cos nΩt + B_n sin nΩt`` by harmonic, the first rows
     (``Ω`` the orbit's fundamental: ``ω``, or ``ω/p`` for an orbit of p drive periods)."""
     ns = sorted(A)
-    rows = [(n, A[n], B.get(n)) for n in ns[:SHOWN_ROWS]]
+    # below the rounding of the largest entry (a sine part that vanishes by symmetry but
+    # carries the balance's 1e-17): 0
+    floor = 1e-14 * max((abs(v) for v in (*A.values(), *B.values())), default=0.0)
+
+    def shown(v: float | None) -> float | None:
+        return None if v is None else (0.0 if abs(v) <= floor else v)
+
+    rows = [(n, shown(A[n]), shown(B.get(n))) for n in ns[:SHOWN_ROWS]]
     note = "; ".join(t for t in (more(len(ns), SHOWN_ROWS, "harmonics"), note) if t)
     return html_table(caption, ("n", "A_n (cos)", "B_n (sin)"), rows, note=note)

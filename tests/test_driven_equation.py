@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 from lindstedt.analysis.driven import Drive
-from lindstedt.analysis.periodic import equation_orbits, periodic_orbits
+from lindstedt.analysis.periodic import periodic_orbits
 from lindstedt.analysis.polynomial import driven_equation
 from lindstedt.cli import main
 from lindstedt.cli.driven import driven_equation_json
@@ -107,7 +107,7 @@ def _distance(a, b, omega):
 
 
 def check_against_reference(text, values, omega, g, force, dissipative=True):
-    found = equation_orbits(driven_equation(text, values, omega))
+    found = periodic_orbits(driven_equation(text, values, omega))
     assert found.complete, found.note
     refs = []
     for mine in found.orbits:
@@ -178,7 +178,7 @@ def test_duffing_as_text_reproduces_the_built_in(Q, omega):
     text = "q'' + q + eps*q**3 = f*cos(w*t)"
     if math.isfinite(Q):
         text, values["Q"] = "q'' + q'/Q + q + eps*q**3 = f*cos(w*t)", "20"
-    mine = equation_orbits(driven_equation(text, values, omega)).orbits
+    mine = periodic_orbits(driven_equation(text, values, omega)).orbits
     built = periodic_orbits(Drive(0.1, 0.3, omega, Q)).orbits
     assert len(mine) == len(built) == (1 if omega == 0.8 else 3)
     for a, b in zip(mine, built, strict=True):
@@ -226,5 +226,5 @@ def test_cost_bounds_the_equation_path():
     cost = COSTS["driven"](build_parser().parse_args(argv))
     assert "harmonics 20" in cost.subject and cost.seconds < 60
     start = time.perf_counter()
-    equation_orbits(driven_equation(ASYMMETRIC, VALUES, 1.2), 20)
+    periodic_orbits(driven_equation(ASYMMETRIC, VALUES, 1.2), 20)
     assert time.perf_counter() - start < cost.seconds

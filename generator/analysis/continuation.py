@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from .polynomial import PolynomialBalance
+from .polynomial import DrivenEquation, PolynomialBalance, amplitude_bound
 
 
 @dataclass(frozen=True)
@@ -173,7 +173,7 @@ CONTINUATION_BUDGET = 15.0
 
 def _crossings(w: np.ndarray, x: np.ndarray) -> list[np.ndarray]:
     """Where one piece of the continued curve meets ``w = 0`` (``w``: its ω minus the drive's),
-    interpolated (see :func:`balance_crossings`)."""
+    interpolated (see :func:`drive_crossings`)."""
     seeds = []
     for i in range(len(w) - 1):
         if w[i] * w[i + 1] <= 0 and w[i] != w[i + 1]:
@@ -224,6 +224,7 @@ class DriveContinuation:
 
 
 MAX_DRIVE_POINTS = 4000
+DRIVE_STEP, DRIVE_GROWTH = 1 / 25, 2.0
 # NOTE: the continuation in f stops after 4000 points (~5 s at 31 unknowns) and says its seeds
 # may be incomplete; a curve up to an amplitude bound of a few hundred takes far fewer.
 
@@ -242,7 +243,7 @@ def continue_in_drive(system: PolynomialBalance, omega: float, bound: float | No
     k1 = int(np.nonzero(system.orders == 1)[0][0])
     sin1 = system.n_cos + int(np.nonzero(system.orders[system.orders > 0] == 1)[0][0])
     scale = abs(system.force) + (bound if bound is not None else 10.0)
-    h_max, h_floor, h_min = scale / 100, scale * 1e-4, scale * 1e-9
+    h_max, h_floor, h_min = scale * DRIVE_STEP, scale * 1e-3, scale * 1e-9
     h = h_max / 4
     y = np.zeros(m + 1)
     deadline = time.monotonic() + max_seconds
@@ -283,7 +284,7 @@ def continue_in_drive(system: PolynomialBalance, omega: float, bound: float | No
             # near ±f the steps shrink with the distance to it, so that a fold of the curve
             # just beyond ±f (two crossings close together) leaves points on both sides
             near = min(abs(y[-1] - system.force), abs(y[-1] + system.force))
-            h = min(1.5 * h, h_max, max(h_floor, 0.5 * near))
+            h = min(DRIVE_GROWTH * h, h_max, max(h_floor, 2.0 * near))
 
 
 def _first_direction(fam: _DriveFamily, y: np.ndarray, h: float, k1: int,
@@ -321,3 +322,19 @@ def _half_period(system: PolynomialBalance, x: np.ndarray) -> np.ndarray:
 def _balance_r(system: PolynomialBalance, x: np.ndarray) -> float:
     A, B = system.amplitudes(x)
     return math.hypot(A.get(1, 0.0), B.get(1, 0.0))
+
+
+def drive_crossings(de: DrivenEquation, harmonics: int
+                    ) -> tuple[PolynomialBalance, list[np.ndarray], DriveContinuation]:
+    """The seeds of every orbit of ``de`` at its ω: the balance (at most
+    CONTINUATION_HARMONICS harmonics) continued in the drive amplitude from rest up to the
+    amplitude bound (:func:`continue_in_drive`), where it crosses ``f`` — and ``−f``, shifted by
+    half a period (:func:`_half_period`) —, quadratic around the folds (:func:`_crossings`);
+    with that balance and the traced curve (its ``complete`` and ``note``)."""
+    coarse = PolynomialBalance(de.terms, de.force, min(harmonics, CONTINUATION_HARMONICS),
+                               de.odd)
+    curve = continue_in_drive(coarse, de.omega,
+                              amplitude_bound(de.terms, de.omega, abs(de.force)))
+    seeds = _crossings(curve.force - de.force, curve.x)
+    seeds += [_half_period(coarse, x) for x in _crossings(curve.force + de.force, curve.x)]
+    return coarse, seeds, curve

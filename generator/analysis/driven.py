@@ -27,16 +27,15 @@ import numpy as np
 from ..algebra.series import (
     laurent_cos,
     laurent_derivative,
-    laurent_from_fourier,
     laurent_product,
     laurent_secular,
     laurent_solve,
     laurent_to_fourier,
 )
-from ..display import SHOWN_ROWS, harmonics_table, html_table
+from ..display import SHOWN_ROWS, html_table
 from ..errors import InputError
 from ..limits import MAGNITUDES, MU_MAX_ORDER, check_int
-from .polynomial import DrivenEquation, PolynomialBalance
+from .polynomial import DrivenEquation, HarmonicBalance, PolynomialBalance
 
 DUFFING_TEXT = "q'' + q'/Q + q + eps*q**3 = f*cos(w*t)"
 
@@ -451,22 +450,6 @@ def _convergence(q: list[np.ndarray]) -> tuple[bool, str]:
 
 # --- harmonic balance ------------------------------------------------------------------------
 
-@dataclass(frozen=True)
-class HarmonicBalance:
-    """Harmonic balance with odd harmonics ``1, 3, …, 2N − 1`` (cos and sin when damped)."""
-
-    harmonics: int
-    coefficients: np.ndarray  # c_n of e^{inωt}, index n + M
-    residual: float
-    converged: bool
-
-    def _repr_html_(self) -> str:
-        A, B = amplitudes(self.coefficients, 0.0, 2 * self.harmonics - 1)
-        return harmonics_table(f"harmonic balance, N = {self.harmonics} odd harmonics", A, B,
-                               f"residual {self.residual:.1e}, "
-                               f"{'converged' if self.converged else 'NOT converged'}")
-
-
 def harmonic_balance(d: Drive, start: Branch | np.ndarray, harmonics: int, tol: float = 1e-13,
                      max_iter: int = 50) -> HarmonicBalance:
     """Newton's method on the balance of eq. 10.60 (:meth:`Drive.balance`, odd harmonics
@@ -482,7 +465,7 @@ def harmonic_balance(d: Drive, start: Branch | np.ndarray, harmonics: int, tol: 
         given = np.asarray(start, dtype=float)
         k = min(len(given) // 2, harmonics)
         x[:k], x[harmonics : harmonics + k] = given[:k], given[len(given) // 2 :][:k]
-    x, converged, residual = system.solve(x, d.omega, tol, max_iter)
-    coefficients = laurent_from_fourier(3 * (2 * harmonics - 1), system.orders,
-                                        x[:harmonics], x[harmonics:])
-    return HarmonicBalance(harmonics, coefficients, residual, converged)
+    found = system.solution(x, d.omega, tol, max_iter)
+    if found is None:  # exactly at a fold
+        raise np.linalg.LinAlgError("the balance's Jacobian is singular")
+    return found

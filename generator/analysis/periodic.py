@@ -1,41 +1,29 @@
-"""Every distinct periodic orbit at one drive: seeds (the one-harmonic roots and the
-crossings of a continued balance), Newton's balance from each, shooting with its Floquet
-multipliers, deduplication; the notes' Duffing and a user's polynomial force; the true fold."""
+"""Every distinct periodic orbit at one drive, of any polynomial force (eq. 10.60 one of
+them): seeds (the crossings of the balance continued in the drive amplitude and, for eq. 10.60,
+the one-harmonic roots), Newton's balance from each, shooting with its Floquet multipliers,
+deduplication; the report of ``driven``."""
 
 from __future__ import annotations
 
-import functools
 import itertools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import InputError
 from ..numerics.floquet import orbit_hill_multipliers
-from ..numerics.integrate import ForceTable
-from ..numerics.shooting import PeriodicOrbit, ShootingFailure, shoot_explained, shoot_table
-from .continuation import (
-    CONTINUATION_BUDGET,
-    CONTINUATION_HARMONICS,
-    _balance_r,
-    _crossings,
-    _half_period,
-    continue_in_drive,
-)
+from ..numerics.integrate import ForceTable, escape_bound
+from ..numerics.shooting import PeriodicOrbit, ShootingFailure, shoot_table
+from .continuation import drive_crossings
 from .driven import (
-    MAGNITUDES,
     Branch,
     Drive,
-    HarmonicBalance,
     MuExpansion,
-    amplitudes,
     first_order_branches,
     harmonic_balance,
     mu_expansion,
 )
-from .polynomial import DrivenEquation, PolynomialBalance, amplitude_bound, check_harmonics
-from .response import continue_balance, response_range
+from .polynomial import DrivenEquation, HarmonicBalance, PolynomialBalance, check_harmonics
 
 SAME_ORBIT = 1e-8
 # NOTE: two shot orbits are one when their states (q(0), q̇(0)/ω) differ by at most 1e-8 of the
@@ -57,48 +45,61 @@ REFINED_HARMONICS = 32
 # shot once more: an orbit near the barrier of a softening spring can be so unstable (Floquet
 # multiplier 7.7e7 at ε −0.1, f 0.3, Q 20, ω 0.3) that the 8-harmonic balance's 1e-5 error
 # carries its trajectory out of the well within the period; 32 harmonics bring it to ~1e-16.
+
+
 @dataclass(frozen=True)
 class Orbit:
     """One distinct periodic orbit of period ``2π/ω`` with how it was found.
 
-    ``seed``: ``"one_harmonic"`` when shooting from a one-harmonic root reached it,
-    ``"continuation"`` when only a crossing of the continued harmonic balance did.
+    ``seed``: ``"one_harmonic"`` when shooting from a one-harmonic root of eq. 10.60 reached
+    it, ``"continuation"`` when only a crossing of the balance continued in the drive did.
     ``branch``: the one-harmonic root that stands for it at first order (the root whose shooting
     reached it, the nearest when several did; or, when as many roots as orbits are left over,
-    the one of the same rank in amplitude), ``None`` when no root does.
-    ``balance``: the harmonic balance whose solution led to the orbit.  ``orbit`` is ``None``
-    for a root whose balance converged but whose shooting did not (at the corners of the
-    domain): then the branch is that balance alone (``paired = "balance"``)."""
+    the one of the same rank in amplitude), ``None`` when no root does (always, for a user's
+    equation).  ``balance``: the harmonic balance whose solution led to the orbit, ``own`` when
+    it converged onto this orbit (within BALANCE_NEAR).  ``orbit`` is ``None`` for a seed whose
+    balance converged but whose shooting did not (at the corners of the domain): then the
+    branch is that balance alone (``paired = "balance"``)."""
 
     orbit: PeriodicOrbit | None  # None: shooting found no orbit (see periodic_orbits)
     balance: HarmonicBalance | None
-    branch: Branch | None
-    seed: str
-    paired: str | None  # "shot" (its shooting reached it), "rank", "balance", None (no root)
+    branch: Branch | None = None
+    seed: str = "continuation"
+    paired: str | None = None  # "shot" (its shooting reached it), "rank", "balance", None
     failure: ShootingFailure | None = None  # orbit None: why shooting from the balance failed
+    own: bool = True
 
     @property
     def r(self) -> float:
         """The first-harmonic amplitude ``√(A₁² + B₁²)`` of the true orbit (of the balance
         where shooting found none)."""
-        return _amplitude({"orbit": self.orbit, "balance": self.balance})
+        if self.orbit is None:
+            return self.balance.r
+        return math.hypot(self.orbit.A.get(1, 0.0), self.orbit.B.get(1, 0.0))
 
 
 @dataclass(frozen=True)
 class Orbits:
-    """Every distinct orbit found at one drive, largest first, and the one-harmonic roots."""
+    """Every distinct orbit found at one drive, largest first; for eq. 10.60 also its
+    one-harmonic roots, each with the index of the orbit it stands for and, where its
+    shooting found none, why."""
 
     orbits: tuple[Orbit, ...]
-    roots: tuple[tuple[Branch, int | None], ...]  # each root, the index of the orbit it stands for
-    complete: bool  # whether the seeds cover the whole response curve (balance_crossings)
+    roots: tuple[tuple[Branch, int | None], ...]
+    complete: bool  # whether the seeds cover every orbit (drive_crossings' curve complete)
     note: str  # how the seeds were found
     failures: tuple[ShootingFailure | None, ...] = ()  # per root: why its shooting found none
+    seeds: int = 0  # crossings of the drive amplitude
 
 
-def _guess(hb: HarmonicBalance, omega: float) -> np.ndarray:
-    """``(q(0), q̇(0)) = (Σ A_n, ω Σ n B_n)`` of a balance solution."""
-    A, B = amplitudes(hb.coefficients, 0.0, 2 * hb.harmonics - 1)
-    return np.array([sum(A.values()), omega * sum(n * b for n, b in B.items())])
+@dataclass(frozen=True)
+class _Seed:
+    """Where shooting starts: the guesses ``(q(0), q̇(0))`` in order, the balance solved from
+    the seed (``None``: singular), the index of the one-harmonic root it came from."""
+
+    guesses: tuple[np.ndarray, ...]
+    balance: HarmonicBalance | None
+    root: int | None = None
 
 
 def _state_distance(a: np.ndarray, b: np.ndarray, omega: float) -> float:
@@ -108,22 +109,12 @@ def _state_distance(a: np.ndarray, b: np.ndarray, omega: float) -> float:
     return float(np.linalg.norm(u - v)) / size if size > 0 else 0.0
 
 
-def _first_harmonic_gap(br: Branch, found: dict) -> float:
+def _first_harmonic_gap(br: Branch, orbit: Orbit) -> float:
     """Distance of a root's ``(A₁ cos δ₀, A₁ sin δ₀)`` from an orbit's ``(A₁, B₁)`` (its
     balance's, where shooting found none)."""
-    if found["orbit"] is None:
-        A, B = amplitudes(found["balance"].coefficients, 0.0, 1)
-    else:
-        A, B = found["orbit"].A, found["orbit"].B
-    return math.hypot(br.A1 * math.cos(br.delta0) - A[1], br.A1 * math.sin(br.delta0) - B[1])
-
-
-def _amplitude(found: dict) -> float:
-    """r of a found orbit, or of its balance when shooting found none."""
-    if found["orbit"] is None:
-        A, B = amplitudes(found["balance"].coefficients, 0.0, 1)
-        return math.hypot(A[1], B[1])
-    return math.hypot(found["orbit"].A[1], found["orbit"].B[1])
+    A, B = orbit.balance.amplitudes() if orbit.orbit is None else (orbit.orbit.A, orbit.orbit.B)
+    return math.hypot(br.A1 * math.cos(br.delta0) - A.get(1, 0.0),
+                      br.A1 * math.sin(br.delta0) - B.get(1, 0.0))
 
 
 def try_balance(d: Drive, start: Branch | np.ndarray, harmonics: int,
@@ -138,117 +129,84 @@ def try_balance(d: Drive, start: Branch | np.ndarray, harmonics: int,
     return hb if hb.converged or not converged else None
 
 
-def _balance_vector(hb: HarmonicBalance) -> np.ndarray:
-    """``x = (a_1, a_3, …, b_1, b_3, …)`` of a balance solution."""
-    A, B = amplitudes(hb.coefficients, 0.0, 2 * hb.harmonics - 1)
-    return np.array([*A.values(), *B.values()])
+def periodic_orbits(system: Drive | DrivenEquation, harmonics: int = 8,
+                    shoot_harmonics: int | None = None) -> Orbits:
+    """Every distinct periodic orbit of period ``2π/ω`` of eq. 10.60 (a :class:`Drive`) or of a
+    user's :class:`DrivenEquation` that the seeds reach, largest ``r`` first, each once, with
+    its Floquet multipliers (:func:`numerics.shooting.shoot_table`, ``shoot_harmonics``
+    harmonics resolved, default ``2N − 1``).
 
-
-@functools.lru_cache(maxsize=16)
-def _traced(eps: float, force: float, Q: float, harmonics: int, lo: float,
-            hi: float) -> tuple[object, str]:
-    """The continued balance on ``[lo, hi]`` (cached: one curve serves every ω on it), or
-    ``None`` and the reason it was refused."""
-    try:
-        return continue_balance(eps, force, Q, harmonics, lo, hi,
-                                max_seconds=CONTINUATION_BUDGET), ""
-    except InputError as exc:
-        return None, str(exc)
-
-
-def balance_crossings(d: Drive, harmonics: int = CONTINUATION_HARMONICS
-                      ) -> tuple[list[np.ndarray], str, bool]:
-    """Every point of the continued harmonic-balance curve at ``d.omega`` (damped only), as
-    balance vectors ``x`` with ``harmonics`` harmonics, interpolated between continuation
-    points (linearly; quadratically around each turn of ω, where both crossings near a fold
-    may lie between two points): seeds, not solutions.  With how they were found, and whether
-    they are complete: every piece of the curve that reaches an end of the range traced (a
-    softening spring's two, see :func:`continue_balance`), or none needed (linear, one orbit;
-    ω above the range, where ``response`` has one branch too).  ``False``: undamped (no
-    continuation), refused, or a root at an end whose balance did not converge."""
-    if d.damping == 0:
-        return [], "undamped: no continuation (the response curve needs damping)", False
-    if d.eps == 0:  # linear: one orbit, the root's (and the curve, up to r = fQ, is long)
-        return [], "linear (eps 0): one orbit, no continuation needed", True
-    lo, hi = response_range(d.eps, d.force, d.Q)
-    if d.omega > hi:
-        return [], (f"omega above the response curve's range (up to {hi:.6g}, 1.25 x its "
-                    "highest one-harmonic fold): no continuation"), True
-    lo = min(lo, max(0.98 * d.omega, MAGNITUDES[0]))
-    cont, why = _traced(d.eps, d.force, d.Q, harmonics, lo, hi)
-    if cont is None:
-        return [], f"continuation refused ({why})", False
-    seeds = []
-    for piece in cont.piece_slices():
-        seeds += _crossings(cont.omega[piece] - d.omega, cont.x[piece])
-    note = f"continued harmonic balance (N = {harmonics}) on [{lo:.6g}, {hi:.6g}]"
-    if not cont.complete:  # a root at an end whose balance did not converge: not traced
-        return seeds, (f"{note}: the balance from a one-harmonic root at an end of the range "
-                       "did not converge, its piece of the curve is missing"), False
-    return seeds, note, True
-
-
-def periodic_orbits(d: Drive, harmonics: int = 8, shoot_harmonics: int = 9) -> Orbits:
-    """Every distinct periodic orbit of period ``2π/ω`` that the seeds reach, largest ``r``
-    first, each once, with its Floquet multipliers (:func:`numerics.shoot`).
-
-    Seeds: every real root of the one-harmonic equation (through its harmonic balance with
-    ``harmonics`` harmonics, or the root itself where that balance does not converge) and,
-    damped, every crossing of the continued harmonic-balance curve with this ω
-    (:func:`balance_crossings`, polished at ``harmonics``): the true folds are not the
-    one-harmonic ones, so near a fold the cubic has too few roots or too many.  Orbits are
-    one when their states differ by at most SAME_ORBIT.  Undamped there is no continuation:
-    the one-harmonic seeds only, deduplicated."""
+    Seeds: every crossing of the balance continued in the drive amplitude from rest
+    (:func:`continuation.drive_crossings`), and for eq. 10.60 first every real root of the
+    one-harmonic cubic (which stands for the orbit its shooting reaches); each is polished by
+    Newton's method on the balance with ``harmonics`` harmonics and shot from
+    (:func:`_shoot_seed`).  Orbits within SAME_ORBIT are one; a seed whose balance converged
+    but whose shooting found nothing, farther than BALANCE_NEAR from every orbit, is kept as
+    its balance alone."""
     check_harmonics(harmonics)
-    roots = first_order_branches(d)
-    seeds: list[tuple[int | None, list[np.ndarray], HarmonicBalance | None]] = []
+    if isinstance(system, Drive):
+        de, roots, bound = system.equation, first_order_branches(system), escape_bound(
+            system.eps, system.force)
+    else:
+        de, roots, bound = system, [], math.inf
+    top = 2 * harmonics - 1
+    shoot_harmonics = top if shoot_harmonics is None else shoot_harmonics
+    omega = de.omega
+    fine = PolynomialBalance(de.terms, de.force, harmonics, de.odd)
+    seeds = []
     for k, br in enumerate(roots):
-        hb = try_balance(d, br, harmonics)
-        first = br.A1 * np.array([math.cos(br.delta0), d.omega * math.sin(br.delta0)])
-        guesses = [_guess(hb, d.omega), first] if hb is not None and hb.converged else [first]
-        seeds.append((k, guesses, hb))
-    crossings, note, complete = balance_crossings(d, min(harmonics, CONTINUATION_HARMONICS))
+        first = br.A1 * np.array([math.cos(br.delta0), omega * math.sin(br.delta0)])
+        hb = fine.solution(fine.vector({1: br.A1 * math.cos(br.delta0)},
+                                       {1: br.A1 * math.sin(br.delta0)}), omega)
+        good = hb is not None and hb.converged
+        seeds.append(_Seed((hb.state(omega), first) if good else (first,), hb, k))
+    coarse, crossings, curve = drive_crossings(de, harmonics)
     for x in crossings:
-        hb = try_balance(d, x, harmonics)
-        h = len(x) // 2
-        raw = np.array([x[:h].sum(), d.omega * np.sum(np.arange(1, 2 * h, 2) * x[h:])])
-        seeds.append((None, [_guess(hb, d.omega), raw] if hb is not None and hb.converged
-                      else [raw], hb))
-    found: list[dict] = []  # orbit, balance, whether that balance is the orbit's, seed
+        hb = fine.solution(fine.vector(*coarse.amplitudes(x)), omega)
+        raw = coarse.state(x, omega)
+        good = hb is not None and hb.converged
+        seeds.append(_Seed((hb.state(omega), raw) if good else (raw,), hb))
+    table = ForceTable.of(de.terms)
+    found: list[Orbit] = []
     reached: dict[int, int] = {}  # root index -> orbit index
     failures: dict[int, ShootingFailure] = {}  # root index -> why its shooting found none
-    for k, guesses, hb in seeds:
-        orbit, failure = _shoot_seed(d, guesses, hb, shoot_harmonics)
+    unshot: list[tuple[_Seed, ShootingFailure | None]] = []
+    for seed in seeds:
+        orbit, failure = _shoot_seed(de, table, seed, shoot_harmonics, bound)
         if orbit is None:
-            if k is not None:
-                failures[k] = failure
+            if seed.root is not None:
+                failures[seed.root] = failure
+            unshot.append((seed, failure))
             continue
-        j = next((j for j, f in enumerate(found) if _state_distance(
-            f["orbit"].initial, orbit.initial, d.omega) <= SAME_ORBIT), None)
+        hb = seed.balance
+        j = next((j for j, o in enumerate(found) if _state_distance(
+            o.orbit.initial, orbit.initial, omega) <= SAME_ORBIT), None)
         # the balance shown beside the orbit: one that converged onto it, if any seed's did
         own = hb is not None and hb.converged and _state_distance(
-            _guess(hb, d.omega), orbit.initial, d.omega) <= BALANCE_NEAR
+            hb.state(omega), orbit.initial, omega) <= BALANCE_NEAR
         if j is None:
             j = len(found)
-            found.append({"orbit": orbit, "balance": hb, "own": own,
-                          "seed": "one_harmonic" if k is not None else "continuation"})
-        elif own and not found[j]["own"]:
-            found[j].update(balance=hb, own=True)
-        if k is not None:
-            reached[k] = j
-    # a root whose shooting failed but whose balance converged elsewhere than every orbit found
+            found.append(Orbit(orbit, hb, seed="one_harmonic" if seed.root is not None
+                               else "continuation", own=own))
+        elif own and not found[j].own:
+            found[j] = replace(found[j], balance=hb, own=True)
+        if seed.root is not None:
+            reached[seed.root] = j
+    # a seed whose shooting failed but whose balance converged elsewhere than every orbit found
     # (the corners of the domain, where RK4 cannot follow the scales): its balance, no orbit
-    for k, _, hb in seeds:
-        if k is None or k in reached or hb is None or not hb.converged:
+    for seed, failure in unshot:
+        hb = seed.balance
+        if hb is None or not hb.converged or seed.root in reached:
             continue
-        state = _guess(hb, d.omega)
-        if all(_state_distance(state, f["orbit"].initial if f["orbit"] is not None
-                               else _guess(f["balance"], d.omega), d.omega)
-               > (BALANCE_NEAR if f["orbit"] is not None else SAME_ORBIT) for f in found):
-            reached[k] = len(found)
-            found.append({"orbit": None, "balance": hb, "own": True, "seed": "one_harmonic",
-                          "failure": failures.get(k)})
-    rank = sorted(range(len(found)), key=lambda j: -_amplitude(found[j]))
+        state = hb.state(omega)
+        if all(_state_distance(state, o.orbit.initial if o.orbit is not None
+                               else o.balance.state(omega), omega)
+               > (BALANCE_NEAR if o.orbit is not None else SAME_ORBIT) for o in found):
+            if seed.root is not None:
+                reached[seed.root] = len(found)
+            found.append(Orbit(None, hb, seed="one_harmonic" if seed.root is not None
+                               else "continuation", failure=failure))
+    rank = sorted(range(len(found)), key=lambda j: -found[j].r)
     found = [found[j] for j in rank]
     new_index = {old: new for new, old in enumerate(rank)}
     # the first-order root standing for each orbit: the nearest root whose shooting reached it
@@ -261,124 +219,43 @@ def periodic_orbits(d: Drive, harmonics: int = 8, shoot_harmonics: int = 9) -> O
     # ... then, when as many roots as orbits are left over, the leftovers by rank in amplitude
     free_roots = [k for k in range(len(roots)) if k not in owner.values()]
     free_orbits = [j for j in range(len(found)) if j not in owner]
-    paired = {j: "shot" if found[j]["orbit"] is not None else "balance" for j in owner}
-    if len(free_roots) == len(free_orbits):
+    paired = {j: "shot" if found[j].orbit is not None else "balance" for j in owner}
+    if roots and len(free_roots) == len(free_orbits):
         owner.update(zip(free_orbits, sorted(free_roots, key=lambda k: -abs(roots[k].A1)),
                          strict=True))
         paired.update(dict.fromkeys(free_orbits, "rank"))
     stands = {k: j for j, k in owner.items()}
-    orbits = tuple(Orbit(f["orbit"], f["balance"], roots[owner[j]] if j in owner else None,
-                         f["seed"], paired.get(j), f.get("failure"))
-                   for j, f in enumerate(found))
+    orbits = tuple(replace(o, branch=roots[owner[j]] if j in owner else None,
+                           paired=paired.get(j)) for j, o in enumerate(found))
+    note = curve.note + f"; {len(crossings)} crossings of the drive amplitude"
     return Orbits(orbits, tuple((br, stands.get(k)) for k, br in enumerate(roots)),
-                  complete, note, tuple(failures.get(k) for k in range(len(roots))))
+                  curve.complete, note, tuple(failures.get(k) for k in range(len(roots))),
+                  len(crossings))
 
 
-def _shoot_seed(d: Drive, guesses: list[np.ndarray], hb: HarmonicBalance | None,
-                shoot_harmonics: int) -> tuple[PeriodicOrbit | None, ShootingFailure | None]:
+def _shoot_seed(de: DrivenEquation, table: ForceTable, seed: _Seed, shoot_harmonics: int,
+                bound: float) -> tuple[PeriodicOrbit | None, ShootingFailure | None]:
     """Shooting from each guess at each of SHOOTING_TOLERANCES, then (a converged balance)
     from the balance solved again with REFINED_HARMONICS; the orbit, or why the first guess
     found none."""
     first = None
-    for tol, guess in itertools.product(SHOOTING_TOLERANCES, guesses):
-        found = shoot_explained(d.eps, d.force, d.omega, d.damping, guess,
-                                harmonics=shoot_harmonics, tol=tol)
+    for tol, guess in itertools.product(SHOOTING_TOLERANCES, seed.guesses):
+        found = shoot_table(table, de.force, de.omega, guess, harmonics=shoot_harmonics,
+                            tol=tol, bound=bound)
         if isinstance(found, PeriodicOrbit):
             return found, None
         first = first or found
+    hb = seed.balance
     if hb is not None and hb.converged and hb.harmonics < REFINED_HARMONICS:
-        fine = try_balance(d, _balance_vector(hb), REFINED_HARMONICS, converged=True)
-        if fine is not None:
+        system = PolynomialBalance(de.terms, de.force, REFINED_HARMONICS, de.odd)
+        fine = system.solution(system.vector(*hb.amplitudes()), de.omega)
+        if fine is not None and fine.converged:
             for tol in SHOOTING_TOLERANCES:
-                found = shoot_explained(d.eps, d.force, d.omega, d.damping,
-                                        _guess(fine, d.omega), harmonics=shoot_harmonics,
-                                        tol=tol)
+                found = shoot_table(table, de.force, de.omega, fine.state(de.omega),
+                                    harmonics=shoot_harmonics, tol=tol, bound=bound)
                 if isinstance(found, PeriodicOrbit):
                     return found, None
     return None, first
-
-
-@dataclass(frozen=True)
-class EquationOrbit:
-    """One distinct periodic orbit of a user's driven oscillator: its balance and, where
-    shooting found it, the true orbit with its Floquet multipliers."""
-
-    orbit: PeriodicOrbit | None
-    balance: np.ndarray | None  # x of the balance solution that led to it
-    converged: bool  # that balance's Newton converged
-    residual: float | None
-    failure: ShootingFailure | None = None
-
-    @property
-    def r(self) -> float:
-        """The first-harmonic amplitude of the true orbit (of the balance where none)."""
-        if self.orbit is not None:
-            return math.hypot(self.orbit.A.get(1, 0.0), self.orbit.B.get(1, 0.0))
-        return float("nan")
-
-
-@dataclass(frozen=True)
-class EquationOrbits:
-    orbits: tuple[EquationOrbit, ...]
-    system: PolynomialBalance
-    complete: bool
-    note: str
-    seeds: int
-
-
-def equation_orbits(de: DrivenEquation, harmonics: int = 8,
-                    shoot_harmonics: int | None = None) -> EquationOrbits:
-    """Every distinct periodic orbit of period ``2π/ω`` of a :class:`driven.DrivenEquation`
-    that the seeds reach, largest ``r`` first, each once, checked by shooting with its Floquet
-    multipliers (:func:`numerics.shoot_table`).
-
-    Seeds: where the balance (at most CONTINUATION_HARMONICS harmonics), continued in the drive
-    amplitude from rest (:func:`continue_in_drive`), crosses ``f`` — and ``−f``, shifted by half
-    a period — (:func:`_crossings`, quadratic around the folds); each is polished by Newton's
-    method at ``harmonics`` and shot from; orbits within SAME_ORBIT are one."""
-    check_harmonics(harmonics)
-    top = 2 * harmonics - 1
-    shoot_harmonics = top if shoot_harmonics is None else shoot_harmonics
-    omega, f = de.omega, de.force
-    coarse = PolynomialBalance(de.terms, f, min(harmonics, CONTINUATION_HARMONICS), de.odd)
-    fine = PolynomialBalance(de.terms, f, harmonics, de.odd)
-    bound = amplitude_bound(de.terms, omega, abs(f))
-    curve = continue_in_drive(coarse, omega, bound)
-    seeds = _crossings(curve.force - f, curve.x)
-    seeds += [_half_period(coarse, x) for x in _crossings(curve.force + f, curve.x)]
-    table = ForceTable.of(de.terms)
-    found: list[EquationOrbit] = []
-    for x in seeds:
-        A, B = coarse.amplitudes(x)
-        start = fine.vector(A, B)
-        xb, converged, residual = fine.solve(start, omega)
-        guesses = [fine.state(xb, omega)] if converged else []
-        guesses.append(coarse.state(x, omega))
-        orbit, failure = None, None
-        for tol, guess in itertools.product(SHOOTING_TOLERANCES, guesses):
-            shot = shoot_table(table, f, omega, guess, harmonics=shoot_harmonics, tol=tol)
-            if isinstance(shot, PeriodicOrbit):
-                orbit, failure = shot, None
-                break
-            failure = failure or shot
-        if orbit is None:
-            if converged and all(o.orbit is not None or _state_distance(
-                    fine.state(o.balance, omega), fine.state(xb, omega), omega) > SAME_ORBIT
-                    for o in found):
-                found.append(EquationOrbit(None, xb, converged, residual, failure))
-            continue
-        j = next((j for j, o in enumerate(found) if o.orbit is not None and _state_distance(
-            o.orbit.initial, orbit.initial, omega) <= SAME_ORBIT), None)
-        own = converged and _state_distance(fine.state(xb, omega), orbit.initial,
-                                            omega) <= BALANCE_NEAR
-        if j is None:
-            found.append(EquationOrbit(orbit, xb if converged else None, converged and own,
-                                       residual if converged else None))
-        elif own and not found[j].converged:
-            found[j] = EquationOrbit(orbit, xb, True, residual)
-    found.sort(key=lambda o: -(o.r if o.orbit is not None else _balance_r(fine, o.balance)))
-    note = curve.note + f"; {len(seeds)} crossings of the drive amplitude"
-    return EquationOrbits(tuple(found), fine, curve.complete, note, len(seeds))
 
 
 @dataclass(frozen=True)
@@ -419,7 +296,7 @@ def driven_report(d: Drive, order: int, harmonics: int) -> DrivenReport:
         mu = None if orb.branch is None else mu_expansion(d, orb.branch, order)
         balance = hill = None
         if orb.balance is not None:
-            balance = amplitudes(orb.balance.coefficients, 0.0, 2 * harmonics - 1)
+            balance = orb.balance.amplitudes()
             hill = orbit_hill_multipliers(table, *balance, d.omega)
         branches.append(BranchReport(orb, mu, balance, hill))
     return DrivenReport(d, order, harmonics, found, tuple(branches))

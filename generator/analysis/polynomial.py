@@ -11,6 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from ..algebra.series import laurent_from_fourier
+from ..display import harmonics_table
 from ..errors import InputError
 from ..limits import MAGNITUDES, MAX_HARMONICS, check_int
 from ..numerics.newton import newton
@@ -55,6 +57,12 @@ class DrivenEquation:
     @property
     def degree(self) -> int:
         return max(a + b for a, b in self.terms)
+
+    @property
+    def where(self) -> str:
+        """The equation named in one line: ``name (text; k = v, …)``."""
+        given = ", ".join(f"{k} = {v}" for k, v in self.values)
+        return f"{self.name} ({self.text}{'; ' if given else ''}{given})"
 
 
 def driven_equation(text: str, values: dict[str, str], omega: float,
@@ -238,6 +246,65 @@ class PolynomialBalance:
         return newton(lambda z: self.residual(z, omega), lambda z: self.jacobian(z, omega), x,
                       tol, max_iter)
 
+    def solution(self, x: np.ndarray, omega: float, tol: float = 1e-13,
+                 max_iter: int = 50) -> HarmonicBalance | None:
+        """:meth:`solve` as a :class:`HarmonicBalance`, or ``None`` where Newton meets a
+        singular Jacobian (exactly at a fold)."""
+        try:
+            x, converged, residual = self.solve(x, omega, tol, max_iter)
+        except np.linalg.LinAlgError:
+            return None
+        return HarmonicBalance(self.harmonics, x, tuple(int(k) for k in self.orders), residual,
+                               converged)
+
+
+@dataclass(frozen=True)
+class HarmonicBalance:
+    """A solution of a :class:`PolynomialBalance` with ``harmonics`` harmonics: its unknowns
+    ``x = (a_k …, b_k …)`` over ``orders`` (odd ``1 … 2N − 1`` for an odd force, else
+    ``0 … 2N − 1``), Newton's residual and whether it converged."""
+
+    harmonics: int
+    x: np.ndarray
+    orders: tuple[int, ...]
+    residual: float
+    converged: bool
+
+    def amplitudes(self) -> tuple[dict[int, float], dict[int, float]]:
+        """``A_k``, ``B_k`` of ``q = Σ A_k cos kωt + B_k sin kωt`` (``A_0`` the mean)."""
+        n = len(self.orders)
+        A = {k: float(a) for k, a in zip(self.orders, self.x[:n], strict=True)}
+        B = {k: float(b) for k, b in zip((k for k in self.orders if k), self.x[n:],
+                                         strict=True)}
+        return A, B
+
+    @property
+    def coefficients(self) -> np.ndarray:
+        """``c_n`` of ``e^{inωt}``, ``n = −M … M`` with ``M = 3(2N − 1)`` (the Fourier kernel's
+        layout, :func:`algebra.series.laurent_from_fourier`)."""
+        A, B = self.amplitudes()
+        orders = np.array(self.orders)
+        return laurent_from_fourier(3 * (2 * self.harmonics - 1), orders,
+                                    np.array([A[k] for k in self.orders]),
+                                    np.array([B.get(k, 0.0) for k in self.orders]))
+
+    @property
+    def r(self) -> float:
+        """The first-harmonic amplitude ``√(A₁² + B₁²)``."""
+        A, B = self.amplitudes()
+        return math.hypot(A.get(1, 0.0), B.get(1, 0.0))
+
+    def state(self, omega: float) -> np.ndarray:
+        """``(q(0), q̇(0))``: a shooting guess."""
+        A, B = self.amplitudes()
+        return np.array([sum(A.values()), omega * sum(k * b for k, b in B.items())])
+
+    def _repr_html_(self) -> str:
+        A, B = self.amplitudes()
+        return harmonics_table(f"harmonic balance, N = {self.harmonics} harmonics", A, B,
+                               f"residual {self.residual:.1e}, "
+                               f"{'converged' if self.converged else 'NOT converged'}")
+
 
 def amplitude_bound(terms: dict[tuple[int, int], float], omega: float,
                     force: float) -> float | None:
@@ -254,7 +321,7 @@ def amplitude_bound(terms: dict[tuple[int, int], float], omega: float,
     window where the two nearly touch counts).  The distortion of a true orbit by its higher
     harmonics is what the factor 2 leaves room for (a one-harmonic bound, not a proof)."""
     d = max(a + b for a, b in terms)
-    if d % 2 == 0 or d < 3:
+    if d % 2 == 0:
         return None
 
     def kappa(n: int) -> float:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -20,15 +20,12 @@ from ..errors import InputError
 from ..numerics.integrate import ForceTable, Sweep, escape_bound, sweep_table
 from ..numerics.shooting import orbit_fold_table
 from .continuation import (
-    CONTINUATION_HARMONICS,
     CONTINUATION_SECONDS,
     MAX_POINTS,
     MAX_Q,
     _balance_r,
     _continue,
-    _crossings,
-    _half_period,
-    continue_in_drive,
+    drive_crossings,
 )
 from .driven import (
     Drive,
@@ -36,7 +33,7 @@ from .driven import (
     amplitude_slope,
     one_harmonic_roots,
 )
-from .polynomial import DrivenEquation, PolynomialBalance, amplitude_bound, check_harmonics
+from .polynomial import DrivenEquation, PolynomialBalance, check_harmonics
 
 if TYPE_CHECKING:
     from .continuation import Continuation
@@ -287,8 +284,8 @@ def equation_range(terms: dict[tuple[int, int], float], force: float,
 
 def equation_continuation_seconds(terms: dict[tuple[int, int], float], force: float,
                                   harmonics: int, odd: bool, lo: float, hi: float,
-                                  step: float = 0.02, max_points: int = MAX_POINTS
-                                  ) -> tuple[float, float]:
+                                  step: float = 0.02, max_points: int = MAX_POINTS,
+                                  where: str | None = None) -> tuple[float, float]:
     """``(points, seconds)`` the continuation of :func:`continue_equation` is estimated at (its
     length ``(hi − lo) + π r_max`` over ``step``, r_max from the one-harmonic amplitudes), or
     :class:`InputError` above ``max_points``."""
@@ -296,7 +293,8 @@ def equation_continuation_seconds(terms: dict[tuple[int, int], float], force: fl
     r_max = one.extent(lo, hi, one.folds(lo, hi, 400))
     estimate = ((hi - lo) + np.pi * r_max) / step
     if not estimate <= max_points:
-        raise InputError(f"force {force:g}: the response curve spans ω in [{lo:.3g}, {hi:.3g}] "
+        where = f"force {force:g}" if where is None else where
+        raise InputError(f"{where}: the response curve spans ω in [{lo:.3g}, {hi:.3g}] "
                          f"with one-harmonic amplitudes up to {r_max:.3g}, about "
                          f"{estimate:.2g} continuation steps of {step:g}; the limit is "
                          f"{max_points}")
@@ -316,15 +314,14 @@ def continue_equation(de: DrivenEquation, harmonics: int, omega_start: float,
     check_harmonics(harmonics)
     fine = PolynomialBalance(de.terms, de.force, harmonics, de.odd)
     lo, hi = sorted((omega_start, omega_stop))
-    given = ", ".join(f"{k} = {v}" for k, v in de.values)
-    where = f"{de.name} ({de.text}{'; ' if given else ''}{given})"
+    where = de.where
     damping = abs(de.terms.get((0, 1), 0.0))
     if 0 < damping < 1 / MAX_Q:
         raise InputError(f"{where}: the damping {damping:.0e}*q' makes the resonance "
                          f"{damping:.0e} wide in ω, too narrow for the continuation to follow "
                          f"in double precision; at least {1 / MAX_Q:.0e} (Q up to {MAX_Q:.0e})")
     estimate, seconds = equation_continuation_seconds(de.terms, de.force, harmonics, de.odd,
-                                                      lo, hi, step, max_points)
+                                                      lo, hi, step, max_points, where)
     if seconds > max_seconds:
         raise InputError(f"harmonics {harmonics}: about {seconds:.0f} s of continuation "
                          f"({estimate:.0f} points) for {where}; the limit is "
@@ -339,7 +336,8 @@ def continuation_seconds(eps: float, force: float, Q: float, harmonics: int, lo:
     """The estimated wall time of :func:`continue_balance`: :func:`equation_continuation_seconds`
     of eq. 10.60; :class:`InputError` for a curve over MAX_POINTS steps."""
     d = Drive(eps, force, lo, Q)
-    return equation_continuation_seconds(d.terms, force, harmonics, True, lo, hi)[1]
+    return equation_continuation_seconds(d.terms, force, harmonics, True, lo, hi,
+                                         where=d.equation.where)[1]
 
 
 def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_start: float,
@@ -361,11 +359,7 @@ def equation_solutions(de: DrivenEquation, fine: PolynomialBalance, omega: float
     """Every balance solution at ``omega`` that the continuation in the drive amplitude from
     rest crosses (at most CONTINUATION_HARMONICS harmonics, then Newton at ``fine``'s), distinct,
     by amplitude; and whether that continuation was complete and every crossing converged."""
-    coarse = PolynomialBalance(de.terms, de.force, min(fine.harmonics, CONTINUATION_HARMONICS),
-                               de.odd)
-    curve = continue_in_drive(coarse, omega, amplitude_bound(de.terms, omega, abs(de.force)))
-    seeds = _crossings(curve.force - de.force, curve.x)
-    seeds += [_half_period(coarse, x) for x in _crossings(curve.force + de.force, curve.x)]
+    coarse, seeds, curve = drive_crossings(replace(de, omega=omega), fine.harmonics)
     out: list[np.ndarray] = []
     complete = curve.complete
     for x in seeds:

@@ -187,20 +187,23 @@ def driven_table(data: dict) -> str:
 def driven_equation_json(text: str, values: dict[str, str], omega: float, harmonics: int,
                          name: str = "oscillator") -> dict:
     """The contract of ``lindstedt driven EQUATION … --json``: every distinct 1:1 orbit found
-    (:func:`response.equation_orbits`), largest first, each by its harmonic balance (``A``
+    (:func:`analysis.periodic.periodic_orbits`), largest first, each by its harmonic balance (``A``
     holds the constant ``"0"`` and even harmonics unless the force is odd) and, checked by
     shooting, the true orbit with its Floquet moduli and verdict."""
-    from ..analysis.periodic import equation_orbits
+    from ..analysis.periodic import periodic_orbits
     from ..analysis.polynomial import driven_equation
 
     de = driven_equation(text, values, omega, name)
-    found = equation_orbits(de, harmonics)
+    found = periodic_orbits(de, harmonics)
     branches = []
     for orb in found.orbits:
-        hb_json = {"harmonics": harmonics, "A": {}, "B": {}, "residual": orb.residual,
-                   "converged": orb.converged, "r": None}
-        if orb.balance is not None:
-            A, B = found.system.amplitudes(orb.balance)
+        hb = orb.balance
+        own = hb is not None and hb.converged and orb.own
+        hb_json = {"harmonics": harmonics, "A": {}, "B": {},
+                   "residual": hb.residual if hb is not None and hb.converged else None,
+                   "converged": own, "r": None}
+        if own:
+            A, B = hb.amplitudes()
             hb_json.update(A=_keyed(A), B=_keyed(B), r=_first_harmonic(A, B))
         numerical = None
         if orb.orbit is not None:

@@ -7,7 +7,7 @@ what it stores:
 * ``response``: the steady amplitude ``r = √(A₁² + B₁²)`` of every 1:1 branch (harmonic
   balance with 10 harmonics from each first-order root), its one-harmonic stability
   (``∂G/∂u > 0``), and the largest and smallest stable amplitude;
-* ``stability``: every distinct periodic orbit (:func:`response.periodic_orbits`: shooting
+* ``stability``: every distinct periodic orbit (:func:`analysis.periodic.periodic_orbits`: shooting
   from each branch's balance solution and from the crossings of the continued balance, which
   find the orbits the one-harmonic roots miss near a fold), how many are Floquet-stable, their
   largest Floquet modulus, and the orbit each first-order branch stands for;
@@ -85,9 +85,9 @@ def _response(omega: float, force: float, eps: float, Q: float) -> dict:
 
 
 def _stability(omega: float, force: float, eps: float, Q: float) -> dict:
-    """Every distinct 1:1 orbit (:func:`response.periodic_orbits`: the one-harmonic roots and,
-    damped, the crossings of the continued balance, shot and deduplicated); per first-order
-    branch, the orbit it stands for (NaN / −1 where it stands for none)."""
+    """Every distinct 1:1 orbit (:func:`analysis.periodic.periodic_orbits`: the one-harmonic
+    roots and the crossings of the balance continued in the drive, shot and deduplicated); per
+    first-order branch, the orbit it stands for (NaN / −1 where it stands for none)."""
     found = periodic_orbits(Drive(eps, force, omega, Q), ORBIT_HARMONICS, shoot_harmonics=1)
     shot = [o.orbit for o in found.orbits if o.orbit is not None]
     r, floquet, stable = [math.nan] * BRANCHES, [math.nan] * BRANCHES, [-1] * BRANCHES
@@ -375,9 +375,10 @@ def _point_values(spec: EquationSpec, axis: Mapping[str, float]) -> dict[str, st
 
 
 def _equation_response(spec: EquationSpec, **axis: float) -> dict:
-    """Every 1:1 orbit at one point (:func:`response.equation_orbits`: the balance continued in
-    the drive amplitude, each crossing shot), largest r first, with its Floquet verdict."""
-    from ..analysis.periodic import equation_orbits
+    """Every 1:1 orbit at one point (:func:`analysis.periodic.periodic_orbits`: the balance
+    continued in the drive amplitude, each crossing shot), largest r first, with its Floquet
+    verdict."""
+    from ..analysis.periodic import periodic_orbits
     from ..analysis.polynomial import driven_equation
 
     values = _point_values(spec, axis)
@@ -386,7 +387,7 @@ def _equation_response(spec: EquationSpec, **axis: float) -> dict:
         de = driven_equation(spec.text, values, omega, spec.name)
     except InputError:  # refused at this point (e.g. a coefficient made 0): no orbit stored
         return {}
-    found = equation_orbits(de, ORBIT_HARMONICS, shoot_harmonics=1)
+    found = periodic_orbits(de, ORBIT_HARMONICS, shoot_harmonics=1)
     shot = [o.orbit for o in found.orbits if o.orbit is not None]
     return _branches(shot, len(shot))
 
