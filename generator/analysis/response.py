@@ -18,6 +18,7 @@ import sympy as sp
 
 from ..errors import InputError
 from ..numerics.integrate import ForceTable, Sweep, escape_bound, sweep_table
+from ..numerics.newton import newton
 from ..numerics.shooting import orbit_fold_table
 from .continuation import (
     CONTINUATION_SECONDS,
@@ -103,19 +104,20 @@ def one_harmonic_folds(eps: float, force: float, Q: float) -> list[float]:
         if not us:
             continue
         u = min(us, key=lambda x: abs(amplitude_residual(x, omega, d)))
-        for _ in range(20):
-            G, Gu = amplitude_residual(u, omega, d), amplitude_slope(u, omega, d)
-            A = 1 - omega**2 + 0.75 * eps * u
-            Gw = u * (-4 * omega * A + 2 * omega * d.damping**2)
+
+        def system(z: np.ndarray) -> np.ndarray:
+            return np.array([amplitude_residual(z[0], z[1], d), amplitude_slope(z[0], z[1], d)])
+
+        def jacobian(z: np.ndarray) -> np.ndarray:
+            u, w = z
+            A = 1 - w**2 + 0.75 * eps * u
+            Gw = u * (-4 * w * A + 2 * w * d.damping**2)
             Guu = 2 * A * 0.75 * eps + 1.5 * eps * A + 1.5 * eps * u * 0.75 * eps
-            Guw = 2 * A * (-2 * omega) + 2 * omega * d.damping**2 + 1.5 * eps * u * (-2 * omega)
-            try:
-                step = np.linalg.solve([[Gu, Gw], [Guu, Guw]], [-G, -Gu])
-            except np.linalg.LinAlgError:  # singular (a cusp, or the scale of u swamps ω)
-                break
-            u, omega = u + step[0], omega + step[1]
-            if np.max(np.abs(step)) < 1e-15 * (1 + abs(omega) + abs(u)):
-                break
+            Guw = 2 * A * (-2 * w) + 2 * w * d.damping**2 + 1.5 * eps * u * (-2 * w)
+            return np.array([[amplitude_slope(u, w, d), Gw], [Guu, Guw]])
+
+        # singular (a cusp, or the scale of u swamps ω): Newton stops, the check below judges
+        (u, omega), _, _ = newton(system, jacobian, np.array([u, omega]), 1e-15, 20)
         if u > 0 and abs(amplitude_residual(u, omega, d)) < 1e-9 * (1 + force**2):
             folds.append(float(omega))
     return sorted({float(w) for w in folds})
@@ -206,27 +208,16 @@ class OneHarmonic:
         return sorted(out)
 
     def _polish_fold(self, z: np.ndarray) -> float | None:
+        """``H = ∂H/∂r = 0`` by Newton's method in ``(r, ω)`` from ``z`` (central differences):
+        its ω, or ``None`` where Newton leaves ``r, ω > 0`` or overflows."""
         def F(z: np.ndarray) -> np.ndarray:
+            if not (z[0] > 0 and z[1] > 0):
+                return np.full(2, np.nan)
             H = self.polynomial(z[1])
             return np.array([_poly.polyval(z[0], H), _poly.polyval(z[0], _poly.polyder(H))])
 
-        for _ in range(40):
-            f0 = F(z)
-            J = np.empty((2, 2))
-            for k in range(2):
-                e = np.zeros(2)
-                e[k] = 1e-7 * (1 + abs(z[k]))
-                J[:, k] = (F(z + e) - F(z - e)) / (2 * e[k])
-            try:
-                dz = np.linalg.solve(J, -f0)
-            except np.linalg.LinAlgError:
-                return None
-            z = z + dz
-            if not (np.all(np.isfinite(z)) and z[0] > 0 and z[1] > 0):
-                return None
-            if np.max(np.abs(dz)) < 1e-15 * (1 + np.max(np.abs(z))):
-                break
-        return float(z[1])
+        z, _, _ = newton(F, None, z, 1e-15, 40)
+        return float(z[1]) if np.all(np.isfinite(z)) and z[0] > 0 and z[1] > 0 else None
 
     def extent(self, lo: float, hi: float, folds: list[float]) -> float:
         """The largest amplitude on ``[lo, hi]`` (a grid and the folds)."""

@@ -22,6 +22,7 @@ from .integrate import (
     escape_bound,
     flow_table,
 )
+from .newton import newton
 
 
 @dataclass(frozen=True)
@@ -193,28 +194,17 @@ def orbit_fold_table(table: ForceTable, force: float, omega: float, y0: np.ndarr
         mono = end[2:].reshape(2, 2).T
         return np.array([*(end[:2] - z[:2]), np.linalg.det(mono - np.eye(2))]), mono
 
-    z = np.array([*y0, omega], dtype=float)
+    def residual(z: np.ndarray) -> np.ndarray:
+        if not z[2] > 0:  # Newton left the frequencies: no fold near this guess
+            return np.full(3, np.nan)
+        return F(z)[0]  # NaN where RK4 overflowed or escaped: no orbit near this guess
+
     with np.errstate(over="ignore", invalid="ignore"):
-        for _ in range(30):
-            if not z[2] > 0:  # Newton left the frequencies: no fold near this guess
-                return None
-            f0, _ = F(z)
-            J = np.empty((3, 3))
-            for k in range(3):
-                e = np.zeros(3)
-                e[k] = 1e-7 * (1 + abs(z[k]))
-                J[:, k] = (F(z + e)[0] - F(z - e)[0]) / (2 * e[k])
-            if not (np.all(np.isfinite(J)) and np.all(np.isfinite(f0))):
-                return None  # RK4 overflowed or escaped: no orbit near this guess
-            try:
-                dz = np.linalg.solve(J, -f0)
-            except np.linalg.LinAlgError:  # singular: no isolated fold here
-                return None
-            z = z + dz
-            if np.max(np.abs(dz)) < tol * (1 + np.max(np.abs(z))):
-                _, mono = F(z)
-                return float(z[2]), z[:2], np.linalg.eigvals(mono)
-    return None
+        z, converged, _ = newton(residual, None, np.array([*y0, omega], dtype=float), tol, 30)
+        if not converged:
+            return None
+        _, mono = F(z)
+    return float(z[2]), z[:2], np.linalg.eigvals(mono)
 
 
 @dataclass(frozen=True)
