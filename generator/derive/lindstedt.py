@@ -453,20 +453,26 @@ class OrderTerms:
     q: dict[int, sp.Expr]
 
 
-def order_terms(solution: SeriesSolution, j: int) -> OrderTerms:
-    """The pieces of the ``y^j`` equation, from the kernel's ``F_j`` (Fourier, exact)."""
+def order_terms(solution: SeriesSolution, j: int,
+                convert: Callable[[Any], sp.Expr] | None = None) -> OrderTerms:
+    """The pieces of the ``y^j`` equation, from the kernel's ``F_j`` (Fourier, exact), each
+    exact coefficient made an expression by ``convert`` (default ``Ground.to_sympy``; the
+    LaTeX lowering passes its own, which keeps a polynomial in the parameters whole)."""
     if not 1 <= j <= solution.order:
         raise ValueError(f"order {j}: equations exist for 1..{solution.order}")
     g = solution.ground
+    convert = g.to_sympy if convert is None else convert
     basis = Basis(solution.model.odd)
-    rest = {n: g.to_sympy(c) for n, c in to_fourier(solution.forcing[j - 1], basis, g).items()}
-    S = sum(g.to_sympy(solution.omega[a] * solution.omega[j - a]) for a in range(1, j))
+    rest = to_fourier(solution.forcing[j - 1], basis, g)
+    resonant = rest.get(1, g.scalar(0))
+    for a in range(1, j):
+        resonant = resonant + solution.omega[a] * solution.omega[j - a]
     return OrderTerms(
         order=j,
-        forcing={n: c for n, c in sorted(rest.items()) if n != 1},
-        resonant=sp.expand(rest.get(1, 0) + S),
-        omega=g.to_sympy(solution.omega[j]),
-        q={n: g.to_sympy(c) for n, c in sorted(solution.q[j].items())},
+        forcing={n: convert(c) for n, c in sorted(rest.items()) if n != 1},
+        resonant=convert(resonant),
+        omega=convert(solution.omega[j]),
+        q={n: convert(c) for n, c in sorted(solution.q[j].items())},
     )
 
 
@@ -692,7 +698,8 @@ def series_radius(coefficients: Sequence) -> float:
     return math.sqrt(est.radius) if est.variable == "x**2" else est.radius
 
 
-def estimated_radius(solution: SeriesSolution, to_args: dict
+def estimated_radius(solution: SeriesSolution, to_args: dict,
+                     convert: Callable[[Any], sp.Expr] | None = None
                      ) -> tuple[sp.Expr, float] | None:
     """The radius of convergence of ``T/2π = Σ τ_j y^j`` where the model knows none, and its
     spread (an error bar; the guard and the error estimate take the radius minus it).
@@ -702,17 +709,21 @@ def estimated_radius(solution: SeriesSolution, to_args: dict
     coefficients :func:`lindstedt.nearest_singularity` (its extrapolations' spread) — the
     smallest of them, with the spread of the estimator used, or the distance between the
     root test and Domb–Sykes below 12 (the range of the root tests without Domb–Sykes).
-    Coefficients in ``QQ[A, …]``: the root test as an expression, spread 0 (no number to
-    state).  None when every τ_j there vanishes (a series that stops: no bound to state)."""
+    Coefficients in ``QQ[A, …]``: the root test as an expression (each τ_j made one by
+    ``convert``, default ``Ground.to_sympy``; ``Min`` unevaluated: SymPy would compare the
+    polynomials term by term), spread 0 (no number to state).  None when every τ_j there
+    vanishes (a series that stops: no bound to state)."""
     top = solution.order
     g = solution.ground
     if not g.is_rational:
+        convert = g.to_sympy if convert is None else convert
         roots = []
         for j in range(max(1, top // 2), top + 1):
-            c = g.to_sympy(solution.period[j]).xreplace(to_args)
+            c = convert(solution.period[j]).xreplace(to_args)
             if c != 0:
                 roots.append(sp.Abs(c) ** sp.Rational(-1, j))
-        return (sp.Min(*roots), 0.0) if roots else None
+        return (sp.Min(*roots, evaluate=False) if len(roots) > 1 else roots[0], 0.0) \
+            if roots else None
     import mpmath
 
     fractions = [g.to_fraction(c) for c in solution.period]

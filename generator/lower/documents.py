@@ -18,6 +18,7 @@ from ..derive.cycles import LimitCycle
 from ..derive.lindstedt import SeriesSolution, order_terms
 from ..errors import InputError
 from .forms import _LOCAL, LOCAL_NAMES, MODULE_NAMES, agm_steps, harmonics
+from .printers import exact
 from .records import (
     ArrayKernel,
     Assign,
@@ -105,15 +106,15 @@ def lower_derivation(solution: SeriesSolution, order: int) -> Derivation:
     m, g = solution.model, solution.ground
     pieces = []
     for j in range(1, order + 1):
-        t = order_terms(solution, j)
+        t = order_terms(solution, j, lambda c: exact(g, c))
         pieces.append(OrderPieces(j, t.resonant, t.omega, tuple(sorted(t.forcing.items())),
                                   tuple(sorted(t.q.items()))))
     return Derivation(
         model=m.name, latex=m.latex, y=m.y, coordinate=m.coordinate, amplitude=m.amplitude,
         order_factor=m.order_factor, coupling=m.coupling, order=order,
-        omega=tuple(g.to_sympy(c) for c in solution.omega[: order + 1]),
-        period=tuple(g.to_sympy(c) for c in solution.period[: order + 1]),
-        q=tuple(tuple((n, g.to_sympy(c)) for n, c in sorted(solution.q[j].items()))
+        omega=tuple(exact(g, c) for c in solution.omega[: order + 1]),
+        period=tuple(exact(g, c) for c in solution.period[: order + 1]),
+        q=tuple(tuple((n, exact(g, c)) for n, c in sorted(solution.q[j].items()))
                 for j in range(order + 1)),
         orders=tuple(pieces))
 

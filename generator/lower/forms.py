@@ -32,8 +32,18 @@ def horner(coeffs: list[sp.Expr], x: sp.Symbol) -> sp.Expr:
         m = 1 << ((len(coeffs) - 1).bit_length() - 1)
         high = horner(coeffs[m:], x)
         return horner(coeffs[:m], x) + x**m * high if high != 0 else horner(coeffs[:m], x)
-    poly = sum((c * x**j for j, c in enumerate(coeffs)), sp.Integer(0))
-    return sp.horner(poly, x) if poly.has(x) else poly
+    # nested directly, c_0 + x(c_1 + x(…)): ``sympy.horner`` would expand the coefficients
+    # (polynomials in the parameters) into one polynomial first and split them again
+    form, skipped = sp.Integer(0), 0
+    for c in reversed(coeffs):
+        if form == 0 and c == 0:
+            continue
+        if c == 0:
+            skipped += 1
+            continue
+        form = c + x ** (skipped + 1) * form if form != 0 else c
+        skipped = 0
+    return form * x**skipped if form != 0 else form
 
 
 def harmonics(top: int, odd: bool, s: sp.Expr, sines: bool) -> tuple[list[Assign], dict, dict]:

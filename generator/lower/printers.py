@@ -5,14 +5,71 @@ Templates never see a SymPy object: everything reaches them through these functi
 
 from __future__ import annotations
 
+import functools
 import itertools
 import keyword
 import math
 
 import sympy as sp
+from sympy.printing.latex import LatexPrinter as SympyLatexPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
 from ..errors import InputError
+
+Terms = tuple[tuple[tuple[tuple[str, int], ...], tuple[int, int]], ...]
+# an exact polynomial in the parameters: ((name, power), …) (names sorted, powers ≥ 1; () the
+# constant) with its rational (p, q), in SymPy's order of terms
+
+
+class Coefficient(sp.Symbol):
+    """An exact coefficient that is a polynomial in the symbolic parameters (``3α²/8 + 15/32``),
+    kept as one atom of the expression tree: SymPy never expands, compares or re-sorts it, and
+    the printers print it from its terms (a series over ``QQ[α]`` at order 30 has ~30 000 of
+    them; through SymPy's arithmetic and printers they took minutes).  Its name is SymPy's
+    spelling of the polynomial, so ``str`` reads as before and equal terms are one atom."""
+
+    terms: Terms
+
+    def __new__(cls, terms: Terms) -> Coefficient:
+        obj = super().__new__(cls, polynomial_text(terms))
+        obj.terms = terms
+        return obj
+
+
+def _monomial(powers: tuple[tuple[str, int], ...], power: str = "**") -> str:
+    return "*".join(n if e == 1 else f"{n}{power}{e}" for n, e in powers)
+
+
+def polynomial_text(terms: Terms) -> str:
+    """SymPy's ``str`` of a polynomial given by its terms (``3*alpha**2/8 - 1/4``)."""
+    out = []
+    for powers, (p, q) in terms:
+        body = _monomial(powers)
+        if body:
+            body = (body if abs(p) == 1 else f"{abs(p)}*{body}") + (f"/{q}" if q != 1 else "")
+        else:
+            body = f"{abs(p)}/{q}" if q != 1 else f"{abs(p)}"
+        out.append(("- " if p < 0 else "+ ") + body)
+    text = " ".join(out) or "+ 0"
+    return text[2:] if text.startswith("+ ") else "-" + text[2:]
+
+
+def exact(ground: object, c: object) -> sp.Expr:
+    """An exact coefficient of ``ground`` (:class:`algebra.series.Ground`) as an expression: a
+    ``Rational`` where it is a number, else a :class:`Coefficient`, built from FLINT's terms
+    (no SymPy arithmetic)."""
+    items = ground.terms(c)
+    if all(not powers for powers, _ in items):
+        v = items[0][1] if items else 0
+        return sp.Rational(int(v.p), int(v.q)) if items else sp.Integer(0)
+    names = sorted({n for powers, _ in items for n, _ in powers})
+
+    def order(term: tuple) -> tuple:  # SymPy's: lex on the names (sorted), descending
+        powers = dict(term[0])
+        return tuple(-powers.get(n, 0) for n in names)
+
+    return Coefficient(tuple((powers, (int(v.p), int(v.q)))
+                             for powers, v in sorted(items, key=order)))
 
 
 class NumbaPrinter(PythonCodePrinter):
@@ -32,6 +89,18 @@ class NumbaPrinter(PythonCodePrinter):
 
     def _print_Half(self, expr: sp.Rational) -> str:
         return "0.5"
+
+    def _print_Coefficient(self, expr: Coefficient) -> str:
+        """The polynomial from its terms, bracketed: ``(0.375*alpha**2 - 0.25)``."""
+        out = []
+        for powers, (p, q) in expr.terms:
+            mono = "*".join(identifier(n) if e == 1 else f"{identifier(n)}**{e}"
+                            for n, e in powers)
+            number = repr(abs(p) / q)
+            body = mono if number == "1.0" and mono else (f"{number}*{mono}" if mono else number)
+            out.append(("- " if p < 0 else "+ ") + body)
+        text = " ".join(out)
+        return "(" + (text[2:] if text.startswith("+ ") else "-" + text[2:]) + ")"
 
     def _print_NotNaN(self, expr: sp.Basic) -> str:  # lower.NotNaN: isnan is a quiet test
         return f"not math.isnan({self._print(expr.args[0])})"
@@ -111,14 +180,40 @@ def latex_rational(r: sp.Rational, stack: bool = True) -> str:
 
 
 def latex_coefficient(c: sp.Expr, stack: bool = True) -> str:
-    """:func:`latex_rational` for a number, SymPy's LaTeX for a polynomial in parameters."""
-    return latex_rational(c, stack) if c.is_Rational else sp.latex(c)
+    """:func:`latex_rational` for a number, :func:`latex_expr` for a polynomial in parameters."""
+    return latex_rational(c, stack) if c.is_Rational else LatexPrinter(stack).doprint(c)
 
 
 EPS = sp.Symbol("eps")
 # NOTE: a user's small parameter, named eps in the equation, is ε in LaTeX.
 
 
+class LatexPrinter(SympyLatexPrinter):
+    """SymPy's LaTeX with ε for ``eps`` and a :class:`Coefficient` printed from its terms:
+    ``\frac{3}{8} \alpha^{2} - \frac{1}{4}`` (digits grouped, :func:`latex_rational`)."""
+
+    def __init__(self, stack: bool = True) -> None:
+        super().__init__({"symbol_names": {EPS: r"\varepsilon"}})
+        self.stack = stack  # long integers stacked in lines (never in a table's cell)
+
+    def _print_Coefficient(self, expr: Coefficient) -> str:
+        out = []
+        for powers, (p, q) in expr.terms:
+            mono = " ".join(_latex_name(n) if e == 1 else f"{_latex_name(n)}^{{{e}}}"
+                            for n, e in powers)
+            number = latex_rational(sp.Rational(abs(p), q), self.stack)
+            body = mono if number == "1" and mono else f"{number} {mono}".strip()
+            out.append(("- " if p < 0 else "+ ") + body)
+        text = " ".join(out)
+        return text[2:] if text.startswith("+ ") else "-" + text[2:]
+
+
+@functools.cache
+def _latex_name(name: str) -> str:
+    """SymPy's LaTeX of a parameter's name (``alpha`` → ``\alpha``, ``w0`` → ``w_{0}``)."""
+    return sp.latex(sp.Symbol(name))
+
+
 def latex_expr(expr: sp.Basic) -> str:
-    """SymPy's LaTeX for short symbolic factors (powers of A, ε, θ₀)."""
-    return sp.latex(expr, symbol_names={EPS: r"\varepsilon"})
+    """LaTeX of short symbolic factors (powers of A, ε, θ₀) and of exact coefficients."""
+    return LatexPrinter().doprint(expr)

@@ -25,7 +25,7 @@ from .forms import (
     horner,
     scaled_variable,
 )
-from .printers import identifier
+from .printers import exact, identifier
 from .records import (
     Assign,
     Evaluator,
@@ -38,6 +38,12 @@ from .records import (
 )
 
 
+def _extreme(kind: type[sp.Min] | type[sp.Max], args: list[sp.Expr]) -> sp.Expr:
+    """``Min``/``Max`` of ``args``: evaluated where every one is a number, else left
+    unevaluated (no symbolic comparison)."""
+    return kind(*args, evaluate=all(a.is_number for a in args))
+
+
 def _truncation_bound(solution: SeriesSolution, order: int, x: sp.Symbol,
                       reach: sp.Expr | None, domain: OrbitDomain) -> sp.Expr:
     """A bound on ``|Σ_(j>K) τ_j y^j|`` (in units of 2π/ω₀): the first omitted term, then a
@@ -47,15 +53,17 @@ def _truncation_bound(solution: SeriesSolution, order: int, x: sp.Symbol,
     rise toward 1/R (log, square root) or fall toward it (a pole of order > 1): r bounds both.
     inf from ``r|y| = 1`` on."""
     g, w0 = solution.ground, solution.model.frequency
-    t1 = sp.Abs(g.to_sympy(solution.period[order + 1]) / w0)
-    t2 = sp.Abs(g.to_sympy(solution.period[order + 2]) / w0)
+    t1 = sp.Abs(exact(g, solution.period[order + 1]) / w0)
+    t2 = sp.Abs(exact(g, solution.period[order + 2]) / w0)
     edges = [sp.Float(v, 17) for v in (-domain.lower, domain.upper) if math.isfinite(v)]
     limits = [e for e in ([reach] if reach is not None else []) + edges]
     if not limits:  # no radius and no edge: the omitted terms alone
         return t1 * sp.Abs(x) ** (order + 1) + t2 * sp.Abs(x) ** (order + 2)
-    R = sp.Min(*limits) if len(limits) > 1 else limits[0]
-    r = sp.Max(1 / R, t2 / t1) if t1 != 0 else 1 / R
-    c = sp.Max(t2, r * t1)
+    # over symbolic parameters Min/Max stay unevaluated: SymPy would compare polynomials in
+    # them term by term (6 s of a 10 s `generate` at order 12), and the printer emits min/max
+    R = _extreme(sp.Min, limits) if len(limits) > 1 else limits[0]
+    r = _extreme(sp.Max, [1 / R, t2 / t1]) if t1 != 0 else 1 / R
+    c = _extreme(sp.Max, [t2, r * t1])
     ax = sp.Abs(x)
     tail = t1 * ax ** (order + 1) + c * ax ** (order + 2) / (1 - r * ax)
     return sp.Piecewise((tail, r * ax < 1), (sp.oo, True))
@@ -83,8 +91,8 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     y = m.y.xreplace(to_args)
     amplitude = m.amplitude.xreplace(to_args)
     # ω₀ = 1 but for a user's linear frequency: ω = ω₀ Σ ω_j y^j, T = (2π/ω₀) Σ τ_j y^j
-    omega = [m.frequency * g.to_sympy(c) for c in solution.omega[: order + 1]]
-    tau = [g.to_sympy(c) / m.frequency for c in solution.period[: order + 1]]
+    omega = [m.frequency * exact(g, c) for c in solution.omega[: order + 1]]
+    tau = [exact(g, c) / m.frequency for c in solution.period[: order + 1]]
     params = tuple(args.values())
     t = sp.Symbol("t")
     guard = m.orbit_condition.xreplace({sp.Symbol("Y"): x})
@@ -94,7 +102,8 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
         guard = sp.And(guard, x > sp.Float(lo, 17))
     if math.isfinite(hi):
         guard = sp.And(guard, x < sp.Float(hi, 17))
-    found = (m.radius, 0.0) if m.radius is not None else estimated_radius(solution, to_args)
+    found = (m.radius, 0.0) if m.radius is not None else estimated_radius(
+        solution, to_args, lambda c: exact(g, c))
     radius, spread = found if found is not None else (None, 0.0)
     reach = None if radius is None else radius - sp.Float(spread, 17) if spread else radius
     if reach is not None and not allow_divergent:
@@ -110,7 +119,7 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
 
     top = max((max(qj) for qj in solution.q[: order + 1] if qj), default=1)
     harmonic = {
-        n: horner([g.to_sympy(solution.q[j].get(n, g.scalar(0))) for j in range(order + 1)], x)
+        n: horner([exact(g, solution.q[j].get(n, g.scalar(0))) for j in range(order + 1)], x)
         for n in range(top + 1)
     }
     harmonic = {n: h for n, h in harmonic.items() if h != 0}
