@@ -174,9 +174,15 @@ def latex_rational(r: sp.Rational, stack: bool = True) -> str:
     '-\\\\frac{21}{256}'
     """
     r = sp.Rational(r)
-    sign = "-" if r < 0 else ""
-    p, q = latex_digits(abs(int(r.p)), stack), latex_digits(int(r.q), stack)
-    return sign + (p if q == "1" else rf"\frac{{{p}}}{{{q}}}")
+    return latex_fraction(int(r.p), int(r.q), stack)
+
+
+def latex_fraction(p: int, q: int, stack: bool = True) -> str:
+    """:func:`latex_rational` of ``p/q`` in lowest terms, ``q > 0`` (plain integers: no
+    SymPy number on the way)."""
+    sign = "-" if p < 0 else ""
+    top, bottom = latex_digits(abs(p), stack), latex_digits(q, stack)
+    return sign + (top if q == 1 else rf"\frac{{{top}}}{{{bottom}}}")
 
 
 def latex_coefficient(c: sp.Expr, stack: bool = True) -> str:
@@ -201,7 +207,7 @@ class LatexPrinter(SympyLatexPrinter):
         for powers, (p, q) in expr.terms:
             mono = " ".join(_latex_name(n) if e == 1 else f"{_latex_name(n)}^{{{e}}}"
                             for n, e in powers)
-            number = latex_rational(sp.Rational(abs(p), q), self.stack)
+            number = latex_fraction(abs(p), q, self.stack)
             body = mono if number == "1" and mono else f"{number} {mono}".strip()
             out.append(("- " if p < 0 else "+ ") + body)
         text = " ".join(out)
