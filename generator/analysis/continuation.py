@@ -284,7 +284,10 @@ def continue_in_drive(system: PolynomialBalance, omega: float, bound: float | No
             # near ±f the steps shrink with the distance to it, so that a fold of the curve
             # just beyond ±f (two crossings close together) leaves points on both sides
             near = min(abs(y[-1] - system.force), abs(y[-1] + system.force))
-            h = min(DRIVE_GROWTH * h, h_max, max(h_floor, 2.0 * near))
+            # far out (the drive or the higher harmonics grown past the scale) the steps grow
+            # with the distance from rest: a crossing of ±f lies only where near is small
+            reach = max(h_max, DRIVE_STEP * float(np.max(np.abs(y))))
+            h = min(DRIVE_GROWTH * h, reach, max(h_floor, 2.0 * near))
 
 
 def _first_direction(fam: _DriveFamily, y: np.ndarray, h: float, k1: int,

@@ -191,22 +191,34 @@ class PolynomialBalance:
         # the cos(n ωt) component, n = drive_harmonic (n > 1: a 1/n subharmonic's balance)
         self.drive[int(np.nonzero(k == drive_harmonic)[0][0])] = 1.0
         self.powers = [(a, b, c) for (a, b), c in sorted(terms.items())]
+        self.top_q = max(a for a, _ in terms)
+        self.top_v = max(b for _, b in terms)
+        self._last: tuple = (None, None)
 
     @property
     def size(self) -> int:
         return len(self.k2)
 
     def _force(self, x: np.ndarray, omega: float) -> tuple[np.ndarray, ...]:
-        """``g``, ``∂g/∂q``, ``∂g/∂q̇`` on the sample points."""
+        """``g``, ``∂g/∂q``, ``∂g/∂q̇`` on the sample points (the last point's kept: Newton
+        and the continuation ask for the residual and the Jacobian at the same ``x``)."""
+        key = (x.tobytes(), float(omega))
+        if key == self._last[0]:
+            return self._last[1]
         q, v = self.basis @ x, omega * (self.d_basis @ x)
+        qs, vs = [np.ones_like(q), q], [np.ones_like(v), v]  # powers by products
+        while len(qs) <= self.top_q:
+            qs.append(qs[-1] * q)
+        while len(vs) <= self.top_v:
+            vs.append(vs[-1] * v)
         g, gq, gv = np.zeros_like(q), np.zeros_like(q), np.zeros_like(q)
         for a, b, c in self.powers:
-            qa, vb = q**a, v**b
-            g += c * qa * vb
+            g += c * qs[a] * vs[b]
             if a:
-                gq += c * a * q ** (a - 1) * vb
+                gq += (c * a) * qs[a - 1] * vs[b]
             if b:
-                gv += c * b * qa * v ** (b - 1)
+                gv += (c * b) * qs[a] * vs[b - 1]
+        self._last = (key, (g, gq, gv))
         return g, gq, gv
 
     def residual(self, x: np.ndarray, omega: float, force: float | None = None) -> np.ndarray:

@@ -239,11 +239,13 @@ STABILITY = Kind(
      Field("orbit_stable", "Floquet stability of the orbit the branch stands for", "int8",
            ("branch",), flag=True)),
     _stability, (("omega", 1.2), ("force", 0.3), ("eps", 0.1), ("Q", 20.0)),
-    48, "stable_orbits",
+    20, "stable_orbits",
     (("orbit_harmonics", ORBIT_HARMONICS), ("continuation_harmonics", CONTINUATION_HARMONICS),
      ("same_orbit", SAME_ORBIT)))
-# NOTE: 48 points: ~25 ms a point damped (up to six seeds shot; the continuation, ~0.7 s, once
-# per worker and (ε, f, Q), 11 ms a point of a 64-point ω line), 10 ms undamped; ~1 s a task.
+# NOTE: 20 points: ~50 ms a point damped (the balance continued in the drive from rest at each
+# point, its crossings and the one-harmonic roots shot; a 64-point ω line on [0.5, 2] at
+# ε 0.1, f 0.3, Q 20), ~110 ms undamped (whose seeds are now complete where the continuation
+# passes no singular point); ~1 s a task.
 
 SUBHARMONIC = Kind(
     "subharmonic", "the 1/3 subharmonic of the undamped oscillator (eq. 10.87), omega its "
