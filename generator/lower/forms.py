@@ -1,4 +1,4 @@
-"""Evaluation forms shared by every lowering: Horner (Estrin from ESTRIN_FROM terms),
+"""Evaluation forms shared by every lowering: polynomials (Horner, Estrin in the printer),
 the Chebyshev recurrence of the harmonics, AGM steps, the argument guards and the scaled
 variable x = εA^k computed factor by factor."""
 
@@ -14,36 +14,20 @@ from sympy.logic.boolalg import BooleanFunction
 
 from ..derive.models import Model
 from ..errors import InputError
+from .printers import Polynomial
 from .records import Assign
-
-ESTRIN_FROM = 8
-# NOTE: polynomials of this many coefficients or more are split by Estrin's scheme (Knuth,
-# TAOCP 2, §4.6.4): Horner's chain of n dependent multiply-adds runs at the FPU's latency in
-# the ufuncs, which numba calls point by point; the split chain is ~2 log2 n long.  Degree 43
-# as a scalar ufunc: 29 ns per point by Horner, 8 ns split (the `_into` loops, vectorised
-# across points, hide the latency either way).
 
 
 def horner(coeffs: list[sp.Expr], x: sp.Symbol) -> sp.Expr:
-    """``Σ c_j x^j``: Horner's form (``sympy.horner``) below :data:`ESTRIN_FROM`
-    coefficients, above it ``L(x) + x^m H(x)`` with ``m`` the largest power of two below
-    the length, each half split again; zero for no coefficients."""
-    if len(coeffs) >= ESTRIN_FROM:
-        m = 1 << ((len(coeffs) - 1).bit_length() - 1)
-        high = horner(coeffs[m:], x)
-        return horner(coeffs[:m], x) + x**m * high if high != 0 else horner(coeffs[:m], x)
-    # nested directly, c_0 + x(c_1 + x(…)): ``sympy.horner`` would expand the coefficients
-    # (polynomials in the parameters) into one polynomial first and split them again
-    form, skipped = sp.Integer(0), 0
-    for c in reversed(coeffs):
-        if form == 0 and c == 0:
-            continue
-        if c == 0:
-            skipped += 1
-            continue
-        form = c + x ** (skipped + 1) * form if form != 0 else c
-        skipped = 0
-    return form * x**skipped if form != 0 else form
+    """``Σ c_j x^j`` as one :class:`printers.Polynomial` node (the printer writes Horner's form,
+    Estrin's split from :data:`printers.ESTRIN_FROM` coefficients); trailing zeros dropped,
+    the constant itself for one coefficient, zero for none."""
+    coeffs = list(coeffs)
+    while coeffs and coeffs[-1] == 0:
+        coeffs.pop()
+    if len(coeffs) <= 1:
+        return coeffs[0] if coeffs else sp.Integer(0)
+    return Polynomial(x, *coeffs)
 
 
 def harmonics(top: int, odd: bool, s: sp.Expr, sines: bool) -> tuple[list[Assign], dict, dict]:
