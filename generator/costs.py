@@ -68,16 +68,19 @@ SERIES_COSTS = {
 
 GENERATE_COSTS = {
     # model: (fixed s, s at the reference size, reference size, growth: power, or "exp" base)
-    "duffing": (2.5, 80.0, 100, 2.2),
-    "pendulum": (2.5, 76.0, 80, 4.0),
-    "oscillator": (2.5, 76.0, 80, 4.0),
-    "balance": (3.0, 59.0, 12, 4.0),
-    "fourier": (3.5, 0.0, 60, 1.0),
+    "duffing": (1.2, 1.3, 100, 2.3),
+    "pendulum": (1.2, 2.15, 100, 2.9),
+    "oscillator": (1.2, 2.15, 100, 2.9),
+    "balance": (1.0, 17.8, 12, 3.5),
+    "fourier": (1.0, 0.0, 60, 1.0),
     "driven": (12.0, 29.0, 5, "6"),
     "driven_damped": (2.0, 53.0, 6, "1.8"),
 }
 # NOTE: wall time of `lindstedt generate MODEL` (derive, lower, print, compile) against its size
-# (--order; --harmonics for balance and fourier), each fitted to its own runs.  driven_damped
+# (--order; --harmonics for balance and fourier), each fitted to its own runs; duffing, pendulum,
+# balance and fourier refitted once polynomials printed as one node (duffing 1.3, 1.7, 2.5,
+# 3.6 s at orders 20, 60, 100, 130; pendulum 1.3, 1.8, 2.3, 3.4, 4.7 s at 20, 60, 80, 100, 120;
+# balance 1.1, 1.5, 5.3, 18.8 s at 2, 4, 8, 12 harmonics; load ~1.5 on 2 cores).  driven_damped
 # (`generate driven --damped`): 5.7 s at order 2, 16 at 4, 55 at 6 (load 5 on 2 cores).
 
 DRIVEN_COSTS = (3.0, 13.3, 100, 3.5)
