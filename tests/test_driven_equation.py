@@ -228,3 +228,29 @@ def test_cost_bounds_the_equation_path():
     start = time.perf_counter()
     periodic_orbits(driven_equation(ASYMMETRIC, VALUES, 1.2), 20)
     assert time.perf_counter() - start < cost.seconds
+
+
+def test_the_full_hill_verdict_of_each_balance_against_dop853():
+    """`driven EQUATION` reports the full Hill equation's multipliers about each balance (the
+    variational equation about the N-harmonic sum, one RK4 pass); with a linear velocity term
+    they are the true orbit's Floquet moduli, which the reference finds by DOP853 and Newton
+    on the return map: q'' + 0.05q' + q + ε(αq² + q³) = f cos ωt inside its fold window."""
+    from lindstedt.analysis.periodic import driven_report
+
+    text = "q'' + 0.05*q' + q + eps*(alpha*q**2 + q**3) = f*cos(w*t)"
+    values = {"eps": "1/10", "alpha": "1", "f": "3/10"}
+
+    def g(q, p):
+        return (q + 0.1 * (q**2 + q**3) + 0.05 * p, 1 + 0.1 * (2 * q + 3 * q**2), 0.05)
+
+    report = driven_report(driven_equation(text, values, 1.2), 0, 12)
+    assert len(report.branches) == 3
+    for b in report.branches:
+        assert b.full_hill is not None and b.balance_amplitudes is not None
+        _, r, moduli, stable = reference_orbit(g, 0.3, 1.2, b.orbit.orbit.initial, True)
+        hill = sorted(float(abs(m)) for m in b.full_hill)
+        assert np.allclose(hill, moduli, rtol=1e-6), (r, hill, moduli)
+        assert (max(hill) < 1) == stable
+    data = driven_equation_json(text, values, 1.2, 12)
+    assert [br["harmonic_balance"]["full_hill_stable"] for br in data["branches"]] \
+        == [br["stable"] for br in data["branches"]] == [True, False, True]

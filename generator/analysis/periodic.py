@@ -273,30 +273,41 @@ class BranchReport:
 
 @dataclass(frozen=True)
 class DrivenReport:
-    """Everything ``lindstedt driven`` prints for the notes' damped driven Duffing at one ω:
-    every distinct orbit (:func:`periodic_orbits`), largest first, each with its μ-expansion
-    to ``order`` and its balance with ``harmonics`` harmonics; the one-harmonic roots."""
+    """Everything ``lindstedt driven`` prints at one ω, for the notes' driven Duffing (``drive``:
+    its parameters) or a user's equation (``drive`` None): every distinct orbit
+    (:func:`periodic_orbits`), largest first, each with its balance with ``harmonics``
+    harmonics and, for eq. 10.60, its μ-expansion to ``order``; the one-harmonic roots."""
 
-    drive: Drive
+    equation: DrivenEquation
+    drive: Drive | None
     order: int
     harmonics: int
     found: Orbits
     branches: tuple[BranchReport, ...]
 
 
-def driven_report(d: Drive, order: int, harmonics: int) -> DrivenReport:
-    """The :class:`DrivenReport` at ``d``: shooting resolves ``max(2N − 1, 2K + 1)``
-    harmonics, the balance's full Hill multipliers are the variational equation's about it
-    (no shooting)."""
+def driven_report(system: Drive | DrivenEquation, order: int, harmonics: int) -> DrivenReport:
+    """The :class:`DrivenReport` of eq. 10.60 at a :class:`Drive` or of a user's equation at its
+    ω: shooting resolves ``max(2N − 1, 2K + 1)`` harmonics, the balance's full Hill multipliers
+    are the variational equation's about it (no shooting; where the force's velocity part is
+    linear, ``c q̇``, as :func:`numerics.floquet.orbit_hill_rows` takes it).  Beside each orbit
+    stands the balance that led to it; for a user's equation only one that converged onto it
+    (``Orbit.own``)."""
+    drive = system if isinstance(system, Drive) else None
+    de = system.equation if drive is not None else system
     top = max(2 * harmonics - 1, 2 * order + 1)
-    found = periodic_orbits(d, harmonics, shoot_harmonics=top)
-    table = {(1, 0): 1.0, (3, 0): d.eps, (0, 1): d.damping}
+    found = periodic_orbits(system, harmonics, shoot_harmonics=top)
+    hill_known = all(b == 0 or (a, b) == (0, 1) for a, b in de.terms)
     branches = []
     for orb in found.orbits:
-        mu = None if orb.branch is None else mu_expansion(d, orb.branch, order)
+        mu = None if drive is None or orb.branch is None else mu_expansion(drive, orb.branch,
+                                                                           order)
         balance = hill = None
-        if orb.balance is not None:
+        shown = orb.balance is not None and (drive is not None
+                                             or (orb.balance.converged and orb.own))
+        if shown:
             balance = orb.balance.amplitudes()
-            hill = orbit_hill_multipliers(table, *balance, d.omega)
+            if hill_known:
+                hill = orbit_hill_multipliers(de.terms, *balance, de.omega)
         branches.append(BranchReport(orb, mu, balance, hill))
-    return DrivenReport(d, order, harmonics, found, tuple(branches))
+    return DrivenReport(de, drive, order, harmonics, found, tuple(branches))

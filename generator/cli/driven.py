@@ -186,25 +186,38 @@ def driven_table(data: dict) -> str:
 
 def driven_equation_json(text: str, values: dict[str, str], omega: float, harmonics: int,
                          name: str = "oscillator") -> dict:
-    """The contract of ``lindstedt driven EQUATION … --json``: every distinct 1:1 orbit found
-    (:func:`analysis.periodic.periodic_orbits`), largest first, each by its harmonic balance (``A``
-    holds the constant ``"0"`` and even harmonics unless the force is odd) and, checked by
-    shooting, the true orbit with its Floquet moduli and verdict."""
-    from ..analysis.periodic import periodic_orbits
+    """The contract of ``lindstedt driven EQUATION … --json``:
+    :func:`driven_equation_report_json` of :func:`analysis.periodic.driven_report` on the
+    equation at ``omega``."""
+    from ..analysis.periodic import driven_report
     from ..analysis.polynomial import driven_equation
 
-    de = driven_equation(text, values, omega, name)
-    found = periodic_orbits(de, harmonics)
+    return driven_equation_report_json(
+        driven_report(driven_equation(text, values, omega, name), 0, harmonics))
+
+
+def driven_equation_report_json(report) -> dict:
+    """The JSON of a user's :class:`analysis.periodic.DrivenReport`, a pure function of it: every
+    distinct 1:1 orbit found, largest first, each by its harmonic balance (``A`` holds the
+    constant ``"0"`` and even harmonics unless the force is odd; the full Hill equation's
+    verdict about it where the velocity part of the force is linear) and, checked by shooting,
+    the true orbit with its Floquet moduli and verdict."""
+    from ..numerics.floquet import multipliers_stable
+
+    de, harmonics, found = report.equation, report.harmonics, report.found
     branches = []
-    for orb in found.orbits:
+    for b in report.branches:
+        orb = b.orbit
         hb = orb.balance
-        own = hb is not None and hb.converged and orb.own
         hb_json = {"harmonics": harmonics, "A": {}, "B": {},
                    "residual": hb.residual if hb is not None and hb.converged else None,
-                   "converged": own, "r": None}
-        if own:
-            A, B = hb.amplitudes()
+                   "converged": b.balance_amplitudes is not None, "r": None}
+        if b.balance_amplitudes is not None:
+            A, B = b.balance_amplitudes
             hb_json.update(A=_keyed(A), B=_keyed(B), r=_first_harmonic(A, B))
+            if b.full_hill is not None:
+                hb_json["full_hill_stable"] = multipliers_stable(b.full_hill, de.dissipative)
+                hb_json["full_hill_moduli"] = sorted(float(abs(m)) for m in b.full_hill)
         numerical = None
         if orb.orbit is not None:
             o = orb.orbit
@@ -219,9 +232,9 @@ def driven_equation_json(text: str, values: dict[str, str], omega: float, harmon
             **_shooting_json(orb.failure),
         })
     return {
-        "equation": text,
-        "name": name,
-        "parameters": {"omega": omega, "harmonics": harmonics, "values": dict(de.values),
+        "equation": de.text,
+        "name": de.name,
+        "parameters": {"omega": de.omega, "harmonics": harmonics, "values": dict(de.values),
                        "drive": {"amplitude": de.force, "frequency": de.frequency}},
         "force": [{"q": a, "dq": b, "c": c} for (a, b), c in sorted(de.terms.items())],
         "odd": de.odd,
