@@ -46,7 +46,15 @@ from .methods.references import (
     reference_period,
     reference_q,
 )
-from .methods.registry import SIMPLEST_FIRST, Candidate, Method, candidates, method, methods_for
+from .methods.registry import (
+    METHODS,
+    SIMPLEST_FIRST,
+    Candidate,
+    Method,
+    candidates,
+    method,
+    methods_for,
+)
 from .methods.targets import Progress
 from .numerics.shooting import shoot
 
@@ -102,41 +110,15 @@ TIE = 0.15
 # depends on this run's timings (and what --emit writes is the same on every run).
 
 COST_MODEL = {
-    "period": {
-        "exact": (22.0, 0.0),
-        "agm": (0.64, 0.24),
-        "lindstedt": (0.33, 0.058),
-        "resummed": (0.43, 0.05),
-        "modified": (0.56, 0.05),
-        "pade": (0.24, 0.17),
-    },
-    "q": {
-        "exact": (73.0, 0.0),
-        "lindstedt": (3.1, 0.21),
-        "fourier": (86.0, 1.2),
-    },
-    "driven": {  # per ω, on the largest branch
-        "one_harmonic": (800.0,),
-        "mu_expansion": (9.98e5, 0.0, 7.27e4),
-        "harmonic_balance": (6.61e5, 8.42e4),
-        "shooting": (5.09e5, 920.0),
-        "mu_expansion, emitted": (110.0, 26.0),
-        "mu_expansion_damped": (9.98e5, 0.0, 7.27e4),  # the same float solve as mu_expansion
-        "mu_expansion_damped, emitted": (161.0, 0.0, 293.0),  # A_n, B_n, n = 1, 3, 5: six
-        "harmonic_balance, emitted": (1960.0, 3794.0),
-    },
+    quantity: {**{m.name: m.cost for m in METHODS if m.quantity == quantity},
+               **{f"{m.name}, emitted": m.emitted_cost for m in METHODS
+                  if m.quantity == quantity and m.emitted_cost}}
+    for quantity in ("period", "q", "driven")
 }
-# NOTE: "mu_expansion_damped, emitted" (six ufuncs: A_n, B_n, n = 1, 3, 5) is fitted like the
-# others at orders 1–4 (`cost_model.py --fit --only "driven/mu_expansion_damped, emitted"`);
-# the line 129 + 286·K fitted by hand at another ω underestimated order 4 by 4× (1.27 µs
-# against the 5.08 µs measured on ω ∈ [1.2, 1.4]).
-# NOTE: ns/point ≈ c₀ + c₁·order + c₂·order² (the coefficients ≥ 0) of each method, per
-# quantity: period and q(t) of the compiled evaluators; for the driven quantities, each method
-# per ω as `choose` runs it (interpreted: the μ-expansion's series products grow with the
-# order squared) and the emitted modules. Fitted once on the 2-core reference machine by
-# `benchmarks/cost_model.py --fit` (docs/benchmarks.md). Every `choose` decides by it, so the
-# choice — and what --emit writes — does not depend on the machine's load; each run's own
-# timings are reported beside.
+# NOTE: the recorded cost of each method and of its emitted module (ns per point, a polynomial
+# in the order), read off the method records (:attr:`methods.registry.Method.cost`,
+# ``emitted_cost``), where they are fitted and explained; a view by quantity and name for
+# `choose` and `benchmarks/cost_model.py`.
 
 
 def modelled_ns(quantity: str, method: str | Method, order: int) -> float:
@@ -154,6 +136,11 @@ def cheapest(items: list[T], cost: Callable[[T], float],
 
 @dataclass(frozen=True)
 class Choice:
+    """The cheapest verified evaluator of the period ``T/2π`` on a range (the free Duffing
+    oscillator's in ``x = εA²``, or a user's oscillator's): method and order, max relative
+    error, measured ns per point, verification points, each method considered ``(name,
+    order, error, ns)`` and the verified candidate, which ``--emit`` lowers."""
+
     method: Method
     order: int
     max_error: float
@@ -251,6 +238,10 @@ APPENDIX_CLAIMS = (
 
 @dataclass(frozen=True)
 class Threshold:
+    """One of the notes' appendix claims checked: an approximation of ``1 − cos θ``, its
+    tolerance, the angle claimed and the true largest angles (degrees) within the
+    tolerance, for the potential and for the period."""
+
     approximation: str
     tolerance: float
     claimed_deg: float
@@ -334,6 +325,9 @@ def pareto_front(costs: np.ndarray, errors: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class SceneResult:
+    """A named scene's answer: the scene, its question, the answer in one line and its
+    numbers (``details``, as the JSON gives them)."""
+
     scene: str
     question: str
     answer: str
@@ -400,6 +394,7 @@ class DrivenTruth:
 
     @property
     def r(self) -> np.ndarray:
+        """``r = √(A₁² + B₁²)`` at each ω: the amplitude of the fundamental."""
         return np.hypot(self.A[:, 0], self.B[:, 0])
 
 
@@ -630,6 +625,10 @@ FOURIER_MAX = 40
 
 @dataclass(frozen=True)
 class SolutionChoice:
+    """The cheapest verified evaluator of the Duffing solution ``q(t)/A`` on a range of
+    ``x = εA²`` (an L–P order, the exact Fourier series of cn, or SciPy's cn): its max
+    error, measured ns per point, verification points and each method considered."""
+
     method: Method  # "lindstedt", "fourier" (exact nome series, N harmonics) or "exact" (ellipj)
     order: int  # L–P order, or number of odd harmonics
     max_error: float  # max |q − A cn| / A over the grid

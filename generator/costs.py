@@ -35,6 +35,8 @@ class Cost:
     what: str  # e.g. "the μ-expansion", "generating duffing"
 
     def refusal(self) -> str:
+        """The one-line refusal: the input, the estimated time of the work, and
+        ``--allow-slow`` to run it anyway."""
         about = (f"about {self.seconds:,.0f} s" if self.seconds < 1e7
                  else f"about {self.seconds:.1e} s" if math.isfinite(self.seconds)
                  else "more than 1e300 s")
@@ -200,6 +202,8 @@ CYCLE_CHECKS = 25.0
 
 
 def series_cost(args: argparse.Namespace) -> Cost:
+    """``series``: the model's own fit at ``--order`` (Duffing, pendulum), else the
+    estimated derivation of its equation (:func:`oscillator_seconds`)."""
     if args.model in SERIES_COSTS:
         seconds = power_law(*SERIES_COSTS[args.model], args.order)
     elif args.model.isidentifier():  # another registry name: its equation is known
@@ -269,6 +273,8 @@ def driven_equation_seconds(harmonics: int) -> float:
 
 
 def driven_cost(args: argparse.Namespace) -> Cost:
+    """``driven``: for an EQUATION the bound of its continuation, balance and shooting at
+    ``--harmonics``; else the μ-expansion's fit at ``--order``."""
     if getattr(args, "model", None) is not None:
         return Cost(driven_equation_seconds(args.harmonics), f"--harmonics {args.harmonics}",
                     "the continuation, balance and shooting of the equation")
@@ -317,6 +323,9 @@ def response_equation_cost(args: argparse.Namespace) -> Cost:
 
 
 def response_cost(args: argparse.Namespace) -> Cost:
+    """``response``: for an EQUATION :func:`response_equation_cost`; else the fixed part and
+    the continuation over the response's ω range at ``--harmonics`` (the fixed part
+    alone when ε, f or Q is missing: the command says so)."""
     from .analysis.response import continuation_seconds, response_range
 
     if getattr(args, "model", None) is not None:
@@ -348,6 +357,8 @@ EQUATION_PARSE = 2.0
 
 
 def fixed_cost(name: str) -> Callable[[argparse.Namespace], Cost]:
+    """The estimator of a command whose work no input scales: its :data:`FIXED_COSTS`
+    entry, plus an EQUATION's parse when one is given."""
     def cost(args: argparse.Namespace) -> Cost:
         extra = EQUATION_PARSE if getattr(args, "model", None) is not None else 0.0
         return Cost(FIXED_COSTS[name] + extra, name, name)
@@ -404,6 +415,7 @@ MATHIEU_FIT = (0.4, 0.5, 100, 3.0)
 
 
 def mathieu_cost(args: argparse.Namespace) -> Cost:
+    """``mathieu``: the Mathieu series' fit at ``--order``."""
     return Cost(power_law(*MATHIEU_FIT, args.order), f"order {args.order}",
                 "the Mathieu series")
 
@@ -420,6 +432,8 @@ TONGUE_EMIT_SECONDS = 6.0
 
 
 def tongues_cost(args: argparse.Namespace) -> Cost:
+    """``tongues``: the fit at ``--order`` times p's highest harmonic to the power 2.5,
+    doubled with ``--damping``, plus ``--plot``'s chart and ``--emit``'s checks."""
     from .derive.hill import fourier_of_text
 
     top = max(fourier_of_text(args.p))
@@ -440,6 +454,8 @@ SLOW_FLOW_FIT = (2.0, 0.95, 4, "2.2")
 
 
 def slow_flow_cost(args: argparse.Namespace) -> Cost:
+    """``slowflow``: the fit at ``--order`` (beyond :data:`SLOW_FLOW_MAX_ORDER` the fixed
+    part only: the derivation refuses at once)."""
     # NOTE: beyond the bound the derivation refuses at once (its own one-line message)
     order = args.order if args.order <= SLOW_FLOW_MAX_ORDER else 0
     return Cost(power_law(*SLOW_FLOW_FIT, order), f"order {args.order}", "the slow flow")

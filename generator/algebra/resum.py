@@ -37,6 +37,7 @@ class Pade:
 
     @property
     def degrees(self) -> tuple[int, int]:
+        """``(L, M)``: the degrees of the numerator and the denominator."""
         return len(self.numerator) - 1, len(self.denominator) - 1
 
     def __call__(self, x: np.ndarray | float) -> np.ndarray:
@@ -57,6 +58,8 @@ def _horner_exact(coeffs: Sequence[Fraction], x: Fraction) -> Fraction:
 
 
 def horner_float(coeffs: Sequence[Fraction], x: np.ndarray) -> np.ndarray:
+    """``Σ c_k x^k`` (coefficients low to high) at float ``x`` by Horner's rule, each
+    coefficient rounded to float64 first."""
     acc = np.zeros_like(x)
     for c in reversed(coeffs):
         acc = acc * x + float(c)

@@ -39,10 +39,12 @@ class Basis:
 
     @property
     def parity(self) -> int:
+        """The power of ``C`` carried by index 0: 1 for odd harmonics, else 0."""
         return 1 if self.odd else 0
 
     @property
     def stride(self) -> int:
+        """The step in the power of ``C`` between neighbouring indices: 2 (odd harmonics) or 1."""
         return 2 if self.odd else 1
 
     def harmonic(self, k: int) -> int:
@@ -86,9 +88,11 @@ class DensePoly:
         return out
 
     def coeffs(self) -> list:
+        """The coefficients, low to high (as FLINT's ``fmpq_poly.coeffs()``)."""
         return self.rep[::-1]
 
     def left_shift(self, k: int) -> DensePoly:
+        """The polynomial times its variable to the power ``k``."""
         return self._wrap(self.rep + [self.dom.zero] * k if self.rep else [], self.dom)
 
     def __add__(self, other: DensePoly) -> DensePoly:
@@ -120,6 +124,8 @@ class MPoly:
         self.p = p
 
     def coeffs(self) -> list:
+        """The coefficients of ``C⁰, C¹, …`` (low to high), each an ``fmpq_mpoly`` free of
+        ``C``."""
         terms = self.p.to_dict()
         if not terms:
             return []
@@ -130,6 +136,7 @@ class MPoly:
         return [ctx.from_dict(b) for b in buckets]
 
     def left_shift(self, k: int) -> MPoly:
+        """The polynomial times ``C^k``."""
         ctx = self.p.context()
         return MPoly(self.p * ctx.gen(0) ** k) if k else self
 
@@ -162,6 +169,7 @@ class Ground:
 
     @property
     def is_rational(self) -> bool:
+        """Whether the ring is QQ (FLINT ``fmpq`` coefficients, no symbolic parameter)."""
         return self.domain == QQ
 
     @property
@@ -201,6 +209,8 @@ class Ground:
         return MPoly(ctx.from_dict(terms))
 
     def to_sympy(self, c: Any) -> sp.Expr:
+        """An exact ring element as a SymPy expression: a ``Rational``, or a polynomial in the
+        parameters."""
         if self.is_rational:
             return sp.Rational(int(c.p), int(c.q))
         if self._flint_ring is None:
@@ -225,6 +235,8 @@ class Ground:
                 for k, v in items if v != 0]
 
     def to_fraction(self, c: Any) -> Fraction:
+        """A rational ring element as a :class:`Fraction`; ``TypeError`` when the ring has
+        symbolic parameters."""
         if not self.is_rational:
             raise TypeError("coefficients with symbolic parameters have no Fraction value")
         return Fraction(int(c.p), int(c.q))
@@ -534,6 +546,7 @@ class TrigSeries:
     """An ε-series of :class:`Trig` sums over QQ, known to some order."""
 
     def coeff(self, i: int) -> Trig:
+        """The :class:`Trig` coefficient of ``ε^i``."""
         raise NotImplementedError
 
     def forget(self, i: int) -> None:
@@ -547,6 +560,7 @@ class TrigTerms(TrigSeries):
         self.terms = terms
 
     def coeff(self, i: int) -> Trig:
+        """``terms[i]``, the coefficient of ``ε^i`` as given."""
         return self.terms[i]
 
 
@@ -557,11 +571,13 @@ class TrigMap(TrigSeries):
         self.source, self.fn, self.cache = source, fn, {}
 
     def coeff(self, i: int) -> Trig:
+        """``fn`` of the source's coefficient ``i``, made once and kept."""
         if i not in self.cache:
             self.cache[i] = self.fn(self.source.coeff(i))
         return self.cache[i]
 
     def forget(self, i: int) -> None:
+        """Coefficient ``i`` of the source changed: drop the one made from it."""
         self.cache.pop(i, None)
 
 
@@ -582,6 +598,9 @@ class RelaxedProduct(TrigSeries):
         self.started = 1  # squares of output index ≤ started are made
 
     def coeff(self, i: int) -> Trig:
+        """Coefficient ``i`` of ``a · b``: the pairs ``(0, i)`` and ``(i, 0)`` term by term, the
+        others from the packed squares, made as far as ``i`` needs (off QQ, the plain Cauchy
+        sum); kept until :meth:`forget`."""
         if i in self.cache:
             return self.cache[i]
         a, b = self.a, self.b
@@ -604,6 +623,9 @@ class RelaxedProduct(TrigSeries):
         return out
 
     def forget(self, i: int) -> None:
+        """Coefficient ``i`` of an input changed: drop the product's coefficient ``i``, whose
+        pairs ``(0, i)`` and ``(i, 0)`` are remade on request (the squares use only final
+        coefficients)."""
         self.cache.pop(i, None)
 
     def _squares(self, n: int) -> None:

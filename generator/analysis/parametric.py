@@ -176,6 +176,7 @@ class OneHarmonicPoint:
 
     @property
     def r(self) -> float:
+        """The amplitude ``r = √(a² + b²)``."""
         return math.hypot(self.a, self.b)
 
 
@@ -219,9 +220,12 @@ class ParametricBalance(PolynomialBalance):
         self.pump = p.eps * (2 * cos1 * cos1 - 1)  # ε cos 2θ on the samples
 
     def residual(self, x: np.ndarray, omega: float, force: float | None = None) -> np.ndarray:
+        """:meth:`PolynomialBalance.residual` plus the harmonics of the pump ``ε q cos 2θ``."""
         return super().residual(x, omega, force) + self.project @ (self.pump * (self.basis @ x))
 
     def jacobian(self, x: np.ndarray, omega: float, force: float | None = None) -> np.ndarray:
+        """:meth:`PolynomialBalance.jacobian` plus the pump's term, the projection of
+        ``ε cos 2θ · ∂q/∂x``."""
         return super().jacobian(x, omega, force) + self.project @ (self.pump[:, None]
                                                                    * self.basis)
 
@@ -247,6 +251,7 @@ class BalancePoint:
 
     @property
     def r(self) -> float:
+        """The first harmonic's amplitude ``√(A₁² + B₁²)``."""
         return math.hypot(self.A[1], self.B[1])
 
 

@@ -56,6 +56,7 @@ class DrivenEquation:
 
     @property
     def degree(self) -> int:
+        """The highest total degree ``a + b`` of the force's terms."""
         return max(a + b for a, b in self.terms)
 
     @property
@@ -197,6 +198,7 @@ class PolynomialBalance:
 
     @property
     def size(self) -> int:
+        """The number of unknowns (the cosine and sine amplitudes)."""
         return len(self.k2)
 
     def _force(self, x: np.ndarray, omega: float) -> tuple[np.ndarray, ...]:
@@ -222,16 +224,21 @@ class PolynomialBalance:
         return g, gq, gv
 
     def residual(self, x: np.ndarray, omega: float, force: float | None = None) -> np.ndarray:
+        """The harmonics of ``q̈ + g(q, q̇) − f cos nωt`` (``n``: ``drive_harmonic``) for the
+        unknowns ``x`` at ``ω``, with ``force`` in place of ``f`` when given: zero at a
+        balance solution."""
         g, _, _ = self._force(x, omega)
         f = self.force if force is None else force
         return -omega**2 * self.k2 * x + self.project @ g - f * self.drive
 
     def jacobian(self, x: np.ndarray, omega: float, force: float | None = None) -> np.ndarray:
+        """``∂residual/∂x`` at ``(x, ω)``, from ``∂g/∂q`` and ``∂g/∂q̇`` on the sample points."""
         _, gq, gv = self._force(x, omega)
         J = self.project @ (gq[:, None] * self.basis + omega * gv[:, None] * self.d_basis)
         return J - np.diag(omega**2 * self.k2)
 
     def d_omega(self, x: np.ndarray, omega: float, force: float | None = None) -> np.ndarray:
+        """``∂residual/∂ω`` at ``(x, ω)``, for the continuation in ω."""
         _, _, gv = self._force(x, omega)
         return -2 * omega * self.k2 * x + self.project @ (gv * (self.d_basis @ x))
 

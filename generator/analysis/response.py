@@ -232,6 +232,8 @@ EQUATION_POINT_SECONDS = (2e-3, 1e-6)
 
 
 def equation_point_seconds(unknowns: int) -> float:
+    """Estimated seconds of one continuation point of a user's equation with ``unknowns``
+    unknowns (:data:`EQUATION_POINT_SECONDS`: fixed, plus per unknown²)."""
     return EQUATION_POINT_SECONDS[0] + EQUATION_POINT_SECONDS[1] * unknowns**2
 
 

@@ -235,6 +235,7 @@ class SubharmonicProblem:
 
     @property
     def drive(self) -> float:
+        """The drive frequency ``nω``."""
         return self.n * self.omega
 
 
@@ -258,6 +259,7 @@ class SubharmonicOrbit:
 
     @property
     def stable(self) -> bool | None:
+        """The shot orbit's Floquet verdict; ``None`` where shooting found no orbit."""
         return None if self.orbit is None else bool(self.orbit.stable)
 
 
@@ -287,10 +289,13 @@ class SubharmonicResponse:
 
     @property
     def exists(self) -> bool:
+        """Whether any 1/n orbit was found."""
         return bool(self.orbits)
 
     @property
     def reason(self) -> str:
+        """One line: how many orbits were found at this drive and ω, and from how many seeds,
+        or that none was."""
         p = self.problem
         if self.orbits:
             return (f"{len(self.orbits)} orbit(s) of {p.n} drive periods at f = {p.force:g}, "

@@ -116,6 +116,10 @@ def check_cost(args: argparse.Namespace) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the ``lindstedt`` command line on ``argv`` (default: ``sys.argv[1:]``): parse,
+    check the command's cost estimate, run it.  Returns the exit status: the command's;
+    2 for bad input, with one line on stderr (argument errors exit with 2 at once); 1 when
+    stdout's reader closed the pipe."""
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

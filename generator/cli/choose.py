@@ -63,6 +63,10 @@ def _print_choice(header: str, chosen: tuple[str, int, float, float],
 
 
 def run_choose(args: argparse.Namespace) -> int:
+    """Run ``lindstedt choose QUANTITY``: the cheapest verified method for a tolerance and
+    a range (the period, of the Duffing oscillator or an EQUATION, with ``--emit`` its
+    module; q, the driven amplitudes and response, a limit cycle's ω and Mathieu's
+    values by their own helpers), as a table or JSON.  Returns the exit status."""
     if args.model is None and (args.param or args.name):
         raise InputError("--param/--name: give an EQUATION (choose period EQUATION …)")
     if args.model is not None and args.quantity != "period":
@@ -165,6 +169,9 @@ def _choose_resummed(args: argparse.Namespace) -> int:
 
 
 def run_clock(args: argparse.Namespace) -> int:
+    """Run ``lindstedt clock``: the notes' appendix claims on approximations of
+    ``1 − cos θ`` against the true threshold angles (potential and period), as a table or
+    JSON.  Returns the exit status."""
     from ..choose import appendix_thresholds
 
     rows = [{"approximation": t.approximation, "tolerance": t.tolerance,
@@ -189,6 +196,8 @@ def run_clock(args: argparse.Namespace) -> int:
 
 
 def run_scene(args: argparse.Namespace) -> int:
+    """Run ``lindstedt scene NAME``: the named scene's question, answer and details, as text
+    or JSON.  Returns the exit status."""
     from ..choose import SCENES
 
     result = SCENES[args.name]()

@@ -69,6 +69,7 @@ class ProgressBar:
         self.drawn = True
 
     def close(self) -> None:
+        """Erase the bar's line, if one was drawn."""
         if self.drawn:
             sys.stderr.write("\r\033[K")
             sys.stderr.flush()
@@ -120,6 +121,7 @@ def _int_text(n: int) -> str:
 
 
 def sp_text(expr) -> str:
+    """A SymPy expression as text, terms in lexicographic order (``sympy.sstr``)."""
     import sympy as sp
 
     return sp.sstr(expr, order="lex")

@@ -122,6 +122,8 @@ def _shooting_json(failure) -> dict:
 
 
 def driven_table(data: dict) -> str:
+    """The text table of ``driven`` (eq. 10.60), from its JSON: each orbit three ways, the
+    one-harmonic roots that stand for none."""
     p = data["parameters"]
     lines = [f"q'' + q'/Q + q + eps q^3 = f cos(w t): eps = {p['eps']}, f = {p['force']}, "
              f"w = {p['omega']}, Q = {p['Q'] if p['Q'] is not None else 'inf (undamped)'}"]
@@ -244,6 +246,8 @@ def driven_equation_report_json(report) -> dict:
 
 
 def driven_equation_table(data: dict) -> str:
+    """The text table of ``driven EQUATION``, from its JSON: each orbit's balance and shot
+    orbit with its Floquet moduli and verdict."""
     p = data["parameters"]
     given = ", ".join(f"{k} = {v}" for k, v in p["values"].items())
     lines = [f"{data['equation']}: {given}{', ' if given else ''}{p['drive']['frequency']} = "
@@ -283,6 +287,8 @@ DRIVE_FLAGS = ("eps", "force", "Q")
 
 
 def run_driven(args: argparse.Namespace) -> int:
+    """Run ``lindstedt driven`` (eq. 10.60 or an EQUATION) at one ω, as a table or JSON.
+    Returns the exit status."""
     from ..analysis.driven import Drive, check_steady_state
 
     if args.model is not None:
@@ -383,6 +389,8 @@ def _response_args(args: argparse.Namespace) -> None:
 
 
 def run_response(args: argparse.Namespace) -> int:
+    """Run ``lindstedt response`` (eq. 10.60 or an EQUATION): the response curve over ω, as a
+    table, JSON or a figure.  Returns the exit status."""
     _response_args(args)
     limit = math.inf if args.allow_slow else COST_LIMIT_SECONDS
     if args.model is not None:
@@ -513,6 +521,8 @@ def subharmonic_orbits_json(found) -> dict:
 
 
 def run_subharmonic(args: argparse.Namespace) -> int:
+    """Run ``lindstedt subharmonic`` (the notes' 1/3 or an EQUATION's 1/n), as a table, JSON
+    or a figure.  Returns the exit status."""
     n = 3 if args.n is None else args.n
     if _equation_args(args, ("eps", "force"), ("eps", "force", "omega")):
         from ..analysis.subharmonic import subharmonic_equation
@@ -673,6 +683,8 @@ def _parametric_table(data: dict) -> list[str]:
 
 
 def run_parametric(args: argparse.Namespace) -> int:
+    """Run ``lindstedt parametric``: the pumped Duffing oscillator over an ω range, as a
+    table, JSON or a figure.  Returns the exit status."""
     return _report(args, lambda: parametric_json(args.eps, args.zeta, args.gamma,
                                                  args.omega_from, args.omega_to, args.points,
                                                  args.harmonics),
@@ -747,6 +759,8 @@ def mixing_equation_json(text: str, values: dict[str, str], name: str = "oscilla
 
 
 def run_mixing(args: argparse.Namespace) -> int:
+    """Run ``lindstedt mixing`` (the notes' Duffing or an EQUATION): the combination tones
+    of a multi-tone drive, as a table, JSON or a figure.  Returns the exit status."""
     if _equation_args(args, ("eps", "Q", "drive"), ("eps", "Q", "drive")):
         from ..analysis.mixing import mixing_equation
 

@@ -185,6 +185,8 @@ def _cycles_text(model, listed: list[dict]) -> str:
 
 
 def limit_cycle_table(lc) -> str:
+    """The text table of a limit cycle's series: its convention and stability, then
+    ``ω_j``, ``(T/2π)_j`` and ``amplitude_j``, exact, for each order ``j``."""
     m = lc.model
     lines = [f"{m.name}: {m.title}, a limit cycle, expansion variable eps, order {lc.order}",
              "convention: q'(0) = 0, q(0) = sum_j amplitude_j eps^j",
@@ -197,6 +199,9 @@ def limit_cycle_table(lc) -> str:
 
 
 def run_series(args: argparse.Namespace) -> int:
+    """Run ``lindstedt series MODEL``: the exact L–P series of a free oscillator, or of a
+    self-excited one's limit cycles (``--cycle``: one of them); ``--singularities``: the
+    nearest singularity of ω.  Prints a table or JSON; returns the exit status."""
     from ..derive.cycles import derive_limit_cycle, limit_cycles
     from ..derive.lindstedt import derive
     from ..derive.models import SelfExcited, series_model
@@ -468,6 +473,8 @@ def run_slowflow(args: argparse.Namespace) -> int:
 
 
 def run_models(args: argparse.Namespace) -> int:
+    """Run ``lindstedt models``: the registry's named oscillators with their equations and
+    aliases, as a table or JSON.  Returns the exit status."""
     from ..derive.models import ALIASES, REGISTRY
 
     aliases = {e.name: sorted(a for a, name in ALIASES.items() if name == e.name)
@@ -484,6 +491,9 @@ def run_models(args: argparse.Namespace) -> int:
 
 
 def run_generate(args: argparse.Namespace) -> int:
+    """Run ``lindstedt generate MODEL``: write into ``--out`` the numba evaluator modules
+    (and LaTeX) of a free oscillator or a limit cycle, or the driven oscillator's
+    ``driven``, ``balance`` or ``fourier`` module; print their paths.  Returns the exit status."""
     order = args.order
     if args.model in EMITTED and (args.param or args.name):
         raise InputError(f"--param/--name: the {args.model} modules take neither")

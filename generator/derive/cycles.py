@@ -78,10 +78,13 @@ class Cycle:
 
     @property
     def rational(self) -> bool:
+        """Whether ``a₀`` is rational (else an algebraic number)."""
         return bool(self.amplitude.is_Rational)
 
     @property
     def stability(self) -> str:
+        """The verdict in words: attracting for the sign of ε with ``ε S'(a₀) > 0``, repelling
+        for the other; semi-stable, with no series in ε, where ``S'(a₀) = 0``."""
         if self.slope == 0:
             return "semi-stable (a double root of S(a)): no series in eps"
         good, bad = ("eps > 0", "eps < 0") if self.slope > 0 else ("eps < 0", "eps > 0")

@@ -66,6 +66,7 @@ class Equation:
 
     @property
     def coordinate(self) -> sp.Symbol:
+        """The coordinate's symbol (``derivatives[0]``)."""
         return self.derivatives[0]
 
 

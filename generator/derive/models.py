@@ -67,9 +67,12 @@ class Model:
 
     @property
     def y(self) -> sp.Expr:
+        """The expansion variable ``y = coupling · order_factor`` (``εA²`` for Duffing)."""
         return self.coupling * self.order_factor
 
     def coefficients(self) -> list[sp.Expr]:
+        """Every coefficient of the forcing (the position and velocity terms, the elementary
+        forces' λ and w): what fixes the derivation's exact ground ring."""
         return ([c for terms in self.forcing for _, c in terms]
                 + [c for terms in self.velocity_forcing for _, _, c in terms]
                 + [c for _, lam, w in self.elementary for c in (lam, w)])
@@ -184,10 +187,12 @@ class Oscillator:
 
     @property
     def coordinate(self) -> sp.Symbol:
+        """The coordinate's symbol (``q``, ``theta``, …)."""
         return self.equation.coordinate
 
     @property
     def velocity(self) -> sp.Symbol:
+        """The symbol of the coordinate's time derivative (``q'``)."""
         return self.equation.derivatives[1]
 
     @property
@@ -197,6 +202,8 @@ class Oscillator:
         return tuple(p for p in self.equation.parameters if p not in given)
 
     def refuse(self, method: str, why: str) -> InputError:
+        """The one-line :class:`InputError` saying that ``method`` does not apply to this
+        oscillator, and ``why``."""
         return InputError(f"{self.name} ({self.equation.text}): {method} does not apply: {why}")
 
 
@@ -528,6 +535,8 @@ class Entry:
     build: Callable[[int], Model] | None = None  # a hand-made model (radius, orbit condition)
 
     def model(self, order: int) -> Model:
+        """The entry's :class:`Model` sized for ``order``: its hand-made one, else
+        :func:`free_model` of its equation."""
         if self.build is not None:
             return self.build(order)
         return free_model(oscillator(self.equation, name=self.name), order)

@@ -76,6 +76,8 @@ class OrbitDomain:
         return lo, hi
 
     def as_json(self) -> dict:
+        """The domain as the JSON contract gives it: the variable, the edges as text (to
+        :data:`DIGITS` digits), ``known`` and ``how``."""
         return {"variable": self.variable, "lower": self.lower_text, "upper": self.upper_text,
                 "known": self.known, "how": self.how}
 
@@ -89,6 +91,8 @@ def _toward_zero(text: str) -> float:
 
 
 def unknown(model: Model, why: str) -> OrbitDomain:
+    """An :class:`OrbitDomain` with no edges (±inf, ``known`` False) whose ``how`` says
+    ``why``."""
     return OrbitDomain(model.variable, -math.inf, math.inf, "-inf", "inf", why, known=False)
 
 

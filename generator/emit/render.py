@@ -78,6 +78,8 @@ def environment(latex: bool) -> jinja2.Environment:
 
 
 def banner(p: Provenance, comment: str) -> str:
+    """A generated file's header: the marker and version (do not edit), the model and order,
+    the command and the inputs' sha256, each line a ``comment`` (``#`` or ``%``)."""
     lines = [
         f"{MARKER} {p.version}: do not edit, regenerate.",
         f"model: {p.model}, order: {p.order}",

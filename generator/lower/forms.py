@@ -179,6 +179,8 @@ class Finite(BooleanFunction):
 
     @classmethod
     def eval(cls, arg: sp.Expr) -> sp.Basic | None:
+        """``true`` for a finite number, ``false`` for ±inf or NaN; ``None`` (left unevaluated)
+        for a symbolic argument."""
         if arg.is_number:
             return sp.true if arg.is_finite else sp.false
         return None
@@ -192,6 +194,8 @@ class NotNaN(BooleanFunction):
 
     @classmethod
     def eval(cls, arg: sp.Expr) -> sp.Basic | None:
+        """``false`` for NaN, ``true`` for any other number (±inf included); ``None`` (left
+        unevaluated) for a symbolic argument."""
         if arg.is_number:
             return sp.false if arg is sp.nan else sp.true
         return None

@@ -91,6 +91,7 @@ class Polynomial(sp.Function):
 
     @classmethod
     def eval(cls, *args: sp.Expr) -> None:
+        """``None`` always: the node stays as built."""
         return None  # never evaluated: the node is the form
 
 

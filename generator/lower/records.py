@@ -89,6 +89,7 @@ class Provenance:
 
     @property
     def version(self) -> str:
+        """The lindstedt version the banner names (``lindstedt.__version__``)."""
         return __version__
 
 

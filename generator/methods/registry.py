@@ -179,6 +179,8 @@ class Method:
     run_emitted: Callable[..., Emitted] | None = None  # driven: read its emitted module
     emittable: Callable[[object], str | None] = _always  # why its module cannot be emitted
     describe: Callable[[int], str] | None = None  # its name at an order (default: "NAME order K")
+    cost: tuple[float, ...] = ()  # ns per point ≈ Σ c_i order^i, as `choose` runs it
+    emitted_cost: tuple[float, ...] = ()  # the same of its emitted module (driven: per ω)
 
     def label(self, order: int) -> str:
         """What the method is at ``order``, as tables print it ("lindstedt order 8",
@@ -228,6 +230,18 @@ SIMPLEST_FIRST = ("lindstedt", "one_harmonic", "pade", "resummed", "modified", "
                   "shooting", "exact")
 # NOTE: the tie order of methods (the simplest formula first).
 
+# NOTE: each method's cost, ns/point ≈ c₀ + c₁·order + c₂·order² (the coefficients ≥ 0), per
+# quantity: period and q(t) of the compiled evaluators; for the driven quantities, each method
+# per ω as `choose` runs it (interpreted: the μ-expansion's series products grow with the
+# order squared) and, as ``emitted_cost``, its emitted module. Fitted once on the 2-core
+# reference machine by `benchmarks/cost_model.py --fit` (docs/benchmarks.md). Every `choose`
+# decides by these figures, so the choice — and what --emit writes — does not depend on the
+# machine's load; each run's own timings are reported beside.  mu_expansion_damped's emitted
+# module (six ufuncs: A_n, B_n, n = 1, 3, 5) is fitted like the others at orders 1–4
+# (`cost_model.py --fit --only "driven/mu_expansion_damped, emitted"`); the line 129 + 286·K
+# fitted by hand at another ω underestimated order 4 by 4× (1.27 µs against the 5.08 µs
+# measured on ω ∈ [1.2, 1.4]).
+
 _PERIOD = "free Duffing T/2π against mpmath's K(m) at 30 digits"
 _Q = "free Duffing q(t)/A against cn (SciPy's ellipj for m ≥ 0, mpmath below)"
 _DRIVEN = "A₁, A₃, A₅ and B_n against shooting (RK4, Richardson-combined, Floquet-checked)"
@@ -235,45 +249,49 @@ _DRIVEN = "A₁, A₃, A₅ and B_n against shooting (RK4, Richardson-combined, 
 METHODS: tuple[Method, ...] = (
     # the period, in the order its candidates are listed
     Method("exact", "period", "4K(m)/√(1+x), SciPy's ellipk", _PERIOD, _free_duffing,
-           steps=True, orders=_exact_orders),
+           steps=True, orders=_exact_orders, cost=(22.0, 0.0)),
     Method("agm", "period", "1/AGM(√(1+x), √(1+x/2)), n steps", _PERIOD, _free_duffing,
            kind=4, steps=True, domain=x_ > -1, orders=_agm_orders, lowered=_lower_agm,
-           target=CHOSEN_PERIOD),
+           target=CHOSEN_PERIOD, cost=(0.64, 0.24)),
     Method("lindstedt", "period", "the L–P series Σ τ_j x^j", _PERIOD, _series_period,
            kind=0, domain=sp.And(x_ > -1, sp.Abs(x_) < 1), orders=_lp_orders,
-           lowered=_lower_lp, target=CHOSEN_PERIOD),
+           lowered=_lower_lp, target=CHOSEN_PERIOD, cost=(0.33, 0.058)),
     Method("resummed", "period", "the series in m = x/(2(1+x)) times √(1 − 2m)", _PERIOD,
            _free_duffing, kind=1, domain=x_ > sp.Rational(-2, 3), orders=_resummed_orders,
-           lowered=_lower_resummed, target=CHOSEN_PERIOD),
+           lowered=_lower_resummed, target=CHOSEN_PERIOD, cost=(0.43, 0.05)),
     Method("modified", "period", "modified L–P (Cheung, Chen & Lau)", _PERIOD, _free_duffing,
            kind=3, domain=x_ > -1, orders=_modified_orders, lowered=_lower_modified,
-           target=CHOSEN_PERIOD),
+           target=CHOSEN_PERIOD, cost=(0.56, 0.05)),
     Method("pade", "period", "diagonal Padé [k/k] of the L–P series", _PERIOD, _series_period,
            kind=2, domain=x_ > -1, orders=_pade_orders, lowered=_lower_pade,
-           target=CHOSEN_PERIOD, describe=lambda k: f"[{k}/{k}] Padé, {2 * k + 1} coefficients"),
+           target=CHOSEN_PERIOD, describe=lambda k: f"[{k}/{k}] Padé, {2 * k + 1} coefficients",
+           cost=(0.24, 0.17)),
     # q(t)
     Method("lindstedt", "q", "the L–P series of q(t) (generate NAME)",
            "q(t) against cn; any free oscillator's period against quadrature", _free,
-           target=FREE),
+           target=FREE, cost=(3.1, 0.21)),
     Method("fourier", "q", "the exact Fourier series of cn in the nome, N odd harmonics", _Q,
-           _free_duffing, target=FOURIER),
+           _free_duffing, target=FOURIER, cost=(86.0, 1.2)),
     Method("exact", "q", "cn by SciPy's ellipj (x ≥ 0; no emitted evaluator)", _Q,
-           _free_duffing),
+           _free_duffing, cost=(73.0, 0.0)),
     # the driven amplitudes A_n(ω) and the response r(ω)
     Method("one_harmonic", "driven", "the one-harmonic cubic in closed form", _DRIVEN,
-           _driven, driven_orders=(1,)),
+           _driven, driven_orders=(1,), cost=(800.0,)),
     Method("mu_expansion", "driven", "the μ-expansion with phase, order K", _DRIVEN, _driven,
            solve=_solve_mu, driven_orders=tuple(range(DRIVEN_MAX + 1)), target=MU,
-           bound=0, run_emitted=_run_mu_module, emittable=_undamped),
+           bound=0, run_emitted=_run_mu_module, emittable=_undamped,
+           cost=(9.98e5, 0.0, 7.27e4), emitted_cost=(110.0, 26.0)),
     Method("mu_expansion_damped", "driven",
            "the μ-expansion with phase for a finite Q, exact orders (generate driven --damped)",
            _DRIVEN, _damped, solve=_solve_mu, driven_orders=tuple(range(1, DAMPED_MAX + 1)),
-           target=MU_DAMPED, bound=0, run_emitted=_run_mu_damped_module, emittable=_damped),
+           target=MU_DAMPED, bound=0, run_emitted=_run_mu_damped_module, emittable=_damped,
+           cost=(9.98e5, 0.0, 7.27e4), emitted_cost=(161.0, 0.0, 293.0)),
     Method("harmonic_balance", "driven", "Galerkin harmonic balance, N odd harmonics", _DRIVEN,
            _driven, solve=_solve_balance, driven_orders=tuple(range(1, DRIVEN_MAX + 1)),
-           target=BALANCE, bound=1, run_emitted=_run_balance_module),
+           target=BALANCE, bound=1, run_emitted=_run_balance_module,
+           cost=(6.61e5, 8.42e4), emitted_cost=(1960.0, 3794.0)),
     Method("shooting", "driven", "shooting with plain RK4, N steps a period", _DRIVEN, _driven,
-           solve=_solve_shooting, driven_orders=SHOOTING_STEPS),
+           solve=_solve_shooting, driven_orders=SHOOTING_STEPS, cost=(5.09e5, 920.0)),
 )
 
 

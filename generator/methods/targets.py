@@ -92,6 +92,7 @@ class HarmonicsRequest(Request):
 
     @property
     def harmonics(self) -> int:
+        """The number of harmonics (the request's ``order``)."""
         return self.order
 
 

@@ -33,6 +33,7 @@ class ForceTable:
 
     @property
     def terms(self) -> dict[tuple[int, int], float]:
+        """The force as ``{(a, b): c}``, the form :meth:`of` reads."""
         return {(int(a), int(b)): float(c) for a, b, c in
                 zip(self.q_powers, self.v_powers, self.coefficients, strict=True)}
 
@@ -59,6 +60,7 @@ class ForceTable:
 
     @property
     def degree(self) -> int:
+        """The highest total degree ``a + b`` of the terms (at least 1)."""
         return int(np.max(self.q_powers + self.v_powers, initial=1))
 
 

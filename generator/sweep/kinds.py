@@ -169,9 +169,12 @@ class Field:
 
     @property
     def fill(self) -> float | int:
+        """The value of a point not computed: NaN for ``float64``, −1 for ``int8``."""
         return math.nan if self.dtype == "float64" else -1
 
     def attrs(self) -> dict:
+        """The variable's attributes in the store: its ``long_name``, with the flag values and
+        their meanings for a flag, or a note on −1 for a count."""
         out: dict = {"long_name": self.long_name}
         if self.flag:
             out |= {"flag_values": [-1, 0, 1], "flag_meanings": "none no yes"}
@@ -204,6 +207,7 @@ class Kind:
 
     @property
     def extra_sizes(self) -> dict[str, int]:
+        """The length of each dimension the fields add beyond the grid's axes."""
         return {dim: len(values) for dim, values in self.extra}
 
 
@@ -344,6 +348,7 @@ class WarmUp(WorkerPlugin):
         self.name = f"lindstedt-sweep-warm-up-{kind.name}-{digest[:12]}"
 
     def setup(self, worker: object) -> None:
+        """Run :func:`warm_up` for the plugin's kind on ``worker`` as it starts."""
         warm_up(self.kind)
 
 

@@ -61,10 +61,12 @@ class Grid:
 
     @property
     def shape(self) -> tuple[int, ...]:
+        """The number of values along each axis."""
         return tuple(v.size for v in self.values)
 
     @property
     def points(self) -> int:
+        """The number of grid points."""
         return math.prod(self.shape)
 
     @property
@@ -74,6 +76,7 @@ class Grid:
 
     @property
     def chunks(self) -> int:
+        """The number of blocks: one task each."""
         return math.prod(self.blocks)
 
     def region(self, chunk: int) -> tuple[slice, ...]:
@@ -85,6 +88,7 @@ class Grid:
         return tuple(reversed(out))
 
     def block_values(self, chunk: int) -> tuple[np.ndarray, ...]:
+        """The axis values of block number ``chunk``, one array per axis."""
         return tuple(v[s] for v, s in zip(self.values, self.region(chunk), strict=True))
 
     def identity(self) -> dict:
