@@ -52,6 +52,9 @@ MAGNITUDES = (1e-16, 1e16)
 # u = r² raises (1 − ω²)/ε to the sixth power, shooting cubes amplitudes up to fQ: within
 # 1e±16 every such combination stays inside double precision (1e±288), beyond it some overflow.
 # (Only εf² matters for the shape: q → λq maps ε, f to ελ², f/λ — rescale rather than widen.)
+PARAMETRIC_MAX_POINTS = 401
+# NOTE: ω points of `parametric`'s range: 401 draw a smooth curve; their cost with --harmonics
+# is costs.parametric_cost's.
 
 # --- work -------------------------------------------------------------------------------------
 

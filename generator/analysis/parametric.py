@@ -38,7 +38,7 @@ import sympy as sp
 
 from ..algebra.series import trig_power
 from ..errors import InputError
-from ..limits import MAGNITUDES
+from ..limits import MAGNITUDES, MAX_HARMONICS, PARAMETRIC_MAX_POINTS, check_int
 from ..numerics.floquet import multipliers_stable, orbit_hill_multipliers
 from ..numerics.integrate import ForceTable
 from ..numerics.shooting import PeriodicOrbit, shoot_table
@@ -323,3 +323,42 @@ def trivial_orbit(p: Pump, omega: float) -> PeriodicOrbit:
     lam = orbit_hill_multipliers(p.terms, {1: 0.0}, {1: 0.0}, omega, p.extra(omega))
     return PeriodicOrbit(np.zeros(2), {1: 0.0}, {1: 0.0}, lam,
                          multipliers_stable(lam, p.zeta > 0), 0.0)
+
+
+SHOTS = 10
+# NOTE: shooting at about ten ω of the range, every branch there: the numerical truth.
+
+
+@dataclass(frozen=True)
+class ParametricReport:
+    """Everything ``lindstedt parametric`` prints: the pump, the ω grid and the harmonics, the
+    tongue's edges, the onsets, the fold of the one-harmonic branches and every branch point
+    of the response (:func:`response`), shot at about :data:`SHOTS` ω."""
+
+    pump: Pump
+    omega_range: tuple[float, float]
+    points: int
+    harmonics: int
+    tongue: tuple[float, float] | None
+    onsets: tuple[Onset, ...]
+    fold: tuple[float, float] | None
+    rows: tuple[ResponseRow, ...]
+
+
+def parametric_report(eps: float, zeta: float, gamma: float, omega_from: float,
+                      omega_to: float, points: int = 41,
+                      harmonics: int = PARAMETRIC_HARMONICS) -> ParametricReport:
+    """The :class:`ParametricReport` of the pumped oscillator over ``points`` ω of
+    ``[omega_from, omega_to]``; each input refused in one line where it does not belong."""
+    p = Pump(eps, zeta, gamma)
+    lo, hi = check_omega(omega_from, "--omega-from"), check_omega(omega_to, "--omega-to")
+    if not lo < hi:
+        raise InputError(f"--omega-from {lo:g} --omega-to {hi:g}: the range must increase")
+    check_int(points, 2, PARAMETRIC_MAX_POINTS,
+              f"--points {points}: must be in 2..{PARAMETRIC_MAX_POINTS}")
+    check_int(harmonics, 1, MAX_HARMONICS, f"--harmonics {harmonics}: must be in "
+              f"1..{MAX_HARMONICS}")
+    rows = response(p, np.linspace(lo, hi, points), harmonics,
+                    shoot_every=max(1, (points - 1) // SHOTS))
+    return ParametricReport(p, (lo, hi), points, harmonics, tongue_edges(p), onsets(p),
+                            fold(p), tuple(rows))

@@ -9,12 +9,11 @@ import math
 from pathlib import Path
 
 from ..errors import InputError
-from ..limits import COST_LIMIT_SECONDS
+from ..limits import COST_LIMIT_SECONDS, PARAMETRIC_MAX_POINTS
 
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
 # well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
 from .common import (
-    MAX_HARMONICS,
     _charts,
     _equation_args,
     _first_harmonic,
@@ -602,43 +601,31 @@ def _orbits_table(data: dict) -> list[str]:
     return lines
 
 
-MAX_PARAMETRIC_POINTS = 401
-# NOTE: ω points of the range: 401 draw a smooth curve; their cost with --harmonics is
-# costs.parametric_cost's.
-PARAMETRIC_SHOTS = 10
-# NOTE: shooting at about ten ω of the range, every branch there: the numerical truth.
-
-
 def parametric_json(eps: float, zeta: float, gamma: float, omega_from: float, omega_to: float,
                     points: int = 41, harmonics: int = 8) -> dict:
-    """The contract of ``lindstedt parametric … --json``: the tongue, the onsets, the fold and
-    every branch point (one harmonic, balance with its full-Hill verdict, shooting)."""
-    import numpy as np
+    """The contract of ``lindstedt parametric … --json``: :func:`parametric_report_json` of
+    :func:`analysis.parametric.parametric_report`."""
+    from ..analysis.parametric import parametric_report
 
-    from ..analysis.parametric import Pump, check_omega, fold, onsets, response, tongue_edges
+    return parametric_report_json(parametric_report(eps, zeta, gamma, omega_from, omega_to,
+                                                    points, harmonics))
 
-    p = Pump(eps, zeta, gamma)
-    lo, hi = check_omega(omega_from, "--omega-from"), check_omega(omega_to, "--omega-to")
-    if not lo < hi:
-        raise InputError(f"--omega-from {lo:g} --omega-to {hi:g}: the range must increase")
-    if not 2 <= points <= MAX_PARAMETRIC_POINTS:
-        raise InputError(f"--points {points}: must be in 2..{MAX_PARAMETRIC_POINTS}")
-    if isinstance(harmonics, bool) or not 1 <= harmonics <= MAX_HARMONICS:
-        raise InputError(f"--harmonics {harmonics}: must be in 1..{MAX_HARMONICS}")
-    rows = response(p, np.linspace(lo, hi, points), harmonics,
-                    shoot_every=max(1, (points - 1) // PARAMETRIC_SHOTS))
-    edges, top = tongue_edges(p), fold(p)
 
+def parametric_report_json(report) -> dict:
+    """The JSON of a :class:`analysis.parametric.ParametricReport`, a pure function of it: the
+    tongue, the onsets, the fold and every branch point (one harmonic, balance with its
+    full-Hill verdict, shooting)."""
     def moduli(lam) -> list[float]:
         return sorted(float(abs(m)) for m in lam)
 
+    p, (lo, hi), edges, top = report.pump, report.omega_range, report.tongue, report.fold
     return {
         "equation": "q'' + 2 zeta q' + (1 + eps cos 2wt) q + gamma q^3 = 0",
-        "parameters": {"eps": eps, "zeta": zeta, "gamma": gamma, "omega_from": lo,
-                       "omega_to": hi, "points": points, "harmonics": harmonics},
+        "parameters": {"eps": p.eps, "zeta": p.zeta, "gamma": p.gamma, "omega_from": lo,
+                       "omega_to": hi, "points": report.points, "harmonics": report.harmonics},
         "tongue": None if edges is None else {"lower": edges[0], "upper": edges[1]},
         "onsets": [{"omega": o.omega, "branch": o.branch, "supercritical": o.supercritical}
-                   for o in onsets(p)],
+                   for o in report.onsets],
         "fold": None if top is None else {"omega": top[0], "r": top[1]},
         "branches": [{
             "branch": r.one.branch, "omega": r.one.omega,
@@ -650,7 +637,7 @@ def parametric_json(eps: float, zeta: float, gamma: float, omega_from: float, om
             "shooting": None if r.orbit is None else {
                 "r": math.hypot(r.orbit.A[1], r.orbit.B[1]), "stable": r.orbit.stable,
                 "floquet_moduli": moduli(r.orbit.multipliers)},
-        } for r in rows],
+        } for r in report.rows],
     }
 
 
@@ -896,7 +883,7 @@ def arguments_parametric(sub: argparse._SubParsersAction) -> argparse.ArgumentPa
     p.add_argument("--omega-to", type=_real, required=True, metavar="W",
                    help="the highest ω (required)")
     p.add_argument("--points", type=_positive, default=41, metavar="N",
-                   help=f"ω points in the range, 2..{MAX_PARAMETRIC_POINTS} (default 41)")
+                   help=f"ω points in the range, 2..{PARAMETRIC_MAX_POINTS} (default 41)")
     _flag_harmonics(p, "odd harmonics of the balance (1, 3, …, 2N − 1)")
     _flag_json(p)
     _flag_plot(p)
