@@ -32,7 +32,7 @@ def run_sweep(args: argparse.Namespace) -> int:
 
         check_plot_path(Path(args.plot))
     from ..sweep.kinds import equation_kind
-    from ..sweep.store import run_sweep
+    from ..sweep.store import run_sweep, summary
 
     builtin = {name: getattr(args, name) for name in ("omega", "force", "eps", "Q")
                if getattr(args, name) is not None}
@@ -59,13 +59,11 @@ def run_sweep(args: argparse.Namespace) -> int:
         from ..charts import sweep_figure
 
         sweep_figure(ds, Path(args.plot))
-    done = ds["done"].values
-    names = list(json.loads(ds.attrs["sweep"])["axes"])
+    held = summary(ds)
     data = {"kind": args.kind, "store": str(args.store),
-            "axes": {name: [float(v) for v in ds[name].values] for name in names},
-            "fields": sorted(name for name in ds.data_vars if name != "done"),
-            "blocks": int(done.size), "finished": int(done.sum()),
-            "complete": bool(done.all())}
+            "axes": {name: list(values) for name, values in held.axes},
+            "fields": list(held.fields), "blocks": held.blocks, "finished": held.finished,
+            "complete": held.complete}
     if args.model is not None:
         data["equation"] = args.model
     if args.plot:
@@ -79,8 +77,6 @@ def run_sweep(args: argparse.Namespace) -> int:
     if args.plot:
         print(f"  figure {args.plot}")
     return 0
-
-
 
 
 def _axis_values(text: str) -> list[float]:

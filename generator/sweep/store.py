@@ -476,6 +476,31 @@ def _connect(scheduler: str | None, workers: int, stack: contextlib.ExitStack) -
     return stack.enter_context(client)
 
 
+@dataclass(frozen=True)
+class SweepSummary:
+    """What a sweep's store holds, for the command to print: its axes (name, values) in the
+    grid's order, its fields, its blocks and how many are finished."""
+
+    axes: tuple[tuple[str, tuple[float, ...]], ...]
+    fields: tuple[str, ...]
+    blocks: int
+    finished: int
+
+    @property
+    def complete(self) -> bool:
+        """Every block computed."""
+        return self.finished == self.blocks
+
+
+def summary(ds: xr.Dataset) -> SweepSummary:
+    """The :class:`SweepSummary` of a sweep's dataset (:func:`run_sweep`'s answer)."""
+    done = ds["done"].values
+    names = list(json.loads(ds.attrs["sweep"])["axes"])
+    return SweepSummary(tuple((n, tuple(float(v) for v in ds[n].values)) for n in names),
+                        tuple(sorted(n for n in ds.data_vars if n != "done")),
+                        int(done.size), int(done.sum()))
+
+
 def run_sweep(kind: str | Kind, axes: Mapping[str, Sequence[float]], store: Path | str,
               scheduler: str | None = None, workers: int = 2, chunk: int | None = None,
               progress: Callable[[SweepProgress], None] | None = None,
