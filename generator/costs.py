@@ -229,8 +229,9 @@ def generate_cost(args: argparse.Namespace) -> Cost:
         raise InputError(f"order {args.order}: the exact μ-expansion is emitted up to order "
                          f"{DRIVEN_MAX_ORDER} (its rational functions grow fast)")
     if args.model not in ("driven", "balance", "fourier") and args.order > GENERATE_MAX_ORDER:
-        raise InputError(f"order {args.order}: generate stops at order {GENERATE_MAX_ORDER} (the "
-                         "code printer's nesting limit); `lindstedt series` derives higher orders")
+        raise InputError(f"order {args.order}: generate stops at order {GENERATE_MAX_ORDER} (numba "
+                         "compiles that module in about a minute on its first import); "
+                         "`lindstedt series` derives higher orders")
     harmonic = args.model in ("balance", "fourier")
     size = args.harmonics if harmonic else args.order
     if args.model not in GENERATE_COSTS:  # a user's: its derivation, then Duffing's emission

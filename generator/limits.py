@@ -13,8 +13,10 @@ SERIES_MAX_ORDER = 100_000
 # NOTE: a hard sanity bound on any L–P order only; the CLI asks for --allow-slow far below it
 # (cost estimate).
 GENERATE_MAX_ORDER = 130
-# NOTE: SymPy's printer recurses once per level of a Horner form: duffing at order 140 exceeds
-# Python's recursion limit (130 prints), so generate stops there, whatever --allow-slow says.
+# NOTE: the bound is the emitted module's compilation, no longer its printing: a polynomial is
+# one node the printer writes itself (order 300 prints in 40 s), but numba compiles the
+# order-130 duffing module on its first import in 65 s and had not finished the order-300 one
+# after 10 minutes; generate stops at 130, whatever --allow-slow says.
 PERIOD_SERIES_ORDER = 60
 # NOTE: the order of the exact series every period method of `choose period` is built from:
 # order 60 takes ~0.1 s and reaches 1e-16 wherever |x| ≤ 0.5.
