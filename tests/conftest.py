@@ -19,8 +19,8 @@ LAYERS = {
     "exact": ("averaging", "branches", "driven", "driven_damped", "driven_equation", "equation",
               "hill", "layout", "lindstedt", "parametric", "response", "response_equation",
               "series", "subharmonic"),
-    "printers": ("charts", "cli", "costs", "emit", "files", "fuzz", "latex", "notebook",
-                 "validity"),
+    "printers": ("charts", "cli", "costs", "emit", "files", "fuzz", "interrupt", "latex",
+                 "notebook", "validity"),
     "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "orbits", "oscillator",
                 "resum", "sweep", "tongues"),
 }

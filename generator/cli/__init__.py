@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from .. import __version__
 from ..costs import COSTS
-from ..errors import InputError
+from ..errors import InputError, Interrupted
 from ..limits import COST_LIMIT_SECONDS
 from .choose import (
     arguments_choose,
@@ -115,6 +115,22 @@ def check_cost(args: argparse.Namespace) -> None:
         raise InputError(cost.refusal())
 
 
+def _terminate_as_interrupt() -> Callable[[], None]:
+    """SIGTERM raises KeyboardInterrupt in the main thread, as Ctrl-C does (one way to stop a
+    command, whichever signal); returns what puts the former handler back."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+
+    def interrupt(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGTERM, interrupt)
+    return lambda: signal.signal(signal.SIGTERM, old)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the ``lindstedt`` command line on ``argv`` (default: ``sys.argv[1:]``): parse,
     check the command's cost estimate, run it.  Returns the exit status: the command's;
@@ -122,6 +138,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     stdout's reader closed the pipe."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    terminated = _terminate_as_interrupt()
     try:
         check_cost(args)
         status = args.func(args)
@@ -130,6 +147,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     except InputError as exc:
         print(f"lindstedt: error: {exc}", file=sys.stderr)
         return 2
+    except (KeyboardInterrupt, Interrupted) as exc:
+        # Ctrl-C or SIGTERM: one line and exit 130 (128 + SIGINT), at once.  Files are written
+        # to temporaries and renamed (emit.write_files), a sweep's blocks with their flags
+        # (sweep.store): what stopped midway is not left half-written.  After a sweep (its
+        # workers already stopped) os._exit skips the interpreter's exit handlers, which would
+        # close its dask cluster in an orderly way: seconds, and log lines.
+        what = str(exc) if isinstance(exc, Interrupted) else (
+            "stopped before the end; no file is left half-written")
+        sys.stdout.flush()
+        print(f"lindstedt: interrupted: {what}", file=sys.stderr, flush=True)
+        if isinstance(exc, Interrupted):
+            os._exit(130)
+        return 130
     except BrokenPipeError:
         # The Python docs' recipe (signal module, "Note on SIGPIPE"): stdout's reader closed
         # the pipe; point stdout at devnull so the interpreter's final flush cannot fail
@@ -137,3 +167,5 @@ def main(argv: Sequence[str] | None = None) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 1
+    finally:
+        terminated()

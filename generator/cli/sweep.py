@@ -52,9 +52,11 @@ def run_sweep(args: argparse.Namespace) -> int:
                              "them; the notes' map takes --omega, --force, --eps, --Q")
         axes = builtin
     bar = ProgressBar(f"sweep {args.kind}", not args.json)
-    ds = run_sweep(kind, axes, _out_folder(args.store, "--store"), args.scheduler,
-                   args.workers, args.chunk, lambda p: bar(p.finished, p.total))
-    bar.close()
+    try:
+        ds = run_sweep(kind, axes, _out_folder(args.store, "--store"), args.scheduler,
+                       args.workers, args.chunk, lambda p: bar(p.finished, p.total))
+    finally:
+        bar.close()  # an interrupt's line starts on a clean line
     if args.plot:
         from ..charts import sweep_figure
 

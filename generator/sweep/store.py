@@ -22,10 +22,11 @@ import math
 import os
 import shutil
 import socket
+import sys
 import tempfile
 import threading
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from numbers import Real
 from pathlib import Path
@@ -34,7 +35,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..analysis.driven import Drive
-from ..errors import InputError
+from ..errors import InputError, Interrupted
 from ..limits import MAX_WORKERS, check_int
 
 if TYPE_CHECKING:
@@ -448,15 +449,42 @@ QUIET = {"distributed.worker.profile.enabled": False,
 # and 2.4 % without (measured): on two cores that is CPU taken from the workers.
 
 
+QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
+# NOTE: multiprocessing's resource tracker, a process of its own, unlinks the semaphores of an
+# interrupted sweep (its workers stopped at once) and warns of each "leaked" one on stderr after
+# the command's one line; it starts with this interpreter's -W options, so it does its work
+# without the warning.
+
+
 def local_cluster(workers: int) -> object:
     """A LocalCluster of ``workers`` single-threaded processes, no dashboard, monitors quiet
     (:data:`QUIET`; the nannies hand the configuration to the workers they start)."""
     import dask
     from distributed import LocalCluster
 
-    with dask.config.set(QUIET):
+    if QUIET_TRACKER not in sys.warnoptions:  # read when multiprocessing starts its tracker
+        sys.warnoptions.append(QUIET_TRACKER)
+    with dask.config.set(QUIET), _sigint_ignored():
         return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                             dashboard_address=None, silence_logs=logging.ERROR)
+
+
+@contextlib.contextmanager
+def _sigint_ignored() -> Iterator[None]:
+    """SIGINT ignored while the workers start, so that they inherit it ignored: Ctrl-C at a
+    terminal reaches the whole process group, and the workers' own KeyboardInterrupt
+    tracebacks would bury the command's one line (the command stops them itself)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
 
 
 def _connect(scheduler: str | None, workers: int, stack: contextlib.ExitStack) -> object:
@@ -535,13 +563,32 @@ def run_sweep(kind: str | Kind, axes: Mapping[str, Sequence[float]], store: Path
         todo = todo[:stop_after]
     if not todo:
         return open_sweep(path) if state.done is not None else _initialise(path, grid)
+    saved = [int(done.sum())]  # blocks in the store, kept up to date by _gather
     with contextlib.ExitStack() as stack:
-        client = _connect(scheduler, workers, stack)
-        if state.done is None:
-            _initialise(path, grid)
-        client.register_plugin(WarmUp(grid.kind))
-        _gather(client, grid, path, todo, int(done.sum()), progress)
+        try:
+            client = _connect(scheduler, workers, stack)
+            if state.done is None:
+                _initialise(path, grid)
+            client.register_plugin(WarmUp(grid.kind))
+            _gather(client, grid, path, todo, saved, progress)
+        except KeyboardInterrupt:
+            stack.pop_all()  # no orderly close of the cluster: it takes seconds and logs
+            _stop_workers()
+            for partial in path.rglob("*.partial"):  # zarr's temporary of a chunk cut short
+                partial.unlink(missing_ok=True)
+            raise Interrupted(f"{saved[0]}/{grid.chunks} blocks saved in {path}; run the same "
+                              "command to resume") from None
     return open_sweep(path)
+
+
+def _stop_workers() -> None:
+    """Stop this process's worker processes at once (an interrupt): every block written so far
+    is whole with its flag; a block being written has no flag and is computed again."""
+    import multiprocessing
+
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+    for child in multiprocessing.active_children():
+        child.kill()
 
 
 def _initialise(path: Path, grid: Grid) -> xr.Dataset:
@@ -555,10 +602,12 @@ def _initialise(path: Path, grid: Grid) -> xr.Dataset:
     return open_sweep(path)
 
 
-def _gather(client: object, grid: Grid, path: Path, todo: list[int], finished: int,
+def _gather(client: object, grid: Grid, path: Path, todo: list[int], saved: list[int],
             progress: Callable[[SweepProgress], None] | None) -> None:
     """Keep every worker busy with one block running and one queued; write each block (then
-    its flag) as it arrives; cancel what is left if stopped early or on an error."""
+    its flag) as it arrives, counting the flags in ``saved[0]``; cancel what is left if stopped
+    early or on an error."""
+    finished = saved[0]
     from distributed import as_completed
 
     start = time.perf_counter()
@@ -582,6 +631,7 @@ def _gather(client: object, grid: Grid, path: Path, todo: list[int], finished: i
             _write_block(arrays, grid, chunk, data)
             _mark_done(arrays, chunk)
             finished += 1
+            saved[0] = finished
             if progress is not None:
                 progress(SweepProgress(chunk, finished, grid.chunks, time.perf_counter() - start))
             following = next(queue, None)
