@@ -60,6 +60,11 @@ def test_table_is_readable():
         (["choose", "period", "--tol", "-1e-8", "--x-min", "0", "--x-max", "0.1"],
          "tol -1e-08: must be > 0"),
         (["mixing", "--eps", "0.1", "--Q", "10", "--drive", "0.3"], "F@W"),
+        (["serie", "duffing"], "invalid choice: 'serie'; did you mean 'series'?"),
+        (["respnse"], "did you mean 'response'?"),
+        (["series", "duffing", "--ordr", "3"], "did you mean --order for --ordr?"),
+        (["sweep", "stability", "--omega", "1", "--store", "x", "--workrs", "2"],
+         "did you mean --workers for --workrs?"),
     ],
 )
 def test_bad_input_one_line_exit_2(args, needle):

@@ -253,8 +253,44 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> None:  # type: ignore[override]
         # one prefix for every error, a subcommand's argparse ones included
+        message = self._did_you_mean(message)
         self.exit(2, f"lindstedt: error: {self.prog.removeprefix('lindstedt ')}: {message}\n"
                   if self.prog != "lindstedt" else f"lindstedt: error: {message}\n")
+
+    def _did_you_mean(self, message: str) -> str:
+        """``message`` with ``did you mean …?`` for a misspelled command or flag: the closest
+        spellings (``difflib``) among the commands, or among the flags of every command."""
+        import difflib
+
+        choice = re.match(r"argument (\S+): invalid choice: '([^']*)' \(choose from (.*)\)$",
+                          message)
+        if choice:
+            names = re.findall(r"'([^']*)'", choice.group(3))
+            close = difflib.get_close_matches(choice.group(2), names, n=1)
+            if not close:
+                return message
+            return (f"argument {choice.group(1)}: invalid choice: {choice.group(2)!r}; did you "
+                    f"mean {close[0]!r}? (choose from {choice.group(3)})")
+        if message.startswith("unrecognized arguments:"):
+            flags = {f for parser in self._parsers() for action in parser._actions
+                     for f in action.option_strings if f.startswith("--")}
+            hints = []
+            for token in message.split(":", 1)[1].split():
+                name = token.split("=", 1)[0]
+                if name.startswith("--") and name not in flags:
+                    close = difflib.get_close_matches(name, sorted(flags), n=1)
+                    if close:
+                        hints.append(f"{close[0]} for {name}")
+            return message + (f"; did you mean {', '.join(hints)}?" if hints else "")
+        return message
+
+    def _parsers(self) -> list[argparse.ArgumentParser]:
+        """This parser and every subcommand's."""
+        out: list[argparse.ArgumentParser] = [self]
+        for action in self._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                out += list(action.choices.values())
+        return out
 
 
 class _DeprecatedForce(argparse.Action):
