@@ -36,7 +36,7 @@ CONVENTION = "q(0) = A, q'(0) = 0, so q_j(0) = 0 for j >= 1"
 s = sp.Symbol("s")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SeriesSolution:
     """The L–P series to order K, exact, in the scaled variable ``y`` of the model.
 
@@ -52,6 +52,37 @@ class SeriesSolution:
     q: tuple[dict[int, Any], ...]
     forcing: tuple  # F_j without its W_j cos s term, in the kernel's basis (display only)
     convention: str = CONVENTION
+
+    def omega_expr(self) -> sp.Expr:
+        """The frequency ``ω = Σ_j ω_j coupling^j`` to the solution's order, a SymPy expression in
+        the model's own symbols (``A``, ``eps`` and the parameters; for a user's equation in
+        its names, ω₀ included): ``1 + 3*A**2*eps/8 - 15*A**4*eps**2/256`` for Duffing."""
+        m = self.model
+        return sp.Add(*(c * m.coupling**j for j, c in enumerate(omega_coefficients(self))))
+
+    def period_expr(self) -> sp.Expr:
+        """The period ``T = (2π/ω₀) Σ_j τ_j y^j`` to the solution's order (SymPy, the model's
+        symbols)."""
+        return period_series(self)
+
+    def q_expr(self, time: sp.Symbol | None = None) -> sp.Expr:
+        """The motion ``q(t) = A Σ_j coupling^j q_j(ωt)`` to the solution's order, with ``ω``
+        truncated at the same order (SymPy, the model's symbols; ``time`` defaults to ``t``)."""
+        return solution_expression(self, t if time is None else time)
+
+    def __repr__(self) -> str:
+        """What the series is and its frequency, as mathematics (SymPy's spelling), the first
+        orders only: ``<duffing: L–P series to order 6 in y = A**2*eps; omega = 1 + …>``."""
+        m = self.model
+        shown = min(self.order, SHOWN_ORDERS)
+        terms = omega_coefficients(self)[: shown + 1]
+        omega = sp.sstr(sp.Add(*(c * m.coupling**j for j, c in enumerate(terms))),
+                        order="rev-lex")  # ascending powers: 1 + 3*A**2*epsilon/8 - …
+        tail = " + …" if shown < self.order else ""
+        return (f"<{m.name}: L–P series to order {self.order} in y = {sp.sstr(m.y)}; "
+                f"omega = {omega}{tail}>")
+
+    __str__ = __repr__
 
     def _repr_latex_(self) -> str:
         """ω, T/2π and the first q_j in y (Jupyter), the first orders only."""
