@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import sys
 from fractions import Fraction
 from pathlib import Path
@@ -110,12 +111,24 @@ def _domain_fields(sol) -> dict:
     return fields
 
 
+def _number(c: object) -> str:
+    """An exact rational as a reader writes it: ``3/8``, an integer as ``1`` (the JSON keeps
+    ``"p/q"`` for scripts)."""
+    return f"{c.p}" if c.q == 1 else f"{c.p}/{c.q}"
+
+
+def _coordinate_named(convention: str, name: str) -> str:
+    """The convention in the user's coordinate: ``theta(0) = A, theta'(0) = 0, …``."""
+    return convention if name == "q" else re.sub(r"\bq(_j)?(?=\(|'\()", name + r"\1",
+                                                 convention)
+
+
 def series_table(sol) -> str:
     """Readable table: ω_j, T_j/2π and the harmonics of q_j per order."""
     m = sol.model
     lines = [
         f"{m.name}: {m.title}, expansion variable {m.variable}, order {sol.order}",
-        f"convention: {sol.convention}",
+        f"convention: {_coordinate_named(sol.convention, str(m.coordinate))}",
     ]
     if m.frequency != 1:
         lines.append(f"omega in units of omega0 = {m.frequency}, T in units of 2*pi/omega0")
@@ -128,9 +141,9 @@ def series_table(sol) -> str:
         lines.append(f"{'j':>3}  {'omega_j':>24}  {'(T/2pi)_j':>24}  "
                      "q_j: harmonic n -> coefficient")
         for j in range(sol.order + 1):
-            harmonics = ", ".join(f"{n}: {_rational(c)}" for n, c in sorted(sol.q[j].items()))
-            lines.append(f"{j:>3}  {_rational(sol.omega[j]):>24}  "
-                         f"{_rational(sol.period[j]):>24}  {harmonics}")
+            harmonics = ", ".join(f"{n}: {_number(c)}" for n, c in sorted(sol.q[j].items()))
+            lines.append(f"{j:>3}  {_number(sol.omega[j]):>24}  "
+                         f"{_number(sol.period[j]):>24}  {harmonics}")
         return "\n".join(lines)
     def g(c: object) -> str:
         return _polynomial_text(sol, c)
@@ -192,9 +205,13 @@ def limit_cycle_table(lc) -> str:
              "convention: q'(0) = 0, q(0) = sum_j amplitude_j eps^j",
              f"stability: {limit_cycle_stability(lc)}",
              f"{'j':>3}  {'omega_j':>22}  {'(T/2pi)_j':>22}  {'amplitude_j':>22}"]
+    def shown(c: object) -> str:  # an integer as a reader writes it: 1, 0, 2
+        text = _fraction_text(c)
+        return text.removesuffix("/1")
+
     for j in range(lc.order + 1):
-        lines.append(f"{j:>3}  {_fraction_text(lc.omega[j]):>22}  "
-                     f"{_fraction_text(lc.period[j]):>22}  {_fraction_text(lc.amplitude[j]):>22}")
+        lines.append(f"{j:>3}  {shown(lc.omega[j]):>22}  {shown(lc.period[j]):>22}  "
+                     f"{shown(lc.amplitude[j]):>22}")
     return "\n".join(lines)
 
 
