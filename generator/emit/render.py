@@ -183,7 +183,7 @@ def latex_context(d: Derivation) -> dict:
         d.model, latex_expr(d.y) if d.y.is_Symbol else f"y = {latex_expr(d.y)}"
     )
     y = variable.split("=")[0].strip()  # a symbol: powers y^{j} of it are valid TeX
-    qs = sp.latex(d.coordinate)
+    qs = latex_expr(d.coordinate)
     rows = [
         {"j": j, "omega": latex_coefficient(w, stack=False),
          "tau": latex_coefficient(tau, stack=False)}
@@ -245,12 +245,12 @@ DMATH_INLINE = 90
 def _dmath(expr: sp.Expr) -> str:
     r"""LaTeX for a breqn ``dmath*``: short expressions as SymPy prints them, long ones
     as ``\frac{1}{D}\Bigl(N\Bigr)``."""
-    text = sp.latex(expr)
+    text = latex_expr(expr)
     if len(text) > DMATH_INLINE:
         num, den = sp.fraction(sp.together(expr))
         num = sp.expand(num)
         if den != 1 and isinstance(num, sp.Add):
-            text = rf"\frac{{1}}{{{sp.latex(den)}}}\Bigl({sp.latex(num)}\Bigr)"
+            text = rf"\frac{{1}}{{{latex_expr(den)}}}\Bigl({latex_expr(num)}\Bigr)"
     return text.replace("A_{1}", "A_1")
 
 
@@ -291,15 +291,13 @@ def render_mu_damped_derivation(d: MuDampedDerivation, p: Provenance) -> dict[st
     } for o in d.orders]
     tex = environment(latex=True).get_template("mu_damped_derivation.tex.j2").render(
         banner=banner(p, "%"), order=d.order, orders=orders,
-        determinant=sp.latex(d.determinant))
+        determinant=latex_expr(d.determinant))
     return {f"{p.model}_derivation.tex": tex}
 
 
 def render_slow_flow(d: SlowFlowDocument, p: Provenance) -> dict[str, str]:
     """``{"<name>_slow_flow.tex": text}``: ``R_k`` and ``Φ_k`` order by order."""
-    names = {sp.Symbol("phi"): r"\varphi", sp.Symbol("sigma"): r"\sigma"}
-    orders = [{"k": k + 1, "radial": sp.latex(a, symbol_names=names),
-               "phase": sp.latex(b, symbol_names=names)}
+    orders = [{"k": k + 1, "radial": latex_expr(a), "phase": latex_expr(b)}
               for k, (a, b) in enumerate(zip(d.radial, d.phase, strict=True))]
     tex = environment(latex=True).get_template("slow_flow.tex.j2").render(
         banner=banner(p, "%"), source=d.source.replace("'", r"\textquotesingle{}")

@@ -267,6 +267,13 @@ class LatexPrinter(SympyLatexPrinter):
         super().__init__({"symbol_names": {EPS: r"\varepsilon"}})
         self.stack = stack  # long integers stacked in lines (never in a table's cell)
 
+    def _print_Symbol(self, expr: sp.Symbol, style: str = "plain") -> str:
+        """ε and φ as ``\\varepsilon``, ``\\varphi`` whatever the symbol's assumptions: one
+        ε in every document (a user's ``eps``, the notes' ``epsilon``)."""
+        if expr.name in LATEX_NAMES:
+            return LATEX_NAMES[expr.name]
+        return super()._print_Symbol(expr, style)
+
     def _print_Coefficient(self, expr: Coefficient) -> str:
         out = []
         for powers, (p, q) in expr.terms:
@@ -279,10 +286,14 @@ class LatexPrinter(SympyLatexPrinter):
         return text[2:] if text.startswith("+ ") else "-" + text[2:]
 
 
+LATEX_NAMES = {"eps": r"\varepsilon", "epsilon": r"\varepsilon", "phi": r"\varphi"}
+# NOTE: the names every LaTeX document spells one way (the small parameter, the phase).
+
+
 @functools.cache
 def _latex_name(name: str) -> str:
-    """SymPy's LaTeX of a parameter's name (``alpha`` → ``\alpha``, ``w0`` → ``w_{0}``)."""
-    return sp.latex(sp.Symbol(name))
+    """The LaTeX of a parameter's name (``alpha`` → ``\\alpha``, ``w0`` → ``w_{0}``)."""
+    return LatexPrinter().doprint(sp.Symbol(name))
 
 
 def latex_expr(expr: sp.Basic) -> str:
