@@ -63,6 +63,8 @@ class Equation:
     time: sp.Symbol
     small: sp.Symbol | None
     parameters: tuple[sp.Symbol, ...]
+    lhs: sp.Expr = sp.S.Zero  # the two sides as written (for typesetting)
+    rhs: sp.Expr = sp.S.Zero
 
     @property
     def coordinate(self) -> sp.Symbol:
@@ -314,4 +316,6 @@ def parse_equation(text: str) -> Equation:
         time=sp.Symbol(TIME),
         small=small,
         parameters=tuple(sp.Symbol(n) for n in others),
+        lhs=lhs.xreplace(rename),
+        rhs=rhs.xreplace(rename),
     )

@@ -24,7 +24,13 @@ import jinja2
 import sympy as sp
 
 from ..errors import InputError
-from ..lower.printers import latex_coefficient, latex_expr, latex_rational, pycode
+from ..lower.printers import (
+    latex_coefficient,
+    latex_equation,
+    latex_expr,
+    latex_rational,
+    pycode,
+)
 from ..lower.records import (
     ArrayKernel,
     CycleDerivation,
@@ -300,9 +306,8 @@ def render_slow_flow(d: SlowFlowDocument, p: Provenance) -> dict[str, str]:
     orders = [{"k": k + 1, "radial": latex_expr(a), "phase": latex_expr(b)}
               for k, (a, b) in enumerate(zip(d.radial, d.phase, strict=True))]
     tex = environment(latex=True).get_template("slow_flow.tex.j2").render(
-        banner=banner(p, "%"), source=d.source.replace("'", r"\textquotesingle{}")
-        .replace("_", r"\_").replace("**", "\\^{}"), order=d.order, driven=d.driven,
-        orders=orders)
+        banner=banner(p, "%"), equation=latex_equation(d.equation), order=d.order,
+        driven=d.driven, orders=orders)
     return {f"{p.model}.tex": tex}
 
 
@@ -359,7 +364,7 @@ def render_cycle_derivation(d: CycleDerivation, p: Provenance) -> dict[str, str]
                  if d.slope > 0 else
                  r"attracting for $\varepsilon < 0$ and repelling for $\varepsilon > 0$")
     tex = environment(latex=True).get_template("cycle_derivation.tex.j2").render(
-        banner=banner(p, "%"), model=_tex_text(d.model), equation=_tex_text(d.equation),
+        banner=banner(p, "%"), model=_tex_text(d.model), equation=latex_equation(d.equation),
         a0=latex_rational(d.a0), slope=latex_rational(d.slope), stability=stability,
         lin=_trig_terms(d.lin_cos, d.lin_sin), orders=orders)
     return {f"{p.model}_derivation.tex": tex}

@@ -15,6 +15,7 @@ from ..derive.averaging import SlowFlow
 from ..derive.averaging import U as U_SLOW
 from ..derive.averaging import V as V_SLOW
 from ..derive.cycles import LimitCycle
+from ..derive.equation import parse_equation
 from ..derive.lindstedt import SeriesSolution, order_terms
 from ..errors import InputError
 from .forms import _LOCAL, LOCAL_NAMES, MODULE_NAMES, agm_steps, harmonics
@@ -134,7 +135,7 @@ def lower_cycle_derivation(lc: LimitCycle, order: int) -> CycleDerivation:
         None if o.a_prev is None else rational(o.a_prev), rational(o.W), rational(o.omega),
         _rational_items(o.q[0]), _rational_items(o.q[1])) for o in lc.orders[:order])
     a0 = rational(lc.amplitude[0])
-    return CycleDerivation(lc.model.name, lc.model.source, a0, rational(lc.slope),
+    return CycleDerivation(lc.model.name, parse_equation(lc.model.source), a0, rational(lc.slope),
                            _rational_items(lc.linearisation[0]),
                            _rational_items(lc.linearisation[1]), pieces)
 
@@ -185,7 +186,7 @@ def lower_slow_flow(flow: SlowFlow, command: str) -> Unit:
                               source=flow.source, parameters=[str(p) for p in params]),
         kernels=tuple(kernels),
     )
-    doc = SlowFlowDocument(flow.name, flow.source, flow.order, flow.driven,
+    doc = SlowFlowDocument(flow.name, parse_equation(flow.source), flow.order, flow.driven,
                            tuple(e.xreplace({R_SLOW: r, PHI_SLOW: phi}) for e in flow.radial),
                            tuple(e.xreplace({R_SLOW: r, PHI_SLOW: phi}) for e in flow.phase))
     return Unit(module, (doc,))

@@ -15,6 +15,7 @@ from sympy.printing.latex import LatexPrinter as SympyLatexPrinter
 from sympy.printing.precedence import PRECEDENCE
 from sympy.printing.pycode import PythonCodePrinter
 
+from ..derive.equation import Equation
 from ..errors import InputError
 
 Terms = tuple[tuple[tuple[tuple[str, int], ...], tuple[int, int]], ...]
@@ -294,6 +295,16 @@ LATEX_NAMES = {"eps": r"\varepsilon", "epsilon": r"\varepsilon", "phi": r"\varph
 def _latex_name(name: str) -> str:
     """The LaTeX of a parameter's name (``alpha`` → ``\\alpha``, ``w0`` → ``w_{0}``)."""
     return LatexPrinter().doprint(sp.Symbol(name))
+
+
+def latex_equation(equation: Equation) -> str:
+    """An equation of motion as mathematics, both sides as written, the derivatives dotted:
+    ``\\ddot{q} + q = \\varepsilon \\left(1 - q^{2}\\right) \\dot{q}``."""
+    name = latex_expr(equation.coordinate)
+    dotted = {equation.derivatives[1]: sp.Symbol(rf"\dot{{{name}}}"),
+              equation.derivatives[2]: sp.Symbol(rf"\ddot{{{name}}}")}
+    return (f"{latex_expr(equation.lhs.xreplace(dotted))} = "
+            f"{latex_expr(equation.rhs.xreplace(dotted))}")
 
 
 def latex_expr(expr: sp.Basic) -> str:

@@ -13,6 +13,7 @@ import sympy as sp
 from .. import __version__
 from ..algebra.resum import Resummed
 from ..analysis.mu_exact import MuDampedOrder, MuOrder
+from ..derive.equation import Equation
 
 Assign = tuple[sp.Symbol, sp.Expr]
 
@@ -279,7 +280,7 @@ class CycleDerivation:
     amplitude equation ``S(a₀) = 0``, the linearisation ``L`` and the first orders."""
 
     model: str
-    equation: str  # q'' + q = eps*f(q, q') as the user wrote it
+    equation: Equation  # q'' + q = eps*f(q, q') as the user wrote it, parsed
     a0: sp.Rational
     slope: sp.Rational
     lin_cos: tuple[tuple[int, sp.Rational], ...]
@@ -304,7 +305,7 @@ class SlowFlowDocument:
     """The slow flow's equations for ``slow_flow.tex.j2``: ``R_k``, ``Φ_k`` by order."""
 
     name: str
-    source: str  # the equation as the user wrote it
+    equation: Equation  # as the user wrote it, parsed
     order: int
     driven: bool
     radial: tuple[sp.Expr, ...]
