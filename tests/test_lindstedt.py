@@ -214,14 +214,18 @@ def test_the_solution_in_sympy_satisfies_its_equation(text, order):
     cubic = text.startswith("x")
     residual = sp.diff(q, time, 2) + w0sq * q + e * (q**3 if cubic else q**2 + q**3)
     at = {a: sp.Rational(1, 2), time: sp.Rational(7, 5)}
-    series = sp.series(residual.subs(at), e, 0, order + 1).removeO()
-    for k in range(order + 1):
-        assert abs(sp.N(series.coeff(e, k), 50)) < 1e-40, k
-    assert sp.simplify(q.subs(time, 0) - a) == 0
-    velocity = sp.diff(q, time).subs({time: 0, a: sp.Rational(1, 2), e: sp.Rational(1, 7)})
-    assert abs(sp.N(velocity, 50)) < 1e-40
-    product = sp.series((omega * period).subs(a, sp.Rational(1, 2)), e, 0, order + 1)
-    assert sp.simplify(product.removeO() - 2 * sp.pi) == 0
+
+    def size(expr: sp.Expr, small: sp.Rational) -> float:
+        return abs(float(sp.N(expr.subs({**at, e: small}), 60)))
+
+    # an O(ε^(K+1)) residual: ten times smaller ε, 10^(K+1) times smaller (within 1 %)
+    for expr in (residual, omega * period - 2 * sp.pi):
+        big, small = size(expr, sp.Rational(1, 10**6)), size(expr, sp.Rational(1, 10**7))
+        assert abs(big / small / 10 ** (order + 1) - 1) < 0.01, (big, small)
+    for e_value in (sp.Rational(1, 7), sp.Rational(-1, 3)):
+        start = {time: 0, a: sp.Rational(1, 2), e: e_value}
+        assert abs(sp.N(q.subs(start) - sp.Rational(1, 2), 60)) < 1e-50
+        assert abs(sp.N(sp.diff(q, time).subs(start), 60)) < 1e-50
     text_repr = repr(sol)
     assert text_repr.startswith(f"<{m.name}: L–P series to order {order}") and "^" not in text_repr
     assert str(sol) == text_repr

@@ -260,16 +260,23 @@ def _dmath(expr: sp.Expr) -> str:
     return text.replace("A_{1}", "A_1")
 
 
+def _trig(kind: str, n: int, var: str = "\\tau") -> str:
+    """``\\cos\\tau``, ``\\cos 3\\tau`` (never ``\\cos 1\\tau``); ``1`` for the constant."""
+    if n == 0 and kind == "cos":
+        return "1"
+    return f"\\{kind}{var}" if n == 1 else f"\\{kind} {n}{var}"
+
+
 def render_mu_derivation(d: MuDerivation, p: Provenance) -> dict[str, str]:
     """``{"driven_derivation.tex": text}``: the μ-expansion order by order and the notes'
     table."""
     orders = [{
         "j": o.order,
-        "forcing": [(n, _dmath(c)) for n, c in sorted(o.forcing.items())],
+        "forcing": [(_trig("cos", n), _dmath(c)) for n, c in sorted(o.forcing.items())],
         "secular": _dmath(o.secular),
         "unknown": _dmath(o.unknown),
         "value": _dmath(o.value) if o.value is not None else "",
-        "solution": [(n, _dmath(c)) for n, c in sorted(o.q.items())],
+        "solution": [(_trig("cos", n), _dmath(c)) for n, c in sorted(o.q.items())],
     } for o in d.orders]
     rows = [{"label": label, **{f"a{n}": v if isinstance(v, str) else f"{v:.6f}"
                                 for n, v in cells}} for label, cells in d.table.rows]
@@ -282,7 +289,7 @@ def render_mu_derivation(d: MuDerivation, p: Provenance) -> dict[str, str]:
 def render_mu_damped_derivation(d: MuDampedDerivation, p: Provenance) -> dict[str, str]:
     """``{"driven_damped_derivation.tex": text}``: the damped μ-expansion order by order."""
     def harmonics(parts: tuple[dict, dict]) -> list[tuple[str, str]]:
-        return [(f"\\{trig} {n}\\tau" if n != 1 else f"\\{trig}\\tau", _dmath(c))
+        return [(_trig(trig, n), _dmath(c))
                 for trig, part in zip(("cos", "sin"), parts, strict=True)
                 for n, c in sorted(part.items())]
 
