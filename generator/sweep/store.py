@@ -456,6 +456,12 @@ QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
 # without the warning.
 
 
+LOCAL_HTTP = "127.0.0.1:0"
+# NOTE: the scheduler serves its HTTP routes even without a dashboard, by default on :8787 of
+# every interface; a second sweep on the machine then warned "Port 8787 is already in use" on
+# stderr. A free port of the loopback interface: no clash, nothing served beyond the machine.
+
+
 def local_cluster(workers: int) -> object:
     """A LocalCluster of ``workers`` single-threaded processes, no dashboard, monitors quiet
     (:data:`QUIET`; the nannies hand the configuration to the workers they start)."""
@@ -466,7 +472,7 @@ def local_cluster(workers: int) -> object:
         sys.warnoptions.append(QUIET_TRACKER)
     with dask.config.set(QUIET), _sigint_ignored():
         return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                            dashboard_address=None, silence_logs=logging.ERROR)
+                            dashboard_address=LOCAL_HTTP, silence_logs=logging.ERROR)
 
 
 @contextlib.contextmanager
