@@ -44,10 +44,10 @@ CASES = [
     ["subharmonic", *DRIVE, "--omega", "1.05", "--json"],
     ["mixing", "--eps", "0.1", "--Q", "20", "--drive", "0.3@0.8", "--drive", "0.2@1.9",
      "--drive", "0.1@2.7", "--drive", "0.1@3.3", "--json"],
-    ["choose", "period", "--tol", "1e-8", "--x-min", "-0.5", "--x-max", "0.5", "--json"],
-    ["choose", "q", "--tol", "1e-6", "--x-min", "0", "--x-max", "0.5", "--json"],
+    ["choose", "period", "--tol", "1e-8", "--range", "-0.5:0.5", "--json"],
+    ["choose", "q", "--tol", "1e-6", "--range", "0:0.5", "--json"],
     ["choose", "amplitudes", *DRIVE, "--Q", "20", "--omega", "1.3", "--json"],
-    ["choose", "response", *DRIVE, "--Q", "20", "--omega-min", "0.5", "--omega-max", "1.5",
+    ["choose", "response", *DRIVE, "--Q", "20", "--omega", "0.5:1.5",
      "--json"],
     ["choose", "amplitudes", *DRIVE, "--omega", "1.3", "--tol", "1e-6", "--json"],
     ["clock", "--json"],
@@ -78,7 +78,7 @@ def main(quick: bool, only: str | None) -> None:
             if args[0] == "generate":
                 args += ["--out", f"{tmp}/g{i}"]
             if args[0] == "sweep":
-                args += ["--store", f"{tmp}/s{i}.zarr"]
+                args += ["--out", f"{tmp}/s{i}.zarr"]
             if args[0] in SLOW:
                 args.append("--allow-slow")
             parsed = build_parser().parse_args(args)

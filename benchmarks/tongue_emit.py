@@ -1,4 +1,4 @@
-"""``lindstedt tongues "cos(t) + 1/2*cos(2*t)" --n 1 --order 30 --emit DIR``: generation time,
+"""``lindstedt tongues "cos(t) + 1/2*cos(2*t)" --n 1 --order 30 --out DIR``: generation time,
 the verified ε of each curve against its estimated radius, and ns per point of the emitted
 ufunc and ``_into`` loop against SymPy's lambdify of the truncated series (median of 5 over
 10⁶ points of ε in (0, verified], the same points for each); then the verification itself:
@@ -100,7 +100,7 @@ def verification() -> None:
 
 def measure(out: Path) -> None:
     t0 = time.perf_counter()
-    assert main(["tongues", P, "--n", str(N), "--order", str(ORDER), "--emit", str(out)]) == 0
+    assert main(["tongues", P, "--n", str(N), "--order", str(ORDER), "--out", str(out)]) == 0
     generated = time.perf_counter() - t0
     mod = load_generated(out / f"tongue_{N}.py")
     eps_ = sp.Symbol("eps")

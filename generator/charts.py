@@ -81,20 +81,134 @@ def _save(fig: plt.Figure, path: Path) -> Path:
     return path
 
 
+# --- what every chart shares: symbols, rounded values, axis labels, the rounding band -------
+
+SYMBOLS = {"omega": "ω", "force": "f", "eps": "ε", "Q": "Q", "zeta": "ζ", "gamma": "γ",
+           "mu_order": "μ-order", "branch": "branch", "root": "root"}
+# NOTE: the notes' parameter names (sweep axes, CLI flags) as the symbols the notes print.
+LABELS = {
+    "omega": "drive frequency ω/ω₀",
+    "omega3": "ω/ω₀ (drive at 3ω)",
+    "omega2": "ω/ω₀ (pump at 2ω)",
+    "r": "first harmonic r = √(A₁² + B₁²)",
+    "force": "drive amplitude f",
+    "eps": "ε",
+    "Q": "quality factor Q",
+    "x": "y = εA² (symlog)",
+    "T error": "relative error |T/T_exact − 1|",
+    "A1 error": "|A₁ − A₁(balance N = 10)|",
+    "t": "time t (units 1/ω₀)",
+}
+# NOTE: time in units of 1/ω₀ (the notes scale the linear frequency to 1): frequencies are
+# ω/ω₀, periods T/2π. A user's equation is drawn against ω/ω₀ with ω₀ = √(its linear term).
+ROUNDING = 1e-15
+# NOTE: ~5 ulp of a number of order 1: an error below it is double rounding, not the method's.
+FLOOR = 1e-17
+# NOTE: points (not lines) whose error is below ROUNDING are drawn at this floor, inside the
+# shaded rounding band (log axes cannot show 0).
+
+
+def _value(x: float) -> str:
+    """A parameter's value for a legend or a title: at most three significant digits.
+
+    >>> _value(0.188889), _value(20.0), _value(1e-15), _value(0.5)
+    ('0.189', '20', '1e-15', '0.5')
+    """
+    return f"{float(x):.3g}"
+
+
+def _named(name: str, x: float) -> str:
+    """``name = value`` with the notes' symbol for ``name`` and :func:`_value`'s rounding.
+
+    >>> _named("force", 0.188889), _named("a", 2.0)
+    ('f = 0.189', 'a = 2')
+    """
+    return f"{SYMBOLS.get(name, name)} = {_value(x)}"
+
+
+def _label(ax: plt.Axes, x: str | None = None, y: str | None = None) -> None:
+    """Axis labels from :data:`LABELS` by key (a text not among them is used as it is)."""
+    if x is not None:
+        ax.set_xlabel(LABELS.get(x, x))
+    if y is not None:
+        ax.set_ylabel(LABELS.get(y, y))
+
+
+def _resolved(err: np.ndarray) -> np.ndarray:
+    """An error curve with what double precision cannot resolve (below :data:`ROUNDING`)
+    left out (NaN): the rounding noise is not data. :func:`_rounding_band` says so."""
+    err = np.asarray(err, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return np.where(err >= ROUNDING, err, np.nan)
+
+
+def _rounding_band(ax: plt.Axes, what: str = "not drawn") -> None:
+    """Shade (and put in the legend) the errors below :data:`ROUNDING`: ``what`` says how
+    the values there are drawn."""
+    ax.axhspan(FLOOR, ROUNDING, color="0.9", zorder=0,
+               label=f"< {ROUNDING:g}: rounding, {what}")
+
+
+def _order_colors(orders: Sequence[int], cmap: str = "viridis") -> dict[int, tuple]:
+    """One colour per order from a sequential colormap (light: low, dark: high; its yellow
+    end left out, too pale on white), so that the order reads from the colour."""
+    ranked = sorted(set(orders))
+    top = max(len(ranked) - 1, 1)
+    return {k: plt.get_cmap(cmap)(0.85 - 0.85 * i / top) for i, k in enumerate(ranked)}
+
+
+SETTLE_TOL = 2e-3
+SETTLE_PERIODS = 20
+# NOTE: a sweep's max |q| is a steady state's where it changed by less than 0.2 % per drive
+# period over the last 20 periods: at the default rate (10⁴ periods over the range) a steady
+# state drifts ~0.03 % a period, while the start-up and the ringing after a jump change it by
+# ~1–50 %. On the notes' response (ε = 0.1, f = 0.3, Q = 20) every point kept is within 0.2 %
+# of a harmonic-balance orbit's max |q| (tests/test_charts.py).
+
+
+def _settled(sweep: object, folds: Sequence[float]) -> np.ndarray:
+    """Which points of a simulated :class:`numerics.integrate.Sweep` are steady states: not
+    changing faster than :data:`SETTLE_TOL` over the last :data:`SETTLE_PERIODS` periods, and
+    not on the lagging branch between a fold the sweep has passed and its jump (near a fold
+    the orbit creeps: slow, but no longer a steady state)."""
+    a = sweep.amplitude
+    with np.errstate(invalid="ignore", divide="ignore"):
+        change = np.abs(np.diff(a, prepend=np.nan)) / a
+    moving = ~(change < SETTLE_TOL)  # the first period and NaN (escaped) count as moving
+    ok = np.convolve(moving, np.ones(SETTLE_PERIODS), "full")[:a.size] == 0
+    if sweep.jump is not None:
+        d = np.sign(sweep.omega[-1] - sweep.omega[0])
+        passed = [f for f in folds if (sweep.jump - f) * d > 0]
+        if passed:
+            fold = max(passed, key=lambda f: f * d)
+            ok &= ~(((sweep.omega - fold) * d > 0) & ((sweep.omega - sweep.jump) * d <= 0))
+    return ok
+
+
 def _response_panel(ax: plt.Axes, r: ResponseReport, title: str) -> None:
-    """The continued N-harmonic balance (its first-harmonic amplitude, each piece), the
-    simulated sweeps up and down (max |q|) and the balance's folds of a
-    :class:`analysis.response.ResponseReport`."""
+    """The continued N-harmonic balance (its first-harmonic amplitude r, each piece), the
+    simulated sweeps up and down (max |q| of each settled drive period, the rest marked as
+    transient by :func:`_settled`) and the balance's folds of a
+    :class:`analysis.response.ResponseReport`, against ω/ω₀."""
+    w0 = r.er.linear_frequency
     amp = np.array([_first(r.fine, x) for x in r.cont.x])
     for k, piece in enumerate(r.cont.piece_slices()):  # a softening spring's: two pieces
-        ax.plot(r.cont.omega[piece], amp[piece], "k-", lw=0.7,
-                label=f"harmonic balance N = {r.fine.harmonics}" if k == 0 else None)
-    ax.plot(r.up.omega, r.up.amplitude, "C3.", ms=1.5, label="sweep up (max |q|)")
-    ax.plot(r.down.omega, r.down.amplitude, "C2.", ms=1.5, label="sweep down (max |q|)")
-    for w in r.cont.folds:
-        ax.axvline(w, color="grey", ls=":", lw=1)
-    ax.set(xlabel=f"drive frequency {r.de.frequency}", ylabel="amplitude", title=title)
-    ax.legend(fontsize=8, loc="upper left")
+        ax.plot(r.cont.omega[piece] / w0, amp[piece], "k-", lw=0.7,
+                label=f"harmonic balance N = {r.fine.harmonics} (r)" if k == 0 else None)
+    transient = []
+    for s, color, way in ((r.up, "C3", "up"), (r.down, "C2", "down")):
+        ok = _settled(s, r.cont.folds)
+        ax.plot(s.omega[ok] / w0, s.amplitude[ok], ".", color=color, ms=1.5,
+                label=f"simulated sweep {way} (max |q|)")
+        transient += [s.omega[~ok], s.amplitude[~ok]]
+    ax.plot(np.concatenate(transient[::2]) / w0, np.concatenate(transient[1::2]), ".",
+            color="0.8", ms=1, zorder=0, label="sweep not settled (transient)")
+    for k, w in enumerate(r.cont.folds):
+        ax.axvline(w / w0, color="grey", ls=":", lw=1,
+                   label="fold of the balance" if k == 0 else None)
+    _label(ax, "omega", "amplitude: r (lines), max |q| (sweeps)")
+    ax.set_title(title)
+    ax.legend(fontsize=7, loc="upper left", markerscale=4)
 
 
 def response_figure(eps: float, force: float, Q: float, harmonics: int, path: Path,
@@ -115,16 +229,19 @@ def response_figure(eps: float, force: float, Q: float, harmonics: int, path: Pa
     for k in range(3):
         r = np.where(jumps, np.nan, curve.r[:, k])
         ax.plot(omega, np.where(curve.stable[:, k], r, np.nan), "C0-", lw=2,
-                label="one harmonic, stable" if k == 0 else None)
+                label="one harmonic, stable (r)" if k == 0 else None)
         ax.plot(omega, np.where(~curve.stable[:, k], r, np.nan), "C0--", lw=1.5,
-                label="one harmonic, unstable" if k == 1 else None)
-    _response_panel(ax, report, f"q̈ + q̇/Q + q + εq³ = f cos ωt  (ε = {eps}, f = {force}, "
-                    f"Q = {Q})")
+                label="one harmonic, unstable (r)" if k == 1 else None)
+    _response_panel(ax, report, "q̈ + q̇/Q + q + εq³ = f cos ωt  ("
+                    + ", ".join(_named(n, v) for n, v in report.notes) + ")")
     w = np.linspace(0.5, 1.5, 1000)
     for i, q in enumerate((2, 5, 10)):
-        lin.plot(w, 1 / np.sqrt((1 - w**2) ** 2 + w**2 / q**2), f"C{i}-", label=f"Q = {q} (3.79)")
-        lin.plot(w, 1 / np.sqrt(4 * (1 - w) ** 2 + 1 / q**2), f"C{i}:", label=f"Q = {q} (3.83)")
-    lin.set(xlabel="ω", ylabel="|q| / f", title="linear oscillator (notes' Fig. 1)")
+        lin.plot(w, 1 / np.sqrt((1 - w**2) ** 2 + w**2 / q**2), f"C{i}-",
+                 label=f"Q = {q}, exact")
+        lin.plot(w, 1 / np.sqrt(4 * (1 - w) ** 2 + 1 / q**2), f"C{i}:",
+                 label=f"Q = {q}, Lorentzian near ω₀")
+    _label(lin, "omega", "r/f (linear: r = max |q|)")
+    lin.set_title("linear oscillator q̈ + q̇/Q + q = f cos ωt")
     lin.legend(fontsize=7)
     fig.tight_layout()
     return _save(fig, path)
@@ -145,10 +262,11 @@ def response_equation_figure(text: str, values: dict[str, str], harmonics: int, 
     lo, hi = report.er.omega_range
     fig, ax = plt.subplots(figsize=(8, 4.2))
     omega = np.linspace(lo, hi, 600)
-    one = [(w, r) for w in omega for r in report.er.one_harmonic.amplitudes(float(w))]
+    one = [(w / report.er.linear_frequency, r) for w in omega
+           for r in report.er.one_harmonic.amplitudes(float(w))]
     if one:
-        ax.plot(*np.array(one).T, "C0.", ms=1.5, label="one harmonic")
-    _response_panel(ax, report, text)
+        ax.plot(*np.array(one).T, "C0.", ms=1.5, label="one harmonic (r)")
+    _response_panel(ax, report, f"{text}  (ω₀ = {_value(report.er.linear_frequency)})")
     fig.tight_layout()
     return _save(fig, path)
 
@@ -196,11 +314,13 @@ def subharmonic_figure(eps: float, force: float, path: Path) -> Path:
         ts = np.array(true_s, dtype=bool)
         ax.plot(np.array(true_w)[ts], np.array(true_a)[ts], f"{color}o", ms=5, mfc="none")
         ax.plot(np.array(true_w)[~ts], np.array(true_a)[~ts], f"{color}x", ms=5)
+    ax.plot([], [], "ko", ms=5, mfc="none", label="true orbit (shooting), stable")
+    ax.plot([], [], "kx", ms=5, label="true orbit (shooting), unstable")
     ax.axhline(0, color="grey", lw=0.5)
-    ax.set(xlabel="ω (drive at 3ω)", ylabel="a, first harmonic",
-           title=f"1/3 subharmonic (ε = {eps}, f = {force}); o stable, x unstable true orbit;\n"
-                 "line: Hill about q₀ (notes); · stable, ▾ unstable: full Hill")
-    ax.legend(fontsize=8)
+    _label(ax, "omega3", "first harmonic a (signed root)")
+    ax.set_title(f"1/3 subharmonic ({_named('eps', eps)}, {_named('force', force)}); lines: "
+                 "Hill about q₀;\nsmall markers: full Hill; o, x: the true orbit")
+    ax.legend(fontsize=7, ncol=2)
     fig.tight_layout()
     return _save(fig, path)
 
@@ -226,13 +346,13 @@ def subharmonic_orbits_figure(text: str, values: dict[str, str], omega: float | 
     for i, o in enumerate(found.orbits, 1):
         style = "-" if o.stable else "--"
         ax.plot(t, q(o.A, o.B), style, color=f"C{i - 1}", lw=1.5,
-                label=f"orbit {i}: r = {o.r:.4g}, "
+                label=f"orbit {i}: r = {_value(o.r)}, "
                 + {True: "stable", False: "unstable", None: "not shot"}[o.stable])
     top = max((float(np.max(np.abs(line.get_ydata()))) for line in ax.lines), default=1.0)
     ax.plot(t, top * np.cos(p.drive * t), ":", color="k", lw=0.8, label="drive cos(nωt), scaled")
-    ax.set(xlabel="t", ylabel="q",
-           title=f"orbits of {p.n} drive periods of {text}\n(ω = {p.omega:g}, drive at "
-                 f"{p.drive:g}, f = {p.force:g})")
+    _label(ax, "t", "q(t)")
+    ax.set_title(f"orbits of {p.n} drive periods of {text}\n(ω = {_value(p.omega)}, drive at "
+                 f"{_value(p.drive)}, f = {_value(p.force)})")
     ax.legend(fontsize=8, loc="upper right")
     fig.tight_layout()
     return _save(fig, path)
@@ -259,9 +379,9 @@ def mixing_figure(table: ForceTable, drives: list[tuple[float, float]], path: Pa
     ax.plot([], [], "kx", label="simulated steady state")
     ax.set_yscale("log")
     ax.set_ylim(1e-7, 2)
-    ax.set(xlabel="frequency", ylabel="amplitude",
-           title=f"frequency mixing ({label}, drives "
-                 + ", ".join(f"{f}@{w}" for f, w in drives) + ")")
+    _label(ax, "tone frequency ω/ω₀", "tone amplitude |q̂(ω)|")
+    ax.set_title(f"frequency mixing ({label}; drives f@ω: "
+                 + ", ".join(f"{_value(f)}@{_value(w)}" for f, w in drives) + ")")
     ax.legend(fontsize=8)
     fig.tight_layout()
     return _save(fig, path)
@@ -289,8 +409,6 @@ def gallery(folder: Path) -> list[Path]:
 
 CHART_X = (0.1, 0.5, 0.9, 5.0, 100.0)
 # NOTE: representative εA²: weak, moderate, near the L–P radius, strong, very strong springs.
-FLOOR = 1e-17
-# NOTE: errors below double precision are drawn at this floor (log axes).
 
 
 def speed_accuracy_figure(path: Path) -> Path:
@@ -310,13 +428,13 @@ def speed_accuracy_figure(path: Path) -> Path:
                 sel = [i for i, t in enumerate(data) if t.method == method]
                 ax.plot(cost[sel], err[sel], "o", color=color, ms=3, label=method)
             ax.plot(cost[front], err[front], "r-", lw=1, label="Pareto front")
-            ax.set(xscale="log", yscale="log", xlabel="ns / point")
+            ax.set(xscale="log", yscale="log", xlabel="cost (ns/point, measured)")
             if row == 0:
-                ax.set_title(f"x = εA² = {x:g}")
+                ax.set_title(f"y = εA² = {x:g}")
             else:
                 ax.set_xlim(0.3, 40)
     for ax in axes[:, 0]:
-        ax.set_ylabel("relative error of T")
+        _label(ax, y="T error")
     axes[0, 0].legend(fontsize=7)
     fig.tight_layout()
     return _save(fig, path)
@@ -362,34 +480,42 @@ def driven_speed_accuracy_figure(path: Path, eps: float = 0.1, force: float = 1.
     return _save(fig, path)
 
 
+VALIDITY_PICKS = {"lindstedt": (4, 12, 40), "resummed": (10, 21, 40), "pade": (4, 12),
+                  "modified": (4, 12), "agm": (2, 4)}
+# NOTE: two or three orders of each method, one panel each: a low order, a middle one, the
+# highest emitted; the order reads from the colour (one sequential colormap for all panels).
+
+
 def validity_figure(path: Path) -> Path:
-    """Error against x from the separatrix to εA² = 10³ for chosen orders of each method."""
+    """Error of the period against x from the separatrix to εA² = 10³, one panel per method
+    with the orders of :data:`VALIDITY_PICKS` coloured by order; errors below
+    :data:`ROUNDING` left out (shaded band), NaN (refused) not drawn."""
     check_plot_path(path)
     x = np.concatenate([-1 + np.logspace(-3, np.log10(0.999), 200), np.logspace(-3, 3, 300)])
     x = np.unique(x[x < 1000])
     ref = reference_period(x)
-    picks = (("lindstedt", 4), ("lindstedt", 12), ("lindstedt", 40), ("resummed", 10),
-             ("resummed", 21), ("resummed", 40), ("pade", 4), ("pade", 12), ("modified", 4),
-             ("modified", 12), ("agm", 2), ("agm", 4))
-    styles = {"lindstedt": "-", "resummed": "--", "pade": ":", "modified": "-.", "agm": "-"}
-    fig, ax = plt.subplots(figsize=(9, 4.5))
-    for c in candidates():
-        if (c.method, c.order) in picks:
-            with np.errstate(invalid="ignore"):
-                err = np.maximum(np.abs(c(x) / ref - 1), FLOOR)
-            ax.plot(x, err, styles[c.method], lw=1.2, label=f"{c.method} {c.order}",
-                    color=plt.cm.tab20(picks.index((c.method, c.order))))
-    for xv, text in ((-1, "separatrix x = −1"), (1, "L–P radius |x| = 1"),
-                     (-2 / 3, "m = −1: resummed limit")):
-        ax.axvline(xv, color="grey", lw=0.8, ls="-.")
-        # on a white box: the curves crowd these lines at every height
-        ax.annotate(text, (xv, 1e-15), rotation=90, fontsize=7, va="bottom", ha="right",
-                    bbox={"fc": "white", "ec": "none", "alpha": 0.85, "pad": 1.0})
-    ax.set(xscale="symlog", yscale="log", ylim=(FLOOR / 2, 10), xlim=(-1.05, 1000),
-           xlabel="x = εA² (symlog)",
-           ylabel="relative error of T", title="where each method holds (NaN = refused)")
-    ax.legend(fontsize=7, ncol=3)
-    fig.tight_layout()
+    colors = _order_colors([k for orders in VALIDITY_PICKS.values() for k in orders])
+    fig, axes = plt.subplots(1, len(VALIDITY_PICKS), figsize=(17, 4.2), sharey=True)
+    for ax, (method, orders) in zip(axes, VALIDITY_PICKS.items(), strict=True):
+        for c in sorted(candidates(), key=lambda c: c.order):
+            if c.method == method and c.order in orders:
+                with np.errstate(invalid="ignore"):
+                    err = _resolved(np.abs(c(x) / ref - 1))
+                ax.plot(x, err, "-", lw=1.4, color=colors[c.order], label=f"order {c.order}")
+        ax.legend(fontsize=7, loc="upper center", ncol=3, handlelength=1.2)
+        for xv, ls, text in ((-1, "-.", "separatrix y = −1"), (1, "--", "L–P radius |y| = 1"),
+                             (-2 / 3, ":", "m = −1: the resummed series' limit")):
+            ax.axvline(xv, color="grey", lw=0.8, ls=ls, label=text)
+        _rounding_band(ax)
+        ax.set(xscale="symlog", yscale="log", ylim=(FLOOR, 1e4), xlim=(-1.05, 1000))
+        ax.set_title(method, fontsize=10)
+        _label(ax, "x")
+    _label(axes[0], y="T error")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles[-4:], labels[-4:], loc="lower center", ncol=4, fontsize=8)
+    fig.suptitle("where each method holds: error of the period T against y = εA² "
+                 "(NaN = refused, not drawn)", fontsize=10)
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
     return _save(fig, path)
 
 
@@ -407,29 +533,37 @@ def driven_validity_figure(path: Path, eps: float = 0.1, force: float = 1.0) -> 
     check_plot_path(path)
     fig, (ax, byf, sub) = plt.subplots(1, 3, figsize=(17, 4.2))
     for axis, grid, label, make in (
-            (ax, np.linspace(0.3, 2.5, 221), "ω", lambda v: Drive(eps, force, float(v))),
-            (byf, np.logspace(-2, 1.2, 161), "f", lambda v: Drive(eps, float(v), 0.6))):
+            (ax, np.linspace(0.3, 2.5, 221), "omega", lambda v: Drive(eps, force, float(v))),
+            (byf, np.logspace(-2, 1.2, 161), "force", lambda v: Drive(eps, float(v), 0.6))):
         rows = [validity_errors(make(v)) for v in grid]
         errors = np.array([np.concatenate([mu, hb]) for mu, hb, _ in rows])
         counts = np.array([n for _, _, n in rows])
+        mu = _order_colors([k for m, k in VALIDITY_METHODS if m == "mu_expansion"])
+        hb = _order_colors([k for m, k in VALIDITY_METHODS if m != "mu_expansion"], "autumn")
         for k, (method, order) in enumerate(VALIDITY_METHODS):
-            name = (f"μ-expansion order {order}" if method == "mu_expansion"
-                    else f"harmonic balance N = {order}")
-            axis.plot(grid, np.maximum(errors[:, k], FLOOR), "--" * (method != "mu_expansion")
-                      or "-", label=name)
-        for i in np.nonzero(np.diff(counts))[0]:
-            axis.axvline(grid[i + 1], color="grey", ls=":", lw=1)
-        axis.set(yscale="log", xlabel=label, ylabel="|A₁ − A₁(balance, N = 10)|")
-    ax.set_title(f"over ω (ε = {eps}, f = {force}); dotted: folds", fontsize=9)
+            first = method == "mu_expansion"
+            axis.plot(grid, _resolved(errors[:, k]), "-" if first else "--",
+                      color=(mu if first else hb)[order],
+                      label=f"μ-expansion order {order}" if first
+                      else f"harmonic balance N = {order}")
+        for j, i in enumerate(np.nonzero(np.diff(counts))[0]):
+            axis.axvline(grid[i + 1], color="grey", ls=":", lw=1,
+                         label="fold: branches appear/vanish" if j == 0 else None)
+        _rounding_band(axis)
+        axis.set(yscale="log", ylim=(FLOOR, None))
+        _label(axis, label, "A1 error")
+    ax.set_title(f"over ω ({_named('eps', eps)}, {_named('force', force)})", fontsize=9)
     byf.set(xscale="log")
-    byf.set_title(f"over f (ε = {eps}, ω = 0.6): gaps = refused (not converging)", fontsize=9)
+    byf.set_title(f"over f ({_named('eps', eps)}, ω/ω₀ = 0.6): gaps = refused "
+                  "(not converging)", fontsize=9)
     ax.legend(fontsize=7)
+    byf.legend(fontsize=7)
     w = np.linspace(1.0, 2.5, 400)
     for e in (0.05, 0.1, 0.3):
         f_max = np.abs(1 - 9 * w**2) * np.sqrt(np.maximum(16 * (w**2 - 1) / (21 * e), 0))
-        sub.plot(w, f_max, label=f"ε = {e}")
-    sub.set(yscale="log", ylim=(1e-2, 1e3), xlabel="ω (drive at 3ω)", ylabel="f",
-            title="1/3 subharmonic exists below each curve (eq. 10.87)")
+        sub.plot(w, f_max, label=_named("eps", e))
+    sub.set(yscale="log", ylim=(1e-2, 1e3), title="1/3 subharmonic exists below each curve")
+    _label(sub, "omega3", "force")
     sub.legend(fontsize=8)
     fig.tight_layout()
     return _save(fig, path)
@@ -454,17 +588,16 @@ def sweep_figure(ds: object, path: Path) -> Path:
     field = ds[name]
     axes = list(json.loads(ds.attrs["sweep"])["axes"])  # the notes' or an equation's names
     extra = [d for d in field.dims if d not in axes]
-    picked = [f"{d} = {ds[d].values[-1]}" for d in extra if d in ds.coords]
     field = field.isel({d: -1 for d in extra})
     varying = [a for a in field.dims if field.sizes[a] > 1]
     field = field.isel({a: 0 for a in field.dims if a not in varying[:2]})
+    count = field.dtype.kind in "iu"  # a count or a flag: whole numbers, a discrete colourbar
     values = field.values.astype(float)
     values[values < 0] = np.nan  # −1: no branch, no orbit, not computed
     log = name.endswith("error")
-    if log:
-        values = np.maximum(values, FLOOR)
-    fixed = ", ".join([*picked, *(f"{a} = {ds[a].values[0]:g}" for a in axes
-                                  if a in ds.dims and a not in varying[:2])])
+    fixed = ", ".join([*(_named(d, ds[d].values[-1]) for d in extra if d in ds.coords),
+                       *(_named(a, ds[a].values[0]) for a in axes
+                         if a in ds.dims and a not in varying[:2])])
     label = field.attrs.get("long_name", name)
 
     def positions(axis: str) -> tuple[np.ndarray, bool]:
@@ -479,33 +612,62 @@ def sweep_figure(ds: object, path: Path) -> Path:
         if not np.all(np.isfinite(v)):
             getattr(ax, f"set_{which}ticks")(np.arange(v.size), [f"{x:g}" for x in v])
 
+    def axis_label(axis: str) -> str:
+        """The notes' axes by their symbols (ω as ω/ω₀), an equation's by their names."""
+        return LABELS.get(axis, SYMBOLS.get(axis, axis))
+
+    def curve(ax: plt.Axes, x: np.ndarray, y: np.ndarray, **kw) -> None:
+        """One cut: errors without their rounding noise, counts on integer ticks."""
+        ax.plot(x, _resolved(y) if log else y, ".-", ms=3, **kw)
+        ax.set(xscale="log" if xlog else "linear", yscale="log" if log else "linear",
+               xlabel=axis_label(xa), ylabel=label)
+        if count:
+            ax.yaxis.set_major_locator(matplotlib.ticker.MaxNLocator(integer=True))
+        ticks(ax, xa, "x")
+
     if len(varying) >= 2:
         xa, ya = varying[:2]
         (x, xlog), (y, ylog) = positions(xa), positions(ya)
         grid = values.reshape(field.sizes[xa], field.sizes[ya]).T
         fig, (ax, cuts) = plt.subplots(1, 2, figsize=(12, 4.4))
-        mesh = ax.pcolormesh(x, y, np.log10(grid) if log else grid, shading="nearest",
-                             cmap="viridis")
-        fig.colorbar(mesh, ax=ax, label=f"log10 {name}" if log else name)
+        if count:  # one colour per whole number, ticks on the numbers
+            found = grid[np.isfinite(grid)]
+            levels = np.arange(found.min(), found.max() + 1) if found.size else np.zeros(1)
+            cmap = plt.get_cmap("viridis", levels.size)
+            norm = matplotlib.colors.BoundaryNorm(np.append(levels, levels[-1] + 1) - 0.5,
+                                                  levels.size)
+            mesh = ax.pcolormesh(x, y, grid, shading="nearest", cmap=cmap, norm=norm)
+            bar = fig.colorbar(mesh, ax=ax, ticks=levels, label=label)
+            meanings = field.attrs.get("flag_meanings", "").split()
+            if meanings:  # a flag: 0 and 1 by their meanings
+                bar.set_ticklabels([meanings[int(v) + 1] for v in levels])
+            else:
+                bar.set_ticklabels([f"{int(v)}" for v in levels])
+        else:
+            shown = np.log10(np.maximum(grid, ROUNDING)) if log else grid
+            mesh = ax.pcolormesh(x, y, shown, shading="nearest", cmap="viridis")
+            fig.colorbar(mesh, ax=ax, label=f"log₁₀ {label}" + (
+                f"\n(clipped at {ROUNDING:g}: rounding)" if log else ""))
         ax.set(xscale="log" if xlog else "linear", yscale="log" if ylog else "linear",
-               xlabel=xa, ylabel=ya)
+               xlabel=axis_label(xa), ylabel=axis_label(ya))
         ticks(ax, xa, "x"), ticks(ax, ya, "y")
-        for j in np.unique(np.linspace(0, y.size - 1, min(SWEEP_CUTS, y.size)).round()):
-            cuts.plot(x, grid[int(j)], ".-", ms=3, label=f"{ya} = {ds[ya].values[int(j)]:g}")
+        picks = np.unique(np.linspace(0, y.size - 1, min(SWEEP_CUTS, y.size)).round())
+        colors = _order_colors(range(picks.size))
+        for i, j in enumerate(picks):
+            curve(cuts, x, grid[int(j)], color=colors[i], label=_named(ya, ds[ya].values[int(j)]))
+        if log:
+            _rounding_band(cuts)
         cuts.legend(fontsize=8)
-        cuts.set(xscale="log" if xlog else "linear", yscale="log" if log else "linear",
-                 xlabel=xa, ylabel=name)
-        ticks(cuts, xa, "x")
     else:
         fig, cuts = plt.subplots(figsize=(7, 4.4))
         xa = varying[0] if varying else next(a for a in axes if a in field.dims)
         x, xlog = positions(xa)
         if not varying:
             x = x[:1]
-        cuts.plot(x, values.ravel(), "o-", ms=3)
-        cuts.set(xscale="log" if xlog else "linear", yscale="log" if log else "linear",
-                 xlabel=xa, ylabel=name)
-        ticks(cuts, xa, "x")
+        curve(cuts, x, values.ravel())
+        if log:
+            _rounding_band(cuts)
+            cuts.legend(fontsize=8)
     fig.suptitle(f"{ds.attrs['kind']} sweep: {label}" + (f"  ({fixed})" if fixed else ""),
                  fontsize=10)
     fig.tight_layout()
@@ -707,8 +869,8 @@ def parametric_figure(eps: float, zeta: float, gamma: float, omega_from: float,
     edges = tongue_edges(p)
     if edges is not None:
         ax.axvspan(*edges, color="0.92", label="tongue: q = 0 unstable")
-        for w in edges:
-            ax.axvline(w, color="0.5", lw=0.8, ls=":")
+        for k, w in enumerate(edges):
+            ax.axvline(w, color="0.5", lw=0.8, ls=":", label="tongue edge" if k == 0 else None)
     colors = {"0": "k", "+": "C0", "-": "C3"}
     for name, color in colors.items():
         pts = [r for r in rows if r.one.branch == name]
@@ -734,9 +896,11 @@ def parametric_figure(eps: float, zeta: float, gamma: float, omega_from: float,
     for o in onsets(p):
         ax.annotate("super" if o.supercritical else "sub", (o.omega, 0), xytext=(0, 8),
                     textcoords="offset points", ha="center", fontsize=8)
-    ax.set(xlabel="ω (pump at 2ω)", ylabel="r, first harmonic",
-           title=f"parametric resonance (ε = {eps}, ζ = {zeta}, γ = {gamma}); "
-           "o stable, x unstable shot orbit")
+    ax.plot([], [], "ko", ms=6, mfc="none", label="shot orbit, stable")
+    ax.plot([], [], "kx", ms=6, label="shot orbit, unstable")
+    _label(ax, "omega2", "r")
+    ax.set_title("parametric resonance (" + ", ".join(
+        _named(n, v) for n, v in (("eps", eps), ("zeta", zeta), ("gamma", gamma))) + ")")
     ax.legend(fontsize=7, loc="upper left")
     return _save(fig, path)
 

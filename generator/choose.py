@@ -9,7 +9,7 @@ against an independent reference and timed; the cheapest within the tolerance wi
 
 The methods themselves — what each applies to, how it derives, evaluates and lowers, and its
 reference — are the records of :mod:`methods`; this module verifies them on a range, times
-them, and picks by the recorded :data:`COST_MODEL`.  With ``--emit`` the choice goes through
+them, and picks by the recorded :data:`COST_MODEL`.  With ``--out`` the choice goes through
 :mod:`compiler`.
 """
 
@@ -107,7 +107,7 @@ T = TypeVar("T")
 TIE = 0.15
 # NOTE: costs within 15 % of the cheapest count as a tie, broken by a fixed order of methods
 # (the simplest formula first). Every choice compares the recorded COST_MODEL, so it never
-# depends on this run's timings (and what --emit writes is the same on every run).
+# depends on this run's timings (and what --out writes is the same on every run).
 
 COST_MODEL = {
     quantity: {**{m.name: m.cost for m in METHODS if m.quantity == quantity},
@@ -139,7 +139,7 @@ class Choice:
     """The cheapest verified evaluator of the period ``T/2π`` on a range (the free Duffing
     oscillator's in ``x = εA²``, or a user's oscillator's): method and order, max relative
     error, measured ns per point, verification points, each method considered ``(name,
-    order, error, ns)`` and the verified candidate, which ``--emit`` lowers."""
+    order, error, ns)`` and the verified candidate, which ``--out`` lowers."""
 
     method: Method
     order: int
@@ -147,7 +147,7 @@ class Choice:
     ns_per_point: float
     verified_on: int
     considered: tuple[tuple[str, int, float, float], ...]  # per method: order, error, ns
-    candidate: Candidate | None = None  # what was verified: what --emit lowers
+    candidate: Candidate | None = None  # what was verified: what --out lowers
 
     def _repr_html_(self) -> str:
         return choice_table(self, "choose_period: T/2π, max relative error")
@@ -791,8 +791,8 @@ def choose_limit_cycle(tol: float, eps_min: float, eps_max: float, order: int | 
     from .numerics.references import cycle_reference
 
     if not (0 < eps_min <= eps_max) or not (tol > 0):
-        raise InputError(f"--x-min {eps_min}, --x-max {eps_max}, --tol {tol}: need "
-                         "0 < x-min ≤ x-max and tol > 0 (the range of ε)")
+        raise InputError(f"--range {eps_min}:{eps_max}, --tol {tol}: need "
+                         "0 < A ≤ B and tol > 0 (the range of ε)")
     order = RESUMMED_ORDER["cycle"] if order is None else order
     vdp = series_model("van_der_pol", order)
     eps = verification_points(eps_min, eps_max, points)
@@ -826,7 +826,7 @@ def choose_mathieu(kind: str, m: int, tol: float, q_min: float, q_max: float,
     from .numerics.references import mathieu_reference
 
     if not (q_min <= q_max) or not (tol > 0):
-        raise InputError(f"--x-min {q_min}, --x-max {q_max}, --tol {tol}: need x-min ≤ x-max "
+        raise InputError(f"--range {q_min}:{q_max}, --tol {tol}: need A ≤ B "
                          "and tol > 0 (the range of q)")
     order = RESUMMED_ORDER["mathieu"] if order is None else order
     q = verification_points(q_min, q_max, points)

@@ -1,7 +1,7 @@
 """The driver: derive -> lower -> render -> write, each stage called once, in order.
 
 Every command that writes files comes through :func:`compile_target`: ``generate`` (a free
-oscillator, ``driven``, ``balance``, ``fourier``), ``choose … --emit`` and ``demo``.  A
+oscillator, ``driven``, ``balance``, ``fourier``), ``choose … --out`` and ``demo``.  A
 :class:`methods.Target` says what its method derives and how it lowers; :mod:`emit` renders
 the :class:`lower.Unit` and writes it.  Every target file is checked before the derivation
 starts.
@@ -121,8 +121,8 @@ def generate_fourier(harmonics: int, out: Path, *, overwrite_edited: bool = Fals
 
 def generate_choice(candidate: Candidate, command: str, out: Path,
                     verified: tuple[float, float], *, overwrite_edited: bool = False,
-                    flag: str = "--emit") -> list[Path]:
-    """``lindstedt choose period … --emit DIR``: just the chosen evaluator, NaN outside the
+                    flag: str = "--out") -> list[Path]:
+    """``lindstedt choose period … --out DIR``: just the chosen evaluator, NaN outside the
     range ``verified`` of x = εA² it was verified on."""
     request = ChoiceRequest(candidate.order, command, candidate.method.formula(candidate),
                             verified)
@@ -131,8 +131,8 @@ def generate_choice(candidate: Candidate, command: str, out: Path,
 
 
 def generate_method(m: Method, order: int, out: Path, *, overwrite_edited: bool = False,
-                    flag: str = "--emit") -> list[Path]:
-    """The module of a method ``choose … --emit`` picked, as ``generate`` writes it."""
+                    flag: str = "--out") -> list[Path]:
+    """The module of a method ``choose … --out`` picked, as ``generate`` writes it."""
     if m.target is None:
         raise InputError(f"{m.name}: no emitted module")
     writer = {FREE: partial(generate, "duffing"), MU: generate_driven,
@@ -150,15 +150,15 @@ def generate_slow_flow(osc: object, order: int, command: str, out: Path, *,
 
 
 def generate_mathieu(kind: str, m: int, order: int, out: Path, *,
-                     overwrite_edited: bool = False, flag: str = "--emit") -> list[Path]:
-    """``lindstedt mathieu a|b --m M --order K --emit DIR``: the resummed a_m(q) or b_m(q)."""
+                     overwrite_edited: bool = False, flag: str = "--out") -> list[Path]:
+    """``lindstedt mathieu a|b --m M --order K --out DIR``: the resummed a_m(q) or b_m(q)."""
     from .derive.hill import mathieu_series
 
     mathieu_series(kind, m, 0)  # the kind and m checked before the derivation
     order = check_order(order)
     if order < 4:
         raise InputError(f"order {order}: a resummed Mathieu evaluator needs order ≥ 4")
-    command = f"lindstedt mathieu {kind} --m {m} --order {order} --emit DIR"
+    command = f"lindstedt mathieu {kind} --m {m} --order {order} --out DIR"
     return compile_target(MATHIEU, MathieuRequest(order, command, kind, m), out,
                           overwrite_edited=overwrite_edited, flag=flag)
 
@@ -168,8 +168,8 @@ TONGUE_MIN_ORDER = 12
 
 
 def generate_tongue(p: str, n: int, order: int, out: Path, *, overwrite_edited: bool = False,
-                    flag: str = "--emit") -> list[Path]:
-    """``lindstedt tongues P --n N --order K --emit DIR``: the resummed transition curves."""
+                    flag: str = "--out") -> list[Path]:
+    """``lindstedt tongues P --n N --order K --out DIR``: the resummed transition curves."""
     from .derive.hill import fourier_of_text, transition_curves
 
     transition_curves(fourier_of_text(p), n, 0)  # p and n checked before the derivation
@@ -177,6 +177,6 @@ def generate_tongue(p: str, n: int, order: int, out: Path, *, overwrite_edited: 
     if order < TONGUE_MIN_ORDER:
         raise InputError(f"order {order}: resummed transition curves need order ≥ "
                          f"{TONGUE_MIN_ORDER}")
-    command = f"lindstedt tongues {shlex.quote(p)} --n {n} --order {order} --emit DIR"
+    command = f"lindstedt tongues {shlex.quote(p)} --n {n} --order {order} --out DIR"
     return compile_target(TONGUE, TongueRequest(order, command, p, n), out,
                           overwrite_edited=overwrite_edited, flag=flag)

@@ -367,24 +367,24 @@ def fixed_cost(name: str) -> Callable[[argparse.Namespace], Cost]:
 
 
 EMIT_FACTOR = 2.0
-# NOTE: `choose amplitudes|response --emit` generates a candidate's module, imports (compiles)
-# it to judge and time it, and writes it again into --emit (the derivation is cached): about
+# NOTE: `choose amplitudes|response --out` generates a candidate's module, imports (compiles)
+# it to judge and time it, and writes it again into --out (the derivation is cached): about
 # twice `generate` (order 4: 7.5 s to generate, 17 s to compile, against 17 s estimated).
 
 
 def emission_seconds(model: str, size: int) -> float:
-    """The estimated cost of trying one emitted module in ``choose … --emit``."""
+    """The estimated cost of trying one emitted module in ``choose … --out``."""
     return EMIT_FACTOR * generate_seconds(model, size)
 
 
 def choose_cost(args: argparse.Namespace) -> Cost:
-    """The choice's fixed work, and for the driven quantities with --emit the dearest module
+    """The choice's fixed work, and for the driven quantities with --out the dearest module
     :func:`emit_bounds` lets compete."""
     fixed = FIXED_COSTS[f"choose {args.quantity}"]
     seconds = fixed
     if getattr(args, "model", None) is not None:  # its series to order 60, its quadrature
         seconds += power_law(*SERIES_COSTS["oscillator"], PERIOD_SERIES_ORDER) + QUADRATURE_SECONDS
-    if args.emit and args.quantity in ("amplitudes", "response"):
+    if args.out and args.quantity in ("amplitudes", "response"):
         mu, harmonics = emit_bounds(args.allow_slow, EMIT_MAX_HARMONICS, args.quantity)
         seconds += max(emission_seconds("driven", mu), emission_seconds("balance", harmonics))
     return Cost(seconds, f"choose {args.quantity}", "verifying the candidates")
@@ -400,7 +400,7 @@ EMIT_MAX_HARMONICS = 12
 def emit_bounds(allow_slow: bool, max_harmonics: int = EMIT_MAX_HARMONICS,
                 quantity: str = "amplitudes") -> tuple[int, int]:
     """The highest μ-order (up to DRIVEN_MAX_ORDER) and the most harmonics (up to
-    ``max_harmonics``) whose emitted module ``choose QUANTITY --emit`` can try within the cost
+    ``max_harmonics``) whose emitted module ``choose QUANTITY --out`` can try within the cost
     limit, after its fixed work; with ``allow_slow`` every one: what may compete."""
     budget = COST_LIMIT_SECONDS - FIXED_COSTS[f"choose {quantity}"]
 
@@ -428,22 +428,22 @@ TONGUES_FIT = (0.5, 0.4, 100, 3.0)
 # x_k grow with p's highest harmonic h, the cost as h^2.5 (2.2 s for h = 2 at order 100).
 
 TONGUE_EMIT_SECONDS = 6.0
-# NOTE: `tongues --emit`: per curve 24 Floquet boundaries at 4096 and 8192 RK4 steps (brentq)
+# NOTE: `tongues --out`: per curve 24 Floquet boundaries at 4096 and 8192 RK4 steps (brentq)
 # and the numba compilation on import: 5.4 s for p = cos t + cos 2t/2, n = 1, order 30.
 
 
 def tongues_cost(args: argparse.Namespace) -> Cost:
     """``tongues``: the fit at ``--order`` times p's highest harmonic to the power 2.5,
-    doubled with ``--damping``, plus ``--plot``'s chart and ``--emit``'s checks."""
+    doubled with ``--zeta``, plus ``--plot``'s chart and ``--out``'s checks."""
     from .derive.hill import fourier_of_text
 
     top = max(fourier_of_text(args.p))
     seconds = power_law(*TONGUES_FIT, args.order) * top**2.5
-    if args.damping is not None:
+    if args.zeta is not None:
         seconds *= 2
     if args.plot:
         seconds += INCE_STRUTT_SECONDS
-    if getattr(args, "emit", None) is not None:
+    if getattr(args, "out", None) is not None:
         seconds += TONGUE_EMIT_SECONDS
     return Cost(seconds, f"order {args.order}, harmonic {top}", "the transition curves")
 
@@ -469,15 +469,16 @@ PARAMETRIC_FIT = (2.0, 1.5e-3)
 
 
 def parametric_cost(args: argparse.Namespace) -> Cost:
-    """Two branches at each of ``--points`` ω, each ``--harmonics`` deep; above the limit a
-    bound (the command has no --allow-slow: fewer points or harmonics answer the same)."""
+    """Two branches at each of the N points of ``--omega A:B:N``, each ``--harmonics`` deep;
+    above the limit a bound (no --allow-slow: fewer points or harmonics answer the same)."""
     points, harmonics = max(args.points, 1), max(args.harmonics, 8)
     seconds = PARAMETRIC_FIT[0] + 2 * points * PARAMETRIC_FIT[1] * harmonics
     if seconds > COST_LIMIT_SECONDS:
-        raise InputError(f"--points {args.points} --harmonics {args.harmonics}: about "
+        raise InputError(f"--omega with {args.points} points, --harmonics {args.harmonics}: "
+                         "about "
                          f"{seconds:,.0f} s of balances; the limit is {COST_LIMIT_SECONDS:.0f} "
                          "s: give fewer points or harmonics")
-    return Cost(seconds, f"--points {args.points}", "the parametric response")
+    return Cost(seconds, f"{args.points} points", "the parametric response")
 
 
 COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {

@@ -148,3 +148,119 @@ def test_subharmonic_figure_marks_the_full_hill_verdict(tmp_path, monkeypatch):
     assert checked
     for sign, verdict, s in checked[:4]:
         assert s.orbit.stable == (verdict == "stable"), (sign, verdict, s.a)
+
+
+def _drawn(monkeypatch):
+    """The figures handed to ``_save`` (they are still written)."""
+    drawn = []
+    save = charts._save
+    monkeypatch.setattr(charts, "_save", lambda fig, path: (drawn.append(fig), save(fig, path))[1])
+    return drawn
+
+
+def _texts(fig):
+    """Every legend entry and title of ``fig``."""
+    out = [t.get_text() for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
+    out += [t.get_text() for leg in fig.legends for t in leg.get_texts()]
+    return out + [ax.get_title() for ax in fig.axes] + [fig._suptitle.get_text()
+                                                        if fig._suptitle else ""]
+
+
+def _digits_ok(texts):
+    """No number in ``texts`` with more than three significant digits."""
+    import re
+
+    for text in texts:
+        for number in re.findall(r"\d+\.\d+|\d+", text):
+            assert len(number.replace(".", "").lstrip("0")) <= 3, (number, text)
+
+
+def test_response_figure_labels_and_settled_sweeps(tmp_path, monkeypatch):
+    """The response chart: ω/ω₀ and r on the axes, the folds in the legend, and every sweep
+    point drawn as data is a steady state — within 0.5 % of the max |q| of an orbit of the
+    continued harmonic balance at its ω (interpolated along each monotone stretch of the
+    curve) — while the start-up and jump transients are drawn apart as "not settled"."""
+    from lindstedt.analysis.response import duffing_response
+
+    drawn = _drawn(monkeypatch)
+    charts.response_figure(0.1, 0.3, 20.0, 8, tmp_path / "r.png")
+    (fig,) = drawn
+    ax = fig.axes[0]
+    assert "ω/ω₀" in ax.get_xlabel() and "r" in ax.get_ylabel() and "max |q|" in ax.get_ylabel()
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "fold of the balance" in labels and "sweep not settled (transient)" in labels
+    assert "f = 0.3" in ax.get_title() and "Q = 20" in ax.get_title()
+    _digits_ok(_texts(fig))
+    r = duffing_response(0.1, 0.3, 20.0, 8)
+    t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    stretches = []
+    for piece in r.cont.piece_slices():
+        w = r.cont.omega[piece]
+        top = [np.max(np.abs(sum(A[k] * np.cos(k * t) + B.get(k, 0.0) * np.sin(k * t)
+                                 for k in A))) for A, B in map(r.fine.amplitudes, r.cont.x[piece])]
+        turns = np.nonzero(np.diff(np.sign(np.diff(w))))[0] + 1
+        for a, b in zip([0, *turns], [*turns, len(w) - 1], strict=True):
+            order = np.argsort(w[a:b + 1])
+            stretches.append((w[a:b + 1][order], np.array(top[a:b + 1])[order]))
+    sweeps = [line for line in ax.lines if line.get_label().startswith("simulated sweep")]
+    assert len(sweeps) == 2
+    for line in sweeps:
+        for w, a in zip(line.get_xdata(), line.get_ydata(), strict=True):
+            steady = [np.interp(w, x, y) for x, y in stretches if x[0] <= w <= x[-1]]
+            assert min(abs(a / s - 1) for s in steady) < 5e-3, (w, a)
+    (rest,) = [line for line in ax.lines if line.get_label().startswith("sweep not settled")]
+    assert max(rest.get_ydata()) > 0.7  # the start-up spike at ω = 0.5 is among them
+
+
+def test_validity_figure_separates_orders_and_hides_rounding(tmp_path, monkeypatch):
+    """One panel per method, its orders in distinct colours; nothing drawn below ROUNDING
+    (the shaded band says so); every line style in a legend."""
+    drawn = _drawn(monkeypatch)
+    charts.validity_figure(tmp_path / "v.png")
+    (fig,) = drawn
+    for ax in fig.axes:
+        curves = [line for line in ax.lines if line.get_label().startswith("order")]
+        assert len({line.get_color() for line in curves}) == len(curves) >= 2
+        for line in curves:
+            y = np.asarray(line.get_ydata(), dtype=float)
+            assert not (y[np.isfinite(y)] < charts.ROUNDING).any()
+    legend = {t.get_text() for t in fig.legends[0].get_texts()}
+    assert any("rounding" in text for text in legend)
+    assert {"separatrix y = −1", "L–P radius |y| = 1"} <= legend
+
+
+@pytest.mark.parametrize("kind,axes,field", [
+    ("stability", {"omega": [1.0, 1.1, 1.2, 1.3], "force": [0.1, 0.188889, 0.3], "eps": [0.1],
+                   "Q": [20.0]}, "stable_orbits"),
+])
+def test_sweep_figure_counts_on_a_discrete_colourbar(tmp_path, monkeypatch, kind, axes, field):
+    """A count's map: a colourbar whose ticks are the whole numbers drawn, a BoundaryNorm
+    (one colour each); the cuts' legend rounds the axis values (f = 0.189) with symbols."""
+    import xarray as xr
+    from matplotlib.colors import BoundaryNorm
+
+    shape = [len(v) for v in axes.values()]
+    counts = np.ones(shape, dtype="int8")
+    counts[1:, 1:] = 2
+    ds = xr.Dataset({field: (list(axes), counts, {"long_name": "distinct Floquet-stable orbits"}),
+                     "done": ("block", np.ones(1, dtype=bool))}, coords=axes,
+                    attrs={"headline": field, "kind": kind,
+                           "sweep": '{"axes": ["omega", "force", "eps", "Q"]}'})
+    drawn = _drawn(monkeypatch)
+    charts.sweep_figure(ds, tmp_path / "atlas.png")
+    (fig,) = drawn
+    bar = fig.axes[-1]
+    ticks = bar.get_yticks()
+    assert list(ticks) == [1, 2] and all(float(t).is_integer() for t in ticks)
+    assert isinstance(fig.axes[0].collections[0].norm, BoundaryNorm)
+    assert fig.axes[0].get_xlabel() == "drive frequency ω/ω₀"
+    labels = [t.get_text() for t in fig.axes[1].get_legend().get_texts()]
+    assert "f = 0.189" in labels
+    _digits_ok(_texts(fig))
+    assert "ε = 0.1" in fig._suptitle.get_text()
+
+
+def test_value_rounds_to_three_digits():
+    assert [charts._value(v) for v in (0.188889, 20.0, 1 / 3, 1234.5)] == [
+        "0.189", "20", "0.333", "1.23e+03"]
+    assert charts._named("force", 0.188889) == "f = 0.189"

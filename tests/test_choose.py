@@ -60,15 +60,15 @@ def test_agm_period_against_mpmath_elliptic_k(steps, x, tol):
 
 def test_choose_contract_and_bad_input():
     run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "period", "--tol", "1e-8",
-                          "--x-min", "0", "--x-max", "1000", "--json"],
+                          "--range", "0:1000", "--json"],
                          capture_output=True, text=True, check=False)
     data = json.loads(run.stdout)
     assert {"method", "order", "max_error", "ns_per_point", "verified_on"} <= data.keys()
     assert data["max_error"] <= 1e-8
-    for args, needle in ((["--tol", "1e-3", "--x-min", "0.5", "--x-max", "0.1"], "reversed"),
-                         (["--tol", "1e-3", "--x-min", "-1.5", "--x-max", "0"], "separatrix"),
-                         (["--tol", "1e-19", "--x-min", "0", "--x-max", "1"], "best reachable"),
-                         (["--tol", "nan", "--x-min", "0", "--x-max", "1"], "not finite")):
+    for args, needle in ((["--tol", "1e-3", "--range", "0.5:0.1"], "reversed"),
+                         (["--tol", "1e-3", "--range", "-1.5:0"], "separatrix"),
+                         (["--tol", "1e-19", "--range", "0:1"], "best reachable"),
+                         (["--tol", "nan", "--range", "0:1"], "not finite")):
         bad = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "period", *args],
                              capture_output=True, text=True, check=False)
         assert bad.returncode == 2 and needle in bad.stderr, bad.stderr
@@ -146,7 +146,7 @@ def test_choose_emits_just_the_chosen_evaluator(tmp_path):
     from lindstedt.emit.render import load_generated
 
     run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "period", "--tol", "1e-8",
-                          "--x-min", "0", "--x-max", "1000", "--emit", str(tmp_path), "--json"],
+                          "--range", "0:1000", "--out", str(tmp_path), "--json"],
                          capture_output=True, text=True, check=False)
     data = json.loads(run.stdout)
     assert data["emitted"] == [str(tmp_path / "chosen_period.py")]
@@ -294,8 +294,8 @@ def test_choose_response_over_a_range_holds_between_the_points():
                           w * branch.A1 * np.sin(branch.delta0)])
         orbit = shoot(0.1, 0.3, w, 0.05, guess)
         assert abs(np.hypot(A[1], B[1]) - np.hypot(orbit.A[1], orbit.B[1])) <= 1e-6
-    for args, needle in ((["--omega", "1", "--omega-max", "2"], "not both"),
-                         (["--omega-min", "2", "--omega-max", "1"], "reversed"),
+    for args, needle in ((["--omega", "1", "--omega", "1:2"], "not both"),
+                         (["--omega", "2:1"], "reversed"),
                          (["--omega", "1", "--tol", "1e-17"], "best reachable"),
                          (["--omega", "-1"], "must be > 0")):
         bad = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "response", "--eps",
@@ -363,12 +363,12 @@ def test_choose_q_for_a_softening_spring_beyond_the_series():
 
 
 def test_choose_q_emits_the_exact_fourier_module(tmp_path):
-    """`choose q --emit` on a softening range writes fourier.py: its q and q_into match mpmath's
+    """`choose q --out` on a softening range writes fourier.py: its q and q_into match mpmath's
     cn off the grid, its omega is 2π/T with T = 4K(m)/√(1+x) (mpmath), NaN past the separatrix."""
     from lindstedt.emit.render import load_generated
 
     run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "q", "--tol", "1e-10",
-                          "--x-min", "-0.95", "--x-max", "0", "--emit", str(tmp_path), "--json"],
+                          "--range", "-0.95:0", "--out", str(tmp_path), "--json"],
                          capture_output=True, text=True, check=False)
     data = json.loads(run.stdout)
     assert data["method"] == "fourier" and data["emitted"] == [str(tmp_path / "fourier.py")]
@@ -389,14 +389,14 @@ def test_choose_q_emits_the_exact_fourier_module(tmp_path):
 
 
 def test_choose_emits_the_driven_module_it_verified(tmp_path):
-    """With --emit only emittable methods compete, ranked by their emitted modules' measured
+    """With --out only emittable methods compete, ranked by their emitted modules' measured
     cost: undamped, the compiled μ-expansion; its A₁ off the grid agrees with shooting."""
     from lindstedt.emit.render import load_generated
     from lindstedt.numerics.shooting import shoot
 
     run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "response", "--eps", "0.1",
-                          "--force", "1", "--omega-min", "0.8", "--omega-max", "1.2", "--tol",
-                          "1e-4", "--emit", str(tmp_path), "--json"],
+                          "--force", "1", "--omega", "0.8:1.2", "--tol",
+                          "1e-4", "--out", str(tmp_path), "--json"],
                          capture_output=True, text=True, check=False)
     data = json.loads(run.stdout)
     assert data["method"] == "mu_expansion" and data["max_error"] <= 1e-4
@@ -481,7 +481,7 @@ def test_choose_period_for_an_equation_refuses_with_a_reason():
         choose_period(1e-8, 0.0, 0.5,
                       model=model_from_text("q'' + q + eps*(alpha*q**2 + q**3) = 0", 60))
     cmd = [sys.executable, "-m", "lindstedt", "choose", "q", "q'' + q + eps*q**5 = 0",
-           "--tol", "1e-8", "--x-min", "0", "--x-max", "0.5"]
+           "--tol", "1e-8", "--range", "0:0.5"]
     done = subprocess.run(cmd, capture_output=True, text=True)
     assert done.returncode == 2 and done.stdout == ""
     assert done.stderr.count("\n") == 1 and "only the period" in done.stderr
@@ -528,7 +528,7 @@ def test_emitted_damped_module_is_not_verified_beside_a_fold():
 
 
 def test_choose_emits_the_damped_module_for_a_finite_Q(tmp_path):
-    """For Q = 20 with --emit the undamped module cannot compete and the damped one is the
+    """For Q = 20 with --out the undamped module cannot compete and the damped one is the
     cheapest verified; its A₁, B₁ at ω off the verified point agree with shooting (started
     from the one-harmonic guess, not from the module's answer)."""
     from lindstedt.analysis.driven import Drive, first_order_branches
@@ -537,7 +537,7 @@ def test_choose_emits_the_damped_module_for_a_finite_Q(tmp_path):
 
     run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "amplitudes", "--eps",
                           "0.1", "--force", "0.3", "--Q", "20", "--omega", "0.8", "--tol",
-                          "1e-6", "--emit", str(tmp_path), "--json"],
+                          "1e-6", "--out", str(tmp_path), "--json"],
                          capture_output=True, text=True, check=False)
     assert run.returncode == 0, run.stderr
     data = json.loads(run.stdout)

@@ -23,7 +23,7 @@ def test_series_duffing_order_40_contract():
     data = json.loads(out.stdout)
     assert {"model", "order", "variable", "omega", "period", "q"} <= data.keys()
     assert data["model"] == "duffing" and data["order"] == 40
-    assert data["variable"] == "x = eps*A**2"
+    assert data["variable"] == "y = eps*A**2"
     exact = duffing_period(40)
     assert [Fraction(c) for c in data["period"]] == exact
     assert [Fraction(c) for c in data["omega"]] == reciprocal(exact)
@@ -35,7 +35,7 @@ def test_series_duffing_order_40_contract():
 
 def test_series_pendulum_contract():
     data = json.loads(run("series", "pendulum", "--order", "12", "--json").stdout)
-    assert data["variable"] == "theta0**2"
+    assert data["variable"] == "y = theta0**2"
     assert [Fraction(c) for c in data["period"]] == pendulum_period(12)
 
 
@@ -57,13 +57,13 @@ def test_table_is_readable():
         (["driven", "--eps", "0.1", "--force", "1", "--omega", "nan"], "--omega: 'nan'"),
         (["driven", "--eps", "0.1", "--force", "1", "--omega", "1", "--harmonics", "0"],
          "--harmonics: 0"),
-        (["choose", "period", "--tol", "-1e-8", "--x-min", "0", "--x-max", "0.1"],
+        (["choose", "period", "--tol", "-1e-8", "--range", "0:0.1"],
          "tol -1e-08: must be > 0"),
         (["mixing", "--eps", "0.1", "--Q", "10", "--drive", "0.3"], "F@W"),
         (["serie", "duffing"], "invalid choice: 'serie'; did you mean 'series'?"),
         (["respnse"], "did you mean 'response'?"),
         (["series", "duffing", "--ordr", "3"], "did you mean --order for --ordr?"),
-        (["sweep", "stability", "--omega", "1", "--store", "x", "--workrs", "2"],
+        (["sweep", "stability", "--omega", "1", "--out", "x", "--workrs", "2"],
          "did you mean --workers for --workrs?"),
     ],
 )
@@ -97,12 +97,12 @@ def test_name_that_shadows_a_module_is_refused(tmp_path, name):
     (["tongues", "cos(t)", "--json"], "--json"),
 ])
 def test_emit_refuses_printing_flags_beside_it(tmp_path, args, dropped):
-    """``--emit`` prints only the module's path: a printing flag beside it is refused in one
+    """``--out`` prints only the module's path: a printing flag beside it is refused in one
     line (exit 2) before anything is derived or written, in ``mathieu`` as in ``tongues``."""
-    out = run(*args, "--emit", str(tmp_path / "new"))
+    out = run(*args, "--out", str(tmp_path / "new"))
     assert out.returncode == 2 and out.stdout == ""
     assert out.stderr.strip().splitlines() == [
-        f"lindstedt: error: --emit writes the module only: drop {dropped}"]
+        f"lindstedt: error: --out writes the module only: drop {dropped}"]
     assert not (tmp_path / "new").exists()
 
 
@@ -148,13 +148,15 @@ def test_help_imports_no_heavy_stage():
 
 
 def test_every_flag_has_help_and_states_its_default():
+    import argparse
+
     from lindstedt.cli import build_parser
 
     parser = build_parser()
     commands = parser._subparsers._group_actions[0].choices
     for name, sub in commands.items():
         for action in sub._actions:
-            if action.dest == "help":
+            if action.dest == "help" or action.help == argparse.SUPPRESS:  # an old spelling
                 continue
             assert action.help, (name, action.option_strings)
             if action.option_strings and not action.required and action.default not in (
@@ -182,3 +184,70 @@ def test_progress_bar_only_on_a_terminal_and_never_with_json(monkeypatch):
         text = stream.getvalue()
         assert ("[" + "#" * 30 + "] 4/4" in text) == drawn
         assert text.endswith("\r\033[K") == drawn
+
+
+OLD_SPELLINGS = {"--emit": "--out", "--store": "--out", "--x-min": "--range",
+                 "--x-max": "--range", "--omega-min": "--omega", "--omega-max": "--omega",
+                 "--omega-from": "--omega", "--omega-to": "--omega", "--points": "--omega",
+                 "--damping": "--zeta", "--at": "--eps"}
+
+
+def test_one_spelling_per_meaning_across_commands():
+    """Every command's visible flags use one spelling per meaning: an output folder is --out, a
+    frequency --omega (W, A:B or A:B:N), a damping ratio --zeta; the old spellings are hidden
+    from --help (they keep working, with a note)."""
+    import argparse
+
+    from lindstedt.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    for name, parser in sub.choices.items():
+        for action in parser._actions:
+            visible = action.help is not argparse.SUPPRESS
+            for flag in action.option_strings:
+                if flag in OLD_SPELLINGS or (flag == "--force" and action.nargs == 0):
+                    assert not visible, f"{name} {flag}: an old spelling shown in --help"
+                if visible and action.metavar in ("DIR", "PATH"):
+                    assert flag == "--out", f"{name} {flag}: an output folder is --out"
+                if visible and "ω" in (action.help or "") and "frequency" in action.help and (
+                        flag.startswith("--omega")):
+                    assert flag == "--omega", f"{name} {flag}"
+
+
+@pytest.mark.parametrize("old, new", [
+    (["tongues", "cos(t)", "--order", "4", "--at", "0.1", "--damping", "0.01", "--json"],
+     ["tongues", "cos(t)", "--order", "4", "--eps", "0.1", "--zeta", "0.01", "--json"]),
+    (["parametric", "--eps", "0.2", "--omega-from", "0.95", "--omega-to", "1.05", "--points",
+      "3", "--harmonics", "2", "--json"],
+     ["parametric", "--eps", "0.2", "--omega", "0.95:1.05:3", "--harmonics", "2", "--json"]),
+])
+def test_old_spellings_still_work_with_a_one_line_note(old, new):
+    """An old spelling gives the same output as the new one, and one note line per old flag
+    on stderr naming the new spelling."""
+    before, after = run(*old), run(*new)
+    assert before.returncode == after.returncode == 0, before.stderr
+    assert before.stdout == after.stdout and after.stderr == ""
+    notes = before.stderr.strip().splitlines()
+    olds = [a for a in old if a in OLD_SPELLINGS]
+    assert len(notes) == len(olds)
+    for flag, note in zip(olds, notes, strict=True):
+        head = f"lindstedt: note: {flag} is deprecated and goes in the next release; use "
+        assert note.startswith(head + OLD_SPELLINGS[flag]), note
+
+
+@pytest.mark.parametrize("args, says", [
+    (["parametric", "--eps", "0.2", "--omega", "1"], "--omega: '1': write A:B or A:B:N"),
+    (["parametric", "--eps", "0.2", "--omega", "1:2:3:4"], "write A:B or A:B:N"),
+    (["parametric", "--eps", "0.2", "--omega", "0.9:1.1:1"], "must be in 2..401"),
+    (["parametric", "--eps", "0.2", "--omega", "0.9:abc"], "'abc': not a number"),
+    (["parametric", "--eps", "0.2"], "required: --omega A:B[:N]"),
+    (["driven", "--eps", "0.1", "--force", "0.3", "--omega", "1:2"], "write W"),
+    (["response", "q'' + q'/10 + q + q**3/10 = cos(w*t)/2", "--omega", "1"], "write A:B"),
+    (["choose", "period", "--tol", "1e-3"], "choose period needs --range A:B"),
+    (["sweep", "stability", "--omega", "1"], "required: --out"),
+])
+def test_spans_are_checked_in_one_line(args, says):
+    out = run(*args)
+    assert out.returncode == 2 and out.stdout == ""
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and says in lines[0], out.stderr

@@ -45,7 +45,7 @@ def test_every_command_but_the_demo_has_an_estimate_and_the_slow_ones_a_switch()
     (["response", "--eps", "0.1", "--force", "1", "--Q", "50", "--harmonics", "100"],
      "--harmonics 100: about"),
     (["sweep", "stability", "--omega", "0.5:1.5:40000", "--force", "0.3", "--eps", "0.1",
-      "--Q", "20", "--store", "map.zarr"], "a grid of 40,000 points: about"),
+      "--Q", "20", "--out", "map.zarr"], "a grid of 40,000 points: about"),
     (["generate", "q'' + q + eps*(alpha*q**2 + q**3) = 0", "--order", "100", "--out", "gen"],
      "order 100: about"),
     # a limit cycle's evaluators: the series to ≥ 60 and the shooting checks, growing with K
@@ -103,7 +103,7 @@ def test_choose_driven_decides_by_the_model_not_the_timings(monkeypatch):
 
 
 def test_choose_emit_generates_the_modelled_cheapest_first_and_only_what_it_needs(monkeypatch):
-    """With --emit the emitted modules are tried cheapest-by-model first; the first whose own
+    """With --out the emitted modules are tried cheapest-by-model first; the first whose own
     error meets the tolerance is chosen, the rest are never generated; the bounds keep out
     what would take over a minute to generate."""
     from lindstedt import choose
@@ -126,7 +126,7 @@ def test_choose_emit_generates_the_modelled_cheapest_first_and_only_what_it_need
 
 
 def test_emit_bounds_keep_choose_emit_within_the_limit():
-    """What competes in ``choose … --emit`` is the most whose trial fits the limit after the
+    """What competes in ``choose … --out`` is the most whose trial fits the limit after the
     choice's fixed work (one more would not); the command's estimate stays within the limit."""
     from lindstedt import choose, costs
     from lindstedt.cli import build_parser
@@ -138,7 +138,7 @@ def test_emit_bounds_keep_choose_emit_within_the_limit():
         assert costs.emission_seconds(model, k) <= budget < costs.emission_seconds(model, k + 1)
     assert costs.emit_bounds(True) == (costs.DRIVEN_MAX_ORDER, choose.DRIVEN_MAX)
     argv = ["choose", "amplitudes", "--eps", "0.1", "--force", "0.3", "--omega", "1.3",
-            "--emit", "e"]
+            "--out", "e"]
     cost = costs.COSTS["choose"](build_parser().parse_args(argv))
     assert costs.FIXED_COSTS["choose amplitudes"] < cost.seconds <= costs.COST_LIMIT_SECONDS
     slow = costs.COSTS["choose"](build_parser().parse_args([*argv, "--allow-slow"]))

@@ -335,9 +335,9 @@ def run_all(folders: dict[str, Path]) -> list[dict]:
 def test_every_emitted_function_refuses_what_it_cannot_handle(tmp_path):
     """One child process calls everything; it must exit normally, every call must behave."""
     for args in (["generate", "fourier", "--harmonics", "4", "--out", str(tmp_path)],
-                 ["choose", "period", "--tol", "1e-6", "--x-min", "-0.5", "--x-max", "0.7",
-                  "--emit", str(tmp_path)],
-                 ["tongues", "cos(t) + 1/2*cos(2*t)", "--n", "1", "--order", "12", "--emit",
+                 ["choose", "period", "--tol", "1e-6", "--range", "-0.5:0.7",
+                  "--out", str(tmp_path)],
+                 ["tongues", "cos(t) + 1/2*cos(2*t)", "--n", "1", "--order", "12", "--out",
                   str(tmp_path)]):
         made = subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
                               text=True, check=False)
@@ -439,9 +439,9 @@ def newer_modules(tmp_path_factory):
     out = tmp_path_factory.mktemp("newer")
     for args in (["generate", "driven", "--damped", "--order", "2"],
                  ["generate", "van_der_pol", "--order", "3"],
-                 ["mathieu", "a", "--m", "1", "--order", "8", "--emit", str(out)],
+                 ["mathieu", "a", "--m", "1", "--order", "8", "--out", str(out)],
                  ["slowflow", "van_der_pol", "--name", "vdp", "--out", str(out)],
-                 ["tongues", "cos(t) + 1/2*cos(2*t)", "--n", "1", "--order", "12", "--emit",
+                 ["tongues", "cos(t) + 1/2*cos(2*t)", "--n", "1", "--order", "12", "--out",
                   str(out)]):
         if args[0] == "generate":
             args = [*args, "--out", str(out)]

@@ -3,7 +3,7 @@ huge, tiny, nan, inf, strings) and valid ones, each run as a subprocess in an em
 
 Every run must end with exit status 0 or 2 within ``TIMEOUT``, never print a traceback, and a
 refusal (exit 2) must be one line on stderr, nothing on stdout, nothing written — not even its
---out, --emit or --plot target.  Seeded (``derandomize``) so CI draws the same runs each time,
+--out or --plot target.  Seeded (``derandomize``) so CI draws the same runs each time,
 and bounded (``max_examples`` pairs of runs per command, ~60 s for the file on a loaded
 2-core machine): valid runs use small orders and harmonics, and known-slow valid regions (a
 subharmonic figure, the demo, the slower scenes, --allow-slow with a large order, `generate
@@ -106,6 +106,18 @@ def maybe(strategy: st.SearchStrategy[str]) -> st.SearchStrategy[str | None]:
 
 NUMBER = st.sampled_from(EDGE_NUMBERS)
 INTEGER = st.sampled_from(EDGE_INTEGERS)
+SPAN_EDGES = st.one_of(NUMBER, st.sampled_from(("1:", ":", ":1", "1:2:3:4", "2:1", "1:1",
+                                                "1:2:0", "1:2:1", "1:2:abc", "nan:1", "1:inf",
+                                                "0:1", "1:2:2.5", "1:2:100000")))
+
+
+def span(lo: float, mid: float, hi: float, points: bool = False) -> st.SearchStrategy[str]:
+    """A valid ``A:B`` (or ``A:B:N`` now and then, with ``points``) with A in [lo, mid] and B
+    in [mid, hi]."""
+    ends = st.tuples(real(lo, mid), real(mid, hi)).map(":".join)
+    if not points:
+        return ends
+    return st.one_of(ends, st.tuples(ends, whole(2, 12)).map(":".join))
 
 
 @dataclass(frozen=True)
@@ -119,7 +131,7 @@ class Opt:
 def plausible(values: list[str]) -> bool:
     """Every value reads as a finite number: the run may compute (and a figure take long)."""
     try:
-        return all(math.isfinite(float(v)) for v in values)
+        return all(math.isfinite(float(x)) for v in values for x in v.split(":"))
     except ValueError:
         return False
 
@@ -190,8 +202,8 @@ SUBHARMONIC = command_line((
 
 PARAMETRIC = command_line((
     Opt("--eps", real(0.01, 0.9), NUMBER), Opt("--zeta", maybe(real(0.0, 0.1)), NUMBER),
-    Opt("--gamma", maybe(real(-2.0, 2.0)), NUMBER), Opt("--omega-from", real(0.5, 1.0), NUMBER),
-    Opt("--omega-to", real(1.0, 1.5), NUMBER), Opt("--points", maybe(whole(2, 12)), INTEGER),
+    Opt("--gamma", maybe(real(-2.0, 2.0)), NUMBER),
+    Opt("--omega", span(0.5, 1.0, 1.5, points=True), SPAN_EDGES),
     Opt("--harmonics", maybe(whole(1, 8)), st.sampled_from(("0", "101", "abc")))), plot="slow")
 # NOTE: its figure (221 ω, ~7 s) only where a value fails to parse, as the subharmonic's.
 
@@ -213,15 +225,14 @@ def mixing(draw) -> list[str]:
 CHOOSE = command_line((
     Opt(None, st.sampled_from(["period", "amplitudes", "response"]),
         st.sampled_from(["nosuch", "q"]), number=False),
-    Opt("--tol", real(1e-6, 1e-3), NUMBER), Opt("--x-min", real(-0.5, 0.2), NUMBER),
-    Opt("--x-max", real(0.2, 1.0), NUMBER), Opt("--t-max", maybe(real(1.0, 10.0)), NUMBER),
+    Opt("--tol", real(1e-6, 1e-3), NUMBER), Opt("--range", span(-0.5, 0.2, 1.0), SPAN_EDGES),
+    Opt("--t-max", maybe(real(1.0, 10.0)), NUMBER),
     Opt("--eps", real(0.0, 0.3), NUMBER), Opt("--force", real(0.1, 1.0), NUMBER),
-    Opt("--omega", real(0.6, 1.6), NUMBER), Opt("--Q", maybe(real(5.0, 50.0)), NUMBER),
-    Opt("--omega-min", st.none(), NUMBER), Opt("--omega-max", st.none(), NUMBER),
-    Opt("--emit", st.none(), st.sampled_from((*BAD_FOLDERS, "out")), number=False)))
+    Opt("--omega", real(0.6, 1.6), SPAN_EDGES), Opt("--Q", maybe(real(5.0, 50.0)), NUMBER),
+    Opt("--out", st.none(), st.sampled_from((*BAD_FOLDERS, "out")), number=False)))
 # NOTE: valid runs verify one ω (a range takes 8 s and more), emit nothing (choosing with
-# --emit may generate the order-6 μ-expansion: minutes) and leave out `q` (11–16 s); edgy runs
-# draw them, where other values may be bad, and a refusal's --emit target must stay unwritten.
+# --out may generate the order-6 μ-expansion: minutes) and leave out `q` (11–16 s); edgy runs
+# draw them, where other values may be bad, and a refusal's --out target must stay unwritten.
 
 CLOCK = st.sampled_from([[], ["--json"], ["--bogus"], ["extra"], ["--json", "--json"]])
 
@@ -236,7 +247,7 @@ TONGUES = command_line((
         st.sampled_from(["cos(sqrt(2)*t)", "t*cos(t)", "cos(t/2)", "a*cos(t)", "1", "",
                          "__import__('os')", "cos(t) + sin(t)", "cos(99*t)"]), number=False),
     Opt("--n", maybe(whole(0, 4)), INTEGER), Opt("--order", maybe(whole(0, 20)), INTEGER),
-    Opt("--damping", maybe(real(0.0, 0.1)), NUMBER), Opt("--at", maybe(real(-0.5, 0.5)), NUMBER),
+    Opt("--zeta", maybe(real(0.0, 0.1)), NUMBER), Opt("--eps", maybe(real(-0.5, 0.5)), NUMBER),
     Opt("--tol", maybe(real(1e-12, 1e-3)), NUMBER)), switches=("--json", "--singularities"),
     plot="slow")
 # NOTE: a chart (two 400 × 400 Floquet grids, ~15 s) only where a value fails to parse.

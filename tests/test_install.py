@@ -79,8 +79,8 @@ def test_generate_from_another_folder(venv, tmp_path):
 
 
 def test_choose_emit_from_another_folder(venv, tmp_path):
-    out = _run([venv / "bin/lindstedt", "choose", "period", "--tol", "1e-6", "--x-min", "0",
-                "--x-max", "0.3", "--emit", "em", "--json"], tmp_path)
+    out = _run([venv / "bin/lindstedt", "choose", "period", "--tol", "1e-6", "--range", "0:0.3",
+                "--out", "em", "--json"], tmp_path)
     assert '"emitted"' in out.stdout
     probe = ("import sys; sys.path.insert(0, 'em'); import chosen_period as c; "
              "print(c.period(1.0, 0.25))")

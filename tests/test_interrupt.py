@@ -53,7 +53,7 @@ def _workers_left(pid: int) -> list[str]:
 @pytest.mark.parametrize("how", ["ctrl-c", "sigterm"])
 def test_an_interrupted_sweep_says_what_it_saved_and_resumes(how, tmp_path):
     store = tmp_path / "map.zarr"
-    p = _start(["sweep", *GRID, "--store", str(store), "--workers", "1"])  # ~1 s a block
+    p = _start(["sweep", *GRID, "--out", str(store), "--workers", "1"])  # ~1 s a block
     deadline = time.monotonic() + 120
     while _blocks_done(store) < 1:
         assert p.poll() is None, p.communicate()
@@ -71,13 +71,13 @@ def test_an_interrupted_sweep_says_what_it_saved_and_resumes(how, tmp_path):
         assert int(ds["done"].values.sum()) == saved
     time.sleep(0.5)
     assert not _workers_left(p.pid)  # the workers went with it
-    resumed = subprocess.run([*LINDSTEDT, "sweep", *GRID, "--store", str(store), "--json"],
+    resumed = subprocess.run([*LINDSTEDT, "sweep", *GRID, "--out", str(store), "--json"],
                              capture_output=True, text=True, check=True)
     assert '"complete": true' in resumed.stdout
     if how != "ctrl-c":
         return
     fresh = tmp_path / "fresh.zarr"
-    subprocess.run([*LINDSTEDT, "sweep", *GRID, "--store", str(fresh)], capture_output=True,
+    subprocess.run([*LINDSTEDT, "sweep", *GRID, "--out", str(fresh)], capture_output=True,
                    check=True)
     with xr.open_zarr(store) as a, xr.open_zarr(fresh) as b:
         for name in ("orbits", "stable_orbits", "r", "floquet"):

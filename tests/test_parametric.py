@@ -240,8 +240,7 @@ def run(*args: str) -> subprocess.CompletedProcess:
 
 
 def test_parametric_command_contract_and_bad_input():
-    out = run("parametric", "--eps", "0.2", "--zeta", "0.01", "--omega-from", "0.95",
-              "--omega-to", "1.1", "--points", "4", "--json")
+    out = run("parametric", "--eps", "0.2", "--zeta", "0.01", "--omega", "0.95:1.1:4", "--json")
     assert out.returncode == 0, out.stderr
     data = json.loads(out.stdout)
     assert data["onsets"][0]["supercritical"] and not data["onsets"][1]["supercritical"]
@@ -251,11 +250,11 @@ def test_parametric_command_contract_and_bad_input():
     for bad, needle in ((["--eps", "0.2", "--zeta", "-1"], "zeta"),
                         (["--eps", "0", "--zeta", "0"], "eps"),
                         (["--eps", "0.2", "--gamma", "inf"], "gamma")):
-        out = run("parametric", *bad, "--omega-from", "0.9", "--omega-to", "1.1")
+        out = run("parametric", *bad, "--omega", "0.9:1.1")
         assert out.returncode == 2 and needle in out.stderr
         assert len(out.stderr.strip().splitlines()) == 1
-    out = run("parametric", "--eps", "0.2", "--omega-from", "1.1", "--omega-to", "0.9")
-    assert out.returncode == 2 and "--omega-from" in out.stderr
+    out = run("parametric", "--eps", "0.2", "--omega", "1.1:0.9")
+    assert out.returncode == 2 and "--omega 1.1:0.9: the range must increase" in out.stderr
 
 
 def test_subharmonic_json_gains_the_full_hill_verdict():
@@ -270,8 +269,7 @@ def test_parametric_figure_is_drawn_and_a_bad_input_draws_nothing(tmp_path, caps
     from lindstedt import cli
 
     path = tmp_path / "p.png"
-    args = ["parametric", "--eps", "0.2", "--zeta", "0.01", "--omega-from", "0.9",
-            "--omega-to", "1.1", "--points", "2"]
+    args = ["parametric", "--eps", "0.2", "--zeta", "0.01", "--omega", "0.9:1.1:2"]
     assert cli.main([*args, "--zeta", "2", "--plot", str(path)]) == 2
     assert list(tmp_path.iterdir()) == []
     assert cli.main([*args, "--plot", str(path)]) == 0

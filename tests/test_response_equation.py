@@ -205,7 +205,7 @@ def test_mixing_as_text_equals_the_flags():
     (["response", "q'' + q + q**3/10 = cos(w*t)/2"], "no damping"),
     (["response", "q'' + w*q'/10 + q + q**3/10 = cos(w*t)/2"], "depends on the drive"),
     (["response", "q'' + q'/10 + q + q**3/10 = cos(w*t)/2", "--eps", "0.1"], "--eps"),
-    (["response", "--eps", "0.1", "--force", "0.3", "--Q", "20", "--omega-max", "2"],
+    (["response", "--eps", "0.1", "--force", "0.3", "--Q", "20", "--omega", "1:2"],
      "give an equation"),
     (["subharmonic", "--eps", "0.1", "--force", "0.5"], "required: --omega"),
 ])
@@ -229,8 +229,7 @@ def test_cost_bounds_response_equation():
 
 
 def test_response_equation_json_keys_keep_the_contract(capsys):
-    assert main(["response", ASYMMETRIC, "--json", "--omega-min", "1.3", "--omega-max",
-                 "1.6"]) == 0
+    assert main(["response", ASYMMETRIC, "--json", "--omega", "1.3:1.6"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert {"parameters", "one_harmonic", "harmonic_balance", "numerical"} <= data.keys()
     assert data["parameters"]["omega_range"] == [1.3, 1.6]

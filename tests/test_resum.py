@@ -312,7 +312,7 @@ def test_mathieu_refined_and_truncation_bound_against_mpmath():
 
 @pytest.mark.parametrize(("kind", "m", "past"), [("a", 0, 2.0), ("a", 3, 1.0), ("b", 6, 5.0)])
 def test_emitted_mathieu_against_the_eigenvalue_reference(kind, m, past, tmp_path):
-    """`lindstedt mathieu KIND --m M --order 60 --emit DIR`: the ufunc within 1e-15·max(1,
+    """`lindstedt mathieu KIND --m M --order 60 --out DIR`: the ufunc within 1e-15·max(1,
     |a|) (a few units in the last place) of the mpmath eigenvalues at 30 digits inside its
     verified q, past the series' radius (|q| ≈ 1.47 for a_0), NaN beyond (and below q = 0 for
     a series with odd powers); the error estimate (the Newton step) covers the error."""
@@ -320,7 +320,7 @@ def test_emitted_mathieu_against_the_eigenvalue_reference(kind, m, past, tmp_pat
     from lindstedt.emit.render import load_generated
     from lindstedt.numerics.references import mathieu_reference
 
-    assert main(["mathieu", kind, "--m", str(m), "--order", "60", "--emit",
+    assert main(["mathieu", kind, "--m", str(m), "--order", "60", "--out",
                  str(tmp_path)]) == 0
     mod = load_generated(tmp_path / f"mathieu_{kind}{m}.py")
     f, estimate = getattr(mod, f"{kind}{m}"), getattr(mod, f"{kind}{m}_error")
@@ -337,9 +337,9 @@ def test_emitted_mathieu_against_the_eigenvalue_reference(kind, m, past, tmp_pat
 def test_mathieu_emit_refuses_bad_input(tmp_path, capsys):
     from lindstedt.cli import main
 
-    assert main(["mathieu", "b", "--m", "0", "--order", "60", "--emit", str(tmp_path)]) == 2
+    assert main(["mathieu", "b", "--m", "0", "--order", "60", "--out", str(tmp_path)]) == 2
     assert "b_0 does not exist" in capsys.readouterr().err
-    assert main(["mathieu", "a", "--m", "1", "--order", "2", "--emit", str(tmp_path)]) == 2
+    assert main(["mathieu", "a", "--m", "1", "--order", "2", "--out", str(tmp_path)]) == 2
     assert list(tmp_path.iterdir()) == []
 
 

@@ -340,7 +340,7 @@ def test_cli_sweep_killed_then_resumed_equals_serial(tmp_path):
     axes = {"omega": [1.0 + 0.6 * i / 23 for i in range(24)], "force": [0.3], "eps": [0.1],
             "Q": [20.0]}
     args = [sys.executable, "-m", "lindstedt", "sweep", "stability", "--omega", "1.0:1.6:24",
-            "--force", "0.3", "--eps", "0.1", "--Q", "20", "--chunk", "4", "--store", "s",
+            "--force", "0.3", "--eps", "0.1", "--Q", "20", "--chunk", "4", "--out", "s",
             "--json"]
     proc = subprocess.Popen(args, cwd=tmp_path, start_new_session=True,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -471,7 +471,7 @@ def test_equation_sweep_refusals(tmp_path, capsys, argv, says):
     from lindstedt.cli import main
 
     store = tmp_path / "s"
-    assert main(["sweep", "response", SWEPT, *argv, "--store", str(store)]) == 2
+    assert main(["sweep", "response", SWEPT, *argv, "--out", str(store)]) == 2
     err = capsys.readouterr().err.strip()
     assert says in err and len(err.splitlines()) == 1, err
     assert not store.exists()
@@ -480,6 +480,6 @@ def test_equation_sweep_refusals(tmp_path, capsys, argv, says):
 def test_validity_takes_no_equation(tmp_path, capsys):
     from lindstedt.cli import main
 
-    assert main(["sweep", "validity", SWEPT, "--axis", "w=1", "--store",
+    assert main(["sweep", "validity", SWEPT, "--axis", "w=1", "--out",
                  str(tmp_path / "s")]) == 2
     assert "the notes'" in capsys.readouterr().err

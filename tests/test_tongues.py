@@ -177,7 +177,7 @@ def test_grid_verdicts_against_solve_ivp(zeta):
 
 def test_the_cli_json():
     out = subprocess.run([sys.executable, "-m", "lindstedt", "tongues", "cos(t) + sin(2*t)",
-                          "--n", "2", "--order", "6", "--json", "--at", "0.1"],
+                          "--n", "2", "--order", "6", "--json", "--eps", "0.1"],
                          capture_output=True, text=True, check=True)
     data = json.loads(out.stdout)
     assert data["variable"] == "eps" and data["delta0"] == "1/1" and data["period"] == "2*pi"
@@ -191,10 +191,10 @@ def test_the_cli_json():
 @pytest.mark.parametrize("args", [
     ["cos(sqrt(2)*t)"], ["t*cos(t)"], ["cos(t/2)"], ["a*cos(t)"], ["exp(t)"], ["1"],
     ["sqrt(2)*cos(t)"], ["cos(t)", "--n", "1.5"], ["cos(t)", "--n", "-1"],
-    ["cos(t)", "--damping", "nan"], ["cos(t)", "--at", "inf"],
-    ["cos(t)", "--order", "20", "--at", "1.5", "--tol", "1e-30"],
+    ["cos(t)", "--zeta", "nan"], ["cos(t)", "--eps", "inf"],
+    ["cos(t)", "--order", "20", "--eps", "1.5", "--tol", "1e-30"],
     ["cos(t) + sin(t)", "--n", "1"], ["cos(t) + sin(2*t)", "--n", "3"],
-    ["cos(t)", "--n", "2", "--damping", "0.1"], ["cos(t)", "--n", "0", "--damping", "0.1"],
+    ["cos(t)", "--n", "2", "--zeta", "0.1"], ["cos(t)", "--n", "0", "--zeta", "0.1"],
     ["cos(t)", "--tol", "1e-3"], ["cos(t)", "--plot", "chart.txt"],
 ])
 def test_bad_input_is_one_line_and_exit_2(args):
@@ -205,7 +205,7 @@ def test_bad_input_is_one_line_and_exit_2(args):
 
 
 def test_the_tolerance_refusal_names_the_best_reachable(capsys):
-    assert main(["tongues", "cos(t)", "--order", "20", "--at", "1.5", "--tol", "1e-30"]) == 2
+    assert main(["tongues", "cos(t)", "--order", "20", "--eps", "1.5", "--tol", "1e-30"]) == 2
     assert "best reachable" in capsys.readouterr().err
     with pytest.raises(InputError, match="not periodic"):
         transition_curves("cos(sqrt(2)*t)", 1, 4)
@@ -232,12 +232,12 @@ def test_the_curves_radius_is_mathieus(capsys):
 
 
 EMIT_P = "cos(t) + 1/2*cos(2*t)"
-EMIT_ARGS = ["tongues", EMIT_P, "--n", "1", "--order", "30", "--emit"]
+EMIT_ARGS = ["tongues", EMIT_P, "--n", "1", "--order", "30", "--out"]
 
 
 @pytest.fixture(scope="module")
 def emitted(tmp_path_factory):
-    """``tongues P --n 1 --order 30 --emit DIR``, twice into two folders, and the module."""
+    """``tongues P --n 1 --order 30 --out DIR``, twice into two folders, and the module."""
     from lindstedt.emit.render import load_generated
 
     first, again = tmp_path_factory.mktemp("tongue"), tmp_path_factory.mktemp("again")
@@ -324,10 +324,10 @@ def test_emit_refuses_in_one_line(tmp_path):
     """A foreign file in the way, a bad P, a too low order: exit 2, one line, nothing written."""
     (tmp_path / "tongue_1.py").write_text("mine\n")
     for args in ([*EMIT_ARGS, str(tmp_path)],
-                 ["tongues", "cos(sqrt(2)*t)", "--emit", str(tmp_path / "new")],
-                 ["tongues", "cos(t)", "--order", "8", "--emit", str(tmp_path / "new")],
-                 ["tongues", "cos(t)", "--emit", " "],
-                 ["tongues", "cos(t)", "--at", "0.1", "--emit", str(tmp_path / "new")]):
+                 ["tongues", "cos(sqrt(2)*t)", "--out", str(tmp_path / "new")],
+                 ["tongues", "cos(t)", "--order", "8", "--out", str(tmp_path / "new")],
+                 ["tongues", "cos(t)", "--out", " "],
+                 ["tongues", "cos(t)", "--eps", "0.1", "--out", str(tmp_path / "new")]):
         done = subprocess.run([sys.executable, "-m", "lindstedt", *args],
                               capture_output=True, text=True, check=False)
         assert done.returncode == 2 and done.stdout == "", args
@@ -342,7 +342,7 @@ def test_an_even_curve_is_emitted_in_eps_squared(tmp_path):
     limit, and equal to the Floquet boundary at ±ε past the radius of a_0 (|q| ≈ 1.4688)."""
     from lindstedt.emit.render import load_generated
 
-    assert main(["tongues", "cos(t)", "--n", "0", "--order", "30", "--emit", str(tmp_path)]) == 0
+    assert main(["tongues", "cos(t)", "--n", "0", "--order", "30", "--out", str(tmp_path)]) == 0
     mod = load_generated(tmp_path / "tongue_0.py")
     assert mod.SYMMETRIC_0 and mod.LIMIT_0 > 1.4688 / 2
     eps = 0.99 * mod.LIMIT_0

@@ -351,11 +351,11 @@ def parametric_report(eps: float, zeta: float, gamma: float, omega_from: float,
     """The :class:`ParametricReport` of the pumped oscillator over ``points`` ω of
     ``[omega_from, omega_to]``; each input refused in one line where it does not belong."""
     p = Pump(eps, zeta, gamma)
-    lo, hi = check_omega(omega_from, "--omega-from"), check_omega(omega_to, "--omega-to")
+    lo, hi = check_omega(omega_from, "--omega A"), check_omega(omega_to, "--omega B")
     if not lo < hi:
-        raise InputError(f"--omega-from {lo:g} --omega-to {hi:g}: the range must increase")
+        raise InputError(f"--omega {lo:g}:{hi:g}: the range must increase")
     check_int(points, 2, PARAMETRIC_MAX_POINTS,
-              f"--points {points}: must be in 2..{PARAMETRIC_MAX_POINTS}")
+              f"--omega A:B:N, N = {points}: must be in 2..{PARAMETRIC_MAX_POINTS}")
     check_int(harmonics, 1, MAX_HARMONICS, f"--harmonics {harmonics}: must be in "
               f"1..{MAX_HARMONICS}")
     rows = response(p, np.linspace(lo, hi, points), harmonics,

@@ -267,11 +267,11 @@ def equation_range(terms: dict[tuple[int, int], float], force: float,
     folds = one.folds(0.1 * w0, 10 * w0)
     lo = 0.5 * min([w0, *folds]) if omega_min is None else omega_min
     hi = 1.25 * max([w0, *folds]) if omega_max is None else omega_max
-    for flag, value in (("--omega-min", lo), ("--omega-max", hi)):
+    for flag, value in (("--omega A", lo), ("--omega B", hi)):
         if not (math.isfinite(value) and value > 0):
-            raise InputError(f"{flag} {value!r}: must be finite and > 0")
+            raise InputError(f"{flag} = {value!r}: must be finite and > 0")
     if not lo < hi:
-        raise InputError(f"--omega-min {lo:g} must lie below --omega-max {hi:g}")
+        raise InputError(f"--omega {lo:g}:{hi:g}: A must lie below B")
     return EquationResponse(one, (lo, hi), [w for w in folds if lo <= w <= hi], w0)
 
 

@@ -17,11 +17,15 @@ from .common import (
     DRIVEN_QUANTITIES,
     SCENE_NAMES,
     ProgressBar,
+    _deprecated,
     _flag_allow_slow,
     _flag_drive,
     _flag_equation,
     _flag_json,
+    _flag_out,
     _flag_overwrite_edited,
+    _flag_range_bounds,
+    _flag_span,
     _order,
     _out_folder,
     _params,
@@ -64,7 +68,7 @@ def _print_choice(header: str, chosen: tuple[str, int, float, float],
 
 def run_choose(args: argparse.Namespace) -> int:
     """Run ``lindstedt choose QUANTITY``: the cheapest verified method for a tolerance and
-    a range (the period, of the Duffing oscillator or an EQUATION, with ``--emit`` its
+    a range (the period, of the Duffing oscillator or an EQUATION, with ``--out`` its
     module; q, the driven amplitudes and response, a limit cycle's ω and Mathieu's
     values by their own helpers), as a table or JSON.  Returns the exit status."""
     if args.model is None and (args.param or args.name):
@@ -79,13 +83,11 @@ def run_choose(args: argparse.Namespace) -> int:
         return _choose_driven(args)
     if args.quantity == "q":
         return _choose_q(args)
-    for name in ("tol", "x_min", "x_max"):
-        if getattr(args, name) is None:
-            raise InputError(f"choose period needs --{name.replace('_', '-')}")
+    _need_range(args, "choose period")
     model = None
     if args.model is not None:
-        if args.emit:
-            raise InputError("--emit: the chosen period module is the Duffing oscillator's; "
+        if args.out:
+            raise InputError("--out: the chosen period module is the Duffing oscillator's; "
                              "`lindstedt generate EQUATION` emits an equation's evaluators")
         from ..derive.models import model_from_text
 
@@ -94,13 +96,13 @@ def run_choose(args: argparse.Namespace) -> int:
     from ..compiler import generate_choice
     from ..emit.render import check_writable
 
-    if args.emit:
-        check_writable(_out_folder(args.emit, "--emit"), ["chosen_period.py"], "--emit",
+    if args.out:
+        check_writable(_out_folder(args.out, "--out"), ["chosen_period.py"], "--out",
                        args.overwrite_edited)
     progress = ProgressBar("timing the verified methods", not args.json)
     choice = choose_period(args.tol, args.x_min, args.x_max, progress, model=model)
     progress.close()
-    variable = "x = eps*A**2" if model is None else model.variable
+    variable = "y = eps*A**2" if model is None else model.variable
     data = {"method": choice.method.name, "order": choice.order,
             "max_error": choice.max_error,
             "ns_per_point": choice.ns_per_point, "verified_on": choice.verified_on,
@@ -111,16 +113,16 @@ def run_choose(args: argparse.Namespace) -> int:
     if model is not None:
         data.update(equation=model.source or model.title, omega0=str(model.frequency),
                     reference="quadrature of the scaled potential (Gauss–Legendre, 256 nodes)")
-    if args.emit:
-        command = (f"lindstedt choose period --tol {args.tol!r} --x-min {args.x_min!r} "
-                   f"--x-max {args.x_max!r}")
+    if args.out:
+        command = (f"lindstedt choose period --tol {args.tol!r} "
+                   f"--range {args.x_min!r}:{args.x_max!r}")
         data["emitted"] = [str(p) for p in generate_choice(
-            choice.candidate, command, Path(args.emit), (args.x_min, args.x_max),
+            choice.candidate, command, Path(args.out), (args.x_min, args.x_max),
             overwrite_edited=args.overwrite_edited)]
     if args.json:
         print(json.dumps(data))
         return 0
-    _print_choice(f"period T(x), {variable} in [{args.x_min:g}, {args.x_max:g}], tolerance "
+    _print_choice(f"period T(y), {variable} in [{args.x_min:g}, {args.x_max:g}], tolerance "
                   f"{args.tol:g} (relative, verified on {choice.verified_on} points):",
                   (choice.method, choice.order, choice.max_error, choice.ns_per_point),
                   choice.considered, quantity="period")
@@ -136,12 +138,10 @@ RESUMMED_QUANTITIES = ("cycle", "mathieu")
 
 def _choose_resummed(args: argparse.Namespace) -> int:
     """``choose cycle`` (ε in [x-min, x-max]) and ``choose mathieu --kind K --m M`` (q)."""
-    for name in ("tol", "x_min", "x_max"):
-        if getattr(args, name) is None:
-            raise InputError(f"choose {args.quantity} needs --{name.replace('_', '-')}")
-    if args.emit:
-        raise InputError(f"--emit: choose {args.quantity} reports; `lindstedt generate "
-                         "van_der_pol` and `lindstedt mathieu … --emit DIR` write the modules")
+    _need_range(args, f"choose {args.quantity}")
+    if args.out:
+        raise InputError(f"--out: choose {args.quantity} reports; `lindstedt generate "
+                         "van_der_pol` and `lindstedt mathieu … --out DIR` write the modules")
     from ..choose import choose_limit_cycle, choose_mathieu
 
     if args.quantity == "cycle":
@@ -212,19 +212,17 @@ def run_scene(args: argparse.Namespace) -> int:
 
 
 def _choose_q(args: argparse.Namespace) -> int:
-    for name in ("tol", "x_min", "x_max"):
-        if getattr(args, name) is None:
-            raise InputError(f"choose q needs --{name.replace('_', '-')}")
+    _need_range(args, "choose q")
     from ..choose import choose_solution, modelled_ns
     from ..compiler import generate_method
     from ..emit.render import check_writable
 
-    if args.emit:
-        check_writable(_out_folder(args.emit, "--emit"), ["duffing.py", "duffing_tables.tex",
-                                         "duffing_derivation.tex", "fourier.py"], "--emit")
+    if args.out:
+        check_writable(_out_folder(args.out, "--out"), ["duffing.py", "duffing_tables.tex",
+                                         "duffing_derivation.tex", "fourier.py"], "--out")
     progress = ProgressBar("verifying the L–P orders", not args.json)
     c = choose_solution(args.tol, args.x_min, args.x_max, args.t_max,
-                        emittable=bool(args.emit), progress=progress)
+                        emittable=bool(args.out), progress=progress)
     progress.close()
     data = {"quantity": "q", "method": c.method.name, "order": c.order,
             "max_error": c.max_error,
@@ -232,17 +230,17 @@ def _choose_q(args: argparse.Namespace) -> int:
             "modelled_ns_per_point": modelled_ns("q", c.method, c.order),
             "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
             "considered": _considered(c.considered)}
-    if args.emit:
+    if args.out:
         data["emitted"] = [str(p) for p in generate_method(
-            c.method, c.order, Path(args.emit), overwrite_edited=args.overwrite_edited)]
+            c.method, c.order, Path(args.out), overwrite_edited=args.overwrite_edited)]
     if args.json:
         print(json.dumps(data))
         return 0
-    _print_choice(f"q(t)/A to {args.tol:g} for x in [{args.x_min:g}, {args.x_max:g}], t in "
+    _print_choice(f"q(t)/A to {args.tol:g} for y = εA² in [{args.x_min:g}, {args.x_max:g}], t in "
                   f"[0, {args.t_max:g}] (verified on {c.verified_on} points):",
                   (c.method, c.order, c.max_error, c.ns_per_point), c.considered)
-    if c.method == "lindstedt" and not args.emit:
-        print(f"  (`lindstedt generate duffing --order {c.order}` or --emit DIR writes it)")
+    if c.method == "lindstedt" and not args.out:
+        print(f"  (`lindstedt generate duffing --order {c.order}` or --out DIR writes it)")
     for path in data.get("emitted", []):
         print(f"  emitted {path}")
     return 0
@@ -254,9 +252,9 @@ def _choose_driven(args: argparse.Namespace) -> int:
         if getattr(args, name) is None:
             raise InputError(f"choose {args.quantity} needs --{name}")
     if args.omega is None and (args.omega_min is None or args.omega_max is None):
-        raise InputError(f"choose {args.quantity} needs --omega, or --omega-min and --omega-max")
+        raise InputError(f"choose {args.quantity} needs --omega W or --omega A:B")
     if args.omega is not None and (args.omega_min is not None or args.omega_max is not None):
-        raise InputError("give --omega or a range (--omega-min, --omega-max), not both")
+        raise InputError("--omega: give one value W or a range A:B, not both")
     tol = args.tol or 1e-4
     lo, hi = (args.omega, None) if args.omega is not None else (args.omega_min, args.omega_max)
     from ..analysis.driven import check_steady_state
@@ -266,14 +264,14 @@ def _choose_driven(args: argparse.Namespace) -> int:
     from ..compiler import generate_method
     from ..emit.render import check_writable
 
-    if args.emit:
-        check_writable(_out_folder(args.emit, "--emit"),
+    if args.out:
+        check_writable(_out_folder(args.out, "--out"),
                        ["driven.py", "driven_derivation.tex", "balance.py", "driven_damped.py",
-                        "driven_damped_derivation.tex"], "--emit")
+                        "driven_damped_derivation.tex"], "--out")
     progress = ProgressBar("shooting the true orbits", not args.json)
     c = choose_driven(args.quantity, tol, args.eps, args.force, args.Q, lo, hi,
                       emit=(emit_bounds(args.allow_slow, DRIVEN_MAX, args.quantity)
-                            if args.emit else None),
+                            if args.out else None),
                       progress=progress)
     progress.close()
     data = {"quantity": args.quantity, "method": c.method.name, "order": c.order,
@@ -289,9 +287,9 @@ def _choose_driven(args: argparse.Namespace) -> int:
                                                   strict=True)]}
     if args.omega is not None:
         data["truth"] = c.truth.A[0].tolist()
-    if args.emit:
+    if args.out:
         data["emitted"] = [str(p) for p in generate_method(
-            c.method, c.order, Path(args.emit), overwrite_edited=args.overwrite_edited)]
+            c.method, c.order, Path(args.out), overwrite_edited=args.overwrite_edited)]
     if args.json:
         print(json.dumps(data))
         return 0
@@ -306,6 +304,14 @@ def _choose_driven(args: argparse.Namespace) -> int:
     return 0
 
 
+def _need_range(args: argparse.Namespace, command: str) -> None:
+    """``--tol`` and ``--range A:B``, which every quantity over a range needs."""
+    if args.tol is None:
+        raise InputError(f"{command} needs --tol")
+    if args.x_min is None or args.x_max is None:
+        raise InputError(f"{command} needs --range A:B")
+
+
 def arguments_choose(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """``lindstedt choose``'s arguments."""
     p = sub.add_parser("choose", help="the cheapest verified method for a tolerance and a range",
@@ -313,33 +319,31 @@ def arguments_choose(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                        "meets the tolerance on the range.")
     p.add_argument("quantity", choices=("period", "q", *DRIVEN_QUANTITIES,
                                         *RESUMMED_QUANTITIES),
-                   help="period T(x); q(t); amplitudes A_n, B_n; response r(ω); cycle: van der "
-                   "Pol's limit-cycle ω(ε), ε in [x-min, x-max]; mathieu: a_m(q) or b_m(q) "
-                   "(--kind, --m), q in [x-min, x-max]")
+                   help="period T(y); q(t); amplitudes A_n, B_n; response r(ω); cycle: van der "
+                   "Pol's limit-cycle ω(ε); mathieu: a_m(q) or b_m(q) (--kind, --m); each "
+                   "over --range")
     p.add_argument("--kind", choices=("a", "b"), default=None,
                    help="mathieu: a (even solutions, default) or b (odd)")
     p.add_argument("--m", type=_order, default=None, metavar="M",
                    help="mathieu: the index m (default 0)")
     _flag_equation(p, "\"q'' + q + eps*q**5 = 0\" (period only: a free oscillator with a "
-                   "polynomial force, judged by quadrature; x is then its expansion variable)")
+                   "polynomial force, judged by quadrature; y is then its expansion variable)")
     p.add_argument("--tol", type=_real, metavar="TOL",
                    help="tolerance > 0 (period, q: relative, required; amplitudes, response: "
                    "absolute, default 1e-4)")
-    p.add_argument("--x-min", type=_real, metavar="X",
-                   help="period, q: smallest x = εA² of the range (required)")
-    p.add_argument("--x-max", type=_real, metavar="X",
-                   help="period, q: largest x = εA² of the range (required)")
+    _flag_span(p, "--range", ("A:B",), "the range A:B of the variable: period, q: y = εA² "
+               "(or an EQUATION's expansion variable); cycle: ε; mathieu: q (required)",
+               (None, "x_min", "x_max"))
+    _deprecated(p, "--x-min", "--range A:B", "x_min", type=_real)
+    _deprecated(p, "--x-max", "--range A:B", "x_max", type=_real)
     p.add_argument("--t-max", type=_real, default=20.0, metavar="T",
                    help="q: times 0..T, in units of 1/(linear natural frequency) (default 20)")
-    _flag_drive(p, required=False, omega="amplitudes, response: one drive frequency ω")
-    p.add_argument("--omega-min", type=_real, metavar="W",
-                   help="amplitudes, response: lowest ω of a range (instead of --omega)")
-    p.add_argument("--omega-max", type=_real, metavar="W",
-                   help="amplitudes, response: highest ω of a range (instead of --omega)")
-    p.add_argument("--emit", metavar="DIR", help="write just the chosen evaluator into DIR "
-                   "(period: chosen_period.py; q: duffing.py or fourier.py; amplitudes, "
-                   "response: driven.py or balance.py, only emittable methods compete; "
-                   "default: write nothing)")
+    _flag_drive(p, required=False, omega="amplitudes, response: the drive frequency ω, one "
+                "value W or a range A:B", omega_forms=("W", "A:B"))
+    _flag_range_bounds(p, "--omega-min", "--omega-max")
+    _flag_out(p, "write just the chosen evaluator into DIR (period: chosen_period.py; q: "
+              "duffing.py or fourier.py; amplitudes, response: driven.py or balance.py, only "
+              "emittable methods compete; default: write nothing)", old="--emit")
     _flag_json(p)
     _flag_overwrite_edited(p)
     _flag_allow_slow(p, deprecated_force=False)
@@ -348,7 +352,8 @@ def arguments_choose(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
 
 def arguments_clock(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """``lindstedt clock``'s arguments."""
-    p = sub.add_parser("clock", help="the notes' grandfather's-clock accuracy claims, checked")
+    p = sub.add_parser("clock", help="a pendulum clock's accuracy claims (its period against "
+                       "its swing), checked")
     _flag_json(p, "JSON")
     return p
 

@@ -293,16 +293,90 @@ class _Parser(argparse.ArgumentParser):
         return out
 
 
-class _DeprecatedForce(argparse.Action):
-    """``--force`` in series/generate: the old spelling of ``--allow-slow`` (one release)."""
+DEPRECATED_IN = "the next release"
+# NOTE: an old spelling keeps working for one release, with a one-line note on stderr.
 
-    def __init__(self, option_strings: Sequence[str], dest: str, **kwargs) -> None:
-        super().__init__(option_strings, dest, nargs=0, **kwargs)
+
+class _Deprecated(argparse.Action):
+    """An old spelling of a flag, kept for one release: a one-line note on stderr naming the
+    new spelling (``new``), then the value stored where the new flag stores it (``dest``);
+    with ``nargs=0``, ``const``.  Hidden from ``--help``."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str, new: str, **kwargs) -> None:
+        self.new = new
+        kwargs.setdefault("help", argparse.SUPPRESS)
+        super().__init__(option_strings, dest, **kwargs)
 
     def __call__(self, parser, namespace, values, option_string=None) -> None:
-        print("lindstedt: note: --force here is deprecated, use --allow-slow (--force F is the "
-              "drive amplitude in driven, response, subharmonic, mixing, choose)", file=sys.stderr)
-        namespace.allow_slow = True
+        print(f"lindstedt: note: {option_string} is deprecated and goes in {DEPRECATED_IN}; "
+              f"use {self.new}", file=sys.stderr)
+        setattr(namespace, self.dest, self.const if self.nargs == 0 else values)
+
+
+def _deprecated(p: argparse.ArgumentParser, old: str, new: str, dest: str, **kwargs) -> None:
+    """Add ``old``, the deprecated spelling of ``new`` (which stores into ``dest``)."""
+    p.add_argument(old, action=_Deprecated, new=new, dest=dest, **kwargs)
+
+
+SPAN_FORMS = {1: "W", 2: "A:B", 3: "A:B:N"}
+# NOTE: the one syntax of a frequency (or any abscissa) on every command: one value W, a range
+# A:B, or a grid A:B:N (N points); each command accepts the forms that mean something to it.
+
+
+class _Span(argparse.Action):
+    """``W``, ``A:B`` or ``A:B:N`` (the forms in ``forms``): W into ``into[0]``, A and B into
+    ``into[1]`` and ``into[2]``, N into ``into[3]``."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str, forms: Sequence[str],
+                 into: Sequence[str | None], **kwargs) -> None:
+        self.forms, self.into = tuple(forms), tuple(into)
+        super().__init__(option_strings, dest, metavar="|".join(self.forms), **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        parts = str(values).split(":")
+        if SPAN_FORMS.get(len(parts)) not in self.forms:
+            raise argparse.ArgumentError(self, f"{values!r}: write {' or '.join(self.forms)}")
+        try:
+            numbers = [_real(part) for part in parts[:2]] + [_positive(part)
+                                                            for part in parts[2:]]
+        except argparse.ArgumentTypeError as exc:
+            raise argparse.ArgumentError(self, f"{values!r}: {exc}") from None
+        names = self.into[:1] if len(numbers) == 1 else self.into[1:1 + len(numbers)]
+        for name, number in zip(names, numbers, strict=True):
+            setattr(namespace, name, number)
+
+
+def _flag_span(p: argparse.ArgumentParser, flag: str, forms: Sequence[str], meaning: str,
+               into: Sequence[str | None], points: int | None = None,
+               required: bool = False) -> None:
+    """``flag`` in the forms ``forms`` (:data:`SPAN_FORMS`), stored into ``into`` (see
+    :class:`_Span`); ``points``: N's default."""
+    p.add_argument(flag, action=_Span, forms=forms, into=into, required=required, help=meaning)
+    p.set_defaults(**{name: None for name in into if name is not None})
+    if points is not None:
+        p.set_defaults(**{into[3]: points})
+
+
+def _flag_omega(p: argparse.ArgumentParser, forms: Sequence[str], meaning: str,
+                points: int | None = None, required: bool = False) -> None:
+    """--omega in the command's forms: W into ``omega``, A:B into ``omega_min``/``omega_max``,
+    N into ``points`` (default ``points``)."""
+    _flag_span(p, "--omega", forms, meaning, ("omega", "omega_min", "omega_max", "points"),
+               points, required)
+
+
+def _flag_range_bounds(p: argparse.ArgumentParser, low: str, high: str) -> None:
+    """The deprecated single bounds ``low`` and ``high`` of ``--omega A:B``."""
+    _deprecated(p, low, "--omega A:B", "omega_min", type=_real)
+    _deprecated(p, high, "--omega A:B", "omega_max", type=_real)
+
+
+def _flag_out(p: argparse.ArgumentParser, what: str, default: str | None = None,
+              old: str | None = None) -> None:
+    """--out DIR, the one output-folder flag (``old``: its deprecated spelling here)."""
+    p.add_argument("--out", default=default, metavar="DIR", help=what)
+    if old is not None:
+        _deprecated(p, old, "--out", "out")
 
 
 # One definition per flag: the same name means the same thing, with one help text and one
@@ -353,8 +427,8 @@ def _flag_allow_slow(p: argparse.ArgumentParser, deprecated_force: bool = True) 
                    help=f"run even when the estimate exceeds {COST_LIMIT_SECONDS:.0f} s "
                    "(default: refuse)")
     if deprecated_force:
-        p.add_argument("--force", action=_DeprecatedForce, dest="allow_slow",
-                       help="deprecated spelling of --allow-slow")
+        _deprecated(p, "--force", "--allow-slow (--force F is the drive amplitude f)",
+                    "allow_slow", nargs=0, const=True)
 
 
 def _flag_overwrite_edited(p: argparse.ArgumentParser) -> None:
@@ -374,12 +448,14 @@ def _flag_plot(p: argparse.ArgumentParser) -> None:
 
 
 def _flag_drive(p: argparse.ArgumentParser, required: bool, omega: str | None,
-                Q: str | None = "optional", force: bool = True, notes: bool = False) -> None:
+                Q: str | None = "optional", force: bool = True, notes: bool = False,
+                omega_forms: Sequence[str] = ("W",)) -> None:
     """--eps, --force, --omega, --Q of q'' + q'/Q + q + eps q^3 = f cos(w t) (``omega``: its
-    meaning, None for none; ``Q``: "optional", "required" or None for none; ``notes``: the
-    command also takes an EQUATION, and --eps, --force belong to the notes' equation)."""
+    meaning, None for none, in the forms ``omega_forms``; ``Q``: "optional", "required" or
+    None for none; ``notes``: the command also takes an EQUATION, and --eps, --force belong to
+    the Duffing oscillator it defaults to)."""
     need = " (required)" if required else ""
-    whose = "the notes' equation, without EQUATION: " if notes else ""
+    whose = "without EQUATION, Duffing's " if notes else ""
     p.add_argument("--eps", type=_real, required=required, metavar="EPS",
                    help=f"{whose}ε, the cubic stiffness coefficient (dimensionless; > 0 "
                    f"hardens, < 0 softens){need}")
@@ -388,8 +464,8 @@ def _flag_drive(p: argparse.ArgumentParser, required: bool, omega: str | None,
                        help=f"{whose}f, the drive amplitude, in units of the linear stiffness "
                        f"× length (q is dimensionless){need}")
     if omega is not None:
-        p.add_argument("--omega", type=_real, required=required, metavar="W",
-                       help=f"{omega}, in units of the linear natural frequency{need}")
+        _flag_omega(p, omega_forms, f"{omega}, in units of the linear natural frequency "
+                    f"ω0{need}", required=required)
     if Q == "required":
         p.add_argument("--Q", type=_quality, required=True, metavar="Q",
                        help="quality factor Q > 0 of the damping q'/Q (finite; required)")

@@ -15,6 +15,7 @@ from ..limits import COST_LIMIT_SECONDS, PARAMETRIC_MAX_POINTS
 # well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
 from .common import (
     _charts,
+    _deprecated,
     _equation_args,
     _first_harmonic,
     _flag_allow_slow,
@@ -22,8 +23,10 @@ from .common import (
     _flag_equation,
     _flag_harmonics,
     _flag_json,
+    _flag_omega,
     _flag_order,
     _flag_plot,
+    _flag_range_bounds,
     _keyed,
     _params,
     _positive,
@@ -380,7 +383,7 @@ def _response_args(args: argparse.Namespace) -> None:
         return
     if args.param or args.name or any(getattr(args, k) is not None
                                       for k in RESPONSE_EQUATION_ONLY):
-        raise InputError("--param/--name/--omega-min/--omega-max: give an equation (EQUATION) "
+        raise InputError("--param/--name/--omega: give an equation (EQUATION) "
                          "to take them")
     missing = [f"--{k}" for k in DRIVE_FLAGS if getattr(args, k) is None]
     if missing:
@@ -672,11 +675,13 @@ def _parametric_table(data: dict) -> list[str]:
 def run_parametric(args: argparse.Namespace) -> int:
     """Run ``lindstedt parametric``: the pumped Duffing oscillator over an ω range, as a
     table, JSON or a figure.  Returns the exit status."""
+    if args.omega_min is None or args.omega_max is None:
+        raise InputError("the following arguments are required: --omega A:B[:N]")
     return _report(args, lambda: parametric_json(args.eps, args.zeta, args.gamma,
-                                                 args.omega_from, args.omega_to, args.points,
+                                                 args.omega_min, args.omega_max, args.points,
                                                  args.harmonics),
                    lambda path: _charts().parametric_figure(args.eps, args.zeta, args.gamma,
-                                                            args.omega_from, args.omega_to,
+                                                            args.omega_min, args.omega_max,
                                                             path),
                    _parametric_table)
 
@@ -825,12 +830,10 @@ def arguments_response(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
     p.add_argument("--Q", type=_quality, default=None, metavar="Q",
                    help="quality factor Q > 0 of the damping q'/Q (finite; required without "
                    "EQUATION)")
-    p.add_argument("--omega-min", type=_real, metavar="W",
-                   help="with EQUATION: the lowest ω of the curve (default: half the lowest of "
-                   "the linear frequency ω0 and the one-harmonic folds)")
-    p.add_argument("--omega-max", type=_real, metavar="W",
-                   help="with EQUATION: the highest ω of the curve (default: 1.25 × the highest "
-                   "of ω0 and the one-harmonic folds)")
+    _flag_omega(p, ("A:B",), "with EQUATION: the drive frequencies ω of the curve, from A to "
+                "B, in units of the linear natural frequency ω0 (default: from half the lowest "
+                "of ω0 and the one-harmonic folds to 1.25 × the highest)")
+    _flag_range_bounds(p, "--omega-min", "--omega-max")
     _flag_harmonics(p, "odd harmonics N of the continued balance (with EQUATION: harmonics "
                     "1..2N-1, with the constant and even ones unless the force is odd)")
     _flag_json(p)
@@ -878,12 +881,11 @@ def arguments_parametric(sub: argparse._SubParsersAction) -> argparse.ArgumentPa
                    help="ζ ≥ 0, the damping ratio of 2ζq' (default 0: undamped)")
     p.add_argument("--gamma", type=_real, default=1.0, metavar="GAMMA",
                    help="γ, the cubic stiffness (> 0 hardens, < 0 softens; default 1)")
-    p.add_argument("--omega-from", type=_real, required=True, metavar="W",
-                   help="the lowest ω, half the pump frequency (required)")
-    p.add_argument("--omega-to", type=_real, required=True, metavar="W",
-                   help="the highest ω (required)")
-    p.add_argument("--points", type=_positive, default=41, metavar="N",
-                   help=f"ω points in the range, 2..{PARAMETRIC_MAX_POINTS} (default 41)")
+    _flag_omega(p, ("A:B", "A:B:N"), "the frequencies ω (half the pump frequency) from A to "
+                "B, in units of the linear natural frequency, N points in "
+                f"2..{PARAMETRIC_MAX_POINTS} (default 41) (required)", points=41)
+    _flag_range_bounds(p, "--omega-from", "--omega-to")
+    _deprecated(p, "--points", "--omega A:B:N", "points", type=_positive)
     _flag_harmonics(p, "odd harmonics of the balance (1, 3, …, 2N − 1)")
     _flag_json(p)
     _flag_plot(p)

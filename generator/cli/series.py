@@ -19,11 +19,13 @@ from ..limits import DRIVEN_MAX_ORDER
 from .common import (
     EMITTED,
     ProgressBar,
+    _deprecated,
     _flag_allow_slow,
     _flag_harmonics,
     _flag_json,
     _flag_order,
     _flag_oscillator,
+    _flag_out,
     _flag_overwrite_edited,
     _fraction_text,
     _nonnegative,
@@ -287,23 +289,23 @@ def _singularities(omega, variable: str, of: str = "omega", degree: int | None =
 
 
 def _emit_only(flags) -> None:
-    """``--emit`` writes a module and prints its path: the printing flags given beside it
+    """``--out`` writes a module and prints its path: the printing flags given beside it
     (``flags``: pairs of a flag and whether it was given) are refused, not ignored."""
     others = [flag for flag, given in flags if given]
     if others:
-        raise InputError(f"--emit writes the module only: drop {', '.join(others)}")
+        raise InputError(f"--out writes the module only: drop {', '.join(others)}")
 
 
 def run_mathieu(args: argparse.Namespace) -> int:
     """``lindstedt mathieu a|b --m M --order K``: DLMF §28.6's series of a_m(q) or b_m(q)."""
     from ..derive.hill import mathieu_series
 
-    if args.emit is not None:
+    if args.out is not None:
         from .. import compiler
 
         _emit_only((("--json", args.json), ("--singularities", args.singularities)))
         for path in compiler.generate_mathieu(args.kind, args.m, args.order,
-                                              _out_folder(args.emit, "--emit"),
+                                              _out_folder(args.out, "--out"),
                                               overwrite_edited=args.overwrite_edited):
             print(path)
         return 0
@@ -329,28 +331,28 @@ def run_mathieu(args: argparse.Namespace) -> int:
 
 
 DAMPING_PANEL = 0.05
-# NOTE: the damped panel of `tongues --plot` without --damping: the tongues visibly lift.
+# NOTE: the damped panel of `tongues --plot` without --zeta: the tongues visibly lift.
 
 
 def run_tongues(args: argparse.Namespace) -> int:
     """``lindstedt tongues P --n N --order K``: the transition curves out of tongue n of
-    x'' + (δ + ε p(t))x = 0, exact; ``--damping Z``: the damped tongue's tip."""
+    x'' + (δ + ε p(t))x = 0, exact; ``--zeta Z``: the damped tongue's tip."""
     from ..derive.hill import fourier_of_text, tongue_tip, transition_curves
     from ..derive.lindstedt import partial_sum, series_radius
 
-    if args.emit is not None:
+    if args.out is not None:
         from .. import compiler
 
-        _emit_only((("--at", args.at is not None), ("--tol", args.tol),
-                    ("--damping", args.damping is not None), ("--plot", args.plot),
+        _emit_only((("--eps", args.eps is not None), ("--tol", args.tol),
+                    ("--zeta", args.zeta is not None), ("--plot", args.plot),
                     ("--json", args.json), ("--singularities", args.singularities)))
         for path in compiler.generate_tongue(args.p, args.n, args.order,
-                                             _out_folder(args.emit, "--emit"),
+                                             _out_folder(args.out, "--out"),
                                              overwrite_edited=args.overwrite_edited):
             print(path)
         return 0
-    if args.tol is not None and args.at is None:
-        raise InputError("--tol: give --at EPS, the eps the tolerance is asked at")
+    if args.tol is not None and args.eps is None:
+        raise InputError("--tol: give --eps EPS, the ε the tolerance is asked at")
     if args.plot:
         from ..charts import check_plot_path
 
@@ -380,40 +382,40 @@ def run_tongues(args: argparse.Namespace) -> int:
             row["singularities"], line = _singularities(list(curve.delta), "eps",
                                                         f"delta ({curve.label})", None)
             lines.append(line)
-        if args.at is not None:
-            value, error, best = partial_sum(curve.delta, args.at)
+        if args.eps is not None:
+            value, error, best = partial_sum(curve.delta, args.eps)
             radius = series_radius(curve.delta)
-            if abs(args.at) >= radius:  # outside the disc of convergence: no value
+            if abs(args.eps) >= radius:  # outside the disc of convergence: no value
                 value, error = math.nan, math.inf
             if args.tol is not None and not error <= args.tol:
-                _, best_error, _ = partial_sum(curve.delta[:best + 1], args.at)
-                raise InputError(f"--tol {args.tol:g}: not reached at eps = {args.at:g} by order "
+                _, best_error, _ = partial_sum(curve.delta[:best + 1], args.eps)
+                raise InputError(f"--tol {args.tol:g}: not reached at eps = {args.eps:g} by order "
                                  f"{args.order} (estimate {error:.2g}); the best reachable is "
                                  f"{best_error:.2g} at order {best}")
-            row["at"] = {"eps": args.at, "delta": value, "error": error, "radius": radius}
-            lines.append(f"at eps = {args.at:g}: delta = {value:.15g} (truncation ~{error:.2g}"
+            row["at"] = {"eps": args.eps, "delta": value, "error": error, "radius": radius}
+            lines.append(f"at eps = {args.eps:g}: delta = {value:.15g} (truncation ~{error:.2g}"
                          f"; radius of convergence ~{radius:.4g})")
         data["curves"].append(row)
-    if args.damping is not None:
+    if args.zeta is not None:
         tip = tongue_tip(p, args.n, args.order)
-        eps, _, _ = partial_sum(tip.eps_min, args.damping)
-        delta, err, _ = partial_sum(tip.delta, args.damping)
+        eps, _, _ = partial_sum(tip.eps_min, args.zeta)
+        delta, err, _ = partial_sum(tip.delta, args.zeta)
         data["damping"] = {
             "variable": "zeta", "equation": "x'' + 2 zeta x' + (delta + eps p(t)) x = 0",
             "eps_min": [_fraction_text(c) for c in tip.eps_min],
             "delta_at_min": [_fraction_text(c) for c in tip.delta],
             "mu_max": [_fraction_text(c) for c in tip.mu],
-            "at": {"zeta": args.damping, "eps_min": eps, "delta": delta, "error": err}}
+            "at": {"zeta": args.zeta, "eps_min": eps, "delta": delta, "error": err}}
         lines.append("damped tongue tip: eps_min(zeta) = sum_k e_k zeta^k at delta = sum_k "
                      "d_k zeta^k (k, e_k, d_k)")
         lines += [f"{k:>4}  {_fraction_text(e):>24}  {_fraction_text(d)}"
                   for k, (e, d) in enumerate(zip(tip.eps_min, tip.delta, strict=True))]
-        lines.append(f"at zeta = {args.damping:g}: eps_min = {eps:.12g}, delta = {delta:.12g}")
+        lines.append(f"at zeta = {args.zeta:g}: eps_min = {eps:.12g}, delta = {delta:.12g}")
     print(json.dumps(data) if args.json else "\n".join(lines))
     if args.plot:
         from ..charts import ince_strutt_figure
 
-        path = ince_strutt_figure(Path(args.plot), args.p, args.damping or DAMPING_PANEL,
+        path = ince_strutt_figure(Path(args.plot), args.p, args.zeta or DAMPING_PANEL,
                                   order=args.order, tongues=range(max(4, args.n + 1)))
         if not args.json:
             print(f"Ince–Strutt chart: {path}")
@@ -594,13 +596,11 @@ def arguments_mathieu(sub: argparse._SubParsersAction) -> argparse.ArgumentParse
     _flag_order(p, "highest power K of q")
     _flag_json(p, "the contract {kind, m, variable, series}")
     _flag_allow_slow(p, deprecated_force=False)
-    p.add_argument("--emit", metavar="DIR", default=None,
-                   help="write DIR/mathieu_<kind><m>.py instead: a numba ufunc of the value, "
-                   "Padé-resummed from the series to --order and refined by a Newton step on "
-                   "the recurrence's determinant, verified against the eigenvalues at 30 digits "
-                   "on a grid of q up to 50 and NaN beyond where it was verified")
-    p.add_argument("--overwrite-edited", action="store_true",
-                   help="with --emit: overwrite a file edited since it was generated")
+    _flag_out(p, "write DIR/mathieu_<kind><m>.py instead: a numba ufunc of the value, "
+              "Padé-resummed from the series to --order and refined by a Newton step on the "
+              "recurrence's determinant, verified against the eigenvalues at 30 digits on a "
+              "grid of q up to 50 and NaN beyond where it was verified", old="--emit")
+    _flag_overwrite_edited(p)
     p.add_argument("--singularities", action="store_true",
                    help="also estimate the nearest singularity (radius of convergence) from "
                    "the exact series, with its spread; in q**2 for a_2n, b_2n; with --json a "
@@ -621,13 +621,15 @@ def arguments_tongues(sub: argparse._SubParsersAction) -> argparse.ArgumentParse
     p.add_argument("--n", type=_order, default=1, metavar="N",
                    help="the tongue delta = N^2/4, an integer ≥ 0 (default 1)")
     _flag_order(p, "highest power K of eps")
-    p.add_argument("--damping", type=_nonnegative, metavar="Z",
-                   help="also the tip of the tongue of x'' + 2Z x' + (delta + eps p) x = 0: "
-                   "eps_min and its delta as series in zeta, and their values at Z")
-    p.add_argument("--at", type=_real, metavar="EPS",
-                   help="also evaluate each curve at eps = EPS with its truncation estimate")
+    p.add_argument("--zeta", type=_nonnegative, metavar="ZETA",
+                   help="also the tip of the tongue of x'' + 2ζ x' + (δ + ε p) x = 0, ζ the "
+                   "damping ratio: ε_min and its δ as series in ζ, and their values at ZETA")
+    _deprecated(p, "--damping", "--zeta", "zeta", type=_nonnegative)
+    p.add_argument("--eps", type=_real, metavar="EPS",
+                   help="also evaluate each curve at ε = EPS with its truncation estimate")
+    _deprecated(p, "--at", "--eps", "eps", type=_real)
     p.add_argument("--tol", type=_positive_real, metavar="TOL",
-                   help="with --at: refuse unless the truncation estimate is ≤ TOL (naming "
+                   help="with --eps: refuse unless the truncation estimate is ≤ TOL (naming "
                    "the best reachable)")
     p.add_argument("--singularities", action="store_true",
                    help="also estimate each curve's nearest singularity in eps (radius of "
@@ -635,17 +637,15 @@ def arguments_tongues(sub: argparse._SubParsersAction) -> argparse.ArgumentParse
     p.add_argument("--plot", metavar="FILE",
                    help="also draw the Ince–Strutt chart of this p into FILE (.png, .svg or "
                    ".pdf): Floquet multipliers on a 400 x 400 grid, undamped and with damping "
-                   f"Z (default {DAMPING_PANEL}), the series curves of tongues 0..max(3, N)")
+                   f"ζ = ZETA (default {DAMPING_PANEL}), the series curves of tongues 0..max(3, N)")
     _flag_json(p, "the curves as JSON {p, n, variable, delta0, harmonics, time_origin, period, "
                "solution_variable, curves: [{label, series, solution}], damping}")
     _flag_allow_slow(p, deprecated_force=False)
-    p.add_argument("--emit", metavar="DIR", default=None,
-                   help="write DIR/tongue_<N>.py instead: numba ufuncs delta_<i>(eps) and "
-                   "delta_<i>_error(eps), one per curve, Padé-resummed from the series to "
-                   "--order (≥ 12), verified against the Floquet boundary |tr M| = 2 to 1e-10 "
-                   "in delta on 240 points up to 3 radii (at most eps = 10), NaN beyond")
-    p.add_argument("--overwrite-edited", action="store_true",
-                   help="with --emit: overwrite a file edited since it was generated")
+    _flag_out(p, "write DIR/tongue_<N>.py instead: numba ufuncs delta_<i>(eps) and "
+              "delta_<i>_error(eps), one per curve, Padé-resummed from the series to --order "
+              "(≥ 12), verified against the Floquet boundary |tr M| = 2 to 1e-10 in delta on "
+              "240 points up to 3 radii (at most eps = 10), NaN beyond", old="--emit")
+    _flag_overwrite_edited(p)
     return p
 
 

@@ -18,6 +18,7 @@ from .common import (
     ProgressBar,
     _flag_allow_slow,
     _flag_json,
+    _flag_out,
     _flag_plot,
     _out_folder,
     _params,
@@ -27,6 +28,8 @@ from .common import (
 
 def run_sweep(args: argparse.Namespace) -> int:
     """A map over a parameter grid on dask.distributed, into a resumable Zarr store."""
+    if args.out is None:
+        raise InputError("the following arguments are required: --out")
     if args.plot:
         from ..charts import check_plot_path
 
@@ -49,11 +52,11 @@ def run_sweep(args: argparse.Namespace) -> int:
     else:
         if args.axis or args.param or args.name or args.n is not None:
             raise InputError("--axis/--param/--name/--n: give an equation (EQUATION) to take "
-                             "them; the notes' map takes --omega, --force, --eps, --Q")
+                             "them; Duffing's map takes --omega, --force, --eps, --Q")
         axes = builtin
     bar = ProgressBar(f"sweep {args.kind}", not args.json)
     try:
-        ds = run_sweep(kind, axes, _out_folder(args.store, "--store"), args.scheduler,
+        ds = run_sweep(kind, axes, _out_folder(args.out, "--out"), args.scheduler,
                        args.workers, args.chunk, lambda p: bar(p.finished, p.total))
     finally:
         bar.close()  # an interrupt's line starts on a clean line
@@ -62,7 +65,7 @@ def run_sweep(args: argparse.Namespace) -> int:
 
         sweep_figure(ds, Path(args.plot))
     held = summary(ds)
-    data = {"kind": args.kind, "store": str(args.store),
+    data = {"kind": args.kind, "store": str(args.out),
             "axes": {name: list(values) for name, values in held.axes},
             "fields": list(held.fields), "blocks": held.blocks, "finished": held.finished,
             "complete": held.complete}
@@ -74,7 +77,7 @@ def run_sweep(args: argparse.Namespace) -> int:
         print(json.dumps(data))
         return 0
     shape = " × ".join(f"{len(v)} {k}" for k, v in data["axes"].items())
-    print(f"sweep {args.kind}: {shape} into {args.store}: {data['finished']}/{data['blocks']} "
+    print(f"sweep {args.kind}: {shape} into {args.out}: {data['finished']}/{data['blocks']} "
           f"blocks done; fields {', '.join(data['fields'])}")
     if args.plot:
         print(f"  figure {args.plot}")
@@ -122,19 +125,19 @@ def arguments_sweep(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                        "dask.distributed (a LocalCluster here by default), block by block into "
                        "a Zarr store; run the same command again to resume an interrupted "
                        "sweep. Your own equation: any of its parameters (the drive frequency "
-                       "included) an --axis, the rest --param; without EQUATION the notes' "
+                       "included) an --axis, the rest --param; without EQUATION Duffing's "
                        "q'' + q'/Q + q + eps q^3 = f cos(wt) over --omega, --force, --eps, --Q "
                        "(A:B:N is N values from A to B; response, stability and validity take "
                        "all four, subharmonic omega, force and eps).")
     p.add_argument("kind", choices=SWEEP_KINDS,
                    help="response: r of every branch; stability: Floquet verdicts of the true "
                    "orbits (with an EQUATION both: every orbit shot, r and its verdict); "
-                   "subharmonic: orbits of n drive periods (the notes': the 1/3 of eq. 10.87); "
-                   "validity: μ-expansion error (the notes' equation only)")
+                   "subharmonic: orbits of n drive periods (without EQUATION: Duffing's 1/3 "
+                   "subharmonic); validity: the μ-expansion's error (Duffing's only)")
     p.add_argument("model", metavar="EQUATION", nargs="?", default=None,
                    help="a driven equation such as \"q'' + 0.05*q' + q + eps*(alpha*q**2 + "
-                   "q**3) = f*cos(w*t)\"; default: the notes' equation with --omega, --force, "
-                   "--eps, --Q")
+                   "q**3) = f*cos(w*t)\"; default: Duffing's q'' + q'/Q + q + εq³ = f cos ωt "
+                   "with --omega, --force, --eps, --Q")
     p.add_argument("--axis", type=_named_axis, action="append", metavar="NAME=VALUES",
                    help="with EQUATION: a parameter swept, e.g. w=0.8:1.6:41 or alpha=0,1/2,1 "
                    "(A:B:N, v1,v2,… or one value; repeatable; the store's coordinates take "
@@ -150,10 +153,9 @@ def arguments_sweep(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                           ("force", "f, drive amplitude"), ("eps", "ε, cubic stiffness"),
                           ("Q", "quality factor (inf: undamped)")):
         p.add_argument(f"--{name}", type=_axis_values, metavar="VALUES",
-                       help=f"the notes' equation: {meaning}: A:B:N, v1,v2,… or one value")
-    p.add_argument("--store", required=True, metavar="PATH",
-                   help="the Zarr store (a folder) the map is written into, block by block "
-                   "(required; an existing store of the same sweep resumes)")
+                       help=f"without EQUATION: {meaning}: A:B:N, v1,v2,… or one value")
+    _flag_out(p, "the Zarr store (a folder) the map is written into, block by block "
+              "(required; an existing store of the same sweep resumes)", old="--store")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="tcp://host:port of a running dask scheduler whose workers have "
                    "lindstedt (default: a LocalCluster on this machine)")

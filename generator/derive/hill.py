@@ -338,11 +338,11 @@ def tongue_tip(p: Harmonics | str, n: int, order: int) -> TongueTip:
     order = max(wanted, 1)  # ζ = μ̃(ε)/2 starts at ε¹: its reversion needs that term
     shift = next((s for s in (0, 1) if all(b == 0 for _, b in _shifted(p, s).values())), None)
     if shift is None:
-        raise InputError("--damping: p(t) must be even about t = 0 or a quarter period (then "
+        raise InputError("--zeta: p(t) must be even about t = 0 or a quarter period (then "
                          "the damped tongue's tip is an exact series)")
     q = _shifted(p, shift)
     if not q.get(n, (0, 0))[0]:
-        raise InputError(f"--damping: p(t) has no harmonic {n}: tongue n = {n} opens only at "
+        raise InputError(f"--zeta: p(t) has no harmonic {n}: tongue n = {n} opens only at "
                          "a higher order in ε (its tip under damping is not handled)")
     P = {(0, 2 * k): fmpq(4 * a.numerator, a.denominator) for k, (a, _) in q.items() if a}
     kernel = {(0, n), (1, n)}

@@ -5,7 +5,7 @@ form the L–P engine solves (notes §10.3, EOM ``ω² q'' + q + ε q³ = 0``)::
 
     ω² u'' + u + Σ_k y^k Σ_n c_kn u^n = 0,     u(0) = 1, u'(0) = 0,
 
-with ``y = coupling · order_factor`` the expansion variable (``x = εA²`` for Duffing,
+with ``y = coupling · order_factor`` the expansion variable (``y = εA²`` for Duffing,
 ``θ₀²`` for the pendulum) and ``forcing[k-1] = ((n, c_kn), ...)``.
 """
 
@@ -90,7 +90,7 @@ def duffing() -> Model:
         amplitude=A,
         coupling=eps,
         order_factor=A**2,
-        variable="x = eps*A**2",
+        variable="y = eps*A**2",
         forcing=(((3, sp.Integer(1)),),),
         radius=sp.Integer(1),
         parameters=(("A", A), ("eps", eps)),
@@ -117,7 +117,7 @@ def pendulum(order: int) -> Model:
         amplitude=theta0,
         coupling=sp.Integer(1),
         order_factor=theta0**2,
-        variable="theta0**2",
+        variable="y = theta0**2",
         forcing=(),
         radius=sp.pi**2,
         parameters=(("theta0", theta0),),
@@ -148,7 +148,7 @@ def polynomial(coefficients: dict[int, object]) -> Model:
     if len(terms) == 1:
         (n, c), = terms
         factor, forcing = A ** (n - 1), (((n, c),),)
-        variable = f"x = eps*A**{n - 1}"
+        variable = f"y = eps*A**{n - 1}"
     else:
         factor, forcing = sp.Integer(1), (tuple((n, c * A ** (n - 1)) for n, c in terms),)
         variable = "eps"
@@ -367,13 +367,13 @@ def free_model(osc: Oscillator, order: int) -> Model:
             math.gcd(*p_values)
         orders = {key: (key[0] + key[1] - 1) // step for key in nonlinear}
         factor, coupling = A**step, sp.Integer(1)
-        variable = "A" if step == 1 else f"A**{step}"
+        variable = "A" if step == 1 else f"y = A**{step}"
         scale = {key: sp.Integer(1) for key in nonlinear}
     elif with_small == {1} and len(p_values) == 1:
         (p,) = p_values
         orders = {key: 1 for key in nonlinear}
         factor, coupling = A**p, small
-        variable = f"x = eps*A**{p}" if p > 1 else "x = eps*A"
+        variable = f"y = eps*A**{p}" if p > 1 else "y = eps*A"
         scale = {key: sp.Integer(1) for key in nonlinear}
     else:
         orders = {key: key[2] for key in nonlinear}

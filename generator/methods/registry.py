@@ -2,7 +2,7 @@
 derives, evaluates and lowers, and what it is checked against.
 
 ``choose`` loops over :data:`METHODS`; the compiler asks a record's :class:`Target`
-(:mod:`.targets`) what to derive and lower for ``generate`` and ``choose --emit``; the kernels,
+(:mod:`.targets`) what to derive and lower for ``generate`` and ``choose --out``; the kernels,
 references and verified resummations live beside it (:mod:`.kernels`, :mod:`.references`,
 :mod:`.verify`).  Adding a method is adding a record.
 
@@ -174,7 +174,7 @@ class Method:
     lowered: Callable[[PeriodTerms], Lowered] = _not_lowered
     solve: Callable[[Drive, Branch, int], Solved] | None = None  # driven: one ω, one order
     driven_orders: tuple[int, ...] = ()
-    target: Target | None = None  # what `generate` / `--emit` writes for it
+    target: Target | None = None  # what `generate` / `--out` writes for it
     bound: int = -1  # driven: which of ``choose``'s emit bounds caps its order (-1: none)
     run_emitted: Callable[..., Emitted] | None = None  # driven: read its emitted module
     emittable: Callable[[object], str | None] = _always  # why its module cannot be emitted
@@ -235,7 +235,7 @@ SIMPLEST_FIRST = ("lindstedt", "one_harmonic", "pade", "resummed", "modified", "
 # per ω as `choose` runs it (interpreted: the μ-expansion's series products grow with the
 # order squared) and, as ``emitted_cost``, its emitted module. Fitted once on the 2-core
 # reference machine by `benchmarks/cost_model.py --fit` (docs/benchmarks.md). Every `choose`
-# decides by these figures, so the choice — and what --emit writes — does not depend on the
+# decides by these figures, so the choice — and what --out writes — does not depend on the
 # machine's load; each run's own timings are reported beside.  mu_expansion_damped's emitted
 # module (six ufuncs: A_n, B_n, n = 1, 3, 5) is fitted like the others at orders 1–4
 # (`cost_model.py --fit --only "driven/mu_expansion_damped, emitted"`); the line 129 + 286·K

@@ -98,7 +98,7 @@ class HarmonicsRequest(Request):
 
 @dataclass(frozen=True)
 class ChoiceRequest(Request):
-    """``choose --emit``: the chosen period formula and the range it was verified on."""
+    """``choose --out``: the chosen period formula and the range it was verified on."""
 
     formula: PeriodFormula
     verified: tuple[float, float]
