@@ -398,7 +398,7 @@ def _flag_oscillator(p: argparse.ArgumentParser, emitted: bool = False) -> None:
 
 
 def _flag_equation(p: argparse.ArgumentParser, example: str,
-                   default: str = "the notes' equation with the flags",
+                   default: str = "the Duffing oscillator with the flags",
                    which: str = "every parameter needs one") -> None:
     """An optional EQUATION of the command's own form, with --param and --name."""
     p.add_argument("model", metavar="EQUATION", nargs="?", default=None,

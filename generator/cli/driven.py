@@ -803,7 +803,8 @@ def arguments_driven(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                        "shooting.")
     _flag_equation(p, "\"q'' + q + eps*q**3 + gamma*q'**3 = f*cos(w*t)\" (a polynomial "
                    "force, one drive f*cos(w*t) whose w is --omega)",
-                   "eq. 10.60 with --eps, --force, --Q", "every parameter but w needs one")
+                   "Duffing's q'' + q'/Q + q + εq³ = f cos ωt with --eps, --force, --Q",
+                   "every parameter but w needs one")
     _flag_drive(p, required=False, omega="ω, the drive frequency (required)", Q="none",
                 notes=True)
     p.add_argument("--Q", type=_quality, default=None, metavar="Q",
@@ -824,7 +825,8 @@ def arguments_response(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
                        "--param for every parameter but w.")
     _flag_equation(p, "\"q'' + 0.05*q' + q + eps*(q**2 + q**3) = f*cos(w*t)\" (a "
                    "polynomial force with damping, one drive f*cos(w*t) whose w the curve "
-                   "varies)", "eq. 10.60 with --eps, --force, --Q", "every parameter but w "
+                   "varies)", "Duffing's q'' + q'/Q + q + εq³ = f cos ωt with --eps, --force, "
+                   "--Q", "every parameter but w "
                    "needs one")
     _flag_drive(p, required=False, omega=None, Q=None, notes=True)
     p.add_argument("--Q", type=_quality, default=None, metavar="Q",
@@ -850,7 +852,7 @@ def arguments_subharmonic(sub: argparse._SubParsersAction) -> argparse.ArgumentP
                        "any polynomial (damped or not): every orbit of n drive periods by "
                        "harmonic balance on the harmonics of w, each shot for its Floquet "
                        "stability, the primary response and the onset (the smallest drive "
-                       "amplitude with such an orbit at this w). Without EQUATION: the notes' "
+                       "amplitude with such an orbit at this w). Without EQUATION: Duffing's "
                        "omega^2 q'' + q + eps q^3 = f cos 3τ in closed form (--eps, --force, "
                        "--omega).")
     _flag_equation(p, "\"x'' + 0.05*x' + x + x**2 = f*cos(w*t)\" (the drive at n times the "
@@ -898,7 +900,7 @@ def arguments_mixing(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                        description="Your own q'' + g(q, q') = Σ f_i cos(w_i t), g any "
                        "polynomial with a linear stiffness and damping: the combination tones "
                        "predicted to the second order of the nonlinearity, beside a simulated "
-                       "steady state; or the notes' q'' + q'/Q + q + eps q^3 (--eps, --Q, "
+                       "steady state; or Duffing's q'' + q'/Q + q + eps q^3 (--eps, --Q, "
                        "--drive).")
     _flag_equation(p, "\"x'' + x'/20 + x + x**2/5 + x**3/10 = 3/20*cos(13*t/10) + "
                    "3/20*cos(17*t/10)\" (every frequency a number or a name given with "
