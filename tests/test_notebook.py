@@ -217,3 +217,29 @@ def test_damped_mu_expansion_shows_sine_coefficients():
     d = Drive(0.1, 0.3, 1.2, 20.0)
     mu = _parse(mu_expansion(d, first_order_branches(d)[0], 3)._repr_html_())
     assert mu.rows[0] == ["order", "A1", "A3", "A5", "B1", "B3", "B5", "δ"]
+
+
+def test_the_notebook_extra_brings_what_the_notebook_imports():
+    """`pip install ".[notebook]"` is all the notebook needs: every module it imports is the
+    package's, a dependency's, or the extra's (IPython comes with ipykernel)."""
+    import ast
+    import tomllib
+
+    nbformat = pytest.importorskip("nbformat")
+    project = tomllib.loads((NOTEBOOK.parent.parent / "pyproject.toml").read_text())["project"]
+    extra = project["optional-dependencies"]["notebook"]
+    assert any(r.startswith("jupyterlab") for r in extra)
+    assert any(r.startswith("ipykernel") for r in extra)
+    provided = {"lindstedt", "IPython", "sys", "tempfile", "pathlib", "mine"} | {
+        r.split(">")[0].split("[")[0].split("<")[0].replace("python-", "") for r in
+        project["dependencies"]}
+    nb = nbformat.read(NOTEBOOK, as_version=4)
+    for cell in nb.cells:
+        if cell.cell_type != "code":
+            continue
+        for node in ast.walk(ast.parse(cell.source)):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else (
+                [node.module] if isinstance(node, ast.ImportFrom) else [])
+            for name in names:
+                top = name.split(".")[0]
+                assert top in provided, (name, sorted(provided))  # mine: the module it writes
