@@ -284,7 +284,7 @@ def test_duffing_json_contract(capsys):
     assert float(data["orbit_limit"]["lower"]) == -1.0
     assert data["orbit_limit"]["upper"] == "inf"
     assert data["model"] == "duffing" and data["order"] == 5
-    assert data["variable"] == "x = eps*A**2" and data["radius"] == "1"
+    assert data["variable"] == "y = eps*A**2" and data["radius"] == "1"
     assert data["convention"] == "q(0) = A, q'(0) = 0, so q_j(0) = 0 for j >= 1"
     assert data["omega"][:4] == ["1/1", "3/8", "-21/256", "81/2048"]
     assert data["period"][:4] == ["1/1", "-3/8", "57/256", "-315/2048"]
@@ -334,7 +334,7 @@ def _quintic_period(order: int) -> list[Fraction]:
 
 def test_quintic_json(capsys):
     data = run_json(capsys, "q'' + q + eps*q**5 = 0", "--order", "6")
-    assert data["variable"] == "x = eps*A**4"
+    assert data["variable"] == "y = eps*A**4"
     assert [_fraction(c) for c in data["period"]] == _quintic_period(6)
     assert [_fraction(c) for c in data["omega"]] == reciprocal(_quintic_period(6))
     for qj in data["q"]:

@@ -159,7 +159,7 @@ def test_polynomial_force_symbolic_coefficients():
 def test_single_power_polynomial_is_duffing():
     sol = derive(polynomial({3: 1}), 10)
     assert fractions(sol, "period") == duffing_period(10)
-    assert polynomial({3: 1}).variable == "x = eps*A**2"
+    assert polynomial({3: 1}).variable == "y = eps*A**2"
 
 
 @pytest.mark.parametrize("bad", [-1, 1.5, "3", True, None])

@@ -150,14 +150,14 @@ CONSERVATIVE = {
     "q'' + q + eps*(q**2 + q**3) = 0": (
         _hd, lambda a, e: e, "eps", 1, [("0.5", "0.2"), ("1", "0.1"), ("0.6", "-0.15")]),
     "q'' + q + eps*q**5 = 0": (
-        lambda q, e: q**2 / 2 + e * q**6 / 6, lambda a, e: e * a**4, "x = eps*A**4", 1,
+        lambda q, e: q**2 / 2 + e * q**6 / 6, lambda a, e: e * a**4, "y = eps*A**4", 1,
         [("0.8", "0.5"), ("1", "-0.2")]),
     "q'' + sinh(q) = 0": (
-        lambda q, e: mp.cosh(q) - 1, lambda a, e: a**2, "A**2", 1, [("0.5", "0"), ("1", "0")]),
+        lambda q, e: mp.cosh(q) - 1, lambda a, e: a**2, "y = A**2", 1, [("0.5", "0"), ("1", "0")]),
     "theta'' + sin(theta) = 0": (
-        lambda q, e: 1 - mp.cos(q), lambda a, e: a**2, "A**2", 1, [("0.5", "0"), ("1", "0")]),
+        lambda q, e: 1 - mp.cos(q), lambda a, e: a**2, "y = A**2", 1, [("0.5", "0"), ("1", "0")]),
     "x'' + 4*x + eps*x**3 = 0": (
-        lambda q, e: 2 * q**2 + e * q**4 / 4, lambda a, e: e * a**2, "x = eps*A**2", 2,
+        lambda q, e: 2 * q**2 + e * q**4 / 4, lambda a, e: e * a**2, "y = eps*A**2", 2,
         [("1", "0.4"), ("0.5", "-1")]),
     "q'' + log(1+q) = 0": (
         lambda q, e: (1 + q) * mp.log(1 + q) - q, lambda a, e: a, "A", 1,
@@ -225,7 +225,7 @@ def test_symmetric_oscillators_exact_period_coefficients(text, series):
     order = 7
     exact = symmetric_period_series(SYMMETRIC[text], X, SIGMA, order)
     sol = series(text, order)
-    assert sol.model.variable == ("x = eps*A**4" if "q**5" in text else "x = eps*A**2")
+    assert sol.model.variable == ("y = eps*A**4" if "q**5" in text else "y = eps*A**2")
     assert fractions(sol) == exact
 
 

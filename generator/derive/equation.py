@@ -17,6 +17,7 @@ from __future__ import annotations
 import ast
 import math
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import sympy as sp
@@ -262,15 +263,16 @@ def parse_expression(text: str, what: str = "expression") -> sp.Expr:
     return _Walker(text, 0, what).parse(text)
 
 
-def parse_equation(text: str) -> Equation:
-    """Parse an equation of motion (see the module docstring); ``= 0`` may be left out."""
-    what = "equation"
+def parse_sides(text: str, what: str = "equation"
+                ) -> tuple[sp.Expr, sp.Expr, dict[str, int], dict[str, int]]:
+    """The two sides of ``text`` through the walker, with ``q'`` and ``q''`` renamed ``q_`` and
+    ``q__`` (the columns stay the user's); each primed name's highest derivative; every name's
+    first column.  ``= 0`` may be left out."""
     if not isinstance(text, str):
-        raise InputError(f"equation {text!r}: not text")
+        raise InputError(f"{what} {text!r}: not text")
     _check_characters(text, what)
     if text.count("=") > 1 or "==" in text:
         raise _fail(text, text.find("="), "one '=' at most (left side = right side)")
-    # primes -> trailing underscores of the same length: the columns stay the user's
     orders: dict[str, int] = {}
     source = text
     for match in _PRIMED.finditer(text):
@@ -292,30 +294,47 @@ def parse_equation(text: str) -> Equation:
         rhs = right_walker.parse(right)
         for name, col in right_walker.names.items():
             names.setdefault(name, col)
+    for name in orders:
+        if name in (TIME, SMALL) or name in RESERVED:
+            raise InputError(f"{what} {text!r}: {name!r} cannot be a coordinate")
+    return lhs, rhs, orders, names
+
+
+def derivative_symbols(coordinate: str) -> tuple[sp.Symbol, sp.Symbol, sp.Symbol]:
+    """``q``, ``q'``, ``q''`` of a coordinate's name."""
+    return tuple(sp.Symbol(coordinate + "'" * k) for k in range(3))
+
+
+def renamed(expr: sp.Expr, coordinates: Sequence[str]) -> sp.Expr:
+    """``q_``, ``q__`` (as :func:`parse_sides` leaves them) back to ``q'``, ``q''``."""
+    return expr.xreplace({sp.Symbol(c + "_" * k): derivative_symbols(c)[k]
+                          for c in coordinates for k in range(3)})
+
+
+def parse_equation(text: str) -> Equation:
+    """Parse an equation of motion (see the module docstring); ``= 0`` may be left out."""
+    lhs, rhs, orders, names = parse_sides(text)
     if len(orders) != 1:
         if not orders:
             raise InputError(f"equation {text!r}: no coordinate — write its acceleration with "
                              "primes, e.g. q''")
         raise InputError(f"equation {text!r}: primes on {', '.join(sorted(orders))}; "
-                         "one coordinate only")
+                         "one coordinate only (a system: one equation per coordinate, "
+                         "separated by ';')")
     (coordinate, top), = orders.items()
-    if coordinate in (TIME, SMALL) or coordinate in RESERVED:
-        raise InputError(f"equation {text!r}: {coordinate!r} cannot be the coordinate")
     if top != 2:
         raise InputError(f"equation {text!r}: the highest derivative is {coordinate}"
                          f"{chr(39) * top}; an oscillator's equation is of second order")
-    derivatives = tuple(sp.Symbol(coordinate + "'" * k) for k in range(3))
-    rename = {sp.Symbol(coordinate + "_" * k): derivatives[k] for k in range(3)}
-    expression = (lhs - rhs).xreplace(rename)
+    derivatives = derivative_symbols(coordinate)
     others = sorted(n for n in names if n.rstrip("_") != coordinate and n not in (TIME, SMALL))
     small = sp.Symbol(SMALL) if SMALL in names else None
     return Equation(
         text=text,
-        expression=expression,
+        expression=renamed(lhs - rhs, [coordinate]),
         derivatives=derivatives,
         time=sp.Symbol(TIME),
         small=small,
         parameters=tuple(sp.Symbol(n) for n in others),
-        lhs=lhs.xreplace(rename),
-        rhs=rhs.xreplace(rename),
+        lhs=renamed(lhs, [coordinate]),
+        rhs=renamed(rhs, [coordinate]),
     )
