@@ -22,6 +22,11 @@ order; a stage imports only stages above it::
     derive.hill             Hill's equation x'' + (δ + ε p(t))x = 0: transition curves out of
                             each tongue, a damped tongue's tip, Mathieu's a_m(q), b_m(q), exact
                             (L–P about cos nτ, sin nτ) [p(t), n, K -> curves]
+    derive.system           a system of coupled oscillators from text: mass, stiffness, force,
+                            the linear modes' exact ω₀² [str -> System]
+    derive.nnm              nonlinear normal modes as exact L–P series in Q or Q(ω₀²), the
+                            secular condition by the left null vector, internal resonances
+                            refused [System, mode, K -> NormalModeSeries]
     derive.averaging        the slow flow of q'' + q = ε f (+ ε F cos ωt): near-identity
                             averaging to any order in van der Pol's variables, exact (R_k, Φ_k
                             of dr/dt, dφ/dt) [Oscillator, K -> SlowFlow]
@@ -93,6 +98,7 @@ order; a stage imports only stages above it::
                             flags, the report shape [argv -> Namespace]
     cli.series              series, mathieu, tongues, slowflow, models, generate
                             [records -> JSON, tables]
+    cli.system              nnm [NormalModeSeries -> JSON, tables]
     cli.driven              driven, response, subharmonic, parametric, mixing
                             [records -> JSON, tables]
     cli.choose              choose, clock, scene [Choice -> JSON, tables]

@@ -481,6 +481,19 @@ def parametric_cost(args: argparse.Namespace) -> Cost:
     return Cost(seconds, f"{args.points} points", "the parametric response")
 
 
+NNM_FIT = (0.6, 4.6e-5, 2.5)
+# NOTE: start-up + c·K³·(d/2)^e seconds for order K and d coordinates: Kerschen's 2-DOF system
+# at order 60 took 7–12 s, the 8-mass FPU-β chain (in Q(ω₀²), a cubic field) at order 10 2.4 s.
+
+
+def nnm_cost(args: argparse.Namespace) -> Cost:
+    """``nnm``: the fit :data:`NNM_FIT` in the order and the number of equations."""
+    fixed, c, e = NNM_FIT
+    d = max(args.system.count(";") + 1, 2)
+    return Cost(fixed + c * args.order**3 * (d / 2) ** e, f"order {args.order}, {d} coordinates",
+                "the normal mode's series")
+
+
 COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "series": series_cost,
     "generate": generate_cost,
@@ -497,6 +510,7 @@ COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "mathieu": mathieu_cost,
     "tongues": tongues_cost,
     "slowflow": slow_flow_cost,
+    "nnm": nnm_cost,
 }
 # NOTE: one estimator per command; `demo` has none: its work is the fixed built-in job
 # (`make demo`), which nothing on its command line scales.

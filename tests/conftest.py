@@ -17,10 +17,10 @@ import pytest
 
 LAYERS = {
     "exact": ("averaging", "branches", "driven", "driven_damped", "driven_equation", "equation",
-              "hill", "layout", "lindstedt", "parametric", "response", "response_equation",
+              "hill", "layout", "lindstedt", "nnm", "parametric", "response", "response_equation",
               "series", "subharmonic"),
     "printers": ("charts", "cli", "costs", "emit", "files", "fuzz", "interrupt", "latex",
-                 "notebook", "validity"),
+                 "notebook", "readme", "validity"),
     "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "orbits", "oscillator",
                 "resum", "sweep", "tongues"),
 }

@@ -1,7 +1,8 @@
 """The ``lindstedt`` command line.  Bad input: one line on stderr, exit status 2.
 
-One module per command family (:mod:`.series`, :mod:`.driven`, :mod:`.choose`,
-:mod:`.sweep`, :mod:`.demo`), each with its commands' arguments, JSON contracts and tables;
+One module per command family (:mod:`.series`, :mod:`.system`, :mod:`.driven`,
+:mod:`.choose`, :mod:`.sweep`, :mod:`.demo`), each with its commands' arguments, JSON contracts
+and tables;
 :data:`COMMANDS` here lists them for the parser, the cost guard and ``--help``."""
 
 from __future__ import annotations
@@ -53,6 +54,7 @@ from .series import (
     run_tongues,
 )
 from .sweep import arguments_sweep, run_sweep
+from .system import arguments_nnm, run_nnm
 
 
 @dataclass(frozen=True)
@@ -75,6 +77,7 @@ COMMANDS: tuple[Command, ...] = tuple(
     ("tongues", arguments_tongues, run_tongues),
     ("models", arguments_models, run_models),
     ("generate", arguments_generate, run_generate),
+    ("nnm", arguments_nnm, run_nnm),
     ("driven", arguments_driven, run_driven),
     ("response", arguments_response, run_response),
     ("subharmonic", arguments_subharmonic, run_subharmonic),

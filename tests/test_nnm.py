@@ -1,0 +1,178 @@
+"""Nonlinear normal modes: exact identities (a system that holds Duffing's oscillator as an
+invariant mode), the backbone against shooting (SciPy's DOP853 and a root finder, another
+route), the JSON contract and the refusals."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from fractions import Fraction
+
+import numpy as np
+import pytest
+import sympy as sp
+from lindstedt.derive.lindstedt import derive
+from lindstedt.derive.models import duffing
+from lindstedt.derive.nnm import normal_mode
+from lindstedt.derive.system import parse_system
+from reference import duffing_period, reciprocal
+from scipy.integrate import solve_ivp
+from scipy.optimize import root
+
+KERSCHEN = "x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0"
+SYMMETRIC = "x1'' + 2*x1 - x2 + x1**3 = 0; x2'' + 2*x2 - x1 + x2**3 = 0"
+# NOTE: x1 = x2 = x gives Duffing's x'' + x + x³ = 0 (mode 1); x1 = −x2 = x gives
+# x'' + 3x + x³ = 0, Duffing with ω₀² = 3 (mode 2): ω(A) = √3 ω_D(A²/3).
+
+
+def run(*args):
+    return subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
+                          text=True, check=False)
+
+
+def test_in_phase_mode_is_duffing_exactly():
+    K = 12
+    mode = normal_mode(parse_system(SYMMETRIC), 1, K)
+    assert mode.variable == "y = A**2" and mode.omega0 == 1
+    exact = duffing_period(K)  # the elliptic integral's series, another route
+    assert [sp.Rational(c) for c in mode.period()] == [sp.Rational(c.numerator, c.denominator)
+                                                      for c in exact]
+    assert mode.omega() == [sp.Rational(c.numerator, c.denominator) for c in reciprocal(exact)]
+    assert mode.coordinate(0) == mode.coordinate(1)
+
+
+def test_out_of_phase_mode_is_duffing_scaled_exactly_in_q_sqrt3():
+    K = 10
+    mode = normal_mode(parse_system(SYMMETRIC), 2, K)
+    r3 = sp.sqrt(3)
+    tau = duffing_period(K)
+    assert mode.omega0 == r3
+    assert mode.period() == [sp.Rational(c.numerator, c.denominator) / 3**j / r3
+                             for j, c in enumerate(tau)]
+    assert mode.omega() == [r3 * sp.Rational(c.numerator, c.denominator) / 3**j
+                            for j, c in enumerate(reciprocal(tau))]
+    one = derive(duffing(), K)  # Duffing's own q_j, from the one-coordinate engine
+    x1, x2 = mode.coordinate(0), mode.coordinate(1)
+    for j in range(K + 1):
+        expected = {n: one.ground.to_sympy(c) / 3**j for n, c in one.q[j].items() if c}
+        assert x1[j] == expected
+        assert x2[j] == {n: -c for n, c in expected.items()}
+
+
+def _shoot(system: str, amplitude: float, guess: list[float], half: float):
+    """The periodic orbit through x1(0) = A with every velocity zero: the unknowns are the
+    other coordinates at t = 0 and the half period, where every velocity vanishes again."""
+    s = parse_system(system)
+    d = s.size
+    f = sp.lambdify([s.coordinates], [-(s.stiffness * sp.Matrix(s.coordinates))[i] - s.force[i]
+                                      for i in range(d)], "numpy")
+
+    def rhs(t, z):
+        return np.concatenate([z[d:], f(z[:d])])
+
+    def at_half(u):
+        x0 = np.concatenate([[amplitude], u[:-1], np.zeros(d)])
+        sol = solve_ivp(rhs, (0, u[-1]), x0, method="DOP853", rtol=1e-13, atol=1e-15)
+        return sol.y[d:, -1]
+
+    out = root(at_half, [*guess, half], method="hybr", tol=1e-14)
+    assert out.success, out.message
+    return out.x[:-1], 2 * out.x[-1]
+
+
+def _evaluate(mode, A: float) -> tuple[float, list[float]]:
+    y = A ** (2 if mode.variable.startswith("y") else 1)
+    period = 2 * np.pi * sum(float(c) * y**j for j, c in enumerate(mode.period()))
+    starts = [A * sum(float(c) * y**j for j, order in enumerate(mode.coordinate(i))
+                      for c in order.values()) for i in range(mode.system.size)]
+    return period, starts
+
+
+@pytest.mark.parametrize("which", [1, 2])
+@pytest.mark.parametrize("A, tol", [(0.1, 1e-8), (0.3, 1e-5)])
+def test_kerschen_backbone_against_shooting(which, A, tol):
+    """Kerschen et al.'s 2-DOF system, order 12: the period and the mode shape x2(0) against
+    the orbit shot by DOP853 (relative error of T, absolute of x2(0)/A)."""
+    mode = normal_mode(parse_system(KERSCHEN), which, 12)
+    period, starts = _evaluate(mode, A)
+    others, shot = _shoot(KERSCHEN, A, starts[1:], period / 2)
+    assert abs(period / shot - 1) <= tol
+    assert abs(starts[1] - others[0]) / A <= tol
+
+
+def test_fpu_beta_chain_lowest_mode_against_shooting():
+    """The FPU-β chain of 8 masses with fixed ends: ω₀² is a root of a cubic (exact in that
+    number field), and the order-6 backbone meets shooting at A = 0.05."""
+    n = 8
+    eqs = []
+    for i in range(1, n + 1):
+        left = f"x{i - 1}" if i > 1 else "0"
+        right = f"x{i + 1}" if i < n else "0"
+        eqs.append(f"x{i}'' + 2*x{i} - {left} - {right} + (x{i} - {left})**3 "
+                   f"- ({right} - x{i})**3 = 0")
+    text = "; ".join(eqs)
+    mode = normal_mode(parse_system(text), 1, 6)
+    assert float(mode.lam) == pytest.approx(4 * np.sin(np.pi / 18) ** 2, rel=1e-15)
+    assert not mode.lam.is_Rational
+    A = 0.05
+    period, starts = _evaluate(mode, A)
+    others, shot = _shoot(text, A, starts[1:], period / 2)
+    assert abs(period / shot - 1) <= 1e-10
+    assert np.max(np.abs(np.array(starts[1:]) - others)) / A <= 1e-9
+
+
+def test_contract_mode_2_order_20_in_q_sqrt3():
+    out = run("nnm", KERSCHEN, "--mode", "2", "--order", "20", "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert {"kind", "mode", "omega0", "variable", "omega", "period", "coordinates"} <= data.keys()
+    assert data["kind"] == "nnm" and data["mode"] == 2 and data["omega0"] == "sqrt(3)"
+    assert data["variable"] == "y = A**2" and len(data["omega"]) == 21
+    r3 = sp.sqrt(3)
+    for text in data["omega"] + data["period"]:
+        ratio = sp.nsimplify(sp.sympify(text) / r3)  # an exact rational multiple of √3
+        assert ratio.is_Rational
+        assert Fraction(str(ratio)) == Fraction(str(sp.sympify(text) / r3))
+    assert set(data["coordinates"]) == {"x1", "x2"}
+    assert data["coordinates"]["x1"][0] == {"1": "1"}
+    assert data["coordinates"]["x2"][0] == {"1": "-1"}  # mode 2 is out of phase
+    assert all(sum(Fraction(c) for c in order.values()) == 0
+               for order in data["coordinates"]["x1"][1:])  # x1(0) = A exactly
+
+
+@pytest.mark.parametrize("args, says", [
+    (["x1'' + x1 + (x1 + x2)**3 = 0; x2'' + 9*x2 + (x1 + x2)**3 = 0"],
+     "mode 1 (ω0² = 1) is in 1:3 internal resonance with mode 2 (ω0² = 9): harmonic 3 of "
+     "order 1"),
+    (["x1'' + x1 + x1*x2 = 0; x2'' + 4*x2 + x1**2 = 0"], "1:2 internal resonance"),
+    (["x1'' + x1 - x2 + x1**3 = 0; x2'' + x2 - x1 = 0"], "a rigid-body linear mode"),
+    (["x1'' - x1 + x1**3 = 0; x2'' + x2 = 0"], "an unstable linear mode"),
+    (["x1'' + x1 + x1**3 = 0"], "one equation per coordinate, separated by ';'"),
+    (["x1'' + x1 + x2 = 0; x1'' + x1 = 0"], "x1'' leads two equations"),
+    (["x1'' + x1 + x2' = 0; x3'' + x3 = 0"], "x2 has no equation of its own"),
+    (["x1'' + x1 + x1'/10 = 0; x2'' + x2 = 0"], "damping"),
+    (["x1'' + x1 + x1**2*x1' = 0; x2'' + 4*x2 = 0"], "not conservative"),
+    ([KERSCHEN, "--mode", "3"], "--mode 3: the system has modes 1..2"),
+    (["x1'' + x1 + x1**3 = 0; x2'' + 4*x2 + x2**3 = 0", "--mode", "2"],
+     "--amplitude x1: this coordinate does not move in mode 2"),
+    ([KERSCHEN, "--amplitude", "x3"], "--amplitude x3: not a coordinate"),
+    (["x1'' + k*x1 + x1**3 = 0; x2'' + x2 = 0"], "give k a value with --param"),
+    (["x1'' + x1 + __import__('os') = 0; x2'' + x2 = 0"], "equation"),
+    ([KERSCHEN, "--order", "500"], "--allow-slow"),
+])
+def test_refusals_one_line_exit_2(args, says):
+    out = run("nnm", *args)
+    assert out.returncode == 2 and out.stdout == ""
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and says in lines[0], out.stderr
+
+
+def test_amplitude_on_another_coordinate_is_the_same_orbit():
+    """--amplitude x2 parametrises the same family: at the same orbit, both conventions give
+    the same period (x2(0) of one is the other's amplitude)."""
+    by_x1 = normal_mode(parse_system(KERSCHEN), 1, 12)
+    by_x2 = normal_mode(parse_system(KERSCHEN), 1, 12, amplitude=1)
+    period1, starts = _evaluate(by_x1, 0.1)
+    period2, _ = _evaluate(by_x2, starts[1])
+    assert abs(period1 / period2 - 1) <= 1e-9
