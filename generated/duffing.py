@@ -2,8 +2,8 @@
 # model: duffing, order: 12
 # command: lindstedt generate duffing --order 12
 # inputs sha256: 66ca4a0e4d6afa8046c93839a6f1efa563f457106a4ae4f18222a37b87ca56f2
-# body sha256: c6137631cddc45ecbd0e0aee2b33cbf3000cb67d571e0dcb1983199b4dfcb312
-"""q'' + q + eps*q**3 = 0: L–P evaluators to order 12 in x = eps*A**2.
+# body sha256: ea8fd5aaf90cb311cd3c9ab39a676d6e47db5a547afe9f9a480c7b9b93b3d67d
+"""q'' + q + eps*q**3 = 0: L–P evaluators to order 12 in y = eps*A**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
 or arrays.  Outside its domain it returns NaN (see each docstring).  Its twin
@@ -21,7 +21,7 @@ from numba.extending import overload
 
 ORDER = 12
 MODEL = 'duffing'
-VARIABLE = 'x = eps*A**2'
+VARIABLE = 'y = eps*A**2'
 CONVENTION = "q(0) = A, q'(0) = 0, so q_j(0) = 0 for j >= 1"
 RADIUS = 1.0
 RADIUS_SPREAD = 0.0

@@ -2,8 +2,8 @@
 # model: pendulum, order: 12
 # command: lindstedt generate pendulum --order 12
 # inputs sha256: 89790c3fd0e75fcdff47f37c71d07dae7a9aef7a774488dd064ce33f5d86074d
-# body sha256: 05d7812c8c09f456fc2f423ea2ff3f03ea8232c45b3321c5294197f2211f753a
-"""theta'' + sin(theta) = 0: L–P evaluators to order 12 in theta0**2.
+# body sha256: 9eb0e58c0caf941da23aca01a4a7fdc34e25b888946219d04a0bd8c2be20b3ac
+"""theta'' + sin(theta) = 0: L–P evaluators to order 12 in y = theta0**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
 or arrays.  Outside its domain it returns NaN (see each docstring).  Its twin
@@ -21,7 +21,7 @@ from numba.extending import overload
 
 ORDER = 12
 MODEL = 'pendulum'
-VARIABLE = 'theta0**2'
+VARIABLE = 'y = theta0**2'
 CONVENTION = "q(0) = A, q'(0) = 0, so q_j(0) = 0 for j >= 1"
 RADIUS = 9.869604401089358
 RADIUS_SPREAD = 0.0

@@ -70,6 +70,8 @@ order; a stage imports only stages above it::
                             [solution -> Module]
     lower.driven            the μ-expansion's branches (Cardano), damped, the harmonic-balance
                             system [orders -> Module]
+    lower.system            a nonlinear normal mode's backbone ω(A), T(A) and shape x_i(t, A),
+                            NaN past the estimated radius [NormalModeSeries -> Module]
     lower.documents         the derivations' LaTeX records, the AGM period, a chosen formula,
                             the slow flow [solution -> Unit]
     emit.render             strict Jinja2 environments, provenance, one-unit writes

@@ -26,6 +26,7 @@ from .methods.targets import (
     MATHIEU,
     MU,
     MU_DAMPED,
+    NNM,
     SLOW_FLOW,
     TONGUE,
     ChoiceRequest,
@@ -33,6 +34,7 @@ from .methods.targets import (
     FreeRequest,
     HarmonicsRequest,
     MathieuRequest,
+    NormalModeRequest,
     Progress,
     Request,
     SlowFlowRequest,
@@ -161,6 +163,16 @@ def generate_mathieu(kind: str, m: int, order: int, out: Path, *,
     command = f"lindstedt mathieu {kind} --m {m} --order {order} --out DIR"
     return compile_target(MATHIEU, MathieuRequest(order, command, kind, m), out,
                           overwrite_edited=overwrite_edited, flag=flag)
+
+
+def generate_nnm(system: object, mode: int, order: int, out: Path, *, amplitude: int = 0,
+                 name: str = "system", command: str = "lindstedt generate SYSTEM",
+                 progress: Progress | None = None, overwrite_edited: bool = False,
+                 flag: str = "--out") -> list[Path]:
+    """``lindstedt generate SYSTEM --mode M``: the mode's backbone and shape evaluators."""
+    order = check_order(order)
+    return compile_target(NNM, NormalModeRequest(order, command, system, mode, amplitude, name),
+                          out, progress, overwrite_edited=overwrite_edited, flag=flag)
 
 
 TONGUE_MIN_ORDER = 12

@@ -234,6 +234,13 @@ def generate_cost(args: argparse.Namespace) -> Cost:
                          "`lindstedt series` derives higher orders")
     harmonic = args.model in ("balance", "fourier")
     size = args.harmonics if harmonic else args.order
+    if ";" in args.model:  # a system's normal mode: its series to the radius order, emitted
+        from .methods.targets import NNM_RADIUS_ORDER
+
+        series = nnm_cost(argparse.Namespace(system=args.model,
+                                             order=max(size + 2, NNM_RADIUS_ORDER)))
+        return Cost(series.seconds + generate_seconds("duffing", size), series.subject,
+                    "generating the normal mode's evaluators")
     if args.model not in GENERATE_COSTS:  # a user's: its derivation, then Duffing's emission
         derivation = series_cost(argparse.Namespace(model=args.model, param=args.param,
                                                     order=size + 2)).seconds

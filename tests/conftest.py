@@ -21,8 +21,8 @@ LAYERS = {
               "series", "subharmonic"),
     "printers": ("charts", "cli", "costs", "emit", "files", "fuzz", "interrupt", "latex",
                  "notebook", "readme", "validity"),
-    "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "orbits", "oscillator",
-                "resum", "sweep", "tongues"),
+    "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "nnm_emitted", "orbits",
+                "oscillator", "resum", "sweep", "tongues"),
 }
 LAYER_OF = {f"test_{name}.py": layer for layer, names in LAYERS.items() for name in names}
 

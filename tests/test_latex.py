@@ -1,5 +1,7 @@
-"""The LaTeX typesets: long integers break only between digit groups, and every kind of .tex
-the tool writes compiles with pdflatex without running into the margin."""
+"""The LaTeX typesets: long integers break only between digit groups, series run several terms
+to a line, the Fourier table is j × n with the exact coefficients, one notation (ε, y, the user's
+coordinate, no raw input), and every kind of .tex the tool writes compiles with pdflatex without
+running into the margin."""
 
 import random
 import re
@@ -9,8 +11,20 @@ from pathlib import Path
 
 import pytest
 import sympy as sp
-from lindstedt.compiler import generate, generate_driven
-from lindstedt.lower.printers import LATEX_LINE_DIGITS, latex_digits, latex_rational
+from lindstedt.compiler import generate, generate_driven, generate_limit_cycle
+from lindstedt.derive.lindstedt import derive
+from lindstedt.derive.models import model_by_name, series_model
+from lindstedt.emit.render import latex_context
+from lindstedt.lower.documents import lower_derivation
+from lindstedt.lower.printers import (
+    LATEX_LINE_DIGITS,
+    LINE_EM,
+    latex_digits,
+    latex_lines,
+    latex_rational,
+    latex_sum_items,
+    latex_width,
+)
 
 GENERATED = Path(__file__).resolve().parents[1] / "generated"
 PDFLATEX = shutil.which("pdflatex")
@@ -65,6 +79,92 @@ def test_rationals_keep_every_digit():
         assert (-value if sign else value) == r
 
 
+def test_lines_hold_several_terms_and_a_short_sum_stays_on_one():
+    assert latex_lines(["a", "+ b", "- c"]) == ["a + b - c"]
+    assert latex_lines(["a", "+ b", "- c"], 3.0) == ["a + b", "- c"]
+    terms = [rf"+ \frac{{{7**k}}}{{{2**k}}}\,y^{{{k}}}" for k in range(1, 13)]
+    lines = latex_lines(["1", *terms], 30.0)
+    assert 2 <= len(lines) <= 4  # 13 terms: never one a line
+    assert " ".join(lines) == " ".join(["1", *terms])  # nothing lost, order kept
+    assert all(latex_width(line) <= 30.0 for line in lines)
+
+
+def test_a_term_wider_than_a_line_is_scaled_not_broken():
+    wide = r"- \frac{" + "1" * 120 + r"}{7}\,y"
+    assert latex_lines(["1", wide, "+ y"], 30.0) == ["1", r"- \fitmath{30em}{" + wide[2:] + "}",
+                                                     "+ y"]
+
+
+def test_common_factors_are_pulled_out_of_a_sum():
+    A, eps, w, f = sp.symbols("A_1 eps omega f")
+    expr = (-45 * A**7 * eps**3 + 60 * A**5 * eps**2 * w**2 - 16 * A**3 * eps) / (
+        128 * w**4 * (9 * A**2 * eps - 4 * w**2 + 4))
+    items = latex_sum_items(expr)
+    assert items[0] == (r"\frac{\varepsilon A_{1}^{3}}{128 \omega^{4} \left(9 \varepsilon "
+                        r"A_{1}^{2} - 4 \omega^{2} + 4\right)} \Bigl(")
+    assert items[1:] == [r"- 45 \varepsilon^{2} A_{1}^{4}", r"+ 60 \varepsilon A_{1}^{2} "
+                         r"\omega^{2}", r"- 16\Bigr)"]
+    assert latex_sum_items(f / w**2 - A / 2) == [r"- \frac{A_{1}}{2} + \frac{f}{\omega^{2}}"]
+
+
+# --- the documents --------------------------------------------------------------------------
+
+def tex_rational(cell: str) -> sp.Rational:
+    """The exact value of a table cell ``-\frac{p}{q}`` or ``p`` (digits grouped)."""
+    m = re.fullmatch(r"(-?)(?:\\frac\{(\d+)\}\{(\d+)\}|(\d+))", ungrouped(cell))
+    assert m, cell
+    sign, p, q, whole = m.groups()
+    value = sp.Integer(whole) if whole else sp.Rational(int(p), int(q))
+    return -value if sign else value
+
+
+def fourier_table(tex: str) -> dict[tuple[int, int], sp.Rational]:
+    """``{(j, n): coefficient}`` read from the Fourier table's blocks of a tables .tex."""
+    section = tex[tex.index(r"\subsection*{Fourier coefficients"):]
+    cells = {}
+    for block in re.findall(r"\\begin\{longtable\}(.*?)\\end\{longtable\}", section, re.S):
+        lines = [line.removesuffix(r" \\") for line in block.splitlines()]
+        header = next(line for line in lines if line.startswith("$j$")).split(" & ")[1:]
+        harmonics = [1 if h == r"$\cos s$" else int(re.fullmatch(r"\$\\cos (\d+)s\$", h)[1])
+                     for h in header]
+        for line in lines:
+            if re.match(r"\d+ &", line):
+                j, *row = line.split(" & ")
+                assert len(row) == len(harmonics), line
+                for n, cell in zip(harmonics, row, strict=True):
+                    if cell:
+                        cells[int(j), n] = tex_rational(cell.removeprefix(r"\padmath{")[:-1])
+    return cells
+
+
+@pytest.mark.parametrize("model", ["duffing", "pendulum"])
+def test_fourier_table_is_j_by_n_with_the_exact_coefficients(model):
+    """The committed table: rows j = 0..K, columns n = 1, 3, …, 2K + 1, each entry the
+    coefficient of cos ns in q_j of the series (Python API); blocks fit the page."""
+    tex = (GENERATED / f"{model}_tables.tex").read_text()
+    order = int(re.search(r"order: (\d+)", tex)[1])
+    solution = derive(model_by_name(model, order), order)
+    exact = {(j, n): sp.Rational(str(c)) for j, qj in enumerate(solution.q) for n, c in qj.items()}
+    assert fourier_table(tex) == exact
+    assert {j for j, _ in exact} == set(range(order + 1))
+    assert {n for _, n in exact} == set(range(1, 2 * order + 2, 2))
+    if model == "duffing":  # q_1 = (cos 3s - cos s)/32: the notes' first order
+        assert exact[1, 1] == sp.Rational(-1, 32) and exact[1, 3] == sp.Rational(1, 32)
+    widths = [sum(float(w) for w in re.findall(r"p\{([\d.]+)em\}", spec))
+              for spec in re.findall(r"\\begin\{longtable\}\{([^\n]*)\}\n", tex)]
+    assert widths and max(widths) <= LINE_EM
+
+
+def test_a_long_series_runs_several_terms_to_a_line():
+    """T and ω of Duffing to order 12 (13 terms) take a few lines, order 2 one line."""
+    ctx = latex_context(lower_derivation(derive(model_by_name("duffing", 12), 12), 12))
+    assert 2 <= len(ctx["period"]) <= 4 and 2 <= len(ctx["frequency"]) <= 4
+    assert all(line.count("y^{") >= 2 for line in ctx["period"][:-1])
+    short = latex_context(lower_derivation(derive(model_by_name("duffing", 2), 2), 2))
+    assert len(short["period"]) == 1 and len(short["frequency"]) == 1
+    assert len(short["orders"][0]["solution"]) == 1  # q_1: two terms, one line
+
+
 # --- pdflatex -------------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
@@ -80,15 +180,23 @@ def written(tmp_path_factory) -> dict[str, Path]:
 
     generate_slow_flow(oscillator("q'' + q = eps*(-k*q' - q**3 + F*cos(w*t))", name="forced"),
                        3, "cmd", out)
+    generate_slow_flow(oscillator(VAN_DER_POL, name="van_der_pol"), 3, "cmd", out)
+    generate_limit_cycle(series_model(VAN_DER_POL, 6, {}, "van_der_pol"), 4, out, resum_order=6)
+    generate(series_model(THETA, 6, {}, "swing"), 4, out)
+    generate(series_model("helmholtz_duffing", 6), 4, out)
     texs = {f"order-high/{p.name}": p for p in out.glob("*.tex")}
     texs.update({f"generated/{p.name}": p for p in GENERATED.glob("*.tex")})
     return texs
 
 
-TEX_NAMES = [f"order-high/{m}_{kind}.tex" for m in ("duffing", "pendulum")
-             for kind in ("tables", "derivation")] + ["order-high/driven_derivation.tex",
-                                                      "order-high/driven_damped_derivation.tex",
-                                                      "order-high/forced_slow_flow.tex"]
+VAN_DER_POL = "q'' + q = eps*(1 - q**2)*q'"
+THETA = "theta'' + sin(theta) = 0"
+TEX_NAMES = [f"order-high/{m}_{kind}.tex" for m in ("duffing", "pendulum", "swing",
+                                                    "helmholtz_duffing")
+             for kind in ("tables", "derivation")] + [
+    f"order-high/{name}.tex" for name in ("driven_derivation", "driven_damped_derivation",
+                                          "forced_slow_flow", "van_der_pol_slow_flow",
+                                          "van_der_pol_derivation")]
 
 
 @pytest.mark.skipif(PDFLATEX is None, reason="pdflatex not installed (`make tex` installs it)")
@@ -129,3 +237,26 @@ def test_no_number_in_a_table_is_split(written, name):
 
 def test_every_kind_of_tex_is_compiled(written):
     assert set(TEX_NAMES) == {n for n in written if n.startswith("order-high/")}
+
+
+@pytest.mark.parametrize("name", [*TEX_NAMES, *(f"generated/{p.name}"
+                                               for p in sorted(GENERATED.glob("*.tex")))])
+def test_one_notation_and_no_raw_input(written, name):
+    """ε is \\varepsilon, cos s never \\cos 1s, no breqn, and the equation is typeset: no
+    input syntax (``**``, ``eps*``, a bare ``sin`` or ``theta``) outside the banner's comments."""
+    body = [line for line in written[name].read_text().splitlines()
+            if not line.startswith("%")]
+    text = "\n".join(body)
+    assert r"\epsilon" not in text and "breqn" not in text
+    assert not re.search(r"\\(cos|sin)\s*\{?\s*1\s*[a-z\\]", text)
+    assert not re.search(r"\*\*|eps\*|(?<!\\)(sin|cos|theta)|\\texttt", text)
+
+
+def test_the_expansion_variable_is_y_and_headers_use_the_coordinate(written):
+    duffing = written["order-high/duffing_tables.tex"].read_text()
+    assert r"y = \varepsilon A^2" in duffing and "x = " not in duffing
+    swing = written["order-high/swing_tables.tex"].read_text()
+    assert r"$\theta(0) = A$" in swing and "q(0)" not in swing
+    assert r"\ddot{\theta} + \sin\theta = 0" in swing
+    cycle = written["order-high/van_der_pol_derivation.tex"].read_text()
+    assert r"\ddot{q} + q = \varepsilon \dot{q} \left(1 - q^{2}\right)" in cycle

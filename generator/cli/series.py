@@ -514,6 +514,10 @@ def run_generate(args: argparse.Namespace) -> int:
     (and LaTeX) of a free oscillator or a limit cycle, or the driven oscillator's
     ``driven``, ``balance`` or ``fourier`` module; print their paths.  Returns the exit status."""
     order = args.order
+    if ";" in args.model:
+        return _generate_system(args)
+    if args.mode is not None or args.amplitude is not None:
+        raise InputError("--mode/--amplitude: a system's flags (equations separated by ';')")
     if args.model in EMITTED and (args.param or args.name):
         raise InputError(f"--param/--name: the {args.model} modules take neither")
     if args.model in EMITTED and args.allow_divergent:
@@ -557,6 +561,43 @@ def run_generate(args: argparse.Namespace) -> int:
         progress = ProgressBar(f"deriving {model.name} to order {order + 2}")
         paths = compiler.generate(model, order, out, args.allow_divergent, progress,
                                   overwrite_edited=args.overwrite_edited)
+        progress.close()
+    for path in paths:
+        print(path)
+    return 0
+
+
+def _generate_system(args: argparse.Namespace) -> int:
+    """``generate SYSTEM --mode M``: the normal mode's module (the flags of free oscillators
+    refused beside it)."""
+    given = [flag for flag, on in (("--allow-divergent", args.allow_divergent),
+                                   ("--damped", args.damped),
+                                   ("--resum-order", args.resum_order is not None)) if on]
+    if given:
+        raise InputError(f"{', '.join(given)}: not for a system's normal mode")
+    from .. import compiler
+    from ..derive.system import parse_system
+    from ..lower.printers import identifier
+
+    system = parse_system(args.model, _params(args.param))
+    names = [str(x) for x in system.coordinates]
+    if args.amplitude is not None and args.amplitude not in names:
+        raise InputError(f"--amplitude {args.amplitude}: not a coordinate of the system "
+                         f"({', '.join(names)})")
+    amplitude = 0 if args.amplitude is None else names.index(args.amplitude)
+    mode = 1 if args.mode is None else args.mode
+    name = identifier(args.name or f"mode{mode}")
+    command = " ".join(["lindstedt generate", f'"{args.model}"', f"--mode {mode}",
+                        f"--order {args.order}", *(f"--param {p}" for p in args.param or ()),
+                        *([f"--amplitude {args.amplitude}"] if args.amplitude else []),
+                        f"--name {name}"])
+    progress = ProgressBar(f"deriving mode {mode}")
+    try:
+        paths = compiler.generate_nnm(system, mode, args.order, _out_folder(args.out),
+                                      amplitude=amplitude, name=name, command=command,
+                                      progress=progress,
+                                      overwrite_edited=args.overwrite_edited)
+    finally:
         progress.close()
     for path in paths:
         print(path)
@@ -679,6 +720,11 @@ def arguments_generate(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
                    help="limit cycles only: derive ω's exact series to order N (at least K + 2) "
                    "for the radius estimate and the resummed evaluators (default 60: van der "
                    "Pol's omega_resummed verified to eps ≈ 3.75; 164: to eps = 10)")
+    p.add_argument("--mode", type=_order, default=None, metavar="M",
+                   help="a SYSTEM's nonlinear normal mode, by increasing linear frequency "
+                   "(default 1): ω(A), T(A) and each coordinate x_i(t, A)")
+    p.add_argument("--amplitude", metavar="NAME",
+                   help="a SYSTEM's coordinate at x = A at t = 0 (default: the first)")
     _flag_allow_slow(p)
     _flag_overwrite_edited(p)
     return p

@@ -25,10 +25,14 @@ import sympy as sp
 
 from ..errors import InputError
 from ..lower.printers import (
+    LINE_EM,
     latex_coefficient,
     latex_equation,
     latex_expr,
+    latex_lines,
     latex_rational,
+    latex_sum_items,
+    latex_width,
     pycode,
 )
 from ..lower.records import (
@@ -164,43 +168,96 @@ def render_module(module: Module) -> str:
 
 
 def _signed(c: sp.Expr, factor: str, first: bool) -> str:
-    """``+ \\frac{p}{q} factor`` with the sign pulled out (LaTeX)."""
+    """``+ \\frac{p}{q} factor`` with the sign pulled out (LaTeX; no number is split)."""
     if not c.is_Rational:  # a polynomial in the symbolic parameters: bracketed, as it is
-        return f"{'' if first else '+'} \\left({latex_expr(c)}\\right)\\,{factor}".strip()
+        return (f"{'' if first else '+'} \\left({latex_coefficient(c, stack=False)}\\right)"
+                f"\\,{factor}").strip()
     c = sp.Rational(c)
     sign = "-" if c < 0 else ("" if first else "+")
     mag = abs(c)
-    body = "" if mag == 1 and factor else latex_rational(mag)
+    body = "" if mag == 1 and factor else latex_rational(mag, stack=False)
     return f"{sign} {body}\\,{factor}".strip() if body else f"{sign} {factor}".strip()
+
+
+def _trig(kind: str, n: int, var: str = "s") -> str:
+    """``\\cos s``, ``\\cos 3s`` (never ``\\cos 1s``); ``""`` for the constant term."""
+    return "" if n == 0 else rf"\{kind} {var}" if n == 1 else rf"\{kind} {n}{var}"
 
 
 def _harmonic_terms(coeffs: Mapping[int, sp.Expr], scale: str, leading: bool) -> list[str]:
     """Signed LaTeX terms ``c·scale·cos ns``; the first without ``+`` when ``leading``."""
-    terms = []
-    for i, (n, c) in enumerate(sorted(coeffs.items())):
-        trig = r"\cos s" if n == 1 else (f"\\cos {n}s" if n else "")
-        terms.append(_signed(c, f"{scale}{trig}", first=leading and i == 0))
-    return terms
+    return [_signed(c, scale + _trig("cos", n), first=leading and i == 0)
+            for i, (n, c) in enumerate(sorted(coeffs.items()))]
+
+
+def _lines(items: list[str], lhs: str) -> list[str]:
+    """``items`` in display lines beside the left side ``lhs`` (an ``align*`` row whose later
+    lines are indented by a ``\\quad``)."""
+    return latex_lines(items, LINE_EM - latex_width(lhs) - 1)
+
+
+def _fit(item: str, lhs: str) -> str:
+    """One item on one display line beside ``lhs``, scaled down if it is wider (never broken)."""
+    return _lines([item], lhs)[0]
+
+
+def _series(head: str, terms: list[str], tail: str, lhs: str) -> list[str]:
+    """A power series ``head(terms tail)`` (``2\\pi\\Bigl(1 …\\Bigr)``) in display lines."""
+    return _lines([f"{head}1" if head else "1", *terms, tail], lhs)
+
+
+TABLE_EM = 36.0
+# NOTE: the content of one block of a table, in em: 44 em of text less the j column and the
+# space between columns; a column wider than this is a block alone, its cells shrunk.
+CELL_MIN_EM = 3.0
+# NOTE: the narrowest column (its header, cos 11s, is ~3 em).
+
+
+def _table_blocks(columns: list[tuple[str, dict[int, str]]]) -> list[dict]:
+    """A table of cells ``{j: LaTeX}`` under their headers, order j by row, as blocks that fit
+    the page: columns packed left to right while their widths (the widest cell of each) sum
+    to at most :data:`TABLE_EM`; a block lists the rows with an entry in it."""
+    width = [min(TABLE_EM, max(CELL_MIN_EM, *map(latex_width, cells.values())))
+             for _, cells in columns]
+    groups: list[list[int]] = []
+    for i, w in enumerate(width):
+        if groups and sum(width[k] for k in groups[-1]) + w <= TABLE_EM:
+            groups[-1].append(i)
+        else:
+            groups.append([i])
+    return [{
+        "columns": "r" + "".join(f"p{{{width[i]:.1f}em}}" for i in group),
+        "header": [columns[i][0] for i in group],
+        "rows": [{"j": j, "cells": [columns[i][1].get(j, "") for i in group]}
+                 for j in sorted({j for i in group for j in columns[i][1]})],
+    } for group in groups]
+
+
+def _fourier_columns(q: tuple) -> list[tuple[str, dict[int, str]]]:
+    """The Fourier coefficients of ``q_j`` as table columns, one per harmonic ``cos ns``."""
+    harmonics = sorted({n for qj in q for n, _ in qj})
+    cells = [dict(qj) for qj in q]
+    return [("$" + (_trig("cos", n) or "1") + "$", {j: latex_coefficient(row[n], stack=False)
+                                   for j, row in enumerate(cells) if n in row})
+            for n in harmonics]
 
 
 def latex_context(d: Derivation) -> dict:
     """Everything the two LaTeX templates use, as strings."""
-    variable = {"duffing": r"x = \varepsilon A^2", "pendulum": r"y = \theta_0^2"}.get(
+    variable = {"duffing": r"y = \varepsilon A^2", "pendulum": r"y = \theta_0^2"}.get(
         d.model, latex_expr(d.y) if d.y.is_Symbol else f"y = {latex_expr(d.y)}"
     )
     y = variable.split("=")[0].strip()  # a symbol: powers y^{j} of it are valid TeX
     qs = latex_expr(d.coordinate)
-    rows = [
-        {"j": j, "omega": latex_coefficient(w, stack=False),
-         "tau": latex_coefficient(tau, stack=False)}
-        for j, (w, tau) in enumerate(zip(d.omega, d.period, strict=True))
-    ]  # table cells: a number is never split; \padmath shrinks one wider than its column
-    fourier = [{"j": j, "n": n, "c": latex_coefficient(c, stack=False)}
-               for j, qj in enumerate(d.q) for n, c in qj]
-    period_terms = [
-        _signed(d.period[j], f"{y}^{{{j}}}" if j > 1 else y, first=False)
-        for j in range(1, d.order + 1) if d.period[j] != 0
-    ]
+    coefficients = [(header, {j: latex_coefficient(c, stack=False) for j, c in enumerate(cs)})
+                    for header, cs in ((r"$\omega_j$", d.omega), (r"$\tau_j$", d.period))]
+    # table cells: a number is never split; \padmath shrinks one wider than its column
+
+    def powers(coeffs: tuple) -> list[str]:
+        return [_signed(coeffs[j], f"{y}^{{{j}}}" if j > 1 else y, first=False)
+                for j in range(1, d.order + 1) if coeffs[j] != 0]
+
+    rest = f"+ O({y}^{{{d.order + 1}}})"
     amp = latex_expr(d.amplitude)
     orders = []
     for t in d.orders:
@@ -208,15 +265,17 @@ def latex_context(d: Derivation) -> dict:
         secular = _signed(t.resonant, scale, first=True) + f" + 2{amp}\\,\\omega_{{{t.j}}}"
         orders.append({
             "j": t.j,
-            # \left(: the resonant coefficient can be a fraction of many stacked lines
-            "forcing": [f"\\left({secular}\\right)\\cos s",
-                        *_harmonic_terms(dict(t.forcing), scale, leading=False)],
-            "secular": secular,
-            "omega": _signed(t.omega, latex_expr(d.order_factor**t.j), first=True),
-            "solution": _harmonic_terms(dict(t.q), scale, leading=True),
+            "forcing": _lines([f"\\left({secular}\\right)\\cos s",
+                               *_harmonic_terms(dict(t.forcing), scale, leading=False)],
+                              f"{qs}_{{{t.j}}}'' + {qs}_{{{t.j}}} = F_{{{t.j}}}(s) ="),
+            "secular": _fit(secular + " = 0", ""),
+            "omega": _fit(_signed(t.omega, latex_expr(d.order_factor**t.j), first=True),
+                          rf"\Longrightarrow\quad \omega_{{{t.j}}} ="),
+            "solution": _lines(_harmonic_terms(dict(t.q), scale, leading=True),
+                               f"{qs}_{{{t.j}}}(s) ="),
         })
     return {
-        "title": f"{d.model.capitalize()}: ${d.latex}$",
+        "title": f"{_model_text(d.model)}: ${d.latex}$",
         "q": qs,
         "variable": variable,
         "y": y,
@@ -224,9 +283,10 @@ def latex_context(d: Derivation) -> dict:
         "convention": (f"${qs}(0) = {amp}$, $\\dot {qs}(0) = 0$, "
                        f"so ${qs}_j(0) = 0$ for $j \\ge 1$"),
         "coupling": "" if d.coupling == 1 else r"\varepsilon^j",
-        "rows": rows,
-        "fourier": fourier,
-        "period_terms": period_terms,
+        "coefficients": _table_blocks(coefficients),
+        "fourier": _table_blocks(_fourier_columns(d.q)),
+        "period": _series(r"2\pi\Bigl(", powers(d.period), rest + r"\Bigr)", "T ="),
+        "frequency": _series("", powers(d.omega), rest, r"\omega ="),
         "orders": orders,
     }
 
@@ -243,28 +303,22 @@ def render_latex(d: Derivation, p: Provenance) -> dict[str, str]:
     }
 
 
-DMATH_INLINE = 90
-# NOTE: longer rational functions are typeset as 1/D·(N), N expanded: breqn can break a sum
-# inside \Bigl(…\Bigr) but never inside a \frac.
+def _display(expr: sp.Expr, lhs: str = "", rhs: str = "") -> list[str]:
+    """``expr`` in display lines beside ``lhs``, common factors pulled out where they are of
+    degree 2 or more or the sum is too long for a line (:func:`latex_sum_items`); ``rhs``
+    (`` = 0``) closes the last line."""
+    width = LINE_EM - latex_width(lhs + rhs) - 1
+    lines = latex_lines(latex_sum_items(expr, width), width)
+    lines[-1] += rhs
+    return lines
 
 
-def _dmath(expr: sp.Expr) -> str:
-    r"""LaTeX for a breqn ``dmath*``: short expressions as SymPy prints them, long ones
-    as ``\frac{1}{D}\Bigl(N\Bigr)``."""
-    text = latex_expr(expr)
-    if len(text) > DMATH_INLINE:
-        num, den = sp.fraction(sp.together(expr))
-        num = sp.expand(num)
-        if den != 1 and isinstance(num, sp.Add):
-            text = rf"\frac{{1}}{{{latex_expr(den)}}}\Bigl({latex_expr(num)}\Bigr)"
-    return text.replace("A_{1}", "A_1")
-
-
-def _trig(kind: str, n: int, var: str = "\\tau") -> str:
-    """``\\cos\\tau``, ``\\cos 3\\tau`` (never ``\\cos 1\\tau``); ``1`` for the constant."""
-    if n == 0 and kind == "cos":
-        return "1"
-    return f"\\{kind}{var}" if n == 1 else f"\\{kind} {n}{var}"
+def _labelled(parts: list[tuple[str, Mapping[int, sp.Expr]]]) -> list[tuple[str, list[str]]]:
+    """``[(label, lines)]``: the coefficient of each ``\\cos nτ`` (``\\sin nτ``) of ``parts``
+    (``(kind, {n: c})``) in display lines beside its label ``[\\cos 3\\tau]``."""
+    labels = [("[" + (_trig(kind, n, r"\tau") or "1") + "]", c)
+              for kind, part in parts for n, c in sorted(part.items())]
+    return [(label, _display(c, label)) for label, c in labels]
 
 
 def render_mu_derivation(d: MuDerivation, p: Provenance) -> dict[str, str]:
@@ -272,11 +326,12 @@ def render_mu_derivation(d: MuDerivation, p: Provenance) -> dict[str, str]:
     table."""
     orders = [{
         "j": o.order,
-        "forcing": [(_trig("cos", n), _dmath(c)) for n, c in sorted(o.forcing.items())],
-        "secular": _dmath(o.secular),
-        "unknown": _dmath(o.unknown),
-        "value": _dmath(o.value) if o.value is not None else "",
-        "solution": [(_trig("cos", n), _dmath(c)) for n, c in sorted(o.q.items())],
+        "forcing": _labelled([("cos", o.forcing)]),
+        "secular": _display(o.secular, rhs=" = 0"),
+        "unknown": latex_expr(o.unknown),
+        "value": _display(o.value, f"{latex_expr(o.unknown)} =") if o.value is not None
+        else [],
+        "solution": _labelled([("cos", o.q)]),
     } for o in d.orders]
     rows = [{"label": label, **{f"a{n}": v if isinstance(v, str) else f"{v:.6f}"
                                 for n, v in cells}} for label, cells in d.table.rows]
@@ -288,40 +343,37 @@ def render_mu_derivation(d: MuDerivation, p: Provenance) -> dict[str, str]:
 
 def render_mu_damped_derivation(d: MuDampedDerivation, p: Provenance) -> dict[str, str]:
     """``{"driven_damped_derivation.tex": text}``: the damped μ-expansion order by order."""
-    def harmonics(parts: tuple[dict, dict]) -> list[tuple[str, str]]:
-        return [(_trig(trig, n), _dmath(c))
-                for trig, part in zip(("cos", "sin"), parts, strict=True)
-                for n, c in sorted(part.items())]
-
     orders = [{
         "j": o.order,
-        "forcing": harmonics(o.forcing),
-        "secular": [_dmath(c) for c in o.secular],
-        "unknowns": [_dmath(u) for u in o.unknowns],
-        "solved": [_dmath(v) for v in o.values] if o.values is not None else [],
-        "solution": harmonics(o.q),
-        "delta": _dmath(o.delta),
+        "forcing": _labelled(list(zip(("cos", "sin"), o.forcing, strict=True))),
+        "secular": [_display(c, rhs=" = 0") for c in o.secular],
+        "solved": [(latex_expr(u), _display(v, f"{latex_expr(u)} ="))
+                   for u, v in zip(o.unknowns, o.values, strict=True)]
+        if o.values is not None else [],
+        "solution": _labelled(list(zip(("cos", "sin"), o.q, strict=True))),
+        "delta": _display(o.delta, rf"\delta_{{{o.order}}} ="),
     } for o in d.orders]
     tex = environment(latex=True).get_template("mu_damped_derivation.tex.j2").render(
         banner=banner(p, "%"), order=d.order, orders=orders,
-        determinant=latex_expr(d.determinant))
+        determinant=_display(d.determinant, r"\Delta =", rhs="."))
     return {f"{p.model}_derivation.tex": tex}
 
 
 def render_slow_flow(d: SlowFlowDocument, p: Provenance) -> dict[str, str]:
     """``{"<name>_slow_flow.tex": text}``: ``R_k`` and ``Φ_k`` order by order."""
-    orders = [{"k": k + 1, "radial": latex_expr(a), "phase": latex_expr(b)}
+    orders = [{"k": k + 1, "radial": _display(a, f"R_{{{k + 1}}} ="),
+               "phase": _display(b, f"\\Phi_{{{k + 1}}} =")}
               for k, (a, b) in enumerate(zip(d.radial, d.phase, strict=True))]
     tex = environment(latex=True).get_template("slow_flow.tex.j2").render(
-        banner=banner(p, "%"), equation=latex_equation(d.equation), order=d.order,
-        driven=d.driven, orders=orders)
+        banner=banner(p, "%"), equation=latex_equation(d.equation),
+        q=latex_expr(d.equation.coordinate), order=d.order, driven=d.driven, orders=orders)
     return {f"{p.model}.tex": tex}
 
 
 def _trig_terms(cos: tuple, sin: tuple) -> list[str]:
     """Signed LaTeX terms ``c cos ns`` then ``c sin ns``, the first without ``+``."""
-    terms = [(c, r"\cos s" if n == 1 else rf"\cos {n}s") for n, c in cos]
-    terms += [(c, r"\sin s" if n == 1 else rf"\sin {n}s") for n, c in sin]
+    terms = [(c, _trig(kind, n)) for kind, part in (("cos", cos), ("sin", sin))
+             for n, c in part]
     return [_signed(c, trig, first=i == 0) for i, (c, trig) in enumerate(terms)] or ["0"]
 
 
@@ -332,8 +384,8 @@ def _linear_form(terms: list[tuple[sp.Rational, str]]) -> str:
     for i, (c, x) in enumerate(kept):
         sign = "-" if c < 0 else ("" if i == 0 else "+")
         mag = abs(sp.Rational(c))
-        body = x if mag == 1 and x else f"{latex_rational(mag)}\\,{x}" if x else \
-            latex_rational(mag)
+        number = latex_rational(mag, stack=False)
+        body = x if mag == 1 and x else f"{number}\\,{x}" if x else number
         out.append(f"{sign} {body}".strip())
     return " ".join(out) or "0"
 
@@ -342,6 +394,7 @@ def render_cycle_derivation(d: CycleDerivation, p: Provenance) -> dict[str, str]
     """``{"<model>_derivation.tex": text}``: a limit cycle's equations order by order."""
     lin_cos, lin_sin = dict(d.lin_cos), dict(d.lin_sin)
     zero = sp.Integer(0)
+    q = latex_expr(d.equation.coordinate)
     orders = []
     for o in d.orders:
         a = f"a_{{{o.j - 1}}}"
@@ -359,29 +412,29 @@ def render_cycle_derivation(d: CycleDerivation, p: Provenance) -> dict[str, str]
         orders.append({
             "j": o.j,
             "with_a": "" if o.a_prev is None else f" + {a} L(s)",
-            "known": _trig_terms(o.known_cos, o.known_sin),
+            "known": _lines(_trig_terms(o.known_cos, o.known_sin), f"K_{{{o.j}}}(s) ="),
             "sin_condition": sin_condition,
-            "a_value": "" if o.a_prev is None else latex_rational(o.a_prev),
+            "a_value": "" if o.a_prev is None else latex_rational(o.a_prev, stack=False),
             "cos_condition": cos_condition,
-            "W": latex_rational(o.W),
-            "omega": latex_rational(o.omega),
-            "solution": _trig_terms(o.q_cos, o.q_sin),
+            "W": latex_rational(o.W, stack=False),
+            "omega": latex_rational(o.omega, stack=False),
+            "solution": _lines([*_trig_terms(o.q_cos, o.q_sin), rf"+ a_{{{o.j}}} \cos s"],
+                               f"{q}_{{{o.j}}}(s) ="),
         })
     stability = (r"attracting for $\varepsilon > 0$ and repelling for $\varepsilon < 0$"
                  if d.slope > 0 else
                  r"attracting for $\varepsilon < 0$ and repelling for $\varepsilon > 0$")
     tex = environment(latex=True).get_template("cycle_derivation.tex.j2").render(
-        banner=banner(p, "%"), model=_tex_text(d.model), equation=latex_equation(d.equation),
-        a0=latex_rational(d.a0), slope=latex_rational(d.slope), stability=stability,
-        lin=_trig_terms(d.lin_cos, d.lin_sin), orders=orders)
+        banner=banner(p, "%"), model=_model_text(d.model), equation=latex_equation(d.equation),
+        q=q, a0=latex_rational(d.a0, stack=False), slope=latex_rational(d.slope, stack=False),
+        stability=stability, lin=_lines(_trig_terms(d.lin_cos, d.lin_sin), "L(s) ="),
+        orders=orders)
     return {f"{p.model}_derivation.tex": tex}
 
 
-def _tex_text(text: str) -> str:
-    """Plain text (an equation as typed) safe in LaTeX's text mode."""
-    return "".join({"_": r"\_", "^": r"\^{}", "&": r"\&", "%": r"\%", "#": r"\#",
-                    "$": r"\$", "{": r"\{", "}": r"\}", "~": r"\~{}",
-                    "\\": r"\textbackslash{}"}.get(ch, ch) for ch in text)
+def _model_text(name: str) -> str:
+    """A model's name as a title's words: ``van_der_pol`` → ``Van der pol``."""
+    return name.replace("_", " ").capitalize()
 
 
 def render(unit: Unit) -> dict[str, str]:

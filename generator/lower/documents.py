@@ -4,6 +4,7 @@ Fourier (AGM) period, a chosen period formula and the slow flow."""
 from __future__ import annotations
 
 import builtins
+import dataclasses
 import keyword
 import re
 
@@ -17,9 +18,10 @@ from ..derive.averaging import V as V_SLOW
 from ..derive.cycles import LimitCycle
 from ..derive.equation import parse_equation
 from ..derive.lindstedt import SeriesSolution, order_terms
+from ..derive.models import Model
 from ..errors import InputError
 from .forms import _LOCAL, LOCAL_NAMES, MODULE_NAMES, agm_steps, harmonics
-from .printers import exact
+from .printers import exact, latex_equation
 from .records import (
     ArrayKernel,
     Assign,
@@ -102,6 +104,18 @@ def lower_choice(formula: PeriodFormula, command: str, verified: tuple[float, fl
     )
 
 
+def _equation_latex(m: Model) -> str:
+    """``m``'s equation typeset as its user wrote it (:func:`printers.latex_equation`), the
+    parameter values given with it substituted; a built-in model's own LaTeX."""
+    if not m.source:
+        return m.latex
+    eq = parse_equation(m.source)
+    given = dict(m.given)
+    values = {p: sp.sympify(given[p.name]) for p in eq.parameters if p.name in given}
+    return latex_equation(dataclasses.replace(eq, lhs=eq.lhs.xreplace(values),
+                                              rhs=eq.rhs.xreplace(values)))
+
+
 def lower_derivation(solution: SeriesSolution, order: int) -> Derivation:
     """The document of ``solution`` at order ``K ≤ solution.order``."""
     m, g = solution.model, solution.ground
@@ -111,8 +125,8 @@ def lower_derivation(solution: SeriesSolution, order: int) -> Derivation:
         pieces.append(OrderPieces(j, t.resonant, t.omega, tuple(sorted(t.forcing.items())),
                                   tuple(sorted(t.q.items()))))
     return Derivation(
-        model=m.name, latex=m.latex, y=m.y, coordinate=m.coordinate, amplitude=m.amplitude,
-        order_factor=m.order_factor, coupling=m.coupling, order=order,
+        model=m.name, latex=_equation_latex(m), y=m.y, coordinate=m.coordinate,
+        amplitude=m.amplitude, order_factor=m.order_factor, coupling=m.coupling, order=order,
         omega=tuple(exact(g, c) for c in solution.omega[: order + 1]),
         period=tuple(exact(g, c) for c in solution.period[: order + 1]),
         q=tuple(tuple((n, exact(g, c)) for n, c in sorted(solution.q[j].items()))

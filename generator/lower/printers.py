@@ -9,6 +9,7 @@ import functools
 import itertools
 import keyword
 import math
+import re
 
 import sympy as sp
 from sympy.printing.latex import LatexPrinter as SympyLatexPrinter
@@ -109,6 +110,7 @@ class NumbaPrinter(PythonCodePrinter):
     printmethod = "_numbacode"
 
     def _print_Rational(self, expr: sp.Rational) -> str:
+        """``\\frac`` of grouped digits (:func:`latex_fraction`)."""
         return repr(int(expr.p) / int(expr.q))
 
     def _print_Half(self, expr: sp.Rational) -> str:
@@ -256,30 +258,58 @@ def latex_coefficient(c: sp.Expr, stack: bool = True) -> str:
     return latex_rational(c, stack) if c.is_Rational else LatexPrinter(stack).doprint(c)
 
 
-EPS = sp.Symbol("eps")
-# NOTE: a user's small parameter, named eps in the equation, is ε in LaTeX.
+EPS_FIRST = sp.Symbol(" eps")
+# NOTE: ε under a name that sorts before every other (a space comes before the letters):
+# SymPy orders a product's factors by name, so ``ε A_1^3`` and not ``A_1^3 ε``.
 
 
 class LatexPrinter(SympyLatexPrinter):
-    """SymPy's LaTeX with ε for ``eps`` and a :class:`Coefficient` printed from its terms:
+    r"""SymPy's LaTeX with ε for ``eps``, first in every product; ``\cos 2\varphi`` for a
+    multiple of one symbol; a :class:`Coefficient` printed from its terms:
     ``\frac{3}{8} \alpha^{2} - \frac{1}{4}`` (digits grouped, :func:`latex_rational`)."""
 
-    def __init__(self, stack: bool = True) -> None:
-        super().__init__({"symbol_names": {EPS: r"\varepsilon"}})
-        self.stack = stack  # long integers stacked in lines (never in a table's cell)
+    def __init__(self, stack: bool = False, names: dict | None = None) -> None:
+        super().__init__({"symbol_names": {EPS_FIRST: r"\varepsilon", **(names or {})}})
+        self.stack = stack  # long integers stacked in lines (no document does: they scale)
+
+    def doprint(self, expr: sp.Basic) -> str:
+        """The LaTeX of ``expr``, its ε renamed to :data:`EPS_FIRST`."""
+        return super().doprint(_eps_first(expr))
 
     def _print_Symbol(self, expr: sp.Symbol, style: str = "plain") -> str:
-        """ε and φ as ``\\varepsilon``, ``\\varphi`` whatever the symbol's assumptions: one
-        ε in every document (a user's ``eps``, the notes' ``epsilon``)."""
+        """φ as ``\\varphi`` whatever the symbol's assumptions (the notes' phase)."""
         if expr.name in LATEX_NAMES:
             return LATEX_NAMES[expr.name]
         return super()._print_Symbol(expr, style)
+
+    def _print_Integer(self, expr: sp.Integer) -> str:
+        """Digits in groups of 3 (:func:`latex_digits`), as in the tables."""
+        return ("-" if expr < 0 else "") + latex_digits(abs(int(expr)), self.stack)
+
+    def _print_Rational(self, expr: sp.Rational) -> str:
+        """``\\frac`` of grouped digits (:func:`latex_fraction`)."""
+        return latex_fraction(int(expr.p), int(expr.q), self.stack)
+
+    def _print_cos(self, expr: sp.cos, exp: str | None = None) -> str:
+        return self._trig("cos", expr, exp)
+
+    def _print_sin(self, expr: sp.sin, exp: str | None = None) -> str:
+        return self._trig("sin", expr, exp)
+
+    def _trig(self, name: str, expr: sp.Function, exp: str | None) -> str:
+        r"""``\cos\varphi``, ``\cos 2\varphi`` (never ``\cos 1\varphi``): a symbol or an
+        integer multiple of one needs no brackets; any other argument is bracketed."""
+        head = rf"\{name}" if exp is None else rf"\{name}^{{{exp}}}"
+        n, rest = expr.args[0].as_coeff_Mul()
+        if not (rest.is_Symbol and n.is_Integer and n > 0):
+            return rf"{head}{{\left({self._print(expr.args[0])} \right)}}"
+        return f"{head}{self._print(rest)}" if n == 1 else f"{head} {n}{self._print(rest)}"
 
     def _print_Coefficient(self, expr: Coefficient) -> str:
         out = []
         for powers, (p, q) in expr.terms:
             mono = " ".join(_latex_name(n) if e == 1 else f"{_latex_name(n)}^{{{e}}}"
-                            for n, e in powers)
+                            for n, e in sorted(powers, key=lambda t: t[0] not in SMALL_NAMES))
             number = latex_fraction(abs(p), q, self.stack)
             body = mono if number == "1" and mono else f"{number} {mono}".strip()
             out.append(("- " if p < 0 else "+ ") + body)
@@ -287,8 +317,16 @@ class LatexPrinter(SympyLatexPrinter):
         return text[2:] if text.startswith("+ ") else "-" + text[2:]
 
 
-LATEX_NAMES = {"eps": r"\varepsilon", "epsilon": r"\varepsilon", "phi": r"\varphi"}
-# NOTE: the names every LaTeX document spells one way (the small parameter, the phase).
+def _eps_first(expr: sp.Basic) -> sp.Basic:
+    """``expr`` with its ε (any symbol of :data:`SMALL_NAMES`) renamed to :data:`EPS_FIRST`."""
+    small = {s: EPS_FIRST for s in getattr(expr, "free_symbols", ()) if s.name in SMALL_NAMES}
+    return expr.xreplace(small) if small else expr
+
+
+SMALL_NAMES = frozenset({"eps", "epsilon"})
+# NOTE: the small parameter's names (a user's eps, the notes' epsilon): ε in every document.
+LATEX_NAMES = {"phi": r"\varphi"}
+# NOTE: the names every LaTeX document spells one way (the phase; ε is EPS_FIRST's).
 
 
 @functools.cache
@@ -299,14 +337,161 @@ def _latex_name(name: str) -> str:
 
 def latex_equation(equation: Equation) -> str:
     """An equation of motion as mathematics, both sides as written, the derivatives dotted:
-    ``\\ddot{q} + q = \\varepsilon \\left(1 - q^{2}\\right) \\dot{q}``."""
+    ``\\ddot{q} + q = \\varepsilon \\dot{q} \\left(1 - q^{2}\\right)``; a side's terms in
+    the order q̈, the terms free of ε, the terms in ε."""
     name = latex_expr(equation.coordinate)
-    dotted = {equation.derivatives[1]: sp.Symbol(rf"\dot{{{name}}}"),
-              equation.derivatives[2]: sp.Symbol(rf"\ddot{{{name}}}")}
-    return (f"{latex_expr(equation.lhs.xreplace(dotted))} = "
-            f"{latex_expr(equation.rhs.xreplace(dotted))}")
+    # NOTE: "~" sorts after the letters: q̇ follows the other factors of a product
+    first, second = (sp.Symbol(f"~{k}{equation.coordinate}") for k in (1, 2))
+    dotted = {equation.derivatives[1]: first, equation.derivatives[2]: second}
+    printer = LatexPrinter(names={first: rf"\dot{{{name}}}", second: rf"\ddot{{{name}}}"})
+
+    def side(expr: sp.Expr) -> str:
+        terms = sorted(sp.Add.make_args(expr.xreplace(dotted)), key=lambda t: (
+            not t.has(second), any(s.name in SMALL_NAMES for s in t.free_symbols)))
+        return " ".join(signed_terms(printer, terms)).removeprefix("+ ")
+
+    return f"{side(equation.lhs)} = {side(equation.rhs)}"
+
+
+def signed_terms(printer: LatexPrinter, terms: list[sp.Expr]) -> list[str]:
+    """Each of ``terms`` printed with its sign in front: ``["+ a", "- b"]``."""
+    return [f"- {printer.doprint(-t)}" if t.could_extract_minus_sign()
+            else f"+ {printer.doprint(t)}" for t in terms]
 
 
 def latex_expr(expr: sp.Basic) -> str:
     """LaTeX of short symbolic factors (powers of A, ε, θ₀) and of exact coefficients."""
     return LatexPrinter().doprint(expr)
+
+
+LINE_EM = 40.0
+# NOTE: a display line's width in em: the text block is 170 mm (A4, 2 cm margins), ~44 em at
+# 11pt; 4 em are kept for the left side's indentation and the estimate's error.
+_TOKEN = re.compile(r"\\[A-Za-z]+|\\.|\d|[A-Za-z]|\s+|.")
+_WIDTHS = {"+": 1.2, "-": 1.2, "=": 1.3, "<": 1.3, ">": 1.3, "(": 0.4, ")": 0.4, "[": 0.3,
+           "]": 0.3, ",": 0.3, ".": 0.3, "'": 0.3, "|": 0.3, "/": 0.5, "&": 0.0, "~": 0.3}
+# NOTE: widths in em of Computer Modern math at text size, with the spacing TeX adds around
+# binary operators and relations; a letter or digit is 0.5 em
+_COMMANDS = {r"\,": 0.17, r"\;": 0.28, r"\:": 0.22, r"\!": -0.17, r"\quad": 1.0,
+             r"\qquad": 2.0, r"\cos": 1.4, r"\sin": 1.1, r"\sinh": 1.6, r"\cosh": 1.9,
+             r"\exp": 1.4, r"\log": 1.2, r"\cdot": 0.8, r"\pi": 0.6, r"\colon": 0.5}
+_SIZED = {r"\left", r"\right", r"\bigl", r"\bigr", r"\Bigl", r"\Bigr", r"\biggl", r"\biggr"}
+_ZERO = {r"\dot", r"\ddot", r"\displaystyle", r"\mathrm", r"\text", r"\operatorname",
+         r"\fitmath", r"\tilde", r"\hat", r"\bar"}
+
+
+def latex_width(tex: str) -> float:
+    r"""The width of a LaTeX math fragment in em, estimated (an upper bound for the fragments
+    the printers write): a ``\frac`` is as wide as its wider part, scripts are smaller.
+
+    >>> latex_width(r"\frac{3}{8} y^{2}") < latex_width(r"3 / 8 y^{2}")
+    True
+    """
+    tokens = _TOKEN.findall(tex)
+    return _group_width(tokens, 0, len(tokens))[0]
+
+
+def _group_width(tokens: list[str], i: int, end: int) -> tuple[float, int]:
+    """The width of ``tokens[i:]`` up to the ``}`` closing this group (or ``end``), and the
+    index after it."""
+    width = 0.0
+    while i < end:
+        tok = tokens[i]
+        if tok == "}":
+            return width, i + 1
+        w, i = _atom_width(tokens, i, end)
+        width += w
+    return width, i
+
+
+def _atom_width(tokens: list[str], i: int, end: int) -> tuple[float, int]:
+    """The width of the atom at ``tokens[i]`` (a group, a command with its arguments, a
+    script, one character) and the index after it."""
+    tok = tokens[i]
+    if tok == "{":
+        return _group_width(tokens, i + 1, end)
+    if tok in ("^", "_"):
+        w, j = _atom_width(tokens, i + 1, end)
+        return 0.7 * w, j
+    if tok in (r"\frac", r"\dfrac", r"\tfrac"):
+        top, j = _atom_width(tokens, i + 1, end)
+        bottom, j = _atom_width(tokens, j, end)
+        return max(top, bottom) + 0.3, j
+    if tok in _SIZED:
+        return 0.5, i + 2  # the delimiter that follows
+    if tok in _ZERO:
+        return 0.0, i + 1
+    if tok.isspace():
+        return 0.0, i + 1
+    if tok.startswith("\\"):
+        return _COMMANDS.get(tok, 0.6), i + 1
+    return _WIDTHS.get(tok, 0.5), i + 1
+
+
+def latex_lines(items: list[str], width: float = LINE_EM) -> list[str]:
+    r"""``items`` (a sum's signed terms, each ``"+ …"`` or ``"- …"``) packed greedily into lines
+    at most ``width`` em wide: several terms per line, a short sum on one line.  A term wider
+    than a line stands on its own, in ``\fitmath`` (the preamble's: scaled down to the line,
+    never broken, so no number is split).
+
+    >>> latex_lines(["a", "+ b", "- c"], 3.0)
+    ['a + b', '- c']
+    """
+    lines: list[list[str]] = []
+    used = width
+    for item in items:
+        w = latex_width(item)
+        if w > width:
+            sign, body = (item[0], item[2:]) if item[:2] in ("+ ", "- ") else ("", item)
+            lines.append([f"{sign} \\fitmath{{{width:.0f}em}}{{{body}}}".strip()])
+            used = width
+        elif used + w > width:
+            lines.append([item])
+            used = w
+        else:
+            lines[-1].append(item)
+            used += w
+    return [" ".join(line) for line in lines]
+
+
+def latex_sum_items(expr: sp.Expr, width: float = LINE_EM) -> list[str]:
+    r"""``expr`` as items for :func:`latex_lines`: itself (each term over its denominator), if
+    it fits a line and its terms have no common factor of degree 2 or more; else the common
+    factor over the denominator in front, ``\frac{\varepsilon A_1^{3}}{D}\Bigl(``, then the
+    signed terms of the rest, the last closing ``\Bigr)`` (a fraction is never broken; a sum
+    breaks between its terms).
+
+    >>> latex_sum_items(sp.sympify("eps**2*A**3*w + 3*eps*A**4"))
+    ['\\varepsilon A^{3} \\Bigl(', '\\varepsilon w', '+ 3 A\\Bigr)']
+    """
+    expr = _eps_first(expr)
+    whole = latex_expr(_distributed(expr))
+    num, den = sp.fraction(sp.together(expr))
+    terms = sp.Add.make_args(sp.expand(num))
+    if len(terms) == 1:
+        return [whole]
+    common = sp.Mul(*(f for f in sp.Mul.make_args(sp.factor_terms(sp.Add(*terms)))
+                      if not f.is_Add))
+    degree = sum(e for base, e in common.as_powers_dict().items() if not base.is_Number)
+    if degree < 2 and latex_width(whole) <= width:
+        return [whole]
+    if degree < 2:
+        common = sp.Integer(1)
+    rest = sp.expand(sp.Add(*terms) / common).as_ordered_terms()
+    items = signed_terms(LatexPrinter(), rest)
+    items[0] = items[0].removeprefix("+ ")
+    head = common / den
+    if head == 1:
+        return items
+    items[-1] += r"\Bigr)"
+    return [latex_expr(head) + r" \Bigl(", *items]
+
+
+def _distributed(expr: sp.Expr) -> sp.Expr:
+    """``expr`` as a sum of single terms, each over its own denominator, the denominators
+    kept factored (``(a/8 + b/4)/r`` → ``a/(8r) + b/(4r)``: no fraction inside a fraction)."""
+    out = []
+    for term in sp.Add.make_args(expr):
+        num, den = sp.fraction(sp.together(term))
+        out += [t / den for t in sp.Add.make_args(sp.expand(num))]
+    return sp.Add(*out)

@@ -29,6 +29,8 @@ from ..derive.averaging import SlowFlow, slow_flow
 from ..derive.cycles import LimitCycle, derive_limit_cycle
 from ..derive.lindstedt import SeriesSolution, derive
 from ..derive.models import Model, Oscillator, SelfExcited
+from ..derive.nnm import NormalModeSeries, normal_mode
+from ..derive.system import System
 from ..errors import InputError
 from ..limits import FOURIER_MAX_HARMONICS, check_int
 from ..lower.documents import (
@@ -50,6 +52,7 @@ from ..lower.records import (
     Unit,
 )
 from ..lower.series import lower_free, lower_limit_cycle, lower_mathieu, lower_tongue
+from ..lower.system import lower_nnm
 from ..numerics.shooting import shoot
 from .verify import resum_cycle, resum_mathieu, resum_tongue
 
@@ -117,6 +120,17 @@ class MathieuRequest(Request):
 
     kind: str
     m: int
+
+
+@dataclass(frozen=True)
+class NormalModeRequest(Request):
+    """One nonlinear normal mode of a system: the mode, its amplitude coordinate (an index)
+    and the module's name."""
+
+    system: System
+    mode: int
+    amplitude: int
+    name: str
 
 
 @dataclass(frozen=True)
@@ -323,3 +337,12 @@ MATHIEU: Target[MathieuRequest, ResummedMathieu] = Target(
     _mathieu_files, _mathieu_derive, _mathieu_lower)
 TONGUE: Target[TongueRequest, ResummedTongue] = Target(
     lambda r: (f"tongue_{r.n}.py",), _tongue_derive, _tongue_lower)
+
+NNM_RADIUS_ORDER = 24
+# NOTE: a mode's radius is estimated from ω to at least this order (nearest_singularity needs
+# 12 coefficients in y; 24 keep the estimate's spread small), whatever order the module sums.
+NNM: Target[NormalModeRequest, NormalModeSeries] = Target(
+    lambda r: (f"{r.name}.py",),
+    lambda r, progress: normal_mode(r.system, r.mode, max(r.order + 2, NNM_RADIUS_ORDER),
+                                    r.amplitude, progress),
+    lambda series, r: Unit(lower_nnm(series, r.order, r.name, r.command)))

@@ -1,0 +1,99 @@
+"""A nonlinear normal mode lowered to a module: the backbone ω(A), T(A) and every
+coordinate's motion x_i(t, A), NaN beyond the radius of convergence (estimated from the exact
+series of ω, less its spread) [NormalModeSeries -> Module]."""
+
+from __future__ import annotations
+
+import math
+
+import sympy as sp
+
+from ..derive.lindstedt import nearest_singularity
+from ..derive.nnm import NormalModeSeries
+from ..errors import InputError
+from .forms import MODULE_NAMES, argument_entry, harmonics, horner
+from .printers import identifier
+from .records import Evaluator, Module, provenance
+
+NNM_ARGUMENT_LIMIT = 1e6
+# NOTE: |t| beyond this loses the phase ωt to rounding (as a free oscillator's module): NaN.
+DIGITS = 30
+# NOTE: coefficients in Q(√λ) or Q(λ) reach the module as floats rounded from 30 digits.
+
+
+def _float(c: sp.Expr) -> sp.Float:
+    return sp.Float(sp.N(c, DIGITS), 17)
+
+
+def radius(mode: NormalModeSeries) -> tuple[float, float] | None:
+    """The estimated radius of convergence of ω in ``y`` and its spread, or None when the
+    series is too short for an estimate."""
+    est = nearest_singularity([c / mode.omega0 for c in mode.omega()], "y", None)
+    if est is None:
+        return None
+    if est.variable.endswith("**2"):
+        r = math.sqrt(est.radius)
+        return r, est.spread / (2 * r)
+    return est.radius, est.spread
+
+
+def lower_nnm(mode: NormalModeSeries, order: int, name: str, command: str) -> Module:
+    """Evaluators ``omega(A)``, ``period(A)`` and one ``x_i(t, A)`` per coordinate, summed to
+    ``order`` (``mode`` derived further: its radius estimate uses every term)."""
+    coordinates = [identifier(str(x)) for x in mode.system.coordinates]
+    clash = sorted(set(coordinates) & (MODULE_NAMES | {"A", "t", "MODE", "OMEGA0", "SYSTEM"}))
+    if clash:
+        raise InputError(f"coordinate {clash[0]!r}: also a name of the emitted module; rename "
+                         "it")
+    A, t = sp.Symbol("A"), sp.Symbol("t")
+    y, w, s = sp.Symbol("_y"), sp.Symbol("_w"), sp.Symbol("_s")
+    omega = [_float(c) for c in mode.omega()[: order + 1]]
+    tau = [_float(c) for c in mode.period()[: order + 1]]
+    found = radius(mode)
+    reach = None if found is None else found[0] - found[1]
+    guard = sp.true if reach is None else sp.Abs(y) < sp.Float(reach, 17)
+    entry, inside = argument_entry(((A, sp.Abs(A) < sp.Float(1e150), 0),), "_inside")
+    prelude = (*entry, (y, A**mode.step))
+    entry_t, inside_t = argument_entry(((A, sp.Abs(A) < sp.Float(1e150), 0),
+                                        (t, sp.Abs(t) <= NNM_ARGUMENT_LIMIT, 0)), "_inside")
+    prelude_t = (*entry_t, (y, A**mode.step))
+    where = ("NaN beyond the radius of convergence less its spread, estimated from the exact "
+             "ω_j" if reach is not None else "no radius estimate: the series is too short")
+    evaluators = [
+        Evaluator("omega", f"Frequency ω(A) of mode {mode.mode} to order {order} ({where}).",
+                  (A,), prelude, sp.And(inside, guard), (), horner(omega, y)),
+        Evaluator("period", f"Period T(A) = 2π Σ τ_j y^j to order {order} ({where}).",
+                  (A,), prelude, sp.And(inside, guard), (), 2 * sp.pi * horner(tau, y)),
+    ]
+    for i, coordinate in enumerate(coordinates):
+        orders = mode.coordinate(i)[: order + 1]
+        top = max((max(o) for o in orders if o), default=1)
+        lines, cos_of, _ = harmonics(top, mode.step == 2, s, sines=False)
+        shape = sum(horner([_float(o.get(n, 0)) for o in orders], y) * cos_of[n]
+                    for n in range(top + 1) if any(n in o for o in orders))
+        evaluators.append(Evaluator(
+            coordinate, f"{coordinate}(t, A) in mode {mode.mode}, s = ωt, harmonics by the "
+            f"Chebyshev recurrence ({where}).", (t, A), prelude_t, sp.And(inside_t, guard),
+            ((w, horner(omega, y)), (s, w * t), *lines), A * shape))
+    constants = (
+        ("ORDER", order),
+        ("MODE", mode.mode),
+        ("MODEL", name),
+        ("SYSTEM", mode.system.text),
+        ("VARIABLE", mode.variable),
+        ("OMEGA0", float(_float(mode.omega0))),
+        ("OMEGA0_EXACT", str(mode.omega0)),
+        ("RADIUS", float("nan") if found is None else found[0]),
+        ("RADIUS_SPREAD", float("nan") if found is None else found[1]),
+        ("OMEGA_EXACT", tuple(str(c) for c in mode.omega()[: order + 1])),
+        ("PERIOD_EXACT", tuple(str(c) for c in mode.period()[: order + 1])),
+    )
+    return Module(
+        name=name,
+        doc=f"Nonlinear normal mode {mode.mode} of {mode.system.text}: L–P evaluators to "
+        f"order {order} in {mode.variable}.",
+        constants=constants,
+        evaluators=tuple(evaluators),
+        provenance=provenance(name, order, command, system=mode.system.text, mode=mode.mode,
+                              amplitude=coordinates[mode.amplitude]),
+    )
