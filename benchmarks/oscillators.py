@@ -1,4 +1,4 @@
-"""Your own oscillator: parsing and derivation times against the issue's targets, in one process.
+"""Your own oscillator: parsing and derivation times against their targets, in one process.
 
     .venv/bin/python benchmarks/oscillators.py [--quick]
 

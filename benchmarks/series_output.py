@@ -7,7 +7,7 @@ wall time against the in-process derivation plus the start-up, measured in the s
 τ_{K+2}), so its baseline is the derivation to K + 2; it writes the numba module, the LaTeX
 tables and the derivation.
 
-The target (issue "one analysis stack", item 4): the command within 1.5× of derivation +
+The target: the command within 1.5× of derivation +
 start-up, i.e. the output (exact coefficients formatted from FLINT's terms) costs at most half
 as much again.  The baseline row is the output through SymPy (``to_sympy``, ``expand``,
 ``str``), the route the command took before, timed on the same solution.

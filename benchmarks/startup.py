@@ -4,7 +4,7 @@ importing every stage up front (what the command line did before its imports wer
 
     .venv/bin/python benchmarks/startup.py [runs]
 
-Targets (issue: installs, imports and scales): `lindstedt --help` ≤ 0.3 s,
+Targets: `lindstedt --help` ≤ 0.3 s,
 `lindstedt series duffing --order 2` ≤ 1 s.
 """
 

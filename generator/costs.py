@@ -267,7 +267,7 @@ DRIVEN_EQUATION_FIXED = 4.0
 DRIVEN_EQUATION_CONTINUATION = 15.0
 # NOTE: `lindstedt driven EQUATION`: start-up with SymPy's parse and the numba kernels from
 # cache (~2.5 s), then the continuation in the drive amplitude, which stops itself at 15 s
-# (response.CONTINUATION_BUDGET; 0.1–2 s measured on the equations), then Newton at N
+# (response.CONTINUATION_BUDGET; 0.1–2 s measured on the documented equations), then Newton at N
 # harmonics and shooting (0.05–0.5 s) on every crossing.
 
 

@@ -149,7 +149,7 @@ def test_asymmetric_spring_with_cubic_damping(omega, stable):
     assert rs == sorted(rs, reverse=True)
 
 
-def test_the_issue_example_and_its_json():
+def test_the_documented_example_and_its_json():
     """γ = 1/20 at ω = 1.2: one orbit, with its constant term and even harmonics (the force is
     not odd), the balance agreeing with shooting."""
     values = {"eps": "1/10", "gamma": "1/20", "f": "3/10"}

@@ -16,7 +16,7 @@ BESIDE = {"errors", "limits", "display"}
 # import them.
 LIMIT = 1000
 # NOTE: no module over about 1 000 lines; the command line's parser and formatters are the
-# exceptions the issue names, split by command family.
+# exceptions named for the layout, split by command family.
 
 
 def stages() -> list[str]:

@@ -153,7 +153,7 @@ def test_refusals_name_what_is_wrong():
         derive_limit_cycle(model("q'' + q = eps*q'"), 4)
 
 
-def test_the_issues_command_vdp(capsys):
+def test_the_documented_command_vdp(capsys):
     """`lindstedt series vdp --order K --json` (vdp: the registry's alias of van_der_pol):
     the published first coefficients, the stability of both signs of ε, and partial sums of
     ω against the period of the cycle shot numerically (numerics.true_limit_cycle)."""

@@ -33,7 +33,7 @@ from ..limits import check_int
 from .system import System
 
 NNM_MAX_ORDER = 200
-# NOTE: far above the order 60 for two coordinates (seconds); each order multiplies
+# NOTE: far above order 60 for two coordinates (seconds); each order multiplies
 # series of every coordinate, so a large system reaches minutes first.
 ALL_HARMONICS = Basis(odd=False)
 

@@ -29,8 +29,8 @@ from ..lower.records import (
 from ..numerics.references import cycle_reference, cycle_samples
 
 RESUM_TOLERANCE = 1e-6
-# NOTE: the relative error the resummed limit-cycle evaluators are verified to (issue #13's
-# target for 1 < ε ≤ 10); within |ε| ≤ 1 they are far better (3e-14 from order 60 on).
+# NOTE: the relative error the resummed limit-cycle evaluators are verified to (the target
+# for 1 < ε ≤ 10); within |ε| ≤ 1 they are far better (3e-14 from order 60 on).
 RESUM_RANGE = 10.0
 RESUM_GRID = 400
 RESUM_SPREAD_MARGIN = 10.0
