@@ -56,6 +56,8 @@ figures: $(STAMP)
 	parametric_figure(*PARAMETRIC_FIGURE, 'docs/figures/parametric.png')"
 	$(BIN)/python -c "from lindstedt.charts import ince_strutt_figure; \
 	ince_strutt_figure('docs/figures/ince_strutt.png')"
+	$(BIN)/lindstedt nnm "x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0" \
+	  --plot docs/figures/nnm.png > /dev/null
 
 generated: $(STAMP)
 	$(BIN)/lindstedt generate duffing --order 12 --out generated

@@ -95,6 +95,8 @@ order; a stage imports only stages above it::
     sweep.store             grids in blocks on dask.distributed, into a resumable Zarr store
                             [kind, axes -> Dataset]
     charts                  matplotlib figures [results -> PNG/SVG/PDF]
+    charts_modes            the frequency–energy plot of a system's normal modes: backbones
+                            from the series beside shot orbits [System -> PNG/SVG/PDF]
     costs                   each command's estimated wall time and bounds [arguments -> Cost]
     cli.common              what every command shares: light constants, argument types and
                             flags, the report shape [argv -> Namespace]

@@ -182,7 +182,7 @@ def test_undamped_branches_each_once():
         assert len(check_against_reference(0.1, 0.3, math.inf, w)) == 3
 
 
-# --- the JSON contract at the documented cases -----------------------------------------------------
+# --- the JSON contract at the documented cases ----------------------------------------------
 
 def test_omega_1491_reports_the_orbits_the_cubic_has_lost():
     """The cubic folds at 1.48939, the true system at 1.493232: at ω = 1.491 it has one root

@@ -264,3 +264,34 @@ def test_value_rounds_to_three_digits():
     assert [charts._value(v) for v in (0.188889, 20.0, 1 / 3, 1234.5)] == [
         "0.189", "20", "0.333", "1.23e+03"]
     assert charts._named("force", 0.188889) == "f = 0.189"
+
+
+def test_frequency_energy_plot_puts_the_shot_orbits_on_the_backbones(tmp_path, monkeypatch):
+    """Kerschen's system: each mode's series backbone, orbits shot beside it (those inside the
+    series' reach lie on it to 1e-9), the reach and the resonance lines in the legend."""
+    from lindstedt import charts_modes
+    from lindstedt.derive.system import parse_system
+
+    drawn = []
+    monkeypatch.setattr(charts_modes, "_save",
+                        lambda fig, path: (drawn.append(fig), charts._save(fig, path))[1])
+    system = parse_system("x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0")
+    charts_modes.nnm_figure(system, tmp_path / "fep.png")
+    (fig,) = drawn
+    (ax,) = fig.axes
+    texts = _texts(fig)
+    for k in (1, 2):
+        assert any(t.startswith(f"mode {k}: series to order") for t in texts)
+        assert any(t.startswith(f"mode {k}: orbits shot") for t in texts)
+        assert any(t.startswith(f"mode {k}: the series' estimated reach") for t in texts)
+    assert any("internal resonance" in t for t in texts)
+    lines = {line.get_label(): line for line in ax.lines}
+    for k in (1, 2):
+        series = lines[next(t for t in lines if t.startswith(f"mode {k}: series"))]
+        shots = lines[next(t for t in lines if t.startswith(f"mode {k}: orbits"))]
+        E, w = series.get_xdata(), series.get_ydata()
+        inside = shots.get_xdata() < E[-1]
+        assert inside.sum() >= 4
+        on_line = np.interp(np.log(shots.get_xdata()[inside]), np.log(E), w)
+        assert np.max(np.abs(on_line / shots.get_ydata()[inside] - 1)) < 1e-4  # interpolated
+    assert (tmp_path / "fep.png").stat().st_size > 0

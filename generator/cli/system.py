@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from pathlib import Path
 
 from ..errors import InputError
 
@@ -65,6 +66,10 @@ def run_nnm(args: argparse.Namespace) -> int:
     from ..derive.nnm import normal_mode
     from ..derive.system import parse_system
 
+    if args.plot:
+        from ..charts import check_plot_path
+
+        check_plot_path(Path(args.plot))
     system = parse_system(args.system, _params(args.param))
     names = [str(x) for x in system.coordinates]
     amplitude = 0
@@ -79,6 +84,10 @@ def run_nnm(args: argparse.Namespace) -> int:
     finally:
         progress.close()
     data = nnm_json(mode)
+    if args.plot:
+        from ..charts_modes import nnm_figure
+
+        nnm_figure(system, Path(args.plot))
     print(json.dumps(data) if args.json else nnm_table(data))
     return 0
 
@@ -107,5 +116,9 @@ def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    "first)")
     _flag_order(p, "highest power K of the expansion variable")
     _flag_json(p)
+    p.add_argument("--plot", metavar="FILE",
+                   help="also draw the frequency–energy plot of every mode (at most 4) into "
+                   "FILE (.png, .svg or .pdf): each backbone from its series beside orbits shot "
+                   "by DOP853, the series' reach, the internal-resonance lines (default: none)")
     _flag_allow_slow(p, deprecated_force=False)
     return p

@@ -289,3 +289,68 @@ def mathieu_refined(kind: str, m: int, q: float, dps: int = 30) -> float:
             if step == 2 and abs(delta) > mpmath.mpf(10) ** (-dps) * max(1, abs(a)):
                 raise RuntimeError(f"mathieu_refined {kind}_{m}({q}): Newton did not converge")
         return +a
+
+
+@dataclass(frozen=True)
+class ModeOrbit:
+    """A periodic orbit of a conservative system through its turning point: every coordinate
+    at t = 0 (velocities zero), its period, its energy, and whether Newton converged."""
+
+    start: np.ndarray
+    period: float
+    energy: float
+    converged: bool
+
+
+def system_rhs(system: object) -> Callable:
+    """``(x', x'')`` of ``x'' + Lx + g(x) = 0`` (a :class:`derive.system.System`) for SciPy."""
+    import sympy as sp
+
+    d = system.size
+    accel = sp.lambdify([system.coordinates],
+                        [-(system.stiffness * sp.Matrix(system.coordinates))[i] - system.force[i]
+                         for i in range(d)], "numpy")
+
+    def rhs(t: float, z: np.ndarray) -> np.ndarray:
+        return np.concatenate([z[d:], np.asarray(accel(z[:d]), dtype=float)])
+    return rhs
+
+
+def system_energy(system: object) -> Callable[[np.ndarray], float]:
+    """The potential ``V(x) = ∫₀¹ xᵀM(L(sx) + g(sx)) ds`` (exact for a force with a potential:
+    the energy at a turning point)."""
+    import sympy as sp
+
+    s = sp.Symbol("_s")
+    x = sp.Matrix(system.coordinates)
+    scaled = {c: s * c for c in system.coordinates}
+    force = system.stiffness * x + sp.Matrix(system.force)
+    integrand = sum(system.mass[i] * x[i] * force[i].xreplace(scaled) for i in range(system.size))
+    V = sp.integrate(sp.expand(integrand), (s, 0, 1))
+    return sp.lambdify([system.coordinates], V, "numpy")
+
+
+def mode_orbit(system: object, A: float, guess: np.ndarray, amplitude: int = 0,
+               rtol: float = CYCLE_RTOL) -> ModeOrbit:
+    """The periodic orbit through ``x_amplitude(0) = A`` with every velocity zero: Newton
+    (:func:`numerics.newton.newton`, differences) on the other coordinates at t = 0 and the half
+    period ``guess[-1]``, where every velocity vanishes again (a time-reversible orbit), each
+    step shot by DOP853 at ``rtol``."""
+    from scipy.integrate import solve_ivp
+
+    from .newton import newton
+
+    d = system.size
+    rhs = system_rhs(system)
+
+    def start_of(u: np.ndarray) -> np.ndarray:
+        return np.insert(u[:-1], amplitude, A)
+
+    def residual(u: np.ndarray) -> np.ndarray:
+        z0 = np.concatenate([start_of(u), np.zeros(d)])
+        sol = solve_ivp(rhs, (0.0, u[-1]), z0, method="DOP853", rtol=rtol, atol=rtol / 10)
+        return sol.y[d:, -1]
+
+    u, converged, _ = newton(residual, None, np.asarray(guess, dtype=float), tol=1e-12)
+    start = start_of(u)
+    return ModeOrbit(start, 2 * u[-1], float(system_energy(system)(start)), converged)
