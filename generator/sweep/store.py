@@ -570,7 +570,7 @@ def run_sweep(kind: str | Kind, axes: Mapping[str, Sequence[float]], store: Path
     if not todo:
         return open_sweep(path) if state.done is not None else _initialise(path, grid)
     saved = [int(done.sum())]  # blocks in the store, kept up to date by _gather
-    with contextlib.ExitStack() as stack:
+    with _interrupts_remembered(), contextlib.ExitStack() as stack:
         try:
             client = _connect(scheduler, workers, stack)
             if state.done is None:
@@ -585,6 +585,35 @@ def run_sweep(kind: str | Kind, axes: Mapping[str, Sequence[float]], store: Path
             raise Interrupted(f"{saved[0]}/{grid.chunks} blocks saved in {path}; run the same "
                               "command to resume") from None
     return open_sweep(path)
+
+
+STOP = threading.Event()
+# NOTE: set by Ctrl-C or SIGTERM during a sweep. The signal also raises KeyboardInterrupt at
+# once; the flag stops the sweep at the next block even where library code caught that
+# exception on its way (seen once in many runs: a sweep that ran on to its end after Ctrl-C).
+
+
+@contextlib.contextmanager
+def _interrupts_remembered() -> Iterator[None]:
+    """SIGINT and SIGTERM set :data:`STOP`, then raise KeyboardInterrupt (the former handlers
+    back afterwards); in the main thread only (signals are delivered there)."""
+    import signal
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    STOP.clear()
+
+    def remember(signum: int, frame: object) -> None:
+        STOP.set()
+        raise KeyboardInterrupt
+
+    old = {sig: signal.signal(sig, remember) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
 
 
 def _stop_workers() -> None:
@@ -632,6 +661,8 @@ def _gather(client: object, grid: Grid, path: Path, todo: list[int], saved: list
                            loop=client.loop)
     try:
         for future in running:
+            if STOP.is_set():
+                raise KeyboardInterrupt
             chunk = index.pop(future)
             data = future.result()
             _write_block(arrays, grid, chunk, data)
