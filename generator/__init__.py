@@ -27,6 +27,8 @@ order; a stage imports only stages above it::
     derive.nnm              nonlinear normal modes as exact L–P series in Q or Q(ω₀²), the
                             secular condition by the left null vector, internal resonances
                             refused [System, mode, K -> NormalModeSeries]
+    derive.resonance        the first-order slow flow of a system's modes in internal
+                            resonance, exact; its coupled modes [System -> ResonantFlow]
     derive.averaging        the slow flow of q'' + q = ε f (+ ε F cos ωt): near-identity
                             averaging to any order in van der Pol's variables, exact (R_k, Φ_k
                             of dr/dt, dφ/dt) [Oscillator, K -> SlowFlow]
@@ -100,9 +102,10 @@ order; a stage imports only stages above it::
     costs                   each command's estimated wall time and bounds [arguments -> Cost]
     cli.common              what every command shares: light constants, argument types and
                             flags, the report shape [argv -> Namespace]
+    cli.system              nnm, and slowflow of a system [NormalModeSeries, ResonantFlow ->
+                            JSON, tables]
     cli.series              series, mathieu, tongues, slowflow, models, generate
                             [records -> JSON, tables]
-    cli.system              nnm [NormalModeSeries -> JSON, tables]
     cli.driven              driven, response, subharmonic, parametric, mixing
                             [records -> JSON, tables]
     cli.choose              choose, clock, scene [Choice -> JSON, tables]

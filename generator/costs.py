@@ -465,8 +465,9 @@ def slow_flow_cost(args: argparse.Namespace) -> Cost:
     """``slowflow``: the fit at ``--order`` (beyond :data:`SLOW_FLOW_MAX_ORDER` the fixed
     part only: the derivation refuses at once)."""
     # NOTE: beyond the bound the derivation refuses at once (its own one-line message)
-    order = args.order if args.order <= SLOW_FLOW_MAX_ORDER else 0
-    return Cost(power_law(*SLOW_FLOW_FIT, order), f"order {args.order}", "the slow flow")
+    asked = args.order if args.order is not None else 1 if ";" in args.model else 2
+    order = asked if asked <= SLOW_FLOW_MAX_ORDER else 0
+    return Cost(power_law(*SLOW_FLOW_FIT, order), f"order {asked}", "the slow flow")
 
 
 PARAMETRIC_FIT = (2.0, 1.5e-3)

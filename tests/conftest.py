@@ -18,7 +18,7 @@ import pytest
 LAYERS = {
     "exact": ("averaging", "branches", "driven", "driven_damped", "driven_equation", "equation",
               "hill", "layout", "lindstedt", "nnm", "parametric", "response", "response_equation",
-              "series", "subharmonic"),
+              "resonance", "series", "subharmonic"),
     "printers": ("charts", "cli", "costs", "emit", "files", "fuzz", "interrupt", "latex",
                  "notebook", "readme", "validity"),
     "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "nnm_emitted", "orbits",

@@ -456,6 +456,14 @@ def run_slowflow(args: argparse.Namespace) -> int:
     from ..derive.averaging import slow_flow
     from ..derive.models import oscillator, registry_entry
 
+    if ";" in args.model:  # a system: its modes in internal resonance
+        from .system import run_slowflow_system
+
+        args.order = 1 if args.order is None else args.order
+        return run_slowflow_system(args)
+    args.order = 2 if args.order is None else args.order
+    if args.start:
+        raise InputError("--start: a system's flag (equations separated by ';')")
     text, name = args.model, args.name or "oscillator"
     if (entry := registry_entry(text)) is not None:  # a name or its alias (vdp)
         text, name = entry.equation, args.name or entry.name
@@ -733,15 +741,23 @@ def arguments_generate(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
 def arguments_slowflow(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """``lindstedt slowflow``'s arguments."""
     p = sub.add_parser("slowflow", help="the slow flow (averaging) of q'' + q = eps*f, free, "
-                       "self-excited or driven", description="Average q'' + q = eps*f(q, q') "
-                       "(+ eps*F*cos(w*t), w = 1 + eps*sigma) to order K: dr/dt and dphi/dt "
-                       "exactly, for q = r cos(t + phi); with --out the compiled right sides and "
-                       "the LaTeX of the flow.")
+                       "self-excited or driven; of a system's modes in internal resonance",
+                       description="Average q'' + q = eps*f(q, q') (+ eps*F*cos(w*t), w = 1 + "
+                       "eps*sigma) to order K: dr/dt and dphi/dt exactly, for q = r cos(t + "
+                       "phi); with --out the compiled right sides and the LaTeX of the flow. A "
+                       "SYSTEM (equations separated by ';') whose linear frequencies are "
+                       "commensurate: the first-order slow flow of the resonant modes, its "
+                       "coupled modes and the energy-exchange period.")
     _flag_oscillator(p)
-    p.add_argument("--order", type=_order, default=2, metavar="K",
-                   help="the order in eps, 1..6 (default 2)")
+    p.add_argument("--order", type=_order, default=None, metavar="K",
+                   help="the order in eps, 1..6 (default 2; a SYSTEM: 1, the only one built)")
+    p.add_argument("--start", action="append", metavar="NAME=VALUE",
+                   help="a SYSTEM: the starting amplitude a_k of a resonant mode for the "
+                   "energy exchange, e.g. a1=0.001 (repeatable; default: the highest mode at "
+                   "0.1, the others at 0.001)")
     _flag_json(p, "the contract {equation, name, order, variable, parameters, driven, "
-               "convention, radial, phase, cycles}")
+               "convention, radial, phase, cycles}; a SYSTEM: {kind, system, modes, omega0, "
+               "resonances, equations, coupled_modes, exchange}")
     p.add_argument("--out", metavar="DIR", help="also write <name>_slow_flow.py (numba "
                    "slow_flow, slow_flow_jacobian, slow_flow_cartesian) and "
                    "<name>_slow_flow.tex into DIR")

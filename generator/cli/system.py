@@ -92,6 +92,81 @@ def run_nnm(args: argparse.Namespace) -> int:
     return 0
 
 
+START_AMPLITUDE = 0.1
+START_SEED = 0.01
+# NOTE: the default start of the energy exchange: the highest resonant mode at amplitude 0.1,
+# the others seeded at 1 % of it (a swing spring set bouncing, its swing growing from a nudge).
+
+
+def resonant_json(flow, start: list[float]) -> dict:
+    """``slowflow SYSTEM --json``: the averaged equations (exact SymPy str), the coupled modes
+    (phase-locked: every amplitude steady) and the energy-exchange period from ``start``."""
+    from ..derive.resonance import coupled_modes
+    from ..numerics.references import exchange_period
+
+    names = [f"a{k}" for k in range(1, len(flow.a) + 1)]
+    equations = {}
+    for k, name in enumerate(names):
+        equations[f"{name}'"] = str(flow.amplitude[k])
+        equations[f"phi{k + 1}'"] = str(flow.phase[k])
+    return {
+        "kind": "slowflow", "system": flow.system.text, "order": 1,
+        "modes": list(flow.modes), "omega0": [str(w) for w in flow.omega],
+        "resonances": list(flow.resonances),
+        "shapes": [[str(v) for v in shape] for shape in flow.shapes],
+        "variables": "x = sum_k shape_k a_k cos(omega0_k t + phi_k), slowly varying a_k, phi_k",
+        "equations": equations,
+        "coupled_modes": [{"gamma": str(g), "ratio": str(r), "ratio_value": float(r)}
+                          for g, r in coupled_modes(flow)],
+        "exchange": {"start": dict(zip(names, start, strict=True)),
+                     "period": exchange_period(flow, start),
+                     "how": "the averaged flow by DOP853 from zero phases: time between two "
+                            "maxima of a1"},
+    }
+
+
+def resonant_table(data: dict) -> str:
+    """The readable slow flow of a system's resonant modes."""
+    lines = [f"{data['system']}: internal resonance {'; '.join(data['resonances'])}",
+             f"the slow flow to order 1 ({data['variables']})"]
+    lines += [f"  {k} = {v}" for k, v in data["equations"].items()]
+    for c in data["coupled_modes"]:
+        lines.append(f"coupled mode: resonant angle {c['gamma']}, a2/a1 = {c['ratio']} "
+                     f"({c['ratio_value']:.6g})")
+    ex = data["exchange"]
+    start = ", ".join(f"{k} = {v:g}" for k, v in ex["start"].items())
+    lines.append(f"energy exchange from {start}: period {ex['period']:.6g}")
+    return "\n".join(lines)
+
+
+def run_slowflow_system(args: argparse.Namespace) -> int:
+    """``slowflow SYSTEM``: the first-order slow flow of the modes in internal resonance."""
+    from ..derive.resonance import resonant_flow
+    from ..derive.system import parse_system
+
+    if args.out is not None:
+        raise InputError("--out: a system's slow flow is printed, not emitted (not built)")
+    flow = resonant_flow(parse_system(args.model, _params(args.param)), args.order)
+    start = [START_AMPLITUDE * (1 if k == len(flow.a) - 1 else START_SEED)
+             for k in range(len(flow.a))]
+    for pair in args.start or ():
+        name, _, value = pair.partition("=")
+        names = [f"a{k}" for k in range(1, len(flow.a) + 1)]
+        if name.strip() not in names:
+            raise InputError(f"--start {pair!r}: write NAME=VALUE with NAME one of "
+                             f"{', '.join(names)}")
+        try:
+            number = float(value)
+        except ValueError:
+            raise InputError(f"--start {pair!r}: {value!r} is not a number") from None
+        if not 0 < number < 1e6:
+            raise InputError(f"--start {pair!r}: an amplitude must be > 0 and finite")
+        start[names.index(name.strip())] = number
+    data = resonant_json(flow, start)
+    print(json.dumps(data) if args.json else resonant_table(data))
+    return 0
+
+
 def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """``lindstedt nnm``'s arguments."""
     p = sub.add_parser("nnm", help="a nonlinear normal mode of coupled oscillators as an exact "

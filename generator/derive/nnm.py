@@ -301,4 +301,5 @@ def _resonance(system: System, mode: int, lams: tuple, n: int, j: int, step: int
     power = "A" if step == 1 else f"y = A**{step}"
     return (f"system {system.text!r}: mode {mode} (ω0² = {lam}) is in 1:{n} internal resonance "
             f"with {which}: harmonic {n} of order {j} in {power} forces it, and the L–P "
-            "series of the mode does not exist there (the modes exchange energy)")
+            "series of the mode does not exist there (the modes exchange energy: lindstedt "
+            "slowflow SYSTEM gives their slow flow)")

@@ -5,7 +5,7 @@ truncated Hill matrix, Newton and mpmath."""
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -354,3 +354,67 @@ def mode_orbit(system: object, A: float, guess: np.ndarray, amplitude: int = 0,
     u, converged, _ = newton(residual, None, np.asarray(guess, dtype=float), tol=1e-12)
     start = start_of(u)
     return ModeOrbit(start, 2 * u[-1], float(system_energy(system)(start)), converged)
+
+
+def exchange_period(flow: object, start: Sequence[float], t_max: float = 1e6) -> float:
+    """The energy-exchange period of a resonant slow flow (a :class:`derive.resonance.
+    ResonantFlow`) from amplitudes ``start`` and zero phases: the time between two successive
+    maxima of the first mode's amplitude, by DOP853 on the averaged equations; NaN if none
+    within ``t_max``."""
+    import sympy as sp
+    from scipy.integrate import solve_ivp
+
+    n = len(flow.a)
+    rates = sp.lambdify([(*flow.a, *flow.phi)], [*flow.amplitude, *flow.phase], "numpy")
+
+    def rhs(t: float, y: np.ndarray) -> list[float]:
+        return rates(y)
+
+    def peak(t: float, y: np.ndarray) -> float:
+        return rates(y)[0]
+    peak.direction = -1
+    y0 = [*start, *([0.0] * n)]
+    span = 100.0
+    while span <= t_max:
+        sol = solve_ivp(rhs, (0.0, span), y0, method="DOP853", rtol=1e-11, atol=1e-14,
+                        events=peak)
+        times = sol.t_events[0]
+        if len(times) >= 2:
+            return float(times[1] - times[0])
+        span *= 4
+    return math.nan
+
+
+def simulated_exchange_period(system: object, flow: object, start: Sequence[float],
+                              periods: int = 3, rhs: Callable | None = None) -> float:
+    """The same period from the full equations (DOP853 at 1e-11; ``rhs``: other equations of
+    the same coordinates, ``(t, z) -> z'``): the first mode's energy ``(q₁'² + ω₁²q₁²)/2``
+    (``q₁ = ψ₁·x``), averaged over each fast period, between its successive maxima;
+    ``x(0) = Σ φ_k a_k``, every velocity zero."""
+    import sympy as sp
+    from scipy.integrate import solve_ivp
+    from scipy.signal import find_peaks
+
+    from ..derive.resonance import _shapes
+
+    lam = sp.Integer(1) * flow.omega[0] ** 2
+    _, left = _shapes(system, lam)
+    psi = np.array([float(v) for v in left])
+    x0 = sum(np.array([float(v) for v in shape]) * a for shape, a in
+             zip(flow.shapes, start, strict=True))
+    guess = exchange_period(flow, start)
+    fast = 2 * np.pi / float(min(flow.omega))
+    t_end = (periods + 0.5) * guess
+    steps = int(t_end / fast) * 64
+    t = np.linspace(0.0, t_end, steps)
+    sol = solve_ivp(rhs or system_rhs(system), (0.0, t_end), [*x0, *np.zeros(system.size)],
+                    method="DOP853", rtol=1e-11, atol=1e-14, t_eval=t)
+    d = system.size
+    w1 = float(flow.omega[0])
+    energy = 0.5 * ((psi @ sol.y[d:]) ** 2 + w1**2 * (psi @ sol.y[:d]) ** 2)
+    window = 64
+    mean = energy[: len(energy) // window * window].reshape(-1, window).mean(axis=1)
+    peaks, _ = find_peaks(mean, prominence=0.2 * (mean.max() - mean.min()))
+    if len(peaks) < 2:
+        return math.nan
+    return float(np.mean(np.diff(peaks)) * fast)

@@ -1,0 +1,126 @@
+"""Internal resonance: the first-order slow flow of the resonant modes, exact (against the
+averages worked by hand), its invariants, its coupled modes, and its energy-exchange period
+against DOP853 on the full equations — the swing spring's polynomial model and the elastic
+pendulum itself."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import sympy as sp
+from lindstedt.derive.resonance import coupled_modes, resonant_flow
+from lindstedt.derive.system import parse_system
+from lindstedt.numerics.references import exchange_period, simulated_exchange_period
+from scipy.integrate import solve_ivp
+
+SWING = "x'' + x + 3*x*y = 0; y'' + 4*y + 3*x**2/2 = 0"
+# NOTE: the elastic pendulum in Cartesian coordinates (unit mass, g = 1, stretched length 1,
+# spring k = 4: ω_z = 2ω_x), x'' = −4(1 − l₀/r)x, y'' = 1 − 4(1 − l₀/r)(1 + y) with l₀ = 3/4
+# and r = √(x² + (1 + y)²), expanded to second order in (x, y).
+CUBIC_1_3 = "x1'' + x1 + (x1 + x2)**3 = 0; x2'' + 9*x2 + (x1 + x2)**3 = 0"
+
+
+def run(*args):
+    return subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
+                          text=True, check=False)
+
+
+def test_swing_spring_flow_equals_the_averages_worked_by_hand():
+    """x = a₁cos θ₁, y = a₂cos θ₂, ⟨sin 2θ₁ cos θ₂⟩ = ½ sin(2φ₁ − φ₂) and the like give
+    a₁' = ¾a₁a₂ sin γ, a₂' = −(3/16)a₁² sin γ, φ₁' = ¾a₂ cos γ, φ₂' = (3/16)(a₁²/a₂) cos γ,
+    γ = 2φ₁ − φ₂."""
+    flow = resonant_flow(parse_system(SWING))
+    a1, a2 = flow.a
+    p1, p2 = flow.phi
+    g = 2 * p1 - p2
+    R = sp.Rational
+    expected = (R(3, 4) * a1 * a2 * sp.sin(g), -R(3, 16) * a1**2 * sp.sin(g),
+                R(3, 4) * a2 * sp.cos(g), R(3, 16) * a1**2 / a2 * sp.cos(g))
+    assert all(sp.simplify(e - f) == 0 for e, f in
+               zip((*flow.amplitude, *flow.phase), expected, strict=True))
+    assert flow.resonances == ("1:2 between mode 1 (ω0 = 1) and mode 2 (ω0 = 2)",)
+
+
+@pytest.mark.parametrize("text", [SWING, CUBIC_1_3])
+def test_the_averaged_flow_conserves_the_linear_energy(text):
+    """Σ ω_k² a_k² is a first integral of the first-order flow (the system is conservative)."""
+    flow = resonant_flow(parse_system(text))
+    rate = sum(w**2 * a * da for w, a, da in zip(flow.omega, flow.a, flow.amplitude,
+                                                 strict=True))
+    assert sp.simplify(rate) == 0
+
+
+def test_coupled_modes_of_the_swing_spring_stay_locked_in_the_full_equations():
+    """a₂/a₁ = √2/4 at γ = 0 and π (γ' = ¾a₂·2 − (3/16)a₁²/a₂ = 0 by hand); started there, the
+    full equations keep the pendulum's energy within 3 % over ten exchange periods, where a
+    start off the ratio exchanges most of it."""
+    system = parse_system(SWING)
+    modes = coupled_modes(resonant_flow(system))
+    assert modes == [(0, sp.sqrt(2) / 4), (sp.pi, sp.sqrt(2) / 4)]
+
+    def rhs(t, z):
+        x, y, vx, vy = z
+        return [vx, vy, -x - 3 * x * y, -4 * y - 1.5 * x * x]
+
+    a1 = 0.05
+    for a2 in (a1 * np.sqrt(2) / 4, a1):  # locked, then off the ratio
+        sol = solve_ivp(rhs, (0, 3000), [a1, a2, 0, 0], method="DOP853", rtol=1e-10,
+                        atol=1e-13, max_step=0.5)
+        energy = 0.5 * (sol.y[2] ** 2 + sol.y[0] ** 2)
+        spread = (energy.max() - energy.min()) / energy.max()
+        assert (spread < 0.03) if a2 < a1 else (spread > 0.5), (a2, spread)
+
+
+@pytest.mark.parametrize("a2, tol", [(0.1, 0.03), (0.025, 0.015)])
+def test_exchange_period_against_dop853(a2, tol):
+    """The averaged flow's period against the full polynomial equations; the error shrinks
+    with the amplitude (first order)."""
+    system = parse_system(SWING)
+    flow = resonant_flow(system)
+    start = (a2 * 0.01, a2)
+    predicted = exchange_period(flow, start)
+    assert predicted == pytest.approx(169.0127 * 0.1 / a2, rel=1e-4)  # the flow scales as 1/a
+    assert abs(predicted / simulated_exchange_period(system, flow, start) - 1) <= tol
+
+
+def test_exchange_period_of_the_elastic_pendulum_itself():
+    """The elastic pendulum (not its expansion) by DOP853, at a small amplitude."""
+    system = parse_system(SWING)
+    flow = resonant_flow(system)
+    l0 = 0.75
+
+    def rhs(t, z):
+        x, y, vx, vy = z
+        r = np.hypot(x, 1 + y)
+        pull = 4 * (1 - l0 / r)
+        return [vx, vy, -pull * x, 1 - pull * (1 + y)]
+
+    start = (0.00025, 0.025)
+    shot = simulated_exchange_period(system, flow, start, rhs=rhs)
+    assert abs(exchange_period(flow, start) / shot - 1) <= 0.03
+
+
+def test_slowflow_system_json_and_refusals():
+    out = run("slowflow", SWING, "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert data["kind"] == "slowflow" and data["modes"] == [1, 2]
+    assert data["omega0"] == ["1", "2"] and data["order"] == 1
+    assert data["equations"]["a1'"] == "3*a1*a2*sin(2*phi1 - phi2)/4"
+    assert data["coupled_modes"][0]["ratio"] == "sqrt(2)/4"
+    assert data["exchange"]["period"] == pytest.approx(169.0127, rel=1e-4)
+    for args, says in (
+        (["x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0"], "no internal resonance"),
+        ([SWING, "--order", "2"], "higher orders are not built"),
+        ([SWING, "--start", "a3=1"], "--start 'a3=1'"),
+        ([SWING, "--start", "a1=-1"], "must be > 0"),
+        ([SWING, "--out", "x"], "--out: a system's slow flow is printed"),
+        (["van_der_pol", "--start", "a1=1"], "--start: a system's flag"),
+    ):
+        bad = run("slowflow", *args)
+        assert bad.returncode == 2 and bad.stdout == "", (args, bad.stderr)
+        assert len(bad.stderr.strip().splitlines()) == 1 and says in bad.stderr, bad.stderr
