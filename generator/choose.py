@@ -605,7 +605,7 @@ def driven_scene(tol: float = 1e-4) -> SceneResult:
     """The notes' driven table (ε = 0.1, f = 1, ω = 1) to ``tol``."""
     c = choose_driven("amplitudes", tol, 0.1, 1.0, np.inf, 1.0)
     orders = {m: o for m, o, _, _ in c.considered}
-    return SceneResult("notes-driven", f"the notes' driven table (A1, A3, A5) to {tol:g}",
+    return SceneResult("notes-driven", f"Hand & Finch's driven table (A1, A3, A5) to {tol:g}",
                        f"μ-expansion order {orders.get('mu_expansion')}, or harmonic balance "
                        f"with {orders.get('harmonic_balance')} harmonics; faster: {c.method}",
                        {"mu_order": orders.get("mu_expansion"),

@@ -184,19 +184,24 @@ def written(tmp_path_factory) -> dict[str, Path]:
     generate_limit_cycle(series_model(VAN_DER_POL, 6, {}, "van_der_pol"), 4, out, resum_order=6)
     generate(series_model(THETA, 6, {}, "swing"), 4, out)
     generate(series_model("helmholtz_duffing", 6), 4, out)
+    from lindstedt.compiler import generate_nnm
+    from lindstedt.derive.system import parse_system
+
+    generate_nnm(parse_system(KERSCHEN), 2, 16, out, name="kerschen")
     texs = {f"order-high/{p.name}": p for p in out.glob("*.tex")}
     texs.update({f"generated/{p.name}": p for p in GENERATED.glob("*.tex")})
     return texs
 
 
 VAN_DER_POL = "q'' + q = eps*(1 - q**2)*q'"
+KERSCHEN = "x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0"
 THETA = "theta'' + sin(theta) = 0"
 TEX_NAMES = [f"order-high/{m}_{kind}.tex" for m in ("duffing", "pendulum", "swing",
                                                     "helmholtz_duffing")
              for kind in ("tables", "derivation")] + [
     f"order-high/{name}.tex" for name in ("driven_derivation", "driven_damped_derivation",
                                           "forced_slow_flow", "van_der_pol_slow_flow",
-                                          "van_der_pol_derivation")]
+                                          "van_der_pol_derivation", "kerschen_tables")]
 
 
 @pytest.mark.skipif(PDFLATEX is None, reason="pdflatex not installed (`make tex` installs it)")
@@ -218,6 +223,7 @@ def test_tex_compiles_without_overfull_lines(written, name, tmp_path):
 
 @pytest.mark.parametrize("name", ["order-high/duffing_tables.tex",
                                   "order-high/pendulum_tables.tex",
+                                  "order-high/kerschen_tables.tex",
                                   *(f"generated/{p.name}"
                                     for p in sorted(GENERATED.glob("*_tables.tex")))])
 def test_no_number_in_a_table_is_split(written, name):
@@ -260,3 +266,13 @@ def test_the_expansion_variable_is_y_and_headers_use_the_coordinate(written):
     assert r"\ddot{\theta} + \sin\theta = 0" in swing
     cycle = written["order-high/van_der_pol_derivation.tex"].read_text()
     assert r"\ddot{q} + q = \varepsilon \dot{q} \left(1 - q^{2}\right)" in cycle
+
+
+def test_normal_mode_tables_hold_the_exact_series(written):
+    """The mode's tables: ω over √3 and the coordinates' coefficients as the series has them
+    (x₁'s order-1 coefficients ∓25/4992, x₂'s order 0 −1), the equations as mathematics."""
+    text = written["order-high/kerschen_tables.tex"].read_text()
+    assert r"\omega_0 = \sqrt{3}" in text and "y = A^{2}" in text
+    assert r"\frac{1}{32}\,y" in text  # ω = √3(1 + y/32 + …)
+    assert r"\frac{25}{4992}" in text
+    assert r"\ddot{x_{1}}" in text and "**" not in text.split("\\begin{document}")[1]

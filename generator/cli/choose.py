@@ -181,7 +181,7 @@ def run_clock(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps({"claims": rows}))
         return 0
-    print("The notes' appendix: 1 - cos(theta) approximated, accurate to a tolerance "
+    print("Hand & Finch's appendix: 1 - cos(theta) approximated, accurate to a tolerance "
           "up to an angle")
     print(f"{'approximation':>24} {'tol':>7} {'claimed':>8} {'potential':>10} {'period':>8}"
           "  holds?")

@@ -339,8 +339,9 @@ class _Span(argparse.Action):
         try:
             numbers = [_real(part) for part in parts[:2]] + [_positive(part)
                                                             for part in parts[2:]]
-        except argparse.ArgumentTypeError as exc:
-            raise argparse.ArgumentError(self, f"{values!r}: {exc}") from None
+        except argparse.ArgumentTypeError as exc:  # its text names the bad part
+            raise argparse.ArgumentError(self, str(exc) if len(parts) == 1 else
+                                         f"{values!r}: {exc}") from None
         names = self.into[:1] if len(numbers) == 1 else self.into[1:1 + len(numbers)]
         for name, number in zip(names, numbers, strict=True):
             setattr(namespace, name, number)

@@ -119,6 +119,12 @@ def _number(c: object) -> str:
     return f"{c.p}" if c.q == 1 else f"{c.p}/{c.q}"
 
 
+def _human(c: object) -> str:
+    """:func:`_fraction_text` as a reader writes it: an integer without ``/1``."""
+    text = _fraction_text(c)
+    return text.removesuffix("/1") if text.endswith("/1") and "/" not in text[:-2] else text
+
+
 def _coordinate_named(convention: str, name: str) -> str:
     """The convention in the user's coordinate: ``theta(0) = A, theta'(0) = 0, …``."""
     return convention if name == "q" else re.sub(r"\bq(_j)?(?=\(|'\()", name + r"\1",
@@ -324,7 +330,7 @@ def run_mathieu(args: argparse.Namespace) -> int:
     print(f"{args.kind}_{args.m}(q) of y'' + (a - 2q cos 2z) y = 0 (DLMF 28.2.1), order "
           f"{args.order}: coefficient of q^k")
     for k, c in enumerate(series):
-        print(f"{k:>4}  {_fraction_text(c)}")
+        print(f"{k:>4}  {_human(c)}")
     if line:
         print(line)
     return 0
@@ -377,7 +383,7 @@ def run_tongues(args: argparse.Namespace) -> int:
                              "sin": {str(j): _fraction_text(c) for (kind, j), c in x.items()
                                      if kind == 1}} for x in curve.solution]}
         lines.append(f"curve {curve.label}: k, delta_k")
-        lines += [f"{k:>4}  {_fraction_text(c)}" for k, c in enumerate(curve.delta)]
+        lines += [f"{k:>4}  {_human(c)}" for k, c in enumerate(curve.delta)]
         if args.singularities:
             row["singularities"], line = _singularities(list(curve.delta), "eps",
                                                         f"delta ({curve.label})", None)
@@ -408,7 +414,7 @@ def run_tongues(args: argparse.Namespace) -> int:
             "at": {"zeta": args.zeta, "eps_min": eps, "delta": delta, "error": err}}
         lines.append("damped tongue tip: eps_min(zeta) = sum_k e_k zeta^k at delta = sum_k "
                      "d_k zeta^k (k, e_k, d_k)")
-        lines += [f"{k:>4}  {_fraction_text(e):>24}  {_fraction_text(d)}"
+        lines += [f"{k:>4}  {_human(e):>24}  {_human(d)}"
                   for k, (e, d) in enumerate(zip(tip.eps_min, tip.delta, strict=True))]
         lines.append(f"at zeta = {args.zeta:g}: eps_min = {eps:.12g}, delta = {delta:.12g}")
     print(json.dumps(data) if args.json else "\n".join(lines))

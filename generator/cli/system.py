@@ -85,9 +85,9 @@ def run_nnm(args: argparse.Namespace) -> int:
         progress.close()
     data = nnm_json(mode)
     if args.plot:
-        from ..charts_modes import nnm_figure
+        from ..charts_modes import FEP_ORDER, nnm_figure
 
-        nnm_figure(system, Path(args.plot))
+        nnm_figure(system, Path(args.plot), max(args.order, FEP_ORDER))
     print(json.dumps(data) if args.json else nnm_table(data))
     return 0
 
@@ -193,7 +193,8 @@ def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     _flag_json(p)
     p.add_argument("--plot", metavar="FILE",
                    help="also draw the frequency–energy plot of every mode (at most 4) into "
-                   "FILE (.png, .svg or .pdf): each backbone from its series beside orbits shot "
-                   "by DOP853, the series' reach, the internal-resonance lines (default: none)")
+                   "FILE (.png, .svg or .pdf): each backbone from its series (to order 24, or "
+                   "--order if higher) beside orbits shot by DOP853, the series' reach, the "
+                   "internal-resonance lines (default: none)")
     _flag_allow_slow(p, deprecated_force=False)
     return p

@@ -544,8 +544,9 @@ class Entry:
 
 REGISTRY = {e.name: e for e in (
     Entry("duffing", "q'' + q + eps*q**3 = 0", "hardening (eps > 0) or softening cubic spring, "
-          "notes §10.3", lambda order: duffing()),
-    Entry("pendulum", "theta'' + sin(theta) = 0", "the plane pendulum, App. 4.1", pendulum),
+          "Hand & Finch §10.3", lambda order: duffing()),
+    Entry("pendulum", "theta'' + sin(theta) = 0", "the plane pendulum, Hand & Finch App. 4.1",
+          pendulum),
     Entry("helmholtz_duffing", "q'' + q + eps*(alpha*q**2 + beta*q**3) = 0",
           "asymmetric spring: quadratic and cubic terms (parameters stay symbolic)"),
     Entry("quintic", "q'' + q + eps*q**5 = 0", "quintic spring"),

@@ -40,6 +40,7 @@ from ..lower.records import (
     CycleDerivation,
     Derivation,
     Evaluator,
+    ModeTables,
     Module,
     MuDampedDerivation,
     MuDerivation,
@@ -432,6 +433,35 @@ def render_cycle_derivation(d: CycleDerivation, p: Provenance) -> dict[str, str]
     return {f"{p.model}_derivation.tex": tex}
 
 
+def render_mode_tables(d: ModeTables, p: Provenance) -> dict[str, str]:
+    """``{name_tables.tex: text}``: a normal mode's frequency, period and coefficient tables."""
+    y = "y"
+    variable = f"y = {latex_expr(d.variable)}" if d.variable != sp.Symbol("A") else "A"
+    if variable == "A":
+        y = "A"
+
+    def powers(coeffs: tuple) -> list[str]:
+        return [_signed(coeffs[j], f"{y}^{{{j}}}" if j > 1 else y, first=False)
+                for j in range(1, d.order + 1) if coeffs[j] != 0]
+
+    rest = f"+ O({y}^{{{d.order + 1}}})"
+    w0 = latex_expr(d.omega0)
+    head = banner(p, "%")
+    ctx = {
+        "title": f"Nonlinear normal mode {d.mode}",
+        "equations": [latex_expr(e) + " = 0" for e in d.equations],
+        "omega0": w0, "variable": variable, "y": y, "order": d.order,
+        "amplitude": latex_expr(d.amplitude),
+        "frequency": _series(w0 + r"\Bigl(", powers(d.omega), rest + r"\Bigr)", r"\omega ="),
+        "period": _series(r"\frac{2\pi}{" + w0 + r"}\Bigl(", powers(d.period),
+                          rest + r"\Bigr)", "T ="),
+        "coordinates": [{"name": latex_expr(x), "blocks": _table_blocks(_fourier_columns(q))}
+                        for x, q in d.coordinates],
+    }
+    text = environment(latex=True).get_template("mode_tables.tex.j2").render(banner=head, **ctx)
+    return {f"{p.model}_tables.tex": text}
+
+
 def _model_text(name: str) -> str:
     """A model's name as a title's words: ``van_der_pol`` → ``Van der pol``."""
     return name.replace("_", " ").capitalize()
@@ -443,7 +473,7 @@ def render(unit: Unit) -> dict[str, str]:
     renderers = {Derivation: render_latex, MuDerivation: render_mu_derivation,
                  MuDampedDerivation: render_mu_damped_derivation,
                  SlowFlowDocument: render_slow_flow,
-                 CycleDerivation: render_cycle_derivation}
+                 CycleDerivation: render_cycle_derivation, ModeTables: render_mode_tables}
     for doc in unit.documents:
         files.update(renderers[type(doc)](doc, unit.module.provenance))
     return files

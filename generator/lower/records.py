@@ -230,6 +230,24 @@ class Derivation:
 
 
 @dataclass(frozen=True)
+class ModeTables:
+    """The tables of a nonlinear normal mode (template ``mode_tables.tex.j2``): the system's
+    equations, ``ω = ω₀ Σ s_j y^j``, ``T = (2π/ω₀) Σ p_j y^j`` and each coordinate's Fourier
+    coefficients per order, exact."""
+
+    model: str
+    mode: int
+    equations: tuple[sp.Expr, ...]  # each equation's left side (= 0), accelerations as ẍ
+    omega0: sp.Expr
+    variable: sp.Expr  # y as a power of A
+    order: int
+    omega: tuple[sp.Expr, ...]  # s_j
+    period: tuple[sp.Expr, ...]  # p_j
+    coordinates: tuple[tuple[sp.Symbol, tuple[tuple[tuple[int, sp.Expr], ...], ...]], ...]
+    amplitude: sp.Symbol
+
+
+@dataclass(frozen=True)
 class NotesTable:
     """The notes' driven table: A₁, A₃, A₅ by μ-order, harmonic balance and shooting at
     ``(eps, force, omega)``; a cell is a number, or the notes' own printed digits."""
@@ -294,7 +312,7 @@ class Unit:
 
     module: Module
     documents: tuple[Derivation | MuDerivation | MuDampedDerivation
-                     | SlowFlowDocument | CycleDerivation, ...] = ()
+                     | SlowFlowDocument | CycleDerivation | ModeTables, ...] = ()
 
 
 # --- the slow flow (averaging) ---------------------------------------------------------------

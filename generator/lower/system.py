@@ -13,7 +13,7 @@ from ..derive.nnm import NormalModeSeries
 from ..errors import InputError
 from .forms import MODULE_NAMES, argument_entry, harmonics, horner
 from .printers import identifier
-from .records import Evaluator, Module, provenance
+from .records import Evaluator, ModeTables, Module, provenance
 
 NNM_ARGUMENT_LIMIT = 1e6
 # NOTE: |t| beyond this loses the phase ωt to rounding (as a free oscillator's module): NaN.
@@ -97,3 +97,21 @@ def lower_nnm(mode: NormalModeSeries, order: int, name: str, command: str) -> Mo
         provenance=provenance(name, order, command, system=mode.system.text, mode=mode.mode,
                               amplitude=coordinates[mode.amplitude]),
     )
+
+
+def mode_tables(mode: NormalModeSeries, order: int, name: str) -> ModeTables:
+    """The LaTeX tables' record of ``mode`` to ``order``: ω and T over their linear values,
+    every coordinate's coefficients, the equations with their accelerations as ẍ."""
+    system = mode.system
+    dots = [sp.Symbol(rf"\ddot{{{sp.latex(x)}}}") for x in system.coordinates]
+    L = system.stiffness * sp.Matrix(system.coordinates)
+    equations = tuple(sp.expand(dots[i] + L[i] + system.force[i])
+                      for i in range(system.size))
+    w0 = mode.omega0
+    return ModeTables(
+        name, mode.mode, equations, w0, sp.Symbol("A") ** mode.step, order,
+        tuple(sp.simplify(c / w0) for c in mode.omega()[: order + 1]),
+        tuple(sp.simplify(c * w0) for c in mode.period()[: order + 1]),
+        tuple((x, tuple(tuple(sorted(o.items())) for o in mode.coordinate(i)[: order + 1]))
+              for i, x in enumerate(system.coordinates)),
+        system.coordinates[mode.amplitude])
