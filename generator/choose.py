@@ -32,6 +32,8 @@ from .analysis.driven import Drive, amplitudes, first_order_branches, harmonic_b
 from .compiler import generate, generate_method
 from .derive.lindstedt import derive
 from .derive.models import Model, duffing, pendulum
+from .derive.nnm import NormalModeSeries
+from .derive.system import System
 from .display import html_table
 from .emit.render import load_generated
 from .errors import InputError
@@ -849,3 +851,84 @@ def choose_mathieu(kind: str, m: int, tol: float, q_min: float, q_max: float,
     rows.append(("reference", 0, _relative(solver, truth, 1.0),
                  RESUMMED_COSTS["mathieu"]["reference"], solver_ns))
     return _pick(f"mathieu {kind}_{m}", "mathieu", tol, order, len(q), rows)
+
+
+# --- a system's backbone: the normal mode's L–P order for a tolerance ------------------------
+
+BACKBONE_POINTS = 17
+# NOTE: Chebyshev points of the amplitude range, ends included (where truncation peaks), each
+# a shot orbit (~0.1–0.3 s for two coordinates).
+BACKBONE_MAX_ORDER = 40
+BACKBONE_FLOOR = 1e-11
+# NOTE: the shot reference (DOP853 at 1e-13, Newton to 1e-12) is trusted to ~1e-12 in T: a
+# tolerance below this floor cannot be verified.
+
+
+@dataclass(frozen=True)
+class BackboneChoice:
+    """The smallest L–P order of a normal mode's period ``T(A)`` within ``tol`` of shot orbits
+    on a range of amplitudes: the order, the max relative error there, the error of every
+    order tried, and the points it was verified on."""
+
+    mode: int
+    order: int
+    max_error: float
+    errors: tuple[float, ...]  # order k -> max relative error on the points
+    verified_on: int
+    radius: float  # the series' estimated radius in A (its reach)
+
+
+def choose_backbone(system: System, mode: int, tol: float, a_min: float, a_max: float,
+                    amplitude: int = 0, progress: Progress = quiet) -> BackboneChoice:
+    """The smallest order whose period is within ``tol`` (relative) of the shot orbits at
+    :data:`BACKBONE_POINTS` Chebyshev amplitudes of ``[a_min, a_max]`` (each seeded by the
+    last: a continuation); refused past the series' reach or below the reference's floor."""
+    from .derive.nnm import normal_mode
+    from .lower.system import radius
+    from .numerics.references import mode_orbit
+
+    if not (np.isfinite(tol) and tol > 0):
+        raise InputError(f"--tol {tol}: must be finite and > 0")
+    if tol < BACKBONE_FLOOR:
+        raise InputError(f"--tol {tol:g}: below {BACKBONE_FLOOR:g}, what the shot orbits "
+                         "verify")
+    if not (np.isfinite(a_min) and np.isfinite(a_max) and 0 < a_min < a_max):
+        raise InputError(f"--range {a_min}:{a_max}: amplitudes with 0 < A < B")
+    series = normal_mode(system, mode, BACKBONE_MAX_ORDER, amplitude)
+    found = radius(series)
+    reach = np.inf if found is None else (found[0] - found[1]) ** (1 / series.step)
+    if a_max >= reach:
+        raise InputError(f"--range {a_min}:{a_max}: the series of mode {mode} reaches "
+                         f"A < {reach:.4g} (its estimated radius less its spread); shoot "
+                         "beyond it")
+    A = verification_points(a_min, a_max, BACKBONE_POINTS)
+    tau = np.array([float(c) for c in series.period()])
+    shape = [np.array(_by_order(series, i)) for i in range(system.size)]
+    truth = np.empty_like(A)
+    guess = None
+    for k, a in enumerate(A):
+        progress(k, len(A))
+        y = a**series.step
+        period = 2 * np.pi * np.polyval(tau[::-1], y)
+        if guess is None:  # the series' own orbit seeds the first shot
+            x0 = np.array([a * np.polyval(c[::-1], y) for c in shape])
+            guess = np.append(np.delete(x0, amplitude), period / 2)
+        orbit = mode_orbit(system, float(a), guess, amplitude)
+        if not orbit.converged:
+            raise InputError(f"A = {a:g}: the shot orbit of mode {mode} did not converge")
+        truth[k] = orbit.period
+        guess = np.append(np.delete(orbit.start, amplitude), orbit.period / 2)
+    y = A**series.step
+    errors = []
+    for k in range(series.order + 1):
+        model = 2 * np.pi * np.polyval(tau[: k + 1][::-1], y)
+        errors.append(float(np.max(np.abs(model / truth - 1))))
+        if errors[-1] <= tol:
+            return BackboneChoice(mode, k, errors[-1], tuple(errors), len(A), float(reach))
+    raise InputError(f"--tol {tol:g}: not reached by order {series.order} on "
+                     f"[{a_min:g}, {a_max:g}]; the best is {min(errors):.1e}")
+
+
+def _by_order(series: NormalModeSeries, i: int) -> list[float]:
+    """Coordinate ``i``'s value at t = 0 per order (the sum of its harmonics), over A."""
+    return [float(sum(order.values())) for order in series.coordinate(i)]

@@ -102,6 +102,7 @@ FIXED_COSTS = {
     "choose response": 12.0,
     "choose cycle": 60.0,
     "choose mathieu": 30.0,
+    "choose backbone": 15.0,
 }
 # NOTE: commands whose work no input scales (bounded by the inputs' own bounds: at most four
 # drives, a fixed set of candidates and verification points): their wall time at most, from

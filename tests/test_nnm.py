@@ -176,3 +176,36 @@ def test_amplitude_on_another_coordinate_is_the_same_orbit():
     period1, starts = _evaluate(by_x1, 0.1)
     period2, _ = _evaluate(by_x2, starts[1])
     assert abs(period1 / period2 - 1) <= 1e-9
+
+
+def test_choose_backbone_picks_the_smallest_order_that_meets_the_tolerance():
+    """choose backbone: its order meets 1e-8 at the range's end against this file's own
+    shooting (another route), and the order below it does not."""
+    out = run("choose", "backbone", KERSCHEN, "--mode", "2", "--tol", "1e-8", "--range",
+              "0.05:0.5", "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    k = data["order"]
+    assert data["quantity"] == "backbone" and data["verified_on"] >= 10
+    series = normal_mode(parse_system(KERSCHEN), 2, 12)
+    A = 0.5
+    _, starts = _evaluate(series, A)
+    period_guess = 2 * np.pi / float(sum(float(c) * A ** (2 * j)
+                                         for j, c in enumerate(series.omega())))
+    _, shot = _shoot(KERSCHEN, A, starts[1:], period_guess / 2)
+    tau = [float(c) for c in series.period()]
+
+    def error(order):
+        return abs(2 * np.pi * sum(tau[j] * A ** (2 * j) for j in range(order + 1)) / shot - 1)
+    assert error(k) <= 1e-8 < error(k - 1)
+
+
+@pytest.mark.parametrize("args, says", [
+    (["--tol", "1e-8", "--range", "0.05:3"], "the series of mode 1 reaches A <"),
+    (["--tol", "1e-14", "--range", "0.05:0.5"], "below 1e-11"),
+    (["--tol", "1e-8", "--range", "0:0.5"], "0 < A < B"),
+])
+def test_choose_backbone_refusals(args, says):
+    out = run("choose", "backbone", KERSCHEN, *args)
+    assert out.returncode == 2 and says in out.stderr, out.stderr
+    assert len(out.stderr.strip().splitlines()) == 1

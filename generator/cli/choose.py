@@ -73,6 +73,10 @@ def run_choose(args: argparse.Namespace) -> int:
     values by their own helpers), as a table or JSON.  Returns the exit status."""
     if args.model is None and (args.param or args.name):
         raise InputError("--param/--name: give an EQUATION (choose period EQUATION …)")
+    if args.quantity == "backbone":
+        return _choose_backbone(args)
+    if args.mode is not None:
+        raise InputError("--mode: choose backbone's flag (a system's normal mode)")
     if args.model is not None and args.quantity != "period":
         raise InputError(f"choose {args.quantity} EQUATION: only the period is chosen for an "
                          "equation (q, amplitudes and response are the notes' Duffing "
@@ -128,6 +132,41 @@ def run_choose(args: argparse.Namespace) -> int:
                   choice.considered, quantity="period")
     for path in data.get("emitted", []):
         print(f"  emitted {path}")
+    return 0
+
+
+def _choose_backbone(args: argparse.Namespace) -> int:
+    """``choose backbone SYSTEM --mode M --tol TOL --range A:B``: the smallest order of the
+    mode's period within the tolerance of shot orbits."""
+    from ..choose import choose_backbone
+    from ..derive.system import parse_system
+
+    if args.model is None:
+        raise InputError("choose backbone needs a SYSTEM (equations separated by ';')")
+    if args.out:
+        raise InputError("--out: `lindstedt generate SYSTEM --mode M --order K` writes the "
+                         "chosen backbone's module")
+    _need_range(args, "choose backbone")
+    mode = 1 if args.mode is None else args.mode
+    progress = ProgressBar("shooting the verification orbits", not args.json)
+    try:
+        c = choose_backbone(parse_system(args.model, _params(args.param)), mode, args.tol,
+                            args.x_min, args.x_max, progress=progress)
+    finally:
+        progress.close()
+    data = {"quantity": "backbone", "mode": c.mode, "method": "lindstedt", "order": c.order,
+            "max_error": c.max_error, "errors": list(c.errors), "verified_on": c.verified_on,
+            "reach": c.radius, "tol": args.tol, "range": [args.x_min, args.x_max],
+            "reference": "orbits shot by DOP853 (rtol 1e-13), a continuation in A"}
+    if args.json:
+        print(json.dumps(data))
+        return 0
+    print(f"backbone T(A) of mode {c.mode}, A in [{args.x_min:g}, {args.x_max:g}], tolerance "
+          f"{args.tol:g} (relative, verified on {c.verified_on} shot orbits):")
+    print(f"  chosen: L–P order {c.order}: max error {c.max_error:.1e} (the series reaches "
+          f"A < {c.radius:.4g})")
+    print("  " + ", ".join(f"order {k}: {e:.1e}" for k, e in enumerate(c.errors)))
+    print(f"  (`lindstedt generate SYSTEM --mode {c.mode} --order {c.order}` writes it)")
     return 0
 
 
@@ -318,21 +357,25 @@ def arguments_choose(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                        description="Time and verify every method, report the cheapest that "
                        "meets the tolerance on the range.")
     p.add_argument("quantity", choices=("period", "q", *DRIVEN_QUANTITIES,
-                                        *RESUMMED_QUANTITIES),
+                                        *RESUMMED_QUANTITIES, "backbone"),
                    help="period T(y); q(t); amplitudes A_n, B_n; response r(ω); cycle: van der "
-                   "Pol's limit-cycle ω(ε); mathieu: a_m(q) or b_m(q) (--kind, --m); each "
-                   "over --range")
+                   "Pol's limit-cycle ω(ε); mathieu: a_m(q) or b_m(q) (--kind, --m); "
+                   "backbone: a SYSTEM's normal mode T(A) (--mode); each over --range")
     p.add_argument("--kind", choices=("a", "b"), default=None,
                    help="mathieu: a (even solutions, default) or b (odd)")
     p.add_argument("--m", type=_order, default=None, metavar="M",
                    help="mathieu: the index m (default 0)")
+    p.add_argument("--mode", type=_order, default=None, metavar="M",
+                   help="backbone: the system's mode, by increasing linear frequency "
+                   "(default 1)")
     _flag_equation(p, "\"q'' + q + eps*q**5 = 0\" (period only: a free oscillator with a "
                    "polynomial force, judged by quadrature; y is then its expansion variable)")
     p.add_argument("--tol", type=_real, metavar="TOL",
                    help="tolerance > 0 (period, q: relative, required; amplitudes, response: "
                    "absolute, default 1e-4)")
     _flag_span(p, "--range", ("A:B",), "the range A:B of the variable: period, q: y = εA² "
-               "(or an EQUATION's expansion variable); cycle: ε; mathieu: q (required)",
+               "(or an EQUATION's expansion variable); cycle: ε; mathieu: q; backbone: "
+               "the amplitude A (required)",
                (None, "x_min", "x_max"))
     _deprecated(p, "--x-min", "--range A:B", "x_min", type=_real)
     _deprecated(p, "--x-max", "--range A:B", "x_max", type=_real)
