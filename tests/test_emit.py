@@ -86,7 +86,8 @@ def test_identifiers_are_validated(bad):
 
 def test_templates_get_exactly_the_variables_they_use(tmp_path, monkeypatch):
     """What the code passes to each template (recorded at render time) against what the
-    template's source reads: module.py.j2 and the mu_*derivation.tex.j2 exactly; tables.tex.j2 and
+    template's source reads: module.py.j2, mode_tables.tex.j2 and the mu_*derivation.tex.j2
+    exactly; tables.tex.j2 and
     derivation.tex.j2 share one context (latex_context and the banner), each reads a part of it
     and the two together all of it.  Every template is rendered or included."""
     passed: dict[str, list[set]] = {}
@@ -108,6 +109,13 @@ def test_templates_get_exactly_the_variables_they_use(tmp_path, monkeypatch):
     generate_slow_flow(oscillator("q'' + q = eps*(1 - q**2)*q'"), 2, "cmd", tmp_path)
     render_cycle_derivation(lower_cycle_derivation(derive_limit_cycle(self_excited_model(
         oscillator("q'' + q = eps*(1 - q**2)*q'", name="vdp")), 4), 4), module.provenance)
+    from lindstedt.derive.nnm import normal_mode
+    from lindstedt.derive.system import parse_system
+    from lindstedt.emit.render import render_mode_tables
+    from lindstedt.lower.system import mode_tables
+
+    mode = normal_mode(parse_system("x1'' + 2*x1 - x2 + x1**3 = 0; x2'' + 2*x2 - x1 = 0"), 1, 4)
+    render_mode_tables(mode_tables(mode, 3, "mode1"), module.provenance)
     folder = template_folder()
     used, includes = {}, {}
     for path in folder.glob("*.j2"):
@@ -120,7 +128,7 @@ def test_templates_get_exactly_the_variables_they_use(tmp_path, monkeypatch):
         for ctx in contexts:
             assert reads <= ctx, (name, reads - ctx)  # nothing undefined
     for name in ("module.py.j2", "mu_derivation.tex.j2", "mu_damped_derivation.tex.j2",
-                 "slow_flow.tex.j2", "cycle_derivation.tex.j2"):
+                 "slow_flow.tex.j2", "cycle_derivation.tex.j2", "mode_tables.tex.j2"):
         assert passed[name] and all(ctx == used[name] for ctx in passed[name]), name
     latex = passed["tables.tex.j2"] + passed["derivation.tex.j2"]
     assert len(latex) == 2 and latex[0] == latex[1]
