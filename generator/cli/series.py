@@ -147,7 +147,7 @@ def series_table(sol) -> str:
                  f"orbit domain not computed: {domain['how']}")
     if sol.ground.is_rational:
         lines.append(f"{'j':>3}  {'omega_j':>24}  {'(T/2pi)_j':>24}  "
-                     "q_j: harmonic n -> coefficient")
+                     f"{m.coordinate}_j: harmonic n -> coefficient")
         for j in range(sol.order + 1):
             harmonics = ", ".join(f"{n}: {_number(c)}" for n, c in sorted(sol.q[j].items()))
             lines.append(f"{j:>3}  {_number(sol.omega[j]):>24}  "
@@ -194,13 +194,23 @@ def _cycles_json(cycles) -> list[dict]:
     """Every limit cycle: its first-order amplitude a₀ (exact, SymPy's str), S'(a₀) and its
     stability, smallest amplitude first."""
     return [{"amplitude0": str(c.amplitude), "slope": str(c.slope), "stability": c.stability,
-             "expandable": c.slope != 0} for c in cycles]
+             "expandable": c.slope != 0, "amplitude0_value": float(c.amplitude)}
+            for c in cycles]
+
+
+def _short(x: float) -> str:
+    """A float as its shortest text, an integer without ``.0`` (``2``, ``1.5``)."""
+    return str(int(x)) if float(x).is_integer() else repr(float(x))
 
 
 def _cycles_text(model, listed: list[dict]) -> str:
-    lines = [f"{model.name}: {len(listed)} limit cycle(s) of S(a), by amplitude:"]
+    lines = [f"{model.name}: {len(listed)} limit cycle(s) of S(a), by amplitude:",
+             "  (S(a): the sin s coefficient of f(a cos s, -a sin s); averaged, "
+             "da/dt = -eps*S(a)/2; a cycle at each root a0 > 0)"]
     for k, c in enumerate(listed, 1):
-        lines.append(f"  cycle {k}: a0 = {c['amplitude0']}, S'(a0) = {c['slope']}: "
+        value = "" if c["amplitude0"] == _short(c["amplitude0_value"]) else \
+            f" = {c['amplitude0_value']:.15g}"
+        lines.append(f"  cycle {k}: a0 = {c['amplitude0']}{value}, S'(a0) = {c['slope']}: "
                      f"{c['stability']}")
     return "\n".join(lines)
 
@@ -399,8 +409,10 @@ def run_tongues(args: argparse.Namespace) -> int:
                                  f"{args.order} (estimate {error:.2g}); the best reachable is "
                                  f"{best_error:.2g} at order {best}")
             row["at"] = {"eps": args.eps, "delta": value, "error": error, "radius": radius}
+            reach = (f"radius of convergence ~{radius:.4g}" if math.isfinite(radius) else
+                     "radius of convergence not estimable at this order: raise --order")
             lines.append(f"at eps = {args.eps:g}: delta = {value:.15g} (truncation ~{error:.2g}"
-                         f"; radius of convergence ~{radius:.4g})")
+                         f"; {reach})")
         data["curves"].append(row)
     if args.zeta is not None:
         tip = tongue_tip(p, args.n, args.order)
