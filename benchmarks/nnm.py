@@ -1,6 +1,6 @@
 """Nonlinear normal modes: derivation time, accuracy against shooting, and the emitted
 backbone against a numeric continuation of the same backbone by shooting (SciPy's DOP853 and
-a root finder), in one run.
+the package's Newton, numerics.references.mode_orbit), in one run.
 
     .venv/bin/python benchmarks/nnm.py
 
@@ -20,11 +20,9 @@ import time
 from pathlib import Path
 
 import numpy as np
-import sympy as sp
 from lindstedt.derive.nnm import normal_mode
 from lindstedt.derive.system import parse_system
-from scipy.integrate import solve_ivp
-from scipy.optimize import root
+from lindstedt.numerics.references import mode_orbit
 
 KERSCHEN = "x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0"
 
@@ -41,37 +39,23 @@ def fpu(n: int = 8) -> str:
 
 
 def shooter(text: str):
-    """The orbit through x1(0) = A with zero velocities: Newton (MINPACK's hybrid) on the
-    other coordinates at t = 0 and the half period, where every velocity vanishes."""
-    s = parse_system(text)
-    d = s.size
-    f = sp.lambdify([s.coordinates], [-(s.stiffness * sp.Matrix(s.coordinates))[i] - s.force[i]
-                                      for i in range(d)], "numpy")
-
-    def rhs(t, z):
-        return np.concatenate([z[d:], f(z[:d])])
+    """The orbit through x1(0) = A with zero velocities (the package's reference,
+    :func:`numerics.references.mode_orbit`): ``(other coordinates at t = 0, T/2)``."""
+    system = parse_system(text)
 
     def shoot(A: float, guess: np.ndarray) -> np.ndarray:
-        def at_half(u):
-            x0 = np.concatenate([[A], u[:-1], np.zeros(d)])
-            sol = solve_ivp(rhs, (0, u[-1]), x0, method="DOP853", rtol=1e-13, atol=1e-15)
-            return sol.y[d:, -1]
-
-        out = root(at_half, guess, method="hybr", tol=1e-14)
-        if not out.success and np.max(np.abs(out.fun)) > 1e-10:  # "no further improvement"
-            raise RuntimeError(out.message)                     # at rounding is a success
-        return out.x
+        orbit = mode_orbit(system, A, guess)
+        if not orbit.converged:
+            raise RuntimeError(f"A = {A}: the shot orbit did not converge")
+        return np.append(orbit.start[1:], orbit.period / 2)
 
     return shoot
 
 
 def series_values(mode, A: float) -> tuple[float, np.ndarray]:
     """T(A) and every coordinate at t = 0, summed from the exact series in floats."""
-    y = A ** mode.step
-    period = 2 * np.pi * sum(float(c) * y**j for j, c in enumerate(mode.period()))
-    starts = np.array([A * sum(float(c) * y**j for j, order in enumerate(mode.coordinate(i))
-                               for c in order.values()) for i in range(mode.system.size)])
-    return period, starts
+    _, period, starts = mode.evaluate(A)
+    return float(period), starts
 
 
 def timed(fn, repeat: int = 3) -> float:

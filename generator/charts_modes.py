@@ -9,7 +9,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .charts import _save, _value, check_plot_path
-from .derive.nnm import NormalModeSeries, normal_mode
+from .derive.nnm import normal_mode
 from .derive.system import System
 from .errors import InputError
 from .lower.system import radius
@@ -25,15 +25,6 @@ FEP_MAX_MODES = 4
 RESONANCES = (2, 3)
 # NOTE: the ratios marked: 1:2 (quadratic couplings) and 1:3 (cubic ones), where the n-th
 # harmonic of one mode meets another mode's linear frequency.
-
-
-def _backbone(mode: NormalModeSeries, A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """ω(A) and the starting point x(0) of every amplitude, summed from the exact series."""
-    y = A**mode.step
-    omega = sum(float(c) * y**j for j, c in enumerate(mode.omega()))
-    starts = np.array([A * sum(float(c) * y**j for j, order in enumerate(mode.coordinate(i))
-                               for c in order.values()) for i in range(mode.system.size)])
-    return omega, starts
 
 
 def nnm_figure(system: System, path: Path, order: int = FEP_ORDER) -> Path:
@@ -58,7 +49,7 @@ def nnm_figure(system: System, path: Path, order: int = FEP_ORDER) -> Path:
         found = radius(mode)
         reach = 1.0 if found is None else (found[0] - found[1]) ** (1 / mode.step)
         A = np.linspace(reach / 200, 0.95 * reach, 200)
-        omega, starts = _backbone(mode, A)
+        omega, _, starts = mode.evaluate(A)
         E = np.array([energy(x) for x in starts.T])
         ax.plot(E, omega, "-", color=color, lw=2,
                 label=f"mode {k}: series to order {order} (ω₀ = {mode.omega0})")
@@ -66,8 +57,8 @@ def nnm_figure(system: System, path: Path, order: int = FEP_ORDER) -> Path:
         guess = None
         for a in np.linspace(0.05, 1.2, FEP_SHOTS) * reach:
             if guess is None:
-                w, x0 = _backbone(mode, np.array([a]))
-                guess = np.append(np.delete(x0[:, 0], mode.amplitude), np.pi / w[0])
+                _, period, x0 = mode.evaluate(a)
+                guess = np.append(np.delete(x0, mode.amplitude), period / 2)
             orbit = mode_orbit(system, float(a), guess, mode.amplitude)
             if not orbit.converged:
                 break
@@ -76,7 +67,7 @@ def nnm_figure(system: System, path: Path, order: int = FEP_ORDER) -> Path:
         if shots:
             ax.plot(*np.array(shots).T, "o", color=color, mfc="none", ms=6,
                     label=f"mode {k}: orbits shot (DOP853)")
-        edge = energy(_backbone(mode, np.array([reach]))[1][:, 0])
+        edge = energy(mode.evaluate(reach)[2])
         ax.axvline(edge, color=color, ls="--", lw=0.8,
                    label=f"mode {k}: the series' estimated reach (A = {_value(reach)})")
     w0 = np.sqrt([float(x) for x in lams])

@@ -32,7 +32,6 @@ from .analysis.driven import Drive, amplitudes, first_order_branches, harmonic_b
 from .compiler import generate, generate_method
 from .derive.lindstedt import derive
 from .derive.models import Model, duffing, pendulum
-from .derive.nnm import NormalModeSeries
 from .derive.system import System
 from .display import html_table
 from .emit.render import load_generated
@@ -903,15 +902,12 @@ def choose_backbone(system: System, mode: int, tol: float, a_min: float, a_max: 
                          "beyond it")
     A = verification_points(a_min, a_max, BACKBONE_POINTS)
     tau = np.array([float(c) for c in series.period()])
-    shape = [np.array(_by_order(series, i)) for i in range(system.size)]
     truth = np.empty_like(A)
     guess = None
     for k, a in enumerate(A):
         progress(k, len(A))
-        y = a**series.step
-        period = 2 * np.pi * np.polyval(tau[::-1], y)
         if guess is None:  # the series' own orbit seeds the first shot
-            x0 = np.array([a * np.polyval(c[::-1], y) for c in shape])
+            _, period, x0 = series.evaluate(a)
             guess = np.append(np.delete(x0, amplitude), period / 2)
         orbit = mode_orbit(system, float(a), guess, amplitude)
         if not orbit.converged:
@@ -927,8 +923,3 @@ def choose_backbone(system: System, mode: int, tol: float, a_min: float, a_max: 
             return BackboneChoice(mode, k, errors[-1], tuple(errors), len(A), float(reach))
     raise InputError(f"--tol {tol:g}: not reached by order {series.order} on "
                      f"[{a_min:g}, {a_max:g}]; the best is {min(errors):.1e}")
-
-
-def _by_order(series: NormalModeSeries, i: int) -> list[float]:
-    """Coordinate ``i``'s value at t = 0 per order (the sum of its harmonics), over A."""
-    return [float(sum(order.values())) for order in series.coordinate(i)]

@@ -24,6 +24,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
 import sympy as sp
 from sympy.polys.domains import QQ
 
@@ -83,6 +84,17 @@ class NormalModeSeries:
     def _ratio(self) -> list[Any]:
         inv = self.ground.scalar(1) / self.omega_squared[0]
         return [c * inv for c in self.omega_squared]
+
+    def evaluate(self, A: np.ndarray | float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The series summed in floats at amplitudes ``A``: ω(A), T(A) and every coordinate
+        at t = 0 (rows), where the orbit starts (a seed for shooting, a point to plot)."""
+        A = np.asarray(A, dtype=float)
+        y = A**self.step
+        omega = np.polyval([float(c) for c in self.omega()][::-1], y)
+        period = 2 * np.pi * np.polyval([float(c) for c in self.period()][::-1], y)
+        starts = np.array([A * np.polyval([float(sum(o.values())) for o in orders][::-1], y)
+                           for orders in map(self.coordinate, range(self.system.size))])
+        return omega, period, starts
 
     def coordinate(self, i: int) -> list[dict[int, sp.Expr]]:
         """Coordinate ``i``'s coefficients per order: ``{n: c}`` of ``cos nτ``, exact."""

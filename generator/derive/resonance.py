@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
-from fractions import Fraction
 
 import sympy as sp
 
@@ -44,8 +43,8 @@ class ResonantFlow:
     degree: int  # the force's lowest degree: the flow is of order (amplitude)^(degree − 1)
 
 
-def resonant_modes(system: System) -> tuple[list[int], list[str], Fraction]:
-    """The modes linked by exact ratios ``ω_j/ω_i = n`` (n ≥ 2), their names, the base."""
+def resonant_modes(system: System) -> tuple[list[int], list[str]]:
+    """The modes linked by exact ratios ``ω_j/ω_i = n`` (n ≥ 2), and the resonances named."""
     lams = system.modes()
     found: set[int] = set()
     names = []
@@ -56,7 +55,7 @@ def resonant_modes(system: System) -> tuple[list[int], list[str], Fraction]:
             found |= {i, j}
             names.append(f"1:{root} between mode {i + 1} (ω0 = {sp.sqrt(lams[i])}) and mode "
                          f"{j + 1} (ω0 = {sp.sqrt(lams[j])})")
-    return sorted(found), names, Fraction(1)
+    return sorted(found), names
 
 
 def _shapes(system: System, lam: sp.Expr) -> tuple[sp.Matrix, sp.Matrix]:
@@ -76,7 +75,7 @@ def resonant_flow(system: System, order: int = 1) -> ResonantFlow:
     if not system.conservative:
         raise InputError(f"system {system.text!r}: a velocity-dependent force; the resonant "
                          "slow flow takes conservative systems")
-    modes, names, _ = resonant_modes(system)
+    modes, names = resonant_modes(system)
     if not modes:
         raise InputError(f"system {system.text!r}: no internal resonance (no ω0 an integer "
                          "multiple of another); lindstedt nnm SYSTEM --mode M gives each mode")
