@@ -303,17 +303,22 @@ RESPONSE_EQUATION_ENDS = 2 * 15.0
 # does not converge (see response_equation_cost).
 
 
+def _values(args: argparse.Namespace) -> dict[str, str]:
+    """``--param NAME=VALUE`` pairs as a dict (the command checks them)."""
+    values: dict[str, str] = {}
+    for pair in args.param or ():
+        key, _, value = pair.partition("=")
+        values[key.strip()] = value.strip()
+    return values
+
+
 def response_equation_cost(args: argparse.Namespace) -> Cost:
     """``response EQUATION``: the equation lowered (refused in one line before anything runs),
     its range and continuation estimated as the command will run them."""
     from .analysis.polynomial import PolynomialBalance
     from .analysis.response import equation_continuation_seconds, equation_range, response_equation
 
-    values: dict[str, str] = {}
-    for pair in args.param or ():
-        key, _, value = pair.partition("=")
-        values[key.strip()] = value.strip()
-    de = response_equation(args.model, values, args.name or "oscillator")
+    de = response_equation(args.model, _values(args), args.name or "oscillator")
     er = equation_range(de.terms, de.force, args.omega_min, args.omega_max)
     lo, hi = er.omega_range
     _, seconds = equation_continuation_seconds(de.terms, de.force, args.harmonics, de.odd, lo,
@@ -337,6 +342,14 @@ def response_cost(args: argparse.Namespace) -> Cost:
     alone when ε, f or Q is missing: the command says so)."""
     from .analysis.response import continuation_seconds, response_range
 
+    if getattr(args, "model", None) is not None and ";" in args.model:
+        from .analysis.response import system_plan
+
+        plan = system_plan(args.model, _values(args), args.harmonics, args.omega_min,
+                           args.omega_max)
+        return Cost(plan.seconds, f"--harmonics {args.harmonics}",
+                    f"the continuation of about {plan.points:.0f} points, the drive "
+                    "continuations and the shots of the system")
     if getattr(args, "model", None) is not None:
         return response_equation_cost(args)
     if any(getattr(args, k, None) is None for k in ("eps", "force", "Q")):

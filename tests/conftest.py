@@ -18,6 +18,7 @@ import pytest
 LAYERS = {
     "exact": ("averaging", "branches", "driven", "driven_damped", "driven_equation", "equation",
               "hill", "layout", "lindstedt", "nnm", "parametric", "response", "response_equation",
+              "response_system",
               "resonance", "series", "subharmonic"),
     "printers": ("charts", "cli", "costs", "emit", "files", "fuzz", "interrupt", "latex",
                  "notebook", "readme", "validity"),

@@ -39,6 +39,10 @@ CONTINUATION_SECONDS = 60.0
 # work (its max_seconds: the CLI's cost limit, lifted by --allow-slow) instead of running for
 # ten minutes: `response --force 1e30 --harmonics 60` once ran 590 s and stopped short of the
 # range, reporting a partial curve.
+MIN_STEP = 1 / 1024
+# NOTE: the continuation halves its step (down to 1/1024 of it) where a step turns the tangent
+# by more than ~25°, lands far from the prediction or does not converge, and grows it back by
+# 1.5 a step: a 2-DOF system's superharmonic resonance (ω0/3, Q = 20) turns within 0.005 in ω.
 MAX_Q = 1e12
 # NOTE: near the resonance x(ω) changes by ~Q·2e-16 relative between neighbouring doubles in ω:
 # the corrector's 1e-13 then needs Q ≲ 1e3 (above, some steps take all 30 iterations: slower,
@@ -76,8 +80,15 @@ def _continue(sysm: PolynomialBalance, end_solutions, omega_start: float,
                     t = -t
                 starts.append(len(points))
                 points.append(y)
-                y_old = None
+                y_start, away = y, False
+                y_old, h = None, step
                 while y_old is None or lo <= y[-1] <= hi:
+                    # a closed curve (an isola) ends where it meets its start again
+                    gap = np.linalg.norm(y - y_start)
+                    away = away or gap > 3 * step
+                    if away and gap < 1.5 * step:
+                        points.append(y_start)
+                        break
                     if len(points) - len(starts) >= limit:
                         raise InputError(f"{where}: the continuation did not leave ω in "
                                          f"[{lo:.3g}, {hi:.3g}] within {limit} steps of "
@@ -89,14 +100,34 @@ def _continue(sysm: PolynomialBalance, end_solutions, omega_start: float,
                                          f"{len(points)} points in (its estimate: "
                                          f"{estimate:.0f}): the corrector does not converge "
                                          "there")
-                    y_new = _corrector(sysm, y + step * t, t)
-                    t_new = _tangent(sysm, y_new, t)
+                    try:
+                        y_new = _corrector(sysm, y + h * t, t)
+                        t_new = _tangent(sysm, y_new, t)
+                    except np.linalg.LinAlgError:
+                        if h <= step * MIN_STEP:
+                            raise
+                        h /= 2
+                        continue
                     if not (np.all(np.isfinite(y_new)) and np.all(np.isfinite(t_new))):
                         raise np.linalg.LinAlgError("the balance overflowed")
+                    # a step that turns the tangent by more than ~25°, lands far or does not
+                    # converge is retaken at half the length (a narrow resonance's sharp turn)
+                    if h > step * MIN_STEP and not (
+                            t_new @ t >= 0.9 and np.linalg.norm(y_new - y) <= 2 * h
+                            and np.max(np.abs(sysm.residual(y_new[:-1], y_new[-1])))
+                            <= 1e-9 * (1 + np.max(np.abs(y_new)))):
+                        h /= 2
+                        continue
                     if t_new[-1] * t[-1] < 0:
-                        folds.append(_refine_fold(sysm, y, t, step))
+                        folds.append(_refine_fold(sysm, y, t, h))
                     y_old, y, t = y, y_new, t_new
                     points.append(y)
+                    h = min(step, 1.5 * h)
+                if lo <= y[-1] <= hi:  # closed: the same start taken the other way is done
+                    for j, e in enumerate(ends):
+                        if e[0] == omega0 and np.array_equal(e[1], x0):
+                            visited[j] = True
+                    continue
                 # the end it left by: the nearest solution there is reached
                 edge = lo if y[-1] < lo else hi
                 s_edge = (edge - y_old[-1]) / (y[-1] - y_old[-1])
@@ -255,7 +286,7 @@ def continue_in_drive(system: PolynomialBalance, omega: float, bound: float | No
             t = _first_direction(fam, y, h, k1, sin1)
         points = [y]
         while True:
-            r = math.hypot(y[k1], y[sin1])
+            r = system.first_harmonic(y[:-1])
             if bound is not None and r > bound:
                 return _drive_curve(points, True, f"continued in the drive amplitude from 0 "
                                     f"up to the amplitude bound r = {bound:.4g}")
@@ -319,25 +350,28 @@ def _half_period(system: PolynomialBalance, x: np.ndarray) -> np.ndarray:
     """``q(t + T/2)``: harmonic k times ``(−1)^k``; it answers ``−f cos ωt`` where ``q`` answers
     ``f cos ωt`` (the force is autonomous)."""
     sign = (-1.0) ** np.concatenate([system.orders, system.orders[system.orders > 0]])
-    return sign * x
+    return np.tile(sign, system.coordinates) * x
 
 
-def _balance_r(system: PolynomialBalance, x: np.ndarray) -> float:
-    A, B = system.amplitudes(x)
-    return math.hypot(A.get(1, 0.0), B.get(1, 0.0))
+def balance_crossings(coarse: PolynomialBalance, omega: float, force: float,
+                      bound: float | None) -> tuple[list[np.ndarray], DriveContinuation]:
+    """The seeds of every solution of ``coarse`` at ``omega`` and drive amplitude ``force``
+    that the continuation in the drive from rest reaches (:func:`continue_in_drive`, up to the
+    first-harmonic ``bound``): where the traced curve crosses ``force`` — and ``−force``,
+    shifted by half a period (:func:`_half_period`) —, quadratic around the folds
+    (:func:`_crossings`); with the traced curve (its ``complete`` and ``note``)."""
+    curve = continue_in_drive(coarse, omega, bound)
+    seeds = _crossings(curve.force - force, curve.x)
+    seeds += [_half_period(coarse, x) for x in _crossings(curve.force + force, curve.x)]
+    return seeds, curve
 
 
 def drive_crossings(de: DrivenEquation, harmonics: int
                     ) -> tuple[PolynomialBalance, list[np.ndarray], DriveContinuation]:
-    """The seeds of every orbit of ``de`` at its ω: the balance (at most
-    CONTINUATION_HARMONICS harmonics) continued in the drive amplitude from rest up to the
-    amplitude bound (:func:`continue_in_drive`), where it crosses ``f`` — and ``−f``, shifted by
-    half a period (:func:`_half_period`) —, quadratic around the folds (:func:`_crossings`);
-    with that balance and the traced curve (its ``complete`` and ``note``)."""
+    """:func:`balance_crossings` of a user's equation at its ω: the balance with at most
+    CONTINUATION_HARMONICS harmonics, up to its amplitude bound; with that balance."""
     coarse = PolynomialBalance(de.terms, de.force, min(harmonics, CONTINUATION_HARMONICS),
                                de.odd)
-    curve = continue_in_drive(coarse, de.omega,
-                              amplitude_bound(de.terms, de.omega, abs(de.force)))
-    seeds = _crossings(curve.force - de.force, curve.x)
-    seeds += [_half_period(coarse, x) for x in _crossings(curve.force + de.force, curve.x)]
+    seeds, curve = balance_crossings(coarse, de.omega, de.force,
+                                     amplitude_bound(de.terms, de.omega, abs(de.force)))
     return coarse, seeds, curve

@@ -15,6 +15,7 @@ from ..algebra.series import laurent_from_fourier
 from ..display import harmonics_table
 from ..errors import InputError
 from ..limits import MAGNITUDES, MAX_HARMONICS, check_int
+from ..numerics.integrate import PolynomialField
 from ..numerics.newton import newton
 
 # --- a user's driven oscillator: q'' + g(q, q') = f cos(w t), g a polynomial -----------------
@@ -155,6 +156,10 @@ class PolynomialBalance:
     exceeds ``(degree + 1)`` times the top harmonic, so no product aliases: the projection is the
     exact Galerkin residual (as :class:`BalanceSystem`'s convolutions are for εq³).
 
+    A system ``ẍ_i + g_i(x, ẋ) = d_i f cos ωt`` is the same balance with ``terms`` one
+    ``{(a₁ … a_n, b₁ … b_n): c}`` per equation (:class:`numerics.integrate.PolynomialField`)
+    and ``shape = (d₁ … d_n)``: its unknowns are each coordinate's, one block after another.
+
     ``drive_harmonic = n`` puts the drive on ``cos nωt`` instead: the balance of a 1/n
     subharmonic, ω its own frequency.
     Unknowns ``x = (a_k …, b_k …)`` of ``q = Σ a_k cos kωt + b_k sin kωt`` over ``orders``:
@@ -163,65 +168,70 @@ class PolynomialBalance:
     :class:`BalanceSystem` (``residual``, ``jacobian``, ``d_omega`` in ``(x, ω)``), with the drive
     amplitude ``force`` as a keyword for the continuation in it."""
 
-    def __init__(self, terms: dict[tuple[int, int], float], force: float, harmonics: int,
-                 odd: bool, drive_harmonic: int = 1) -> None:
+    def __init__(self, terms: dict[tuple[int, int], float]
+                 | tuple[dict[tuple[int, ...], float], ...], force: float, harmonics: int,
+                 odd: bool, drive_harmonic: int = 1,
+                 shape: tuple[float, ...] = (1.0,)) -> None:
         check_harmonics(harmonics)
-        self.terms, self.force, self.harmonics, self.odd = dict(terms), force, harmonics, odd
+        equations = (dict(terms),) if isinstance(terms, dict) else tuple(map(dict, terms))
+        if len(shape) != len(equations):
+            raise ValueError("PolynomialBalance: one drive entry per equation")
+        self.field = PolynomialField.of(equations)
+        self.terms = equations[0] if isinstance(terms, dict) else equations
+        self.force, self.harmonics, self.odd = force, harmonics, odd
+        self.coordinates = len(equations)
         self.drive_harmonic = drive_harmonic
         top = 2 * harmonics - 1
         if drive_harmonic > top or (odd and drive_harmonic % 2 == 0):
             raise InputError(f"harmonic {drive_harmonic} of the drive is not among the "
                              f"balance's orders (top {top}{', odd only' if odd else ''})")
         self.orders = np.arange(1, top + 1, 2) if odd else np.arange(0, top + 1)
-        degree = max(a + b for a, b in terms)
         samples = 16
-        while samples <= (degree + 1) * top:
+        while samples <= (self.field.degree + 1) * top:
             samples *= 2
         theta = 2 * np.pi * np.arange(samples) / samples
         k = self.orders
         sines = k[k > 0]
         self.n_cos = len(k)
-        cos, sin = np.cos(np.outer(theta, k)), np.sin(np.outer(theta, sines))
-        self.basis = np.hstack([cos, sin])  # (S, m): q = basis @ x
-        self.d_basis = np.hstack([-k * np.sin(np.outer(theta, k)),
-                                  sines * np.cos(np.outer(theta, sines))])  # d/dθ
+        self.basis, self.d_basis = self._bases(samples)  # (S, m): q = basis @ x, d/dθ
         weights = np.where(k == 0, 1.0, 2.0)
-        self.project = np.vstack([weights[:, None] * cos.T, 2.0 * sin.T]) / samples
+        self.project = np.vstack([weights[:, None] * np.cos(np.outer(theta, k)).T,
+                                  2.0 * np.sin(np.outer(theta, sines)).T]) / samples
         self.k2 = np.concatenate([k, sines]).astype(float) ** 2
-        self.drive = np.zeros(len(self.k2))
+        block = np.zeros(len(self.k2))
         # the cos(n ωt) component, n = drive_harmonic (n > 1: a 1/n subharmonic's balance)
-        self.drive[int(np.nonzero(k == drive_harmonic)[0][0])] = 1.0
-        self.powers = [(a, b, c) for (a, b), c in sorted(terms.items())]
-        self.top_q = max(a for a, _ in terms)
-        self.top_v = max(b for _, b in terms)
+        block[int(np.nonzero(k == drive_harmonic)[0][0])] = 1.0
+        self.drive = np.concatenate([d * block for d in shape])
         self._last: tuple = (None, None)
+
+    def _bases(self, samples: int) -> tuple[np.ndarray, np.ndarray]:
+        """``cos kθ, sin kθ`` over the orders on ``samples`` points, and their θ-derivatives."""
+        theta = 2 * np.pi * np.arange(samples) / samples
+        k = self.orders
+        sines = k[k > 0]
+        return (np.hstack([np.cos(np.outer(theta, k)), np.sin(np.outer(theta, sines))]),
+                np.hstack([-k * np.sin(np.outer(theta, k)),
+                           sines * np.cos(np.outer(theta, sines))]))
 
     @property
     def size(self) -> int:
-        """The number of unknowns (the cosine and sine amplitudes)."""
-        return len(self.k2)
+        """The number of unknowns (the cosine and sine amplitudes of every coordinate)."""
+        return self.coordinates * len(self.k2)
+
+    def _blocks(self, x: np.ndarray) -> np.ndarray:
+        return x.reshape(self.coordinates, len(self.k2))
 
     def _force(self, x: np.ndarray, omega: float) -> tuple[np.ndarray, ...]:
-        """``g``, ``∂g/∂q``, ``∂g/∂q̇`` on the sample points (the last point's kept: Newton
-        and the continuation ask for the residual and the Jacobian at the same ``x``)."""
+        """``g``, ``∂g/∂x``, ``∂g/∂ẋ`` on the sample points, ``(n, S)`` and ``(n, n, S)`` (the
+        last point's kept: Newton and the continuation ask for the residual and the Jacobian
+        at the same ``x``)."""
         key = (x.tobytes(), float(omega))
         if key == self._last[0]:
             return self._last[1]
-        q, v = self.basis @ x, omega * (self.d_basis @ x)
-        qs, vs = [np.ones_like(q), q], [np.ones_like(v), v]  # powers by products
-        while len(qs) <= self.top_q:
-            qs.append(qs[-1] * q)
-        while len(vs) <= self.top_v:
-            vs.append(vs[-1] * v)
-        g, gq, gv = np.zeros_like(q), np.zeros_like(q), np.zeros_like(q)
-        for a, b, c in self.powers:
-            g += c * qs[a] * vs[b]
-            if a:
-                gq += (c * a) * qs[a - 1] * vs[b]
-            if b:
-                gv += (c * b) * qs[a] * vs[b - 1]
-        self._last = (key, (g, gq, gv))
-        return g, gq, gv
+        xb = self._blocks(x)
+        found = self.field.evaluate(xb @ self.basis.T, omega * (xb @ self.d_basis.T))
+        self._last = (key, found)
+        return found
 
     def residual(self, x: np.ndarray, omega: float, force: float | None = None) -> np.ndarray:
         """The harmonics of ``q̈ + g(q, q̇) − f cos nωt`` (``n``: ``drive_harmonic``) for the
@@ -229,23 +239,31 @@ class PolynomialBalance:
         balance solution."""
         g, _, _ = self._force(x, omega)
         f = self.force if force is None else force
-        return -omega**2 * self.k2 * x + self.project @ g - f * self.drive
+        return (-omega**2 * self.k2 * self._blocks(x) + g @ self.project.T).ravel() \
+            - f * self.drive
 
     def jacobian(self, x: np.ndarray, omega: float, force: float | None = None) -> np.ndarray:
-        """``∂residual/∂x`` at ``(x, ω)``, from ``∂g/∂q`` and ``∂g/∂q̇`` on the sample points."""
-        _, gq, gv = self._force(x, omega)
-        J = self.project @ (gq[:, None] * self.basis + omega * gv[:, None] * self.d_basis)
-        return J - np.diag(omega**2 * self.k2)
+        """``∂residual/∂x`` at ``(x, ω)``, from ``∂g/∂x`` and ``∂g/∂ẋ`` on the sample points."""
+        _, gx, gv = self._force(x, omega)
+        n, m = self.coordinates, len(self.k2)
+        J = self.project @ (gx[..., None] * self.basis + omega * gv[..., None] * self.d_basis)
+        J = J.transpose(0, 2, 1, 3).reshape(n * m, n * m)
+        return J - np.diag(np.tile(omega**2 * self.k2, n))
 
     def d_omega(self, x: np.ndarray, omega: float, force: float | None = None) -> np.ndarray:
         """``∂residual/∂ω`` at ``(x, ω)``, for the continuation in ω."""
         _, _, gv = self._force(x, omega)
-        return -2 * omega * self.k2 * x + self.project @ (gv * (self.d_basis @ x))
+        xb = self._blocks(x)
+        dv = np.einsum("ijs,js->is", gv, xb @ self.d_basis.T)
+        return (-2 * omega * self.k2 * xb + dv @ self.project.T).ravel()
 
-    def amplitudes(self, x: np.ndarray) -> tuple[dict[int, float], dict[int, float]]:
-        """``A_k``, ``B_k`` of ``x`` (``A_0`` the mean, when the orders hold it)."""
-        A = {int(k): float(a) for k, a in zip(self.orders, x[: self.n_cos], strict=True)}
-        B = {int(k): float(b) for k, b in zip(self.orders[self.orders > 0], x[self.n_cos:],
+    def amplitudes(self, x: np.ndarray, coordinate: int = 0
+                   ) -> tuple[dict[int, float], dict[int, float]]:
+        """``A_k``, ``B_k`` of ``x`` (``A_0`` the mean, when the orders hold it) of one
+        coordinate (the first by default)."""
+        xb = self._blocks(x)[coordinate]
+        A = {int(k): float(a) for k, a in zip(self.orders, xb[: self.n_cos], strict=True)}
+        B = {int(k): float(b) for k, b in zip(self.orders[self.orders > 0], xb[self.n_cos:],
                                               strict=True)}
         return A, B
 
@@ -254,10 +272,33 @@ class PolynomialBalance:
         return np.array([A.get(int(k), 0.0) for k in self.orders]
                         + [B.get(int(k), 0.0) for k in self.orders if k > 0])
 
+    def refined(self, other: PolynomialBalance, x: np.ndarray) -> np.ndarray:
+        """``other``'s unknowns ``x`` (the same equations, other harmonics) in this balance's
+        layout: harmonics beyond its orders dropped, missing ones 0."""
+        return np.concatenate([self.vector(*other.amplitudes(x, i))
+                               for i in range(self.coordinates)])
+
+    def first_harmonic(self, x: np.ndarray) -> float:
+        """``√Σ_i (A_i1² + B_i1²)``: the first harmonic's size over every coordinate."""
+        k1 = int(np.nonzero(self.orders == 1)[0][0])
+        s1 = self.n_cos + int(np.nonzero(self.orders[self.orders > 0] == 1)[0][0])
+        xb = self._blocks(x)
+        return float(math.sqrt(np.sum(xb[:, k1] ** 2 + xb[:, s1] ** 2)))
+
     def state(self, x: np.ndarray, omega: float) -> np.ndarray:
-        """``(q(0), q̇(0))`` of a balance solution: a shooting guess."""
-        A, B = self.amplitudes(x)
-        return np.array([sum(A.values()), omega * sum(k * b for k, b in B.items())])
+        """``(x(0), ẋ(0))`` of a balance solution, every coordinate's: a shooting guess."""
+        xb = self._blocks(x)
+        return np.concatenate([xb[:, : self.n_cos].sum(axis=1),
+                               omega * xb @ self.d_basis[0]])
+
+    def linearization(self, x: np.ndarray, omega: float, samples: int
+                      ) -> tuple[np.ndarray, np.ndarray]:
+        """``∂g/∂x`` and ``∂g/∂ẋ`` along the balance orbit ``x`` at ``θ = ωt = 2πj/samples``:
+        arrays ``(samples, n, n)``, the variational equation's coefficients."""
+        basis, d_basis = self._bases(samples)
+        xb = self._blocks(x)
+        _, gx, gv = self.field.evaluate(xb @ basis.T, omega * (xb @ d_basis.T))
+        return gx.transpose(2, 0, 1), gv.transpose(2, 0, 1)
 
     def solve(self, x: np.ndarray, omega: float, tol: float = 1e-13,
               max_iter: int = 50) -> tuple[np.ndarray, bool, float]:

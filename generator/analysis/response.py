@@ -22,9 +22,9 @@ from ..numerics.newton import newton
 from ..numerics.shooting import orbit_fold_table
 from .continuation import (
     CONTINUATION_SECONDS,
+    Continuation,
     MAX_POINTS,
     MAX_Q,
-    _balance_r,
     _continue,
     drive_crossings,
 )
@@ -37,7 +37,7 @@ from .driven import (
 from .polynomial import DrivenEquation, PolynomialBalance, check_harmonics
 
 if TYPE_CHECKING:
-    from .continuation import Continuation
+    from ..derive.system import System
 
 
 _u, _w, _e, _f, _g = sp.symbols("u w e f g")  # u = r², w = ω², g = 1/Q
@@ -353,17 +353,22 @@ def equation_solutions(de: DrivenEquation, fine: PolynomialBalance, omega: float
     rest crosses (at most CONTINUATION_HARMONICS harmonics, then Newton at ``fine``'s), distinct,
     by amplitude; and whether that continuation was complete and every crossing converged."""
     coarse, seeds, curve = drive_crossings(replace(de, omega=omega), fine.harmonics)
+    return polished(coarse, seeds, curve.complete, fine, omega)
+
+
+def polished(coarse: PolynomialBalance, seeds: list[np.ndarray], complete: bool,
+             fine: PolynomialBalance, omega: float) -> tuple[list[np.ndarray], bool]:
+    """The ``seeds`` of ``coarse`` polished by Newton at ``fine``'s harmonics, distinct, by
+    first-harmonic size; ``complete`` and whether every seed converged."""
     out: list[np.ndarray] = []
-    complete = curve.complete
     for x in seeds:
-        A, B = coarse.amplitudes(x)
-        xb, converged, _ = fine.solve(fine.vector(A, B), omega)
+        xb, converged, _ = fine.solve(fine.refined(coarse, x), omega)
         if not converged:
             complete = False
             continue
         if all(np.linalg.norm(y - xb) > 1e-6 * (1 + np.linalg.norm(xb)) for y in out):
             out.append(xb)
-    out.sort(key=lambda x: _balance_r(fine, x))
+    out.sort(key=fine.first_harmonic)
     return out, complete
 
 
@@ -392,7 +397,7 @@ def _equation_ends(de: DrivenEquation, fine: PolynomialBalance, omega_start: flo
                 break
             if all(np.linalg.norm(y - x) > 1e-6 * (1 + np.linalg.norm(x)) for y in found):
                 found.append(x)
-        found.sort(key=lambda x: _balance_r(fine, x))
+        found.sort(key=fine.first_harmonic)
         out.extend((omega, x, float(direction)) for x in found)
     if not out or out[0][0] != omega_start:
         raise np.linalg.LinAlgError(f"no balance converged at ω = {omega_start:.4g}")
@@ -518,3 +523,323 @@ def duffing_response(eps: float, force: float, Q: float, harmonics: int,
     return response_report(d.equation, er, harmonics, max_seconds, barrier,
                            escape_bound(eps, force),
                            (("eps", float(eps)), ("force", float(force)), ("Q", float(Q))))
+
+
+# --- a driven, damped system of coupled oscillators: every branch, checked -------------------
+
+SYSTEM_PROBES = 6
+# NOTE: interior frequencies, besides each linear ω0 in the range, where the drive is continued
+# from rest to look for branches the continuation from the two ends does not pass (isolas).
+SYSTEM_CHECKS = 12
+# NOTE: the longest stable and unstable stretches of the traced curve whose middle points are
+# shot as true orbits (DOP853, ~0.1–0.5 s each).
+FLOQUET_SAMPLES = 512
+# NOTE: samples per period of the variational equation about each balance orbit (times the
+# power of two above ω0,max/ω): RK4 of 256 and 128 steps, Richardson-combined; |λ| to ~1e-9 on
+# the suite's systems (checked against the linear system's exact e^(−cT/2)).
+
+
+@dataclass(frozen=True)
+class BranchCheck:
+    """A point of the traced curve shot as the true orbit: the balance's and the shot orbit's
+    first-harmonic amplitude of each coordinate, the largest difference of any harmonic
+    coefficient, the shot orbit's Floquet multipliers ``|λ|`` and both stability verdicts."""
+
+    omega: float
+    piece: int
+    balance: tuple[float, ...]
+    shot: tuple[float, ...]
+    error: float  # NaN where shooting failed
+    multipliers: tuple[float, ...]
+    stable: bool | None  # the shot orbit's verdict (None: not shot)
+    balance_stable: bool
+    note: str = ""
+
+
+@dataclass(frozen=True)
+class SystemResponse:
+    """``response SYSTEM``: the balance of a driven, damped system traced over ω, every point
+    with its Floquet multipliers (the monodromy of the variational equation about it), the
+    folds, the jumps of slow sweeps, points shot as true orbits, and how the search for
+    branches was made (``note``)."""
+
+    system: System
+    harmonics: int
+    omega_range: tuple[float, float]
+    linear_frequencies: tuple[float, ...]
+    cont: Continuation
+    closed: tuple[bool, ...]  # per piece: an isola (a closed curve inside the range)
+    amplitudes: np.ndarray  # (points, n): each coordinate's first-harmonic amplitude
+    multiplier: np.ndarray  # (points,): the largest |λ|
+    stable: np.ndarray  # (points,) bool
+    jumps: tuple[tuple[str, float, int, int], ...]  # (up | down, ω, point before, point after)
+    checks: tuple[BranchCheck, ...]
+    bound: float | None  # r1 ≤ bound/ω for every orbit
+    complete: bool
+    note: str
+
+
+def _driven_system(text: str, values: dict[str, str]) -> System:
+    """The system of ``response SYSTEM``, refused in one line where it has no drive, no
+    damping, or a linear mode that is not an oscillation."""
+    from ..derive.system import parse_system
+
+    system = parse_system(text, values, driven=True)
+    if system.frequency is None:
+        raise InputError(f"system {text!r}: no drive; write f*cos(w*t) on the right of an "
+                         "equation (w is the frequency the response varies)")
+    if system.damping is None and not any(f.has(*system.velocities) for f in system.force):
+        raise InputError(f"system {text!r}: no damping (a velocity term): no steady state to "
+                         "draw a response curve of (lindstedt nnm gives the free modes)")
+    for k, lam in enumerate(system.modes(), 1):
+        if not sp.N(lam, 30) > 0:
+            raise InputError(f"system {text!r}: mode {k} has ω0² = {lam}: no oscillation "
+                             "about the origin (every ω0² must be > 0)")
+    return system
+
+
+def _on_curve(cont: Continuation, omega: float, x: np.ndarray) -> bool:
+    """Whether the solution ``x`` at ``omega`` lies on a traced piece (within 1 % of its size,
+    the curve interpolated between its points)."""
+    for piece in cont.piece_slices():
+        w, X = cont.omega[piece], cont.x[piece]
+        for i in np.nonzero((w[:-1] - omega) * (w[1:] - omega) <= 0)[0]:
+            s = 0.0 if w[i + 1] == w[i] else (omega - w[i]) / (w[i + 1] - w[i])
+            if np.linalg.norm(X[i] + s * (X[i + 1] - X[i]) - x) \
+                    <= 1e-2 * (1 + np.linalg.norm(x)):
+                return True
+    return False
+
+
+def _merged(a: Continuation | None, b: Continuation) -> Continuation:
+    if a is None:
+        return b
+    return Continuation(np.concatenate([a.omega, b.omega]), np.vstack([a.x, b.x]),
+                        sorted(a.folds + b.folds),
+                        a.pieces + tuple(len(a.omega) + p for p in b.pieces),
+                        a.complete and b.complete)
+
+
+def _runs(flags: np.ndarray, piece: slice) -> list[tuple[int, int]]:
+    """The maximal runs ``[i, j)`` of equal ``flags`` within a piece."""
+    out, start = [], piece.start
+    for i in range(piece.start + 1, piece.stop + 1):
+        if i == piece.stop or flags[i] != flags[start]:
+            out.append((start, i))
+            start = i
+    return out
+
+
+def _jumps(cont: Continuation, r: np.ndarray, stable: np.ndarray, lo: float, hi: float
+           ) -> tuple[tuple[str, float, int, int], ...]:
+    """Where a slow sweep up (from ``lo``) and down (from ``hi``) leaves a stable stretch that
+    ends inside the range (a fold or a loss of stability) and lands on the stable stretch at
+    that ω nearest in state (its basin is not computed): ``(way, ω, point before, point
+    after)``, the points' indices."""
+    stretches = []  # (ω low, ω high, points) of each stable stretch, ω monotone along it
+    for piece in cont.piece_slices():
+        for i, j in _runs(stable, piece):
+            if stable[i] and j - i >= 2:
+                stretches.append((i, j))
+    out = []
+    for way, start, sign in (("up", lo, 1.0), ("down", hi, -1.0)):
+        here = [k for k, (i, j) in enumerate(stretches)
+                if min(cont.omega[i:j]) <= start + 1e-9 * abs(start)
+                and max(cont.omega[i:j]) >= start - 1e-9 * abs(start)]
+        if not here:
+            continue
+        k = min(here, key=lambda k: np.min(r[stretches[k][0]:stretches[k][1]]))
+        for _ in range(10):
+            i, j = stretches[k]
+            w = cont.omega[i:j]
+            end = int(np.argmax(sign * w)) + i
+            w_end = cont.omega[end]
+            if sign * w_end >= sign * (hi if sign > 0 else lo) - 1e-9:
+                break
+            ahead = [(m, (a, b)) for m, (a, b) in enumerate(stretches) if m != k
+                     and min(cont.omega[a:b]) <= w_end <= max(cont.omega[a:b])
+                     and sign * max(sign * cont.omega[a:b]) > sign * w_end]
+            if not ahead:
+                break
+            m, (a, b) = min(ahead, key=lambda e: np.min(np.linalg.norm(
+                cont.x[e[1][0]:e[1][1]] - cont.x[end], axis=1)
+                + 1e3 * np.abs(cont.omega[e[1][0]:e[1][1]] - w_end)))
+            land = a + int(np.argmin(np.abs(cont.omega[a:b] - w_end)))
+            out.append((way, float(w_end), end, land))
+            k = m
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class SystemPlan:
+    """What ``response SYSTEM`` will run, known before it runs: the system, the ω range, the
+    linear frequencies, the continuation's estimated points and the whole estimated seconds."""
+
+    system: System
+    omega_range: tuple[float, float]
+    linear_frequencies: tuple[float, ...]
+    points: float
+    seconds: float
+
+
+SYSTEM_FIXED_SECONDS = 3.0
+# NOTE: `response SYSTEM` besides its continuation: SymPy's parse and modes (~1 s), the drive
+# continuations at the ends and the probes (0.1–0.5 s each at N = 8), the Floquet pass
+# (~0.1 ms a point) and the shots (0.1–0.5 s each); measured 3–8 s on the documented systems.
+
+
+def system_plan(text: str, values: dict[str, str], harmonics: int,
+                omega_min: float | None = None, omega_max: float | None = None) -> SystemPlan:
+    """The :class:`SystemPlan` of :func:`system_response` (its refusals, in one line, first):
+    the range defaults to half the lowest to 1.5 × the highest linear ω0; the curve's length
+    ``(B − A) + π r √n`` over the step 0.02, r the power-balance bound at the lowest ω0 (at
+    most 50)."""
+    check_harmonics(harmonics)
+    system = _driven_system(text, values)
+    w0 = tuple(float(sp.N(sp.sqrt(lam), 20)) for lam in system.modes())
+    lo = 0.5 * w0[0] if omega_min is None else omega_min
+    hi = 1.5 * w0[-1] if omega_max is None else omega_max
+    for flag, value in (("--omega A", lo), ("--omega B", hi)):
+        if not (math.isfinite(value) and value > 0):
+            raise InputError(f"{flag} = {value!r}: must be finite and > 0")
+    if not lo < hi:
+        raise InputError(f"--omega {lo:g}:{hi:g}: A must lie below B")
+    bound, _ = system.response_bound()
+    r_scale = min(50.0, 10.0 if bound is None else bound / w0[0])
+    points = ((hi - lo) + np.pi * r_scale * math.sqrt(len(w0))) / 0.02
+    odd = all(sum(key) % 2 for eq in system.equations() for key in eq)
+    unknowns = system.size * (2 * harmonics if odd else 4 * harmonics - 1)
+    return SystemPlan(system, (lo, hi), w0, points, SYSTEM_FIXED_SECONDS
+                      + points * equation_point_seconds(unknowns))
+
+
+def system_response(text: str, values: dict[str, str], harmonics: int = 6,
+                    omega_min: float | None = None, omega_max: float | None = None,
+                    max_seconds: float = CONTINUATION_SECONDS, checks: int = SYSTEM_CHECKS
+                    ) -> SystemResponse:
+    """Every branch of the periodic response of ``ẍ_i + g_i(x, ẋ) = d_i f cos ωt`` over
+    ``[omega_min, omega_max]`` (default: half the lowest to 1.5 × the highest linear ω0).
+
+    The balance (:class:`PolynomialBalance` with ``harmonics``) is solved at both ends by the
+    continuation in the drive amplitude from rest up to the power-balance bound on the
+    amplitude (:meth:`System.response_bound`: every orbit lies below it), traced in ω through
+    its folds from each solution there; then at interior probes (each linear ω0 and
+    :data:`SYSTEM_PROBES` more) the drive continuation again, and any solution off the traced
+    curve is traced too (an isola).  Each point's Floquet multipliers come from the monodromy
+    of its variational equation (:func:`numerics.floquet.variational_multipliers`); the middle
+    of the longest stable and unstable stretches is shot as the true orbit (DOP853) and
+    compared."""
+    from ..numerics.floquet import variational_multipliers
+    from ..numerics.integrate import PolynomialField
+    from ..numerics.shooting import PeriodicOrbit, shoot_system
+    from .continuation import CONTINUATION_HARMONICS, balance_crossings
+
+    plan = system_plan(text, values, harmonics, omega_min, omega_max)
+    system, (lo, hi), w0 = plan.system, plan.omega_range, plan.linear_frequencies
+    equations = system.equations()
+    drive = np.array([float(d) for d in system.drive])
+    f = float(np.max(np.abs(drive)))
+    shape = tuple(drive / f)
+    odd = PolynomialField.of(equations).odd
+    fine = PolynomialBalance(equations, f, harmonics, odd, shape=shape)
+    coarse = PolynomialBalance(equations, f, min(harmonics, CONTINUATION_HARMONICS), odd,
+                               shape=shape)
+    bound, why = system.response_bound()
+    where = f"system {text!r}"
+
+    def solutions(w: float) -> tuple[list[np.ndarray], bool, str]:
+        seeds, curve = balance_crossings(coarse, w, f, None if bound is None
+                                         else 1.01 * bound / w)
+        found, complete = polished(coarse, seeds, curve.complete, fine, w)
+        return found, complete, curve.note
+
+    notes: list[str] = []
+    complete = bound is not None
+
+    def ends() -> tuple[list[tuple[float, np.ndarray, float]], bool]:
+        nonlocal complete
+        out = []
+        for w, direction in ((lo, 1.0), (hi, -1.0)):
+            found, whole, note = solutions(w)
+            complete = complete and whole
+            notes.append(f"at w = {w:.4g}: {len(found)} solution(s); {note}")
+            out.extend((w, x, direction) for x in found)
+        if not out or out[0][0] != lo:
+            raise np.linalg.LinAlgError(f"no balance converged at ω = {lo:.4g}")
+        return out, True
+
+    estimate, per_point = plan.points, equation_point_seconds(fine.size)
+    cont = _continue(fine, ends, lo, hi, 0.02, estimate, max_seconds, per_point, MAX_POINTS,
+                     where)
+    probes = sorted({*(w for w in w0 if lo < w < hi),
+                     *np.linspace(lo, hi, SYSTEM_PROBES + 2)[1:-1]})
+    closed = [False] * len(cont.pieces)
+    isolas = 0
+    for w in probes:
+        found, whole, _ = solutions(float(w))
+        complete = complete and whole
+        for x in found:
+            if _on_curve(cont, float(w), x):
+                continue
+            extra = _continue(fine, lambda: ([(float(w), x, 1.0), (float(w), x, -1.0)], True),
+                              lo, hi, 0.02, estimate, max_seconds, per_point, MAX_POINTS,
+                              where)
+            isolas += 1
+            for piece in extra.piece_slices():
+                closed.append(bool(lo < extra.omega[piece.stop - 1] < hi))
+            cont = _merged(cont, extra)
+    notes.append(f"probes at w = {', '.join(f'{w:.4g}' for w in probes)}: "
+                 f"{isolas} branch(es) off the curve traced from the ends")
+    # stability of every point: the monodromy of its variational equation
+    multiplier = np.empty(len(cont.omega))
+    # the samples per period grow with ω0/ω (a slow drive holds many fast oscillations)
+    samples = FLOQUET_SAMPLES * 2 ** np.ceil(np.log2(np.maximum(1.0, w0[-1] / cont.omega)))
+    for s in np.unique(samples):
+        where_s = np.nonzero(samples == s)[0]
+        for chunk in np.array_split(where_s, max(1, len(where_s) * int(s) // 2**15)):
+            lin = [fine.linearization(cont.x[i], cont.omega[i], int(s)) for i in chunk]
+            lam = variational_multipliers(np.array([a for a, _ in lin]),
+                                          np.array([b for _, b in lin]), cont.omega[chunk])
+            multiplier[chunk] = np.max(np.abs(lam), axis=1)
+    stable = multiplier < 1
+    n = system.size
+    amplitudes = np.array([[math.hypot(*_first(fine, x, i)) for i in range(n)]
+                           for x in cont.x])
+    r = np.array([fine.first_harmonic(x) for x in cont.x])
+    # shooting: the middle of the longest stable and unstable stretches
+    field = PolynomialField.of(equations)
+    stretches = sorted(((j - i, k, i, j) for k, piece in enumerate(cont.piece_slices())
+                        for i, j in _runs(stable, piece) if j - i >= 3), reverse=True)
+    shots = []
+    for _, k, i, j in stretches[:checks]:
+        mid = (i + j) // 2
+        x, w = cont.x[mid], float(cont.omega[mid])
+        orbit = shoot_system(field, drive, w, fine.state(x, w), harmonics=2 * harmonics - 1)
+        balance = tuple(float(a) for a in amplitudes[mid])
+        if not isinstance(orbit, PeriodicOrbit):
+            shots.append(BranchCheck(w, k, balance, (), math.nan, (), None, bool(stable[mid]),
+                                     orbit.reason))
+            continue
+        error = 0.0
+        for c, (A, B) in enumerate(orbit.coordinates):
+            a, b = fine.amplitudes(x, c)
+            error = max(error, *(abs(A.get(h, 0.0) - a.get(h, 0.0)) for h in set(A) | set(a)),
+                        *(abs(B.get(h, 0.0) - b.get(h, 0.0)) for h in set(B) | set(b)))
+        shots.append(BranchCheck(
+            w, k, balance, tuple(math.hypot(A.get(1, 0.0), B.get(1, 0.0))
+                                 for A, B in orbit.coordinates), float(error),
+            tuple(sorted(float(abs(m)) for m in orbit.multipliers)), orbit.stable,
+            bool(stable[mid])))
+    shots.sort(key=lambda c: (c.piece, c.omega))
+    how = (f"every orbit has r1 <= {bound:.6g}/w ({why}); the drive was continued from rest "
+           "past it at both ends and at each probe" if bound is not None else
+           f"no amplitude bound ({why}): the drive continuation from rest stops at its budget, "
+           "branches beyond it may be missed")
+    return SystemResponse(system, harmonics, (lo, hi), w0, cont, tuple(closed), amplitudes,
+                          multiplier, stable, _jumps(cont, r, stable, lo, hi), tuple(shots),
+                          bound, complete and cont.complete, "; ".join([how, *notes]))
+
+
+def _first(balance: PolynomialBalance, x: np.ndarray, i: int) -> tuple[float, float]:
+    A, B = balance.amplitudes(x, i)
+    return A.get(1, 0.0), B.get(1, 0.0)

@@ -395,6 +395,10 @@ def run_response(args: argparse.Namespace) -> int:
     table, JSON or a figure.  Returns the exit status."""
     _response_args(args)
     limit = math.inf if args.allow_slow else COST_LIMIT_SECONDS
+    if args.model is not None and ";" in args.model:
+        from .system import run_response_system
+
+        return run_response_system(args, limit)
     if args.model is not None:
         values, name = _params(args.param), args.name or "oscillator"
         return _report(

@@ -198,3 +198,108 @@ def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    "internal-resonance lines (default: none)")
     _flag_allow_slow(p, deprecated_force=False)
     return p
+
+
+def response_system_json(r) -> dict:
+    """``response SYSTEM --json``: a :class:`analysis.response.SystemResponse` as data: each
+    traced branch (ω, every coordinate's first-harmonic amplitude, the largest Floquet |λ|,
+    stable or not), the folds, the sweeps' jumps, the points shot as true orbits and how the
+    branches were searched."""
+    names = [str(x) for x in r.system.coordinates]
+    branches = []
+    for k, piece in enumerate(r.cont.piece_slices()):
+        branches.append({
+            "closed": r.closed[k],
+            "omega": [float(w) for w in r.cont.omega[piece]],
+            "amplitudes": {name: [float(a) for a in r.amplitudes[piece, i]]
+                           for i, name in enumerate(names)},
+            "multiplier": [float(m) for m in r.multiplier[piece]],
+            "stable": [bool(s) for s in r.stable[piece]],
+        })
+    return {
+        "kind": "response", "system": r.system.text, "coordinates": names,
+        "parameters": {
+            "frequency": str(r.system.frequency),
+            "drive": {name: str(d) for name, d in zip(names, r.system.drive, strict=True)},
+            "omega_range": list(r.omega_range),
+            "linear_frequencies": list(r.linear_frequencies),
+            "harmonics": r.harmonics,
+        },
+        "branches": branches,
+        "folds": [float(w) for w in r.cont.folds],
+        "jumps": [{"sweep": way, "omega": w,
+                   "from": {n: float(r.amplitudes[a, i]) for i, n in enumerate(names)},
+                   "to": {n: float(r.amplitudes[b, i]) for i, n in enumerate(names)}}
+                  for way, w, a, b in r.jumps],
+        "checks": [{"omega": c.omega, "branch": c.piece,
+                    "balance": dict(zip(names, c.balance, strict=True)),
+                    "shot": dict(zip(names, c.shot, strict=False)),
+                    "error": None if c.error != c.error else c.error,
+                    "multipliers": list(c.multipliers), "stable": c.stable,
+                    "balance_stable": c.balance_stable, "note": c.note} for c in r.checks],
+        "completeness": {"complete": r.complete, "bound": r.bound, "how": r.note},
+        "amplitude": "r_i = sqrt(A_i1^2 + B_i1^2), the first harmonic of coordinate i",
+    }
+
+
+def response_system_table(data: dict) -> list[str]:
+    """The table of ``response SYSTEM``, from its JSON."""
+    p = data["parameters"]
+    names = data["coordinates"]
+    lo, hi = p["omega_range"]
+    drive = ", ".join(f"{k}: {v}" for k, v in p["drive"].items() if v != "0")
+    lines = [f"response of {data['system']}",
+             f"  {p['frequency']} in [{lo:.4g}, {hi:.4g}]; linear omega0 = "
+             + ", ".join(f"{w:.6g}" for w in p["linear_frequencies"])
+             + f"; drive amplitude {drive}; balance of {p['harmonics']} harmonics"]
+    for k, b in enumerate(data["branches"], 1):
+        stable = sum(b["stable"])
+        peak = ", ".join(f"{n} {max(b['amplitudes'][n]):.4g}" for n in names)
+        kind = "closed (an isola)" if b["closed"] else f"w {b['omega'][0]:.4g} -> " \
+            f"{b['omega'][-1]:.4g}"
+        lines.append(f"  branch {k}: {kind}, {len(b['omega'])} points, largest r: {peak}; "
+                     f"{stable} of {len(b['stable'])} points stable")
+    lines.append("  folds: " + (", ".join(f"{w:.8f}" for w in data["folds"]) or "none"))
+    for way in ("up", "down"):
+        jumps = [j for j in data["jumps"] if j["sweep"] == way]
+        lines.append(f"  sweep {way}: " + ("; ".join(
+            f"jumps at {j['omega']:.6f} (" + ", ".join(
+                f"{n} {j['from'][n]:.4g} -> {j['to'][n]:.4g}" for n in names) + ")"
+            for j in jumps)
+            or "no jump"))
+    checks = data["checks"]
+    shot = [c for c in checks if c["error"] is not None]
+    agree = sum(c["stable"] == c["balance_stable"] for c in shot)
+    if checks:
+        lines.append(f"  shooting (DOP853): {len(shot)} of {len(checks)} points converged, "
+                     "largest harmonic difference "
+                     + (f"{max(c['error'] for c in shot):.1e}" if shot else "-")
+                     + f", stability agrees at {agree} of {len(shot)}")
+    for c in checks:
+        if c["error"] is None:
+            lines.append(f"    w = {c['omega']:.6g}: not shot ({c['note']})")
+    done = data["completeness"]
+    lines.append(("  every branch: " if done["complete"] else "  warning: branches may be "
+                  "missing: ") + done["how"])
+    return lines
+
+
+def run_response_system(args: argparse.Namespace, limit: float) -> int:
+    """Run ``lindstedt response SYSTEM``: every branch of the driven, damped system's response
+    over ω, as a table, JSON or a figure."""
+    from ..analysis.response import system_response
+
+    plot = None
+    if args.plot:
+        from ..charts import check_plot_path
+
+        plot = check_plot_path(Path(args.plot))
+    r = system_response(args.model, _params(args.param), args.harmonics, args.omega_min,
+                        args.omega_max, limit)
+    if plot is not None:
+        from ..charts_modes import response_system_figure
+
+        response_system_figure(r, plot)
+    data = response_system_json(r)
+    print(json.dumps(data) if args.json else "\n".join(response_system_table(data)))
+    return 0

@@ -1,16 +1,19 @@
 """A system of coupled oscillators from text: one equation per coordinate, separated by ``;``.
 
-``M x'' + K x + f(x, x') = 0`` with a diagonal mass ``M`` (each equation holds one
-acceleration), the stiffness ``K`` and the nonlinear force ``f`` (terms of degree ≥ 2), every
-coefficient exact.  The linear modes are the roots ``λ = ω₀²`` of ``det(K − λM) = 0``, kept
+``M x'' + C x' + K x + f(x, x') = F cos ωt`` with a diagonal mass ``M`` (each equation holds
+one acceleration), the damping ``C``, the stiffness ``K``, the nonlinear force ``f`` (terms of
+degree ≥ 2) and a drive ``F cos ωt`` (``response`` takes it; ``nnm`` and ``slowflow`` take
+``C = 0``, ``F = 0``), every coefficient exact.  The linear modes are the roots ``λ = ω₀²`` of ``det(K − λM) = 0``, kept
 exact: a rational, or an algebraic number (SymPy's ``CRootOf`` with its minimal polynomial),
 never rounded; modes are numbered by increasing linear frequency.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
+import numpy as np
 import sympy as sp
 
 from ..errors import InputError
@@ -33,6 +36,9 @@ class System:
     mass: tuple[sp.Rational, ...]
     stiffness: sp.Matrix  # M⁻¹K
     force: tuple[sp.Expr, ...]  # M⁻¹ f(x, x'), degree ≥ 2
+    damping: sp.Matrix | None = None  # M⁻¹C (None: no linear velocity term)
+    drive: tuple[sp.Rational, ...] = ()  # M⁻¹F: the amplitude of cos(ωt) in each equation
+    frequency: sp.Symbol | None = None  # ω's name in the drive
 
     @property
     def size(self) -> int:
@@ -41,8 +47,57 @@ class System:
 
     @property
     def conservative(self) -> bool:
-        """No velocity in any force (time-reversible: the cosine ansatz of ``nnm`` holds)."""
-        return not any(f.has(*self.velocities) for f in self.force)
+        """No velocity in any force and no drive (time-reversible: the cosine ansatz of
+        ``nnm`` holds)."""
+        return (self.damping is None and not self.drive
+                and not any(f.has(*self.velocities) for f in self.force))
+
+    def response_bound(self) -> tuple[float | None, str]:
+        """``b`` with ``√Σ_i (A_i1² + B_i1²) ≤ b/ω`` for every periodic orbit of period
+        ``2π/ω`` — and every harmonic-balance solution —, with the reason; ``None`` and why not
+        where it does not hold.
+
+        Multiply the equations by the masses: ``Mẍ + Cẋ + Kx + ∇V(x) = F cos ωt``.  Where ``K``
+        is symmetric, the nonlinear force a gradient and ``C + Cᵀ`` positive definite, the
+        power balance over a period is ``⟨ẋᵀCẋ⟩ = ½ Fᵀ V₁`` (``V₁`` the cos ωt part of ``ẋ``:
+        ``Mẍ``, ``Kx`` and ``∇V`` do no net work round a closed orbit), so
+        ``c_min ⟨|ẋ|²⟩ ≤ ½ |F| |V₁|`` with ``⟨|ẋ|²⟩ ≥ ½|V₁|²``: ``ω r₁ ≤ |V₁| ≤ |F|/c_min``.  A
+        balance solution meets it too: ``ẋ`` lies in the span the residual is orthogonal to."""
+        n = self.size
+        M = sp.diag(*self.mass)
+        K = M * self.stiffness
+        g = [sp.expand(self.mass[i] * self.force[i]) for i in range(n)]
+        if self.damping is None:
+            return None, "no damping"
+        if any(f.has(*self.velocities) for f in g):
+            return None, "a nonlinear velocity term (the power balance needs linear damping)"
+        if K != K.T:
+            return None, "the stiffness M·K is not symmetric"
+        if any(sp.expand(sp.diff(g[i], self.coordinates[j]) - sp.diff(g[j], self.coordinates[i]))
+               != 0 for i in range(n) for j in range(i)):
+            return None, "the nonlinear force has no potential"
+        C = M * self.damping
+        c_min = float(np.linalg.eigvalsh(np.array((C + C.T) / 2, dtype=float)).min())
+        if not c_min > 0:
+            return None, "the damping M·C is not positive definite"
+        F = math.sqrt(sum(float(self.mass[i] * d) ** 2 for i, d in enumerate(self.drive)))
+        return F / c_min, (f"the power balance: r1 <= |F|/(c_min w) with |F| = {F:.6g}, "
+                           f"c_min = {c_min:.6g} (the damping's smallest eigenvalue)")
+
+    def equations(self) -> tuple[dict[tuple[int, ...], float], ...]:
+        """Each equation's force ``g_i`` (``ẍ_i + g_i(x, ẋ) = d_i cos ωt``: stiffness, damping
+        and the nonlinear terms) as ``{(a₁ … a_n, b₁ … b_n): c}`` in floats, the form of
+        :class:`numerics.integrate.PolynomialField`."""
+        n = self.size
+        out = []
+        for i in range(n):
+            g = (sum(self.stiffness[i, j] * self.coordinates[j] for j in range(n))
+                 + (0 if self.damping is None else
+                    sum(self.damping[i, j] * self.velocities[j] for j in range(n)))
+                 + self.force[i])
+            poly = sp.Poly(g, *self.coordinates, *self.velocities)
+            out.append({k: float(c) for k, c in poly.terms() if c != 0})
+        return tuple(out)
 
     def modes(self) -> tuple[sp.Expr, ...]:
         """The exact ``λ = ω₀²`` of each linear mode, by increasing value (``M⁻¹K``'s
@@ -64,9 +119,12 @@ def _roots(factor: sp.Poly) -> list[sp.Expr]:
     return [sp.CRootOf(factor, k) for k in range(factor.count_roots())]
 
 
-def parse_system(text: str, values: dict[str, str] | None = None) -> System:
+def parse_system(text: str, values: dict[str, str] | None = None,
+                 driven: bool = False) -> System:
     """A :class:`System` from ``"x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0"``:
-    every name but the coordinates needs an exact value (``values``, from ``--param``)."""
+    every name but the coordinates needs an exact value (``values``, from ``--param``).
+    ``driven``: the system may be driven, ``f*cos(w*t)`` on the right of one or more
+    equations, one frequency ``w`` (left free: the response varies it)."""
     values = dict(values or {})
     parts = text.split(";") if isinstance(text, str) else [text]
     if len(parts) < 2:
@@ -93,9 +151,17 @@ def parse_system(text: str, values: dict[str, str] | None = None) -> System:
                          "coordinate needs its acceleration (x'') and its equation")
     exprs = [renamed(lhs - rhs, coordinates) for lhs, rhs, _, _ in sides]
     names = {n for _, _, _, ns in sides for n in ns if n.rstrip("_") not in coordinates}
+    frequency = None
     if TIME in names:
-        raise InputError(f"system {text!r}: t appears explicitly; a driven system is not a "
-                         "free one (nnm takes autonomous systems)")
+        if not driven:
+            raise InputError(f"system {text!r}: t appears explicitly; a driven system is not a "
+                             "free one (nnm takes autonomous systems; lindstedt response "
+                             "takes driven ones)")
+        exprs, frequency = _drive_split(text, exprs)
+        names -= {TIME, str(frequency)}
+        if str(frequency) in values:
+            raise InputError(f"--param {frequency}: {frequency} is the drive frequency; the "
+                             "response varies it (give its range with --omega A:B)")
     missing = sorted(names - set(values))
     if missing:
         raise InputError(f"system {text!r}: give {', '.join(missing)} a value with --param "
@@ -108,16 +174,68 @@ def parse_system(text: str, values: dict[str, str] | None = None) -> System:
     unused = sorted(str(k) for k in given if str(k) not in names)
     if unused:
         raise InputError(f"--param {unused[0]}: no such name in the system")
-    return _lowered(text, coordinates, [e.xreplace(given) for e in exprs])
+    if frequency is not None:
+        exprs = [(e.xreplace(given), d.xreplace(given)) for e, d in exprs]
+        for i, (_, d) in enumerate(exprs):
+            if d.free_symbols & set(map(sp.Symbol, coordinates)) or d.has(*(
+                    s for c in coordinates for s in derivative_symbols(c))):
+                raise InputError(f"system {text!r}: equation {i + 1}: {sp.sstr(d)}*cos(...) "
+                                 "is not a drive f*cos(w*t): it multiplies a coordinate "
+                                 "(parametric excitation is not taken)")
+            if not d.is_Rational:
+                raise InputError(f"system {text!r}: equation {i + 1}: the drive's amplitude "
+                                 f"{d} is not an exact number")
+        if all(d == 0 for _, d in exprs):
+            raise InputError(f"system {text!r}: the drive vanishes with the values given")
+        system = _lowered(text, coordinates, [e for e, _ in exprs], allow_damping=True)
+        return System(*[getattr(system, f) for f in ("text", "coordinates", "velocities",
+                                                     "mass", "stiffness", "force", "damping")],
+                      tuple(d / m for (_, d), m in zip(exprs, system.mass, strict=True)),
+                      frequency)
+    return _lowered(text, coordinates, [e.xreplace(given) for e in exprs],
+                    allow_damping=driven)
 
 
-def _lowered(text: str, coordinates: list[str], exprs: list[sp.Expr]) -> System:
+def _drive_split(text: str, exprs: list[sp.Expr]
+                 ) -> tuple[list[tuple[sp.Expr, sp.Expr]], sp.Symbol]:
+    """Each equation's autonomous part and its drive's amplitude ``d`` (``d cos(w t)`` on the
+    right), with the one frequency ``w``; one line where a term in t is not ``d*cos(w*t)``."""
+    t = sp.Symbol(TIME)
+    out, frequencies = [], set()
+    for i, e in enumerate(exprs):
+        rest, timed = sp.expand(e).as_independent(t, as_Add=True)
+        amplitude = sp.Integer(0)
+        for term in sp.Add.make_args(timed):
+            if term == 0:
+                continue
+            c, wave = term.as_independent(t, as_Add=False)
+            if not isinstance(wave, sp.cos) or not wave.args[0].is_Mul \
+                    or wave.args[0].as_independent(t, as_Add=False)[1] != t:
+                raise InputError(f"system {text!r}: equation {i + 1}: the term "
+                                 f"{sp.sstr(term)} is not a drive f*cos(w*t) (a sine, a "
+                                 "parametric term or another function of t)")
+            w = wave.args[0].as_independent(t, as_Add=False)[0]
+            if not isinstance(w, sp.Symbol) or c.has(w):
+                raise InputError(f"system {text!r}: equation {i + 1}: the drive's frequency "
+                                 f"{sp.sstr(w)} must be one name, w in f*cos(w*t)")
+            frequencies.add(w)
+            amplitude -= c  # on the left: the drive is minus it
+        out.append((rest, amplitude))
+    if len(frequencies) != 1:
+        raise InputError(f"system {text!r}: the drives name the frequencies "
+                         f"{', '.join(sorted(map(str, frequencies)))}; one frequency w, "
+                         "f*cos(w*t) on each driven equation")
+    return out, frequencies.pop()
+
+
+def _lowered(text: str, coordinates: list[str], exprs: list[sp.Expr],
+             allow_damping: bool = False) -> System:
     """Mass, stiffness and force of each equation, checked."""
     symbols = [derivative_symbols(c) for c in coordinates]
     x = [s[0] for s in symbols]
     v = [s[1] for s in symbols]
     a = [s[2] for s in symbols]
-    mass, rows, force = [], [], []
+    mass, rows, force, damp = [], [], [], []
     for i, e in enumerate(exprs):
         try:
             poly = sp.Poly(sp.expand(e), *a, *x, *v)
@@ -138,11 +256,15 @@ def _lowered(text: str, coordinates: list[str], exprs: list[sp.Expr]) -> System:
                              "origin must be an equilibrium")
         linear = [p.coeff_monomial(s) for s in x]
         damping = [p.coeff_monomial(s) for s in v]
-        if any(damping):
+        if any(damping) and not allow_damping:
             raise InputError(f"system {text!r}: equation {i + 1} has a linear velocity term "
-                             "(damping); nnm takes conservative systems (response and "
-                             "slowflow take damped ones)")
+                             "(damping); nnm takes conservative systems (response takes "
+                             "damped, driven ones)")
         mass.append(m)
         rows.append([c / m for c in linear])
-        force.append(sp.expand((rest - sum(c * s for c, s in zip(linear, x, strict=True))) / m))
-    return System(text, tuple(x), tuple(v), tuple(mass), sp.Matrix(rows), tuple(force))
+        damp.append([c / m for c in damping])
+        force.append(sp.expand((rest - sum(c * s for c, s in zip(linear, x, strict=True))
+                                - sum(c * s for c, s in zip(damping, v, strict=True))) / m))
+    C = sp.Matrix(damp)
+    return System(text, tuple(x), tuple(v), tuple(mass), sp.Matrix(rows), tuple(force),
+                  None if C.is_zero_matrix else C)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numba import njit
@@ -487,3 +488,111 @@ def steady_state_fit(table: ForceTable, forces: list[float],
         var = np.where(amp > 0, (c * c * var_c + s * s * var_s + 2 * c * s * cov_cs)
                        / np.where(amp > 0, amp * amp, 1.0), (var_c + var_s) / 2)
     return ToneFit(amp, np.sqrt(np.maximum(var, 0.0)), math.sqrt(sigma2), float(coef[0]))
+
+
+# --- a system's polynomial force: x_i'' + g_i(x, x') = d_i f cos ωt ---------------------------
+
+@dataclass(frozen=True)
+class PolynomialField:
+    """The force ``g_i(x, ẋ) = Σ c x₁^a₁ … x_n^a_n ẋ₁^b₁ … ẋ_n^b_n`` of each equation of
+    ``ẍ_i + g_i(x, ẋ) = d_i f cos ωt`` (the linear part included) as arrays: one row per term,
+    its exponents ``(a₁ … a_n, b₁ … b_n)``, its equation and its coefficient.  One coordinate
+    (``n = 1``) is :class:`ForceTable`'s force."""
+
+    exponents: np.ndarray  # (terms, 2n) int64
+    rows: np.ndarray  # (terms,) int64: the equation of each term
+    coefficients: np.ndarray  # (terms,) float64
+    size: int  # n
+
+    @staticmethod
+    def of(equations: tuple[dict[tuple[int, ...], float], ...]) -> PolynomialField:
+        """From one ``{exponents: c}`` per equation (zero coefficients dropped)."""
+        n = len(equations)
+        items = [(i, tuple(int(e) for e in key), float(c)) for i, eq in enumerate(equations)
+                 for key, c in sorted(eq.items()) if c != 0]
+        if any(len(key) != 2 * n for _, key, _ in items):
+            raise ValueError(f"PolynomialField: each term needs {2 * n} exponents")
+        return PolynomialField(np.array([key for _, key, _ in items],
+                                        dtype=np.int64).reshape(-1, 2 * n),
+                               np.array([i for i, _, _ in items], dtype=np.int64),
+                               np.array([c for _, _, c in items], dtype=np.float64), n)
+
+    @property
+    def odd(self) -> bool:
+        """``g(−x, −ẋ) = −g(x, ẋ)``: a response to ``cos ωt`` holds odd harmonics only."""
+        return bool(np.all(self.exponents.sum(axis=1) % 2 == 1))
+
+    @property
+    def degree(self) -> int:
+        """The highest total degree of the terms (at least 1)."""
+        return int(np.max(self.exponents.sum(axis=1), initial=1))
+
+    @cached_property
+    def _terms(self) -> list[tuple[int, float, list[tuple[int, int]]]]:
+        """Each term as ``(equation, c, [(variable, exponent) …])`` over its variables."""
+        return [(int(i), float(c), [(j, int(e)) for j, e in enumerate(key) if e])
+                for key, i, c in zip(self.exponents, self.rows, self.coefficients, strict=True)]
+
+    def evaluate(self, X: np.ndarray, V: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``g``, ``∂g_i/∂x_j`` and ``∂g_i/∂ẋ_j`` at the states ``X``, ``V`` (``(n, S)``):
+        arrays ``(n, S)``, ``(n, n, S)``, ``(n, n, S)``; powers by products."""
+        n = self.size
+        Z = np.concatenate([X, V])
+        powers = []
+        for j, top in enumerate(np.max(self.exponents, axis=0, initial=0)):
+            p = [None, Z[j]]
+            while len(p) <= top:
+                p.append(p[-1] * Z[j])
+            powers.append(p)
+        g = np.zeros_like(X)
+        dg = np.zeros((n, 2 * n, X.shape[1]))
+        for i, c, used in self._terms:
+            factors = [powers[j][e] for j, e in used]
+            mono = c * factors[0]
+            for f in factors[1:]:
+                mono = mono * f
+            g[i] += mono
+            for k, (j, e) in enumerate(used):
+                part = c * e if e == 1 else (c * e) * powers[j][e - 1]
+                for l, f in enumerate(factors):
+                    if l != k:
+                        part = part * f
+                dg[i, j] += part
+        return g, dg[:, :n], dg[:, n:]
+
+
+@njit(cache=True)
+def _system_field(t: float, y: np.ndarray, exponents: np.ndarray, rows: np.ndarray,
+                  cs: np.ndarray, drive: np.ndarray, omega: float, n: int) -> np.ndarray:
+    """``(ẋ, ẍ, Φ̇)`` of ``ẍ_i + g_i(x, ẋ) = d_i cos ωt`` (the field's arrays) and its
+    variational equation ``Φ̇ = [[0, I], [−∂g/∂x, −∂g/∂ẋ]] Φ``, ``Φ`` column-major after the
+    state ``y[:2n]``."""
+    m = 2 * n
+    out = np.zeros_like(y)
+    A = np.zeros((m, m))
+    for i in range(n):
+        out[i] = y[n + i]
+        out[n + i] = drive[i] * np.cos(omega * t)
+        A[i, n + i] = 1.0
+    for r in range(cs.size):
+        i = rows[r]
+        mono = cs[r]
+        for j in range(m):
+            mono *= _power(y[j], exponents[r, j])
+        out[n + i] -= mono
+        for j in range(m):
+            e = exponents[r, j]
+            if e == 0:
+                continue
+            part = cs[r] * e
+            for k in range(m):
+                part *= _power(y[k], exponents[r, k] - (1 if k == j else 0))
+            A[n + i, j] -= part
+    for col in range(m):
+        for i in range(m):
+            s = 0.0
+            for k in range(m):
+                s += A[i, k] * y[m + col * m + k]
+            out[m + col * m + i] = s
+    return out

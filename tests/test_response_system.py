@@ -1,0 +1,153 @@
+"""``response SYSTEM``: a driven, damped system's branches against other routes — the linear
+system's exact complex amplitudes and Floquet multipliers, the power balance, simulations from
+rest and across a jump by SciPy's DOP853 — and the refusals."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from lindstedt.analysis.polynomial import PolynomialBalance
+from lindstedt.analysis.response import system_response
+from lindstedt.derive.system import parse_system
+from scipy.integrate import solve_ivp
+
+LINEAR = "x1'' + x1'/10 + 2*x1 - x2 = f*cos(w*t); x2'' + x2'/10 + 2*x2 - x1 = 0"
+KERSCHEN = ("x1'' + 0.05*x1' + 2*x1 - x2 + x1**3/2 = f*cos(w*t); "
+            "x2'' + 0.05*x2' + 2*x2 - x1 = 0")
+
+
+def run(*args):
+    return subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
+                          text=True, check=False)
+
+
+@pytest.fixture(scope="module")
+def kerschen():
+    return system_response(KERSCHEN, {"f": "3/10"}, harmonics=6)
+
+
+def _at(r, piece, omega):
+    """The curve's point of ``piece`` nearest ``omega`` (its index)."""
+    s = r.cont.piece_slices()[piece]
+    return s.start + int(np.argmin(np.abs(r.cont.omega[s] - omega)))
+
+
+def _simulated(text, values, omega, start, periods):
+    """The first harmonic of each coordinate over the last of ``periods`` drive periods
+    simulated by DOP853 from ``start`` (x, x')."""
+    system = parse_system(text, values, driven=True)
+    from lindstedt.numerics.integrate import PolynomialField, _system_field
+
+    field = PolynomialField.of(system.equations())
+    drive = np.array([float(d) for d in system.drive])
+    n = system.size
+    eye = np.eye(2 * n).ravel()
+    T = 2 * np.pi / omega
+    t = np.linspace((periods - 1) * T, periods * T, 257)[:-1]
+    sol = solve_ivp(lambda s, z: _system_field(s, np.concatenate([z, eye]),
+                                               field.exponents, field.rows,
+                                               field.coefficients, drive, omega, n)[:2 * n],
+                    (0.0, periods * T), start, method="DOP853", rtol=1e-11, atol=1e-13,
+                    t_eval=t)
+    c = np.fft.rfft(sol.y[:n], axis=1) / 256
+    return 2 * np.abs(c[:, 1])
+
+
+def test_linear_system_matches_complex_amplitudes_and_multipliers_exactly():
+    r = system_response(LINEAR, {"f": "1/10"}, harmonics=2)
+    K = np.array([[2.0, -1.0], [-1.0, 2.0]])
+    F = np.array([0.1, 0.0])
+    exact = np.array([np.abs(np.linalg.solve(K - w**2 * np.eye(2) + 0.1j * w * np.eye(2), F))
+                      for w in r.cont.omega])
+    assert len(r.cont.pieces) == 1 and r.cont.folds == [] and r.jumps == ()
+    assert np.max(np.abs(r.amplitudes - exact)) < 1e-12
+    # C = I/10: every multiplier of ξ'' + ξ'/10 + Kξ = 0 has |λ| = exp(−T/20), T = 2π/ω
+    assert np.max(np.abs(r.multiplier / np.exp(-np.pi / (10 * r.cont.omega)) - 1)) < 1e-9
+    assert r.stable.all() and r.complete
+
+
+def test_power_balance_holds_on_every_balance_solution(kerschen):
+    """⟨ẋᵀCẋ⟩ = ½ Fᵀ V₁ (the bound's identity), from the harmonics of each solution, and
+    the bound itself."""
+    system = parse_system(KERSCHEN, {"f": "3/10"}, driven=True)
+    fine = PolynomialBalance(system.equations(), 0.3, 6, True, shape=(1.0, 0.0))
+    for i in range(0, len(kerschen.cont.omega), 37):
+        x, w = kerschen.cont.x[i], kerschen.cont.omega[i]
+        power = 0.0
+        for c in range(2):
+            A, B = fine.amplitudes(x, c)
+            power += 0.05 * sum((k * w) ** 2 * (A[k] ** 2 + B[k] ** 2) / 2 for k in A)
+        A1, B1 = fine.amplitudes(x, 0)
+        assert power == pytest.approx(0.5 * 0.3 * w * B1[1], rel=1e-9)
+        assert fine.first_harmonic(x) <= kerschen.bound / w
+
+
+def test_every_branch_agrees_with_shooting_and_its_floquet_verdict(kerschen):
+    assert len(kerschen.checks) >= 4
+    for c in kerschen.checks:
+        assert c.error < 1e-9, c
+        assert c.stable == c.balance_stable
+    assert {c.stable for c in kerschen.checks} == {True, False}
+    assert len(kerschen.cont.folds) == 4 and kerschen.complete
+
+
+def test_a_simulation_from_rest_settles_on_the_curve(kerschen):
+    w = 0.8
+    i = _at(kerschen, 0, w)
+    w = float(kerschen.cont.omega[i])
+    sim = _simulated(KERSCHEN, {"f": "3/10"}, w, np.zeros(4), 150)
+    assert np.max(np.abs(sim - kerschen.amplitudes[i])) < 1e-7
+
+
+def test_the_up_sweep_jump_lands_where_the_simulation_does(kerschen):
+    way, w, before, after = next(j for j in kerschen.jumps if j[0] == "up")
+    assert kerschen.stable[before] and kerschen.stable[after]
+    past = w + 2e-3  # just past the fold: the upper branch is gone
+    system = parse_system(KERSCHEN, {"f": "3/10"}, driven=True)
+    fine = PolynomialBalance(system.equations(), 0.3, 6, True, shape=(1.0, 0.0))
+    start = fine.state(kerschen.cont.x[before], w)  # the upper branch's end, at its fold
+    sim = _simulated(KERSCHEN, {"f": "3/10"}, past, start, 400)
+    s = kerschen.cont.piece_slices()[0]
+    low = [k for k in range(s.start, s.stop) if kerschen.stable[k]
+           and abs(kerschen.cont.omega[k] - past) < 5e-3 and kerschen.amplitudes[k, 0] < 1.0]
+    assert low
+    k = min(low, key=lambda k: abs(kerschen.cont.omega[k] - past))
+    assert np.max(np.abs(sim - kerschen.amplitudes[k])) < 0.02
+
+
+def test_cli_json_table_and_plot(tmp_path):
+    out = run("response", KERSCHEN, "--param", "f=1/20", "--harmonics", "3", "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert data["kind"] == "response" and data["coordinates"] == ["x1", "x2"]
+    assert set(data["branches"][0]) >= {"omega", "amplitudes", "stable", "multiplier"}
+    assert data["completeness"]["complete"] and data["parameters"]["drive"]["x1"] == "1/20"
+    table = run("response", KERSCHEN, "--param", "f=1/20", "--harmonics", "3",
+                "--omega", "0.8:1.2", "--plot", str(tmp_path / "r.png"))
+    assert table.returncode == 0, table.stderr
+    assert "branch 1: w 0.8 ->" in table.stdout and "every branch:" in table.stdout
+    assert (tmp_path / "r.png").stat().st_size > 10000
+
+
+@pytest.mark.parametrize(("system", "params", "says"), [
+    ("x1'' + 2*x1 - x2 = f*cos(w*t); x2'' + 2*x2 - x1 = 0", ["f=1"], "no damping"),
+    ("x1'' + x1'/10 + 2*x1 - x2 = 0; x2'' + x2'/10 + 2*x2 - x1 = 0", [], "no drive"),
+    ("x1'' + x1'/10 + 2*x1 - x2 = f*sin(w*t); x2'' + 2*x2 - x1 = 0", ["f=1"],
+     "is not a drive"),
+    ("x1'' + x1'/10 + 2*x1 - x2 = f*cos(w*t); x2'' + 2*x2 - x1 = f*cos(v*t)", ["f=1"],
+     "frequencies"),
+    ("x1'' + x1'/10 + x1 - x2 = f*cos(w*t); x2'' + x2 - x1 = 0", ["f=1"], "every ω0²"),
+    ("x1'' + x1'/10 + 2*x1 - x2 = f*cos(w*t); x2'' + 2*x2 - x1 = 0", ["f=1", "w=2"],
+     "drive frequency"),
+    ("x1'' + x1'/10 + 2*x1 - x2 = f*x1*cos(w*t); x2'' + 2*x2 - x1 = 0", ["f=1"],
+     "is not a drive"),
+])
+def test_bad_systems_are_refused_in_one_line(system, params, says):
+    out = run("response", system, *[a for p in params for a in ("--param", p)])
+    assert out.returncode == 2 and out.stdout == ""
+    assert len(out.stderr.strip().splitlines()) == 1 and says in out.stderr, out.stderr
