@@ -5,7 +5,6 @@ rest and across a jump by SciPy's DOP853 — and the refusals."""
 from __future__ import annotations
 
 import json
-import math
 import subprocess
 import sys
 
@@ -82,7 +81,7 @@ def test_power_balance_holds_on_every_balance_solution(kerschen):
         for c in range(2):
             A, B = fine.amplitudes(x, c)
             power += 0.05 * sum((k * w) ** 2 * (A[k] ** 2 + B[k] ** 2) / 2 for k in A)
-        A1, B1 = fine.amplitudes(x, 0)
+        _, B1 = fine.amplitudes(x, 0)
         assert power == pytest.approx(0.5 * 0.3 * w * B1[1], rel=1e-9)
         assert fine.first_harmonic(x) <= kerschen.bound / w
 
@@ -105,7 +104,7 @@ def test_a_simulation_from_rest_settles_on_the_curve(kerschen):
 
 
 def test_the_up_sweep_jump_lands_where_the_simulation_does(kerschen):
-    way, w, before, after = next(j for j in kerschen.jumps if j[0] == "up")
+    _, w, before, after = next(j for j in kerschen.jumps if j[0] == "up")
     assert kerschen.stable[before] and kerschen.stable[after]
     past = w + 2e-3  # just past the fold: the upper branch is gone
     system = parse_system(KERSCHEN, {"f": "3/10"}, driven=True)

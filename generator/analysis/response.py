@@ -17,15 +17,18 @@ import numpy as np
 import sympy as sp
 
 from ..errors import InputError
-from ..numerics.integrate import ForceTable, Sweep, escape_bound, sweep_table
+from ..numerics.floquet import variational_multipliers
+from ..numerics.integrate import ForceTable, PolynomialField, Sweep, escape_bound, sweep_table
 from ..numerics.newton import newton
-from ..numerics.shooting import orbit_fold_table
+from ..numerics.shooting import PeriodicOrbit, orbit_fold_table, shoot_system
 from .continuation import (
+    CONTINUATION_HARMONICS,
     CONTINUATION_SECONDS,
-    Continuation,
     MAX_POINTS,
     MAX_Q,
+    Continuation,
     _continue,
+    balance_crossings,
     drive_crossings,
 )
 from .driven import (
@@ -713,6 +716,64 @@ def system_plan(text: str, values: dict[str, str], harmonics: int,
                       + points * equation_point_seconds(unknowns))
 
 
+@dataclass(frozen=True)
+class SystemBalance:
+    """A driven system's balance, set up once: its force per equation, the drive (its largest
+    amplitude ``f`` and each equation's share), the balance at ``harmonics`` and the coarse one
+    that seeds it, the power-balance bound (or why there is none) and the linear ω0."""
+
+    system: System
+    equations: tuple[dict[tuple[int, ...], float], ...]
+    drive: np.ndarray
+    fine: PolynomialBalance
+    coarse: PolynomialBalance
+    bound: float | None
+    why: str
+    linear_frequencies: tuple[float, ...]
+
+    @staticmethod
+    def of(system: System, harmonics: int) -> SystemBalance:
+        equations = system.equations()
+        drive = np.array([float(d) for d in system.drive])
+        f = float(np.max(np.abs(drive)))
+        shape = tuple(drive / f)
+        odd = PolynomialField.of(equations).odd
+        bound, why = system.response_bound()
+        return SystemBalance(
+            system, equations, drive, PolynomialBalance(equations, f, harmonics, odd,
+                                                        shape=shape),
+            PolynomialBalance(equations, f, min(harmonics, CONTINUATION_HARMONICS), odd,
+                              shape=shape), bound, why,
+            tuple(float(sp.N(sp.sqrt(lam), 20)) for lam in system.modes()))
+
+    def solutions(self, omega: float) -> tuple[list[np.ndarray], bool, str]:
+        """Every balance solution at ``omega`` the continuation in the drive amplitude from
+        rest reaches up to the bound (:func:`continuation.balance_crossings`), polished at the
+        fine harmonics; whether that is all of them, and the continuation's note."""
+        seeds, curve = balance_crossings(self.coarse, omega, self.fine.force,
+                                         None if self.bound is None
+                                         else 1.01 * self.bound / omega)
+        found, complete = polished(self.coarse, seeds, curve.complete, self.fine, omega)
+        return found, complete, curve.note
+
+    def multiplier(self, X: np.ndarray, omega: np.ndarray) -> np.ndarray:
+        """The largest Floquet ``|λ|`` of each balance solution ``X[k]`` at ``omega[k]``: the
+        monodromy of its variational equation (:func:`numerics.floquet.
+        variational_multipliers`), the samples per period growing with ω0/ω."""
+        omega = np.asarray(omega, dtype=float)
+        out = np.empty(len(omega))
+        samples = FLOQUET_SAMPLES * 2 ** np.ceil(np.log2(np.maximum(
+            1.0, self.linear_frequencies[-1] / omega)))
+        for s in np.unique(samples):
+            where_s = np.nonzero(samples == s)[0]
+            for chunk in np.array_split(where_s, max(1, len(where_s) * int(s) // 2**15)):
+                lin = [self.fine.linearization(X[i], omega[i], int(s)) for i in chunk]
+                lam = variational_multipliers(np.array([a for a, _ in lin]),
+                                              np.array([b for _, b in lin]), omega[chunk])
+                out[chunk] = np.max(np.abs(lam), axis=1)
+        return out
+
+
 def system_response(text: str, values: dict[str, str], harmonics: int = 6,
                     omega_min: float | None = None, omega_max: float | None = None,
                     max_seconds: float = CONTINUATION_SECONDS, checks: int = SYSTEM_CHECKS
@@ -729,30 +790,13 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
     of its variational equation (:func:`numerics.floquet.variational_multipliers`); the middle
     of the longest stable and unstable stretches is shot as the true orbit (DOP853) and
     compared."""
-    from ..numerics.floquet import variational_multipliers
-    from ..numerics.integrate import PolynomialField
-    from ..numerics.shooting import PeriodicOrbit, shoot_system
-    from .continuation import CONTINUATION_HARMONICS, balance_crossings
-
     plan = system_plan(text, values, harmonics, omega_min, omega_max)
     system, (lo, hi), w0 = plan.system, plan.omega_range, plan.linear_frequencies
-    equations = system.equations()
-    drive = np.array([float(d) for d in system.drive])
-    f = float(np.max(np.abs(drive)))
-    shape = tuple(drive / f)
-    odd = PolynomialField.of(equations).odd
-    fine = PolynomialBalance(equations, f, harmonics, odd, shape=shape)
-    coarse = PolynomialBalance(equations, f, min(harmonics, CONTINUATION_HARMONICS), odd,
-                               shape=shape)
-    bound, why = system.response_bound()
+    sb = SystemBalance.of(system, harmonics)
+    fine, drive, bound, why = sb.fine, sb.drive, sb.bound, sb.why
+    equations = sb.equations
     where = f"system {text!r}"
-
-    def solutions(w: float) -> tuple[list[np.ndarray], bool, str]:
-        seeds, curve = balance_crossings(coarse, w, f, None if bound is None
-                                         else 1.01 * bound / w)
-        found, complete = polished(coarse, seeds, curve.complete, fine, w)
-        return found, complete, curve.note
-
+    solutions = sb.solutions
     notes: list[str] = []
     complete = bound is not None
 
@@ -781,9 +825,9 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
         for x in found:
             if _on_curve(cont, float(w), x):
                 continue
-            extra = _continue(fine, lambda: ([(float(w), x, 1.0), (float(w), x, -1.0)], True),
-                              lo, hi, 0.02, estimate, max_seconds, per_point, MAX_POINTS,
-                              where)
+            start = [(float(w), x, 1.0), (float(w), x, -1.0)]
+            extra = _continue(fine, lambda start=start: (start, True), lo, hi, 0.02, estimate,
+                              max_seconds, per_point, MAX_POINTS, where)
             isolas += 1
             for piece in extra.piece_slices():
                 closed.append(bool(lo < extra.omega[piece.stop - 1] < hi))
@@ -791,16 +835,7 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
     notes.append(f"probes at w = {', '.join(f'{w:.4g}' for w in probes)}: "
                  f"{isolas} branch(es) off the curve traced from the ends")
     # stability of every point: the monodromy of its variational equation
-    multiplier = np.empty(len(cont.omega))
-    # the samples per period grow with ω0/ω (a slow drive holds many fast oscillations)
-    samples = FLOQUET_SAMPLES * 2 ** np.ceil(np.log2(np.maximum(1.0, w0[-1] / cont.omega)))
-    for s in np.unique(samples):
-        where_s = np.nonzero(samples == s)[0]
-        for chunk in np.array_split(where_s, max(1, len(where_s) * int(s) // 2**15)):
-            lin = [fine.linearization(cont.x[i], cont.omega[i], int(s)) for i in chunk]
-            lam = variational_multipliers(np.array([a for a, _ in lin]),
-                                          np.array([b for _, b in lin]), cont.omega[chunk])
-            multiplier[chunk] = np.max(np.abs(lam), axis=1)
+    multiplier = sb.multiplier(cont.x, cont.omega)
     stable = multiplier < 1
     n = system.size
     amplitudes = np.array([[math.hypot(*_first(fine, x, i)) for i in range(n)]

@@ -3,9 +3,9 @@
 ``M x'' + C x' + K x + f(x, x') = F cos ωt`` with a diagonal mass ``M`` (each equation holds
 one acceleration), the damping ``C``, the stiffness ``K``, the nonlinear force ``f`` (terms of
 degree ≥ 2) and a drive ``F cos ωt`` (``response`` takes it; ``nnm`` and ``slowflow`` take
-``C = 0``, ``F = 0``), every coefficient exact.  The linear modes are the roots ``λ = ω₀²`` of ``det(K − λM) = 0``, kept
-exact: a rational, or an algebraic number (SymPy's ``CRootOf`` with its minimal polynomial),
-never rounded; modes are numbered by increasing linear frequency.
+``C = 0``, ``F = 0``), every coefficient exact.  The linear modes are the roots ``λ = ω₀²``
+of ``det(K − λM) = 0``, kept exact: a rational, or an algebraic number (SymPy's ``CRootOf``
+with its minimal polynomial), never rounded; modes are numbered by increasing linear frequency.
 """
 
 from __future__ import annotations

@@ -555,8 +555,8 @@ class PolynomialField:
             g[i] += mono
             for k, (j, e) in enumerate(used):
                 part = c * e if e == 1 else (c * e) * powers[j][e - 1]
-                for l, f in enumerate(factors):
-                    if l != k:
+                for m, f in enumerate(factors):
+                    if m != k:
                         part = part * f
                 dg[i, j] += part
         return g, dg[:, :n], dg[:, n:]
