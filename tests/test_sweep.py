@@ -456,6 +456,31 @@ def test_equation_subharmonic_sweep_against_the_command():
     assert ds["exists"].values[1] == 1
 
 
+SYSTEM = "x1'' + c*x1' + 2*x1 - x2 + k*x1**3 = f*cos(w*t); x2'' + c*x2' + 2*x2 - x1 = 0"
+
+
+def test_system_sweep_linear_points_are_the_complex_amplitudes_exactly():
+    """``sweep response SYSTEM --axis w=… --axis c=…`` with the cubic switched off (k = 0): one
+    stable orbit at every point, its r = |(K − ω² + iωc)⁻¹F| (linear algebra, another route);
+    with the cubic on, a point inside the fold (ω = 1.14, between the folds 1.1189 and 1.1648
+    that test_response_system checks by shooting) holds two stable orbits around an unstable
+    one."""
+    kind = equation_kind("response", SYSTEM, {"f": "1/10", "k": "0"}, ["w", "c"])
+    ds = serial_sweep(kind, {"w": [0.7, 1.0, 1.5, 2.2], "c": [0.05, 0.2]})
+    K = np.array([[2.0, -1.0], [-1.0, 2.0]])
+    for i, w in enumerate(ds["w"].values):
+        for j, c in enumerate(ds["c"].values):
+            X = np.linalg.solve(K - w**2 * np.eye(2) + 1j * w * c * np.eye(2), [0.1, 0.0])
+            assert ds["orbits"].values[i, j] == 1 and ds["stable"].values[i, j, 0] == 1
+            assert abs(ds["r"].values[i, j, 0] - np.linalg.norm(X)) < 1e-12
+            assert ds["floquet"].values[i, j, 0] == pytest.approx(np.exp(-np.pi * c / w),
+                                                                  rel=1e-8)
+    hard = equation_kind("response", SYSTEM, {"f": "3/10", "k": "1/2", "c": "1/20"}, ["w"])
+    ds = serial_sweep(hard, {"w": [1.14]})
+    assert ds["orbits"].values[0] == 3
+    assert list(ds["stable"].values[0][:3]) == [1, 0, 1]
+
+
 @pytest.mark.parametrize("argv, says", [
     (["--axis", "beta=0:1:3", "--param", "eps=1/10", "--param", "f=3/10", "--param",
       "alpha=1"], "beta: not a parameter"),

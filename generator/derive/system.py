@@ -119,13 +119,17 @@ def _roots(factor: sp.Poly) -> list[sp.Expr]:
     return [sp.CRootOf(factor, k) for k in range(factor.count_roots())]
 
 
-def parse_system(text: str, values: dict[str, str] | None = None,
-                 driven: bool = False) -> System:
-    """A :class:`System` from ``"x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0"``:
-    every name but the coordinates needs an exact value (``values``, from ``--param``).
-    ``driven``: the system may be driven, ``f*cos(w*t)`` on the right of one or more
-    equations, one frequency ``w`` (left free: the response varies it)."""
-    values = dict(values or {})
+def system_parameters(text: str) -> tuple[tuple[str, ...], str | None]:
+    """The names of a (possibly driven) system's parameters, and its drive frequency's name
+    (``None``: not driven); refused in one line as :func:`parse_system` refuses."""
+    _, _, names, frequency = _read(text, True)
+    return tuple(sorted(names)), None if frequency is None else str(frequency)
+
+
+def _read(text: str, driven: bool
+          ) -> tuple[list[str], list, set[str], sp.Symbol | None]:
+    """The coordinates, each equation (with its drive's amplitude apart when driven), the
+    parameters' names and the drive's frequency of ``text``."""
     parts = text.split(";") if isinstance(text, str) else [text]
     if len(parts) < 2:
         raise InputError(f"system {text!r}: one equation per coordinate, separated by ';' (a "
@@ -159,14 +163,25 @@ def parse_system(text: str, values: dict[str, str] | None = None,
                              "takes driven ones)")
         exprs, frequency = _drive_split(text, exprs)
         names -= {TIME, str(frequency)}
-        if str(frequency) in values:
-            raise InputError(f"--param {frequency}: {frequency} is the drive frequency; the "
-                             "response varies it (give its range with --omega A:B)")
+    return coordinates, exprs, names, frequency
+
+
+def parse_system(text: str, values: dict[str, str] | None = None,
+                 driven: bool = False) -> System:
+    """A :class:`System` from ``"x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0"``:
+    every name but the coordinates needs an exact value (``values``, from ``--param``).
+    ``driven``: the system may be driven, ``f*cos(w*t)`` on the right of one or more
+    equations, one frequency ``w`` (left free: the response varies it)."""
+    values = dict(values or {})
+    coordinates, exprs, names, frequency = _read(text, driven)
+    if frequency is not None and str(frequency) in values:
+        raise InputError(f"--param {frequency}: {frequency} is the drive frequency; the "
+                         "response varies it (give its range with --omega A:B)")
     missing = sorted(names - set(values))
     if missing:
         raise InputError(f"system {text!r}: give {', '.join(missing)} a value with --param "
-                         f"(e.g. --param {missing[0]}=1/2); a system's series are in the "
-                         "amplitude A")
+                         f"(e.g. --param {missing[0]}=1/2)"
+                         + ("" if driven else "; a system's series are in the amplitude A"))
     given = {sp.Symbol(k): parse_expression(v, f"--param {k}") for k, v in values.items()}
     for k, v in given.items():
         if not v.is_Rational:

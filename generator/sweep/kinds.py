@@ -400,16 +400,44 @@ def _equation_response(spec: EquationSpec, **axis: float) -> dict:
 
 
 def _branches(shot: list, count: int) -> dict:
+    """The fields of the shot orbits ``shot`` (``count`` found)."""
+    return _orbit_fields([math.hypot(o.A.get(1, 0.0), o.B.get(1, 0.0)) for o in shot],
+                         [float(np.max(np.abs(o.multipliers))) for o in shot], count)
+
+
+def _orbit_fields(r_all: list[float], floquet_all: list[float], count: int) -> dict:
+    """The stored fields of orbits of first-harmonic sizes ``r_all`` and largest Floquet
+    moduli ``floquet_all`` (stable below 1, a damped system's verdict), the first
+    :data:`EQUATION_BRANCHES` kept."""
     r, stable = [math.nan] * EQUATION_BRANCHES, [-1] * EQUATION_BRANCHES
     floquet = [math.nan] * EQUATION_BRANCHES
-    for k, orbit in enumerate(shot[:EQUATION_BRANCHES]):
-        r[k] = math.hypot(orbit.A.get(1, 0.0), orbit.B.get(1, 0.0))
-        stable[k] = int(orbit.stable)
-        floquet[k] = float(np.max(np.abs(orbit.multipliers)))
+    for k, (size, modulus) in enumerate(zip(r_all[:EQUATION_BRANCHES],
+                                            floquet_all[:EQUATION_BRANCHES], strict=True)):
+        r[k], stable[k], floquet[k] = size, int(modulus < 1), modulus
     kept = [x for x, s in zip(r, stable, strict=True) if s == 1]
-    return {"orbits": count, "stable_orbits": sum(bool(o.stable) for o in shot), "r": r,
+    return {"orbits": count, "stable_orbits": sum(m < 1 for m in floquet_all), "r": r,
             "stable": stable, "floquet": floquet, "r_stable_max": max(kept, default=math.nan),
             "r_stable_min": min(kept, default=math.nan)}
+
+
+def _system_response(spec: EquationSpec, **axis: float) -> dict:
+    """Every periodic response of a driven system at one point (the balance at
+    :data:`ORBIT_HARMONICS` harmonics, seeded by the drive continued from rest up to the
+    power-balance bound: :meth:`analysis.response.SystemBalance.solutions`), largest first,
+    with the Floquet verdict of its variational equation; ``r`` is the first harmonic over
+    every coordinate, ``√Σ_i (A_i1² + B_i1²)``."""
+    from ..analysis.response import SystemBalance, _driven_system
+
+    values = _point_values(spec, axis)
+    omega = float(Fraction(values.pop(spec.frequency)))
+    try:
+        sb = SystemBalance.of(_driven_system(spec.text, values), ORBIT_HARMONICS)
+    except InputError:  # refused at this point (e.g. the damping made 0): no orbit stored
+        return {}
+    found, _, _ = sb.solutions(omega)
+    found.sort(key=sb.fine.first_harmonic, reverse=True)
+    floquet = list(sb.multiplier(np.array(found), np.full(len(found), omega))) if found else []
+    return _orbit_fields([sb.fine.first_harmonic(x) for x in found], floquet, len(found))
 
 
 def _equation_subharmonic(spec: EquationSpec, **axis: float) -> dict:
@@ -439,8 +467,10 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
     value in ``values``; refused in one line: an axis that names no parameter, a parameter
     both an axis and a value, a parameter with neither, a kind that takes no equation."""
     from ..analysis.polynomial import driven_form
+    from ..analysis.response import _driven_system
     from ..analysis.subharmonic import check_n
     from ..derive.models import oscillator
+    from ..derive.system import system_parameters
 
     if kind not in EQUATION_KINDS:
         raise InputError(f"sweep {kind} EQUATION: the {kind} map is the notes' (μ-expansion "
@@ -449,10 +479,21 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
         check_n(n)
     if not axes:
         raise InputError("sweep EQUATION: give at least one axis, --axis NAME=A:B:N")
-    osc = oscillator(text, {}, name)
-    names = {str(p) for p in osc.equation.parameters}
-    if osc.equation.small is not None:
-        names.add("eps")
+    system = ";" in text
+    if system:
+        if kind != "response":
+            raise InputError(f"sweep {kind} SYSTEM: a system's map is response (every periodic "
+                             "response with its Floquet verdict)")
+        parameters, frequency = system_parameters(text)
+        if frequency is None:
+            raise InputError(f"system {text!r}: no drive; sweep response SYSTEM needs "
+                             "f*cos(w*t) on the right of an equation")
+        names = {*parameters, frequency}
+    else:
+        osc = oscillator(text, {}, name)
+        names = {str(p) for p in osc.equation.parameters}
+        if osc.equation.small is not None:
+            names.add("eps")
     both = sorted(set(axes) & set(values))
     if both:
         raise InputError(f"--axis {both[0]} and --param {both[0]}: a parameter is an axis or a "
@@ -471,11 +512,14 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
     if clash:
         raise InputError(f"--axis {clash[0]}: the store holds a field of that name; rename the "
                          "parameter in the equation")
-    frequency = _frequency_name(osc, text, name)
-    form = driven_form(text, {**dict(values), **{a: "1" for a in axes if a != frequency}},
-                       name, f"sweep {kind}", "a polynomial force and one drive f*cos(w*t)",
-                       True)
-    if len(form.drives) != 1:
+    if system:
+        _driven_system(text, {**dict(values), **{a: "1" for a in axes if a != frequency}})
+    else:
+        frequency = _frequency_name(osc, text, name)
+        form = driven_form(text, {**dict(values), **{a: "1" for a in axes if a != frequency}},
+                           name, f"sweep {kind}", "a polynomial force and one drive "
+                           "f*cos(w*t)", True)
+    if not system and len(form.drives) != 1:
         raise InputError(f"{name} ({text}): sweep {kind} takes one drive f*cos(w*t), not "
                          f"{len(form.drives)}")
     spec = EquationSpec(kind, text, tuple(sorted(values.items())), frequency, n, name)
@@ -496,6 +540,12 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
                     (branch,), (Field("exists", "an orbit of n drive periods was found", "int8",
                                       flag=True), *common),
                     functools.partial(_equation_subharmonic, spec), warm, 4, "stable_orbits",
+                    settings, builtin=False, positive=(frequency,))
+    if system:
+        return Kind(kind, f"every periodic response of the system {text} (harmonic balance, "
+                    "r over every coordinate) with the Floquet verdict of its variational "
+                    "equation", tuple(axes), (branch,), common,
+                    functools.partial(_system_response, spec), warm, 4, "r_stable_max",
                     settings, builtin=False, positive=(frequency,))
     return Kind(kind, f"every 1:1 orbit of {text} with its Floquet verdict", tuple(axes),
                 (branch,), common, functools.partial(_equation_response, spec), warm, 4,
