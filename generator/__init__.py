@@ -22,8 +22,9 @@ order; a stage imports only stages above it::
     derive.hill             Hill's equation x'' + (δ + ε p(t))x = 0: transition curves out of
                             each tongue, a damped tongue's tip, Mathieu's a_m(q), b_m(q), exact
                             (L–P about cos nτ, sin nτ) [p(t), n, K -> curves]
-    derive.system           a system of coupled oscillators from text: mass, stiffness, force,
-                            the linear modes' exact ω₀² [str -> System]
+    derive.system           a system of coupled oscillators from text: mass, damping,
+                            stiffness, force, drive, the linear modes' exact ω₀², the power-
+                            balance bound on a driven one's orbits [str -> System]
     derive.nnm              nonlinear normal modes as exact L–P series in Q or Q(ω₀²), the
                             secular condition by the left null vector, internal resonances
                             refused [System, mode, K -> NormalModeSeries]
@@ -33,16 +34,19 @@ order; a stage imports only stages above it::
                             averaging to any order in van der Pol's variables, exact (R_k, Φ_k
                             of dr/dt, dφ/dt) [Oscillator, K -> SlowFlow]
     numerics.integrate      the one integrator: RK4 of any polynomial force table, compiled;
-                            flows, sweeps with their jumps, simulations [ForceTable -> flows]
+                            flows, sweeps with their jumps, simulations; a system's polynomial
+                            force and its compiled field [ForceTable | PolynomialField -> flows]
     numerics.newton         the one Newton's method for R(x) = 0 [R, J, x -> root]
     numerics.floquet        Floquet multipliers: Hill about q₀, a damped pump over a grid, the
-                            full Hill equation, the verdict [orbit -> multipliers]
+                            full Hill equation, a system's variational monodromy about many
+                            orbits at once, the verdict [orbit -> multipliers]
     numerics.shooting       periodic orbits by Newton on the flow map, true folds, true limit
-                            cycles [guess -> PeriodicOrbit]
+                            cycles, a driven system's orbit (DOP853) [guess -> PeriodicOrbit]
     numerics.references     elliptic periods, cn, the pendulum, a cycle by DOP853, Mathieu by
                             the Hill matrix and mpmath [x -> truth]
     analysis.polynomial     a user's driven equation lowered to data, the Galerkin balance of
-                            any polynomial force, an amplitude bound [text -> DrivenEquation]
+                            any polynomial force of one or more coordinates, an amplitude bound
+                            [text -> DrivenEquation, PolynomialBalance]
     analysis.driven         the notes' driven Duffing: one harmonic, μ-expansion with phase,
                             harmonic balance [Drive -> branches]
     analysis.mu_exact       the μ-expansion (undamped, damped) and the balance equations,
@@ -50,8 +54,9 @@ order; a stage imports only stages above it::
     analysis.continuation   pseudo-arclength through folds, in ω or in the drive amplitude from
                             rest; crossings of a level [system -> curve]
     analysis.response       one-harmonic curves and folds, the balance continued over an ω range
-                            (the notes' and any polynomial force)
-                            [Drive | equation, ω range -> folds]
+                            (the notes' and any polynomial force); a driven system's every
+                            branch, its Floquet verdicts and shooting checks
+                            [Drive | equation | System, ω range -> folds, branches]
     analysis.periodic       every distinct periodic orbit at one drive: seeds, balance,
                             shooting, Floquet; the report of `driven`
                             [Drive | equation -> orbits]
@@ -93,17 +98,18 @@ order; a stage imports only stages above it::
     choose                  methods × orders, verified error, recorded cost model
                             [tol, range -> Choice]
     sweep.kinds             what one point of a map computes: the notes' kinds, and any
-                            equation's parameters as axes [point -> fields]
+                            equation's or driven system's parameters as axes [point -> fields]
     sweep.store             grids in blocks on dask.distributed, into a resumable Zarr store
                             [kind, axes -> Dataset]
     charts                  matplotlib figures [results -> PNG/SVG/PDF]
     charts_modes            the frequency–energy plot of a system's normal modes: backbones
-                            from the series beside shot orbits [System -> PNG/SVG/PDF]
+                            from the series beside shot orbits; a driven system's response
+                            [System, SystemResponse -> PNG/SVG/PDF]
     costs                   each command's estimated wall time and bounds [arguments -> Cost]
     cli.common              what every command shares: light constants, argument types and
                             flags, the report shape [argv -> Namespace]
-    cli.system              nnm, and slowflow of a system [NormalModeSeries, ResonantFlow ->
-                            JSON, tables]
+    cli.system              nnm, slowflow and response of a system [NormalModeSeries,
+                            ResonantFlow, SystemResponse -> JSON, tables]
     cli.series              series, mathieu, tongues, slowflow, models, generate
                             [records -> JSON, tables]
     cli.driven              driven, response, subharmonic, parametric, mixing

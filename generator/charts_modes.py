@@ -1,5 +1,6 @@
-"""The frequency–energy plot of a system's nonlinear normal modes: each backbone from its exact
-series beside orbits shot by DOP853, the series' radius, the internal-resonance lines."""
+"""The frequency–energy plot of a system's nonlinear normal modes (each backbone from its exact
+series beside orbits shot by DOP853, the series' radius, the internal-resonance lines), and a
+driven system's response curves."""
 
 from __future__ import annotations
 

@@ -826,10 +826,16 @@ def arguments_response(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
                        description="Response curve over ω: folds three ways, sweep jumps. "
                        "q'' + q'/Q + q + eps q^3 = f cos(w t) (--eps, --force, --Q), or your "
                        "own damped equation q'' + g(q, q') = f*cos(w*t), g a polynomial, with "
-                       "--param for every parameter but w.")
+                       "--param for every parameter but w; or a SYSTEM of coupled damped "
+                       "oscillators, one equation per coordinate separated by ';', driven by "
+                       "f*cos(w*t) on one or more of them: every branch (a bound on the "
+                       "amplitude says none is missed), Floquet stability, folds, sweep jumps, "
+                       "each branch checked by shooting.")
     _flag_equation(p, "\"q'' + 0.05*q' + q + eps*(q**2 + q**3) = f*cos(w*t)\" (a "
                    "polynomial force with damping, one drive f*cos(w*t) whose w the curve "
-                   "varies)", "Duffing's q'' + q'/Q + q + εq³ = f cos ωt with --eps, --force, "
+                   "varies), or a system \"x1'' + 0.05*x1' + 2*x1 - x2 + x1**3/2 = "
+                   "f*cos(w*t); x2'' + 0.05*x2' + 2*x2 - x1 = 0\"",
+                   "Duffing's q'' + q'/Q + q + εq³ = f cos ωt with --eps, --force, "
                    "--Q", "every parameter but w "
                    "needs one")
     _flag_drive(p, required=False, omega=None, Q=None, notes=True)
@@ -838,7 +844,8 @@ def arguments_response(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
                    "EQUATION)")
     _flag_omega(p, ("A:B",), "with EQUATION: the drive frequencies ω of the curve, from A to "
                 "B, in units of the linear natural frequency ω0 (default: from half the lowest "
-                "of ω0 and the one-harmonic folds to 1.25 × the highest)")
+                "of ω0 and the one-harmonic folds to 1.25 × the highest); with a SYSTEM: in "
+                "its own time units (default: half the lowest linear ω0 to 1.5 × the highest)")
     _flag_range_bounds(p, "--omega-min", "--omega-max")
     _flag_harmonics(p, "odd harmonics N of the continued balance (with EQUATION: harmonics "
                     "1..2N-1, with the constant and even ones unless the force is odd)")

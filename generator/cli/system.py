@@ -1,5 +1,5 @@
-"""``nnm``: the nonlinear normal modes of a system of coupled oscillators (JSON contract and
-table)."""
+"""A system of coupled oscillators: ``nnm`` (its nonlinear normal modes), ``slowflow SYSTEM``
+and ``response SYSTEM`` (a driven, damped system's branches): JSON and tables."""
 
 from __future__ import annotations
 
