@@ -806,7 +806,8 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
         for w, direction in ((lo, 1.0), (hi, -1.0)):
             found, whole, note = solutions(w)
             complete = complete and whole
-            notes.append(f"at w = {w:.4g}: {len(found)} solution(s); {note}")
+            notes.append(f"w = {w:.4g} ({len(found)} solution{'s' * (len(found) != 1)})"
+                         + ("" if whole else f" [{note}]"))
             out.extend((w, x, direction) for x in found)
         if not out or out[0][0] != lo:
             raise np.linalg.LinAlgError(f"no balance converged at ω = {lo:.4g}")
@@ -832,8 +833,9 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
             for piece in extra.piece_slices():
                 closed.append(bool(lo < extra.omega[piece.stop - 1] < hi))
             cont = _merged(cont, extra)
-    notes.append(f"probes at w = {', '.join(f'{w:.4g}' for w in probes)}: "
-                 f"{isolas} branch(es) off the curve traced from the ends")
+    probed = (f"{len(probes)} probes (w = {', '.join(f'{w:.4g}' for w in probes)}): "
+              f"{isolas} solution{'s' * (isolas != 1)} off the curve traced from the ends"
+              + (", each traced" if isolas else ""))
     # stability of every point: the monodromy of its variational equation
     multiplier = sb.multiplier(cont.x, cont.omega)
     stable = multiplier < 1
@@ -867,12 +869,13 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
             bool(stable[mid])))
     shots.sort(key=lambda c: (c.piece, c.omega))
     how = (f"every orbit has r1 <= {bound:.6g}/w ({why}); the drive was continued from rest "
-           "past it at both ends and at each probe" if bound is not None else
-           f"no amplitude bound ({why}): the drive continuation from rest stops at its budget, "
-           "branches beyond it may be missed")
+           f"past that bound at {', '.join(notes)} and at "
+           if bound is not None else
+           f"no amplitude bound ({why}): the drive continuation from rest stopped at its "
+           f"budget at {', '.join(notes)} and at ")
     return SystemResponse(system, harmonics, (lo, hi), w0, cont, tuple(closed), amplitudes,
                           multiplier, stable, _jumps(cont, r, stable, lo, hi), tuple(shots),
-                          bound, complete and cont.complete, "; ".join([how, *notes]))
+                          bound, complete and cont.complete, how + probed)
 
 
 def _first(balance: PolynomialBalance, x: np.ndarray, i: int) -> tuple[float, float]:

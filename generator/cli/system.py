@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import textwrap
 from pathlib import Path
 
 from ..errors import InputError
@@ -262,11 +263,9 @@ def response_system_table(data: dict) -> list[str]:
     lines.append("  folds: " + (", ".join(f"{w:.8f}" for w in data["folds"]) or "none"))
     for way in ("up", "down"):
         jumps = [j for j in data["jumps"] if j["sweep"] == way]
-        lines.append(f"  sweep {way}: " + ("; ".join(
-            f"jumps at {j['omega']:.6f} (" + ", ".join(
-                f"{n} {j['from'][n]:.4g} -> {j['to'][n]:.4g}" for n in names) + ")"
-            for j in jumps)
-            or "no jump"))
+        lines.append(f"  sweep {way}:" + (" no jump" if not jumps else ""))
+        lines += [f"    jumps at {j['omega']:.6f}: " + ", ".join(
+            f"{n} {j['from'][n]:.4g} -> {j['to'][n]:.4g}" for n in names) for j in jumps]
     checks = data["checks"]
     shot = [c for c in checks if c["error"] is not None]
     agree = sum(c["stable"] == c["balance_stable"] for c in shot)
@@ -279,8 +278,9 @@ def response_system_table(data: dict) -> list[str]:
         if c["error"] is None:
             lines.append(f"    w = {c['omega']:.6g}: not shot ({c['note']})")
     done = data["completeness"]
-    lines.append(("  every branch: " if done["complete"] else "  warning: branches may be "
-                  "missing: ") + done["how"])
+    lines += textwrap.wrap(("every branch: " if done["complete"] else "warning: branches may "
+                            "be missing: ") + done["how"], 96, initial_indent="  ",
+                           subsequent_indent="    ")
     return lines
 
 

@@ -81,8 +81,8 @@ class System:
         if not c_min > 0:
             return None, "the damping M·C is not positive definite"
         F = math.sqrt(sum(float(self.mass[i] * d) ** 2 for i, d in enumerate(self.drive)))
-        return F / c_min, (f"the power balance: r1 <= |F|/(c_min w) with |F| = {F:.6g}, "
-                           f"c_min = {c_min:.6g} (the damping's smallest eigenvalue)")
+        return F / c_min, (f"power balance: |F| = {F:.6g}, c_min = {c_min:.6g}, the "
+                           "damping's smallest eigenvalue")
 
     def equations(self) -> tuple[dict[tuple[int, ...], float], ...]:
         """Each equation's force ``g_i`` (``ẍ_i + g_i(x, ẋ) = d_i cos ωt``: stiffness, damping
