@@ -150,3 +150,25 @@ def test_bad_systems_are_refused_in_one_line(system, params, says):
     out = run("response", system, *[a for p in params for a in ("--param", p)])
     assert out.returncode == 2 and out.stdout == ""
     assert len(out.stderr.strip().splitlines()) == 1 and says in out.stderr, out.stderr
+
+
+def test_variational_multipliers_are_the_shot_orbits_monodromy(kerschen):
+    """Every Floquet multiplier (complex) of a balance point on an unstable stretch and on a
+    stable one, from the variational equation about the balance orbit, against the monodromy
+    of the orbit shot by DOP853 (a real multiplier > 1 on the unstable one: the saddle)."""
+    from lindstedt.numerics.floquet import variational_multipliers
+    from lindstedt.numerics.integrate import PolynomialField
+    from lindstedt.numerics.shooting import shoot_system
+
+    system = parse_system(KERSCHEN, {"f": "3/10"}, driven=True)
+    fine = PolynomialBalance(system.equations(), 0.3, 6, True, shape=(1.0, 0.0))
+    field = PolynomialField.of(system.equations())
+    for flag in (False, True):
+        k = next(i for i in range(len(kerschen.stable)) if kerschen.stable[i] == flag
+                 and 1.12 < kerschen.cont.omega[i] < 1.16)
+        x, w = kerschen.cont.x[k], float(kerschen.cont.omega[k])
+        gx, gv = fine.linearization(x, w, 2048)
+        lam = variational_multipliers(gx[None], gv[None], np.array([w]))[0]
+        shot = shoot_system(field, np.array([0.3, 0.0]), w, fine.state(x, w)).multipliers
+        assert max(np.min(np.abs(shot - z)) for z in lam) < 1e-7
+        assert (np.max(np.abs(lam)) < 1) == flag
