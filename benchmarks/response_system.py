@@ -68,11 +68,13 @@ def main() -> None:
         found = []
         for w in omegas:  # the same stretch by Newton from the previous point (no arclength)
             x, converged, _ = fine.solve(x, float(w))
+            if not converged:
+                raise RuntimeError(f"N = {N}: the balance did not converge at w = {w}")
             found.append(x)
         sb.multiplier(np.array(found), omegas)  # the verdict, as the command computes it
         per_point = (time.perf_counter() - start) / len(omegas)
         error = 0.0
-        for x, w, orbit in zip(found, omegas, shots, strict=True):
+        for x, orbit in zip(found, shots, strict=True):
             for c, (A, B) in enumerate(orbit.coordinates):
                 a, b = fine.amplitudes(x, c)
                 error = max(error, *(abs(A.get(h, 0.0) - a.get(h, 0.0)) for h in A),

@@ -730,6 +730,7 @@ class SystemBalance:
     bound: float | None
     why: str
     linear_frequencies: tuple[float, ...]
+    backbones: tuple[tuple[np.ndarray, np.ndarray], ...] = ()  # per mode: ω(A), x(0) on a grid
 
     @staticmethod
     def of(system: System, harmonics: int) -> SystemBalance:
@@ -739,12 +740,12 @@ class SystemBalance:
         shape = tuple(drive / f)
         odd = PolynomialField.of(equations).odd
         bound, why = system.response_bound()
+        w0 = tuple(float(sp.N(sp.sqrt(lam), 20)) for lam in system.modes())
         return SystemBalance(
             system, equations, drive, PolynomialBalance(equations, f, harmonics, odd,
                                                         shape=shape),
             PolynomialBalance(equations, f, min(harmonics, CONTINUATION_HARMONICS), odd,
-                              shape=shape), bound, why,
-            tuple(float(sp.N(sp.sqrt(lam), 20)) for lam in system.modes()))
+                              shape=shape), bound, why, w0, _backbones(system, bound, w0))
 
     def solutions(self, omega: float) -> tuple[list[np.ndarray], bool, str]:
         """Every balance solution at ``omega`` the continuation in the drive amplitude from
@@ -754,7 +755,29 @@ class SystemBalance:
                                          None if self.bound is None
                                          else 1.01 * self.bound / omega)
         found, complete = polished(self.coarse, seeds, curve.complete, self.fine, omega)
+        more, _ = polished(self.fine, self.backbone_seeds(omega), True, self.fine, omega)
+        found += [x for x in more if all(np.linalg.norm(y - x) > 1e-6 * (1 + np.linalg.norm(x))
+                                         for y in found)]
+        found.sort(key=self.fine.first_harmonic)
         return found, complete, curve.note
+
+    def backbone_seeds(self, omega: float) -> list[np.ndarray]:
+        """Where a backbone (the free system's nonlinear normal mode, its series) passes
+        ``omega``: the mode's shape at that amplitude, in quadrature with the drive (``±`` its
+        ``x(0)`` on ``sin ωt``: the phase of a damped resonance), as balance unknowns."""
+        fine = self.fine
+        m = len(fine.k2)
+        s1 = fine.n_cos + int(np.nonzero(fine.orders[fine.orders > 0] == 1)[0][0])
+        out = []
+        for om, starts in self.backbones:
+            for i in np.nonzero((om[:-1] - omega) * (om[1:] - omega) <= 0)[0]:
+                t = 0.0 if om[i + 1] == om[i] else (omega - om[i]) / (om[i + 1] - om[i])
+                shape = starts[:, i] + t * (starts[:, i + 1] - starts[:, i])
+                for sign in (1.0, -1.0):
+                    x = np.zeros(fine.size)
+                    x[np.arange(fine.coordinates) * m + s1] = sign * shape
+                    out.append(x)
+        return out
 
     def multiplier(self, X: np.ndarray, omega: np.ndarray) -> np.ndarray:
         """The largest Floquet ``|λ|`` of each balance solution ``X[k]`` at ``omega[k]``: the
@@ -772,6 +795,48 @@ class SystemBalance:
                                               np.array([b for _, b in lin]), omega[chunk])
                 out[chunk] = np.max(np.abs(lam), axis=1)
         return out
+
+
+BACKBONE_ORDER = 6
+# NOTE: the order of the free system's normal-mode series whose backbones seed the balance
+# (0.01–0.1 s a mode): a seed, polished by Newton, not an answer.
+BACKBONE_POINTS = 400
+
+
+def _backbones(system: System, bound: float | None, w0: tuple[float, ...]
+               ) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+    """Each mode's backbone ω(A) and its x(0) on a grid of amplitudes up to the power-balance
+    bound at that mode's ω0 (10 without one), from the series of the free system (damping and
+    drive removed), cut where ω(A) stops being monotone; none where the free system has a
+    velocity-dependent force, and none for a mode in internal resonance (the series is
+    refused)."""
+    from dataclasses import replace as _replace
+
+    from ..derive.nnm import normal_mode
+
+    if any(f.has(*system.velocities) for f in system.force):
+        return ()
+    free = _replace(system, damping=None, drive=(), frequency=None)
+    out = []
+    for k in range(1, system.size + 1):
+        for a in range(system.size):
+            try:
+                mode = normal_mode(free, k, BACKBONE_ORDER, a)
+            except InputError:  # x_a does not move in this mode, or an internal resonance
+                continue
+            top = 10.0 if bound is None else 1.2 * bound / w0[k - 1]
+            with np.errstate(over="ignore", invalid="ignore"):
+                omega, _, starts = mode.evaluate(np.linspace(0.0, top, BACKBONE_POINTS))
+            # the series is kept up to where ω(A) stops being monotone (past its radius the
+            # partial sums swing) or finite
+            step = np.sign(np.diff(omega))
+            bad = np.nonzero((step != step[0]) | ~np.isfinite(omega[1:])
+                             | ~np.all(np.isfinite(starts[:, 1:]), axis=0))[0]
+            keep = len(omega) if not len(bad) else int(bad[0]) + 1
+            if keep > 1:
+                out.append((omega[:keep], starts[:, :keep]))
+            break
+    return tuple(out)
 
 
 def system_response(text: str, values: dict[str, str], harmonics: int = 6,
@@ -833,7 +898,10 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
             for piece in extra.piece_slices():
                 closed.append(bool(lo < extra.omega[piece.stop - 1] < hi))
             cont = _merged(cont, extra)
-    probed = (f"{len(probes)} probes (w = {', '.join(f'{w:.4g}' for w in probes)}): "
+    seeded = (f"; Newton also started from {len(sb.backbones)} backbone(s) (the free system's "
+              f"normal modes, series to order {BACKBONE_ORDER}) wherever they cross w there"
+              if sb.backbones else "")
+    probed = (f"{len(probes)} probes (w = {', '.join(f'{w:.4g}' for w in probes)}){seeded}: "
               f"{isolas} solution{'s' * (isolas != 1)} off the curve traced from the ends"
               + (", each traced" if isolas else ""))
     # stability of every point: the monodromy of its variational equation
