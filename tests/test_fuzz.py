@@ -247,6 +247,21 @@ NNM = command_line((
         number=False)), plot="slow")
 # NOTE: the figure shoots 16 orbits (~7 s): only where a value fails to parse.
 
+RESPONSE_SYSTEM = command_line((
+    Opt(None, st.sampled_from(["x1'' + x1'/20 + 2*x1 - x2 + x1**3/2 = f*cos(w*t); "
+                               "x2'' + x2'/20 + 2*x2 - x1 = 0"]),
+        st.sampled_from(["x1'' + 2*x1 - x2 = f*cos(w*t); x2'' + 2*x2 - x1 = 0", ";",
+                         "x1'' + x1'/20 + x1 = f*sin(w*t); x2'' + x2 = 0",
+                         "x1'' + x1'/20 + x1 = f*x1*cos(w*t); x2'' + x2'/20 + x2 = 0",
+                         "x1'' + x1'/20 + x1 = f*cos(w*t); x2'' + x2 = f*cos(v*t)",
+                         "x1'' + x1'/20 - x1 = f*cos(w*t); x2'' + x2'/20 + x2 = 0",
+                         "x1'' + __import__('os') = f*cos(w*t); x2'' = 0"]), number=False),
+    Opt("--param", st.just("f=3/10"), st.sampled_from(["f=abc", "w=1", "g=1", "f=1e400"]),
+        number=False),
+    Opt("--omega", span(0.9, 1.0, 1.3), SPAN_EDGES),
+    Opt("--harmonics", maybe(whole(1, 3)), st.sampled_from(("0", "101", "abc")))), plot="slow")
+# NOTE: a driven system's response over a short range at N ≤ 3 harmonics (2–4 s a valid run).
+
 CLOCK = st.sampled_from([[], ["--json"], ["--bogus"], ["extra"], ["--json", "--json"]])
 
 MODELS = st.sampled_from([[], ["--json"], ["--bogus"], ["extra"], ["--json", "--json"]])
@@ -288,13 +303,15 @@ BUDGET = {"series": (SERIES, 2), "generate": (GENERATE, 2), "driven": (DRIVEN, 4
           "mixing": (mixing(), 3), "choose": (CHOOSE, 2), "clock": (CLOCK, 1),
           "scene": (SCENE, 1), "demo": (DEMO, 1), "models": (MODELS, 1),
           "mathieu": (MATHIEU, 2), "parametric": (PARAMETRIC, 2),
-          "slowflow": (SLOWFLOW, 2), "tongues": (TONGUES, 2), "nnm": (NNM, 2)}
+          "slowflow": (SLOWFLOW, 2), "tongues": (TONGUES, 2), "nnm": (NNM, 2),
+          "response SYSTEM": (RESPONSE_SYSTEM, 2)}
 # NOTE: examples (pairs of runs side by side) per command: 54 runs, the file ~60 s on the
 # 2-core machine with other work loading it (a refusal takes 0.1–3 s, a valid run 2–8 s).
 
 
-def _fuzz(command: str):
-    strategy, examples = BUDGET[command]
+def _fuzz(key: str):
+    strategy, examples = BUDGET[key]
+    command = key.split()[0]
 
     @settings(max_examples=examples, derandomize=True, database=None,
               deadline=timedelta(seconds=TIMEOUT + 10), phases=(Phase.explicit, Phase.generate),
@@ -303,7 +320,7 @@ def _fuzz(command: str):
     def test(args: list[list[str]]) -> None:
         check(*([command, *a] for a in args))
 
-    test.__name__ = f"test_fuzz_{command}"
+    test.__name__ = f"test_fuzz_{key.replace(' ', '_').lower()}"
     return test
 
 
@@ -323,6 +340,7 @@ test_fuzz_tongues = _fuzz("tongues")
 test_fuzz_slowflow = _fuzz("slowflow")
 test_fuzz_parametric = _fuzz("parametric")
 test_fuzz_nnm = _fuzz("nnm")
+test_fuzz_response_system = _fuzz("response SYSTEM")
 
 
 NOT_FUZZED = {"sweep": "a dask cluster per run (tests/test_sweep.py covers its refusals)"}
