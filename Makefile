@@ -49,6 +49,7 @@ bench: $(STAMP)
 
 # The committed copies: docs/figures (the README's computed figures, byte-identical run to run)
 # and generated/ (the default evaluators and LaTeX).
+DRIVEN_SYSTEM = x1'' + 0.05*x1' + 2*x1 - x2 + x1**3/2 = f*cos(w*t); x2'' + 0.05*x2' + 2*x2 - x1 = 0
 figures: $(STAMP)
 	$(BIN)/python -c "from lindstedt.charts import gallery; gallery('docs/figures')"
 	$(BIN)/python -c "from lindstedt.charts import slow_flow_figures; slow_flow_figures('docs/figures')"
@@ -58,6 +59,8 @@ figures: $(STAMP)
 	ince_strutt_figure('docs/figures/ince_strutt.png')"
 	$(BIN)/lindstedt nnm "x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0" \
 	  --plot docs/figures/nnm.png > /dev/null
+	$(BIN)/lindstedt response "$(DRIVEN_SYSTEM)" --param f=3/10 \
+	  --plot docs/figures/response_system.png > /dev/null
 
 generated: $(STAMP)
 	$(BIN)/lindstedt generate duffing --order 12 --out generated
