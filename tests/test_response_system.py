@@ -172,3 +172,32 @@ def test_variational_multipliers_are_the_shot_orbits_monodromy(kerschen):
         shot = shoot_system(field, np.array([0.3, 0.0]), w, fine.state(x, w)).multipliers
         assert max(np.min(np.abs(shot - z)) for z in lam) < 1e-7
         assert (np.max(np.abs(lam)) < 1) == flag
+
+
+ISOLA = ("q1'' + c*q1' + q1 + a*q1**3 + b*q1**2*q2 = f*cos(w*t); "
+         "q2'' + c*q2' + W2*q2 + b*q1**3/3 = 0")
+ISOLA_VALUES = {"c": "1/50", "a": "1/2", "b": "1", "W2": "10", "f": "17/1000"}
+# NOTE: two modes near 1:3 internal resonance (ω₀ = 1 and √10): the resonance of the first
+# detaches from the main curve, a closed branch around its backbone for ω ≈ 1.058 … 1.102,
+# between the probes (1 and 1.106): found by the scan along the backbones.
+
+
+def test_an_isola_between_the_probes_is_found_and_is_a_true_attractor():
+    r = system_response(ISOLA, ISOLA_VALUES, harmonics=6)
+    assert r.closed.count(True) == 1
+    k = r.closed.index(True)
+    piece = r.cont.piece_slices()[k]
+    w = r.cont.omega[piece]
+    assert 1.05 < w.min() < 1.065 and 1.095 < w.max() < 1.11
+    # its stable point nearest ω = 1.09: DOP853 from 2 % off it settles back onto it
+    stable = [i for i in range(piece.start, piece.stop) if r.stable[i]
+              and abs(r.cont.omega[i] - 1.09) < 0.01]
+    assert stable
+    i = min(stable, key=lambda i: abs(r.cont.omega[i] - 1.09))
+    system = parse_system(ISOLA, {k: v for k, v in ISOLA_VALUES.items()}, driven=True)
+    fine = PolynomialBalance(system.equations(), 0.017, 6, True, shape=(1.0, 0.0))
+    start = 1.02 * fine.state(r.cont.x[i], float(r.cont.omega[i]))
+    periods = int(1500 * r.cont.omega[i] / (2 * np.pi))
+    sim = _simulated(ISOLA, ISOLA_VALUES, float(r.cont.omega[i]), start, periods)
+    assert np.max(np.abs(sim - r.amplitudes[i])) < 1e-7
+    assert r.amplitudes[i, 0] > 0.6  # well above the main curve's 0.1–0.3 there

@@ -354,13 +354,14 @@ def _half_period(system: PolynomialBalance, x: np.ndarray) -> np.ndarray:
 
 
 def balance_crossings(coarse: PolynomialBalance, omega: float, force: float,
-                      bound: float | None) -> tuple[list[np.ndarray], DriveContinuation]:
+                      bound: float | None, max_seconds: float = CONTINUATION_BUDGET
+                      ) -> tuple[list[np.ndarray], DriveContinuation]:
     """The seeds of every solution of ``coarse`` at ``omega`` and drive amplitude ``force``
     that the continuation in the drive from rest reaches (:func:`continue_in_drive`, up to the
     first-harmonic ``bound``): where the traced curve crosses ``force`` — and ``−force``,
     shifted by half a period (:func:`_half_period`) —, quadratic around the folds
     (:func:`_crossings`); with the traced curve (its ``complete`` and ``note``)."""
-    curve = continue_in_drive(coarse, omega, bound)
+    curve = continue_in_drive(coarse, omega, bound, max_seconds=max_seconds)
     seeds = _crossings(curve.force - force, curve.x)
     seeds += [_half_period(coarse, x) for x in _crossings(curve.force + force, curve.x)]
     return seeds, curve

@@ -536,6 +536,15 @@ SYSTEM_PROBES = 6
 SYSTEM_CHECKS = 12
 # NOTE: the longest stable and unstable stretches of the traced curve whose middle points are
 # shot as true orbits (DOP853, ~0.1–0.5 s each).
+NO_BOUND_FACTOR = 10.0
+NO_BOUND_SECONDS = 3.0
+# NOTE: without the power-balance bound (no potential, nonlinear damping) the drive is continued
+# from rest up to 10 × the linear response's size, 3 s at most per frequency (unbounded, it ran
+# 15 s at each of the ten frequencies: two minutes); the result says it may be incomplete.
+SCAN_HARMONICS = 3
+SCAN_STEP = 0.01
+# NOTE: the balance that scans along each backbone for branches off the traced curve (a Newton
+# solve ~1 ms on a 2-DOF system); a hit is polished at the harmonics asked.
 FLOQUET_SAMPLES = 512
 # NOTE: samples per period of the variational equation about each balance orbit (times the
 # power of two above ω0,max/ω): RK4 of 256 and 128 steps, Richardson-combined; |λ| to ~1e-9 on
@@ -712,7 +721,10 @@ def system_plan(text: str, values: dict[str, str], harmonics: int,
     points = ((hi - lo) + np.pi * r_scale * math.sqrt(len(w0))) / 0.02
     odd = all(sum(key) % 2 for eq in system.equations() for key in eq)
     unknowns = system.size * (2 * harmonics if odd else 4 * harmonics - 1)
-    return SystemPlan(system, (lo, hi), w0, points, SYSTEM_FIXED_SECONDS
+    # without the bound each drive continuation (the ends and the probes) runs to its budget
+    searches = 0.0 if bound is not None else NO_BOUND_SECONDS * (
+        2 + SYSTEM_PROBES + sum(lo < w < hi for w in w0))
+    return SystemPlan(system, (lo, hi), w0, points, SYSTEM_FIXED_SECONDS + searches
                       + points * equation_point_seconds(unknowns))
 
 
@@ -749,23 +761,50 @@ class SystemBalance:
 
     def solutions(self, omega: float) -> tuple[list[np.ndarray], bool, str]:
         """Every balance solution at ``omega`` the continuation in the drive amplitude from
-        rest reaches up to the bound (:func:`continuation.balance_crossings`), polished at the
-        fine harmonics; whether that is all of them, and the continuation's note."""
-        seeds, curve = balance_crossings(self.coarse, omega, self.fine.force,
-                                         None if self.bound is None
-                                         else 1.01 * self.bound / omega)
-        found, complete = polished(self.coarse, seeds, curve.complete, self.fine, omega)
+        rest reaches up to the bound (:func:`continuation.balance_crossings`), and those Newton
+        reaches from the backbones there, polished at the fine harmonics; whether the drive
+        continuation passed the bound (without one it stops at :data:`NO_BOUND_FACTOR` × the
+        linear response, within :data:`NO_BOUND_SECONDS`, and says it may be incomplete), and
+        its note."""
+        if self.bound is not None:
+            seeds, curve = balance_crossings(self.coarse, omega, self.fine.force,
+                                             1.01 * self.bound / omega)
+            whole, note = curve.complete, curve.note
+        else:
+            cap = NO_BOUND_FACTOR * self.linear_response(omega)
+            seeds, curve = balance_crossings(self.coarse, omega, self.fine.force, cap,
+                                             NO_BOUND_SECONDS)
+            whole, note = False, (f"no bound: the drive continued from rest up to r = {cap:.4g}"
+                                  f", {NO_BOUND_FACTOR:g} × the linear response"
+                                  if curve.complete else curve.note)
+        found, complete = polished(self.coarse, seeds, whole, self.fine, omega)
         more, _ = polished(self.fine, self.backbone_seeds(omega), True, self.fine, omega)
         found += [x for x in more if all(np.linalg.norm(y - x) > 1e-6 * (1 + np.linalg.norm(x))
                                          for y in found)]
         found.sort(key=self.fine.first_harmonic)
-        return found, complete, curve.note
+        return found, complete, note
 
-    def backbone_seeds(self, omega: float) -> list[np.ndarray]:
+    def linear_response(self, omega: float) -> float:
+        """``|(K − ω² + iωC)⁻¹ d f|``: the linear system's first harmonic at ``omega`` (at least
+        ``|d f|``, so that an undamped resonance gives a finite scale)."""
+        system = self.system
+        K = np.array(system.stiffness, dtype=float)
+        C = np.zeros_like(K) if system.damping is None else np.array(system.damping,
+                                                                     dtype=float)
+        F = self.drive
+        try:
+            X = np.linalg.solve(K - omega**2 * np.eye(len(F)) + 1j * omega * C, F)
+        except np.linalg.LinAlgError:
+            return float(np.linalg.norm(F)) * 1e3
+        return float(max(np.linalg.norm(X), np.linalg.norm(F)))
+
+    def backbone_seeds(self, omega: float, balance: PolynomialBalance | None = None
+                       ) -> list[np.ndarray]:
         """Where a backbone (the free system's nonlinear normal mode, its series) passes
         ``omega``: the mode's shape at that amplitude, in quadrature with the drive (``±`` its
-        ``x(0)`` on ``sin ωt``: the phase of a damped resonance), as balance unknowns."""
-        fine = self.fine
+        ``x(0)`` on ``sin ωt``: the phase of a damped resonance), as unknowns of ``balance``
+        (the fine one by default)."""
+        fine = self.fine if balance is None else balance
         m = len(fine.k2)
         s1 = fine.n_cos + int(np.nonzero(fine.orders[fine.orders > 0] == 1)[0][0])
         out = []
@@ -807,7 +846,8 @@ def _backbones(system: System, bound: float | None, w0: tuple[float, ...]
                ) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
     """Each mode's backbone ω(A) and its x(0) on a grid of amplitudes up to the power-balance
     bound at that mode's ω0 (10 without one), from the series of the free system (damping and
-    drive removed), cut where ω(A) stops being monotone; none where the free system has a
+    drive removed), the first-order backbone beyond where ω(A) stops being monotone; none
+    where the free system has a
     velocity-dependent force, and none for a mode in internal resonance (the series is
     refused)."""
     from dataclasses import replace as _replace
@@ -822,19 +862,23 @@ def _backbones(system: System, bound: float | None, w0: tuple[float, ...]
         for a in range(system.size):
             try:
                 mode = normal_mode(free, k, BACKBONE_ORDER, a)
+                first = normal_mode(free, k, 1, a)
             except InputError:  # x_a does not move in this mode, or an internal resonance
                 continue
             top = 10.0 if bound is None else 1.2 * bound / w0[k - 1]
+            grid = np.linspace(0.0, top, BACKBONE_POINTS)
             with np.errstate(over="ignore", invalid="ignore"):
-                omega, _, starts = mode.evaluate(np.linspace(0.0, top, BACKBONE_POINTS))
-            # the series is kept up to where ω(A) stops being monotone (past its radius the
-            # partial sums swing) or finite
+                omega, _, starts = mode.evaluate(grid)
+                omega1, _, starts1 = first.evaluate(grid)
+            # the series is kept up to where ω(A) stops being monotone or finite (past its
+            # radius, or near an internal resonance, the partial sums swing), the first-order
+            # backbone beyond: a seed there, not an answer
             step = np.sign(np.diff(omega))
             bad = np.nonzero((step != step[0]) | ~np.isfinite(omega[1:])
                              | ~np.all(np.isfinite(starts[:, 1:]), axis=0))[0]
             keep = len(omega) if not len(bad) else int(bad[0]) + 1
-            if keep > 1:
-                out.append((omega[:keep], starts[:, :keep]))
+            out.append((np.concatenate([omega[:keep], omega1[keep:]]),
+                        np.hstack([starts[:, :keep], starts1[:, keep:]])))
             break
     return tuple(out)
 
@@ -885,25 +929,49 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
                      *np.linspace(lo, hi, SYSTEM_PROBES + 2)[1:-1]})
     closed = [False] * len(cont.pieces)
     isolas = 0
+
+    def trace(w: float, x: np.ndarray) -> None:
+        """A solution off the traced curve: its branch traced both ways and added."""
+        nonlocal cont, isolas
+        start = [(w, x, 1.0), (w, x, -1.0)]
+        extra = _continue(fine, lambda: (start, True), lo, hi, 0.02, estimate, max_seconds,
+                          per_point, MAX_POINTS, where)
+        isolas += 1
+        for piece in extra.piece_slices():
+            closed.append(bool(lo < extra.omega[piece.stop - 1] < hi))
+        cont = _merged(cont, extra)
+
     for w in probes:
         found, whole, _ = solutions(float(w))
         complete = complete and whole
         for x in found:
-            if _on_curve(cont, float(w), x):
+            if not _on_curve(cont, float(w), x):
+                trace(float(w), x)
+    # between the probes: Newton at a few harmonics from each backbone wherever it crosses ω
+    # on a fine grid (an isola of a lightly damped system hugs its backbone)
+    scan = PolynomialBalance(sb.equations, fine.force, min(harmonics, SCAN_HARMONICS),
+                             fine.odd, shape=tuple(sb.drive / fine.force))
+    step = min(SCAN_STEP, (hi - lo) / 100)
+    scanned = 0
+    for w in np.arange(lo + step / 2, hi, step):
+        for seed in sb.backbone_seeds(float(w), scan):
+            scanned += 1
+            try:
+                x, converged, _ = scan.solve(seed, float(w), 1e-10, 15)
+                if converged:
+                    x, converged, _ = fine.solve(fine.refined(scan, x), float(w))
+            except np.linalg.LinAlgError:
                 continue
-            start = [(float(w), x, 1.0), (float(w), x, -1.0)]
-            extra = _continue(fine, lambda start=start: (start, True), lo, hi, 0.02, estimate,
-                              max_seconds, per_point, MAX_POINTS, where)
-            isolas += 1
-            for piece in extra.piece_slices():
-                closed.append(bool(lo < extra.omega[piece.stop - 1] < hi))
-            cont = _merged(cont, extra)
-    seeded = (f"; Newton also started from {len(sb.backbones)} backbone(s) (the free system's "
-              f"normal modes, series to order {BACKBONE_ORDER}) wherever they cross w there"
-              if sb.backbones else "")
+            if converged and not _on_curve(cont, float(w), x):
+                trace(float(w), x)
+    seeded = (f"; Newton started from {len(sb.backbones)} backbone(s) (the free system's "
+              f"normal modes, series to order {BACKBONE_ORDER}) at the probes and every "
+              f"{step:.3g} in w between them ({scanned} seeds)"
+              if sb.backbones else "; no backbone seeds (a velocity-dependent force)")
     probed = (f"{len(probes)} probes (w = {', '.join(f'{w:.4g}' for w in probes)}){seeded}: "
-              f"{isolas} solution{'s' * (isolas != 1)} off the curve traced from the ends"
-              + (", each traced" if isolas else ""))
+              f"{isolas} branch{'es' * (isolas != 1)} off the curve traced from the ends"
+              + (", each traced" if isolas else "") + ". A branch reached neither from rest "
+              "(in the drive, at the ends and probes) nor from a backbone is not excluded")
     # stability of every point: the monodromy of its variational equation
     multiplier = sb.multiplier(cont.x, cont.omega)
     stable = multiplier < 1
