@@ -534,8 +534,8 @@ SYSTEM_PROBES = 6
 # NOTE: interior frequencies, besides each linear ω0 in the range, where the drive is continued
 # from rest to look for branches the continuation from the two ends does not pass (isolas).
 SYSTEM_CHECKS = 12
-# NOTE: the longest stable and unstable stretches of the traced curve whose middle points are
-# shot as true orbits (DOP853, ~0.1–0.5 s each).
+# NOTE: stretches of the traced curve (stable or unstable) whose middle points are shot as true
+# orbits (DOP853, ~0.1–0.5 s each): the longest of every branch, then the longest of the rest.
 NO_BOUND_FACTOR = 10.0
 NO_BOUND_SECONDS = 3.0
 # NOTE: without the power-balance bound (no potential, nonlinear damping) the drive is continued
@@ -983,8 +983,14 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
     field = PolynomialField.of(equations)
     stretches = sorted(((j - i, k, i, j) for k, piece in enumerate(cont.piece_slices())
                         for i, j in _runs(stable, piece) if j - i >= 3), reverse=True)
+    # the longest stretch of every branch first, then the longest of the rest
+    first = {}
+    for item in stretches:
+        first.setdefault(item[1], item)
+    chosen = sorted(first.values(), reverse=True)
+    chosen += [item for item in stretches if item not in chosen]
     shots = []
-    for _, k, i, j in stretches[:checks]:
+    for _, k, i, j in chosen[:max(checks, len(first))]:
         mid = (i + j) // 2
         x, w = cont.x[mid], float(cont.omega[mid])
         orbit = shoot_system(field, drive, w, fine.state(x, w), harmonics=2 * harmonics - 1)
