@@ -86,7 +86,8 @@ def test_identifiers_are_validated(bad):
 
 def test_templates_get_exactly_the_variables_they_use(tmp_path, monkeypatch):
     """What the code passes to each template (recorded at render time) against what the
-    template's source reads: module.py.j2, mode_tables.tex.j2 and the mu_*derivation.tex.j2
+    template's source reads: module.py.j2, mode_tables.tex.j2, mode_derivation.tex.j2 and the
+    mu_*derivation.tex.j2
     exactly; tables.tex.j2 and
     derivation.tex.j2 share one context (latex_context and the banner), each reads a part of it
     and the two together all of it.  Every template is rendered or included."""
@@ -116,6 +117,10 @@ def test_templates_get_exactly_the_variables_they_use(tmp_path, monkeypatch):
 
     mode = normal_mode(parse_system("x1'' + 2*x1 - x2 + x1**3 = 0; x2'' + 2*x2 - x1 = 0"), 1, 4)
     render_mode_tables(mode_tables(mode, 3, "mode1"), module.provenance)
+    from lindstedt.emit.render import render_mode_derivation
+    from lindstedt.lower.system import mode_derivation
+
+    render_mode_derivation(mode_derivation(mode, 3, "mode1"), module.provenance)
     folder = template_folder()
     used, includes = {}, {}
     for path in folder.glob("*.j2"):
@@ -128,7 +133,8 @@ def test_templates_get_exactly_the_variables_they_use(tmp_path, monkeypatch):
         for ctx in contexts:
             assert reads <= ctx, (name, reads - ctx)  # nothing undefined
     for name in ("module.py.j2", "mu_derivation.tex.j2", "mu_damped_derivation.tex.j2",
-                 "slow_flow.tex.j2", "cycle_derivation.tex.j2", "mode_tables.tex.j2"):
+                 "slow_flow.tex.j2", "cycle_derivation.tex.j2", "mode_tables.tex.j2",
+                 "mode_derivation.tex.j2"):
         assert passed[name] and all(ctx == used[name] for ctx in passed[name]), name
     latex = passed["tables.tex.j2"] + passed["derivation.tex.j2"]
     assert len(latex) == 2 and latex[0] == latex[1]

@@ -201,7 +201,8 @@ TEX_NAMES = [f"order-high/{m}_{kind}.tex" for m in ("duffing", "pendulum", "swin
              for kind in ("tables", "derivation")] + [
     f"order-high/{name}.tex" for name in ("driven_derivation", "driven_damped_derivation",
                                           "forced_slow_flow", "van_der_pol_slow_flow",
-                                          "van_der_pol_derivation", "kerschen_tables")]
+                                          "van_der_pol_derivation", "kerschen_tables",
+                                          "kerschen_derivation")]
 
 
 @pytest.mark.skipif(PDFLATEX is None, reason="pdflatex not installed (`make tex` installs it)")

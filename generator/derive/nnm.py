@@ -53,6 +53,9 @@ class NormalModeSeries:
     ground: Ground
     omega_squared: tuple[Any, ...]
     coefficients: tuple[tuple[dict[int, Any], ...], ...]
+    left: tuple[Any, ...] = ()  # ψ, the left null vector of L − λ
+    right_sides: tuple[dict[int, tuple[Any, ...]], ...] = ()
+    # order j ≥ 1 (index j − 1): harmonic n → R_jn = n² Σ_k Ω_k c_(j−k)n − N_jn, before Ω_j
 
     @property
     def order(self) -> int:
@@ -244,6 +247,7 @@ def normal_mode(system: System, mode: int, order: int, amplitude: int = 0,
     series = [[from_fourier(c, ALL_HARMONICS, g)] for c in coefficients[0]]
     products = _Products(series, g)
     omega2 = [lam_g]
+    right_sides: list[dict[int, tuple[Any, ...]]] = []
     for j in range(1, order + 1):
         force = []
         for row in terms:
@@ -264,6 +268,7 @@ def normal_mode(system: System, mode: int, order: int, amplitude: int = 0,
                     if c:
                         r[i] = r[i] + omega2[k] * c * (n * n)
             rhs[n] = r
+        right_sides.append({n: tuple(r) for n, r in rhs.items()})
         w = zero - sum((p * v for p, v in zip(psi, rhs[1], strict=True)), zero) / psi_phi
         omega2.append(w)
         rhs[1] = [r + w * v for r, v in zip(rhs[1], phi, strict=True)]
@@ -286,7 +291,8 @@ def normal_mode(system: System, mode: int, order: int, amplitude: int = 0,
         if progress is not None:
             progress(j, order)
     return NormalModeSeries(system, mode, amplitude, lam, step, g, tuple(omega2),
-                            tuple(tuple(c) for c in coefficients))
+                            tuple(tuple(c) for c in coefficients), tuple(psi),
+                            tuple(right_sides))
 
 
 def _force_terms(system: System, g: Ground) -> list[list[tuple[Any, tuple[int, ...], int]]]:

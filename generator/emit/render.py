@@ -40,6 +40,7 @@ from ..lower.records import (
     CycleDerivation,
     Derivation,
     Evaluator,
+    ModeDerivation,
     ModeTables,
     Module,
     MuDampedDerivation,
@@ -462,6 +463,34 @@ def render_mode_tables(d: ModeTables, p: Provenance) -> dict[str, str]:
     return {f"{p.model}_tables.tex": text}
 
 
+def render_mode_derivation(d: ModeDerivation, p: Provenance) -> dict[str, str]:
+    """``{name_derivation.tex: text}``: a normal mode's L–P derivation, order by order."""
+    y = "A" if d.variable == sp.Symbol("A") else "y"
+    variable = "A" if y == "A" else f"y = {latex_expr(d.variable)}"
+    names = [latex_expr(x) for x in d.coordinates]
+
+    def vector(values: tuple) -> str:
+        return r"\begin{pmatrix}" + r" \\ ".join(latex_expr(v) for v in values) \
+            + r"\end{pmatrix}"
+
+    matrix = r"\begin{pmatrix}" + r" \\ ".join(
+        " & ".join(latex_expr(d.stiffness[i, k]) for k in range(d.stiffness.cols))
+        for i in range(d.stiffness.rows)) + r"\end{pmatrix}"
+    orders = [{
+        "j": o.j, "omega": latex_expr(o.omega_squared), "secular": latex_expr(o.secular),
+        "rows": [{"n": n, "x": names[i], "r": latex_expr(r[i]), "c": latex_expr(c[i])}
+                 for n, r, c in o.harmonics for i in range(len(names)) if r[i] != 0 or c[i] != 0],
+    } for o in d.orders]
+    tex = environment(latex=True).get_template("mode_derivation.tex.j2").render(
+        banner=banner(p, "%"), title=f"Nonlinear normal mode {d.mode}",
+        equations=[latex_expr(e) + " = 0" for e in d.equations], stiffness=matrix,
+        lam=latex_expr(d.lam), right=vector(d.right), left=vector(d.left), y=y,
+        variable=variable, amplitude=latex_expr(d.amplitude),
+        psi_phi=latex_expr(sum(a * b for a, b in zip(d.left, d.right, strict=True))),
+        orders=orders)
+    return {f"{p.model}_derivation.tex": tex}
+
+
 def _model_text(name: str) -> str:
     """A model's name as a title's words: ``van_der_pol`` → ``Van der pol``."""
     return name.replace("_", " ").capitalize()
@@ -473,7 +502,8 @@ def render(unit: Unit) -> dict[str, str]:
     renderers = {Derivation: render_latex, MuDerivation: render_mu_derivation,
                  MuDampedDerivation: render_mu_damped_derivation,
                  SlowFlowDocument: render_slow_flow,
-                 CycleDerivation: render_cycle_derivation, ModeTables: render_mode_tables}
+                 CycleDerivation: render_cycle_derivation, ModeTables: render_mode_tables,
+                 ModeDerivation: render_mode_derivation}
     for doc in unit.documents:
         files.update(renderers[type(doc)](doc, unit.module.provenance))
     return files

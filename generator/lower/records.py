@@ -248,6 +248,37 @@ class ModeTables:
 
 
 @dataclass(frozen=True)
+class ModeOrder:
+    """Order ``j`` of a normal mode's derivation: ``Ω_j`` from the secular condition (with
+    ``ψ·R_j1``), and per harmonic ``n`` the right side ``R_jn`` and the solution ``c_jn``, one
+    entry per coordinate, exact."""
+
+    j: int
+    omega_squared: sp.Expr
+    secular: sp.Expr  # ψ·R_j1
+    harmonics: tuple[tuple[int, tuple[sp.Expr, ...], tuple[sp.Expr, ...]], ...]  # (n, R, c)
+
+
+@dataclass(frozen=True)
+class ModeDerivation:
+    """A nonlinear normal mode's L–P derivation order by order (template
+    ``mode_derivation.tex.j2``): the equations, ``L = M⁻¹K``, ``λ = ω₀²``, the shapes ``φ``
+    (right) and ``ψ`` (left) of ``L − λ``, the amplitude coordinate, then each order."""
+
+    model: str
+    mode: int
+    equations: tuple[sp.Expr, ...]
+    stiffness: sp.Matrix
+    lam: sp.Expr
+    variable: sp.Expr  # y as a power of A
+    amplitude: sp.Symbol
+    coordinates: tuple[sp.Symbol, ...]
+    right: tuple[sp.Expr, ...]  # φ
+    left: tuple[sp.Expr, ...]  # ψ
+    orders: tuple[ModeOrder, ...]
+
+
+@dataclass(frozen=True)
 class NotesTable:
     """The notes' driven table: A₁, A₃, A₅ by μ-order, harmonic balance and shooting at
     ``(eps, force, omega)``; a cell is a number, or the notes' own printed digits."""
@@ -312,7 +343,8 @@ class Unit:
 
     module: Module
     documents: tuple[Derivation | MuDerivation | MuDampedDerivation
-                     | SlowFlowDocument | CycleDerivation | ModeTables, ...] = ()
+                     | SlowFlowDocument | CycleDerivation | ModeTables | ModeDerivation,
+                     ...] = ()
 
 
 # --- the slow flow (averaging) ---------------------------------------------------------------

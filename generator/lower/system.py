@@ -13,7 +13,7 @@ from ..derive.nnm import NormalModeSeries
 from ..errors import InputError
 from .forms import MODULE_NAMES, argument_entry, harmonics, horner
 from .printers import identifier
-from .records import Evaluator, ModeTables, Module, provenance
+from .records import Evaluator, ModeDerivation, ModeOrder, ModeTables, Module, provenance
 
 NNM_ARGUMENT_LIMIT = 1e6
 # NOTE: |t| beyond this loses the phase ωt to rounding (as a free oscillator's module): NaN.
@@ -115,3 +115,30 @@ def mode_tables(mode: NormalModeSeries, order: int, name: str) -> ModeTables:
         tuple((x, tuple(tuple(sorted(o.items())) for o in mode.coordinate(i)[: order + 1]))
               for i, x in enumerate(system.coordinates)),
         system.coordinates[mode.amplitude])
+
+
+def mode_derivation(mode: NormalModeSeries, order: int, name: str) -> ModeDerivation:
+    """The derivation's record of ``mode`` to ``order``: at each order ``j`` the right sides
+    ``R_jn`` and solutions ``c_jn`` per harmonic, and ``Ω_j`` from ``ψ·(R_j1 + Ω_j φ) = 0``."""
+    system = mode.system
+    exact = mode.ground.to_sympy
+    dots = [sp.Symbol(rf"\ddot{{{sp.latex(x)}}}") for x in system.coordinates]
+    L = system.stiffness * sp.Matrix(system.coordinates)
+    equations = tuple(sp.expand(dots[i] + L[i] + system.force[i])
+                      for i in range(system.size))
+    zero = mode.ground.scalar(0)
+    orders = []
+    for j in range(1, min(order, len(mode.right_sides)) + 1):
+        rhs = mode.right_sides[j - 1]
+        solved = mode.coefficients[j]
+        harmonics = sorted(set(rhs) | {n for c in solved for n in c})
+        secular = sum((p * r for p, r in zip(mode.left, rhs.get(1, ()), strict=False)), zero)
+        orders.append(ModeOrder(
+            j, exact(mode.omega_squared[j]), exact(secular),
+            tuple((n, tuple(exact(r) for r in rhs.get(n, (zero,) * system.size)),
+                   tuple(exact(c.get(n, zero)) for c in solved)) for n in harmonics)))
+    return ModeDerivation(
+        name, mode.mode, equations, system.stiffness, mode.lam,
+        sp.Symbol("A") ** mode.step, system.coordinates[mode.amplitude], system.coordinates,
+        tuple(exact(c.get(1, zero)) for c in mode.coefficients[0]),
+        tuple(exact(v) for v in mode.left), tuple(orders))

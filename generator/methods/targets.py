@@ -52,7 +52,7 @@ from ..lower.records import (
     Unit,
 )
 from ..lower.series import lower_free, lower_limit_cycle, lower_mathieu, lower_tongue
-from ..lower.system import lower_nnm, mode_tables
+from ..lower.system import lower_nnm, mode_derivation, mode_tables
 from ..numerics.shooting import shoot
 from .verify import resum_cycle, resum_mathieu, resum_tongue
 
@@ -342,8 +342,9 @@ NNM_RADIUS_ORDER = 24
 # NOTE: a mode's radius is estimated from ω to at least this order (nearest_singularity needs
 # 12 coefficients in y; 24 keep the estimate's spread small), whatever order the module sums.
 NNM: Target[NormalModeRequest, NormalModeSeries] = Target(
-    lambda r: (f"{r.name}.py", f"{r.name}_tables.tex"),
+    lambda r: (f"{r.name}.py", f"{r.name}_tables.tex", f"{r.name}_derivation.tex"),
     lambda r, progress: normal_mode(r.system, r.mode, max(r.order + 2, NNM_RADIUS_ORDER),
                                     r.amplitude, progress),
     lambda series, r: Unit(lower_nnm(series, r.order, r.name, r.command),
-                           (mode_tables(series, r.order, r.name),)))
+                           (mode_tables(series, r.order, r.name),
+                            mode_derivation(series, r.order, r.name))))
