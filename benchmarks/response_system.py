@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 from lindstedt.analysis.polynomial import PolynomialBalance
-from lindstedt.analysis.response import SystemBalance, system_response
+from lindstedt.analysis.systems import SystemBalance, system_response
 from lindstedt.derive.system import parse_system
 from lindstedt.numerics.floquet import variational_multipliers
 from lindstedt.numerics.integrate import PolynomialField

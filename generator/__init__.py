@@ -54,9 +54,12 @@ order; a stage imports only stages above it::
     analysis.continuation   pseudo-arclength through folds, in ω or in the drive amplitude from
                             rest; crossings of a level [system -> curve]
     analysis.response       one-harmonic curves and folds, the balance continued over an ω range
-                            (the notes' and any polynomial force); a driven system's every
-                            branch, its Floquet verdicts and shooting checks
-                            [Drive | equation | System, ω range -> folds, branches]
+                            (the notes' and any polynomial force)
+                            [Drive | equation, ω range -> folds]
+    analysis.systems        a driven, damped system's every branch: the balance of every
+                            coordinate continued in ω, sought from rest and from the backbones,
+                            Floquet verdicts, folds, jumps, shooting checks
+                            [System, ω range -> SystemResponse]
     analysis.periodic       every distinct periodic orbit at one drive: seeds, balance,
                             shooting, Floquet; the report of `driven`
                             [Drive | equation -> orbits]

@@ -93,7 +93,7 @@ def nnm_figure(system: System, path: Path, order: int = FEP_ORDER) -> Path:
 
 
 def response_system_figure(r: object, path: Path) -> Path:
-    """A driven system's response (:class:`analysis.response.SystemResponse`): one panel per
+    """A driven system's response (:class:`analysis.systems.SystemResponse`): one panel per
     coordinate (at most :data:`FEP_MAX_MODES`), its first-harmonic amplitude over ω along
     every traced branch, stable solid and unstable dashed, the folds, the sweeps' jumps as
     arrows, the points shot as true orbits as circles, the linear ω₀ as dotted lines."""

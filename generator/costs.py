@@ -343,7 +343,7 @@ def response_cost(args: argparse.Namespace) -> Cost:
     from .analysis.response import continuation_seconds, response_range
 
     if getattr(args, "model", None) is not None and ";" in args.model:
-        from .analysis.response import system_plan
+        from .analysis.systems import system_plan
 
         plan = system_plan(args.model, _values(args), args.harmonics, args.omega_min,
                            args.omega_max)

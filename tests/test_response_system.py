@@ -11,7 +11,7 @@ import sys
 import numpy as np
 import pytest
 from lindstedt.analysis.polynomial import PolynomialBalance
-from lindstedt.analysis.response import system_response
+from lindstedt.analysis.systems import system_response
 from lindstedt.derive.system import parse_system
 from scipy.integrate import solve_ivp
 

@@ -202,7 +202,7 @@ def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def response_system_json(r) -> dict:
-    """``response SYSTEM --json``: a :class:`analysis.response.SystemResponse` as data: each
+    """``response SYSTEM --json``: a :class:`analysis.systems.SystemResponse` as data: each
     traced branch (ω, every coordinate's first-harmonic amplitude, the largest Floquet |λ|,
     stable or not), the folds, the sweeps' jumps, the points shot as true orbits and how the
     branches were searched."""
@@ -287,7 +287,7 @@ def response_system_table(data: dict) -> list[str]:
 def run_response_system(args: argparse.Namespace, limit: float) -> int:
     """Run ``lindstedt response SYSTEM``: every branch of the driven, damped system's response
     over ω, as a table, JSON or a figure."""
-    from ..analysis.response import system_response
+    from ..analysis.systems import system_response
 
     plot = None
     if args.plot:

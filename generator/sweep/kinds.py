@@ -423,15 +423,15 @@ def _orbit_fields(r_all: list[float], floquet_all: list[float], count: int) -> d
 def _system_response(spec: EquationSpec, **axis: float) -> dict:
     """Every periodic response of a driven system at one point (the balance at
     :data:`ORBIT_HARMONICS` harmonics, seeded by the drive continued from rest up to the
-    power-balance bound: :meth:`analysis.response.SystemBalance.solutions`), largest first,
+    power-balance bound: :meth:`analysis.systems.SystemBalance.solutions`), largest first,
     with the Floquet verdict of its variational equation; ``r`` is the first harmonic over
     every coordinate, ``√Σ_i (A_i1² + B_i1²)``."""
-    from ..analysis.response import SystemBalance, _driven_system
+    from ..analysis.systems import SystemBalance, driven_system
 
     values = _point_values(spec, axis)
     omega = float(Fraction(values.pop(spec.frequency)))
     try:
-        sb = SystemBalance.of(_driven_system(spec.text, values), ORBIT_HARMONICS)
+        sb = SystemBalance.of(driven_system(spec.text, values), ORBIT_HARMONICS)
     except InputError:  # refused at this point (e.g. the damping made 0): no orbit stored
         return {}
     found, _, _ = sb.solutions(omega)
@@ -467,8 +467,8 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
     value in ``values``; refused in one line: an axis that names no parameter, a parameter
     both an axis and a value, a parameter with neither, a kind that takes no equation."""
     from ..analysis.polynomial import driven_form
-    from ..analysis.response import _driven_system
     from ..analysis.subharmonic import check_n
+    from ..analysis.systems import driven_system
     from ..derive.models import oscillator
     from ..derive.system import system_parameters
 
@@ -513,7 +513,7 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
         raise InputError(f"--axis {clash[0]}: the store holds a field of that name; rename the "
                          "parameter in the equation")
     if system:
-        _driven_system(text, {**dict(values), **{a: "1" for a in axes if a != frequency}})
+        driven_system(text, {**dict(values), **{a: "1" for a in axes if a != frequency}})
     else:
         frequency = _frequency_name(osc, text, name)
         form = driven_form(text, {**dict(values), **{a: "1" for a in axes if a != frequency}},
