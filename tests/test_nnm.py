@@ -237,3 +237,26 @@ def test_the_derivation_document_s_equations_hold_exactly():
                     assert sp.simplify(psi.dot(sp.Matrix(R)) - o.secular) == 0
                 amplitude += c[0]
             assert sp.simplify(amplitude) == 0
+
+
+def test_a_symbolic_nonlinear_parameter_gives_polynomial_coefficients_exactly():
+    """``alpha`` left without a value in the symmetric system: mode 1 is Duffing's
+    ``x'' + x + αx³ = 0``, so T/2π's order j is the elliptic integral's coefficient times α^j
+    (another route); mode 2 at α = 1/2 is Kerschen's own series.  The CLI's JSON names the
+    symbol; a symbol in the linear part is refused."""
+    alpha = sp.Symbol("alpha")
+    text = "x1'' + 2*x1 - x2 + alpha*x1**3 = 0; x2'' + 2*x2 - x1 + alpha*x2**3 = 0"
+    mode = normal_mode(parse_system(text, symbolic=True), 1, 8)
+    exact = duffing_period(8)
+    assert [sp.expand(c) for c in mode.period()] == [
+        sp.Rational(c.numerator, c.denominator) * alpha**j for j, c in enumerate(exact)]
+    half = normal_mode(parse_system(KERSCHEN.replace("x1**3/2", "alpha*x1**3"),
+                                    symbolic=True), 2, 6)
+    numeric = normal_mode(parse_system(KERSCHEN), 2, 6)
+    assert [sp.simplify(c.subs(alpha, sp.Rational(1, 2)) - d)
+            for c, d in zip(half.omega(), numeric.omega(), strict=True)] == [0] * 7
+    out = run("nnm", text, "--order", "2", "--json")
+    assert out.returncode == 0 and json.loads(out.stdout)["parameters"] == ["alpha"]
+    assert json.loads(out.stdout)["period"][1] == "-3*alpha/8"
+    bad = run("nnm", "x1'' + k*x1 - x2 + alpha*x1**3 = 0; x2'' + 2*x2 - x1 = 0")
+    assert bad.returncode == 2 and "k stands in the linear part" in bad.stderr

@@ -41,6 +41,8 @@ def nnm_json(mode) -> dict:
         "lambda": str(mode.lam),
         "linear_frequencies_squared": [str(x) for x in mode.system.modes()],
         "convention": CONVENTION.format(a=names[mode.amplitude]),
+        "parameters": sorted({str(s) for f in mode.system.force for s in f.free_symbols}
+                             - set(names) - {str(v) for v in mode.system.velocities}),
         "period_units": "T/(2*pi): period[j] is the coefficient of y^j",
     }
 
@@ -71,7 +73,12 @@ def run_nnm(args: argparse.Namespace) -> int:
         from ..charts import check_plot_path
 
         check_plot_path(Path(args.plot))
-    system = parse_system(args.system, _params(args.param))
+    system = parse_system(args.system, _params(args.param), symbolic=True)
+    symbols = sorted({str(s) for f in system.force for s in f.free_symbols}
+                     - {str(x) for x in (*system.coordinates, *system.velocities)})
+    if symbols and args.plot:
+        raise InputError(f"--plot: give {', '.join(symbols)} a value with --param (the chart "
+                         "evaluates the series; without a value it is kept as a symbol)")
     names = [str(x) for x in system.coordinates]
     amplitude = 0
     if args.amplitude is not None:
@@ -181,10 +188,11 @@ def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("system", metavar="SYSTEM",
                    help="equations such as \"x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 "
                    "= 0\" (x'' the accelerations, one per equation; every other name a "
-                   "parameter given with --param)")
+                   "parameter: a value with --param, or left a symbol in the nonlinear terms)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE",
-                   help="an exact value for a parameter, e.g. beta=1/10 (repeatable; every "
-                   "parameter needs one)")
+                   help="an exact value for a parameter, e.g. beta=1/10 (repeatable; those in "
+                   "the linear part need one, those in the nonlinear terms may stay symbols: "
+                   "the coefficients are then polynomials in them)")
     p.add_argument("--mode", type=_order, default=1, metavar="M",
                    help="the mode, numbered 1, 2, … by increasing linear frequency (default 1)")
     p.add_argument("--amplitude", metavar="NAME",

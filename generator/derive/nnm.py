@@ -128,9 +128,23 @@ def _inverse_series(s: list[Any], g: Ground) -> list[Any]:
     return p
 
 
+def _inverse(x: Any) -> Any:
+    """``1/x`` of a nonzero number of the ground: a field element, or a constant polynomial of
+    ``K[params]`` (the matrices of the recursion hold numbers only: the linear part has
+    values)."""
+    try:
+        return x ** -1
+    except ValueError:  # SymPy's K[params] inverts a constant through its domain
+        ring = x.ring
+        if not x.is_ground:
+            raise
+        return ring.ground_new(ring.domain.quo(ring.domain.one, x.LC))
+
+
 def _echelon(rows: list[list[Any]], width: int) -> tuple[list[list[Any]], list[int]]:
     """The reduced row echelon form of ``rows`` over its first ``width`` columns (the rest
-    carried along) and its pivot columns; exact, any field."""
+    carried along) and its pivot columns; exact, any field (pivots numbers when the ring is a
+    polynomial ring over one)."""
     rows = [list(r) for r in rows]
     pivots: list[int] = []
     r = 0
@@ -139,7 +153,7 @@ def _echelon(rows: list[list[Any]], width: int) -> tuple[list[list[Any]], list[i
         if pick is None:
             continue
         rows[r], rows[pick] = rows[pick], rows[r]
-        inv = rows[r][col] ** -1
+        inv = _inverse(rows[r][col])
         rows[r] = [v * inv for v in rows[r]]
         for i in range(len(rows)):
             if i != r and rows[i][col]:
@@ -220,7 +234,10 @@ def normal_mode(system: System, mode: int, order: int, amplitude: int = 0,
     if sum(1 for other in lams if other == lam) > 1:
         raise InputError(f"--mode {mode}: ω0² = {lam} is shared by two linear modes (a 1:1 "
                          "internal resonance): the mode shape is not unique")
-    g = Ground(QQ) if lam.is_Rational else Ground(QQ.algebraic_field(lam))
+    params = sorted(set().union(*(f.free_symbols for f in system.force))
+                    - set(system.coordinates) - set(system.velocities), key=str)
+    field = QQ if lam.is_Rational else QQ.algebraic_field(lam)
+    g = Ground(field[tuple(params)] if params else field)
     zero, one = g.scalar(0), g.scalar(1)
     lam_g = g.scalar(lam)
     d = system.size

@@ -167,7 +167,7 @@ def _read(text: str, driven: bool
 
 
 def parse_system(text: str, values: dict[str, str] | None = None,
-                 driven: bool = False) -> System:
+                 driven: bool = False, symbolic: bool = False) -> System:
     """A :class:`System` from ``"x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0"``:
     every name but the coordinates needs an exact value (``values``, from ``--param``).
     ``driven``: the system may be driven, ``f*cos(w*t)`` on the right of one or more
@@ -178,6 +178,8 @@ def parse_system(text: str, values: dict[str, str] | None = None,
         raise InputError(f"--param {frequency}: {frequency} is the drive frequency; the "
                          "response varies it (give its range with --omega A:B)")
     missing = sorted(names - set(values))
+    if missing and symbolic:  # kept as symbols: the nonlinear terms' coefficients only
+        return _symbolic(text, coordinates, exprs, names, values)
     if missing:
         raise InputError(f"system {text!r}: give {', '.join(missing)} a value with --param "
                          f"(e.g. --param {missing[0]}=1/2)"
@@ -209,6 +211,43 @@ def parse_system(text: str, values: dict[str, str] | None = None,
                       frequency)
     return _lowered(text, coordinates, [e.xreplace(given) for e in exprs],
                     allow_damping=driven)
+
+
+def _symbolic(text: str, coordinates: list[str], exprs: list[sp.Expr], names: set[str],
+              values: dict[str, str]) -> System:
+    """:func:`parse_system` with the names left without a value kept as symbols: allowed in the
+    nonlinear terms, each coefficient a polynomial in them with rational coefficients; the
+    mass and the linear part need numbers (the modes are exact numbers)."""
+    given = {sp.Symbol(k): parse_expression(v, f"--param {k}") for k, v in values.items()}
+    for k, v in given.items():
+        if not v.is_Rational:
+            raise InputError(f"--param {k}={values[str(k)]}: an exact rational, e.g. 1/3")
+    unused = sorted(str(k) for k in given if str(k) not in names)
+    if unused:
+        raise InputError(f"--param {unused[0]}: no such name in the system")
+    exprs = [sp.expand(e.xreplace(given)) for e in exprs]
+    params = sorted((s for e in exprs for s in e.free_symbols if str(s) in names), key=str)
+    symbols = [derivative_symbols(c) for c in coordinates]
+    variables = [s for triple in symbols for s in triple]
+    for i, e in enumerate(exprs):
+        for monom, c in sp.Poly(e, *variables).terms():
+            if sum(monom) <= 1 and c.free_symbols:
+                need = ", ".join(sorted(map(str, c.free_symbols)))
+                raise InputError(f"system {text!r}: equation {i + 1}: {need} stands in the "
+                                 f"linear part; give {need} a value with --param (symbols may "
+                                 "stand in the nonlinear terms only: the modes are exact "
+                                 "numbers)")
+    system = _lowered(text, coordinates, [e.xreplace({p: sp.Integer(1) for p in params})
+                                          for e in exprs])
+    # the checks passed with every symbol at 1; the force is taken again with the symbols
+    force = []
+    for i, e in enumerate(exprs):
+        x = system.coordinates
+        linear = sum(system.stiffness[i, j] * system.mass[i] * x[j] for j in range(len(x)))
+        rest = e - system.mass[i] * symbols[i][2] - linear
+        force.append(sp.expand(rest / system.mass[i]))
+    return System(text, system.coordinates, system.velocities, system.mass, system.stiffness,
+                  tuple(force), system.damping)
 
 
 def _drive_split(text: str, exprs: list[sp.Expr]
