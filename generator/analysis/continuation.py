@@ -18,11 +18,12 @@ from .polynomial import DrivenEquation, PolynomialBalance, amplitude_bound
 @dataclass(frozen=True)
 class Continuation:
     """The N-harmonic balance traced in ω by pseudo-arclength: one or more pieces, each a
-    curve from one end of the range to an end (``pieces``: the index of each piece's first
-    point; consecutive points of different pieces are not neighbours on the curve)."""
+    curve from one end of the range to an end, or closed inside it (an isola, its first point
+    repeated at its end) (``pieces``: the index of each piece's first point; consecutive
+    points of different pieces are not neighbours on the curve)."""
 
     omega: np.ndarray
-    x: np.ndarray  # (points, 2N): a_1, a_3, …, b_1, b_3, …
+    x: np.ndarray  # (points, unknowns): a_1, a_3, …, b_1, b_3, … of each coordinate in turn
     folds: list[float]  # where dω/ds changes sign, refined
     pieces: tuple[int, ...] = (0,)
     complete: bool = True  # every one-harmonic root at both ends lies on a traced piece
@@ -55,9 +56,11 @@ def _continue(sysm: PolynomialBalance, end_solutions, omega_start: float,
               per_point: float, max_points: int, where: str) -> Continuation:
     """The pseudo-arclength loop of :func:`continue_balance` on any balance with ``residual``,
     ``jacobian`` and ``d_omega`` in ``(x, ω)``: from each of ``end_solutions()`` (``(ω, x,
-    direction into the range)`` at the two ends, the first at ``omega_start``, and whether
-    they are complete) not reached yet, until ω leaves the range; ``estimate`` points of
-    ``per_point`` seconds, ``seconds`` in all, bound its steps and its time."""
+    direction)``: at the two ends, the first at ``omega_start``, or a point inside the range
+    taken both ways; and whether they are complete) not reached yet, until ω leaves the range
+    or the piece closes on its start (an isola); the step halves where a step turns or fails
+    (:data:`MIN_STEP`); ``estimate`` points of ``per_point`` seconds, ``seconds`` in all,
+    bound its steps and its time."""
     lo, hi = sorted((omega_start, omega_stop))
     limit = min(max_points, int(2 * max(seconds, CONTINUATION_SECONDS) / per_point))
     allowed = 2 * max(seconds, CONTINUATION_SECONDS)
