@@ -646,8 +646,8 @@ def sweep_figure(ds: object, path: Path) -> Path:
         else:
             shown = np.log10(np.maximum(grid, ROUNDING)) if log else grid
             mesh = ax.pcolormesh(x, y, shown, shading="nearest", cmap="viridis")
-            fig.colorbar(mesh, ax=ax, label=f"log₁₀ {label}" + (
-                f"\n(clipped at {ROUNDING:g}: rounding)" if log else ""))
+            fig.colorbar(mesh, ax=ax, label=(f"log₁₀ {label}\n(clipped at {ROUNDING:g}: "
+                                             "rounding)") if log else label)
         ax.set(xscale="log" if xlog else "linear", yscale="log" if ylog else "linear",
                xlabel=axis_label(xa), ylabel=axis_label(ya))
         ticks(ax, xa, "x"), ticks(ax, ya, "y")

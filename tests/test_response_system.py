@@ -106,6 +106,7 @@ def test_a_simulation_from_rest_settles_on_the_curve(kerschen):
 def test_the_up_sweep_jump_lands_where_the_simulation_does(kerschen):
     _, w, before, after = next(j for j in kerschen.jumps if j[0] == "up")
     assert kerschen.stable[before] and kerschen.stable[after]
+    assert w in kerschen.cont.folds  # the jump is at its refined fold
     past = w + 2e-3  # just past the fold: the upper branch is gone
     system = parse_system(KERSCHEN, {"f": "3/10"}, driven=True)
     fine = PolynomialBalance(system.equations(), 0.3, 6, True, shape=(1.0, 0.0))
@@ -129,7 +130,7 @@ def test_cli_json_table_and_plot(tmp_path):
     table = run("response", KERSCHEN, "--param", "f=1/20", "--harmonics", "3",
                 "--omega", "0.8:1.2", "--plot", str(tmp_path / "r.png"))
     assert table.returncode == 0, table.stderr
-    assert "branch 1: w 0.8 ->" in table.stdout and "every branch:" in table.stdout
+    assert "branch 1: w 0.8 -> 1.2," in table.stdout and "  search: every orbit" in table.stdout
     assert (tmp_path / "r.png").stat().st_size > 10000
 
 

@@ -40,6 +40,9 @@ NO_BOUND_SECONDS = 3.0
 # NOTE: without the power-balance bound (no potential, nonlinear damping) the drive is continued
 # from rest up to 10 × the linear response's size, 3 s at most per frequency (unbounded, it ran
 # 15 s at each of the ten frequencies: two minutes); the result says it may be incomplete.
+NEUTRAL = 1 + 1e-8
+# NOTE: a point is stable when every Floquet |λ| < 1 + 1e-8: a neutral direction (an undamped
+# coordinate the drive leaves at rest, |λ| = 1 to rounding) counts as stable, not unstable.
 SCAN_HARMONICS = 3
 SCAN_STEP = 0.01
 # NOTE: the balance that scans along each backbone for branches off the traced curve (a Newton
@@ -54,14 +57,14 @@ FLOQUET_SAMPLES = 512
 class BranchCheck:
     """A point of the traced curve shot as the true orbit: the balance's and the shot orbit's
     first-harmonic amplitude of each coordinate, the largest difference of any harmonic
-    coefficient, the shot orbit's Floquet multipliers ``|λ|`` and both stability verdicts."""
+    coefficient, the shot orbit's Floquet multipliers and both stability verdicts."""
 
     omega: float
     piece: int
     balance: tuple[float, ...]
     shot: tuple[float, ...]
     error: float  # NaN where shooting failed
-    multipliers: tuple[float, ...]
+    multipliers: tuple[complex, ...]  # the shot monodromy's eigenvalues, by modulus
     stable: bool | None  # the shot orbit's verdict (None: not shot)
     balance_stable: bool
     note: str = ""
@@ -122,6 +125,26 @@ def _on_curve(cont: Continuation, omega: float, x: np.ndarray) -> bool:
     return False
 
 
+def _clipped(cont: Continuation, lo: float, hi: float, fine: PolynomialBalance
+             ) -> Continuation:
+    """The pieces with the last point that left ``[lo, hi]`` moved back onto the edge it
+    crossed (linear between it and the point before, then Newton there; left as it was where
+    Newton does not converge)."""
+    omega, x = cont.omega.copy(), cont.x.copy()
+    for piece in cont.piece_slices():
+        k = piece.stop - 1
+        if k > piece.start and not lo <= omega[k] <= hi:
+            edge = lo if omega[k] < lo else hi
+            t = (edge - omega[k - 1]) / (omega[k] - omega[k - 1])
+            try:
+                z, converged, _ = fine.solve(x[k - 1] + t * (x[k] - x[k - 1]), edge)
+            except np.linalg.LinAlgError:
+                converged = False
+            if converged:
+                x[k], omega[k] = z, edge
+    return Continuation(omega, x, cont.folds, cont.pieces, cont.complete)
+
+
 def _merged(a: Continuation | None, b: Continuation) -> Continuation:
     if a is None:
         return b
@@ -176,7 +199,10 @@ def _jumps(cont: Continuation, r: np.ndarray, stable: np.ndarray, lo: float, hi:
                 cont.x[e[1][0]:e[1][1]] - cont.x[end], axis=1)
                 + 1e3 * np.abs(cont.omega[e[1][0]:e[1][1]] - w_end)))
             land = a + int(np.argmin(np.abs(cont.omega[a:b] - w_end)))
-            out.append((way, float(w_end), end, land))
+            # at the refined fold when the stretch ends at one (its last point is a step short)
+            folds = [f for f in cont.folds if abs(f - w_end) <= 0.02]
+            at = min(folds, key=lambda f: abs(f - w_end)) if folds else float(w_end)
+            out.append((way, float(at), end, land))
             k = m
     return tuple(out)
 
@@ -470,9 +496,10 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
               f"{isolas} branch{'es' * (isolas != 1)} off the curve traced from the ends"
               + (", each traced" if isolas else "") + ". A branch reached neither from rest "
               "(in the drive, at the ends and probes) nor from a backbone is not excluded")
+    cont = _clipped(cont, lo, hi, fine)
     # stability of every point: the monodromy of its variational equation
     multiplier = sb.multiplier(cont.x, cont.omega)
-    stable = multiplier < 1
+    stable = multiplier < NEUTRAL
     n = system.size
     amplitudes = np.array([[math.hypot(*_first(fine, x, i)) for i in range(n)]
                            for x in cont.x])
@@ -505,7 +532,7 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
         shots.append(BranchCheck(
             w, k, balance, tuple(math.hypot(A.get(1, 0.0), B.get(1, 0.0))
                                  for A, B in orbit.coordinates), float(error),
-            tuple(sorted(float(abs(m)) for m in orbit.multipliers)), orbit.stable,
+            tuple(sorted((complex(m) for m in orbit.multipliers), key=abs)), orbit.stable,
             bool(stable[mid])))
     shots.sort(key=lambda c: (c.piece, c.omega))
     how = (f"every orbit has r1 <= {bound:.6g}/w ({why}); the drive was continued from rest "

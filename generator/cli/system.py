@@ -244,7 +244,9 @@ def response_system_json(r) -> dict:
                     "balance": dict(zip(names, c.balance, strict=True)),
                     "shot": dict(zip(names, c.shot, strict=False)),
                     "error": None if c.error != c.error else c.error,
-                    "multipliers": list(c.multipliers), "stable": c.stable,
+                    "multipliers": [abs(m) for m in c.multipliers],
+                    "multipliers_complex": [[m.real, m.imag] for m in c.multipliers],
+                    "stable": c.stable,
                     "balance_stable": c.balance_stable, "note": c.note} for c in r.checks],
         "completeness": {"complete": r.complete, "bound": r.bound, "how": r.note},
         "amplitude": "r_i = sqrt(A_i1^2 + B_i1^2), the first harmonic of coordinate i",
@@ -286,8 +288,8 @@ def response_system_table(data: dict) -> list[str]:
         if c["error"] is None:
             lines.append(f"    w = {c['omega']:.6g}: not shot ({c['note']})")
     done = data["completeness"]
-    lines += textwrap.wrap(("every branch: " if done["complete"] else "warning: branches may "
-                            "be missing: ") + done["how"], 96, initial_indent="  ",
+    lines += textwrap.wrap(("search: " if done["complete"] else "warning: the search may be "
+                            "incomplete: ") + done["how"], 96, initial_indent="  ",
                            subsequent_indent="    ")
     return lines
 
