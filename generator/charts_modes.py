@@ -134,9 +134,12 @@ def response_system_figure(r: object, path: Path) -> Path:
             ax.plot([], [], "-", color="grey", lw=0.5, label="fold")
             handles, labels = ax.get_legend_handles_labels()
             unique = dict(zip(labels, handles, strict=True))
-            ax.legend(unique.values(), unique.keys(), fontsize=7, loc="best", framealpha=0.8)
+    # the legend below the panels, where it hides no curve
+    fig.legend(unique.values(), unique.keys(), fontsize=7, loc="lower center",
+               ncol=min(4, len(unique)), frameon=False)
     axes[-1, 0].set_xlabel(f"drive frequency {r.system.frequency} (ω)")
     title = r.system.text if len(r.system.text) <= 90 else r.system.text[:89] + "…"
     axes[0, 0].set_title(f"response: {title}", fontsize=8)
-    fig.tight_layout()
+    rows = -(-len(unique) // min(4, len(unique)))
+    fig.tight_layout(rect=(0, 0.035 * rows + 0.01, 1, 1))
     return _save(fig, path)
