@@ -24,7 +24,8 @@ def mode2(tmp_path_factory):
     out = tmp_path_factory.mktemp("nnm")
     done = run("generate", KERSCHEN, "--mode", "2", "--order", "12", "--out", str(out))
     assert done.returncode == 0, done.stderr
-    assert done.stdout.split() == [str(out / "mode2.py"), str(out / "mode2_tables.tex")]
+    assert done.stdout.split() == [str(out / "mode2.py"), str(out / "mode2_derivation.tex"),
+                                   str(out / "mode2_tables.tex")]
     spec = importlib.util.spec_from_file_location("mode2", out / "mode2.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
