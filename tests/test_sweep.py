@@ -473,6 +473,8 @@ def test_system_sweep_linear_points_are_the_complex_amplitudes_exactly():
             X = np.linalg.solve(K - w**2 * np.eye(2) + 1j * w * c * np.eye(2), [0.1, 0.0])
             assert ds["orbits"].values[i, j] == 1 and ds["stable"].values[i, j, 0] == 1
             assert abs(ds["r"].values[i, j, 0] - np.linalg.norm(X)) < 1e-12
+            assert abs(ds["r_x1"].values[i, j, 0] - abs(X[0])) < 1e-12
+            assert abs(ds["r_x2"].values[i, j, 0] - abs(X[1])) < 1e-12
             assert ds["floquet"].values[i, j, 0] == pytest.approx(np.exp(-np.pi * c / w),
                                                                   rel=1e-8)
     hard = equation_kind("response", SYSTEM, {"f": "3/10", "k": "1/2", "c": "1/20"}, ["w"])

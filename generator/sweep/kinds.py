@@ -425,7 +425,7 @@ def _system_response(spec: EquationSpec, **axis: float) -> dict:
     :data:`ORBIT_HARMONICS` harmonics, seeded by the drive continued from rest up to the
     power-balance bound: :meth:`analysis.systems.SystemBalance.solutions`), largest first,
     with the Floquet verdict of its variational equation; ``r`` is the first harmonic over
-    every coordinate, ``√Σ_i (A_i1² + B_i1²)``."""
+    every coordinate, ``√Σ_i (A_i1² + B_i1²)``, and ``r_<x>`` each coordinate's."""
     from ..analysis.systems import SystemBalance, driven_system
 
     values = _point_values(spec, axis)
@@ -437,7 +437,14 @@ def _system_response(spec: EquationSpec, **axis: float) -> dict:
     found, _, _ = sb.solutions(omega)
     found.sort(key=sb.fine.first_harmonic, reverse=True)
     floquet = list(sb.multiplier(np.array(found), np.full(len(found), omega))) if found else []
-    return _orbit_fields([sb.fine.first_harmonic(x) for x in found], floquet, len(found))
+    out = _orbit_fields([sb.fine.first_harmonic(x) for x in found], floquet, len(found))
+    for i, x in enumerate(sb.system.coordinates):  # each coordinate's, in the same order
+        r = [math.nan] * EQUATION_BRANCHES
+        for k, z in enumerate(found[:EQUATION_BRANCHES]):
+            A, B = sb.fine.amplitudes(z, i)
+            r[k] = math.hypot(A.get(1, 0.0), B.get(1, 0.0))
+        out[f"r_{x}"] = r
+    return out
 
 
 def _equation_subharmonic(spec: EquationSpec, **axis: float) -> dict:
@@ -513,7 +520,9 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
         raise InputError(f"--axis {clash[0]}: the store holds a field of that name; rename the "
                          "parameter in the equation")
     if system:
-        driven_system(text, {**dict(values), **{a: "1" for a in axes if a != frequency}})
+        coordinates = driven_system(text, {**dict(values),
+                                           **{a: "1" for a in axes if a != frequency}}
+                                    ).coordinates
     else:
         frequency = _frequency_name(osc, text, name)
         form = driven_form(text, {**dict(values), **{a: "1" for a in axes if a != frequency}},
@@ -542,9 +551,15 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
                     functools.partial(_equation_subharmonic, spec), warm, 4, "stable_orbits",
                     settings, builtin=False, positive=(frequency,))
     if system:
+        each = tuple(Field(f"r_{x}", f"r of {x} = sqrt(A1^2 + B1^2) of each orbit (in r's "
+                           "order)", dims=("branch",)) for x in coordinates)
+        clash = sorted(set(axes) & {f.name for f in each})
+        if clash:
+            raise InputError(f"--axis {clash[0]}: the store holds a field of that name; rename "
+                             "the parameter in the system")
         return Kind(kind, f"every periodic response of the system {text} (harmonic balance, "
                     "r over every coordinate) with the Floquet verdict of its variational "
-                    "equation", tuple(axes), (branch,), common,
+                    "equation", tuple(axes), (branch,), (*common, *each),
                     functools.partial(_system_response, spec), warm, 4, "r_stable_max",
                     settings, builtin=False, positive=(frequency,))
     return Kind(kind, f"every 1:1 orbit of {text} with its Floquet verdict", tuple(axes),
