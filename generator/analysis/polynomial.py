@@ -189,14 +189,12 @@ class PolynomialBalance:
         samples = 16
         while samples <= (self.field.degree + 1) * top:
             samples *= 2
-        theta = 2 * np.pi * np.arange(samples) / samples
         k = self.orders
         sines = k[k > 0]
         self.n_cos = len(k)
         self.basis, self.d_basis = self._bases(samples)  # (S, m): q = basis @ x, d/dθ
-        weights = np.where(k == 0, 1.0, 2.0)
-        self.project = np.vstack([weights[:, None] * np.cos(np.outer(theta, k)).T,
-                                  2.0 * np.sin(np.outer(theta, sines)).T]) / samples
+        weights = np.concatenate([np.where(k == 0, 1.0, 2.0), np.full(len(sines), 2.0)])
+        self.project = (weights * self.basis).T / samples  # the harmonics of samples
         self.k2 = np.concatenate([k, sines]).astype(float) ** 2
         block = np.zeros(len(self.k2))
         # the cos(n ωt) component, n = drive_harmonic (n > 1: a 1/n subharmonic's balance)
@@ -278,12 +276,16 @@ class PolynomialBalance:
         return np.concatenate([self.vector(*other.amplitudes(x, i))
                                for i in range(self.coordinates)])
 
-    def first_harmonic(self, x: np.ndarray) -> float:
-        """``√Σ_i (A_i1² + B_i1²)``: the first harmonic's size over every coordinate."""
+    def first_harmonics(self, x: np.ndarray) -> np.ndarray:
+        """``√(A_i1² + B_i1²)`` of each coordinate ``i``."""
         k1 = int(np.nonzero(self.orders == 1)[0][0])
         s1 = self.n_cos + int(np.nonzero(self.orders[self.orders > 0] == 1)[0][0])
         xb = self._blocks(x)
-        return float(math.sqrt(np.sum(xb[:, k1] ** 2 + xb[:, s1] ** 2)))
+        return np.hypot(xb[:, k1], xb[:, s1])
+
+    def first_harmonic(self, x: np.ndarray) -> float:
+        """``√Σ_i (A_i1² + B_i1²)``: the first harmonic's size over every coordinate."""
+        return float(np.linalg.norm(self.first_harmonics(x)))
 
     def state(self, x: np.ndarray, omega: float) -> np.ndarray:
         """``(x(0), ẋ(0))`` of a balance solution, every coordinate's: a shooting guess."""

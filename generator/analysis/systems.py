@@ -244,7 +244,7 @@ def system_plan(text: str, values: dict[str, str], harmonics: int,
     bound, _ = system.response_bound()
     r_scale = min(50.0, 10.0 if bound is None else bound / w0[0])
     points = ((hi - lo) + np.pi * r_scale * math.sqrt(len(w0))) / 0.02
-    odd = all(sum(key) % 2 for eq in system.equations() for key in eq)
+    odd = PolynomialField.of(system.equations()).odd
     unknowns = system.size * (2 * harmonics if odd else 4 * harmonics - 1)
     # without the bound each drive continuation (the ends and the probes) runs to its budget
     searches = 0.0 if bound is not None else NO_BOUND_SECONDS * (
@@ -372,10 +372,8 @@ def _backbones(system: System, bound: float | None, w0: tuple[float, ...]
     """Each mode's backbone ω(A) and its x(0) on a grid of amplitudes up to the power-balance
     bound at that mode's ω0 (10 without one), from the series of the free system (damping and
     drive removed), the first-order backbone beyond where ω(A) stops being monotone; none
-    where the free system has a
-    velocity-dependent force, and none for a mode in internal resonance (the series is
-    refused)."""
-
+    where the free system has a velocity-dependent force, and none for a mode in internal
+    resonance (the series is refused)."""
     from ..derive.nnm import normal_mode
 
     if any(f.has(*system.velocities) for f in system.force):
@@ -426,10 +424,8 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
     plan = system_plan(text, values, harmonics, omega_min, omega_max)
     system, (lo, hi), w0 = plan.system, plan.omega_range, plan.linear_frequencies
     sb = SystemBalance.of(system, harmonics)
-    fine, drive, bound, why = sb.fine, sb.drive, sb.bound, sb.why
-    equations = sb.equations
+    fine, bound, why, solutions = sb.fine, sb.bound, sb.why, sb.solutions
     where = f"system {text!r}"
-    solutions = sb.solutions
     notes: list[str] = []
     complete = bound is not None
 
@@ -500,16 +496,29 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
     # stability of every point: the monodromy of its variational equation
     multiplier = sb.multiplier(cont.x, cont.omega)
     stable = multiplier < NEUTRAL
-    n = system.size
-    amplitudes = np.array([[math.hypot(*_first(fine, x, i)) for i in range(n)]
-                           for x in cont.x])
-    r = np.array([fine.first_harmonic(x) for x in cont.x])
-    # shooting: the middle of the longest stable and unstable stretches
-    field = PolynomialField.of(equations)
+    amplitudes = np.array([fine.first_harmonics(x) for x in cont.x])
+    shots = _shot_checks(sb, cont, amplitudes, stable, checks)
+    how = (f"every orbit has r1 <= {bound:.6g}/w ({why}); the drive was continued from rest "
+           f"past that bound at {', '.join(notes)} and at "
+           if bound is not None else
+           f"no amplitude bound ({why}): the drive continuation from rest stopped at its "
+           f"budget at {', '.join(notes)} and at ")
+    return SystemResponse(system, harmonics, (lo, hi), w0, cont, tuple(closed), amplitudes,
+                          multiplier, stable,
+                          _jumps(cont, np.linalg.norm(amplitudes, axis=1), stable, lo, hi),
+                          shots, bound, complete and cont.complete, how + probed)
+
+
+def _shot_checks(sb: SystemBalance, cont: Continuation, amplitudes: np.ndarray,
+                 stable: np.ndarray, checks: int) -> tuple[BranchCheck, ...]:
+    """The middle point of the longest stretch (stable or unstable) of every branch, then of
+    the longest of the rest up to ``checks`` in all, shot as the true orbit and compared
+    harmonic by harmonic; by branch and ω."""
+    fine = sb.fine
+    field = PolynomialField.of(sb.equations)
     stretches = sorted(((j - i, k, i, j) for k, piece in enumerate(cont.piece_slices())
                         for i, j in _runs(stable, piece) if j - i >= 3), reverse=True)
-    # the longest stretch of every branch first, then the longest of the rest
-    first = {}
+    first: dict[int, tuple] = {}
     for item in stretches:
         first.setdefault(item[1], item)
     chosen = sorted(first.values(), reverse=True)
@@ -518,7 +527,8 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
     for _, k, i, j in chosen[:max(checks, len(first))]:
         mid = (i + j) // 2
         x, w = cont.x[mid], float(cont.omega[mid])
-        orbit = shoot_system(field, drive, w, fine.state(x, w), harmonics=2 * harmonics - 1)
+        orbit = shoot_system(field, sb.drive, w, fine.state(x, w),
+                             harmonics=2 * fine.harmonics - 1)
         balance = tuple(float(a) for a in amplitudes[mid])
         if not isinstance(orbit, PeriodicOrbit):
             shots.append(BranchCheck(w, k, balance, (), math.nan, (), None, bool(stable[mid]),
@@ -534,17 +544,4 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
                                  for A, B in orbit.coordinates), float(error),
             tuple(sorted((complex(m) for m in orbit.multipliers), key=abs)), orbit.stable,
             bool(stable[mid])))
-    shots.sort(key=lambda c: (c.piece, c.omega))
-    how = (f"every orbit has r1 <= {bound:.6g}/w ({why}); the drive was continued from rest "
-           f"past that bound at {', '.join(notes)} and at "
-           if bound is not None else
-           f"no amplitude bound ({why}): the drive continuation from rest stopped at its "
-           f"budget at {', '.join(notes)} and at ")
-    return SystemResponse(system, harmonics, (lo, hi), w0, cont, tuple(closed), amplitudes,
-                          multiplier, stable, _jumps(cont, r, stable, lo, hi), tuple(shots),
-                          bound, complete and cont.complete, how + probed)
-
-
-def _first(balance: PolynomialBalance, x: np.ndarray, i: int) -> tuple[float, float]:
-    A, B = balance.amplitudes(x, i)
-    return A.get(1, 0.0), B.get(1, 0.0)
+    return tuple(sorted(shots, key=lambda c: (c.piece, c.omega)))

@@ -11,7 +11,8 @@ with its minimal polynomial), never rounded; modes are numbered by increasing li
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 import sympy as sp
@@ -101,7 +102,12 @@ class System:
 
     def modes(self) -> tuple[sp.Expr, ...]:
         """The exact ``λ = ω₀²`` of each linear mode, by increasing value (``M⁻¹K``'s
-        eigenvalues; each root of the characteristic polynomial's irreducible factors)."""
+        eigenvalues; each root of the characteristic polynomial's irreducible factors),
+        computed once per system."""
+        return self._modes
+
+    @cached_property
+    def _modes(self) -> tuple[sp.Expr, ...]:
         lam = sp.Symbol("lambda")
         poly = sp.Poly(self.stiffness.charpoly(lam).as_expr(), lam)
         roots: list[sp.Expr] = []
@@ -177,13 +183,6 @@ def parse_system(text: str, values: dict[str, str] | None = None,
     if frequency is not None and str(frequency) in values:
         raise InputError(f"--param {frequency}: {frequency} is the drive frequency; the "
                          "response varies it (give its range with --omega A:B)")
-    missing = sorted(names - set(values))
-    if missing and symbolic:  # kept as symbols: the nonlinear terms' coefficients only
-        return _symbolic(text, coordinates, exprs, names, values)
-    if missing:
-        raise InputError(f"system {text!r}: give {', '.join(missing)} a value with --param "
-                         f"(e.g. --param {missing[0]}=1/2)"
-                         + ("" if driven else "; a system's series are in the amplitude A"))
     given = {sp.Symbol(k): parse_expression(v, f"--param {k}") for k, v in values.items()}
     for k, v in given.items():
         if not v.is_Rational:
@@ -191,6 +190,13 @@ def parse_system(text: str, values: dict[str, str] | None = None,
     unused = sorted(str(k) for k in given if str(k) not in names)
     if unused:
         raise InputError(f"--param {unused[0]}: no such name in the system")
+    missing = sorted(names - set(values))
+    if missing and symbolic:  # kept as symbols: the nonlinear terms' coefficients only
+        return _symbolic(text, coordinates, exprs, names, given)
+    if missing:
+        raise InputError(f"system {text!r}: give {', '.join(missing)} a value with --param "
+                         f"(e.g. --param {missing[0]}=1/2)"
+                         + ("" if driven else "; a system's series are in the amplitude A"))
     if frequency is not None:
         exprs = [(e.xreplace(given), d.xreplace(given)) for e, d in exprs]
         for i, (_, d) in enumerate(exprs):
@@ -205,26 +211,18 @@ def parse_system(text: str, values: dict[str, str] | None = None,
         if all(d == 0 for _, d in exprs):
             raise InputError(f"system {text!r}: the drive vanishes with the values given")
         system = _lowered(text, coordinates, [e for e, _ in exprs], allow_damping=True)
-        return System(*[getattr(system, f) for f in ("text", "coordinates", "velocities",
-                                                     "mass", "stiffness", "force", "damping")],
-                      tuple(d / m for (_, d), m in zip(exprs, system.mass, strict=True)),
-                      frequency)
+        return replace(system, frequency=frequency, drive=tuple(
+            d / m for (_, d), m in zip(exprs, system.mass, strict=True)))
     return _lowered(text, coordinates, [e.xreplace(given) for e in exprs],
                     allow_damping=driven)
 
 
 def _symbolic(text: str, coordinates: list[str], exprs: list[sp.Expr], names: set[str],
-              values: dict[str, str]) -> System:
-    """:func:`parse_system` with the names left without a value kept as symbols: allowed in the
-    nonlinear terms, each coefficient a polynomial in them with rational coefficients; the
-    mass and the linear part need numbers (the modes are exact numbers)."""
-    given = {sp.Symbol(k): parse_expression(v, f"--param {k}") for k, v in values.items()}
-    for k, v in given.items():
-        if not v.is_Rational:
-            raise InputError(f"--param {k}={values[str(k)]}: an exact rational, e.g. 1/3")
-    unused = sorted(str(k) for k in given if str(k) not in names)
-    if unused:
-        raise InputError(f"--param {unused[0]}: no such name in the system")
+              given: dict[sp.Symbol, sp.Rational]) -> System:
+    """:func:`parse_system` with the names left without a value (not in ``given``) kept as
+    symbols: allowed in the nonlinear terms, each coefficient a polynomial in them with
+    rational coefficients; the mass and the linear part need numbers (the modes are exact
+    numbers)."""
     exprs = [sp.expand(e.xreplace(given)) for e in exprs]
     params = sorted((s for e in exprs for s in e.free_symbols if str(s) in names), key=str)
     symbols = [derivative_symbols(c) for c in coordinates]
@@ -246,8 +244,7 @@ def _symbolic(text: str, coordinates: list[str], exprs: list[sp.Expr], names: se
         linear = sum(system.stiffness[i, j] * system.mass[i] * x[j] for j in range(len(x)))
         rest = e - system.mass[i] * symbols[i][2] - linear
         force.append(sp.expand(rest / system.mass[i]))
-    return System(text, system.coordinates, system.velocities, system.mass, system.stiffness,
-                  tuple(force), system.damping)
+    return replace(system, force=tuple(force))
 
 
 def _drive_split(text: str, exprs: list[sp.Expr]

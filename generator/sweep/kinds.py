@@ -438,12 +438,10 @@ def _system_response(spec: EquationSpec, **axis: float) -> dict:
     found.sort(key=sb.fine.first_harmonic, reverse=True)
     floquet = list(sb.multiplier(np.array(found), np.full(len(found), omega))) if found else []
     out = _orbit_fields([sb.fine.first_harmonic(x) for x in found], floquet, len(found))
-    for i, x in enumerate(sb.system.coordinates):  # each coordinate's, in the same order
-        r = [math.nan] * EQUATION_BRANCHES
-        for k, z in enumerate(found[:EQUATION_BRANCHES]):
-            A, B = sb.fine.amplitudes(z, i)
-            r[k] = math.hypot(A.get(1, 0.0), B.get(1, 0.0))
-        out[f"r_{x}"] = r
+    each = np.full((sb.system.size, EQUATION_BRANCHES), math.nan)  # in r's order
+    for k, z in enumerate(found[:EQUATION_BRANCHES]):
+        each[:, k] = sb.fine.first_harmonics(z)
+    out.update({f"r_{x}": list(row) for x, row in zip(sb.system.coordinates, each, strict=True)})
     return out
 
 
