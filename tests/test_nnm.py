@@ -5,13 +5,12 @@ route), the JSON contract and the refusals."""
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from fractions import Fraction
 
 import numpy as np
 import pytest
 import sympy as sp
+from commands import run
 from lindstedt.derive.lindstedt import derive
 from lindstedt.derive.models import duffing
 from lindstedt.derive.nnm import normal_mode
@@ -25,10 +24,6 @@ SYMMETRIC = "x1'' + 2*x1 - x2 + x1**3 = 0; x2'' + 2*x2 - x1 + x2**3 = 0"
 # NOTE: x1 = x2 = x gives Duffing's x'' + x + x³ = 0 (mode 1); x1 = −x2 = x gives
 # x'' + 3x + x³ = 0, Duffing with ω₀² = 3 (mode 2): ω(A) = √3 ω_D(A²/3).
 
-
-def run(*args):
-    return subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
-                          text=True, check=False)
 
 
 def test_in_phase_mode_is_duffing_exactly():

@@ -4,19 +4,13 @@ NaN beyond the radius, the ``_into`` twins, and bad input for ``generate SYSTEM`
 from __future__ import annotations
 
 import importlib.util
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from commands import run
 from lindstedt.derive.nnm import normal_mode
 from lindstedt.derive.system import parse_system
 from test_nnm import KERSCHEN, _evaluate, _shoot
-
-
-def run(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
-                          text=True, check=False, cwd=cwd)
 
 
 @pytest.fixture(scope="module")

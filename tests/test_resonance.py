@@ -6,12 +6,11 @@ pendulum itself."""
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 import sympy as sp
+from commands import run
 from lindstedt.derive.resonance import coupled_modes, resonant_flow
 from lindstedt.derive.system import parse_system
 from lindstedt.numerics.references import exchange_period, simulated_exchange_period
@@ -23,10 +22,6 @@ SWING = "x'' + x + 3*x*y = 0; y'' + 4*y + 3*x**2/2 = 0"
 # and r = √(x² + (1 + y)²), expanded to second order in (x, y).
 CUBIC_1_3 = "x1'' + x1 + (x1 + x2)**3 = 0; x2'' + 9*x2 + (x1 + x2)**3 = 0"
 
-
-def run(*args):
-    return subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
-                          text=True, check=False)
 
 
 def test_swing_spring_flow_equals_the_averages_worked_by_hand():

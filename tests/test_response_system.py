@@ -5,11 +5,10 @@ rest and across a jump by SciPy's DOP853 — and the refusals."""
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from commands import run
 from lindstedt.analysis.polynomial import PolynomialBalance
 from lindstedt.analysis.systems import system_response
 from lindstedt.derive.system import parse_system
@@ -19,10 +18,6 @@ LINEAR = "x1'' + x1'/10 + 2*x1 - x2 = f*cos(w*t); x2'' + x2'/10 + 2*x2 - x1 = 0"
 KERSCHEN = ("x1'' + 0.05*x1' + 2*x1 - x2 + x1**3/2 = f*cos(w*t); "
             "x2'' + 0.05*x2' + 2*x2 - x1 = 0")
 
-
-def run(*args):
-    return subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
-                          text=True, check=False)
 
 
 @pytest.fixture(scope="module")
