@@ -5,13 +5,27 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test test-fast tex lint bench figures generated clean
+.PHONY: demo test test-fast tex lint lock bench figures generated clean
 
-$(STAMP): pyproject.toml
+# constraints.txt pins every package of the test and demo environment (make lock refreshes it).
+$(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e '.[test]'
+	$(BIN)/pip install --quiet -c constraints.txt --upgrade pip
+	$(BIN)/pip install --quiet -c constraints.txt -e '.[test]'
 	touch $(STAMP)
+
+# Re-pins constraints.txt from pyproject.toml's ranges in a scratch venv: run it on purpose,
+# then run make test and commit both.
+lock:
+	rm -rf .lock-venv
+	$(PYTHON) -m venv .lock-venv
+	.lock-venv/bin/pip install --quiet --upgrade pip
+	.lock-venv/bin/pip install --quiet '.[test]'
+	{ sed -n '1,3p' constraints.txt; \
+	  echo "pip==$$(.lock-venv/bin/pip --version | cut -d' ' -f2)"; \
+	  .lock-venv/bin/pip freeze --exclude lindstedt; } > constraints.txt.new
+	mv constraints.txt.new constraints.txt
+	rm -rf .lock-venv
 
 # pdflatex for the tests that compile every generated .tex (Debian's texlive).
 tex:

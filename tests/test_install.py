@@ -42,7 +42,9 @@ def venv(tmp_path_factory) -> Path:
     (wheel,) = (work / "dist").glob("lindstedt-*.whl")
     base = Path(getattr(sys, "_base_executable", sys.executable))
     _run([base, "-m", "venv", work / "venv"], work)
-    _run([work / "venv/bin/python", "-m", "pip", "install", "--quiet", wheel], work)
+    # NOTE: the pinned versions of make test (constraints.txt), so the wheel meets what CI had.
+    _run([work / "venv/bin/python", "-m", "pip", "install", "--quiet", "-c",
+          ROOT / "constraints.txt", wheel], work)
     return work / "venv"
 
 
