@@ -71,7 +71,12 @@ order; a stage imports only stages above it::
     analysis.parametric     q̈ + 2ζq̇ + (1 + ε cos 2ωt)q + γq³ = 0: one-harmonic branches,
                             tongue, onsets, balance, full-Hill stability
                             [Pump, ω range -> branches]
-    lower.printers          NumbaPrinter(PythonCodePrinter), LaTeX rationals [Expr -> str]
+    analysis.curves         the curves a command draws and writes as CSV, sampled once: a free
+                            oscillator's ω, T across its validity, a limit cycle's amplitude
+                            and ω against ε, a slow flow's portrait, a normal mode's backbone
+                            [series | SlowFlow -> SeriesCurves, CycleCurves, Portrait, Backbone]
+    lower.printers          NumbaPrinter(PythonCodePrinter), LaTeX rationals, a series'
+                            validity in words [Expr -> str]
     lower.records           the IR records (Module, Evaluator, Derivation, PeriodFormula, Unit)
                             a template lays out [-> records]
     lower.forms             Horner/Estrin, the Chebyshev recurrence, AGM steps, argument guards,
@@ -108,6 +113,9 @@ order; a stage imports only stages above it::
     charts_modes            the frequency–energy plot of a system's normal modes: backbones
                             from the series beside shot orbits; a driven system's response
                             [System, SystemResponse -> PNG/SVG/PDF]
+    charts_series           a free oscillator's ω and T against its amplitude variable with the
+                            orbit edge and the radius marked; a limit cycle against ε; a slow
+                            flow's phase portrait [curves -> PNG/SVG/PDF]
     costs                   each command's estimated wall time and bounds [arguments -> Cost]
     cli.common              what every command shares: light constants, argument types and
                             flags, the report shape [argv -> Namespace]

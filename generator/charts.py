@@ -212,14 +212,15 @@ def _response_panel(ax: plt.Axes, r: ResponseReport, title: str) -> None:
 
 
 def response_figure(eps: float, force: float, Q: float, harmonics: int, path: Path,
-                    max_seconds: float = CONTINUATION_SECONDS) -> Path:
-    """Response r(ω) of eq. 10.60 (:func:`analysis.response.duffing_response`): the cubic's
-    one-harmonic branches (stable solid, unstable dashed) beside :func:`_response_panel`; and
-    the linear curves of Fig. 1 (``max_seconds``: the continuation's cost limit)."""
+                    max_seconds: float = CONTINUATION_SECONDS, report=None) -> Path:
+    """Response r(ω) of eq. 10.60 (:func:`analysis.response.duffing_response`, or ``report``
+    when computed): the cubic's one-harmonic branches (stable solid, unstable dashed) beside
+    :func:`_response_panel`; the linear curves of Fig. 1 (``max_seconds``: the cost limit)."""
     from .analysis.response import duffing_response
 
     check_plot_path(path)
-    report = duffing_response(eps, force, Q, harmonics, max_seconds)
+    if report is None:
+        report = duffing_response(eps, force, Q, harmonics, max_seconds)
     lo, hi = report.er.omega_range
     omega = np.linspace(lo, hi, 2000)
     curve = one_harmonic_curve(eps, force, Q, omega)
@@ -250,15 +251,16 @@ def response_figure(eps: float, force: float, Q: float, harmonics: int, path: Pa
 def response_equation_figure(text: str, values: dict[str, str], harmonics: int, path: Path,
                              name: str = "oscillator", omega_min: float | None = None,
                              omega_max: float | None = None,
-                             max_seconds: float = CONTINUATION_SECONDS) -> Path:
+                             max_seconds: float = CONTINUATION_SECONDS, report=None) -> Path:
     """Response r(ω) of a user's damped driven oscillator
-    (:func:`analysis.response.equation_response`): the one-harmonic amplitudes beside
-    :func:`_response_panel`."""
+    (:func:`analysis.response.equation_response`, or ``report`` when computed): the
+    one-harmonic amplitudes beside :func:`_response_panel`."""
     from .analysis.response import equation_response
 
     check_plot_path(path)
-    report = equation_response(text, values, harmonics, name, omega_min, omega_max,
-                               max_seconds)
+    if report is None:
+        report = equation_response(text, values, harmonics, name, omega_min, omega_max,
+                                   max_seconds)
     lo, hi = report.er.omega_range
     fig, ax = plt.subplots(figsize=(8, 4.2))
     omega = np.linspace(lo, hi, 600)

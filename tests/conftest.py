@@ -20,7 +20,7 @@ LAYERS = {
               "hill", "layout", "lindstedt", "nnm", "parametric", "response", "response_equation",
               "response_system",
               "resonance", "series", "subharmonic"),
-    "printers": ("charts", "cli", "costs", "emit", "files", "fuzz", "interrupt", "latex",
+    "printers": ("charts", "cli", "costs", "curves", "emit", "files", "fuzz", "interrupt", "latex",
                  "notebook", "readme", "validity"),
     "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "nnm_emitted", "orbits",
                 "oscillator", "resum", "sweep", "tongues"),

@@ -89,7 +89,7 @@ class Computed(Exception):
 
 
 @pytest.mark.parametrize("args,compute", [
-    (["response", "--eps", "0.1", "--force", "0.3", "--Q", "20"], "response_json"),
+    (["response", "--eps", "0.1", "--force", "0.3", "--Q", "20"], "response_report"),
     (["subharmonic", "--eps", "0.1", "--force", "0.5", "--omega", "1.2"], "subharmonic_json"),
     (["mixing", "--eps", "0.1", "--Q", "10", "--drive", "0.3@1.3"], "mixing_json"),
 ])

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import numbers
 import os
 import re
 import sys
@@ -158,6 +159,71 @@ def _charts():
     from .. import charts
 
     return charts
+
+
+CSV_HEADER = re.compile(r"[^,\[\]]+ \[[^,\[\]]*\](,[^,\[\]]+ \[[^,\[\]]*\])*")
+# NOTE: every CSV this tool writes names its columns `name [meaning or unit]`: a file whose
+# first line has that shape is one of its own, and only such a file is ever replaced.
+
+
+def _csv_state(path: Path) -> str:
+    """``"generated"`` for a CSV this tool wrote (:data:`CSV_HEADER`), else ``"foreign"``."""
+    with path.open("rb") as fh:
+        first = fh.readline(1 << 16).decode("utf-8", errors="replace").rstrip("\r\n")
+    return "generated" if CSV_HEADER.fullmatch(first) else "foreign"
+
+
+def check_csv_path(text: str) -> Path:
+    """``--csv FILE`` before any work: a usable folder, and a file that is new or a CSV this
+    tool wrote; else :class:`InputError` (one line, nothing computed or written)."""
+    from ..emit.render import check_folder, check_target
+
+    path = Path(text)
+    if not text.strip() or not path.name:
+        raise InputError(f"--csv {text!r}: name a file")
+    folder = path.parent if str(path.parent) else Path(".")
+    check_folder(folder, "--csv")
+    if not folder.is_dir():
+        raise InputError(f"--csv {path}: folder {folder} does not exist")
+    check_target(path, "--csv", ours=_csv_state)
+    return path
+
+
+def check_outputs(args: argparse.Namespace) -> tuple[Path | None, Path | None]:
+    """``--plot`` and ``--csv`` checked before any work (matplotlib imported only for
+    --plot): their paths, or None."""
+    plot = _charts().check_plot_path(Path(args.plot)) if getattr(args, "plot", None) else None
+    return plot, check_csv_path(args.csv) if getattr(args, "csv", None) else None
+
+
+def _cell(x: object) -> str:
+    """A CSV cell: an integer as itself, a float as its ``repr`` (shortest round-trip text:
+    read back bit for bit), a boolean as 1 or 0.
+
+    >>> _cell(0.1), _cell(3), _cell(True), _cell(float("nan"))
+    ('0.1', '3', '1', 'nan')
+    """
+    if isinstance(x, numbers.Integral):  # bool too
+        return str(int(x))
+    return repr(float(x))
+
+
+def write_csv(path: Path, columns: Sequence[tuple[str, str]], rows) -> Path:
+    """Write ``rows`` under the header ``columns`` (``(name, meaning)`` pairs: ``name
+    [meaning]``) into ``path`` atomically (a temporary in its folder, then a rename: nothing
+    half-written on any failure)."""
+    from ..emit.render import write_files
+
+    header = ",".join(f"{name} [{meaning}]" for name, meaning in columns)
+    if not CSV_HEADER.fullmatch(header):
+        raise ValueError(f"write_csv: {header!r}: a column's name or meaning holds ',', '[' "
+                         "or ']'")
+    lines = [header, *(",".join(_cell(x) for x in row) for row in rows)]
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    write_files(folder, {path.name: ("\n".join(lines) + "\n").encode()}, "--csv",
+                ours=_csv_state)
+    return path
 
 
 def _equation_args(args: argparse.Namespace, flags: Sequence[str],
@@ -446,6 +512,13 @@ def _flag_json(p: argparse.ArgumentParser, what: str = "the JSON contract") -> N
 def _flag_plot(p: argparse.ArgumentParser) -> None:
     p.add_argument("--plot", metavar="FILE",
                    help="also draw the figure into FILE (.png, .svg or .pdf; default: none)")
+
+
+def _flag_csv(p: argparse.ArgumentParser, what: str) -> None:
+    p.add_argument("--csv", metavar="FILE",
+                   help=f"also write {what} into FILE as CSV: a header row naming each column "
+                   "`name [meaning]`, one row per point, floats as Python's repr (written "
+                   "whole or not at all; replaces only a CSV lindstedt wrote)")
 
 
 def _flag_drive(p: argparse.ArgumentParser, required: bool, omega: str | None,

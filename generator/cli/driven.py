@@ -19,6 +19,7 @@ from .common import (
     _equation_args,
     _first_harmonic,
     _flag_allow_slow,
+    _flag_csv,
     _flag_drive,
     _flag_equation,
     _flag_harmonics,
@@ -33,6 +34,8 @@ from .common import (
     _quality,
     _real,
     _report,
+    check_outputs,
+    write_csv,
 )
 
 
@@ -390,31 +393,52 @@ def _response_args(args: argparse.Namespace) -> None:
         raise InputError(f"the following arguments are required: {', '.join(missing)}")
 
 
+def response_report(args: argparse.Namespace, limit: float):
+    """The one computation of ``response`` (eq. 10.60 or an EQUATION): its
+    :class:`analysis.response.ResponseReport`, which the JSON, the table, the figure and the
+    CSV print."""
+    from ..analysis.response import duffing_response, equation_response
+
+    if args.model is not None:
+        return equation_response(args.model, _params(args.param), args.harmonics,
+                                 args.name or "oscillator", args.omega_min, args.omega_max,
+                                 limit)
+    return duffing_response(args.eps, args.force, args.Q, args.harmonics, limit)
+
+
+def response_csv(r, path: Path) -> Path:
+    """``response --csv``: every point of the continued balance, branch by branch (the
+    curve drawn), its first-harmonic amplitude."""
+    columns = (("branch", "piece of the continued balance from 1"),
+               ("omega", "drive frequency"), ("r", "first harmonic sqrt(A1^2 + B1^2)"))
+    rows = ((k, w, _first_harmonic(*r.fine.amplitudes(x)))
+            for k, piece in enumerate(r.cont.piece_slices(), 1)
+            for w, x in zip(r.cont.omega[piece], r.cont.x[piece], strict=True))
+    return write_csv(path, columns, rows)
+
+
 def run_response(args: argparse.Namespace) -> int:
     """Run ``lindstedt response`` (eq. 10.60 or an EQUATION): the response curve over ω, as a
-    table, JSON or a figure.  Returns the exit status."""
+    table, JSON, a figure or CSV, computed once.  Returns the exit status."""
     _response_args(args)
     limit = math.inf if args.allow_slow else COST_LIMIT_SECONDS
     if args.model is not None and ";" in args.model:
         from .system import run_response_system
 
         return run_response_system(args, limit)
-    if args.model is not None:
-        values, name = _params(args.param), args.name or "oscillator"
-        return _report(
-            args, lambda: response_equation_json(args.model, values, args.harmonics, name,
-                                                 args.omega_min, args.omega_max, limit),
-            lambda path: _charts().response_equation_figure(
-                args.model, values, args.harmonics, path, name, args.omega_min,
-                args.omega_max, limit),
-            _response_table)
-    return _report(
-        args, lambda: response_json(args.eps, args.force, args.Q, args.harmonics,
-                                    math.inf if args.allow_slow else COST_LIMIT_SECONDS),
-        lambda path: _charts().response_figure(
-            args.eps, args.force, args.Q, args.harmonics, path,
-            math.inf if args.allow_slow else COST_LIMIT_SECONDS),
-        _response_table)
+    plot, csv = check_outputs(args)
+    r = response_report(args, limit)
+    if plot is not None and args.model is not None:
+        _charts().response_equation_figure(args.model, _params(args.param), args.harmonics,
+                                           plot, args.name or "oscillator", report=r)
+    elif plot is not None:
+        _charts().response_figure(args.eps, args.force, args.Q, args.harmonics, plot,
+                                  report=r)
+    if csv is not None:
+        response_csv(r, csv)
+    data = response_report_json(r)
+    print(json.dumps(data) if args.json else "\n".join(_response_table(data)))
+    return 0
 
 
 def _response_table(data: dict) -> list[str]:
@@ -851,6 +875,8 @@ def arguments_response(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
                     "1..2N-1, with the constant and even ones unless the force is odd)")
     _flag_json(p)
     _flag_plot(p)
+    _flag_csv(p, "the branches of the continued balance (branch, omega, r; a SYSTEM: each "
+              "coordinate's r, the largest Floquet modulus, stable)")
     _flag_allow_slow(p, deprecated_force=False)
     return p
 

@@ -21,6 +21,7 @@ from .common import (
     ProgressBar,
     _deprecated,
     _flag_allow_slow,
+    _flag_csv,
     _flag_harmonics,
     _flag_json,
     _flag_order,
@@ -35,7 +36,9 @@ from .common import (
     _positive_real,
     _rational,
     _real,
+    check_outputs,
     sp_text,
+    write_csv,
 )
 
 
@@ -78,8 +81,9 @@ def _polynomial_text(sol, c: object) -> str:
     return text[2:] if text.startswith("+ ") else "-" + text[2:]
 
 
-def series_json(sol) -> dict:
-    """The contract of ``lindstedt series MODEL --order K --json`` (keys are stable)."""
+def series_json(sol, valid=None) -> dict:
+    """The contract of ``lindstedt series MODEL --order K --json`` (keys are stable);
+    ``valid``: the solution's :class:`derive.lindstedt.Validity` when already computed."""
     m = sol.model
     data = {
         "model": m.name,
@@ -91,26 +95,37 @@ def series_json(sol) -> dict:
         "convention": sol.convention,
         "radius": None if m.radius is None else str(m.radius),
     }
-    data.update(_domain_fields(sol))
+    data.update(_domain_fields(sol, valid))
     if m.source:
         data.update(equation=m.source, omega0=str(m.frequency),
                     units="omega in units of omega0, period in units of 2*pi/omega0")
     return data
 
 
-def _domain_fields(sol) -> dict:
+def _domain_fields(sol, valid=None) -> dict:
     """Where the series may be used: ``orbit_limit`` (the family of periodic orbits exists
     for lower < y < upper, 30 digits, or ``known`` false with the reason) and, where the
     model states no radius, ``radius_estimate`` (value and spread, from the τ_j)."""
-    from ..derive.lindstedt import estimated_radius
-    from ..derive.orbits import orbit_domain
+    from ..derive.lindstedt import validity
 
-    fields = {"orbit_limit": orbit_domain(sol.model).as_json()}
-    if sol.model.radius is None and sol.ground.is_rational and sol.order >= 2:
-        found = estimated_radius(sol, {})
-        if found is not None:
-            fields["radius_estimate"] = {"value": float(found[0]), "spread": found[1]}
+    valid = validity(sol) if valid is None else valid
+    fields = {"orbit_limit": valid.orbit.as_json()}
+    if valid.exact is None and valid.radius is not None:
+        fields["radius_estimate"] = {"value": valid.radius, "spread": valid.spread}
     return fields
+
+
+def _radius_line(valid, y: str) -> str:
+    """The table's line on the radius of convergence of the series in ``y``."""
+    if valid.exact is not None:
+        shown = str(valid.exact)
+        value = "" if shown == _short(valid.radius) else f" = {valid.radius:.12g}"
+        return f"the series converges for |{y}| < {shown}{value} (the radius, exact)"
+    if valid.radius is not None:
+        return (f"the series converges for |{y}| < {valid.radius:.6g} (the radius estimated "
+                f"from tau_j to order {valid.order}, spread {valid.spread:.2g})")
+    return ("radius of convergence not estimated (symbolic coefficients, or order < 2: "
+            "raise --order, give the parameters values)")
 
 
 def _number(c: object) -> str:
@@ -131,8 +146,11 @@ def _coordinate_named(convention: str, name: str) -> str:
                                                  convention)
 
 
-def series_table(sol) -> str:
-    """Readable table: ω_j, T_j/2π and the harmonics of q_j per order."""
+def series_table(sol, valid=None) -> str:
+    """Readable table: where the series holds (its orbits, its radius), then ω_j, T_j/2π and
+    the harmonics of q_j per order (``valid``: the solution's validity when computed)."""
+    from ..derive.lindstedt import validity
+
     m = sol.model
     lines = [
         f"{m.name}: {m.title}, expansion variable {m.variable}, order {sol.order}",
@@ -140,11 +158,13 @@ def series_table(sol) -> str:
     ]
     if m.frequency != 1:
         lines.append(f"omega in units of omega0 = {m.frequency}, T in units of 2*pi/omega0")
-    domain = _domain_fields(sol)["orbit_limit"]
+    valid = validity(sol) if valid is None else valid
+    domain = valid.orbit.as_json()
     y = m.variable.partition("=")[0].strip() or m.variable
     lines.append(f"periodic orbits for {domain['lower']} < {y} < {domain['upper']} "
                  f"({domain['how']})" if domain["known"] else
                  f"orbit domain not computed: {domain['how']}")
+    lines.append(_radius_line(valid, y))
     if sol.ground.is_rational:
         lines.append(f"{'j':>3}  {'omega_j':>24}  {'(T/2pi)_j':>24}  "
                      f"{m.coordinate}_j: harmonic n -> coefficient")
@@ -215,13 +235,18 @@ def _cycles_text(model, listed: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def limit_cycle_table(lc) -> str:
-    """The text table of a limit cycle's series: its convention and stability, then
+def limit_cycle_table(lc, reach=None) -> str:
+    """The text table of a limit cycle's series: its convention and stability (and the radius
+    of ω's series, ``reach``: :class:`analysis.curves.CycleRadius`, when computed), then
     ``ω_j``, ``(T/2π)_j`` and ``amplitude_j``, exact, for each order ``j``."""
     m = lc.model
     lines = [f"{m.name}: {m.title}, a limit cycle, expansion variable eps, order {lc.order}",
              "convention: q'(0) = 0, q(0) = sum_j amplitude_j eps^j",
              f"stability: {limit_cycle_stability(lc)}",
+             *([] if reach is None else [
+                 f"omega's series converges for |eps| < {reach.value:.6g} (estimated, spread "
+                 f"{reach.spread:.2g})" if reach.value is not None else
+                 "radius of convergence in eps not estimated at this order (from about 24)"]),
              f"{'j':>3}  {'omega_j':>22}  {'(T/2pi)_j':>22}  {'amplitude_j':>22}"]
     def shown(c: object) -> str:  # an integer as a reader writes it: 1, 0, 2
         text = _fraction_text(c)
@@ -233,19 +258,43 @@ def limit_cycle_table(lc) -> str:
     return "\n".join(lines)
 
 
+SERIES_CSV = (("omega", "frequency in units of omega0"),
+              ("period", "T/(2*pi) in units of 1/omega0"))
+
+
+def series_csv(c, path: Path) -> Path:
+    """The CSV of ``series --csv`` of a free oscillator: the points of
+    :class:`analysis.curves.SeriesCurves`, as drawn."""
+    columns = (("y", f"expansion variable {c.variable}"), *SERIES_CSV,
+               ("converges", "1 where |y| < the radius and a periodic orbit exists"))
+    return write_csv(path, columns, zip(c.y, c.omega, c.period, map(bool, c.inside),
+                                        strict=True))
+
+
+def cycle_csv(c, path: Path) -> Path:
+    """The CSV of ``series --csv`` of a limit cycle: :class:`analysis.curves.CycleCurves`."""
+    columns = (("eps", "the small parameter"), ("amplitude", "q(0) at q'(0) = 0"),
+               *SERIES_CSV)
+    return write_csv(path, columns, zip(c.eps, c.amplitude, c.omega, c.period, strict=True))
+
+
 def run_series(args: argparse.Namespace) -> int:
     """Run ``lindstedt series MODEL``: the exact L–P series of a free oscillator, or of a
-    self-excited one's limit cycles (``--cycle``: one of them); ``--singularities``: the
-    nearest singularity of ω.  Prints a table or JSON; returns the exit status."""
+    self-excited oscillator's limit cycles (``--cycle``: one of them); ``--singularities``:
+    the nearest singularity of ω; ``--plot``, ``--csv``: its curves.  Prints a table or
+    JSON; returns the exit status."""
     from ..derive.cycles import derive_limit_cycle, limit_cycles
-    from ..derive.lindstedt import derive
+    from ..derive.lindstedt import derive, validity
     from ..derive.models import SelfExcited, series_model
 
+    plot, csv = check_outputs(args)
     found = series_model(args.model, args.order, _params(args.param), args.name)
     if args.cycle is not None and not isinstance(found, SelfExcited):
         raise InputError(f"--cycle {args.cycle}: {args.model!r} is conservative: a family of "
                          "orbits, no limit cycles to pick from")
     if isinstance(found, SelfExcited):
+        from ..analysis.curves import cycle_curves, cycle_radius
+
         cycles = limit_cycles(found)
         if args.cycle is not None and not 1 <= args.cycle <= len(cycles):
             raise InputError(f"--cycle {args.cycle}: {found.name} has {len(cycles)} limit "
@@ -253,7 +302,10 @@ def run_series(args: argparse.Namespace) -> int:
         listed = _cycles_json(cycles)
         first = args.cycle if args.cycle is not None else 1
         lc = derive_limit_cycle(found, args.order, first - 1)
-        data = {**limit_cycle_json(lc), "cycle": first, "cycles": listed}
+        reach = cycle_radius(lc)
+        data = {**limit_cycle_json(lc), "cycle": first, "cycles": listed,
+                "radius_estimate": None if reach.value is None else
+                {"variable": "eps", "value": reach.value, "spread": reach.spread}}
         omega = lc.omega
         # the table: the cycle asked for, or each in turn (one that cannot be expanded says why)
         texts = [_cycles_text(found, listed)]
@@ -262,25 +314,40 @@ def run_series(args: argparse.Namespace) -> int:
         for k in shown:
             c = cycles[k - 1]
             if k == first:
-                texts.append(f"cycle {k}: " + limit_cycle_table(lc))
+                texts.append(f"cycle {k}: " + limit_cycle_table(lc, reach))
             elif c.slope == 0:
                 texts.append(f"cycle {k}: not expanded: {c.stability}")
             else:
                 texts.append(f"cycle {k}: " + limit_cycle_table(
                     derive_limit_cycle(found, args.order, k - 1)))
         text = "\n\n".join(texts)
+        curves = cycle_curves(lc, reach) if plot or csv else None
+        draw, tabulate = "cycle_figure", cycle_csv
     else:
         model = found  # series_model built it (model_from_text): parse and expand once
         progress = ProgressBar(f"deriving {model.name} to order {args.order}", not args.json)
         sol = derive(model, args.order, progress)
         progress.close()
-        data = series_json(sol)
-        text = "" if args.json else series_table(sol)  # build only what is printed
+        valid = validity(sol)
+        data = series_json(sol, valid)
+        text = "" if args.json else series_table(sol, valid)  # build only what is printed
         omega = [sol.ground.to_fraction(c) for c in sol.omega] if sol.ground.is_rational \
             else None
+        if plot or csv:
+            from ..analysis.curves import series_curves
+
+            curves = series_curves(sol, valid, " and ".join(
+                f for f, given in (("--plot", plot), ("--csv", csv)) if given))
+        draw, tabulate = "series_figure", series_csv
     if args.singularities:
         data["singularities"], line = _singularities(omega, data["variable"])
         text += "\n" + line
+    if plot is not None:
+        from .. import charts_series
+
+        getattr(charts_series, draw)(curves, plot)
+    if csv is not None:
+        tabulate(curves, csv)
     print(json.dumps(data) if args.json else text)
     return 0
 
@@ -474,20 +541,37 @@ def run_slowflow(args: argparse.Namespace) -> int:
     from ..derive.averaging import slow_flow
     from ..derive.models import oscillator, registry_entry
 
+    portrait_flags = [f for f, given in (("--plot", args.plot), ("--csv", args.csv),
+                                         ("--eps", args.eps is not None),
+                                         ("--sigma", args.sigma is not None)) if given]
     if ";" in args.model:  # a system: its modes in internal resonance
         from .system import run_slowflow_system
 
+        if portrait_flags:
+            raise InputError(f"{', '.join(portrait_flags)}: a system's slow flow is printed, "
+                             "not drawn (not built)")
         args.order = 1 if args.order is None else args.order
         return run_slowflow_system(args)
     args.order = 2 if args.order is None else args.order
     if args.start:
         raise InputError("--start: a system's flag (equations separated by ';')")
+    if (args.eps is not None or args.sigma is not None) and not (args.plot or args.csv):
+        raise InputError("--eps/--sigma: the portrait's values; give --plot or --csv")
+    plot, csv = check_outputs(args)
     text, name = args.model, args.name or "oscillator"
     if (entry := registry_entry(text)) is not None:  # a name or its alias (vdp)
         text, name = entry.equation, args.name or entry.name
     out = _out_folder(args.out) if args.out is not None else None
     osc = oscillator(text, _params(args.param), name)
     flow = slow_flow(osc, args.order)
+    drawn = None
+    if plot or csv:
+        from ..analysis.curves import portrait
+
+        if args.sigma is not None and not flow.driven:
+            raise InputError("--sigma: the detuning of a drive; this flow is not driven")
+        drawn = portrait(flow, PORTRAIT_EPS if args.eps is None else args.eps,
+                         {"sigma": args.sigma or 0.0} if flow.driven else {})
     written = []
     if out is not None:  # written before anything is printed: a refusal prints nothing
         from ..compiler import generate_slow_flow
@@ -496,6 +580,12 @@ def run_slowflow(args: argparse.Namespace) -> int:
         command = f'lindstedt slowflow "{text}" --name {name} --order {args.order}{params}'
         written = generate_slow_flow(osc, args.order, command, out,
                                      overwrite_edited=args.overwrite_edited)
+    if plot is not None:
+        from ..charts_series import portrait_figure
+
+        portrait_figure(drawn, plot)
+    if csv is not None:
+        portrait_csv(drawn, csv)
     if args.json:
         print(json.dumps(slow_flow_json(flow)))
     else:
@@ -515,6 +605,20 @@ def run_slowflow(args: argparse.Namespace) -> int:
     for path in written:
         print(f"  {path}", file=sys.stderr if args.json else sys.stdout)
     return 0
+
+
+PORTRAIT_EPS = 0.1
+# NOTE: the ε of `slowflow --plot/--csv` without --eps: small enough for the averaged flow to
+# hold over the slow times drawn, at any order.
+
+
+def portrait_csv(p, path: Path) -> Path:
+    """The CSV of ``slowflow --csv``: every trajectory of :class:`analysis.curves.Portrait`,
+    point by point, as drawn."""
+    columns = (("trajectory", "number from 1"), ("t", "time"), ("x", "r cos(phi)"),
+               ("y", "r sin(phi)"))
+    return write_csv(path, columns, ((k, *point) for k, tr in enumerate(p.trajectories, 1)
+                                     for point in tr.T))
 
 
 def run_models(args: argparse.Namespace) -> int:
@@ -647,6 +751,12 @@ def arguments_series(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    "(Domb–Sykes or Mercer–Roberts, extrapolated in 1/n; their spread over the "
                    "last orders); with --json a key 'singularities'")
     _flag_json(p)
+    p.add_argument("--plot", metavar="FILE",
+                   help="also draw into FILE (.png, .svg or .pdf) ω and T against the "
+                   "expansion variable y, with the orbits' edge and the radius of convergence "
+                   "marked; a limit cycle: its amplitude and ω against ε (default: none)")
+    _flag_csv(p, "the curves drawn by --plot (y, omega, period, converges; a limit cycle: "
+              "eps, amplitude, omega, period)")
     _flag_allow_slow(p)
     return p
 
@@ -779,5 +889,15 @@ def arguments_slowflow(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
     p.add_argument("--out", metavar="DIR", help="also write <name>_slow_flow.py (numba "
                    "slow_flow, slow_flow_jacobian, slow_flow_cartesian) and "
                    "<name>_slow_flow.tex into DIR")
+    p.add_argument("--plot", metavar="FILE",
+                   help="also draw the phase portrait into FILE (.png, .svg or .pdf): "
+                   "trajectories in the plane (r cos phi, r sin phi) from 8 starts, the limit "
+                   "cycles and fixed points (default: none)")
+    _flag_csv(p, "the portrait's trajectories (trajectory, t, x = r cos phi, y = r sin phi)")
+    p.add_argument("--eps", type=_real, default=None, metavar="EPS",
+                   help=f"with --plot/--csv: the value of eps (default {PORTRAIT_EPS})")
+    p.add_argument("--sigma", type=_real, default=None, metavar="SIGMA",
+                   help="with --plot/--csv, a driven flow: the detuning sigma of w = 1 + "
+                   "eps*sigma (default 0)")
     _flag_overwrite_edited(p)
     return p

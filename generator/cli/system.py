@@ -15,10 +15,13 @@ from ..errors import InputError
 from .common import (
     ProgressBar,
     _flag_allow_slow,
+    _flag_csv,
     _flag_json,
     _flag_order,
     _order,
     _params,
+    check_outputs,
+    write_csv,
 )
 
 CONVENTION = ("at t = 0 every velocity is zero and {a}(0) = A (a turning point); "
@@ -64,21 +67,28 @@ def nnm_table(data: dict) -> str:
     return "\n".join(lines)
 
 
+def backbone_csv(b, path: Path) -> Path:
+    """``nnm --csv``: the mode's backbone (:class:`analysis.curves.Backbone`), from its series
+    to --order, up to 95 % of its estimated reach."""
+    columns = (("A", f"amplitude of {b.amplitude} at its turning point"),
+               ("omega", "frequency"), ("period", "T"))
+    return write_csv(path, columns, zip(b.A, b.omega, b.period, strict=True))
+
+
 def run_nnm(args: argparse.Namespace) -> int:
     """Run ``lindstedt nnm``: parse the system, derive the mode, print JSON or the table."""
     from ..derive.nnm import normal_mode
     from ..derive.system import parse_system
 
-    if args.plot:
-        from ..charts import check_plot_path
-
-        check_plot_path(Path(args.plot))
+    plot, csv = check_outputs(args)
     system = parse_system(args.system, _params(args.param), symbolic=True)
     symbols = sorted({str(s) for f in system.force for s in f.free_symbols}
                      - {str(x) for x in (*system.coordinates, *system.velocities)})
-    if symbols and args.plot:
-        raise InputError(f"--plot: give {', '.join(symbols)} a value with --param (the chart "
-                         "evaluates the series; without a value it is kept as a symbol)")
+    if symbols and (plot or csv):
+        flags = " and ".join(f for f, given in (("--plot", plot), ("--csv", csv)) if given)
+        raise InputError(f"{flags}: give {', '.join(symbols)} a value with --param (the chart "
+                         "and the CSV evaluate the series; without a value it is kept as a "
+                         "symbol)")
     names = [str(x) for x in system.coordinates]
     amplitude = 0
     if args.amplitude is not None:
@@ -92,10 +102,14 @@ def run_nnm(args: argparse.Namespace) -> int:
     finally:
         progress.close()
     data = nnm_json(mode)
-    if args.plot:
+    if plot is not None:
         from ..charts_modes import FEP_ORDER, nnm_figure
 
-        nnm_figure(system, Path(args.plot), max(args.order, FEP_ORDER))
+        nnm_figure(system, plot, max(args.order, FEP_ORDER))
+    if csv is not None:
+        from ..analysis.curves import backbone
+
+        backbone_csv(backbone(mode), csv)
     print(json.dumps(data) if args.json else nnm_table(data))
     return 0
 
@@ -205,6 +219,8 @@ def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    "FILE (.png, .svg or .pdf): each backbone from its series (to order 24, or "
                    "--order if higher) beside orbits shot by DOP853, the series' reach, the "
                    "internal-resonance lines (default: none)")
+    _flag_csv(p, "the mode's backbone (A, omega, period) summed from its series to --order, "
+              "up to 95 % of the series' estimated reach (to A = 0.95 without an estimate)")
     _flag_allow_slow(p, deprecated_force=False)
     return p
 
@@ -294,22 +310,32 @@ def response_system_table(data: dict) -> list[str]:
     return lines
 
 
+def response_system_csv(r, path: Path) -> Path:
+    """``response SYSTEM --csv``: every point of every branch, as drawn and in the JSON."""
+    names = [str(x) for x in r.system.coordinates]
+    columns = (("branch", "number from 1"), ("omega", "drive frequency"),
+               *((f"r_{n}", f"first harmonic of {n}") for n in names),
+               ("multiplier", "largest Floquet modulus"), ("stable", "1 if stable"))
+    rows = ((k, r.cont.omega[i], *r.amplitudes[i], r.multiplier[i], bool(r.stable[i]))
+            for k, piece in enumerate(r.cont.piece_slices(), 1)
+            for i in range(len(r.cont.omega))[piece])
+    return write_csv(path, columns, rows)
+
+
 def run_response_system(args: argparse.Namespace, limit: float) -> int:
     """Run ``lindstedt response SYSTEM``: every branch of the driven, damped system's response
     over ω, as a table, JSON or a figure."""
     from ..analysis.systems import system_response
 
-    plot = None
-    if args.plot:
-        from ..charts import check_plot_path
-
-        plot = check_plot_path(Path(args.plot))
+    plot, csv = check_outputs(args)
     r = system_response(args.model, _params(args.param), args.harmonics, args.omega_min,
                         args.omega_max, limit)
     if plot is not None:
         from ..charts_modes import response_system_figure
 
         response_system_figure(r, plot)
+    if csv is not None:
+        response_system_csv(r, csv)
     data = response_system_json(r)
     print(json.dumps(data) if args.json else "\n".join(response_system_table(data)))
     return 0

@@ -789,3 +789,40 @@ def estimated_radius(solution: SeriesSolution, to_args: dict,
 DOMB_SYKES_FIT = 0.02
 # NOTE: the largest relative misfit of the ratios' line for its R to count (a pair of complex
 # singularities makes the ratios oscillate: no line, no estimate from it)
+
+
+@dataclass(frozen=True)
+class Validity:
+    """Where a free oscillator's series may be used: the family of periodic orbits
+    (``orbit``, a :class:`derive.orbits.OrbitDomain` in ``y``) and the radius of convergence
+    of ``T/2π = Σ τ_j y^j`` in ``|y|`` — the model's exact one (``exact``, ``spread`` 0), or
+    :func:`estimated_radius` from the τ_j of the solution (``exact`` None), or none
+    (``radius`` None: symbolic coefficients, or too few orders)."""
+
+    orbit: Any  # OrbitDomain (derive.orbits, imported lazily: mpmath, SciPy)
+    radius: float | None
+    exact: sp.Expr | None
+    spread: float
+    order: int  # the order the estimate was made from
+
+    @property
+    def reach(self) -> float | None:
+        """The radius less its spread (where the evaluators stop), or None."""
+        return None if self.radius is None else self.radius - self.spread
+
+
+def validity(solution: SeriesSolution) -> Validity:
+    """The :class:`Validity` of ``solution``: its orbit domain and its radius, the one
+    computation the JSON, the table, the figure and the LaTeX print."""
+    from .orbits import orbit_domain
+
+    m = solution.model
+    orbit = orbit_domain(m)
+    if m.radius is not None:
+        value = float(m.radius) if m.radius.is_number else None
+        return Validity(orbit, value, m.radius, 0.0, solution.order)
+    if solution.ground.is_rational and solution.order >= 2:
+        found = estimated_radius(solution, {})
+        if found is not None:
+            return Validity(orbit, float(found[0]), None, float(found[1]), solution.order)
+    return Validity(orbit, None, None, 0.0, solution.order)

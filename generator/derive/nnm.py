@@ -20,6 +20,7 @@ Exact over Q when ``λ`` is rational, else over the number field Q(λ); ω itsel
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -31,6 +32,7 @@ from sympy.polys.domains import QQ
 from ..algebra.series import Basis, Ground, from_fourier, to_fourier
 from ..errors import InputError
 from ..limits import check_int
+from .lindstedt import nearest_singularity
 from .system import System
 
 NNM_MAX_ORDER = 200
@@ -338,3 +340,15 @@ def _resonance(system: System, mode: int, lams: tuple, n: int, j: int, step: int
             f"with {which}: harmonic {n} of order {j} in {power} forces it, and the L–P "
             "series of the mode does not exist there (the modes exchange energy: lindstedt "
             "slowflow SYSTEM gives their slow flow)")
+
+
+def radius(mode: NormalModeSeries) -> tuple[float, float] | None:
+    """The estimated radius of convergence of ω in ``y`` and its spread, or None when the
+    series is too short for an estimate."""
+    est = nearest_singularity([c / mode.omega0 for c in mode.omega()], "y", None)
+    if est is None:
+        return None
+    if est.variable.endswith("**2"):
+        r = math.sqrt(est.radius)
+        return r, est.spread / (2 * r)
+    return est.radius, est.spread

@@ -32,6 +32,7 @@ from ..lower.printers import (
     latex_lines,
     latex_rational,
     latex_sum_items,
+    latex_validity,
     latex_width,
     pycode,
 )
@@ -290,6 +291,7 @@ def latex_context(d: Derivation) -> dict:
         "period": _series(r"2\pi\Bigl(", powers(d.period), rest + r"\Bigr)", "T ="),
         "frequency": _series("", powers(d.omega), rest, r"\omega ="),
         "orders": orders,
+        "validity": latex_validity(d.validity, y),
     }
 
 

@@ -17,7 +17,7 @@ from ..derive.averaging import U as U_SLOW
 from ..derive.averaging import V as V_SLOW
 from ..derive.cycles import LimitCycle
 from ..derive.equation import parse_equation
-from ..derive.lindstedt import SeriesSolution, order_terms
+from ..derive.lindstedt import SeriesSolution, order_terms, validity
 from ..derive.models import Model
 from ..errors import InputError
 from .forms import _LOCAL, LOCAL_NAMES, MODULE_NAMES, agm_steps, harmonics
@@ -131,7 +131,7 @@ def lower_derivation(solution: SeriesSolution, order: int) -> Derivation:
         period=tuple(exact(g, c) for c in solution.period[: order + 1]),
         q=tuple(tuple((n, exact(g, c)) for n, c in sorted(solution.q[j].items()))
                 for j in range(order + 1)),
-        orders=tuple(pieces))
+        orders=tuple(pieces), validity=validity(solution))
 
 
 def _rational_items(d: dict) -> tuple[tuple[int, sp.Rational], ...]:

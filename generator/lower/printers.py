@@ -495,3 +495,35 @@ def _distributed(expr: sp.Expr) -> sp.Expr:
         num, den = sp.fraction(sp.together(term))
         out += [t / den for t in sp.Add.make_args(sp.expand(num))]
     return sp.Add(*out)
+
+
+def _edge(text: str) -> str:
+    """An orbit edge (30 digits) as a reader reads it: 12 significant digits.
+
+    >>> _edge("9.86960440108935861883449099988"), _edge("-1.0")
+    ('9.86960440109', '-1')
+    """
+    return f"{float(text):.12g}"
+
+
+def latex_validity(valid, y: str) -> str:
+    """Where a free oscillator's series holds, as a LaTeX sentence: the range of ``y`` over
+    which its periodic orbits exist (``valid.orbit``) and the radius of convergence of its
+    series (:class:`derive.lindstedt.Validity`, exact or estimated)."""
+    o = valid.orbit
+    lo = "" if math.isinf(o.lower) else f"{_edge(o.lower_text)} < "
+    hi = "" if math.isinf(o.upper) else f" < {_edge(o.upper_text)}"
+    orbits = ("the range of the periodic orbits was not computed" if not o.known else
+              f"periodic orbits exist for ${lo}{y}{hi}$" if lo or hi else
+              f"periodic orbits exist for every ${y}$ searched")
+    if valid.exact is not None:
+        radius = (f"the series converge for $|{y}| < {sp.latex(valid.exact)}$ (the radius of "
+                  "convergence, exact)")
+    elif valid.radius is not None:
+        radius = (f"the series of $T$ converges for $|{y}| < {valid.radius:.6g}$ (the radius "
+                  f"of convergence estimated from the $\\tau_j$ to order {valid.order}, spread "
+                  f"${valid.spread:.2g}$)")
+    else:
+        radius = "no radius of convergence is estimated"
+    return (f"Validity: {orbits}; {radius}.  The truncated sums hold only where both "
+            "do.")

@@ -14,6 +14,7 @@ from .. import __version__
 from ..algebra.resum import Resummed
 from ..analysis.mu_exact import MuDampedOrder, MuOrder
 from ..derive.equation import Equation
+from ..derive.lindstedt import Validity
 
 Assign = tuple[sp.Symbol, sp.Expr]
 
@@ -227,6 +228,7 @@ class Derivation:
     period: tuple[sp.Expr, ...]
     q: tuple[tuple[tuple[int, sp.Expr], ...], ...]
     orders: tuple[OrderPieces, ...]
+    validity: Validity  # the orbits' range and the radius of convergence
 
 
 @dataclass(frozen=True)

@@ -4,12 +4,9 @@ series of ω, less its spread) [NormalModeSeries -> Module]."""
 
 from __future__ import annotations
 
-import math
-
 import sympy as sp
 
-from ..derive.lindstedt import nearest_singularity
-from ..derive.nnm import NormalModeSeries
+from ..derive.nnm import NormalModeSeries, radius
 from ..errors import InputError
 from .forms import MODULE_NAMES, argument_entry, harmonics, horner
 from .printers import identifier
@@ -23,18 +20,6 @@ DIGITS = 30
 
 def _float(c: sp.Expr) -> sp.Float:
     return sp.Float(sp.N(c, DIGITS), 17)
-
-
-def radius(mode: NormalModeSeries) -> tuple[float, float] | None:
-    """The estimated radius of convergence of ω in ``y`` and its spread, or None when the
-    series is too short for an estimate."""
-    est = nearest_singularity([c / mode.omega0 for c in mode.omega()], "y", None)
-    if est is None:
-        return None
-    if est.variable.endswith("**2"):
-        r = math.sqrt(est.radius)
-        return r, est.spread / (2 * r)
-    return est.radius, est.spread
 
 
 def lower_nnm(mode: NormalModeSeries, order: int, name: str, command: str) -> Module:
