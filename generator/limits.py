@@ -58,6 +58,18 @@ PARAMETRIC_MAX_POINTS = 401
 # NOTE: ω points of `parametric`'s range: 401 draw a smooth curve; their cost with --harmonics
 # is costs.parametric_cost's.
 
+EXCHANGE_MAX_STEPS = 20_000
+# NOTE: DOP853 steps of a resonant slow flow's energy exchange (rescaled to unit amplitude, so
+# the count does not grow with it): two exchanges take 10–300 steps on the documented systems,
+# ~0.3 ms each; a start that finds no two maxima in 20 000 (about 6 s) reports NaN.
+WEAK_NONLINEARITY = 1.0
+# NOTE: the first-order slow flow of a system's resonant modes averages a weak nonlinear force
+# over the linear modes' fast oscillation.  Where the nonlinear force at the start's peak
+# coordinates reaches the slowest mode's linear restoring force ω0²·a, it can cancel it: the
+# motion is no slowly modulated linear mode and no time scales separate; `slowflow SYSTEM
+# --start` refuses there (its error grows like that ratio well before: 1.5 % at 0.3 for the
+# swing spring, tests/test_resonance.py).
+
 # --- work -------------------------------------------------------------------------------------
 
 COST_LIMIT_SECONDS = 60.0

@@ -119,3 +119,57 @@ def test_slowflow_system_json_and_refusals():
         bad = run("slowflow", *args)
         assert bad.returncode == 2 and bad.stdout == "", (args, bad.stderr)
         assert len(bad.stderr.strip().splitlines()) == 1 and says in bad.stderr, bad.stderr
+
+
+QUADRATIC_1_2 = "x1'' + x1 + x1*x2 = 0; x2'' + 4*x2 + x1**2 = 0"
+
+
+def test_exchange_period_at_a_large_amplitude_takes_the_steps_of_a_small_one():
+    """From a₁ = a₂ = 1000 two maxima of a₁ come within the 200 steps that suffice at 0.1 (the
+    integration is no longer over a span fixed in time, which a large amplitude's fast exchange
+    filled with ~amplitude × more steps), and the period is that of SciPy's own events on the
+    unscaled flow, integrated over a span fitted to it; the step bound is honoured (NaN)."""
+    flow = resonant_flow(parse_system(QUADRATIC_1_2))
+    rates = sp.lambdify([(*flow.a, *flow.phi)], [*flow.amplitude, *flow.phase], "numpy")
+
+    def peak(t, y):
+        return rates(y)[0]
+    peak.direction = -1
+    for a in (0.1, 1000.0):
+        period = exchange_period(flow, (a, a), max_steps=200)
+        sol = solve_ivp(lambda t, y: rates(y), (0, 30 / a), [a, a, 0, 0], method="DOP853",
+                        rtol=1e-11, atol=1e-14 * a, events=peak)
+        times = sol.t_events[0]
+        assert period == pytest.approx(times[1] - times[0], rel=1e-8), a
+    assert np.isnan(exchange_period(flow, (1000.0, 1000.0), max_steps=5))
+
+
+@pytest.mark.parametrize("value", ["1000", "1e40"])
+def test_slowflow_start_beyond_the_weak_nonlinearity_is_refused(value, capsys):
+    """At a₁ = a₂ = a the peaks are x₁ = x₂ = a and the forces x₁x₂ = x₁² = a² against
+    ω0₁²·a = a: a times the linear force, so a ≤ 1 (by hand); refused in one line that says
+    so, before any integration; a = 0.5 runs."""
+    from lindstedt.cli import main
+
+    status = main(["slowflow", QUADRATIC_1_2, "--start", f"a1={value}", "--start",
+                   f"a2={value}"])
+    out = capsys.readouterr()
+    assert status == 2 and out.out == "", out
+    line, = out.err.strip().splitlines()
+    assert f"--start a1={float(value):g}, a2={float(value):g}" in line
+    assert f"is {float(value):.3g} times" in line and "weak nonlinearity" in line
+    assert "largest is ≤ 1" in line and "finite" not in line
+    assert main(["slowflow", QUADRATIC_1_2, "--start", "a1=0.5", "--start", "a2=0.5"]) == 0
+
+
+def test_slowflow_system_cost_does_not_grow_with_the_start():
+    """The estimate is bounded (the integration is bounded by steps), whatever --start says."""
+    import argparse
+
+    from lindstedt.costs import slow_flow_cost
+    from lindstedt.limits import COST_LIMIT_SECONDS
+
+    costs = {slow_flow_cost(argparse.Namespace(model=QUADRATIC_1_2, order=None,
+                                               start=[f"a1={a}"])).seconds
+             for a in ("0.1", "1000", "1e40")}
+    assert len(costs) == 1 and 2 < costs.pop() < COST_LIMIT_SECONDS

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import textwrap
 from pathlib import Path
 
@@ -181,12 +182,32 @@ def run_slowflow_system(args: argparse.Namespace) -> int:
             number = float(value)
         except ValueError:
             raise InputError(f"--start {pair!r}: {value!r} is not a number") from None
-        if not 0 < number < 1e6:
+        if not 0 < number < math.inf:
             raise InputError(f"--start {pair!r}: an amplitude must be > 0 and finite")
         start[names.index(name.strip())] = number
+    check_weak(flow, start, bool(args.start))
     data = resonant_json(flow, start)
     print(json.dumps(data) if args.json else resonant_table(data))
     return 0
+
+
+def check_weak(flow, start: list[float], given: bool) -> None:
+    """Refuse a start (``given`` by --start, else the default) where the nonlinear force
+    reaches the linear one (limits.WEAK_NONLINEARITY): the first-order slow flow assumes a
+    weak nonlinearity."""
+    from ..derive.resonance import force_ratio
+    from ..limits import WEAK_NONLINEARITY
+
+    log_ratio, factor = force_ratio(flow, tuple(start), WEAK_NONLINEARITY)
+    if log_ratio <= math.log10(WEAK_NONLINEARITY):
+        return
+    values = ", ".join(f"a{k}={a:g}" for k, a in enumerate(start, 1))
+    ratio = f"{10**log_ratio:.3g}" if log_ratio < 300 else f"1e{log_ratio:.0f}"
+    raise InputError(
+        f"{'--start' if given else 'the default start'} {values}: the nonlinear force there "
+        f"is {ratio} times the slowest mode's linear restoring force ω0²·a, where the "
+        f"first-order slow flow needs a weak nonlinearity (below {WEAK_NONLINEARITY:g}×): "
+        f"scale the amplitudes so that the largest is ≤ {max(start) * factor:.3g}")
 
 
 def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -12,6 +12,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.special import ellipj, ellipk
 
+from ..limits import EXCHANGE_MAX_STEPS
+
 
 def duffing_period_exact(A: ArrayLike, eps: ArrayLike) -> np.ndarray:
     """``T = 4K(m)/√(1+x)``, ``m = x/(2(1+x))``, ``x = εA²`` (notes App. 4.9); NaN for x ≤ -1.
@@ -356,32 +358,43 @@ def mode_orbit(system: object, A: float, guess: np.ndarray, amplitude: int = 0,
     return ModeOrbit(start, 2 * u[-1], float(system_energy(system)(start)), converged)
 
 
-def exchange_period(flow: object, start: Sequence[float], t_max: float = 1e6) -> float:
+def exchange_period(flow: object, start: Sequence[float],
+                    max_steps: int = EXCHANGE_MAX_STEPS) -> float:
     """The energy-exchange period of a resonant slow flow (a :class:`derive.resonance.
     ResonantFlow`) from amplitudes ``start`` and zero phases: the time between two successive
-    maxima of the first mode's amplitude, by DOP853 on the averaged equations; NaN if none
-    within ``t_max``."""
+    maxima of the first mode's amplitude, by DOP853 on the averaged equations; NaN if there are
+    not two within ``max_steps`` steps (or the step size collapses where an amplitude nears 0,
+    its phase's rate ~ 1/a).
+
+    The flow is homogeneous (``a_k'`` of degree d, ``φ_k'`` of degree d − 1 in the amplitudes,
+    d the force's lowest degree): ``a(t) → λa(λ^{d−1}t)`` maps solutions to solutions.  So the
+    flow is integrated from ``start / max(start)`` and its period divided by
+    ``max(start)^{d−1}``: the same steps whatever the amplitude (integrated as given, a large
+    start's fast exchange over a fixed span took ~ amplitude^{d−1} steps)."""
     import sympy as sp
-    from scipy.integrate import solve_ivp
+    from scipy.integrate import DOP853
+    from scipy.optimize import brentq
 
     n = len(flow.a)
+    scale = max(start)
     rates = sp.lambdify([(*flow.a, *flow.phi)], [*flow.amplitude, *flow.phase], "numpy")
-
-    def rhs(t: float, y: np.ndarray) -> list[float]:
-        return rates(y)
-
-    def peak(t: float, y: np.ndarray) -> float:
-        return rates(y)[0]
-    peak.direction = -1
-    y0 = [*start, *([0.0] * n)]
-    span = 100.0
-    while span <= t_max:
-        sol = solve_ivp(rhs, (0.0, span), y0, method="DOP853", rtol=1e-11, atol=1e-14,
-                        events=peak)
-        times = sol.t_events[0]
-        if len(times) >= 2:
-            return float(times[1] - times[0])
-        span *= 4
+    y0 = np.array([*(a / scale for a in start), *([0.0] * n)])
+    solver = DOP853(lambda t, y: rates(y), 0.0, y0, math.inf, rtol=1e-11, atol=1e-13)
+    maxima: list[float] = []
+    before = rates(y0)[0]
+    for _ in range(max_steps):
+        solver.step()
+        if solver.status != "running":
+            return math.nan
+        now = rates(solver.y)[0]
+        if before >= 0 >= now:  # a₁' falls through 0 in this step (solve_ivp's event rule)
+            dense = solver.dense_output()
+            maxima.append(brentq(lambda t, dense=dense: rates(dense(t))[0], solver.t_old,
+                                 solver.t, xtol=4 * np.finfo(float).eps))
+            if len(maxima) == 2:
+                log = math.log(maxima[1] - maxima[0]) - (flow.degree - 1) * math.log(scale)
+                return math.exp(log) if log < 709 else math.inf
+        before = now
     return math.nan
 
 
