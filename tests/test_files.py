@@ -122,6 +122,56 @@ def test_stale_temporaries_of_a_killed_run_are_cleaned(tmp_path):
     assert len({inputs_hash(tmp_path / name) for name in SET}) == 1
 
 
+WRITER = """
+import sys, time
+from pathlib import Path
+from lindstedt.emit import render
+
+real = render._FolderLock
+
+
+class Paused(real):  # its temporaries are written: wait for the go before installing
+    def __enter__(self):
+        print("written", flush=True)
+        while not Path(sys.argv[2]).exists():
+            time.sleep(0.01)
+        return super().__enter__()
+
+
+render._FolderLock = Paused
+render.write_files(Path(sys.argv[1]), {"a.txt": b"first a", "b.txt": b"first b"},
+                   ours=lambda path: "generated")
+"""
+
+
+def test_concurrent_runs_into_one_folder_keep_each_others_temporaries(tmp_path):
+    """A second run with the same names, whose clean-up runs while the first has written its
+    temporaries, leaves them (their owner lives) and removes those of a dead process; both runs
+    succeed, each installs a whole set, and no temporary is left."""
+    out, go = tmp_path / "out", tmp_path / "go"
+    out.mkdir()
+    ended = subprocess.Popen([sys.executable, "-c", "pass"])
+    ended.wait()
+    (out / f".a.txt.{ended.pid}-gone.tmp").write_bytes(b"a killed run's")
+    first = subprocess.Popen([sys.executable, "-c", WRITER, str(out), str(go)],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert first.stdout.readline() == "written\n", first.stderr.read()
+        theirs = sorted(p.name for p in out.glob(f".*.{first.pid}-*.tmp"))
+        assert len(theirs) == 2
+        emit.write_files(out, {"a.txt": b"second a", "b.txt": b"second b"},
+                         ours=lambda path: "generated")
+        assert sorted(p.name for p in out.glob(".*.tmp")) == theirs  # the dead one's removed
+        assert [(out / n).read_bytes() for n in ("a.txt", "b.txt")] == [b"second a",
+                                                                         b"second b"]
+    finally:
+        go.touch()
+        _, err = first.communicate(timeout=60)
+    assert first.returncode == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["a.txt", "b.txt"]
+    assert [(out / n).read_bytes() for n in ("a.txt", "b.txt")] == [b"first a", b"first b"]
+
+
 @pytest.mark.parametrize("delay", [0.5, 1.5, 3.0])
 def test_sigkill_never_leaves_a_mixed_set(tmp_path, delay):
     """Killed at any moment while regenerating a set at another order, the folder holds the

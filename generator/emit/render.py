@@ -602,17 +602,63 @@ def check_writable(out: Path, names: list[str], flag: str = "--out",
         check_target(out / name, flag, overwrite_edited)
 
 
+def _stale(temporary: Path, name: str) -> bool:
+    """Whether a temporary of ``name`` belongs to no live run: named ``.NAME.PID-TOKEN.tmp``
+    (or ``.old``, :func:`_temporary`) by a process that has ended, or unnamed (an earlier
+    version's).  Signal 0 asks whether a process runs without sending anything; another
+    user's process refuses it, and lives."""
+    owner = re.fullmatch(rf"\.{re.escape(name)}\.(\d+)-[^.]*\.(?:tmp|old)", temporary.name)
+    if owner is None:
+        return True
+    try:
+        os.kill(int(owner.group(1)), 0)
+    except ProcessLookupError:
+        return True
+    except PermissionError:
+        return False
+    return False
+
+
 def _clean_stale(out: Path, names: list[str]) -> None:
     """Temporaries of an earlier run that was killed: new files are deleted, a displaced old
-    file whose target is missing is put back."""
+    file whose target is missing is put back.  Those of a live run (another command writing
+    into the same folder) are left alone (:func:`_stale`)."""
     for name in names:
-        for stale in sorted(out.glob(f".{glob.escape(name)}.*.tmp")):
-            stale.unlink(missing_ok=True)
+        for tmp in sorted(out.glob(f".{glob.escape(name)}.*.tmp")):
+            if _stale(tmp, name):
+                tmp.unlink(missing_ok=True)
         for old in sorted(out.glob(f".{glob.escape(name)}.*.old")):
+            if not _stale(old, name):
+                continue
             if (out / name).exists():
                 old.unlink(missing_ok=True)
             else:
                 os.replace(old, out / name)
+
+
+def _temporary(out: Path, name: str) -> tuple[int, Path]:
+    """A new temporary for ``name`` in ``out``, owned by this run: ``.NAME.PID-TOKEN.tmp``
+    (mkstemp's random token; the pid tells another run whether its owner still lives)."""
+    fd, tmp = tempfile.mkstemp(dir=out, prefix=f".{name}.{os.getpid()}-", suffix=".tmp")
+    return fd, Path(tmp)
+
+
+class _FolderLock:
+    """An exclusive ``flock`` on the folder itself (no lock file among the outputs), held while
+    a run clears stale temporaries and installs its set: two runs writing the same names into
+    one folder install one whole set after the other, never a mix."""
+
+    def __init__(self, out: Path) -> None:
+        self.out = out
+
+    def __enter__(self) -> None:
+        import fcntl
+
+        self.fd = os.open(self.out, os.O_RDONLY | os.O_DIRECTORY)
+        fcntl.flock(self.fd, fcntl.LOCK_EX)
+
+    def __exit__(self, *exc: object) -> None:
+        os.close(self.fd)  # closing releases the lock
 
 
 def install_files(out: Path, temporaries: Mapping[str, Path]) -> list[Path]:
@@ -645,8 +691,9 @@ def write_files(out: Path, files: Mapping[str, str | bytes], flag: str = "--out"
                 overwrite_edited: bool = False,
                 ours: Callable[[Path], str] = _generated_state) -> list[Path]:
     """Write ``files`` into ``out`` as one unit: every target checked, every file written to
-    a temporary in the folder, then all renamed; on any failure nothing is replaced and no
-    temporary is left.  Text files are sealed (:func:`seal`); bytes are written as given."""
+    a temporary of this run in the folder, then all renamed under the folder's lock; on any
+    failure nothing is replaced and no temporary of this run is left.  Text files are sealed
+    (:func:`seal`); bytes are written as given."""
     out = Path(out)
     check_folder(out, flag)
     for name in files:
@@ -654,17 +701,18 @@ def write_files(out: Path, files: Mapping[str, str | bytes], flag: str = "--out"
     temporaries: dict[str, Path] = {}
     try:
         out.mkdir(parents=True, exist_ok=True)
-        _clean_stale(out, list(files))
         for name, content in sorted(files.items()):
-            fd, tmp = tempfile.mkstemp(dir=out, prefix=f".{name}.", suffix=".tmp")
-            temporaries[name] = Path(tmp)
+            fd, tmp = _temporary(out, name)
+            temporaries[name] = tmp
             data = content if isinstance(content, bytes) else seal(content).encode("utf-8")
             with os.fdopen(fd, "wb") as fh:
                 fh.write(data)
                 fh.flush()
                 os.fsync(fh.fileno())
             os.chmod(tmp, 0o644)
-        return install_files(out, temporaries)
+        with _FolderLock(out):
+            _clean_stale(out, list(files))
+            return install_files(out, temporaries)
     except OSError as exc:
         raise InputError(f"{flag} {out}: {exc.strerror or exc}; nothing replaced") from None
     finally:
