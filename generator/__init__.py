@@ -105,6 +105,7 @@ order; a stage imports only stages above it::
                             [Target, Request -> files]
     choose                  methods × orders, verified error, recorded cost model
                             [tol, range -> Choice]
+    sweep.cores             the cores a local sweep may use (CPU affinity) [-> int]
     sweep.kinds             what one point of a map computes: the notes' kinds, and any
                             equation's or driven system's parameters as axes [point -> fields]
     sweep.store             grids in blocks on dask.distributed, into a resumable Zarr store

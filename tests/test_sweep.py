@@ -358,6 +358,7 @@ def test_cli_sweep_killed_then_resumed_equals_serial(tmp_path):
     run = subprocess.run(args, cwd=tmp_path, capture_output=True, text=True, timeout=600,
                          check=False)
     assert run.returncode == 0, run.stderr
+    assert run.stderr == ""  # dask's closing says nothing once the store is whole
     summary = json.loads(run.stdout)
     assert summary["complete"] and summary["finished"] == summary["blocks"] == 6
     resumed = open_sweep(tmp_path / "s")
@@ -510,3 +511,211 @@ def test_validity_takes_no_equation(tmp_path, capsys):
     assert main(["sweep", "validity", SWEPT, "--axis", "w=1", "--out",
                  str(tmp_path / "s")]) == 2
     assert "the notes'" in capsys.readouterr().err
+
+
+# --- faults: concurrent runs, too many workers, a full disk, a vanishing drive, dask's noise ----
+
+def test_runs_racing_to_create_one_store_leave_it_whole(tmp_path):
+    """Six threads make the same new store at once (metadata only, no cluster): each gets the
+    store or the one-line "another sweep is writing it"; the store is whole (it opens and is
+    this sweep's), and no temporary folder is left beside it."""
+    import threading
+
+    store = tmp_path / "s.zarr"
+    outcomes, start = [], threading.Barrier(6)
+
+    def run():
+        start.wait()
+        try:
+            outcomes.append(run_sweep("response", RESPONSE_AXES, store, stop_after=0))
+        except InputError as e:
+            outcomes.append(str(e))
+
+    threads = [threading.Thread(target=run) for _ in range(6)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(outcomes) == 6
+    for o in outcomes:
+        assert isinstance(o, xr.Dataset) or ("another sweep is writing it" in o
+                                             and "\n" not in o), o
+    assert os.listdir(tmp_path) == ["s.zarr"]
+    ds = open_sweep(store)
+    assert not ds.done.values.any() and ds.r.shape == (3, 2, 1, 1, 3)
+
+
+def test_a_second_run_of_a_store_being_written_is_refused(scheduler, tmp_path):
+    """While one run holds its store (made under a temporary name, renamed, locked), a second
+    run — of the store it found, or racing to make it — stops in one line before any block;
+    the first run's store then resumes to the serial map."""
+    from lindstedt.sweep import store as sweep
+
+    path = tmp_path / "s.zarr"
+    grid = make_grid("response", RESPONSE_AXES, 2)
+    with sweep._claimed(path, grid, True):
+        assert os.listdir(tmp_path) == ["s.zarr"]
+        with pytest.raises(InputError, match="another sweep is writing it") as err:
+            run_sweep("response", RESPONSE_AXES, path, scheduler=scheduler, chunk=2)
+        assert "\n" not in str(err.value)
+        # a run that also found no store: its rename fails, it finds this one, locked
+        with pytest.raises(InputError, match="another sweep is writing it"), \
+                sweep._claimed(path, grid, True):
+            pass
+        assert os.listdir(tmp_path) == ["s.zarr"]
+    ds = run_sweep("response", RESPONSE_AXES, path, scheduler=scheduler)
+    xr.testing.assert_identical(ds.load(), serial_sweep("response", RESPONSE_AXES, chunk=2))
+
+
+def test_workers_beyond_the_cores_are_cut_with_a_note(scheduler, tmp_path, capsys,
+                                                     monkeypatch):
+    """--workers 64 on a machine of 2 usable cores runs 2 (the cost estimate counts 2), with
+    one line on stderr; the library cuts likewise; the core count is the affinity's."""
+    import lindstedt.cli.sweep as cli_sweep
+    from lindstedt.cli import build_parser, main
+    from lindstedt.costs import sweep_cost
+    from lindstedt.sweep import store as sweep
+    from lindstedt.sweep.cores import usable_cores
+
+    if hasattr(os, "sched_getaffinity"):
+        assert usable_cores() == len(os.sched_getaffinity(0))
+    monkeypatch.setattr(cli_sweep, "usable_cores", lambda: 2)
+    argv = ["sweep", "response", "--omega", "0.7,1.2", "--force", "0.3", "--eps", "0.1",
+            "--Q", "20", "--out", str(tmp_path / "s.zarr")]
+    args = build_parser().parse_args([*argv, "--workers", "64"])
+    assert (args.workers, args.workers_asked) == (2, 64)
+    two = build_parser().parse_args([*argv, "--workers", "2"])
+    assert sweep_cost(args).seconds == sweep_cost(two).seconds
+    run_sweep("response", {**RESPONSE_AXES, "omega": [0.7, 1.2], "force": [0.3]},
+              tmp_path / "s.zarr", scheduler=scheduler)  # complete: the command starts no cluster
+    assert main([*argv, "--workers", "64"]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["lindstedt: note: --workers 64: 2 cores here; running 2 workers"]
+    asked = []
+
+    def cluster(workers):
+        asked.append(workers)
+        raise InputError("no cluster in this test")
+
+    monkeypatch.setattr(sweep, "usable_cores", lambda: 3)
+    monkeypatch.setattr(sweep, "local_cluster", cluster)
+    with pytest.raises(InputError, match="no cluster"):
+        run_sweep("response", RESPONSE_AXES, tmp_path / "t.zarr", workers=64)
+    assert asked == [3]
+
+
+def test_a_full_disk_ends_in_one_line_and_the_store_resumes(scheduler, tmp_path, capsys,
+                                                           monkeypatch):
+    """ENOSPC on the third block's write: the command prints one line naming the store, the
+    error and how to resume, exit 2; the two blocks saved stay, the rest resumes to the serial
+    map. EACCES making a new store leaves nothing behind."""
+    import errno
+
+    from lindstedt.cli import main
+    from lindstedt.sweep import store as sweep
+
+    path = tmp_path / "s.zarr"
+    write, calls = sweep._write_block, []
+
+    def full(arrays, grid, chunk, data):
+        calls.append(chunk)
+        if len(calls) == 3:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path / "r" / "c"))
+        write(arrays, grid, chunk, data)
+
+    monkeypatch.setattr(sweep, "_write_block", full)
+    argv = ["sweep", "response", "--omega", "0.7,1.2,1.5", "--force", "0.1,0.3", "--eps",
+            "0.1", "--Q", "20", "--chunk", "1", "--out", str(path), "--scheduler", scheduler,
+            "--json"]
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and len(err.strip().splitlines()) == 1, err
+    assert f"store {path}: cannot write (No space left on device); 2/6 blocks saved" in err
+    assert "run the same command to resume" in err
+    assert int(open_sweep(path).done.values.sum()) == 2
+    assert not list(path.rglob("*.partial"))
+    monkeypatch.setattr(sweep, "_write_block", write)
+    assert main(argv) == 0
+    assert json.loads(capsys.readouterr().out)["complete"]
+    xr.testing.assert_identical(open_sweep(path).load(),
+                                serial_sweep("response", RESPONSE_AXES, chunk=1))
+
+    def denied(path, grid):
+        raise OSError(errno.EACCES, os.strerror(errno.EACCES), str(path))
+
+    monkeypatch.setattr(sweep, "_write_metadata", denied)
+    with pytest.raises(InputError, match=r"t\.zarr: cannot write \(Permission denied\)"):
+        run_sweep("response", RESPONSE_AXES, tmp_path / "t.zarr", stop_after=0)
+    assert sorted(os.listdir(tmp_path)) == ["s.zarr"]
+
+
+def test_a_vanishing_drive_is_the_rest_state_of_the_damped_system(scheduler, tmp_path, capsys):
+    """``--axis f=0:1/10:3``: at f = 0 the response is the rest state, r = 0 on every
+    coordinate, one stable orbit, its Floquet modulus exp(−πc/ω) (C = cI: every mode decays as
+    e^{−ct/2}), the limit of the points at f → 0; the scalar equation likewise. A point the
+    equation is refused at (c = 0: no steady state) is noted by the command."""
+    from lindstedt.cli import main
+
+    kind = equation_kind("response", SYSTEM, {"c": "1/20", "k": "1/2"}, ["f", "w"])
+    ds = serial_sweep(kind, {"f": [0.0, 1e-7, 0.05], "w": [1.0, 1.7]})
+    for j, w in enumerate([1.0, 1.7]):
+        rest = ds.isel(f=0, w=j)
+        assert int(rest.orbits) == 1 and int(rest.stable_orbits) == 1
+        for name in ("r", "r_x1", "r_x2"):
+            assert float(rest[name][0]) == 0.0 and np.isnan(rest[name][1:]).all()
+        assert int(rest.stable[0]) == 1 and float(rest.r_stable_max) == 0.0
+        assert float(rest.floquet[0]) == pytest.approx(math.exp(-math.pi * 0.05 / w), rel=1e-12)
+        assert float(ds.floquet.isel(f=1, w=j, branch=0)) == pytest.approx(
+            float(rest.floquet[0]), rel=1e-6)
+        assert 0 < float(ds.r.isel(f=1, w=j, branch=0)) < 1e-5
+    scalar = equation_kind("response", SWEPT, {"eps": "1/10", "alpha": "0"}, ["f", "w"])
+    one = serial_sweep(scalar, {"f": [0.0], "w": [0.8]}).isel(f=0, w=0)
+    assert int(one.orbits) == 1 and float(one.r[0]) == 0.0 and int(one.stable[0]) == 1
+    assert float(one.floquet[0]) == pytest.approx(math.exp(-math.pi * 0.05 / 0.8), rel=1e-12)
+    store = tmp_path / "c.zarr"
+    assert main(["sweep", "response", SYSTEM, "--axis", "c=0,1/20", "--param", "f=1/10",
+                 "--param", "k=0", "--axis", "w=1", "--out", str(store), "--scheduler",
+                 scheduler]) == 0
+    out = capsys.readouterr().out
+    assert "note: 1 of 2 points hold no orbit (orbits = -1)" in out and "first at c = 0" in out
+    ds = open_sweep(store)
+    assert ds.orbits.values.tolist() == [[-1], [1]]
+    assert "refused" in ds.orbits.attrs["comment"]
+
+
+def test_dask_noise_of_a_whole_run_stays_off_stderr(scheduler, tmp_path):
+    """What distributed logs during a run whose store ends whole (a worker's result gathered
+    again, comms closing) reaches no handler; in a run that fails, it does."""
+    import logging
+
+    class Collect(logging.Handler):
+        def __init__(self):
+            super().__init__(logging.ERROR)
+            self.seen = []
+
+        def emit(self, record):
+            self.seen.append(record.getMessage())
+
+    log, top, collect = logging.getLogger("distributed.scheduler"), logging.getLogger(
+        "distributed"), Collect()
+    top.addHandler(collect)  # beside distributed's own StreamHandler to stderr
+
+    def noisy(p):
+        log.error("Couldn't gather keys: {'x': 'memory'} (test)")
+
+    try:
+        ds = run_sweep("response", RESPONSE_AXES, tmp_path / "a.zarr", scheduler=scheduler,
+                       chunk=2, progress=noisy)
+        assert bool(ds.done.values.all()) and collect.seen == []
+
+        def failing(p):
+            noisy(p)
+            raise RuntimeError("a bug in the caller")
+
+        with pytest.raises(RuntimeError, match="a bug"):
+            run_sweep("response", RESPONSE_AXES, tmp_path / "b.zarr", scheduler=scheduler,
+                      chunk=2, progress=failing)
+        assert "Couldn't gather keys: {'x': 'memory'} (test)" in collect.seen
+        assert all(not h.filters for h in top.handlers)
+    finally:
+        top.removeHandler(collect)

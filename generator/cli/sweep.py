@@ -5,11 +5,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from fractions import Fraction
 from pathlib import Path
 
 from ..errors import InputError
 from ..limits import SWEEP_MAX_VALUES
+from ..sweep.cores import usable_cores
 
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
 # well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
@@ -54,6 +56,10 @@ def run_sweep(args: argparse.Namespace) -> int:
             raise InputError("--axis/--param/--name/--n: give an equation (EQUATION) to take "
                              "them; Duffing's map takes --omega, --force, --eps, --Q")
         axes = builtin
+    asked = getattr(args, "workers_asked", None)
+    if args.scheduler is None and asked is not None and asked > args.workers:
+        print(f"lindstedt: note: --workers {asked}: {usable_cores()} cores here; running "
+              f"{args.workers} workers", file=sys.stderr)
     bar = ProgressBar(f"sweep {args.kind}", not args.json)
     try:
         ds = run_sweep(kind, axes, _out_folder(args.out, "--out"), args.scheduler,
@@ -68,7 +74,7 @@ def run_sweep(args: argparse.Namespace) -> int:
     data = {"kind": args.kind, "store": str(args.out),
             "axes": {name: list(values) for name, values in held.axes},
             "fields": list(held.fields), "blocks": held.blocks, "finished": held.finished,
-            "complete": held.complete}
+            "complete": held.complete, "refused_points": held.refused}
     if args.model is not None:
         data["equation"] = args.model
     if args.plot:
@@ -79,6 +85,11 @@ def run_sweep(args: argparse.Namespace) -> int:
     shape = " × ".join(f"{len(v)} {k}" for k, v in data["axes"].items())
     print(f"sweep {args.kind}: {shape} into {args.out}: {data['finished']}/{data['blocks']} "
           f"blocks done; fields {', '.join(data['fields'])}")
+    if held.refused:
+        where = ", ".join(f"{k} = {v:g}" for k, v in held.first_refused)
+        print(f"  note: {held.refused} of {math.prod(map(len, data['axes'].values()))} points "
+              f"hold no orbit (orbits = -1): the equation is refused there, first at {where} "
+              f"(lindstedt response EQUATION at that point says why)")
     if args.plot:
         print(f"  figure {args.plot}")
     return 0
@@ -116,6 +127,16 @@ def _named_axis(text: str) -> tuple[str, list[float]]:
         raise argparse.ArgumentTypeError(f"{text!r}: expected NAME=A:B:N, NAME=v1,v2,… or "
                                          "NAME=value")
     return name.strip(), _axis_values(values)
+
+
+class _Workers(argparse.Action):
+    """``--workers N``: at most :func:`~lindstedt.sweep.cores.usable_cores` (the cost estimate
+    then counts the workers that run); the number asked is kept for the command's note."""
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                 values: object, option_string: str | None = None) -> None:
+        namespace.workers_asked = values
+        namespace.workers = min(values, usable_cores())
 
 
 def arguments_sweep(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -159,8 +180,12 @@ def arguments_sweep(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="tcp://host:port of a running dask scheduler whose workers have "
                    "lindstedt (default: a LocalCluster on this machine)")
-    p.add_argument("--workers", type=_positive, default=2, metavar="N",
-                   help="worker processes of the LocalCluster, one thread each (default 2)")
+    cores = usable_cores()
+    p.add_argument("--workers", type=_positive, action=_Workers, default=min(2, cores),
+                   metavar="N", help="worker processes of the LocalCluster, one thread each "
+                   f"(default 2), at most the cores this process may use ({cores} here): a "
+                   "larger N is cut to that, with a note on stderr (more single-threaded "
+                   "workers than cores would only share them)")
     p.add_argument("--chunk", type=_positive, default=None, metavar="POINTS",
                    help="grid points per task (default: the kind's, about 1 s of work)")
     _flag_json(p, "a JSON summary")

@@ -166,6 +166,7 @@ class Field:
     dtype: str = "float64"
     dims: tuple[str, ...] = ()  # beyond the grid's axes
     flag: bool = False  # int8 verdict: 1 yes, 0 no, −1 none
+    unset: str = "not computed"  # what −1 means in an int8 count
 
     @property
     def fill(self) -> float | int:
@@ -179,7 +180,7 @@ class Field:
         if self.flag:
             out |= {"flag_values": [-1, 0, 1], "flag_meanings": "none no yes"}
         elif self.dtype == "int8":
-            out["comment"] = "-1: not computed"
+            out["comment"] = f"-1: {self.unset}"
         return out
 
 
@@ -393,10 +394,86 @@ def _equation_response(spec: EquationSpec, **axis: float) -> dict:
     try:
         de = driven_equation(spec.text, values, omega, spec.name)
     except InputError:  # refused at this point (e.g. a coefficient made 0): no orbit stored
-        return {}
+        linear = _undriven_linear_part(spec, values)
+        if linear is None:
+            return {}
+        return _rest_state(*linear, omega)
     found = periodic_orbits(de, ORBIT_HARMONICS, shoot_harmonics=1)
     shot = [o.orbit for o in found.orbits if o.orbit is not None]
     return _branches(shot, len(shot))
+
+
+def _undriven_linear_part(spec: EquationSpec, values: dict[str, str]
+                          ) -> tuple[np.ndarray, np.ndarray] | None:
+    """``(K, C)`` of ``q̈ + C q̇ + K q + … = 0`` where the drive vanishes at ``values`` (its
+    amplitude 0, e.g. an axis f = 0) and q = 0 is an equilibrium; ``None`` where the equation
+    is refused for any other reason."""
+    import sympy as sp
+
+    from ..derive.models import oscillator
+
+    values = dict(values)
+    small = values.pop("eps", None)
+    try:
+        osc = oscillator(spec.text, values, spec.name)
+    except InputError:
+        return None
+    subs = {} if small is None else {osc.equation.small: sp.Rational(small)}
+    force = sp.expand(osc.force.xreplace(subs))
+    q, v = osc.coordinate, osc.velocity
+    if osc.drive.xreplace(subs) != 0 or osc.parametric != 0 or force.free_symbols - {q, v} \
+            or not force.is_polynomial(q, v):
+        return None
+    poly = sp.Poly(force, q, v)
+    if poly.coeff_monomial(1) != 0:
+        return None  # q = 0 is no equilibrium
+    k, c = (float(poly.coeff_monomial(m)) for m in (q, v))
+    if k == 0 and c == 0:
+        return None  # no linear term: refused as driven_equation refuses it
+    return np.array([[k]]), np.array([[c]])
+
+
+def _system_undriven_linear_part(spec: EquationSpec, values: dict[str, str]
+                                 ) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]] | None:
+    """:func:`_undriven_linear_part` of a system ``ẍ + M⁻¹C ẋ + M⁻¹K x + … = 0``, with its
+    coordinates (its checks those of :func:`analysis.systems.driven_system`: damped, every
+    linear mode an oscillation); ``None`` where it is refused for any other reason."""
+    import sympy as sp
+
+    from ..derive.system import _lowered, _read
+
+    try:
+        coordinates, exprs, _, _ = _read(spec.text, True)
+        given = {sp.Symbol(k): sp.Rational(v) for k, v in values.items()}
+        if any(d.xreplace(given) != 0 for _, d in exprs):
+            return None  # driven here: refused for another reason
+        system = _lowered(spec.text, coordinates, [e.xreplace(given) for e, _ in exprs],
+                          allow_damping=True)
+    except InputError:
+        return None
+    if system.damping is None and not any(f.has(*system.velocities) for f in system.force):
+        return None  # no damping: no steady state (as driven_system refuses)
+    if not all(sp.N(lam, 30) > 0 for lam in system.modes()):
+        return None
+    K = np.array(system.stiffness, dtype=float)
+    C = np.zeros_like(K) if system.damping is None else np.array(system.damping, dtype=float)
+    return K, C, tuple(map(str, system.coordinates))
+
+
+def _rest_state(K: np.ndarray, C: np.ndarray, omega: float, coordinates: Sequence[str] = ()
+                ) -> dict:
+    """The fields of the response where the drive vanishes: the rest state ``x = 0`` (the
+    start of the continuation from rest, and every orbit there is, where the power balance
+    holds: ``⟨ẋᵀCẋ⟩ = 0`` with C positive definite leaves no motion), ``r = 0``, its Floquet
+    multipliers ``exp(λT)`` over one drive period ``T = 2π/ω``, λ the eigenvalues of the linear
+    system ``ẍ + Cẋ + Kx = 0``."""
+    n = len(K)
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-K, -C]])
+    modulus = float(np.max(np.abs(np.exp(np.linalg.eigvals(A) * 2 * math.pi / omega))))
+    out = _orbit_fields([0.0], [modulus], 1)
+    zero = [0.0] + [math.nan] * (EQUATION_BRANCHES - 1)
+    out.update({f"r_{x}": zero for x in coordinates})
+    return out
 
 
 def _branches(shot: list, count: int) -> dict:
@@ -433,7 +510,11 @@ def _system_response(spec: EquationSpec, **axis: float) -> dict:
     try:
         sb = SystemBalance.of(driven_system(spec.text, values), ORBIT_HARMONICS)
     except InputError:  # refused at this point (e.g. the damping made 0): no orbit stored
-        return {}
+        linear = _system_undriven_linear_part(spec, values)
+        if linear is None:
+            return {}
+        K, C, coordinates = linear
+        return _rest_state(K, C, omega, coordinates)
     found, _, _ = sb.solutions(omega)
     found.sort(key=sb.fine.first_harmonic, reverse=True)
     floquet = list(sb.multiplier(np.array(found), np.full(len(found), omega))) if found else []
@@ -532,7 +613,9 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
     spec = EquationSpec(kind, text, tuple(sorted(values.items())), frequency, n, name)
     branch = ("branch", tuple(range(1, EQUATION_BRANCHES + 1)))
     common = (
-        Field("orbits", "distinct periodic orbits found (shooting)", "int8"),
+        Field("orbits", "distinct periodic orbits found (shooting)", "int8",
+              unset="not computed, or the equation is refused at this point (e.g. a damping "
+              "axis at 0)"),
         Field("stable_orbits", "distinct Floquet-stable orbits", "int8"),
         Field("r", "r = sqrt(A1^2 + B1^2) of each orbit, largest first", dims=("branch",)),
         Field("stable", "Floquet stability of each orbit", "int8", ("branch",), flag=True),

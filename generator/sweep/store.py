@@ -7,14 +7,18 @@ each finished block into a Zarr store (into the block's region of a store whose 
 ``to_zarr(compute=False)`` wrote first), then that block's ``done`` flag. Zarr's local store
 writes each chunk file atomically, so a flag is never half-written, and a block whose data was
 written but whose flag was not is simply computed again: an interrupted sweep resumes where
-it stopped. :func:`serial_sweep` computes
-the same map in this process, block by block, without dask: the reference and the baseline.
+it stopped. A new store is made whole under a temporary name and renamed into place, and a
+run holds an exclusive lock (``flock``) on its store's folder while it writes: two runs of
+one store never write it at once, and no store is ever left half-made. :func:`serial_sweep`
+computes the same map in this process, block by block, without dask: the reference and the
+baseline.
 """
 
 from __future__ import annotations
 
 import asyncio
 import contextlib
+import errno
 import itertools
 import json
 import logging
@@ -37,6 +41,7 @@ import numpy as np
 from ..analysis.driven import Drive
 from ..errors import InputError, Interrupted
 from ..limits import MAX_WORKERS, check_int
+from .cores import usable_cores
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -513,12 +518,16 @@ def _connect(scheduler: str | None, workers: int, stack: contextlib.ExitStack) -
 @dataclass(frozen=True)
 class SweepSummary:
     """What a sweep's store holds, for the command to print: its axes (name, values) in the
-    grid's order, its fields, its blocks and how many are finished."""
+    grid's order, its fields, its blocks and how many are finished; an equation's points that
+    its finished blocks hold no orbit count for (``orbits`` −1: the equation is refused there,
+    e.g. a damping axis at 0) and the first of them."""
 
     axes: tuple[tuple[str, tuple[float, ...]], ...]
     fields: tuple[str, ...]
     blocks: int
     finished: int
+    refused: int = 0
+    first_refused: tuple[tuple[str, float], ...] = ()
 
     @property
     def complete(self) -> bool:
@@ -529,10 +538,22 @@ class SweepSummary:
 def summary(ds: xr.Dataset) -> SweepSummary:
     """The :class:`SweepSummary` of a sweep's dataset (:func:`run_sweep`'s answer)."""
     done = ds["done"].values
-    names = list(json.loads(ds.attrs["sweep"])["axes"])
+    identity = json.loads(ds.attrs["sweep"])
+    names = list(identity["axes"])
+    refused, first = 0, ()
+    if "orbits" in ds.data_vars:  # an equation's map: −1 in a finished block is a refusal
+        shape, block = ds["orbits"].shape, identity["block"]
+        finished = done.reshape([-(-n // b) for n, b in zip(shape, block, strict=True)])
+        for axis, b in enumerate(block):
+            finished = np.repeat(finished, b, axis=axis)
+        bad = finished[tuple(slice(0, n) for n in shape)] & (ds["orbits"].values == -1)
+        refused = int(bad.sum())
+        if refused:
+            first = tuple((n, float(ds[n].values[i]))
+                          for n, i in zip(names, np.argwhere(bad)[0], strict=True))
     return SweepSummary(tuple((n, tuple(float(v) for v in ds[n].values)) for n in names),
                         tuple(sorted(n for n in ds.data_vars if n != "done")),
-                        int(done.size), int(done.sum()))
+                        int(done.size), int(done.sum()), refused, first)
 
 
 def run_sweep(kind: str | Kind, axes: Mapping[str, Sequence[float]], store: Path | str,
@@ -543,41 +564,52 @@ def run_sweep(kind: str | Kind, axes: Mapping[str, Sequence[float]], store: Path
 
     ``scheduler``: an address (``tcp://host:port``) of a running scheduler whose workers can
     import lindstedt (blocks wait until it has some); ``None`` starts a :func:`local_cluster` of
-    ``workers`` processes, one thread each (``workers`` is ignored with a scheduler).
-    ``chunk``: points per task (default the kind's, ~1 s of work; resuming, the store's).
+    ``workers`` processes, one thread each, at most
+    :func:`~lindstedt.sweep.cores.usable_cores` (more single-threaded workers than cores only
+    share them, at ~50 MB each; ``workers`` is ignored with a scheduler). ``chunk``: points
+    per task (default the kind's, ~1 s of work; resuming, the store's).
     A store of this sweep resumes: only blocks without their ``done`` flag are computed.
     ``stop_after``: write at most this many blocks in this run, then stop (the store resumes
     later). ``progress`` is called after each block is written.
 
     Refused with :class:`InputError` before any work: a bad kind, axis or chunk; a store of
     another sweep or that cannot be written or whose disk is too small; a scheduler that does
-    not answer (within ~2 × :data:`SCHEDULER_TIMEOUT`). Returns :func:`open_sweep` of the store.
+    not answer (within ~2 × :data:`SCHEDULER_TIMEOUT`); a store another run is writing (each
+    run locks its store). An OSError writing the store (a full disk, …) stops the run with
+    :class:`StoreWriteError`: every block saved so far stays, and the store resumes. Returns
+    :func:`open_sweep` of the store.
     """
     grid = make_grid(kind, axes, chunk)
     if scheduler is None:
         check_int(workers, 1, MAX_WORKERS,
                   f"workers {workers!r}: must be a whole number in 1..{MAX_WORKERS}")
+        workers = min(workers, usable_cores())
     if stop_after is not None:
         check_int(stop_after, 0, None, f"stop_after {stop_after!r}: must be a whole number >= 0")
     if chunk is None:  # resuming without chunk: the store's blocks
         grid = _adopt_block(Path(store), grid)
     state = check_store(store, grid)
     path = state.path
-    done = np.zeros(grid.chunks, dtype=bool) if state.done is None else state.done
-    todo = [int(i) for i in np.flatnonzero(~done)]
-    if stop_after is not None:
-        todo = todo[:stop_after]
-    if not todo:
-        return open_sweep(path) if state.done is not None else _initialise(path, grid)
-    saved = [int(done.sum())]  # blocks in the store, kept up to date by _gather
-    with _interrupts_remembered(), contextlib.ExitStack() as stack:
+    if not _todo(state.done, grid, stop_after):  # no worker needed
+        if state.done is None:
+            with _claimed(path, grid, True):
+                pass
+        return open_sweep(path)
+    saved = [0]  # blocks in the store, kept up to date by _gather
+    with _interrupts_remembered(), _HeldLogs() as held, contextlib.ExitStack() as stack:
         try:
             client = _connect(scheduler, workers, stack)
-            if state.done is None:
-                _initialise(path, grid)
-            client.register_plugin(WarmUp(grid.kind))
-            _gather(client, grid, path, todo, saved, progress)
+            with _claimed(path, grid, state.done is None) as done:
+                saved[0] = int(done.sum())
+                todo = _todo(done, grid, stop_after)
+                if todo:
+                    client.register_plugin(WarmUp(grid.kind))
+                    _gather(client, grid, path, todo, saved, progress)
+            held.whole = True  # what distributed says from here on is its closing
+            if scheduler is None:  # our own workers: quiet as they close
+                client.run(_quiet_logs, on_error="ignore")
         except KeyboardInterrupt:
+            held.whole = True  # an interrupt's one line says it all
             stack.pop_all()  # no orderly close of the cluster: it takes seconds and logs
             _stop_workers()
             for partial in path.rglob("*.partial"):  # zarr's temporary of a chunk cut short
@@ -585,6 +617,12 @@ def run_sweep(kind: str | Kind, axes: Mapping[str, Sequence[float]], store: Path
             raise Interrupted(f"{saved[0]}/{grid.chunks} blocks saved in {path}; run the same "
                               "command to resume") from None
     return open_sweep(path)
+
+
+def _todo(done: np.ndarray | None, grid: Grid, stop_after: int | None) -> list[int]:
+    """The blocks this run computes: those not done, the first ``stop_after`` of them."""
+    todo = list(range(grid.chunks)) if done is None else [int(i) for i in np.flatnonzero(~done)]
+    return todo if stop_after is None else todo[:stop_after]
 
 
 STOP = threading.Event()
@@ -616,6 +654,75 @@ def _interrupts_remembered() -> Iterator[None]:
             signal.signal(sig, handler)
 
 
+DISTRIBUTED_LOGGERS = ("distributed", "tornado", "asyncio")
+# NOTE: where dask's scheduler, nannies, comms and event loop log: a worker that went away
+# mid-task ("Couldn't gather keys", then rescheduled), comms closed while the cluster closes
+# (CommClosedError tracebacks), tasks the closing loop drops.
+
+
+def _handlers_and_loggers() -> list[logging.Handler | logging.Logger]:
+    """Every handler of :data:`DISTRIBUTED_LOGGERS` and the loggers below them (distributed
+    gives several their own, unpropagated), and each of those loggers without a handler of
+    its own at the top (asyncio's records go to Python's last-resort handler)."""
+    out: list[logging.Handler | logging.Logger] = []
+    for name, logger in sorted(logging.root.manager.loggerDict.items()):
+        if isinstance(logger, logging.Logger) and any(
+                name == top or name.startswith(top + ".") for top in DISTRIBUTED_LOGGERS):
+            out += [h for h in logger.handlers if h not in out]
+            if name in DISTRIBUTED_LOGGERS and not logger.handlers:
+                out.append(logger)
+    return out
+
+
+class _HeldLogs:
+    """Holds back what dask logs in this process during a run; on exit drops it where the
+    result is whole (:attr:`whole`, set once every block is written, or on an interrupt,
+    whose line says what was saved), else passes it on, so that a run that fails shows why.
+    A filter on each handler (:func:`_handlers_and_loggers`): the levels stay as they were,
+    and so does what other threads of a library user log elsewhere."""
+
+    def __init__(self) -> None:
+        self.whole = False
+        self.records: list[tuple[logging.Handler | logging.Logger, logging.LogRecord]] = []
+        self.where: list[logging.Handler | logging.Logger] = []
+
+    def __enter__(self) -> _HeldLogs:
+        import distributed  # noqa: F401  (its logging configuration: the handlers to hold)
+
+        self.where = _handlers_and_loggers()
+        for target in self.where:
+            target.addFilter(self._hold(target))
+        return self
+
+    def _hold(self, target: logging.Handler | logging.Logger) -> Callable[[logging.LogRecord],
+                                                                          bool]:
+        def hold(record: logging.LogRecord) -> bool:
+            self.records.append((target, record))
+            return False
+        hold.held_by = self  # type: ignore[attr-defined]
+        return hold
+
+    def __exit__(self, *exc: object) -> None:
+        for target in self.where:
+            for f in list(target.filters):
+                if getattr(f, "held_by", None) is self:
+                    target.removeFilter(f)
+        if self.whole or isinstance(exc[1], InputError):  # a one-line refusal stays one line
+            return
+        for target, record in self.records:
+            target.handle(record)
+
+
+def _quiet_logs() -> None:
+    """On each of our workers once every block is written: nothing but a crash from its
+    closing reaches the terminal."""
+    for name in DISTRIBUTED_LOGGERS:
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+    for name, logger in list(logging.root.manager.loggerDict.items()):
+        if isinstance(logger, logging.Logger) and name.split(".")[0] in DISTRIBUTED_LOGGERS:
+            logger.setLevel(logging.CRITICAL)
+
+
 def _stop_workers() -> None:
     """Stop this process's worker processes at once (an interrupt): every block written so far
     is whole with its flag; a block being written has no flag and is computed again."""
@@ -626,15 +733,95 @@ def _stop_workers() -> None:
         child.kill()
 
 
-def _initialise(path: Path, grid: Grid) -> xr.Dataset:
-    """Metadata, coordinates and fill values of a new store (no block is written)."""
+def _write_metadata(path: Path, grid: Grid) -> None:
+    """Metadata, coordinates and fill values of a new store at ``path`` (no block)."""
     import warnings
 
     with warnings.catch_warnings():  # zarr's note that v3 does not yet specify consolidation
         warnings.filterwarnings("ignore", "Consolidated metadata", UserWarning)
         _dataset(grid, None, None).to_zarr(str(path), mode="w", compute=False,
                                            consolidated=True, encoding=_encoding(grid))
-    return open_sweep(path)
+
+
+class StoreWriteError(InputError):
+    """Writing the store failed (a full disk, permissions, a read-only mount): one line naming
+    the store and the error, with what was saved and how to resume."""
+
+
+def _write_failed(path: Path, e: OSError, saved: int, total: int) -> StoreWriteError:
+    """The one line of an OSError ``e`` met writing the store at ``path``."""
+    for partial in path.rglob("*.partial"):  # zarr's temporary of a chunk cut short
+        with contextlib.suppress(OSError):
+            partial.unlink()
+    return StoreWriteError(f"store {path}: cannot write ({e.strerror or _first_line(e)}); "
+                           f"{saved}/{total} blocks saved; run the same command to resume "
+                           "once the store can be written")
+
+
+def _busy(path: Path) -> InputError:
+    return InputError(f"store {path}: another sweep is writing it now; run the command again "
+                      "when it has finished (it resumes)")
+
+
+def _lock(fd: int, path: Path) -> None:
+    """An exclusive ``flock`` on the open folder ``fd``, or :func:`_busy` at once (the lock
+    goes with the process: a killed run leaves none behind)."""
+    import fcntl
+
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        raise _busy(path) from None
+
+
+def _created(path: Path, grid: Grid) -> int | None:
+    """Make the store at ``path`` whole under a temporary name beside it, locked, and rename
+    it into place (atomic: another run sees no store or a whole one); the open, locked folder,
+    or ``None`` where another run's store took the place first. An OSError leaves nothing."""
+    import secrets
+
+    folder = path.parent if str(path.parent) else Path(".")
+    tmp = folder / f".{path.name}.{os.getpid()}-{secrets.token_hex(4)}.new"
+    os.mkdir(tmp)  # the umask's mode, as any folder the user makes
+    fd = None
+    try:
+        _write_metadata(tmp, grid)  # (zarr's mode "w" makes the folder anew: lock after)
+        fd = os.open(tmp, os.O_RDONLY)
+        _lock(fd, tmp)  # ours alone: no one else knows the name; the lock follows the rename
+        os.rename(tmp, path)  # replaces an empty folder; never a non-empty one
+    except OSError as e:
+        if fd is not None:
+            os.close(fd)
+        shutil.rmtree(tmp, ignore_errors=True)
+        if e.errno in (errno.ENOTEMPTY, errno.EEXIST) and path.is_dir():
+            return None
+        raise
+    return fd
+
+
+@contextlib.contextmanager
+def _claimed(path: Path, grid: Grid, new: bool) -> Iterator[np.ndarray]:
+    """The store at ``path`` locked for this run (:func:`_busy` if another run holds it),
+    made first when ``new``; yields its ``done`` flags as they stand once locked."""
+    import zarr
+
+    fd = None
+    try:
+        if new:
+            try:
+                fd = _created(path, grid)
+            except OSError as e:
+                raise _write_failed(path, e, 0, grid.chunks) from None
+        if fd is None:  # an existing store, or one another run made a moment ago
+            problem = _mismatch(path, _stored_identity(path), grid)
+            if problem:
+                raise InputError(f"{problem}; give a new store path or delete it")
+            fd = os.open(path, os.O_RDONLY)
+            _lock(fd, path)
+        yield np.asarray(zarr.open_array(str(path / "done"), mode="r")[:], dtype=bool)
+    finally:
+        if fd is not None:
+            os.close(fd)  # releases the lock
 
 
 def _gather(client: object, grid: Grid, path: Path, todo: list[int], saved: list[int],
@@ -649,7 +836,10 @@ def _gather(client: object, grid: Grid, path: Path, todo: list[int], saved: list
     window = 2 * max(1, sum(client.nthreads().values()))
     queue = iter(todo)
     index: dict = {}
-    arrays = _open_arrays(path, grid)
+    try:
+        arrays = _open_arrays(path, grid)
+    except OSError as e:
+        raise _write_failed(path, e, finished, grid.chunks) from None
 
     def submit(chunk: int) -> object:
         future = client.submit(compute_block, grid.kind, grid.block_values(chunk),
@@ -665,8 +855,11 @@ def _gather(client: object, grid: Grid, path: Path, todo: list[int], saved: list
                 raise KeyboardInterrupt
             chunk = index.pop(future)
             data = future.result()
-            _write_block(arrays, grid, chunk, data)
-            _mark_done(arrays, chunk)
+            try:
+                _write_block(arrays, grid, chunk, data)
+                _mark_done(arrays, chunk)
+            except OSError as e:  # ENOSPC, EACCES, EROFS, EDQUOT…: the store stops here
+                raise _write_failed(path, e, finished, grid.chunks) from None
             finished += 1
             saved[0] = finished
             if progress is not None:
