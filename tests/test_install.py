@@ -105,4 +105,4 @@ def test_make_demo_in_a_clean_clone_leaves_git_status_clean(venv, tmp_path):
     assert status == ""
     written = {p.relative_to(clone / "out").as_posix() for p in (clone / "out").rglob("*")}
     assert {"duffing.py", "pendulum.py", "driven.py", "balance.py", "figures/response.png",
-            "figures/speed_accuracy.png"} <= written
+            "figures/mixing.png", "duffing_derivation.pdf"} <= written
