@@ -4,7 +4,8 @@ The pipeline, a folder per group of stages and a module per stage [input -> outp
 order; a stage imports only stages above it::
 
     algebra.series          the one Fourier kernel: exact P(C) + S·R(C) over QQ (FLINT
-                            fmpq_poly) and QQ[params] (fmpq_mpoly), the odd-cosine fast path,
+                            fmpq_poly), a number field Q(θ) (fmpq_poly parts) and QQ[params]
+                            (fmpq_mpoly), the odd-cosine fast path,
                             relaxed (online) products of ε-series of Trig sums, the Laurent form
                             in e^{is} over complex128 for the numeric methods
                             [coefficients -> Trig]
@@ -85,8 +86,9 @@ order; a stage imports only stages above it::
                             [solution -> Module]
     lower.driven            the μ-expansion's branches (Cardano), damped, the harmonic-balance
                             system [orders -> Module]
-    lower.system            a nonlinear normal mode's backbone ω(A), T(A) and shape x_i(t, A),
-                            NaN past the estimated radius [NormalModeSeries -> Module]
+    lower.system            a nonlinear normal mode's backbone ω(A), T(A), shape x_i(t, A)
+                            and truncation error's bound, NaN past the radius' lower bound
+                            [NormalModeSeries -> Module]
     lower.documents         the derivations' LaTeX records, the AGM period, a chosen formula,
                             the slow flow [solution -> Unit]
     emit.render             strict Jinja2 environments, provenance, one-unit writes

@@ -10,10 +10,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .charts import _save, _value, check_plot_path
-from .derive.nnm import normal_mode
+from .derive.nnm import normal_mode, radius
 from .derive.system import System
 from .errors import InputError
-from .lower.system import radius
 from .numerics.references import mode_orbit, system_energy
 
 FEP_ORDER = 24
@@ -48,7 +47,7 @@ def nnm_figure(system: System, path: Path, order: int = FEP_ORDER) -> Path:
             notes.append(f"mode {k}: no series ({str(exc).split(': ', 2)[-1][:60]}…)")
             continue
         found = radius(mode)
-        reach = 1.0 if found is None else (found[0] - found[1]) ** (1 / mode.step)
+        reach = 1.0 if found is None or not found.lower > 0 else found.reach
         A = np.linspace(reach / 200, 0.95 * reach, 200)
         omega, _, starts = mode.evaluate(A)
         E = np.array([energy(x) for x in starts.T])

@@ -857,7 +857,11 @@ def choose_mathieu(kind: str, m: int, tol: float, q_min: float, q_max: float,
 BACKBONE_POINTS = 17
 # NOTE: Chebyshev points of the amplitude range, ends included (where truncation peaks), each
 # a shot orbit (~0.1–0.3 s for two coordinates).
+BACKBONE_FIRST_ORDER = 24
 BACKBONE_MAX_ORDER = 40
+# NOTE: the series is derived to the first order (the radius estimate needs it: a few seconds
+# over Q(λ)) and only where no order up to it meets the tolerance to the last (seconds to
+# tens of seconds: the exact coefficients grow).
 BACKBONE_FLOOR = 1e-11
 # NOTE: the shot reference (DOP853 at 1e-13, Newton to 1e-12) is trusted to ~1e-12 in T: a
 # tolerance below this floor cannot be verified.
@@ -882,8 +886,7 @@ def choose_backbone(system: System, mode: int, tol: float, a_min: float, a_max: 
     """The smallest order whose period is within ``tol`` (relative) of the shot orbits at
     :data:`BACKBONE_POINTS` Chebyshev amplitudes of ``[a_min, a_max]`` (each seeded by the
     last: a continuation); refused past the series' reach or below the reference's floor."""
-    from .derive.nnm import normal_mode
-    from .lower.system import radius
+    from .derive.nnm import normal_mode, radius
     from .numerics.references import mode_orbit
 
     if not (np.isfinite(tol) and tol > 0):
@@ -893,15 +896,14 @@ def choose_backbone(system: System, mode: int, tol: float, a_min: float, a_max: 
                          "verify")
     if not (np.isfinite(a_min) and np.isfinite(a_max) and 0 < a_min < a_max):
         raise InputError(f"--range {a_min}:{a_max}: amplitudes with 0 < A < B")
-    series = normal_mode(system, mode, BACKBONE_MAX_ORDER, amplitude)
+    series = normal_mode(system, mode, BACKBONE_FIRST_ORDER, amplitude)
     found = radius(series)
-    reach = np.inf if found is None else (found[0] - found[1]) ** (1 / series.step)
+    reach = np.inf if found is None else found.reach
     if a_max >= reach:
         raise InputError(f"--range {a_min}:{a_max}: the series of mode {mode} reaches "
-                         f"A < {reach:.4g} (its estimated radius less its spread); shoot "
+                         f"A < {reach:.4g} (the lower bound of its estimated radius); shoot "
                          "beyond it")
     A = verification_points(a_min, a_max, BACKBONE_POINTS)
-    tau = np.array([float(c) for c in series.period()])
     truth = np.empty_like(A)
     guess = None
     for k, a in enumerate(A):
@@ -915,11 +917,16 @@ def choose_backbone(system: System, mode: int, tol: float, a_min: float, a_max: 
         truth[k] = orbit.period
         guess = np.append(np.delete(orbit.start, amplitude), orbit.period / 2)
     y = A**series.step
-    errors = []
-    for k in range(series.order + 1):
-        model = 2 * np.pi * np.polyval(tau[: k + 1][::-1], y)
-        errors.append(float(np.max(np.abs(model / truth - 1))))
-        if errors[-1] <= tol:
-            return BackboneChoice(mode, k, errors[-1], tuple(errors), len(A), float(reach))
+    errors: list[float] = []
+    for top in (BACKBONE_FIRST_ORDER, BACKBONE_MAX_ORDER):
+        if series.order < top:  # not reached yet: the longer series (slower: Q(λ) grows)
+            series = normal_mode(system, mode, top, amplitude)
+        tau = np.array([float(c) for c in series.period()])
+        for k in range(len(errors), series.order + 1):
+            model = 2 * np.pi * np.polyval(tau[: k + 1][::-1], y)
+            errors.append(float(np.max(np.abs(model / truth - 1))))
+            if errors[-1] <= tol:
+                return BackboneChoice(mode, k, errors[-1], tuple(errors), len(A),
+                                      float(reach))
     raise InputError(f"--tol {tol:g}: not reached by order {series.order} on "
                      f"[{a_min:g}, {a_max:g}]; the best is {min(errors):.1e}")

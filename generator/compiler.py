@@ -168,10 +168,11 @@ def generate_mathieu(kind: str, m: int, order: int, out: Path, *,
 def generate_nnm(system: object, mode: int, order: int, out: Path, *, amplitude: int = 0,
                  name: str = "system", command: str = "lindstedt generate SYSTEM",
                  progress: Progress | None = None, overwrite_edited: bool = False,
-                 flag: str = "--out") -> list[Path]:
+                 flag: str = "--out", allow_divergent: bool = False) -> list[Path]:
     """``lindstedt generate SYSTEM --mode M``: the mode's backbone and shape evaluators."""
     order = check_order(order)
-    return compile_target(NNM, NormalModeRequest(order, command, system, mode, amplitude, name),
+    return compile_target(NNM, NormalModeRequest(order, command, system, mode, amplitude, name,
+                                                 allow_divergent),
                           out, progress, overwrite_edited=overwrite_edited, flag=flag)
 
 

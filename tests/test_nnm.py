@@ -263,3 +263,24 @@ def test_a_symbolic_nonlinear_parameter_gives_polynomial_coefficients_exactly():
     assert json.loads(out.stdout)["period"][1] == "-3*alpha/8"
     bad = run("nnm", "x1'' + k*x1 - x2 + alpha*x1**3 = 0; x2'' + 2*x2 - x1 = 0")
     assert bad.returncode == 2 and "k stands in the linear part" in bad.stderr
+
+
+def test_number_field_products_equal_sympy_s_field_arithmetic():
+    """NFPoly (FLINT parts in Q(θ), reduced by θ's minimal polynomial) against SymPy's own
+    field arithmetic (DensePoly over the AlgebraicField), another route: products, sums and
+    scalar multiples agree exactly, in a quadratic and a cubic field."""
+    from lindstedt.algebra.series import DensePoly, Ground
+    from sympy.polys.domains import QQ
+
+    x = sp.Symbol("x")
+    for theta in (sp.Rational(321, 200) - sp.sqrt(10441) / 200,
+                  sp.CRootOf(x**3 - 3 * x + 1, 1)):
+        K = QQ.algebraic_field(theta)
+        g = Ground(K)
+        t = K.from_sympy(theta)
+        a = [K.one * 3, t, t * t / 7 + 1, K.zero, -t]
+        b = [t / 5, K.one, t * 2 - 3]
+        fast = (g.poly(a) * g.poly(b) + g.poly(b) * t - g.poly(a).left_shift(2) * 4).coeffs()
+        slow = (DensePoly(a, K) * DensePoly(b, K) + DensePoly(b, K) * t
+                - DensePoly(a, K).left_shift(2) * 4).coeffs()
+        assert fast == slow

@@ -3,10 +3,12 @@ NaN beyond the radius, the ``_into`` twins, and bad input for ``generate SYSTEM`
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 
 import numpy as np
 import pytest
+import sympy as sp
 from commands import run
 from lindstedt.derive.nnm import normal_mode
 from lindstedt.derive.system import parse_system
@@ -68,3 +70,97 @@ def test_generate_system_refusals_write_nothing(tmp_path, args, says):
 def test_mode_flag_without_a_system_is_refused():
     out = run("generate", "duffing", "--mode", "2", "--out", "x")
     assert out.returncode == 2 and "a system's flags" in out.stderr
+
+
+MEMS = "x1'' + x1 + 0.5*(x1-x2) + 0.3*x1**3 = 0; x2'' + 1.21*x2 + 0.5*(x2-x1) = 0"
+# NOTE: ω0² = (321 ∓ √10441)/200: the coefficients live in Q(√10441), and the ratios of
+# mode 1's ω_j swing (3.3 … 19 over the first orders), so its radius estimate spreads wide.
+
+
+def _load(path, name):
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@functools.cache
+def _mems_series(which: int):
+    return normal_mode(parse_system(MEMS), which, 24)  # as generate derives it (radius)
+
+
+@pytest.fixture(scope="module")
+def mems1(tmp_path_factory):
+    """Mode 1's order-8 module, the one whose guard was ``if not (False)``: NaN everywhere."""
+    from lindstedt.emit.render import render_module
+    from lindstedt.lower.system import lower_nnm
+
+    path = tmp_path_factory.mktemp("mems") / "mems1.py"
+    path.write_text(render_module(lower_nnm(_mems_series(1), 8, "mems1", "test")))
+    return _load(path, "mems1")
+
+
+def _shot_period(which: int, A: float) -> float:
+    series = _mems_series(which)
+    period, starts = _evaluate(series, A)
+    return _shoot(MEMS, A, starts[1:], period / 2)[1]
+
+
+def test_mems_mode_1_module_meets_shooting_with_a_real_positive_radius_bound(mems1):
+    """The order-8 module of a pair in Q(√10441): ω within 1e-8 of shooting at A = 0.2 and
+    0.5, the radius' lower bound real and positive, NaN beyond it."""
+    m = mems1
+    assert isinstance(m.RADIUS_LOWER, float) and 0 < m.RADIUS_LOWER <= m.RADIUS
+    assert m.ALLOW_DIVERGENT is False
+    for A in (0.2, 0.5):
+        assert abs(m.omega(A) - 2 * np.pi / _shot_period(1, A)) <= 1e-8
+    beyond = 1.01 * np.sqrt(m.RADIUS_LOWER)
+    assert np.isnan(m.omega(beyond)) and np.isnan(m.error_estimate(beyond))
+    assert np.isfinite(m.omega(0.99 * np.sqrt(m.RADIUS_LOWER)))
+
+
+def test_mems_error_estimate_bounds_the_true_error_within_ten_times(mems1):
+    """error_estimate against the period's true error (shooting, trusted to ~1e-12) on a grid
+    of A: never below it, at most 10× above it where it is above rounding."""
+    checked = 0
+    for A in (0.3, 0.5, 0.65, 0.8, 0.9):
+        true = abs(mems1.period(A) / _shot_period(1, A) - 1)
+        estimate = mems1.error_estimate(A)
+        assert estimate >= true or true < 1e-12, (A, estimate, true)
+        if true > 1e-11:
+            assert estimate <= 10 * true, (A, estimate, true)
+            checked += 1
+    assert checked >= 2
+
+
+def test_mems_mode_2_series_meets_shooting_inside_its_bound():
+    """Mode 2 (a complex pair of singularities: Mercer–Roberts): its lower bound real and
+    positive, the order-8 sum within 1e-8 of shooting at A = 0.2 and 0.5."""
+    from lindstedt.derive.nnm import radius
+
+    series = _mems_series(2)
+    bound = radius(series)
+    assert 0.5 < bound.reach < bound.estimate ** 0.5
+    tau = [float(c) for c in series.period()[:9]]
+    for A in (0.2, 0.5):
+        model = 2 * np.pi * np.polyval(tau[::-1], A * A)
+        assert abs(2 * np.pi / model - 2 * np.pi / _shot_period(2, A)) <= 1e-8
+
+
+def test_mems_allow_divergent_lifts_the_guard_and_a_bound_of_zero_is_refused(monkeypatch):
+    from lindstedt.derive.nnm import ModeRadius
+    from lindstedt.errors import InputError
+    from lindstedt.lower import system as lowering
+
+    series = _mems_series(1)
+    guarded = lowering.lower_nnm(series, 4, "m", "test")
+    free = lowering.lower_nnm(series, 4, "m", "test", allow_divergent=True)
+    assert dict(free.constants)["ALLOW_DIVERGENT"] is True
+    lower = dict(guarded.constants)["RADIUS_LOWER"]
+    assert any(abs(float(f) - lower) < 1e-9 for f in guarded.evaluators[0].guard.atoms(
+        sp.Float)) and not any(abs(float(f) - lower) < 1e-9 for f in
+                               free.evaluators[0].guard.atoms(sp.Float))
+    monkeypatch.setattr(lowering, "radius", lambda mode: ModeRadius(1.0, 5.0, 0.0, "test", 2))
+    with pytest.raises(InputError, match="every amplitude would be NaN"):
+        lowering.lower_nnm(series, 4, "m", "test")
+    assert lowering.lower_nnm(series, 4, "m", "test", allow_divergent=True)

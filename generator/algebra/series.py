@@ -8,8 +8,9 @@ sums hold odd harmonics only, ``u = C · P(C²)``, and the kernel works with ``P
 ``v = C²``: a quarter of the length of the Laurent polynomial in ``z = e^{is}``.
 ``docs/benchmarks.md`` records the representations that were measured against it.
 
-Coefficients stay exact: rationals (FLINT), or, when a parameter is left symbolic,
-elements of a SymPy polynomial domain such as ``QQ[A]`` (:class:`DensePoly`).
+Coefficients stay exact: rationals (FLINT), elements of a number field ``Q(θ)``
+(:class:`NFPoly`, FLINT underneath), or, when a parameter is left symbolic, elements of a
+SymPy polynomial domain such as ``QQ[A]`` (:class:`DensePoly`, :class:`MPoly`).
 """
 
 from __future__ import annotations
@@ -155,6 +156,114 @@ class MPoly:
     __rmul__ = __mul__
 
 
+class NFPoly:
+    """Polynomial in ``C`` over a number field ``Q(θ) = Q[t]/m(t)`` (SymPy's
+    ``AlgebraicField``), held as its ``k = deg m`` parts, the coefficients of ``θ⁰ … θ^(k−1)``,
+    each a FLINT ``fmpq_poly`` in ``C``: a product is ``k²`` products in C and a reduction of
+    ``θ^k … θ^(2k−2)`` by ``m`` (:class:`DensePoly` over SymPy's field took 135 s where this
+    takes a few, a normal mode of two coordinates in ``Q(√10441)`` to order 40).  Its
+    coefficients are SymPy's field elements (``ANP``)."""
+
+    __slots__ = ("field", "parts")
+
+    def __init__(self, parts: list, field: _NumberField) -> None:
+        self.parts, self.field = parts, field
+
+    @classmethod
+    def from_coeffs(cls, coeffs: Sequence[Any], field: _NumberField) -> NFPoly:
+        """From field elements (``ANP``, or rationals), low to high in ``C``."""
+        rows = [field.parts(c) for c in coeffs]
+        return cls([fmpq_poly([r[i] for r in rows]) for i in range(field.k)], field)
+
+    def coeffs(self) -> list:
+        """The coefficients of ``C⁰, C¹, …`` (low to high), each an ``ANP`` of the field."""
+        lists = [p.coeffs() for p in self.parts]
+        top = max(map(len, lists))
+        zero = fmpq(0)
+        return [self.field.element([c[n] if n < len(c) else zero for c in lists])
+                for n in range(top)]
+
+    def left_shift(self, k: int) -> NFPoly:
+        """The polynomial times ``C^k``."""
+        return NFPoly([p.left_shift(k) for p in self.parts], self.field)
+
+    def __add__(self, other: NFPoly) -> NFPoly:
+        return NFPoly([a + b for a, b in zip(self.parts, other.parts, strict=True)],
+                      self.field)
+
+    def __sub__(self, other: NFPoly) -> NFPoly:
+        return NFPoly([a - b for a, b in zip(self.parts, other.parts, strict=True)],
+                      self.field)
+
+    def __neg__(self) -> NFPoly:
+        return NFPoly([-a for a in self.parts], self.field)
+
+    def __mul__(self, other: Any) -> NFPoly:
+        k = self.field.k
+        if isinstance(other, NFPoly):
+            right = other.parts
+        elif isinstance(other, int):
+            return NFPoly([a * other for a in self.parts], self.field)
+        else:
+            right = self.field.parts(other)
+        out = [fmpq_poly() for _ in range(2 * k - 1)]
+        for i, a in enumerate(self.parts):
+            if a.is_zero():
+                continue
+            for j, b in enumerate(right):
+                if b:
+                    out[i + j] += a * b
+        for i in range(k, 2 * k - 1):
+            if not out[i].is_zero():
+                for m, r in enumerate(self.field.powers[i - k]):
+                    if r:
+                        out[m] += out[i] * r
+        return NFPoly(out[:k], self.field)
+
+    __rmul__ = __mul__
+
+
+@dataclass(frozen=True)
+class _NumberField:
+    """``Q(θ)`` for :class:`NFPoly`: the degree ``k``, ``θ^i`` for ``i = k … 2k−2`` in the
+    basis ``θ⁰ … θ^(k−1)`` (rationals, low to high), and SymPy's field for its elements."""
+
+    domain: Any
+    k: int
+    powers: tuple[tuple[Any, ...], ...]
+
+    def parts(self, c: Any) -> list:
+        """A field element (``ANP``, or a rational) as its ``k`` rationals, low to high."""
+        if not hasattr(c, "to_list"):
+            c = self.domain.convert(c)
+        low = [_fmpq(x) for x in reversed(c.to_list())]
+        return low + [fmpq(0)] * (self.k - len(low))
+
+    def element(self, low: list) -> Any:
+        """The ``ANP`` of rationals ``low`` (low to high)."""
+        q = self.domain.dom
+        return self.domain.new([q(int(x.p), int(x.q)) for x in reversed(low)])
+
+
+def _fmpq(x: Any) -> fmpq:
+    return x if isinstance(x, fmpq) else fmpq(int(x.numerator), int(x.denominator))
+
+
+@cache
+def _number_field(domain: Any) -> _NumberField:
+    """The reduction data of SymPy's ``AlgebraicField`` ``domain`` (its minimal polynomial
+    made monic: ``θ^k = −Σ a_l θ^l``), computed once per field."""
+    mod = [_fmpq(x) for x in reversed(domain.mod.to_list())]  # low to high
+    k = len(mod) - 1
+    cur = [-c / mod[k] for c in mod[:k]]  # θ^k
+    top, powers = cur, []
+    for _ in range(k - 1):
+        powers.append(tuple(cur))
+        shifted = [fmpq(0), *cur[:-1]]  # θ·cur, its θ^k part reduced by θ^k itself
+        cur = [s + cur[-1] * t for s, t in zip(shifted, top, strict=True)]
+    return _NumberField(domain, k, tuple(powers))
+
+
 @cache
 def _mpoly_context(names: tuple[str, ...]) -> Any:
     # NOTE: "_C" cannot be a parameter's name (user names never start with '_')
@@ -199,6 +308,8 @@ class Ground:
         """Polynomial from coefficients listed low to high."""
         if self.is_rational:
             return fmpq_poly(list(coeffs))
+        if self.domain.is_AlgebraicField:
+            return NFPoly.from_coeffs(coeffs, _number_field(self.domain))
         ctx = self._flint_ring
         if ctx is None:
             return DensePoly(coeffs, self.domain)
@@ -366,6 +477,16 @@ def from_fourier(coeffs: dict[int, Any], basis: Basis, ground: Ground) -> Any:
         for i, x in enumerate(b):
             nxt[i] -= x
         cheb.append(nxt)
+    if ground.domain.is_AlgebraicField:  # each rational part by FLINT, not SymPy's field
+        field = _number_field(ground.domain)
+        sums = [fmpq_poly() for _ in range(field.k)]
+        for n, a in coeffs.items():
+            t = fmpq_poly(cheb[n])
+            for i, c in enumerate(field.parts(a)):
+                if c:
+                    sums[i] += t * c
+        return NFPoly([fmpq_poly(p.coeffs()[basis.parity :: basis.stride]) for p in sums],
+                      field)
     mono = [ground.scalar(0)] * (top + 1)
     for n, a in coeffs.items():
         for i, t in enumerate(cheb[n]):

@@ -250,7 +250,7 @@ BACKBONE_POINTS = 200
 def backbone(mode: NormalModeSeries, points: int = BACKBONE_POINTS) -> Backbone:
     """:class:`Backbone` of ``mode`` (:meth:`NormalModeSeries.evaluate` on its amplitudes)."""
     found = radius(mode)
-    reach = None if found is None else (found[0] - found[1]) ** (1 / mode.step)
+    reach = None if found is None or not found.lower > 0 else found.reach
     A = np.linspace(0.0, 0.95 * (1.0 if reach is None else reach), points)
     omega, period, _ = mode.evaluate(A)
     return Backbone(mode.mode, str(mode.system.coordinates[mode.amplitude]), reach, A,

@@ -700,8 +700,7 @@ def run_generate(args: argparse.Namespace) -> int:
 def _generate_system(args: argparse.Namespace) -> int:
     """``generate SYSTEM --mode M``: the normal mode's module (the flags of free oscillators
     refused beside it)."""
-    given = [flag for flag, on in (("--allow-divergent", args.allow_divergent),
-                                   ("--damped", args.damped),
+    given = [flag for flag, on in (("--damped", args.damped),
                                    ("--resum-order", args.resum_order is not None)) if on]
     if given:
         raise InputError(f"{', '.join(given)}: not for a system's normal mode")
@@ -720,13 +719,15 @@ def _generate_system(args: argparse.Namespace) -> int:
     command = " ".join(["lindstedt generate", f'"{args.model}"', f"--mode {mode}",
                         f"--order {args.order}", *(f"--param {p}" for p in args.param or ()),
                         *([f"--amplitude {args.amplitude}"] if args.amplitude else []),
-                        f"--name {name}"])
+                        f"--name {name}",
+                        *(["--allow-divergent"] if args.allow_divergent else [])])
     progress = ProgressBar(f"deriving mode {mode}")
     try:
         paths = compiler.generate_nnm(system, mode, args.order, _out_folder(args.out),
                                       amplitude=amplitude, name=name, command=command,
                                       progress=progress,
-                                      overwrite_edited=args.overwrite_edited)
+                                      overwrite_edited=args.overwrite_edited,
+                                      allow_divergent=args.allow_divergent)
     finally:
         progress.close()
     for path in paths:

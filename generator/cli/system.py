@@ -31,8 +31,13 @@ CONVENTION = ("at t = 0 every velocity is zero and {a}(0) = A (a turning point);
 
 def nnm_json(mode) -> dict:
     """The contract of ``lindstedt nnm … --json``: ω₀, the expansion variable, ω and T/2π
-    per order and every coordinate's Fourier coefficients, each exact (SymPy's str)."""
+    per order and every coordinate's Fourier coefficients, each exact (SymPy's str), and
+    beside each its decimal (``*_decimal``, 12 significant digits) and ω₀'s minimal
+    polynomial (``None`` for a rational ω₀)."""
+    from ..lower.printers import decimal_text, minimal_polynomial
+
     names = [str(x) for x in mode.system.coordinates]
+    root = minimal_polynomial(mode.omega0, "x")
     return {
         "kind": "nnm", "mode": mode.mode, "omega0": str(mode.omega0),
         "variable": mode.variable, "order": mode.order,
@@ -48,24 +53,61 @@ def nnm_json(mode) -> dict:
         "parameters": sorted({str(s) for f in mode.system.force for s in f.free_symbols}
                              - set(names) - {str(v) for v in mode.system.velocities}),
         "period_units": "T/(2*pi): period[j] is the coefficient of y^j",
+        "omega0_decimal": decimal_text(mode.omega0),
+        "omega0_minimal_polynomial": None if root is None else str(root),
+        "lambda_decimal": decimal_text(mode.lam),
+        "linear_frequencies_squared_decimal": [decimal_text(x) for x in mode.system.modes()],
+        "omega_decimal": [decimal_text(c) for c in mode.omega()],
+        "period_decimal": [decimal_text(c) for c in mode.period()],
+        "coordinates_decimal": {name: [{str(n): decimal_text(c) for n, c in order.items()}
+                                       for order in mode.coordinate(i)]
+                                for i, name in enumerate(names)},
     }
 
 
-def nnm_table(data: dict) -> str:
-    """The readable table: ω_j, (T/2π)_j and each coordinate's harmonics per order."""
+TEXT_WIDTH = 200
+# NOTE: no line of nnm's table is longer; --exact prints a long exact number on lines of its
+# own, broken at this width.
+SHORT_EXACT = 24
+# NOTE: as lower.printers.EXACT_WIDTH (not imported: the table must not load SymPy).
+
+
+def _shown(exact: str, decimal: str, full: bool) -> str:
+    """The exact form when it is short or ``full`` (--exact), else the decimal."""
+    return exact if full or len(exact) <= SHORT_EXACT else decimal
+
+
+def nnm_table(data: dict, exact: bool = False) -> str:
+    """The readable table: ω_j, (T/2π)_j and each coordinate's harmonics per order; a long
+    exact number as its decimal (12 significant digits) unless ``exact`` (--exact), which
+    lists the exact forms one to a line instead; no line over :data:`TEXT_WIDTH`."""
+    w0 = _shown(data["omega0"], data["omega0_decimal"], exact)
+    if w0 != data["omega0"]:
+        w0 += f" (a root of {data['omega0_minimal_polynomial']})"
+    squares = ", ".join(_shown(e, d, exact) for e, d in zip(
+        data["linear_frequencies_squared"], data["linear_frequencies_squared_decimal"],
+        strict=True))
     lines = [f"mode {data['mode']} of {data['system']}",
-             f"omega0 = {data['omega0']} (omega0^2 of every mode: "
-             f"{', '.join(data['linear_frequencies_squared'])}), expansion variable "
+             f"omega0 = {w0} (omega0^2 of every mode: {squares}), expansion variable "
              f"{data['variable']}, order {data['order']}",
-             f"convention: {data['convention']}",
-             f"{'j':>3}  {'omega_j':>28}  {'(T/2pi)_j':>28}"]
-    for j, (w, t) in enumerate(zip(data["omega"], data["period"], strict=True)):
-        lines.append(f"{j:>3}  {w:>28}  {t:>28}")
+             f"convention: {data['convention']}"]
+    cells = [(_shown(w, wd, exact), _shown(t, td, exact)) for w, wd, t, td in zip(
+        data["omega"], data["omega_decimal"], data["period"], data["period_decimal"],
+        strict=True)]
+    if exact and any(len(w) > 28 or len(t) > 28 for w, t in cells):
+        for j, (w, t) in enumerate(cells):
+            lines += [f"omega_{j} = {w}", f"(T/2pi)_{j} = {t}"]
+    else:
+        lines.append(f"{'j':>3}  {'omega_j':>28}  {'(T/2pi)_j':>28}")
+        lines += [f"{j:>3}  {w:>28}  {t:>28}" for j, (w, t) in enumerate(cells)]
     for name, orders in data["coordinates"].items():
         lines.append(f"{name}: harmonic n -> coefficient, per order")
-        for j, order in enumerate(orders):
-            lines.append(f"{j:>3}  " + ", ".join(f"{n}: {c}" for n, c in order.items()))
-    return "\n".join(lines)
+        for j, (order, decimals) in enumerate(zip(orders, data["coordinates_decimal"][name],
+                                                  strict=True)):
+            lines.append(f"{j:>3}  " + ", ".join(f"{n}: {_shown(c, decimals[n], exact)}"
+                                                  for n, c in order.items()))
+    return "\n".join(piece for line in lines for piece in textwrap.wrap(
+        line, TEXT_WIDTH, subsequent_indent="     ", break_on_hyphens=False) or [""])
 
 
 def backbone_csv(b, path: Path) -> Path:
@@ -111,7 +153,7 @@ def run_nnm(args: argparse.Namespace) -> int:
         from ..analysis.curves import backbone
 
         backbone_csv(backbone(mode), csv)
-    print(json.dumps(data) if args.json else nnm_table(data))
+    print(json.dumps(data) if args.json else nnm_table(data, args.exact))
     return 0
 
 
@@ -235,6 +277,10 @@ def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    "first)")
     _flag_order(p, "highest power K of the expansion variable")
     _flag_json(p)
+    p.add_argument("--exact", action="store_true",
+                   help="the table shows every number exactly (default: a long exact form, "
+                   "such as an algebraic ω0 or a coefficient in Q(ω0²), as its decimal to 12 "
+                   "significant digits; --json holds both)")
     p.add_argument("--plot", metavar="FILE",
                    help="also draw the frequency–energy plot of every mode (at most 4) into "
                    "FILE (.png, .svg or .pdf): each backbone from its series (to order 24, or "
@@ -273,10 +319,23 @@ def response_system_json(r) -> dict:
         },
         "branches": branches,
         "folds": [float(w) for w in r.cont.folds],
-        "jumps": [{"sweep": way, "omega": w,
-                   "from": {n: float(r.amplitudes[a, i]) for i, n in enumerate(names)},
-                   "to": {n: float(r.amplitudes[b, i]) for i, n in enumerate(names)}}
-                  for way, w, a, b in r.jumps],
+        "jumps": [{"sweep": j.way, "omega": j.omega,
+                   "from": dict(zip(names, j.leaving, strict=True)),
+                   "to": dict(zip(names, j.landing, strict=True)),
+                   "at_fold": j.at_fold, "landing_converged": j.landing_converged,
+                   "landing_multiplier": j.landing_multiplier,
+                   "simulated": {n: None if a != a else a
+                                 for n, a in zip(names, j.simulated, strict=True)},
+                   "simulation_difference": None if j.difference != j.difference
+                   else j.difference,
+                   "nearest_points": {
+                       "from": {"omega": float(r.cont.omega[j.before]),
+                                **{n: float(r.amplitudes[j.before, i])
+                                   for i, n in enumerate(names)}},
+                       "to": {"omega": float(r.cont.omega[j.after]),
+                              **{n: float(r.amplitudes[j.after, i])
+                                 for i, n in enumerate(names)}}}}
+                  for j in r.sweep_jumps],
         "checks": [{"omega": c.omega, "branch": c.piece,
                     "balance": dict(zip(names, c.balance, strict=True)),
                     "shot": dict(zip(names, c.shot, strict=False)),
@@ -288,6 +347,18 @@ def response_system_json(r) -> dict:
         "completeness": {"complete": r.complete, "bound": r.bound, "how": r.note},
         "amplitude": "r_i = sqrt(A_i1^2 + B_i1^2), the first harmonic of coordinate i",
     }
+
+
+def _jump_check(j: dict) -> str:
+    """How a jump of ``response SYSTEM --json`` was computed and checked, in words."""
+    where = ("both at the fold" if j.get("at_fold") else "where the stretch loses stability")
+    if not j.get("landing_converged", True):
+        where += "; landing: the nearest point (Newton did not converge)"
+    diff = j.get("simulation_difference")
+    check = ("DOP853 from the fold state did not settle" if diff is None else
+             f"DOP853 from the fold state lands within {diff:.1e}" if diff <= 1e-3 else
+             f"warning: DOP853 from the fold state settles {diff:.2g} away")
+    return f" ({where}; {check})"
 
 
 def response_system_table(data: dict) -> list[str]:
@@ -312,7 +383,8 @@ def response_system_table(data: dict) -> list[str]:
         jumps = [j for j in data["jumps"] if j["sweep"] == way]
         lines.append(f"  sweep {way}:" + (" no jump" if not jumps else ""))
         lines += [f"    jumps at {j['omega']:.6f}: " + ", ".join(
-            f"{n} {j['from'][n]:.4g} -> {j['to'][n]:.4g}" for n in names) for j in jumps]
+            f"{n} {j['from'][n]:.4g} -> {j['to'][n]:.4g}" for n in names) + _jump_check(j)
+            for j in jumps]
     checks = data["checks"]
     shot = [c for c in checks if c["error"] is not None]
     agree = sum(c["stable"] == c["balance_stable"] for c in shot)

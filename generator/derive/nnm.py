@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -79,12 +80,33 @@ class NormalModeSeries:
 
     def omega(self) -> list[sp.Expr]:
         """``ω = Σ_j ω_j y^j`` exactly: ``√λ`` times the series of ``√(Ω/λ)``."""
-        return [self.omega0 * self._exact(c) for c in _sqrt_series(self._ratio(), self.ground)]
+        return list(self._omega)
 
     def period(self) -> list[sp.Expr]:
         """``T/2π = Σ_j τ_j y^j`` exactly: ``1/√λ`` times the series of ``(Ω/λ)^(−1/2)``."""
+        return list(self._period)
+
+    def omega_over_omega0(self) -> list[sp.Expr]:
+        """``ω_j/ω₀``, exact in the ground (no square root of λ)."""
+        return list(self._ratios[0])
+
+    def period_times_omega0(self) -> list[sp.Expr]:
+        """``τ_j ω₀``, exact in the ground."""
+        return list(self._ratios[1])
+
+    @cached_property
+    def _ratios(self) -> tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]]:
         root = _sqrt_series(self._ratio(), self.ground)
-        return [self._exact(c) / self.omega0 for c in _inverse_series(root, self.ground)]
+        return (tuple(map(self._exact, root)),
+                tuple(map(self._exact, _inverse_series(root, self.ground))))
+
+    @cached_property
+    def _omega(self) -> tuple[sp.Expr, ...]:
+        return tuple(self.omega0 * c for c in self._ratios[0])
+
+    @cached_property
+    def _period(self) -> tuple[sp.Expr, ...]:
+        return tuple(c / self.omega0 for c in self._ratios[1])
 
     def _ratio(self) -> list[Any]:
         inv = self.ground.scalar(1) / self.omega_squared[0]
@@ -101,10 +123,12 @@ class NormalModeSeries:
                            for orders in map(self.coordinate, range(self.system.size))])
         return omega, period, starts
 
-    def coordinate(self, i: int) -> list[dict[int, sp.Expr]]:
-        """Coordinate ``i``'s coefficients per order: ``{n: c}`` of ``cos nτ``, exact."""
-        return [{n: self._exact(c) for n, c in sorted(order[i].items()) if c}
-                for order in self.coefficients]
+    def coordinate(self, i: int, order: int | None = None) -> list[dict[int, sp.Expr]]:
+        """Coordinate ``i``'s coefficients per order (up to ``order``; default all): ``{n: c}``
+        of ``cos nτ``, exact."""
+        top = self.order if order is None else order
+        return [{n: self._exact(c) for n, c in sorted(orders[i].items()) if c}
+                for orders in self.coefficients[: top + 1]]
 
 
 def _sqrt_series(a: list[Any], g: Ground) -> list[Any]:
@@ -342,13 +366,61 @@ def _resonance(system: System, mode: int, lams: tuple, n: int, j: int, step: int
             "slowflow SYSTEM gives their slow flow)")
 
 
-def radius(mode: NormalModeSeries) -> tuple[float, float] | None:
-    """The estimated radius of convergence of ω in ``y`` and its spread, or None when the
-    series is too short for an estimate."""
-    est = nearest_singularity([c / mode.omega0 for c in mode.omega()], "y", None)
+RELIABLE_SPREAD = 0.5
+# NOTE: an estimate whose spread is below this fraction of it bounds the radius from below by
+# itself less its spread; a larger spread (the ratios of ω_j still swinging, as where several
+# singularities lie at nearly one distance) falls back on the smallest ratio of the tail.
+
+
+@dataclass(frozen=True)
+class ModeRadius:
+    """The radius of convergence of a mode's ω series in ``y``: the estimate, its spread and
+    a lower bound ``lower > 0`` (in ``y``), with how the bound was found; ``reach`` is the
+    bound in the amplitude A."""
+
+    estimate: float
+    spread: float
+    lower: float
+    how: str
+    step: int
+
+    @property
+    def reach(self) -> float:
+        """The lower bound in the amplitude: ``lower^(1/step)``."""
+        return self.lower ** (1 / self.step)
+
+
+def radius(mode: NormalModeSeries) -> ModeRadius | None:
+    """The estimated radius of convergence of ω in ``y`` (:func:`nearest_singularity`) with a
+    real, positive lower bound; None when the series is too short for an estimate (or ends:
+    a polynomial ω converges everywhere).  The bound is the estimate less its spread where the
+    spread is below :data:`RELIABLE_SPREAD` of it, else the smaller of the estimate and the
+    smallest ratio ``|c_(n−1)/c_n|`` over the last half of the coefficients: swinging ratios
+    pass below their limit, which is the radius."""
+    coefficients = mode.omega_over_omega0()
+    est = nearest_singularity(coefficients, "y", None)
     if est is None:
         return None
-    if est.variable.endswith("**2"):
-        r = math.sqrt(est.radius)
-        return r, est.spread / (2 * r)
-    return est.radius, est.spread
+    values = [float(sp.N(c, 30)) for c in coefficients]
+    square = est.variable.endswith("**2")  # read in y², the radius converted back to y
+    if square:
+        values = values[::2]
+    while values and values[-1] == 0:
+        values.pop()
+    ratios = [abs(values[n - 1] / values[n]) for n in range(max(2, len(values) // 2),
+                                                           len(values))
+              if values[n] and values[n - 1]]
+    r, spread = est.radius, est.spread
+    if math.isfinite(r) and r > 0 and math.isfinite(spread) and spread < RELIABLE_SPREAD * r:
+        lower, how = r - spread, "the estimate less its spread"
+    else:
+        candidates = [x for x in (r, *ratios) if math.isfinite(x) and x > 0]
+        lower = min(candidates, default=0.0)
+        how = ("the smallest of the estimate and the ratios |c_(n-1)/c_n| of the last half "
+               f"of the {len(values)} coefficients (the estimate's spread {spread:.3g} is "
+               f"not below {RELIABLE_SPREAD:g} of it)")
+    if square:
+        root = math.sqrt(r) if r > 0 else math.nan
+        return ModeRadius(root, spread / (2 * root) if r > 0 else math.inf,
+                          math.sqrt(lower), how, mode.step)
+    return ModeRadius(r, spread, lower, how, mode.step)

@@ -26,6 +26,7 @@ import sympy as sp
 from ..errors import InputError
 from ..lower.printers import (
     LINE_EM,
+    is_long,
     latex_coefficient,
     latex_equation,
     latex_expr,
@@ -34,7 +35,9 @@ from ..lower.printers import (
     latex_sum_items,
     latex_validity,
     latex_width,
+    minimal_polynomial,
     pycode,
+    readable,
 )
 from ..lower.records import (
     ArrayKernel,
@@ -172,6 +175,9 @@ def render_module(module: Module) -> str:
 
 def _signed(c: sp.Expr, factor: str, first: bool) -> str:
     """``+ \\frac{p}{q} factor`` with the sign pulled out (LaTeX; no number is split)."""
+    if c.is_Float:  # a long exact number shown as its decimal
+        sign = "-" if c < 0 else ("" if first else "+")
+        return f"{sign} {latex_expr(abs(c))}\\,{factor}".strip()
     if not c.is_Rational:  # a polynomial in the symbolic parameters: bracketed, as it is
         return (f"{'' if first else '+'} \\left({latex_coefficient(c, stack=False)}\\right)"
                 f"\\,{factor}").strip()
@@ -444,21 +450,24 @@ def render_mode_tables(d: ModeTables, p: Provenance) -> dict[str, str]:
         y = "A"
 
     def powers(coeffs: tuple) -> list[str]:
-        return [_signed(coeffs[j], f"{y}^{{{j}}}" if j > 1 else y, first=False)
+        return [_signed(readable(coeffs[j]), f"{y}^{{{j}}}" if j > 1 else y, first=False)
                 for j in range(1, d.order + 1) if coeffs[j] != 0]
 
     rest = f"+ O({y}^{{{d.order + 1}}})"
-    w0 = latex_expr(d.omega0)
+    w0 = latex_expr(readable(d.omega0))
+    root = minimal_polynomial(d.omega0, "omega_0") if is_long(d.omega0) else None
     head = banner(p, "%")
     ctx = {
         "title": f"Nonlinear normal mode {d.mode}",
         "equations": [latex_expr(e) + " = 0" for e in d.equations],
-        "omega0": w0, "variable": variable, "y": y, "order": d.order,
+        "omega0": w0, "omega0_root": "" if root is None else latex_expr(root),
+        "variable": variable, "y": y, "order": d.order,
         "amplitude": latex_expr(d.amplitude),
         "frequency": _series(w0 + r"\Bigl(", powers(d.omega), rest + r"\Bigr)", r"\omega ="),
         "period": _series(r"\frac{2\pi}{" + w0 + r"}\Bigl(", powers(d.period),
                           rest + r"\Bigr)", "T ="),
-        "coordinates": [{"name": latex_expr(x), "blocks": _table_blocks(_fourier_columns(q))}
+        "coordinates": [{"name": latex_expr(x), "blocks": _table_blocks(_fourier_columns(
+            tuple(tuple((n, readable(c)) for n, c in qj) for qj in q)))}
                         for x, q in d.coordinates],
     }
     text = environment(latex=True).get_template("mode_tables.tex.j2").render(banner=head, **ctx)
@@ -471,24 +480,27 @@ def render_mode_derivation(d: ModeDerivation, p: Provenance) -> dict[str, str]:
     variable = "A" if y == "A" else f"y = {latex_expr(d.variable)}"
     names = [latex_expr(x) for x in d.coordinates]
 
+    def number(c: sp.Expr) -> str:  # a long exact number as its decimal
+        return latex_expr(readable(c))
+
     def vector(values: tuple) -> str:
-        return r"\begin{pmatrix}" + r" \\ ".join(latex_expr(v) for v in values) \
+        return r"\begin{pmatrix}" + r" \\ ".join(number(v) for v in values) \
             + r"\end{pmatrix}"
 
     matrix = r"\begin{pmatrix}" + r" \\ ".join(
         " & ".join(latex_expr(d.stiffness[i, k]) for k in range(d.stiffness.cols))
         for i in range(d.stiffness.rows)) + r"\end{pmatrix}"
     orders = [{
-        "j": o.j, "omega": latex_expr(o.omega_squared), "secular": latex_expr(o.secular),
-        "rows": [{"n": n, "x": names[i], "r": latex_expr(r[i]), "c": latex_expr(c[i])}
+        "j": o.j, "omega": number(o.omega_squared), "secular": number(o.secular),
+        "rows": [{"n": n, "x": names[i], "r": number(r[i]), "c": number(c[i])}
                  for n, r, c in o.harmonics for i in range(len(names)) if r[i] != 0 or c[i] != 0],
     } for o in d.orders]
     tex = environment(latex=True).get_template("mode_derivation.tex.j2").render(
         banner=banner(p, "%"), title=f"Nonlinear normal mode {d.mode}",
         equations=[latex_expr(e) + " = 0" for e in d.equations], stiffness=matrix,
-        lam=latex_expr(d.lam), right=vector(d.right), left=vector(d.left), y=y,
+        lam=number(d.lam), right=vector(d.right), left=vector(d.left), y=y,
         variable=variable, amplitude=latex_expr(d.amplitude),
-        psi_phi=latex_expr(sum(a * b for a, b in zip(d.left, d.right, strict=True))),
+        psi_phi=number(sp.expand(sum(a * b for a, b in zip(d.left, d.right, strict=True)))),
         orders=orders)
     return {f"{p.model}_derivation.tex": tex}
 

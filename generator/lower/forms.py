@@ -59,7 +59,7 @@ def harmonics(top: int, odd: bool, s: sp.Expr, sines: bool) -> tuple[list[Assign
 MODULE_NAMES = frozenset({
     "math", "np", "numba", "njit", "vectorize", "overload", "types", "TRIG_LIMIT", "SIN_KERNEL",
     "COS_KERNEL", "ORDER", "MODEL", "VARIABLE", "CONVENTION", "RADIUS", "ALLOW_DIVERGENT",
-    "RADIUS_SPREAD", "ORBIT_LIMIT", "ORBIT_LIMIT_EXACT",
+    "RADIUS_SPREAD", "RADIUS_LOWER", "ORBIT_LIMIT", "ORBIT_LIMIT_EXACT",
     "OMEGA", "PERIOD", "Q", "OMEGA_EXACT", "PERIOD_EXACT", "omega", "period", "error_estimate",
 })
 LOCAL_NAMES = frozenset({"out", "i", "t"})
@@ -85,6 +85,32 @@ def check_emitted_names(model: Model) -> None:
         if name in taken or _LOCAL.fullmatch(name):
             raise InputError(f"coordinate {coordinate!r}: the emitted module would define "
                              f"{name!r}, which it uses already; rename the coordinate")
+
+
+def _extreme(kind: type[sp.Min] | type[sp.Max], args: list[sp.Expr]) -> sp.Expr:
+    """``Min``/``Max`` of ``args``: evaluated where every one is a number, else left
+    unevaluated (no symbolic comparison)."""
+    return kind(*args, evaluate=all(a.is_number for a in args))
+
+
+def tail_bound(t1: sp.Expr, t2: sp.Expr, order: int, x: sp.Symbol, limits: list[sp.Expr]
+               ) -> sp.Expr:
+    """A bound on the omitted tail ``|Σ_(j>K) τ_j x^j|`` of a series summed to order ``K``
+    from ``t1 = |τ_{K+1}|``, ``t2 = |τ_{K+2}|`` and the radii ``limits`` (its radius less
+    spread, an orbit edge…; their smallest is ``R``): the first omitted term, then a geometric
+    tail from ``τ_{K+2}`` at the ratio ``r = max(1/R, t2/t1)``.  Ratios of a branch point's
+    coefficients rise toward 1/R (log, square root) or fall toward it (a pole of order > 1):
+    r bounds both.  inf from ``r|x| = 1`` on."""
+    if not limits:  # no radius and no edge: the omitted terms alone
+        return t1 * sp.Abs(x) ** (order + 1) + t2 * sp.Abs(x) ** (order + 2)
+    # over symbolic parameters Min/Max stay unevaluated: SymPy would compare polynomials in
+    # them term by term (6 s of a 10 s `generate` at order 12), and the printer emits min/max
+    R = _extreme(sp.Min, limits) if len(limits) > 1 else limits[0]
+    r = _extreme(sp.Max, [1 / R, t2 / t1]) if t1 != 0 else 1 / R
+    c = _extreme(sp.Max, [t2, r * t1])
+    ax = sp.Abs(x)
+    tail = t1 * ax ** (order + 1) + c * ax ** (order + 2) / (1 - r * ax)
+    return sp.Piecewise((tail, r * ax < 1), (sp.oo, True))
 
 
 def _hex(c: Fraction) -> str:

@@ -364,6 +364,41 @@ def latex_expr(expr: sp.Basic) -> str:
     return LatexPrinter().doprint(expr)
 
 
+EXACT_WIDTH = 24
+DECIMAL_DIGITS = 12
+# NOTE: an exact number whose SymPy form is longer than EXACT_WIDTH characters is shown to
+# DECIMAL_DIGITS significant digits where people read (tables, LaTeX): a normal mode's
+# coefficients in Q(√10441) reach numerators of 90 digits by order 4; the JSON keeps them.
+
+
+def is_long(c: sp.Expr) -> bool:
+    """Whether the exact form of ``c`` is too long to read (over :data:`EXACT_WIDTH`)."""
+    return len(sp.sstr(c)) > EXACT_WIDTH
+
+
+def readable(c: sp.Expr) -> sp.Expr:
+    """``c`` itself when its exact form is short, else its decimal (:data:`DECIMAL_DIGITS`
+    significant digits; a symbolic parameter stays a symbol).
+
+    >>> readable(sp.Rational(3, 64)), readable(sp.sqrt(sp.Rational(321, 200) - sp.sqrt(10441)/200))
+    (3/64, 1.04598945602)
+    """
+    return sp.N(c, DECIMAL_DIGITS) if is_long(c) else c
+
+
+def decimal_text(c: sp.Expr) -> str:
+    """``c`` to :data:`DECIMAL_DIGITS` significant digits, as text."""
+    return sp.sstr(sp.N(c, DECIMAL_DIGITS))
+
+
+def minimal_polynomial(c: sp.Expr, name: str = "x") -> sp.Expr | None:
+    """The minimal polynomial of the algebraic number ``c`` over Q in ``name``, integer
+    coefficients; None for a rational (it is its own exact form)."""
+    if c.is_Rational:
+        return None
+    return sp.minimal_polynomial(c, sp.Symbol(name), polys=False)
+
+
 LINE_EM = 40.0
 # NOTE: a display line's width in em: the text block is 170 mm (A4, 2 cm margins), ~44 em at
 # 11pt; 4 em are kept for the left side's indentation and the estimate's error.

@@ -24,6 +24,7 @@ from .forms import (
     harmonics,
     horner,
     scaled_variable,
+    tail_bound,
 )
 from .printers import exact, identifier
 from .records import (
@@ -38,35 +39,16 @@ from .records import (
 )
 
 
-def _extreme(kind: type[sp.Min] | type[sp.Max], args: list[sp.Expr]) -> sp.Expr:
-    """``Min``/``Max`` of ``args``: evaluated where every one is a number, else left
-    unevaluated (no symbolic comparison)."""
-    return kind(*args, evaluate=all(a.is_number for a in args))
-
-
 def _truncation_bound(solution: SeriesSolution, order: int, x: sp.Symbol,
                       reach: sp.Expr | None, domain: OrbitDomain) -> sp.Expr:
-    """A bound on ``|Σ_(j>K) τ_j y^j|`` (in units of 2π/ω₀): the first omitted term, then a
-    geometric tail from ``τ_{K+2}`` at the ratio ``r = max(1/R, |τ_{K+2}/τ_{K+1}|)``, ``R``
-    the smaller of ``reach`` (radius less spread) and the distance to the orbits' edge — a
-    singularity of T, where the period diverges.  Ratios of a branch point's coefficients
-    rise toward 1/R (log, square root) or fall toward it (a pole of order > 1): r bounds both.
-    inf from ``r|y| = 1`` on."""
+    """A bound on ``|Σ_(j>K) τ_j y^j|`` (in units of 2π/ω₀), :func:`tail_bound` of ``τ_{K+1}``,
+    ``τ_{K+2}`` with ``R`` the smaller of ``reach`` (radius less spread) and the distance to
+    the orbits' edge — a singularity of T, where the period diverges."""
     g, w0 = solution.ground, solution.model.frequency
     t1 = sp.Abs(exact(g, solution.period[order + 1]) / w0)
     t2 = sp.Abs(exact(g, solution.period[order + 2]) / w0)
     edges = [sp.Float(v, 17) for v in (-domain.lower, domain.upper) if math.isfinite(v)]
-    limits = [e for e in ([reach] if reach is not None else []) + edges]
-    if not limits:  # no radius and no edge: the omitted terms alone
-        return t1 * sp.Abs(x) ** (order + 1) + t2 * sp.Abs(x) ** (order + 2)
-    # over symbolic parameters Min/Max stay unevaluated: SymPy would compare polynomials in
-    # them term by term (6 s of a 10 s `generate` at order 12), and the printer emits min/max
-    R = _extreme(sp.Min, limits) if len(limits) > 1 else limits[0]
-    r = _extreme(sp.Max, [1 / R, t2 / t1]) if t1 != 0 else 1 / R
-    c = _extreme(sp.Max, [t2, r * t1])
-    ax = sp.Abs(x)
-    tail = t1 * ax ** (order + 1) + c * ax ** (order + 2) / (1 - r * ax)
-    return sp.Piecewise((tail, r * ax < 1), (sp.oo, True))
+    return tail_bound(t1, t2, order, x, ([reach] if reach is not None else []) + edges)
 
 
 def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = False) -> Module:

@@ -124,13 +124,14 @@ class MathieuRequest(Request):
 
 @dataclass(frozen=True)
 class NormalModeRequest(Request):
-    """One nonlinear normal mode of a system: the mode, its amplitude coordinate (an index)
-    and the module's name."""
+    """One nonlinear normal mode of a system: the mode, its amplitude coordinate (an index),
+    the module's name and whether it may be evaluated past its radius."""
 
     system: System
     mode: int
     amplitude: int
     name: str
+    allow_divergent: bool = False
 
 
 @dataclass(frozen=True)
@@ -345,6 +346,6 @@ NNM: Target[NormalModeRequest, NormalModeSeries] = Target(
     lambda r: (f"{r.name}.py", f"{r.name}_tables.tex", f"{r.name}_derivation.tex"),
     lambda r, progress: normal_mode(r.system, r.mode, max(r.order + 2, NNM_RADIUS_ORDER),
                                     r.amplitude, progress),
-    lambda series, r: Unit(lower_nnm(series, r.order, r.name, r.command),
+    lambda series, r: Unit(lower_nnm(series, r.order, r.name, r.command, r.allow_divergent),
                            (mode_tables(series, r.order, r.name),
                             mode_derivation(series, r.order, r.name))))
