@@ -19,9 +19,11 @@ from dataclasses import dataclass
 from .errors import InputError
 from .limits import (
     COST_LIMIT_SECONDS,
+    DRIVE_POINT_SECONDS,
     DRIVEN_MAX_ORDER,
     EXCHANGE_MAX_STEPS,
     GENERATE_MAX_ORDER,
+    MAX_DRIVE_POINTS,
     PERIOD_SERIES_ORDER,
     SLOW_FLOW_MAX_ORDER,
 )
@@ -266,15 +268,15 @@ def generate_cost(args: argparse.Namespace) -> Cost:
 
 
 DRIVEN_EQUATION_FIXED = 4.0
-DRIVEN_EQUATION_CONTINUATION = 15.0
+DRIVEN_EQUATION_CONTINUATION = MAX_DRIVE_POINTS * DRIVE_POINT_SECONDS
 # NOTE: `lindstedt driven EQUATION`: start-up with SymPy's parse and the numba kernels from
-# cache (~2.5 s), then the continuation in the drive amplitude, which stops itself at 15 s
-# (response.CONTINUATION_BUDGET; 0.1–2 s measured on the documented equations), then Newton at N
-# harmonics and shooting (0.05–0.5 s) on every crossing.
+# cache (~2.5 s), then the continuation in the drive amplitude, which stops itself after
+# limits.MAX_DRIVE_POINTS points (12 s at most; 0.1–2 s measured on the documented equations),
+# then Newton at N harmonics and shooting (0.05–0.5 s) on every crossing.
 
 
 def driven_equation_seconds(harmonics: int) -> float:
-    """An upper bound of ``driven EQUATION``: the fixed part, the continuation's own deadline,
+    """An upper bound of ``driven EQUATION``: the fixed part, the continuation's points,
     and three crossings' Newton solves at N harmonics (up to 4N − 1 unknowns, 50 dense steps
     at ~1 GFlop/s) with their shooting (0.5 s each at most: 4 tries of up to 30 periods)."""
     unknowns = 4 * harmonics - 1
@@ -297,11 +299,11 @@ RESPONSE_EQUATION_FIXED = 10.0
 # SymPy's parse twice (~2.5 s), the one-harmonic folds (~0.3 s), the ends' Newton solves, each
 # fold refined on the true orbit (~0.1–0.5 s each) and the two sweeps on the table's integrator
 # (0.1–1 s each; a force of degree 7 with velocity terms 2 s), bounded from measured 3–6 s.
-RESPONSE_EQUATION_ENDS = 2 * 15.0
+RESPONSE_EQUATION_ENDS = 2 * DRIVEN_EQUATION_CONTINUATION
 # NOTE: where a balance at an end of the range does not converge from its one-harmonic root, its
-# seeds come from the continuation in the drive amplitude, which stops itself at 15 s
-# (response.CONTINUATION_BUDGET): counted only when the estimate meets an end whose balance
-# does not converge (see response_equation_cost).
+# seeds come from the continuation in the drive amplitude, which stops itself after
+# limits.MAX_DRIVE_POINTS points (12 s at most): counted only when the estimate meets an end
+# whose balance does not converge (see response_equation_cost).
 
 
 def _values(args: argparse.Namespace) -> dict[str, str]:
@@ -349,8 +351,9 @@ def response_cost(args: argparse.Namespace) -> Cost:
         plan = system_plan(args.model, _values(args), args.harmonics, args.omega_min,
                            args.omega_max)
         return Cost(plan.seconds, f"--harmonics {args.harmonics}",
-                    f"the continuation of about {plan.points:.0f} points, the drive "
-                    "continuations and the shots of the system")
+                    f"the continuation of about {plan.points:.0f} points, {plan.drives} drive "
+                    f"continuations (at most {plan.drive_points} points each) and the shots "
+                    "of the system")
     if getattr(args, "model", None) is not None:
         return response_equation_cost(args)
     if any(getattr(args, k, None) is None for k in ("eps", "force", "Q")):

@@ -58,6 +58,16 @@ PARAMETRIC_MAX_POINTS = 401
 # NOTE: ω points of `parametric`'s range: 401 draw a smooth curve; their cost with --harmonics
 # is costs.parametric_cost's.
 
+MAX_DRIVE_POINTS = 4000
+# NOTE: points of a continuation in the drive amplitude from rest (the seeds of every orbit at
+# one ω): it stops there and says its seeds may be incomplete.  ~12 s at 31 unknowns, ~23 s at
+# 62 (a 2-DOF system at N = 8); a curve up to an amplitude bound of a few hundred takes 150–550
+# points, one winding through the superharmonic resonances of a hardening system at half its
+# lowest ω0 3300.  Points, not seconds: the seeds do not depend on how busy the machine is.
+DRIVE_POINT_SECONDS = 3e-3
+# NOTE: one point of that continuation at the coarse balance (at most 31 unknowns for one
+# coordinate: an SVD and ~1.5 corrector solves), measured 2–3 ms: 4000 points in 12 s at most.
+
 EXCHANGE_MAX_STEPS = 20_000
 # NOTE: DOP853 steps of a resonant slow flow's energy exchange (rescaled to unit amplitude, so
 # the count does not grow with it): two exchanges take 10–300 steps on the documented systems,

@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import itertools
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import InputError
+from ..limits import MAX_DRIVE_POINTS
 from .polynomial import DrivenEquation, PolynomialBalance, amplitude_bound
 
 
@@ -49,6 +49,9 @@ MAX_Q = 1e12
 # the corrector's 1e-13 then needs Q ≲ 1e3 (above, some steps take all 30 iterations: slower,
 # still right); by Q ~ 1e16 the peak is narrower than the doubles around ω = 1 and the
 # continuation wanders for good.  Below 1e12 it is only slower.
+RETAKES = 3
+# NOTE: corrector steps per allowed point, retaken (halved) ones included: a curve takes ~1.2–1.6
+# a point; three bound a corrector that keeps failing somewhere by work, not by the clock.
 
 
 def _continue(sysm: PolynomialBalance, end_solutions, omega_start: float,
@@ -60,11 +63,13 @@ def _continue(sysm: PolynomialBalance, end_solutions, omega_start: float,
     taken both ways; and whether they are complete) not reached yet, until ω leaves the range
     or the piece closes on its start (an isola); the step halves where a step turns or fails
     (:data:`MIN_STEP`); ``estimate`` points of ``per_point`` seconds, ``seconds`` in all,
-    bound its steps and its time."""
+    bound its points (twice the larger of ``seconds`` and :data:`CONTINUATION_SECONDS` in
+    points, at most ``max_points``) and its corrector steps, retaken ones included
+    (:data:`RETAKES` per point) — never the clock, so that a run gives the same curve on a busy
+    machine as on a quiet one."""
     lo, hi = sorted((omega_start, omega_stop))
     limit = min(max_points, int(2 * max(seconds, CONTINUATION_SECONDS) / per_point))
-    allowed = 2 * max(seconds, CONTINUATION_SECONDS)
-    deadline = time.monotonic() + allowed
+    attempts, max_attempts = 0, RETAKES * limit
     points: list[np.ndarray] = []
     starts: list[int] = []
     folds: list[float] = []
@@ -97,9 +102,10 @@ def _continue(sysm: PolynomialBalance, end_solutions, omega_start: float,
                                          f"[{lo:.3g}, {hi:.3g}] within {limit} steps of "
                                          f"{step:g} (the estimate was {estimate:.0f}); the "
                                          "curve is longer than it looks")
-                    if time.monotonic() > deadline:
+                    attempts += 1
+                    if attempts > max_attempts:
                         raise InputError(f"{where}: the continuation gave up after "
-                                         f"{allowed:.0f} s at ω = {y[-1]:.6g}, "
+                                         f"{max_attempts} corrector steps at ω = {y[-1]:.6g}, "
                                          f"{len(points)} points in (its estimate: "
                                          f"{estimate:.0f}): the corrector does not converge "
                                          "there")
@@ -178,7 +184,15 @@ def _corrector(sysm: PolynomialBalance, y: np.ndarray, t: np.ndarray) -> np.ndar
 
 
 def _refine_fold(sysm: PolynomialBalance, y: np.ndarray, t: np.ndarray, step: float) -> float:
-    """Secant on the step length for ``t_ω = 0`` between two continuation points."""
+    """The ω of :func:`fold_point`."""
+    return float(fold_point(sysm, y, t, step)[-1])
+
+
+def fold_point(sysm: PolynomialBalance, y: np.ndarray, t: np.ndarray, step: float
+               ) -> np.ndarray:
+    """The fold ``(x, ω)`` near the continuation point ``y`` along its tangent ``t``: secant on
+    the step length for ``t_ω = 0`` (each iterate corrected onto the curve), from ``0`` and
+    ``step``."""
     def t_omega(h: float) -> tuple[float, np.ndarray]:
         z = _corrector(sysm, y + h * t, t)
         return _tangent(sysm, z, t)[-1], z
@@ -194,15 +208,14 @@ def _refine_fold(sysm: PolynomialBalance, y: np.ndarray, t: np.ndarray, step: fl
         h0, f0, h1, f1 = h1, f1, h2, f2
         if abs(f2) < 1e-13:
             break
-    return float(z[-1])
+    return z
 
 
 CONTINUATION_HARMONICS = 8
 # NOTE: the continuation that seeds the orbits carries at most 8 harmonics (2 ms a point; its
 # crossings are then polished at the harmonics asked): a seed, not an answer.
-CONTINUATION_BUDGET = 15.0
-# NOTE: seconds the seeding continuation may take (its own estimate, checked before it starts);
-# above, the seeds are the one-harmonic roots only and the result says it may be incomplete.
+DRIVE_RETAKES = 2
+# NOTE: corrector steps per allowed point, halved ones included (a curve takes ~1.2–1.6).
 
 
 def _crossings(w: np.ndarray, x: np.ndarray) -> list[np.ndarray]:
@@ -257,21 +270,18 @@ class DriveContinuation:
     note: str
 
 
-MAX_DRIVE_POINTS = 4000
 DRIVE_STEP, DRIVE_GROWTH = 1 / 25, 2.0
-# NOTE: the continuation in f stops after 4000 points (~5 s at 31 unknowns) and says its seeds
-# may be incomplete; a curve up to an amplitude bound of a few hundred takes far fewer.
 
 
 def continue_in_drive(system: PolynomialBalance, omega: float, bound: float | None,
-                      max_points: int = MAX_DRIVE_POINTS,
-                      max_seconds: float = CONTINUATION_BUDGET) -> DriveContinuation:
+                      max_points: int = MAX_DRIVE_POINTS) -> DriveContinuation:
     """Trace the balance from ``f = 0``, ``x = 0`` by pseudo-arclength in ``(x, f)`` until the
     first harmonic exceeds ``bound`` (:func:`driven.amplitude_bound`; then every orbit at the
-    drive lies on the traced part, up to isolated branches the curve does not pass) or the
-    budget ends.  The step adapts: halved where the corrector fails or the tangent turns by
-    more than ~25°, grown by 1.5 where it does not, up to 1 % of the curve's scale and, near
-    ``±f``, to half the distance from it (down to 1e-4 of the scale)."""
+    drive lies on the traced part, up to isolated branches the curve does not pass) or after
+    ``max_points`` points (:data:`DRIVE_RETAKES` corrector steps each, halved ones included).
+    The step adapts: halved where the corrector fails or the tangent turns by more than ~25°,
+    grown by 1.5 where it does not, up to 1 % of the curve's scale and, near ``±f``, to half
+    the distance from it (down to 1e-4 of the scale)."""
     fam = _DriveFamily(system, omega)
     m = system.size
     k1 = int(np.nonzero(system.orders == 1)[0][0])
@@ -280,7 +290,7 @@ def continue_in_drive(system: PolynomialBalance, omega: float, bound: float | No
     h_max, h_floor, h_min = scale * DRIVE_STEP, scale * 1e-3, scale * 1e-9
     h = h_max / 4
     y = np.zeros(m + 1)
-    deadline = time.monotonic() + max_seconds
+    attempts = 0
     with np.errstate(over="ignore", invalid="ignore"):
         t = _tangent(fam, y, None)
         if t[-1] < 0:
@@ -293,10 +303,12 @@ def continue_in_drive(system: PolynomialBalance, omega: float, bound: float | No
             if bound is not None and r > bound:
                 return _drive_curve(points, True, f"continued in the drive amplitude from 0 "
                                     f"up to the amplitude bound r = {bound:.4g}")
-            if len(points) >= max_points or time.monotonic() > deadline:
+            if len(points) >= max_points or attempts >= DRIVE_RETAKES * max_points:
                 return _drive_curve(points, False, f"the continuation in the drive stopped at "
-                                    f"r = {r:.4g} after {len(points)} points"
-                                    + ("" if bound is None else f" (bound {bound:.4g})"))
+                                    f"r = {r:.4g} after {len(points)} points ({attempts} "
+                                    "steps)" + ("" if bound is None else
+                                                f" (bound {bound:.4g})"))
+            attempts += 1
             try:
                 y_new = _corrector(fam, y + h * t, t)
                 t_new = _tangent(fam, y_new, t)
@@ -357,14 +369,14 @@ def _half_period(system: PolynomialBalance, x: np.ndarray) -> np.ndarray:
 
 
 def balance_crossings(coarse: PolynomialBalance, omega: float, force: float,
-                      bound: float | None, max_seconds: float = CONTINUATION_BUDGET
+                      bound: float | None, max_points: int = MAX_DRIVE_POINTS
                       ) -> tuple[list[np.ndarray], DriveContinuation]:
     """The seeds of every solution of ``coarse`` at ``omega`` and drive amplitude ``force``
     that the continuation in the drive from rest reaches (:func:`continue_in_drive`, up to the
-    first-harmonic ``bound``): where the traced curve crosses ``force`` — and ``−force``,
-    shifted by half a period (:func:`_half_period`) —, quadratic around the folds
-    (:func:`_crossings`); with the traced curve (its ``complete`` and ``note``)."""
-    curve = continue_in_drive(coarse, omega, bound, max_seconds=max_seconds)
+    first-harmonic ``bound``, at most ``max_points``): where the traced curve crosses
+    ``force`` — and ``−force``, shifted by half a period (:func:`_half_period`) —, quadratic
+    around the folds (:func:`_crossings`); with the traced curve (its ``complete`` and ``note``)."""
+    curve = continue_in_drive(coarse, omega, bound, max_points)
     seeds = _crossings(curve.force - force, curve.x)
     seeds += [_half_period(coarse, x) for x in _crossings(curve.force + force, curve.x)]
     return seeds, curve

@@ -17,14 +17,17 @@ from ..derive.system import System
 from ..errors import InputError
 from ..numerics.floquet import variational_multipliers
 from ..numerics.integrate import PolynomialField
-from ..numerics.shooting import PeriodicOrbit, shoot_system
+from ..numerics.shooting import PeriodicOrbit, settle_system, shoot_system
 from .continuation import (
     CONTINUATION_HARMONICS,
     CONTINUATION_SECONDS,
+    MAX_DRIVE_POINTS,
     MAX_POINTS,
     Continuation,
     _continue,
+    _tangent,
     balance_crossings,
+    fold_point,
 )
 from .polynomial import PolynomialBalance, check_harmonics
 from .response import equation_point_seconds, polished
@@ -36,10 +39,16 @@ SYSTEM_CHECKS = 12
 # NOTE: stretches of the traced curve (stable or unstable) whose middle points are shot as true
 # orbits (DOP853, ~0.1–0.5 s each): the longest of every branch, then the longest of the rest.
 NO_BOUND_FACTOR = 10.0
-NO_BOUND_SECONDS = 3.0
+NO_BOUND_POINTS = 600
 # NOTE: without the power-balance bound (no potential, nonlinear damping) the drive is continued
-# from rest up to 10 × the linear response's size, 3 s at most per frequency (unbounded, it ran
-# 15 s at each of the ten frequencies: two minutes); the result says it may be incomplete.
+# from rest up to 10 × the linear response's size, 600 points at most per frequency (~3.5 s at
+# N = 8 on a 2-DOF system; unbounded, it ran 15 s at each of the ten frequencies: two minutes;
+# 130–300 points reach the cap on the suite's systems); the result says it may be incomplete.
+# Points, not seconds: the same command finds the same orbits on a busy machine.
+DRIVE_POINTS_TYPICAL = 500
+# NOTE: the points a drive continuation up to the power-balance bound is estimated at (150–550
+# measured on the documented systems; 3300 at half the lowest ω0 of a hardening system winding
+# through its superharmonic resonances; at most continuation.MAX_DRIVE_POINTS).
 NEUTRAL = 1 + 1e-8
 # NOTE: a point is stable when every Floquet |λ| < 1 + 1e-8: a neutral direction (an undamped
 # coordinate the drive leaves at rest, |λ| = 1 to rounding) counts as stable, not unstable.
@@ -71,6 +80,26 @@ class BranchCheck:
 
 
 @dataclass(frozen=True)
+class SweepJump:
+    """Where a slow sweep leaves a stable stretch and where it lands, both at the fold's ω:
+    leaving, the fold point of the balance (polished: ``t_ω = 0``); landing, Newton on the
+    other stable stretch at exactly that ω from its nearest point; checked by DOP853 from the
+    fold state pushed towards the unstable side."""
+
+    way: str  # up | down
+    omega: float  # the fold's ω (where the stretch loses stability, when not at a fold)
+    at_fold: bool
+    leaving: tuple[float, ...]  # each coordinate's first-harmonic amplitude
+    landing: tuple[float, ...]
+    landing_converged: bool  # Newton at ω converged (else: the nearest point's amplitudes)
+    landing_multiplier: float  # its largest Floquet |λ|
+    simulated: tuple[float, ...]  # where DOP853 from the fold state settles (NaN: failed)
+    difference: float  # max |simulated − landing| over the coordinates
+    before: int  # the curve's points nearest the fold and the landing
+    after: int
+
+
+@dataclass(frozen=True)
 class SystemResponse:
     """``response SYSTEM``: the balance of a driven, damped system traced over ω, every point
     with its Floquet multipliers (the monodromy of the variational equation about it), the
@@ -91,6 +120,7 @@ class SystemResponse:
     bound: float | None  # r1 ≤ bound/ω for every orbit
     complete: bool
     note: str
+    sweep_jumps: tuple[SweepJump, ...] = ()  # the jumps, each at its fold's ω exactly
 
 
 def driven_system(text: str, values: dict[str, str]) -> System:
@@ -199,29 +229,98 @@ def _jumps(cont: Continuation, r: np.ndarray, stable: np.ndarray, lo: float, hi:
                 cont.x[e[1][0]:e[1][1]] - cont.x[end], axis=1)
                 + 1e3 * np.abs(cont.omega[e[1][0]:e[1][1]] - w_end)))
             land = a + int(np.argmin(np.abs(cont.omega[a:b] - w_end)))
-            # at the refined fold when the stretch ends at one (its last point is a step short)
-            folds = [f for f in cont.folds if abs(f - w_end) <= 0.02]
-            at = min(folds, key=lambda f: abs(f - w_end)) if folds else float(w_end)
-            out.append((way, float(at), end, land))
+            out.append((way, float(w_end), end, land))
             k = m
+    return tuple(out)
+
+
+JUMP_PUSH = 0.05
+JUMP_PERIODS = 300
+# NOTE: the check of a jump: DOP853 from the fold state pushed by 5 % of its size towards the
+# unstable branch, over 300 drive periods.  At the fold's ω the state drifts off along the
+# centre direction (~50–100 periods from a 3 % push on the suite's 2-DOF system; a 1 % push
+# had not left after 200), then decays onto the landing orbit (|λ| ≈ 0.9 a period there: 1e-8
+# after 150 periods); ~1 s of DOP853 a jump.
+
+
+def _at_folds(sb: SystemBalance, cont: Continuation, stable: np.ndarray,
+              jumps: tuple[tuple[str, float, int, int], ...]) -> tuple[SweepJump, ...]:
+    """Each jump of :func:`_jumps` at its fold's ω exactly: the fold point polished from the
+    last two stable points (:func:`continuation.fold_point`), where the curve's ω turns there;
+    the landing solved by Newton at that ω from the landing stretch's nearest point; DOP853
+    from the fold state pushed towards the unstable side (:data:`JUMP_PUSH`), where it
+    settles after :data:`JUMP_PERIODS` periods.  A stretch that loses stability without a fold
+    leaves from its last stable point, at its ω."""
+    fine = sb.fine
+    field = PolynomialField.of(sb.equations)
+    out = []
+    for way, w_end, end, land in jumps:
+        piece = next(p for p in cont.piece_slices() if p.start <= end < p.stop)
+        d = 1 if end - 1 >= piece.start and stable[end - 1] else -1  # along the stretch
+        x, w = cont.x[end], float(w_end)
+        # the curve's ω turns within two points of the stretch's end (the balance's fold and
+        # the variational equation's |λ| = 1 may lie a point apart): polished from the point
+        # before the turn
+        turns = [i for i in range(end - 2 * d, end + 3 * d, d)
+                 if piece.start <= i - 1 and i + 1 < piece.stop
+                 and (cont.omega[i] - cont.omega[i - 1]) * (cont.omega[i + 1] - cont.omega[i])
+                 < 0]
+        at_fold = False
+        if turns:
+            i = min(turns, key=lambda i: abs(i - end))
+            y0 = np.append(cont.x[i - d], cont.omega[i - d])
+            y1 = np.append(cont.x[i], cont.omega[i])
+            try:
+                with np.errstate(over="ignore", invalid="ignore"):
+                    z = fold_point(fine, y0, _tangent(fine, y0, y1 - y0),
+                                   float(np.linalg.norm(y1 - y0)))
+                at_fold = bool(np.all(np.isfinite(z))
+                               and abs(z[-1] - cont.omega[i]) <= abs(cont.omega[i + d]
+                                                                     - cont.omega[i - d])
+                               and np.max(np.abs(fine.residual(z[:-1], z[-1])))
+                               <= 1e-9 * (1 + np.max(np.abs(z))))
+            except np.linalg.LinAlgError:
+                at_fold = False
+            if at_fold:
+                x, w = z[:-1], float(z[-1])
+        beyond = (i if at_fold else end) + d
+        try:
+            landed, converged, _ = fine.solve(cont.x[land], w)
+        except np.linalg.LinAlgError:
+            converged = False
+        if not converged:
+            landed = cont.x[land]
+        multiplier = float(sb.multiplier(landed[None], np.array([w]))[0])
+        push = cont.x[beyond] - x if piece.start <= beyond < piece.stop else x
+        # (towards the unstable side, where the state drifts off at the fold's ω)
+        push = JUMP_PUSH * np.linalg.norm(x) * push / (np.linalg.norm(push) or 1.0)
+        simulated = settle_system(field, sb.drive, w, fine.state(x + push, w), JUMP_PERIODS)
+        landing = fine.first_harmonics(landed)
+        out.append(SweepJump(way, w, at_fold, tuple(float(a) for a in fine.first_harmonics(x)),
+                             tuple(float(a) for a in landing), bool(converged), multiplier,
+                             tuple(float(a) for a in simulated),
+                             float(np.max(np.abs(simulated - landing))), end, land))
     return tuple(out)
 
 
 @dataclass(frozen=True)
 class SystemPlan:
     """What ``response SYSTEM`` will run, known before it runs: the system, the ω range, the
-    linear frequencies, the continuation's estimated points and the whole estimated seconds."""
+    linear frequencies, the continuation's estimated points, the drive continuations (how many,
+    each's cap in points) and the whole estimated seconds."""
 
     system: System
     omega_range: tuple[float, float]
     linear_frequencies: tuple[float, ...]
     points: float
     seconds: float
+    drives: int = 0
+    drive_points: int = 0
 
 
 SYSTEM_FIXED_SECONDS = 3.0
-# NOTE: `response SYSTEM` besides its continuation: SymPy's parse and modes (~1 s), the drive
-# continuations at the ends and the probes (0.1–0.5 s each at N = 8), the Floquet pass
+# NOTE: `response SYSTEM` besides its continuation and its drive continuations (estimated by
+# their points): SymPy's parse and modes (~1 s), the Floquet pass
 # (~0.1 ms a point) and the shots (0.1–0.5 s each); measured 3–8 s on the documented systems.
 
 
@@ -246,11 +345,15 @@ def system_plan(text: str, values: dict[str, str], harmonics: int,
     points = ((hi - lo) + np.pi * r_scale * math.sqrt(len(w0))) / 0.02
     odd = PolynomialField.of(system.equations()).odd
     unknowns = system.size * (2 * harmonics if odd else 4 * harmonics - 1)
-    # without the bound each drive continuation (the ends and the probes) runs to its budget
-    searches = 0.0 if bound is not None else NO_BOUND_SECONDS * (
-        2 + SYSTEM_PROBES + sum(lo < w < hi for w in w0))
+    # each drive continuation (the ends and the probes) at the coarse balance's size: its
+    # typical length up to the bound, its cap without one
+    coarse = min(harmonics, CONTINUATION_HARMONICS)
+    drives = 2 + SYSTEM_PROBES + sum(lo < w < hi for w in w0)
+    searches = drives * (DRIVE_POINTS_TYPICAL if bound is not None else NO_BOUND_POINTS) \
+        * equation_point_seconds(system.size * (2 * coarse if odd else 4 * coarse - 1))
     return SystemPlan(system, (lo, hi), w0, points, SYSTEM_FIXED_SECONDS + searches
-                      + points * equation_point_seconds(unknowns))
+                      + points * equation_point_seconds(unknowns), drives,
+                      MAX_DRIVE_POINTS if bound is not None else NO_BOUND_POINTS)
 
 
 @dataclass(frozen=True)
@@ -289,7 +392,7 @@ class SystemBalance:
         rest reaches up to the bound (:func:`continuation.balance_crossings`), and those Newton
         reaches from the backbones there, polished at the fine harmonics; whether the drive
         continuation passed the bound (without one it stops at :data:`NO_BOUND_FACTOR` × the
-        linear response, within :data:`NO_BOUND_SECONDS`, and says it may be incomplete), and
+        linear response, within :data:`NO_BOUND_POINTS`, and says it may be incomplete), and
         its note."""
         if self.bound is not None:
             seeds, curve = balance_crossings(self.coarse, omega, self.fine.force,
@@ -298,7 +401,7 @@ class SystemBalance:
         else:
             cap = NO_BOUND_FACTOR * self.linear_response(omega)
             seeds, curve = balance_crossings(self.coarse, omega, self.fine.force, cap,
-                                             NO_BOUND_SECONDS)
+                                             NO_BOUND_POINTS)
             whole, note = False, (f"no bound: the drive continued from rest up to r = {cap:.4g}"
                                   f", {NO_BOUND_FACTOR:g} × the linear response"
                                   if curve.complete else curve.note)
@@ -501,12 +604,15 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
     how = (f"every orbit has r1 <= {bound:.6g}/w ({why}); the drive was continued from rest "
            f"past that bound at {', '.join(notes)} and at "
            if bound is not None else
-           f"no amplitude bound ({why}): the drive continuation from rest stopped at its "
-           f"budget at {', '.join(notes)} and at ")
+           f"no amplitude bound ({why}): the drive continuation from rest stopped at "
+           f"{NO_BOUND_FACTOR:g} × the linear response or {NO_BOUND_POINTS} points at "
+           f"{', '.join(notes)} and at ")
+    jumps = _at_folds(sb, cont, stable, _jumps(cont, np.linalg.norm(amplitudes, axis=1),
+                                               stable, lo, hi))
     return SystemResponse(system, harmonics, (lo, hi), w0, cont, tuple(closed), amplitudes,
                           multiplier, stable,
-                          _jumps(cont, np.linalg.norm(amplitudes, axis=1), stable, lo, hi),
-                          shots, bound, complete and cont.complete, how + probed)
+                          tuple((j.way, j.omega, j.before, j.after) for j in jumps),
+                          shots, bound, complete and cont.complete, how + probed, jumps)
 
 
 def _shot_checks(sb: SystemBalance, cont: Continuation, amplitudes: np.ndarray,
