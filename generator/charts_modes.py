@@ -13,7 +13,7 @@ from .charts import _save, _value, check_plot_path
 from .derive.nnm import normal_mode, radius
 from .derive.system import System
 from .errors import InputError
-from .numerics.references import mode_orbit, system_energy
+from .numerics.references import check_shootable, mode_orbit, system_energy
 
 FEP_ORDER = 24
 # NOTE: the backbone drawn from the series to this order (and its radius estimated from it);
@@ -36,6 +36,7 @@ def nnm_figure(system: System, path: Path, order: int = FEP_ORDER) -> Path:
     if len(lams) > FEP_MAX_MODES:
         raise InputError(f"--plot: the chart draws systems of up to {FEP_MAX_MODES} modes; "
                          f"this one has {len(lams)}")
+    check_shootable(system, "--plot")
     energy = system_energy(system)
     fig, ax = plt.subplots(figsize=(8, 4.8))
     notes = []

@@ -887,7 +887,7 @@ def choose_backbone(system: System, mode: int, tol: float, a_min: float, a_max: 
     :data:`BACKBONE_POINTS` Chebyshev amplitudes of ``[a_min, a_max]`` (each seeded by the
     last: a continuation); refused past the series' reach or below the reference's floor."""
     from .derive.nnm import normal_mode, radius
-    from .numerics.references import mode_orbit
+    from .numerics.references import check_shootable, mode_orbit
 
     if not (np.isfinite(tol) and tol > 0):
         raise InputError(f"--tol {tol}: must be finite and > 0")
@@ -896,6 +896,7 @@ def choose_backbone(system: System, mode: int, tol: float, a_min: float, a_max: 
                          "verify")
     if not (np.isfinite(a_min) and np.isfinite(a_max) and 0 < a_min < a_max):
         raise InputError(f"--range {a_min}:{a_max}: amplitudes with 0 < A < B")
+    check_shootable(system, "choose backbone")
     series = normal_mode(system, mode, BACKBONE_FIRST_ORDER, amplitude)
     found = radius(series)
     reach = np.inf if found is None else found.reach

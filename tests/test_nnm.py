@@ -284,3 +284,37 @@ def test_number_field_products_equal_sympy_s_field_arithmetic():
         slow = (DensePoly(a, K) * DensePoly(b, K) + DensePoly(b, K) * t
                 - DensePoly(a, K).left_shift(2) * 4).coeffs()
         assert fast == slow
+
+
+@pytest.mark.parametrize("stiff", ["1e10", "1e16", "1e30", "10**20"])
+def test_a_stiff_coupling_keeps_omega0_an_exact_root(stiff):
+    """x1'' + k x1 − x2 + x1³/2 = 0 with k up to 1e30: ω0² stays an exact root of det(L − λ)
+    (nsimplify used to round it to a rational: no null vector, StopIteration), equal to
+    mpmath's eigenvalue at 120 digits; ω's first correction exact in Q(ω0²)."""
+    import mpmath
+
+    text = f"x1'' + {stiff}*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0"
+    system = parse_system(text)
+    lam = sp.Symbol("lam")
+    charpoly = system.stiffness.charpoly(lam).as_expr()
+    with mpmath.workdps(120):  # k = 1e30 costs 30 of them in the small eigenvalue
+        L = mpmath.matrix([[mpmath.mpf(c.p) / c.q for c in row]
+                           for row in system.stiffness.tolist()])
+        truth = sorted(mpmath.eig(L)[0], key=abs)
+    for which in (1, 2):
+        mode = normal_mode(system, which, 2)
+        assert sp.expand(charpoly.subs(lam, mode.lam)) == 0
+        exact = sp.N(mode.lam, 80)
+        assert abs(exact - sp.Float(mpmath.nstr(truth[which - 1].real, 80), 80)) <= 1e-40 * exact
+        assert len(mode.omega()) == 3 and mode.omega()[1] != 0
+
+
+def test_stiff_shooting_and_a_linear_system_answer_in_one_line_or_exactly():
+    stiff = "x1'' + 1e16*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0"
+    out = run("choose", "backbone", stiff, "--tol", "1e-6", "--range", "0.01:0.1")
+    assert out.returncode == 2 and "stiff" in out.stderr, out.stderr
+    assert len(out.stderr.strip().splitlines()) == 1
+    linear = normal_mode(parse_system("x1'' + 2*x1 - x2 = 0; x2'' + 2*x2 - x1 = 0"), 2, 6)
+    assert linear.omega() == [sp.sqrt(3)] + [0] * 6  # no nonlinear term: ω = ω0 exactly
+    out = run("nnm", "x1'' + x1 + x1**3 = 0; x2'' + x2 + x2**3 = 0")
+    assert out.returncode == 2 and "1:1 internal resonance" in out.stderr

@@ -121,8 +121,16 @@ def _roots(factor: sp.Poly) -> list[sp.Expr]:
     if factor.degree() <= 2:
         roots = sp.roots(factor, multiple=True)
         if all(r.is_real for r in roots):
-            return [sp.nsimplify(r) for r in roots]
+            return [_simpler(factor, r) for r in roots]
     return [sp.CRootOf(factor, k) for k in range(factor.count_roots())]
+
+
+def _simpler(factor: sp.Poly, root: sp.Expr) -> sp.Expr:
+    """``nsimplify``'s form of a quadratic's root where it is still a root, exactly: for a
+    large coefficient (1e16) it returns a nearby rational instead, and ``L − λ`` would then
+    have no null vector."""
+    simpler = sp.nsimplify(root)
+    return simpler if sp.expand(factor.as_expr().subs(factor.gen, simpler)) == 0 else root
 
 
 def system_parameters(text: str) -> tuple[tuple[str, ...], str | None]:

@@ -332,6 +332,26 @@ def system_energy(system: object) -> Callable[[np.ndarray], float]:
     return sp.lambdify([system.coordinates], V, "numpy")
 
 
+STIFF_RATIO = 1e3
+# NOTE: DOP853 steps at the fastest linear frequency: a slower mode's period costs this many
+# times more steps than the fast one's (≥ 1e4 steps a period at rtol 1e-13): past it a shot
+# orbit takes minutes to hours, and shooting is refused with the reason.
+
+
+def check_shootable(system: object, why: str) -> None:
+    """Refuse, in one line, to shoot the orbits of a stiff system (linear frequencies spread
+    over more than :data:`STIFF_RATIO`): ``why`` names what needs the shots."""
+    from ..errors import InputError
+
+    squares = [float(x) for x in system.modes()]
+    if min(squares) > 0 and math.sqrt(max(squares) / min(squares)) > STIFF_RATIO:
+        ratio = math.sqrt(max(squares) / min(squares))
+        raise InputError(f"system {system.text!r}: its linear frequencies span a ratio of "
+                         f"{ratio:.3g} (stiff, above {STIFF_RATIO:g}): {why} shoots orbits "
+                         "with DOP853, which would take ~ratio times a mode's period in steps "
+                         "of the fastest; the series itself (lindstedt nnm, generate) is exact")
+
+
 def mode_orbit(system: object, A: float, guess: np.ndarray, amplitude: int = 0,
                rtol: float = CYCLE_RTOL) -> ModeOrbit:
     """The periodic orbit through ``x_amplitude(0) = A`` with every velocity zero: Newton
