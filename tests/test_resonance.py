@@ -173,3 +173,13 @@ def test_slowflow_system_cost_does_not_grow_with_the_start():
                                                start=[f"a1={a}"])).seconds
              for a in ("0.1", "1000", "1e40")}
     assert len(costs) == 1 and 2 < costs.pop() < COST_LIMIT_SECONDS
+
+
+def test_slowflow_of_a_linear_resonant_system_is_refused_in_one_line():
+    """1:3 in ω0 but no nonlinear term: nothing couples the modes (min() of no degree was a
+    ValueError)."""
+    from commands import run
+
+    out = run("slowflow", "x1'' + x1 = 0; x2'' + 9*x2 = 0")
+    assert out.returncode == 2 and out.stdout == ""
+    assert len(out.stderr.strip().splitlines()) == 1 and "no nonlinear term" in out.stderr

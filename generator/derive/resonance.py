@@ -76,6 +76,10 @@ def resonant_flow(system: System, order: int = 1) -> ResonantFlow:
     if not system.conservative:
         raise InputError(f"system {system.text!r}: a velocity-dependent force; the resonant "
                          "slow flow takes conservative systems")
+    if all(f == 0 for f in system.force):
+        raise InputError(f"system {system.text!r}: no nonlinear term: a linear system's modes "
+                         "are independent and exchange no energy, so there is no slow flow to "
+                         "average; lindstedt nnm SYSTEM --mode M gives each mode")
     modes, names = resonant_modes(system)
     if not modes:
         raise InputError(f"system {system.text!r}: no internal resonance (no ω0 an integer "
