@@ -13,7 +13,7 @@ import shlex
 from functools import partial
 from pathlib import Path
 
-from .derive.models import Model, check_order, model_by_name
+from .derive.models import Model, check_module_name, check_order, model_by_name
 from .emit.render import check_writable, render, write_files
 from .errors import InputError
 from .methods.registry import Candidate, Method
@@ -170,6 +170,7 @@ def generate_nnm(system: object, mode: int, order: int, out: Path, *, amplitude:
                  progress: Progress | None = None, overwrite_edited: bool = False,
                  flag: str = "--out", allow_divergent: bool = False) -> list[Path]:
     """``lindstedt generate SYSTEM --mode M``: the mode's backbone and shape evaluators."""
+    check_module_name(name)
     order = check_order(order)
     return compile_target(NNM, NormalModeRequest(order, command, system, mode, amplitude, name,
                                                  allow_divergent),

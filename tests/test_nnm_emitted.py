@@ -59,6 +59,7 @@ def test_ufuncs_and_into_twins_agree_and_refuse_past_the_radius(mode2):
     (["--mode", "3"], "--mode 3: the system has modes 1..2"),
     (["--damped"], "--damped: not for a system's normal mode"),
     (["--amplitude", "x9"], "--amplitude x9: not a coordinate"),
+    (["--name", "numpy"], "name 'numpy': a module of that name is importable"),
 ])
 def test_generate_system_refusals_write_nothing(tmp_path, args, says):
     out = run("generate", KERSCHEN, *args, "--out", str(tmp_path / "new"))

@@ -178,8 +178,6 @@ def test_slowflow_system_cost_does_not_grow_with_the_start():
 def test_slowflow_of_a_linear_resonant_system_is_refused_in_one_line():
     """1:3 in ω0 but no nonlinear term: nothing couples the modes (min() of no degree was a
     ValueError)."""
-    from commands import run
-
     out = run("slowflow", "x1'' + x1 = 0; x2'' + 9*x2 = 0")
     assert out.returncode == 2 and out.stdout == ""
     assert len(out.stderr.strip().splitlines()) == 1 and "no nonlinear term" in out.stderr

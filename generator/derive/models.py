@@ -212,12 +212,7 @@ def oscillator(text: str, values: dict[str, str] | None = None, name: str = "osc
     """Parse ``text`` (see :mod:`lindstedt.derive.equation`) with parameter ``values`` (exact
     text such as ``"1/3"``) into an :class:`Oscillator`; every value must name a parameter of
     the text."""
-    if not NAME.fullmatch(name or "") or keyword.iskeyword(name):
-        raise InputError(f"name {name!r}: letters, digits and '_' only, starting with a letter, "
-                         "and no Python keyword (the module is imported by that name)")
-    if shadows_a_module(name):
-        raise InputError(f"name {name!r}: a module of that name is importable (Python's own or "
-                         "installed); the written module would shadow it: choose another name")
+    check_module_name(name)
     eq = parse_equation(text)
     known = {str(p): p for p in eq.parameters}
     if eq.small is not None:  # a value for eps too: the amplitude is then the small quantity
@@ -256,6 +251,17 @@ def oscillator(text: str, values: dict[str, str] | None = None, name: str = "osc
 
 
 NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,31}")
+
+
+def check_module_name(name: str) -> None:
+    """Refuse a name for an emitted module that Python cannot import as it is, or that would
+    shadow an importable module (every kind of ``generate`` names its files by it)."""
+    if not NAME.fullmatch(name or "") or keyword.iskeyword(name):
+        raise InputError(f"name {name!r}: letters, digits and '_' only, starting with a letter, "
+                         "and no Python keyword (the module is imported by that name)")
+    if shadows_a_module(name):
+        raise InputError(f"name {name!r}: a module of that name is importable (Python's own or "
+                         "installed); the written module would shadow it: choose another name")
 
 
 def shadows_a_module(name: str) -> bool:
