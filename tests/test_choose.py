@@ -604,3 +604,21 @@ def test_choose_cycle_reports_the_series_error_against_shooting(monkeypatch):
     assert 1e-12 < max(errors) <= 1e-6
     assert abs(rows["series"][1] - max(errors)) <= 1e-3 * max(errors) + 1e-12, (rows, errors)
     assert choice.method == "series" and rows["resummed"][1] < 1e-11
+
+
+def test_backbone_reference_keeps_its_relative_accuracy_at_tiny_amplitudes():
+    """choose backbone's reference orbits in units of their amplitude: at A = 1e-12 the period
+    of x1'' + 2x1 − x2 + x1³/2 = 0, x2'' + 2x2 − x1 = 0 in mode 1 is Duffing's on the mode to
+    O(A⁴), its shape (1, 1) — an absolute tolerance of 1e-14 once put it 1e-4 off and
+    `choose backbone --range 1e-12:2e-12 --tol 1e-4` refused order 0."""
+    from lindstedt.derive.system import parse_system
+    from lindstedt.numerics.references import mode_orbit
+
+    system = parse_system("x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0", {})
+    for A in (1e-12, 1e-9, 1e-3):
+        orbit = mode_orbit(system, A, np.array([1.02 * A, 1.01 * np.pi]))
+        # on the mode x1 = x2 = q: q'' + q + q³/4 = 0, ω = 1 + (3/8)(1/4)A² + O(A⁴)
+        linear = 2 * np.pi * (1 - 3 * A**2 / 32)
+        assert orbit.converged
+        assert abs(orbit.period / linear - 1) < 1e-11, (A, orbit.period)
+        assert abs(orbit.start[1] / A - 1) < 1e-9 + A**2, orbit.start

@@ -275,3 +275,37 @@ def test_parametric_figure_is_drawn_and_a_bad_input_draws_nothing(tmp_path, caps
     assert cli.main([*args, "--plot", str(path)]) == 0
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     capsys.readouterr()
+
+
+@pytest.mark.parametrize(("eps", "zeta", "outside"), [(0.1, 0.01, True), (0.1, 0.0235, False)])
+def test_a_fold_outside_the_range_or_the_model_says_so(eps, zeta, outside):
+    """The one-harmonic fold ω = ε/(4ζ) is flagged where printed: outside the range, and
+    outside the model where ¾γr² > 1 — there the balance continued through its true fold (6
+    harmonics, shooting's equal to 1e-12 here) puts it > 5 % away, inside the model < 2 %."""
+    from lindstedt.analysis.continuation import _continue
+    from lindstedt.analysis.parametric import ParametricBalance, parametric_report
+    from lindstedt.cli.driven import _parametric_table, parametric_report_json
+
+    p = Pump(eps, zeta, 1.0)
+    w1, r1 = fold(p)
+    assert w1 == pytest.approx(eps / (4 * zeta), rel=1e-15)
+    data = parametric_report_json(parametric_report(eps, zeta, 1.0, 0.9, 1.0, points=2,
+                                                    harmonics=3))
+    f = data["fold"]
+    assert not f["in_range"] and f["in_model"] == (not outside)
+    assert (0.75 * r1 * r1 > 1) == outside
+    line = next(x for x in _parametric_table(data) if x.startswith("fold"))
+    assert "outside the range [0.9, 1]" in line
+    assert ("outside the one-harmonic model" in line) == outside
+    # the true fold: the balance traced in ω from the + branch halfway to the formula's fold
+    w0 = 0.5 * (1 + w1)
+    start = next(q for q in one_harmonic(p, w0) if q.branch == "+")
+    balance = ParametricBalance(p, 6)
+    x = np.zeros(balance.size)
+    x[0], x[6] = start.a, start.b
+    x, converged, _ = balance.solve(x, w0)
+    assert converged
+    curve = _continue(balance, lambda: ([(w0, x, 1.0)], True), w0, 1.5 * w1, 0.02, 1000, 60,
+                      5e-3, 20000, "the pumped oscillator")
+    true = min(curve.folds, key=lambda w: abs(w - w1))
+    assert (abs(true / w1 - 1) > 0.05) == outside and abs(true / w1 - 1) < 0.1, true

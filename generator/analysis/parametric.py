@@ -142,6 +142,25 @@ def fold(p: Pump) -> tuple[float, float] | None:
     return (w, math.sqrt(r2)) if r2 > 0 else None
 
 
+ONE_HARMONIC_NONLINEARITY = 1.0
+# NOTE: the one-harmonic model is a weakly nonlinear one: the cubic's share of the stiffness,
+# ¾|γ|r², against the linear 1.  At the fold ω² − 1 = ¾γr², so a fold at ω = ε/(4ζ) far above
+# 1 is a far larger amplitude than the model describes (ε = 0.5, ζ = 0.01: ω = 12.5, r = 14.4,
+# ¾γr² = 155); where it stays below 1 the balance of 8 harmonics agrees to ~1 % (ε = 0.5, ζ =
+# 0.01, r ≤ 0.8: 0.2 %).
+
+
+def outside_model(p: Pump, r: float) -> str:
+    """Why a one-harmonic point of amplitude ``r`` lies outside the model's validity (the
+    cubic's share ``¾|γ|r²`` of the stiffness above :data:`ONE_HARMONIC_NONLINEARITY`), or
+    ``""`` inside it."""
+    share = 0.75 * abs(p.gamma) * r * r
+    if share <= ONE_HARMONIC_NONLINEARITY:
+        return ""
+    return (f"outside the one-harmonic model: 3/4 |gamma| r^2 = {share:.3g} > "
+            f"{ONE_HARMONIC_NONLINEARITY:g} (not weakly nonlinear)")
+
+
 @dataclass(frozen=True)
 class Onset:
     """Where a nontrivial branch leaves ``r = 0``: the tongue edge ``omega``, the branch, and

@@ -113,6 +113,7 @@ def run_choose(args: argparse.Namespace) -> int:
             "modelled_ns_per_point": modelled_ns("period", choice.method, choice.order),
             "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
             "quantity": "period", "variable": variable,
+            "error_measure": "relative: max |T/T_ref - 1|",
             "considered": _considered(choice.considered, "period")}
     if model is not None:
         data.update(equation=model.source or model.title, omega0=str(model.frequency),
@@ -157,7 +158,9 @@ def _choose_backbone(args: argparse.Namespace) -> int:
     data = {"quantity": "backbone", "mode": c.mode, "method": "lindstedt", "order": c.order,
             "max_error": c.max_error, "errors": list(c.errors), "verified_on": c.verified_on,
             "reach": c.radius, "tol": args.tol, "range": [args.x_min, args.x_max],
-            "reference": "orbits shot by DOP853 (rtol 1e-13), a continuation in A"}
+            "error_measure": "relative: max |T/T_shot - 1|",
+            "reference": "orbits shot by DOP853 (rtol 1e-13, in units of A), a continuation "
+                         "in A"}
     if args.json:
         print(json.dumps(data))
         return 0
@@ -196,6 +199,7 @@ def _choose_resummed(args: argparse.Namespace) -> int:
         print(json.dumps({"quantity": args.quantity, "method": c.method, "order": c.order,
                           "max_error": c.max_error, "ns_per_point": c.ns_per_point,
                           "verified_on": c.verified_on, "considered": rows,
+                          "error_measure": "relative",
                           "decided_by": "recorded costs (lindstedt.choose.RESUMMED_COSTS)"}))
         return 0
     print(f"{what}, tolerance {args.tol:g} (relative, {c.verified_on} points): {c.method}"
@@ -268,6 +272,7 @@ def _choose_q(args: argparse.Namespace) -> int:
             "ns_per_point": c.ns_per_point, "verified_on": c.verified_on,
             "modelled_ns_per_point": modelled_ns("q", c.method, c.order),
             "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
+            "error_measure": "relative to the amplitude: max |q/A - q_ref/A|",
             "considered": _considered(c.considered)}
     if args.out:
         data["emitted"] = [str(p) for p in generate_method(
@@ -316,6 +321,9 @@ def _choose_driven(args: argparse.Namespace) -> int:
     data = {"quantity": args.quantity, "method": c.method.name, "order": c.order,
             "max_error": c.max_error, "ns_per_point": c.ns_per_point,
             "verified_on": c.verified_on, "seconds": c.ns_per_point * 1e-9,
+            "error_measure": "absolute: max |A_n - A_n,shot|, |B_n - B_n,shot|"
+                             if args.quantity == "amplitudes" else "absolute: max |r - r_shot|",
+            "scale": float(max(c.truth.r)),  # the largest true r: what the error compares to
             "modelled_ns_per_point": c.modelled_ns_per_point,
             "decided_by": "cost model (lindstedt.choose.COST_MODEL); ns_per_point measured",
             "alternatives": {m: {"order": o, "max_error": e, "seconds": ns * 1e-9}

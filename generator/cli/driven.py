@@ -649,15 +649,27 @@ def parametric_report_json(report) -> dict:
     def moduli(lam) -> list[float]:
         return sorted(float(abs(m)) for m in lam)
 
+    from ..analysis.parametric import outside_model
+
     p, (lo, hi), edges, top = report.pump, report.omega_range, report.tongue, report.fold
+
+    def where(omega: float, r: float | None = None) -> dict:
+        """Whether ``omega`` lies in the range and ``(omega, r)`` in the model, in words."""
+        notes = [] if lo <= omega <= hi else [f"outside the range [{lo:g}, {hi:g}]"]
+        model = "" if r is None else outside_model(p, r)
+        return {"in_range": lo <= omega <= hi, **({} if r is None else {"in_model": not model}),
+                "note": "; ".join([*notes, *([model] if model else [])])}
+
     return {
         "equation": "q'' + 2 zeta q' + (1 + eps cos 2wt) q + gamma q^3 = 0",
         "parameters": {"eps": p.eps, "zeta": p.zeta, "gamma": p.gamma, "omega_from": lo,
                        "omega_to": hi, "points": report.points, "harmonics": report.harmonics},
-        "tongue": None if edges is None else {"lower": edges[0], "upper": edges[1]},
-        "onsets": [{"omega": o.omega, "branch": o.branch, "supercritical": o.supercritical}
-                   for o in report.onsets],
-        "fold": None if top is None else {"omega": top[0], "r": top[1]},
+        "tongue": None if edges is None else {
+            "lower": edges[0], "upper": edges[1],
+            "lower_in_range": lo <= edges[0] <= hi, "upper_in_range": lo <= edges[1] <= hi},
+        "onsets": [{"omega": o.omega, "branch": o.branch, "supercritical": o.supercritical,
+                    **where(o.omega, 0.0)} for o in report.onsets],
+        "fold": None if top is None else {"omega": top[0], "r": top[1], **where(*top)},
         "branches": [{
             "branch": r.one.branch, "omega": r.one.omega,
             "one_harmonic": {"a": r.one.a, "b": r.one.b, "r": r.one.r, "stable": r.one.stable},
@@ -676,13 +688,18 @@ def _parametric_table(data: dict) -> list[str]:
     p, t = data["parameters"], data["tongue"]
     lines = [f"{data['equation']}: eps = {p['eps']}, zeta = {p['zeta']}, gamma = {p['gamma']}",
              "tongue (one harmonic): " + ("closed by the damping" if t is None else
-                                          f"{t['lower']:.6f} < omega < {t['upper']:.6f}")]
+                                          f"{t['lower']:.6f} < omega < {t['upper']:.6f}")
+             + ("" if t is None or (t.get("lower_in_range", True)
+                                    and t.get("upper_in_range", True)) else
+                f" (an edge outside the range [{p['omega_from']:g}, {p['omega_to']:g}])")]
     for o in data["onsets"]:
         lines.append(f"onset of branch {o['branch']} at omega = {o['omega']:.6f}: "
-                     + ("supercritical" if o["supercritical"] else "subcritical"))
-    if data["fold"] is not None:
-        lines.append(f"fold (branches + and - meet): omega = {data['fold']['omega']:.6g}, "
-                     f"r = {data['fold']['r']:.6g}")
+                     + ("supercritical" if o["supercritical"] else "subcritical")
+                     + (f" ({o['note']})" if o.get("note") else ""))
+    f = data["fold"]
+    if f is not None:
+        lines.append(f"fold (branches + and - meet): omega = {f['omega']:.6g}, "
+                     f"r = {f['r']:.6g}" + (f" ({f['note']})" if f.get("note") else ""))
     lines.append(f"{'omega':>9} {'branch':>6} {'r (1 harm.)':>12} {'stable':>7} "
                  f"{'r (balance)':>12} {'full Hill':>9} {'r (shot)':>12} {'shot':>8}")
     lines.append("  (branch 0 is q = 0: its Floquet multipliers are Mathieu's; a balance 'none' "
