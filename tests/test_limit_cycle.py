@@ -475,3 +475,42 @@ def test_odd_harmonic_sums_round_trip_through_the_kernel():
         t = Trig.from_fourier(*({n: g.scalar(c) for n, c in d.items()} for d in sums), g)
         back = [{n: g.to_fraction(v) for n, v in part.items()} for part in t.to_fourier()]
         assert back == [{n: c for n, c in d.items() if c} for d in sums]
+
+
+def test_a_cycles_three_amplitudes_are_named_and_each_is_what_it_says(capsys):
+    """Rayleigh's cycle: `series` gives q(0) (the displacement where the velocity vanishes,
+    2 + 17/96 ε²) and the first harmonic √(A₁² + B₁²) (2 + 9/64 ε²), `slowflow` the averaged
+    radius r (2 + 5/64 ε²), each under its own name; q(0) and the first harmonic against the
+    cycle DOP853 settles on at ε = 0.1 (their ε⁴ series to ε⁶), r apart from both."""
+    eps = 0.1
+    assert main(["series", "rayleigh", "--order", "4", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["q0"] == data["amplitude"]
+    assert data["q0"][:3] == ["2/1", "0/1", "17/96"]
+    assert data["first_harmonic"][:3] == ["2/1", "0/1", "9/64"]
+    assert {"q0", "first_harmonic", "slowflow_r"} <= set(data["amplitudes"])
+    assert main(["slowflow", "rayleigh", "--order", "3", "--json"]) == 0
+    cycle = json.loads(capsys.readouterr().out)["cycles"][0]
+    assert cycle["averaged_radius"] == cycle["radius"] == ["2", "0", "5/64"]
+    assert "averaged amplitude" in cycle["radius_meaning"]
+
+    def summed(series: list[str]) -> float:
+        return sum(float(F(c)) * eps**j for j, c in enumerate(series))
+
+    def rhs(t, y):
+        return [y[1], -y[0] + eps * (y[1] - y[1] ** 3 / 3)]
+
+    def turning(t, y):  # q' = 0 falling: q at its maximum
+        return y[1]
+
+    turning.direction = -1
+    sol = solve_ivp(rhs, (0.0, 200.0), [summed(data["q0"]), 0.0], method="DOP853",
+                    rtol=1e-12, atol=1e-14, events=turning, dense_output=True)
+    t0, t1 = sol.t_events[0][-2:]
+    q0 = sol.y_events[0][-1][0]
+    t = np.linspace(t0, t1, 1025)[:-1]
+    first = 2 * abs(np.fft.rfft(sol.sol(t)[0])[1]) / len(t)
+    assert abs(q0 - summed(data["q0"])) < 1e-5
+    assert abs(first - summed(data["first_harmonic"])) < 1e-5
+    r = summed(cycle["averaged_radius"])
+    assert abs(first - r) > 5e-4 and abs(q0 - r) > 5e-4  # (9/64 − 5/64) ε², (17/96 − 5/64) ε²

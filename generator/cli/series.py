@@ -193,6 +193,9 @@ def limit_cycle_json(lc) -> dict:
         "model": m.name, "order": lc.order, "variable": "eps",
         "omega": [frac(c) for c in lc.omega], "period": [frac(c) for c in lc.period],
         "amplitude": [frac(c) for c in lc.amplitude],
+        "q0": [frac(c) for c in lc.amplitude],
+        "first_harmonic": [frac(c) for c in lc.first_harmonic],
+        "amplitudes": CYCLE_AMPLITUDES,
         "q": [{"cos": {str(n): frac(c) for n, c in sorted(cos.items())},
                "sin": {str(n): frac(c) for n, c in sorted(sin.items())}} for cos, sin in lc.q],
         "convention": "q'(0) = 0; q(0) = sum_j amplitude[j] eps^j, s = omega t",
@@ -200,6 +203,19 @@ def limit_cycle_json(lc) -> dict:
         "stable_for": "eps > 0" if lc.slope > 0 else "eps < 0",
         "stability": limit_cycle_stability(lc),
     }
+
+
+CYCLE_AMPLITUDES = {
+    "q0": "q(0), the displacement where the velocity vanishes (q'(0) = 0: the turning point); "
+          "'amplitude' is the same series",
+    "first_harmonic": "sqrt(A1^2 + B1^2) of q(s) = sum_n (A_n cos ns + B_n sin ns): the orbit's "
+                      "first-harmonic amplitude",
+    "slowflow_r": "not given here: slowflow's r, the averaged amplitude (van der Pol's radius "
+                  "after the mean-free near-identity transformation); all three agree at order "
+                  "eps and differ at eps^2 (Rayleigh: q0 2 + 17/96 eps^2, first harmonic "
+                  "2 + 9/64 eps^2, r 2 + 5/64 eps^2)",
+}
+# NOTE: a limit cycle has several "amplitudes"; each output names its own and how they relate.
 
 
 def limit_cycle_stability(lc) -> str:
@@ -242,19 +258,25 @@ def limit_cycle_table(lc, reach=None) -> str:
     m = lc.model
     lines = [f"{m.name}: {m.title}, a limit cycle, expansion variable eps, order {lc.order}",
              "convention: q'(0) = 0, q(0) = sum_j amplitude_j eps^j",
+             "amplitudes: amplitude_j of q(0), the displacement where the velocity vanishes; "
+             "r1_j of the first harmonic sqrt(A1^2 + B1^2); slowflow's averaged r is a "
+             "third, equal to both at order eps only",
              f"stability: {limit_cycle_stability(lc)}",
              *([] if reach is None else [
                  f"omega's series converges for |eps| < {reach.value:.6g} (estimated, spread "
                  f"{reach.spread:.2g})" if reach.value is not None else
                  "radius of convergence in eps not estimated at this order (from about 24)"]),
-             f"{'j':>3}  {'omega_j':>22}  {'(T/2pi)_j':>22}  {'amplitude_j':>22}"]
+             f"{'j':>3}  {'omega_j':>22}  {'(T/2pi)_j':>22}  {'amplitude_j':>22}  "
+             f"{'r1_j':>22}"]
     def shown(c: object) -> str:  # an integer as a reader writes it: 1, 0, 2
         text = _fraction_text(c)
         return text.removesuffix("/1")
 
+    harmonic = lc.first_harmonic
+
     for j in range(lc.order + 1):
         lines.append(f"{j:>3}  {shown(lc.omega[j]):>22}  {shown(lc.period[j]):>22}  "
-                     f"{shown(lc.amplitude[j]):>22}")
+                     f"{shown(lc.amplitude[j]):>22}  {shown(harmonic[j]):>22}")
     return "\n".join(lines)
 
 
@@ -523,10 +545,20 @@ def slow_flow_json(flow) -> dict:
         "radial": [sp_text(e) for e in flow.radial],
         "phase": [sp_text(e) for e in flow.phase],
         "cycles": [{"radius": [sp_text(c) for c in cyc.radius],
+                    "averaged_radius": [sp_text(c) for c in cyc.radius],
+                    "radius_meaning": SLOWFLOW_RADIUS,
                     "omega": [sp_text(c) for c in cyc.omega],
                     "stable_for": "eps > 0" if cyc.slope < 0 else "eps < 0"}
                    for cyc in _cycles(flow)],
     }
+
+
+SLOWFLOW_RADIUS = ("r, the averaged amplitude: van der Pol's radius after the mean-free "
+                   "near-identity transformation (the slow flow's variable), not q(0) (series' "
+                   "q0: the displacement where the velocity vanishes) nor the orbit's first "
+                   "harmonic (series' first_harmonic); the three agree at order eps and differ "
+                   "at eps^2 (Rayleigh: r 2 + 5/64 eps^2, q0 2 + 17/96, first harmonic "
+                   "2 + 9/64)")
 
 
 def _cycles(flow) -> list:
@@ -601,6 +633,9 @@ def run_slowflow(args: argparse.Namespace) -> int:
                   f"{'eps > 0' if cyc.slope < 0 else 'eps < 0'}): r = sum_j eps^j r_j, "
                   "omega = sum_j eps^j omega_j")
             print("  r_j:     " + ", ".join(sp_text(c) for c in cyc.radius))
+            print("  (r: the averaged amplitude, van der Pol's radius after the mean-free "
+                  "near-identity transformation; series' q(0) and first harmonic equal it at "
+                  "order eps, not beyond)")
             print("  omega_j: " + ", ".join(sp_text(c) for c in cyc.omega))
     for path in written:
         print(f"  {path}", file=sys.stderr if args.json else sys.stdout)
