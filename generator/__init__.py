@@ -54,6 +54,11 @@ order; a stage imports only stages above it::
                             exactly, for LaTeX and emission [K -> exact orders]
     analysis.continuation   pseudo-arclength through folds, in ω or in the drive amplitude from
                             rest; crossings of a level [system -> curve]
+    analysis.attractors     along every traced branch: folds, period doublings, Neimark–Sacker
+                            points (refined by secant on |μ| − 1); where no period-1 orbit is
+                            stable or one loses stability by Neimark–Sacker, the attractor a
+                            simulation settles on (period-k, quasi-periodic, chaotic), its
+                            spectral lines and ranges [branches, multipliers -> Dynamics]
     analysis.response       one-harmonic curves and folds, the balance continued over an ω range
                             (the notes' and any polynomial force)
                             [Drive | equation, ω range -> folds]

@@ -16,7 +16,8 @@ from pathlib import Path
 import pytest
 
 LAYERS = {
-    "exact": ("averaging", "branches", "driven", "driven_damped", "driven_equation", "equation",
+    "exact": ("attractors", "averaging", "branches", "driven", "driven_damped", "driven_equation",
+              "equation",
               "hill", "layout", "lindstedt", "nnm", "parametric", "response", "response_equation",
               "response_system",
               "resonance", "series", "subharmonic"),

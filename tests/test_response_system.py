@@ -166,7 +166,8 @@ def test_cli_json_table_and_plot(tmp_path):
     table = run("response", KERSCHEN, "--param", "f=1/20", "--harmonics", "3",
                 "--omega", "0.8:1.2", "--plot", str(tmp_path / "r.png"))
     assert table.returncode == 0, table.stderr
-    assert "branch 1: w 0.8 -> 1.2," in table.stdout and "  search: every orbit" in table.stdout
+    assert "branch 1: w 0.8 -> 1.2," in table.stdout
+    assert "  search for period-1 orbits: every orbit" in table.stdout
     assert (tmp_path / "r.png").stat().st_size > 10000
 
 

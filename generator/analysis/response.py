@@ -19,6 +19,7 @@ from ..errors import InputError
 from ..numerics.integrate import ForceTable, Sweep, escape_bound, sweep_table
 from ..numerics.newton import newton
 from ..numerics.shooting import orbit_fold_table
+from .attractors import Dynamics, dynamics, orbit_multipliers
 from .continuation import (
     CONTINUATION_SECONDS,
     MAX_POINTS,
@@ -461,6 +462,7 @@ class ResponseReport:
     down: Sweep
     true_folds: tuple[tuple[float, tuple[float, ...]], ...]  # (ω, sorted |Floquet multipliers|)
     notes: tuple[tuple[str, float], ...] = ()
+    dynamics: Dynamics | None = None  # bifurcations on the branches, attractors simulated
 
 
 def response_report(de: DrivenEquation, er: EquationResponse, harmonics: int,
@@ -470,7 +472,8 @@ def response_report(de: DrivenEquation, er: EquationResponse, harmonics: int,
     """The :class:`ResponseReport` of ``de`` over ``er``'s range: the continuation
     (:func:`continue_equation`), each balance fold polished into the true orbit's
     (:func:`numerics.shooting.orbit_fold_table`), the simulated sweeps both ways, escapes
-    detected past ``barrier`` (default :data:`ESCAPE_FACTOR` × the largest balance)."""
+    detected past ``barrier`` (default :data:`ESCAPE_FACTOR` × the largest balance); the
+    bifurcations along the curve and the attractors off it (:func:`attractors.dynamics`)."""
     lo, hi = er.omega_range
     cont = continue_equation(de, harmonics, lo, hi, max_seconds=max_seconds)
     table = ForceTable.of(de.terms)
@@ -484,11 +487,14 @@ def response_report(de: DrivenEquation, er: EquationResponse, harmonics: int,
         found = orbit_fold_table(table, de.force, w, fine.state(x, w), bound=bound)
         if found is not None:
             true_folds.append((found[0], tuple(sorted(float(abs(m)) for m in found[2]))))
+    lam = orbit_multipliers(fine, cont.x, cont.omega, er.linear_frequency)
     return ResponseReport(
         de, er, cont, fine, table, barrier, bound,
         sweep_table(table, de.force, lo, hi, barrier=barrier, bound=bound),
         sweep_table(table, de.force, hi, lo, barrier=barrier, bound=bound),
-        tuple(sorted(true_folds)), notes)
+        tuple(sorted(true_folds)), notes,
+        dynamics(fine, fine.field, np.array([de.force]), cont, lam, lo, hi,
+                 er.linear_frequency))
 
 
 def equation_response(text: str, values: dict[str, str], harmonics: int,

@@ -15,9 +15,9 @@ import sympy as sp
 
 from ..derive.system import System
 from ..errors import InputError
-from ..numerics.floquet import variational_multipliers
 from ..numerics.integrate import PolynomialField
 from ..numerics.shooting import PeriodicOrbit, settle_system, shoot_system
+from .attractors import Dynamics, dynamics, orbit_multipliers
 from .continuation import (
     CONTINUATION_HARMONICS,
     CONTINUATION_SECONDS,
@@ -56,10 +56,6 @@ SCAN_HARMONICS = 3
 SCAN_STEP = 0.01
 # NOTE: the balance that scans along each backbone for branches off the traced curve (a Newton
 # solve ~1 ms on a 2-DOF system); a hit is polished at the harmonics asked.
-FLOQUET_SAMPLES = 512
-# NOTE: samples per period of the variational equation about each balance orbit (times the
-# power of two above ω0,max/ω): RK4 of 256 and 128 steps, Richardson-combined; |λ| to ~1e-9 on
-# the suite's systems (checked against the linear system's exact e^(−cT/2)).
 
 
 @dataclass(frozen=True)
@@ -121,6 +117,7 @@ class SystemResponse:
     complete: bool
     note: str
     sweep_jumps: tuple[SweepJump, ...] = ()  # the jumps, each at its fold's ω exactly
+    dynamics: Dynamics | None = None  # bifurcations on the branches, attractors simulated
 
 
 def driven_system(text: str, values: dict[str, str]) -> System:
@@ -450,18 +447,8 @@ class SystemBalance:
         """The largest Floquet ``|λ|`` of each balance solution ``X[k]`` at ``omega[k]``: the
         monodromy of its variational equation (:func:`numerics.floquet.
         variational_multipliers`), the samples per period growing with ω0/ω."""
-        omega = np.asarray(omega, dtype=float)
-        out = np.empty(len(omega))
-        samples = FLOQUET_SAMPLES * 2 ** np.ceil(np.log2(np.maximum(
-            1.0, self.linear_frequencies[-1] / omega)))
-        for s in np.unique(samples):
-            where_s = np.nonzero(samples == s)[0]
-            for chunk in np.array_split(where_s, max(1, len(where_s) * int(s) // 2**15)):
-                lin = [self.fine.linearization(X[i], omega[i], int(s)) for i in chunk]
-                lam = variational_multipliers(np.array([a for a, _ in lin]),
-                                              np.array([b for _, b in lin]), omega[chunk])
-                out[chunk] = np.max(np.abs(lam), axis=1)
-        return out
+        lam = orbit_multipliers(self.fine, X, omega, self.linear_frequencies[-1])
+        return np.max(np.abs(lam), axis=1)
 
 
 BACKBONE_ORDER = 6
@@ -597,7 +584,8 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
               "(in the drive, at the ends and probes) nor from a backbone is not excluded")
     cont = _clipped(cont, lo, hi, fine)
     # stability of every point: the monodromy of its variational equation
-    multiplier = sb.multiplier(cont.x, cont.omega)
+    lam = orbit_multipliers(fine, cont.x, cont.omega, w0[-1])
+    multiplier = np.max(np.abs(lam), axis=1)
     stable = multiplier < NEUTRAL
     amplitudes = np.array([fine.first_harmonics(x) for x in cont.x])
     shots = _shot_checks(sb, cont, amplitudes, stable, checks)
@@ -612,7 +600,9 @@ def system_response(text: str, values: dict[str, str], harmonics: int = 6,
     return SystemResponse(system, harmonics, (lo, hi), w0, cont, tuple(closed), amplitudes,
                           multiplier, stable,
                           tuple((j.way, j.omega, j.before, j.after) for j in jumps),
-                          shots, bound, complete and cont.complete, how + probed, jumps)
+                          shots, bound, complete and cont.complete, how + probed, jumps,
+                          dynamics(fine, PolynomialField.of(sb.equations), sb.drive, cont, lam,
+                                   lo, hi, w0[-1]))
 
 
 def _shot_checks(sb: SystemBalance, cont: Continuation, amplitudes: np.ndarray,

@@ -546,3 +546,55 @@ def _flag_drive(p: argparse.ArgumentParser, required: bool, omega: str | None,
     elif Q == "optional":
         p.add_argument("--Q", type=_quality, default=math.inf, metavar="Q",
                        help="quality factor Q > 0 of the damping q'/Q (default inf: undamped)")
+
+
+def dynamics_json(d, names: list[str]) -> dict:
+    """The bifurcations and attractors of an :class:`analysis.attractors.Dynamics` as data
+    (``names``: the coordinates), for ``response`` with and without SYSTEM."""
+    def multipliers(ms) -> list:
+        return [[m.real, m.imag] for m in ms]
+
+    return {
+        "bifurcations": [
+            {"kind": b.kind, "omega": b.omega, "branch": b.piece,
+             "amplitude": dict(zip(names, b.amplitudes, strict=True)),
+             "multipliers": multipliers(b.multipliers),
+             "moduli": [abs(m) for m in b.multipliers],
+             "crossing_residual": b.residual, "stable_side": b.stable_side}
+            for b in d.bifurcations],
+        "attractors": [
+            {"omega": a.omega, "interval": list(a.interval), "why": a.why, "kind": a.kind,
+             "period": a.period, "second_frequency": a.second_frequency,
+             "power_on_lines": a.power_in_lines,
+             "lines": {n: [{"frequency": f, "amplitude": amp} for f, amp in ls]
+                       for n, ls in zip(names, a.lines, strict=False)},
+             "range": {n: list(r) for n, r in zip(names, a.ranges, strict=False)},
+             "from_orbit": dict(zip(names, a.start_amplitudes, strict=True)),
+             "transient_periods": a.transient, "recorded_periods": a.periods}
+            for a in d.attractors],
+        "unstable_intervals": [list(g) for g in d.unstable_intervals],
+    }
+
+
+def dynamics_lines(data: dict) -> list[str]:
+    """The table lines of :func:`dynamics_json`'s bifurcations and attractors."""
+    lines = []
+    for b in data["bifurcations"]:
+        top = max(b["moduli"])
+        lines.append(f"  {b['kind'].replace('_', '-')} at w = {b['omega']:.8f} (branch "
+                     f"{b['branch'] + 1}, " + ", ".join(
+                         f"{n} {r:.4g}" for n, r in b["amplitude"].items())
+                     + f"; largest |mu| {top:.6g}; stable side: {b['stable_side']})")
+    for g in data["unstable_intervals"]:
+        lines.append(f"  no stable period-1 orbit for w in [{g[0]:.6g}, {g[1]:.6g}]")
+    for a in data["attractors"]:
+        extra = (f", second frequency {a['second_frequency']:.6g} (ratio "
+                 f"{a['second_frequency'] / a['omega']:.6g})"
+                 if a["second_frequency"] is not None else "")
+        lines.append(f"  attractor at w = {a['omega']:.6g} ({a['why']}): {a['kind']}{extra}; "
+                     f"after {a['transient_periods']} periods, over {a['recorded_periods']}")
+        for n, ls in a["lines"].items():
+            lo, hi = a["range"][n]
+            lines.append(f"    {n} in [{lo:.4g}, {hi:.4g}], lines: " + ", ".join(
+                f"{e['frequency']:.5g} ({e['amplitude']:.3g})" for e in ls[:6]))
+    return lines

@@ -35,6 +35,8 @@ from .common import (
     _real,
     _report,
     check_outputs,
+    dynamics_json,
+    dynamics_lines,
     write_csv,
 )
 
@@ -340,7 +342,10 @@ def response_report_json(r) -> dict:
         "one_harmonic": {"folds": [float(w) for w in er.one_harmonic_folds]},
         "harmonic_balance": {"harmonics": r.fine.harmonics,
                              "folds": [float(w) for w in cont.folds],
-                             "complete": cont.complete},
+                             "complete": cont.complete, "about": "period-1 orbits"},
+        "completeness": {"complete": cont.complete, "about": "period-1 orbits",
+                         "note": None if r.dynamics is None else r.dynamics.note},
+        **({} if r.dynamics is None else dynamics_json(r.dynamics, ["q"])),
         "numerical": {"folds": [w for w, _ in true_folds],
                       "fold_floquet_moduli": [m for _, m in true_folds],
                       "sweep_up_jump": up.jump, "sweep_down_jump": down.jump,
@@ -467,9 +472,12 @@ def _response_table(data: dict) -> list[str]:
         else:
             text = "no jump"
         lines.append(f"{'sweep ' + way:>26}: {text}")
+    lines += dynamics_lines(data) if "bifurcations" in data else []
     if not data["harmonic_balance"]["complete"]:
         lines.append("warning: a balance at an end of the range did not converge from its "
                      "one-harmonic root: pieces of the curve may be missing")
+    if data.get("completeness", {}).get("note"):
+        lines.append(data["completeness"]["note"])
     return lines
 
 

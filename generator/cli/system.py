@@ -22,6 +22,8 @@ from .common import (
     _order,
     _params,
     check_outputs,
+    dynamics_json,
+    dynamics_lines,
     write_csv,
 )
 
@@ -344,7 +346,10 @@ def response_system_json(r) -> dict:
                     "multipliers_complex": [[m.real, m.imag] for m in c.multipliers],
                     "stable": c.stable,
                     "balance_stable": c.balance_stable, "note": c.note} for c in r.checks],
-        "completeness": {"complete": r.complete, "bound": r.bound, "how": r.note},
+        "completeness": {"complete": r.complete, "bound": r.bound, "how": r.note,
+                         "about": "period-1 orbits",
+                         "note": None if r.dynamics is None else r.dynamics.note},
+        **({} if r.dynamics is None else dynamics_json(r.dynamics, names)),
         "amplitude": "r_i = sqrt(A_i1^2 + B_i1^2), the first harmonic of coordinate i",
     }
 
@@ -396,10 +401,14 @@ def response_system_table(data: dict) -> list[str]:
     for c in checks:
         if c["error"] is None:
             lines.append(f"    w = {c['omega']:.6g}: not shot ({c['note']})")
+    lines += dynamics_lines(data) if "bifurcations" in data else []
     done = data["completeness"]
-    lines += textwrap.wrap(("search: " if done["complete"] else "warning: the search may be "
-                            "incomplete: ") + done["how"], 96, initial_indent="  ",
-                           subsequent_indent="    ")
+    lines += textwrap.wrap(("search for period-1 orbits: " if done["complete"] else
+                            "warning: the search for period-1 orbits may be incomplete: ")
+                           + done["how"], 96, initial_indent="  ", subsequent_indent="    ")
+    if done.get("note"):
+        lines += textwrap.wrap(done["note"], 96, initial_indent="  ",
+                               subsequent_indent="    ")
     return lines
 
 
