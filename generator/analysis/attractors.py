@@ -211,13 +211,13 @@ def bifurcations(fine: PolynomialBalance, cont: Continuation, lam: np.ndarray,
     for k, piece in enumerate(cont.piece_slices()):
         for i in range(piece.start, piece.stop - 1):
             a, b = counts[i], counts[i + 1]
-            d_total = sum(b) - sum(a)
             y0 = np.append(cont.x[i], cont.omega[i])
             y1 = np.append(cont.x[i + 1], cont.omega[i + 1])
             kinds = []
-            if b[0] != a[0] and d_total == 2 * (b[0] - a[0]) and b[1:] == a[1:]:
+            # (a pair that turns real within the step, or meets the other way, is no crossing)
+            if b[0] != a[0] and b[1:] == a[1:]:
                 kinds.append("neimark_sacker")
-            if b[1] != a[1] and d_total == b[1] - a[1] and b[0] == a[0]:
+            if b[1] != a[1] and b[0] == a[0] and b[2] == a[2]:
                 kinds.append("period_doubling")
             for kind in kinds:
                 g0, g1 = _crossing(lam[i], kind), _crossing(lam[i + 1], kind)
