@@ -22,7 +22,7 @@ LAYERS = {
               "response_system",
               "resonance", "series", "subharmonic"),
     "printers": ("charts", "cli", "costs", "curves", "emit", "files", "fuzz", "interrupt", "latex",
-                 "notebook", "readme", "validity"),
+                 "messages", "notebook", "readme", "validity"),
     "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "nnm_emitted", "orbits",
                 "oscillator", "resum", "sweep", "tongues"),
 }

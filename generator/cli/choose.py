@@ -29,7 +29,9 @@ from .common import (
     _order,
     _out_folder,
     _params,
+    _positive,
     _real,
+    interval,
 )
 
 
@@ -127,7 +129,7 @@ def run_choose(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(data))
         return 0
-    _print_choice(f"period T(y), {variable} in [{args.x_min:g}, {args.x_max:g}], tolerance "
+    _print_choice(f"period T(y), {variable} in {interval(args.x_min, args.x_max, 6)}, tolerance "
                   f"{args.tol:g} (relative, verified on {choice.verified_on} points):",
                   (choice.method, choice.order, choice.max_error, choice.ns_per_point),
                   choice.considered, quantity="period")
@@ -164,7 +166,7 @@ def _choose_backbone(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(data))
         return 0
-    print(f"backbone T(A) of mode {c.mode}, A in [{args.x_min:g}, {args.x_max:g}], tolerance "
+    print(f"backbone T(A) of mode {c.mode}, A in {interval(args.x_min, args.x_max, 6)}, tolerance "
           f"{args.tol:g} (relative, verified on {c.verified_on} shot orbits):")
     print(f"  chosen: L–P order {c.order}: max error {c.max_error:.1e} (the series reaches "
           f"A < {c.radius:.4g})")
@@ -188,11 +190,11 @@ def _choose_resummed(args: argparse.Namespace) -> int:
 
     if args.quantity == "cycle":
         c = choose_limit_cycle(args.tol, args.x_min, args.x_max)
-        what = f"van der Pol's limit-cycle ω(ε), ε in [{args.x_min:g}, {args.x_max:g}]"
+        what = f"van der Pol's limit-cycle ω(ε), ε in {interval(args.x_min, args.x_max, 6)}"
     else:
         kind, m = args.kind or "a", args.m if args.m is not None else 0
         c = choose_mathieu(kind, m, args.tol, args.x_min, args.x_max)
-        what = f"Mathieu's {kind}_{m}(q), q in [{args.x_min:g}, {args.x_max:g}]"
+        what = f"Mathieu's {kind}_{m}(q), q in {interval(args.x_min, args.x_max, 6)}"
     rows = [{"method": m, "order": o, "max_error": e, "recorded_ns_per_point": r,
              "ns_per_point": ns} for m, o, e, r, ns in c.considered]
     if args.json:
@@ -280,8 +282,9 @@ def _choose_q(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(data))
         return 0
-    _print_choice(f"q(t)/A to {args.tol:g} for y = εA² in [{args.x_min:g}, {args.x_max:g}], t in "
-                  f"[0, {args.t_max:g}] (verified on {c.verified_on} points):",
+    _print_choice(f"q(t)/A to {args.tol:g} for y = εA² in "
+                  f"{interval(args.x_min, args.x_max, 6)}, t in [0, {args.t_max:g}] (verified "
+                  f"on {c.verified_on} points):",
                   (c.method, c.order, c.max_error, c.ns_per_point), c.considered)
     if c.method == "lindstedt" and not args.out:
         print(f"  (`lindstedt generate duffing --order {c.order}` or --out DIR writes it)")
@@ -341,7 +344,7 @@ def _choose_driven(args: argparse.Namespace) -> int:
         print(json.dumps(data))
         return 0
     what = {"amplitudes": "A1, A3, A5 (and B_n)", "response": "r = sqrt(A1^2 + B1^2)"}
-    where = f"omega = {lo:g}" if hi is None else f"omega in [{lo:g}, {hi:g}]"
+    where = f"omega = {lo:g}" if hi is None else f"omega in {interval(lo, hi, 6)}"
     _print_choice(f"{what[args.quantity]} to {tol:g} (absolute, largest branch, {where}, "
                   f"verified on {c.verified_on} point{'s' * (c.verified_on > 1)} against "
                   "shooting):", (c.method, c.order, c.max_error, c.ns_per_point), c.considered,
@@ -373,7 +376,7 @@ def arguments_choose(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    help="mathieu: a (even solutions, default) or b (odd)")
     p.add_argument("--m", type=_order, default=None, metavar="M",
                    help="mathieu: the index m (default 0)")
-    p.add_argument("--mode", type=_order, default=None, metavar="M",
+    p.add_argument("--mode", type=_positive, default=None, metavar="M",
                    help="backbone: the system's mode, by increasing linear frequency "
                    "(default 1)")
     _flag_equation(p, "\"q'' + q + eps*q**5 = 0\" (period only: a free oscillator with a "

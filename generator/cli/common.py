@@ -244,29 +244,49 @@ def _equation_args(args: argparse.Namespace, flags: Sequence[str],
     return False
 
 
-def _order(text: str) -> int:
-    """An order K (or an index such as mathieu's m): a non-negative integer."""
+def interval(lo: float, hi: float, digits: int = 4) -> str:
+    """``[lo, hi]`` to ``digits`` significant digits, or as many more as tell two different
+    ends apart (a range the user gave must not print as ``[1, 1]``).
+
+    >>> interval(1, 1.0000001)
+    '[1, 1.0000001]'
+    >>> interval(0.5, 2.25)
+    '[0.5, 2.25]'
+    """
+    for d in range(digits, 18):
+        a, b = f"{lo:.{d}g}", f"{hi:.{d}g}"
+        if a != b or lo == hi:
+            return f"[{a}, {b}]"
+    return f"[{lo!r}, {hi!r}]"
+
+
+def _integer(text: str) -> int:
     try:
-        value = int(text)
+        return int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r}: not an integer") from None
+
+
+def _order(text: str) -> int:
+    """An order K (or an index such as mathieu's m): a non-negative integer."""
+    value = _integer(text)
     if value < 0:
         raise argparse.ArgumentTypeError(f"{value}: must be ≥ 0")
     return value
 
 
 def _positive(text: str) -> int:
-    """A positive integer (workers, points per task)."""
-    value = _order(text)
+    """A positive integer (workers, points per task, a mode's number, slowflow's order)."""
+    value = _integer(text)
     if value < 1:
-        raise argparse.ArgumentTypeError(f"{value}: must be ≥ 1")
+        raise argparse.ArgumentTypeError(f"{value}: must be > 0")
     return value
 
 
 def _count(text: str) -> int:
     """A number of harmonics: an integer in 1..MAX_HARMONICS."""
-    value = _positive(text)
-    if value > MAX_HARMONICS:
+    value = _integer(text)
+    if not 1 <= value <= MAX_HARMONICS:
         raise argparse.ArgumentTypeError(f"{value}: must be in 1..{MAX_HARMONICS}")
     return value
 
@@ -586,7 +606,7 @@ def dynamics_lines(data: dict) -> list[str]:
                          f"{n} {r:.4g}" for n, r in b["amplitude"].items())
                      + f"; largest |mu| {top:.6g}; stable side: {b['stable_side']})")
     for g in data["unstable_intervals"]:
-        lines.append(f"  no stable period-1 orbit for w in [{g[0]:.6g}, {g[1]:.6g}]")
+        lines.append(f"  no stable period-1 orbit for w in {interval(*g, 6)}")
     for a in data["attractors"]:
         extra = (f", second frequency {a['second_frequency']:.6g} (ratio "
                  f"{a['second_frequency'] / a['omega']:.6g})"
@@ -595,6 +615,6 @@ def dynamics_lines(data: dict) -> list[str]:
                      f"after {a['transient_periods']} periods, over {a['recorded_periods']}")
         for n, ls in a["lines"].items():
             lo, hi = a["range"][n]
-            lines.append(f"    {n} in [{lo:.4g}, {hi:.4g}], lines: " + ", ".join(
+            lines.append(f"    {n} in {interval(lo, hi)}, lines: " + ", ".join(
                 f"{e['frequency']:.5g} ({e['amplitude']:.3g})" for e in ls[:6]))
     return lines

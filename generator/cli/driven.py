@@ -37,6 +37,7 @@ from .common import (
     check_outputs,
     dynamics_json,
     dynamics_lines,
+    interval,
     write_csv,
 )
 
@@ -453,7 +454,7 @@ def _response_table(data: dict) -> list[str]:
     harmonics = data["harmonic_balance"]["harmonics"]
     lo, hi = p["omega_range"]
     lines = [f"{data['equation']}: {given}{'; ' if given else ''}{p['drive']['frequency']} in "
-             f"[{lo:.4g}, {hi:.4g}] (omega0 = {p['linear_frequency']:.6g})"]
+             f"{interval(lo, hi)} (omega0 = {p['linear_frequency']:.6g})"]
     num = data["numerical"]
     for label, folds in (("one harmonic", data["one_harmonic"]["folds"]),
                          (f"harmonic balance N={harmonics}", data["harmonic_balance"]["folds"]),

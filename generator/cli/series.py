@@ -33,6 +33,7 @@ from .common import (
     _order,
     _out_folder,
     _params,
+    _positive,
     _positive_real,
     _rational,
     _real,
@@ -892,7 +893,7 @@ def arguments_generate(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
                    help="limit cycles only: derive ω's exact series to order N (at least K + 2) "
                    "for the radius estimate and the resummed evaluators (default 60: van der "
                    "Pol's omega_resummed verified to eps ≈ 3.75; 164: to eps = 10)")
-    p.add_argument("--mode", type=_order, default=None, metavar="M",
+    p.add_argument("--mode", type=_positive, default=None, metavar="M",
                    help="a SYSTEM's nonlinear normal mode, by increasing linear frequency "
                    "(default 1): ω(A), T(A) and each coordinate x_i(t, A)")
     p.add_argument("--amplitude", metavar="NAME",
@@ -913,7 +914,7 @@ def arguments_slowflow(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
                        "commensurate: the first-order slow flow of the resonant modes, its "
                        "coupled modes and the energy-exchange period.")
     _flag_oscillator(p)
-    p.add_argument("--order", type=_order, default=None, metavar="K",
+    p.add_argument("--order", type=_positive, default=None, metavar="K",
                    help="the order in eps, 1..6 (default 2; a SYSTEM: 1, the only one built)")
     p.add_argument("--start", action="append", metavar="NAME=VALUE",
                    help="a SYSTEM: the starting amplitude a_k of a resonant mode for the "

@@ -19,11 +19,12 @@ from .common import (
     _flag_csv,
     _flag_json,
     _flag_order,
-    _order,
     _params,
+    _positive,
     check_outputs,
     dynamics_json,
     dynamics_lines,
+    interval,
     write_csv,
 )
 
@@ -272,7 +273,7 @@ def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    help="an exact value for a parameter, e.g. beta=1/10 (repeatable; those in "
                    "the linear part need one, those in the nonlinear terms may stay symbols: "
                    "the coefficients are then polynomials in them)")
-    p.add_argument("--mode", type=_order, default=1, metavar="M",
+    p.add_argument("--mode", type=_positive, default=1, metavar="M",
                    help="the mode, numbered 1, 2, … by increasing linear frequency (default 1)")
     p.add_argument("--amplitude", metavar="NAME",
                    help="the coordinate at its turning point x = A at t = 0 (default: the "
@@ -373,7 +374,7 @@ def response_system_table(data: dict) -> list[str]:
     lo, hi = p["omega_range"]
     drive = ", ".join(f"{k}: {v}" for k, v in p["drive"].items() if v != "0")
     lines = [f"response of {data['system']}",
-             f"  {p['frequency']} in [{lo:.4g}, {hi:.4g}]; linear omega0 = "
+             f"  {p['frequency']} in {interval(lo, hi)}; linear omega0 = "
              + ", ".join(f"{w:.6g}" for w in p["linear_frequencies"])
              + f"; drive amplitude {drive}; balance of {p['harmonics']} harmonics"]
     for k, b in enumerate(data["branches"], 1):
