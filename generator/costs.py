@@ -350,7 +350,8 @@ def response_cost(args: argparse.Namespace) -> Cost:
 
         plan = system_plan(args.model, _values(args), args.harmonics, args.omega_min,
                            args.omega_max)
-        return Cost(plan.seconds, f"--harmonics {args.harmonics}",
+        given = "".join(f", --param {pair}" for pair in args.param or ())
+        return Cost(plan.seconds, f"--harmonics {args.harmonics}{given}",
                     f"the continuation of about {plan.points:.0f} points, {plan.drives} drive "
                     f"continuations (at most {plan.drive_points} points each) and the shots "
                     "of the system")

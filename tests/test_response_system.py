@@ -279,3 +279,26 @@ def test_the_same_command_gives_the_same_answer_on_a_busy_machine(monkeypatch):
         hog.kill()
         hog.wait()
     assert busy == quiet
+
+
+def test_a_strong_drive_is_refused_before_the_continuation(monkeypatch, capsys):
+    """KERSCHEN at f = 1000: the power balance bounds r₁ by |F|/(c ω) = 2·10⁴/ω, and the curve
+    grows with it (at f = 1000 the continuation ran 20 000 steps, 85 s, before refusing); the
+    estimate, uncapped, refuses it up front in one line naming the drive; f = 1/20 stays
+    under the limit."""
+    import argparse
+
+    from lindstedt.analysis import systems
+    from lindstedt.cli import main
+    from lindstedt.costs import response_cost
+    from lindstedt.limits import COST_LIMIT_SECONDS
+
+    def forbidden(*args, **kwargs):
+        raise AssertionError("the response ran before its estimate refused it")
+    monkeypatch.setattr(systems, "system_response", forbidden)
+    assert main(["response", KERSCHEN, "--param", "f=1000", "--harmonics", "2"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--param f=1000" in err and "--allow-slow" in err
+    args = argparse.Namespace(model=KERSCHEN, param=["f=1/20"], harmonics=3, omega_min=None,
+                              omega_max=None)
+    assert response_cost(args).seconds < COST_LIMIT_SECONDS
