@@ -8,13 +8,8 @@ import sys
 from fractions import Fraction
 
 import pytest
+from commands import run
 from reference import duffing_period, pendulum_period, reciprocal
-
-
-def run(*args):
-    return subprocess.run(
-        [sys.executable, "-m", "lindstedt", *args], capture_output=True, text=True, check=False
-    )
 
 
 def test_series_duffing_order_40_contract():

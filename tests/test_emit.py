@@ -8,6 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import commands
 import jinja2.meta
 import mpmath
 import numpy as np
@@ -425,8 +426,7 @@ def test_refuses_to_overwrite_foreign_file(tmp_path):
 
 
 def run_cli(*args):
-    return subprocess.run([sys.executable, "-m", "lindstedt", *args],
-                          capture_output=True, text=True, check=False)
+    return commands.run(*args)
 
 
 @pytest.mark.skipif(os.geteuid() == 0, reason="root can write anywhere")

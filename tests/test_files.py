@@ -13,6 +13,7 @@ import sys
 import time
 from pathlib import Path
 
+import commands
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -29,9 +30,8 @@ from lindstedt.methods import targets as methods
 SET = ("duffing.py", "duffing_tables.tex", "duffing_derivation.tex")
 
 
-def cli(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "lindstedt", *args], cwd=cwd,
-                          capture_output=True, text=True, timeout=timeout, check=False)
+def cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return commands.run(*args, cwd=cwd)
 
 
 def inputs_hash(path: Path) -> str:
@@ -89,7 +89,7 @@ def test_odd_targets_are_refused_before_any_work(tmp_path, no_derivation):
 
 def test_cli_refuses_a_fifo_without_hanging_and_an_empty_out(tmp_path):
     os.mkfifo(tmp_path / "duffing.py")
-    out = cli("generate", "duffing", "--out", str(tmp_path), cwd=tmp_path, timeout=60)
+    out = cli("generate", "duffing", "--out", str(tmp_path), cwd=tmp_path)
     assert out.returncode == 2 and "not a regular file" in out.stderr
     out = cli("generate", "duffing", "--out", "", cwd=tmp_path)
     assert out.returncode == 2 and len(out.stderr.strip().splitlines()) == 1

@@ -7,8 +7,8 @@ from __future__ import annotations
 import json
 import math
 import subprocess
-import sys
 
+import commands
 import numpy as np
 import pytest
 from lindstedt.analysis.driven import Drive, amplitudes
@@ -235,8 +235,7 @@ def test_full_hill_on_driven_duffing_branches(eps, force, Q, omega):
 
 
 def run(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
-                          text=True, check=False)
+    return commands.run(*args)
 
 
 def test_parametric_command_contract_and_bad_input():
