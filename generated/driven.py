@@ -2,15 +2,15 @@
 # model: driven, order: 3
 # command: lindstedt generate driven --order 3
 # inputs sha256: cef33ff01dffb2211c3af2d37365f7b8bff5e57c04ba6b53bf77b6cbbf023e34
-# body sha256: 93d6019b928b330c480bb19ce3d44273a7f17d4fd163bf8d66c6ecb48daf8644
+# body sha256: 0785a633feb4ec97635b827485f47d974d2199aff1acaa009c4adfb8580cd3ec
 """Driven Duffing q'' + q + eps*q**3 = f cos(omega t): μ-expansion to order 3.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
 or arrays.  Outside its domain it returns NaN (see each docstring).  Its twin
 ``<name>_into(out, ...)`` writes into ``out``, a writable 1-D C-contiguous float64 array, each
 argument a real number or a 1-D array of ``out``'s length (converted to float64; one that
-overlaps ``out`` is copied first): a contiguous compiled loop that LLVM vectorises (the
-ufunc's strided loop cannot be).  Anything else raises TypeError or ValueError before a single
+overlaps ``out`` is copied first; where a masked array is masked, ``out`` is NaN): a
+contiguous compiled loop that LLVM vectorises (the ufunc's strided loop cannot be).  Anything else raises TypeError or ValueError before a single
 element is read or written."""
 
 import math
@@ -103,6 +103,19 @@ def _arg(v, out, where, name):
             return np.ascontiguousarray(v, dtype=_FLOAT64)
     raise ValueError(f"{where}: {name} must be a real number or a 1-D array of out's length "
                      f"{out.size}, got shape {v.shape}")
+
+
+def _masked(out, *args):
+    """Where any argument that is a masked array is masked (a bool array of ``out``'s shape),
+    or None: a masked element has no value, so ``out`` is NaN there, as NumPy's ``filled``
+    of the ufunc's masked result would be with NaN.  O(1) unless an argument is masked."""
+    mask = None
+    for v in args:
+        if isinstance(v, np.ma.MaskedArray) and v.mask is not np.ma.nomask:
+            m = np.ma.getmaskarray(v)
+            if m.shape in ((), out.shape):  # any other shape: _arg refuses it
+                mask = m if mask is None else mask | m
+    return mask
 
 
 TRIG_LIMIT = 1048576.0
@@ -253,9 +266,10 @@ def _A_1_into(out, omega_in, eps_in, force_in, branch_in):
 
 def A_1_into(out, omega, eps, force, branch):
     """``A_1`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "A_1_into")
+    masked = _masked(out, omega, eps, force, branch)
     omega = _arg(omega, out, "A_1_into", "omega")
     eps = _arg(eps, out, "A_1_into", "eps")
     force = _arg(force, out, "A_1_into", "force")
@@ -264,8 +278,11 @@ def A_1_into(out, omega, eps, force, branch):
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(A_1(omega, eps, force, branch))
-        return out
-    return _A_1_into(out, omega, eps, force, branch)
+    else:
+        _A_1_into(out, omega, eps, force, branch)
+    if masked is not None:
+        out[masked] = math.nan
+    return out
 
 
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -356,9 +373,10 @@ def _A_3_into(out, omega_in, eps_in, force_in, branch_in):
 
 def A_3_into(out, omega, eps, force, branch):
     """``A_3`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "A_3_into")
+    masked = _masked(out, omega, eps, force, branch)
     omega = _arg(omega, out, "A_3_into", "omega")
     eps = _arg(eps, out, "A_3_into", "eps")
     force = _arg(force, out, "A_3_into", "force")
@@ -367,8 +385,11 @@ def A_3_into(out, omega, eps, force, branch):
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(A_3(omega, eps, force, branch))
-        return out
-    return _A_3_into(out, omega, eps, force, branch)
+    else:
+        _A_3_into(out, omega, eps, force, branch)
+    if masked is not None:
+        out[masked] = math.nan
+    return out
 
 
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -437,9 +458,10 @@ def _A_5_into(out, omega_in, eps_in, force_in, branch_in):
 
 def A_5_into(out, omega, eps, force, branch):
     """``A_5`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "A_5_into")
+    masked = _masked(out, omega, eps, force, branch)
     omega = _arg(omega, out, "A_5_into", "omega")
     eps = _arg(eps, out, "A_5_into", "eps")
     force = _arg(force, out, "A_5_into", "force")
@@ -448,8 +470,11 @@ def A_5_into(out, omega, eps, force, branch):
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(A_5(omega, eps, force, branch))
-        return out
-    return _A_5_into(out, omega, eps, force, branch)
+    else:
+        _A_5_into(out, omega, eps, force, branch)
+    if masked is not None:
+        out[masked] = math.nan
+    return out
 
 
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -508,9 +533,10 @@ def _A_7_into(out, omega_in, eps_in, force_in, branch_in):
 
 def A_7_into(out, omega, eps, force, branch):
     """``A_7`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "A_7_into")
+    masked = _masked(out, omega, eps, force, branch)
     omega = _arg(omega, out, "A_7_into", "omega")
     eps = _arg(eps, out, "A_7_into", "eps")
     force = _arg(force, out, "A_7_into", "force")
@@ -519,8 +545,11 @@ def A_7_into(out, omega, eps, force, branch):
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(A_7(omega, eps, force, branch))
-        return out
-    return _A_7_into(out, omega, eps, force, branch)
+    else:
+        _A_7_into(out, omega, eps, force, branch)
+    if masked is not None:
+        out[masked] = math.nan
+    return out
 
 
 @vectorize(["float64(float64, float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -577,9 +606,10 @@ def _first_order_into(out, omega_in, eps_in, force_in, branch_in):
 
 def first_order_into(out, omega, eps, force, branch):
     """``first_order`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "first_order_into")
+    masked = _masked(out, omega, eps, force, branch)
     omega = _arg(omega, out, "first_order_into", "omega")
     eps = _arg(eps, out, "first_order_into", "eps")
     force = _arg(force, out, "first_order_into", "force")
@@ -588,5 +618,8 @@ def first_order_into(out, omega, eps, force, branch):
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(first_order(omega, eps, force, branch))
-        return out
-    return _first_order_into(out, omega, eps, force, branch)
+    else:
+        _first_order_into(out, omega, eps, force, branch)
+    if masked is not None:
+        out[masked] = math.nan
+    return out

@@ -2,15 +2,15 @@
 # model: duffing, order: 12
 # command: lindstedt generate duffing --order 12
 # inputs sha256: 66ca4a0e4d6afa8046c93839a6f1efa563f457106a4ae4f18222a37b87ca56f2
-# body sha256: ea8fd5aaf90cb311cd3c9ab39a676d6e47db5a547afe9f9a480c7b9b93b3d67d
+# body sha256: 7f739f60f69ac47ac0d23474ae3e9e4e71b484c7cee58d5d8601c601bc2bac13
 """q'' + q + eps*q**3 = 0: L–P evaluators to order 12 in y = eps*A**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
 or arrays.  Outside its domain it returns NaN (see each docstring).  Its twin
 ``<name>_into(out, ...)`` writes into ``out``, a writable 1-D C-contiguous float64 array, each
 argument a real number or a 1-D array of ``out``'s length (converted to float64; one that
-overlaps ``out`` is copied first): a contiguous compiled loop that LLVM vectorises (the
-ufunc's strided loop cannot be).  Anything else raises TypeError or ValueError before a single
+overlaps ``out`` is copied first; where a masked array is masked, ``out`` is NaN): a
+contiguous compiled loop that LLVM vectorises (the ufunc's strided loop cannot be).  Anything else raises TypeError or ValueError before a single
 element is read or written."""
 
 import math
@@ -193,6 +193,19 @@ def _arg(v, out, where, name):
                      f"{out.size}, got shape {v.shape}")
 
 
+def _masked(out, *args):
+    """Where any argument that is a masked array is masked (a bool array of ``out``'s shape),
+    or None: a masked element has no value, so ``out`` is NaN there, as NumPy's ``filled``
+    of the ufunc's masked result would be with NaN.  O(1) unless an argument is masked."""
+    mask = None
+    for v in args:
+        if isinstance(v, np.ma.MaskedArray) and v.mask is not np.ma.nomask:
+            m = np.ma.getmaskarray(v)
+            if m.shape in ((), out.shape):  # any other shape: _arg refuses it
+                mask = m if mask is None else mask | m
+    return mask
+
+
 TRIG_LIMIT = 1048576.0
 # NOTE: |x| < 2**20: the multiple n of π/2 has at most 20 bits, so n times each 33-bit part
 # of π/2 is exact and the three-part reduction keeps full precision.
@@ -284,17 +297,21 @@ def _omega_into(out, A_in, eps_in):
 
 def omega_into(out, A, eps):
     """``omega`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "omega_into")
+    masked = _masked(out, A, eps)
     A = _arg(A, out, "omega_into", "A")
     eps = _arg(eps, out, "omega_into", "eps")
     if type(A) is float and type(eps) is float:
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(omega(A, eps))
-        return out
-    return _omega_into(out, A, eps)
+    else:
+        _omega_into(out, A, eps)
+    if masked is not None:
+        out[masked] = math.nan
+    return out
 
 
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -340,17 +357,21 @@ def _period_into(out, A_in, eps_in):
 
 def period_into(out, A, eps):
     """``period`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "period_into")
+    masked = _masked(out, A, eps)
     A = _arg(A, out, "period_into", "A")
     eps = _arg(eps, out, "period_into", "eps")
     if type(A) is float and type(eps) is float:
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(period(A, eps))
-        return out
-    return _period_into(out, A, eps)
+    else:
+        _period_into(out, A, eps)
+    if masked is not None:
+        out[masked] = math.nan
+    return out
 
 
 @vectorize(["float64(float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -437,9 +458,10 @@ def _q_into(out, t_in, A_in, eps_in):
 
 def q_into(out, t, A, eps):
     """``q`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "q_into")
+    masked = _masked(out, t, A, eps)
     t = _arg(t, out, "q_into", "t")
     A = _arg(A, out, "q_into", "A")
     eps = _arg(eps, out, "q_into", "eps")
@@ -447,8 +469,11 @@ def q_into(out, t, A, eps):
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(q(t, A, eps))
-        return out
-    return _q_into(out, t, A, eps)
+    else:
+        _q_into(out, t, A, eps)
+    if masked is not None:
+        out[masked] = math.nan
+    return out
 
 
 @vectorize(["float64(float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -561,9 +586,10 @@ def _qdot_into(out, t_in, A_in, eps_in):
 
 def qdot_into(out, t, A, eps):
     """``qdot`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "qdot_into")
+    masked = _masked(out, t, A, eps)
     t = _arg(t, out, "qdot_into", "t")
     A = _arg(A, out, "qdot_into", "A")
     eps = _arg(eps, out, "qdot_into", "eps")
@@ -571,8 +597,11 @@ def qdot_into(out, t, A, eps):
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(qdot(t, A, eps))
-        return out
-    return _qdot_into(out, t, A, eps)
+    else:
+        _qdot_into(out, t, A, eps)
+    if masked is not None:
+        out[masked] = math.nan
+    return out
 
 
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -620,14 +649,18 @@ def _error_estimate_into(out, A_in, eps_in):
 
 def error_estimate_into(out, A, eps):
     """``error_estimate`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "error_estimate_into")
+    masked = _masked(out, A, eps)
     A = _arg(A, out, "error_estimate_into", "A")
     eps = _arg(eps, out, "error_estimate_into", "eps")
     if type(A) is float and type(eps) is float:
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(error_estimate(A, eps))
-        return out
-    return _error_estimate_into(out, A, eps)
+    else:
+        _error_estimate_into(out, A, eps)
+    if masked is not None:
+        out[masked] = math.nan
+    return out

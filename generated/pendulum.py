@@ -2,15 +2,15 @@
 # model: pendulum, order: 12
 # command: lindstedt generate pendulum --order 12
 # inputs sha256: 89790c3fd0e75fcdff47f37c71d07dae7a9aef7a774488dd064ce33f5d86074d
-# body sha256: 9eb0e58c0caf941da23aca01a4a7fdc34e25b888946219d04a0bd8c2be20b3ac
+# body sha256: e7286097522082c39004ccff2d2a6e6a86eb59cf1322f26d0489d933cdd4e8f9
 """theta'' + sin(theta) = 0: L–P evaluators to order 12 in y = theta0**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
 or arrays.  Outside its domain it returns NaN (see each docstring).  Its twin
 ``<name>_into(out, ...)`` writes into ``out``, a writable 1-D C-contiguous float64 array, each
 argument a real number or a 1-D array of ``out``'s length (converted to float64; one that
-overlaps ``out`` is copied first): a contiguous compiled loop that LLVM vectorises (the
-ufunc's strided loop cannot be).  Anything else raises TypeError or ValueError before a single
+overlaps ``out`` is copied first; where a masked array is masked, ``out`` is NaN): a
+contiguous compiled loop that LLVM vectorises (the ufunc's strided loop cannot be).  Anything else raises TypeError or ValueError before a single
 element is read or written."""
 
 import math
@@ -193,6 +193,19 @@ def _arg(v, out, where, name):
                      f"{out.size}, got shape {v.shape}")
 
 
+def _masked(out, *args):
+    """Where any argument that is a masked array is masked (a bool array of ``out``'s shape),
+    or None: a masked element has no value, so ``out`` is NaN there, as NumPy's ``filled``
+    of the ufunc's masked result would be with NaN.  O(1) unless an argument is masked."""
+    mask = None
+    for v in args:
+        if isinstance(v, np.ma.MaskedArray) and v.mask is not np.ma.nomask:
+            m = np.ma.getmaskarray(v)
+            if m.shape in ((), out.shape):  # any other shape: _arg refuses it
+                mask = m if mask is None else mask | m
+    return mask
+
+
 TRIG_LIMIT = 1048576.0
 # NOTE: |x| < 2**20: the multiple n of π/2 has at most 20 bits, so n times each 33-bit part
 # of π/2 is exact and the three-part reduction keeps full precision.
@@ -274,16 +287,20 @@ def _omega_into(out, theta0_in):
 
 def omega_into(out, theta0):
     """``omega`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "omega_into")
+    masked = _masked(out, theta0)
     theta0 = _arg(theta0, out, "omega_into", "theta0")
     if type(theta0) is float:
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(omega(theta0))
-        return out
-    return _omega_into(out, theta0)
+    else:
+        _omega_into(out, theta0)
+    if masked is not None:
+        out[masked] = math.nan
+    return out
 
 
 @vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -319,16 +336,20 @@ def _period_into(out, theta0_in):
 
 def period_into(out, theta0):
     """``period`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "period_into")
+    masked = _masked(out, theta0)
     theta0 = _arg(theta0, out, "period_into", "theta0")
     if type(theta0) is float:
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(period(theta0))
-        return out
-    return _period_into(out, theta0)
+    else:
+        _period_into(out, theta0)
+    if masked is not None:
+        out[masked] = math.nan
+    return out
 
 
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -405,17 +426,21 @@ def _theta_into(out, t_in, theta0_in):
 
 def theta_into(out, t, theta0):
     """``theta`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "theta_into")
+    masked = _masked(out, t, theta0)
     t = _arg(t, out, "theta_into", "t")
     theta0 = _arg(theta0, out, "theta_into", "theta0")
     if type(t) is float and type(theta0) is float:
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(theta(t, theta0))
-        return out
-    return _theta_into(out, t, theta0)
+    else:
+        _theta_into(out, t, theta0)
+    if masked is not None:
+        out[masked] = math.nan
+    return out
 
 
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -518,17 +543,21 @@ def _thetadot_into(out, t_in, theta0_in):
 
 def thetadot_into(out, t, theta0):
     """``thetadot`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "thetadot_into")
+    masked = _masked(out, t, theta0)
     t = _arg(t, out, "thetadot_into", "t")
     theta0 = _arg(theta0, out, "thetadot_into", "theta0")
     if type(t) is float and type(theta0) is float:
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(thetadot(t, theta0))
-        return out
-    return _thetadot_into(out, t, theta0)
+    else:
+        _thetadot_into(out, t, theta0)
+    if masked is not None:
+        out[masked] = math.nan
+    return out
 
 
 @vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -566,13 +595,17 @@ def _error_estimate_into(out, theta0_in):
 
 def error_estimate_into(out, theta0):
     """``error_estimate`` into ``out``, a writable 1-D C-contiguous float64 array, returned; each
-    argument a real number or a 1-D array of ``out``'s length.  TypeError or ValueError for
-    anything else, before ``out`` is touched."""
+    argument a real number or a 1-D array of ``out``'s length (NaN where a masked array is
+    masked).  TypeError or ValueError for anything else, before ``out`` is touched."""
     _out(out, "error_estimate_into")
+    masked = _masked(out, theta0)
     theta0 = _arg(theta0, out, "error_estimate_into", "theta0")
     if type(theta0) is float:
         # NOTE: one value for every element, from the ufunc: LLVM can take minutes over a loop
         # whose arguments are all scalars.
         out.fill(error_estimate(theta0))
-        return out
-    return _error_estimate_into(out, theta0)
+    else:
+        _error_estimate_into(out, theta0)
+    if masked is not None:
+        out[masked] = math.nan
+    return out

@@ -564,3 +564,23 @@ def test_free_and_limit_cycle_modules_are_nan_without_a_warning(newer_modules):
                             rel_tol=1e-2, abs_tol=1e-3), (A, eps)
     # beyond the domain still NaN: x = 1e100, and |A| past 1e300 (x in range only for ε = 0)
     assert math.isnan(duffing.omega(1e200, 1e-300)) and math.isnan(duffing.q(1.0, 1e301, 0.0))
+
+
+def test_into_writes_nan_where_an_argument_is_masked():
+    """A masked element has no value: ``_into`` writes what NumPy's ufunc on masked arrays,
+    filled with NaN, gives — NaN where any argument is masked, the ufunc's value elsewhere —
+    whether the mask is an array's or a masked scalar's (``np.ma.masked``: every element)."""
+    from lindstedt.emit.render import load_generated
+
+    duffing = load_generated(GENERATED / "duffing.py")
+    A = np.ma.array([0.5, 1.0, 1.5, 2.0], mask=[False, True, False, False])
+    eps = np.ma.array([0.1, 0.1, 0.2, 1e300], mask=[False, False, False, True])
+    expected = np.ma.filled(np.ma.masked_array(duffing.period(A.data, eps.data),
+                                               mask=A.mask | eps.mask), np.nan)
+    assert np.isnan(expected).tolist() == [False, True, False, True]
+    np.testing.assert_array_equal(duffing.period_into(np.empty(4), A, eps), expected)
+    np.testing.assert_array_equal(duffing.period_into(np.empty(4), A.data, eps.data),
+                                  duffing.period(A.data, eps.data))
+    assert np.isnan(duffing.period_into(np.empty(4), A.data, np.ma.masked)).all()
+    with pytest.raises(ValueError, match="length"):
+        duffing.period_into(np.empty(4), np.ma.array(np.ones(3), mask=[0, 1, 0]), 0.1)
