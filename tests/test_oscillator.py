@@ -517,3 +517,33 @@ def test_emitted_user_module_is_nan_beyond_its_estimated_radius(tmp_path):
     asym = load_generated(tmp_path / "asym_guard.py")
     assert math.isnan(asym.period(3.0, 1.0))  # εA ~ 3: far outside any convergence
     assert math.isfinite(asym.period(0.5, 0.1))
+
+
+
+def test_a_symbolic_eps_module_finds_its_orbit_domain_at_each_eps(emitted):
+    """q'' + q + ε(q² + q³) = 0 with ε symbolic: its orbits depend on ε and A separately (no
+    single edge in ε), so the module finds the domain at the ε it is called with — NaN past
+    the first integral's barrier (the saddles and V's level there by mpmath here), where it
+    once answered a period (`q'' + q + eps*(q**2 - q**4)` gave period(-1.80, 0.1) = 7.666 past
+    A = -1.78398); inside, error_estimate bounds period()'s error against quadrature."""
+    m = emitted["q'' + q + eps*(q**2 + q**3) = 0"]
+    for e in (-0.1, -0.3):
+        with mp.workdps(30):
+            E = mp.mpf(e)
+            V = lambda q, E=E: q**2 / 2 + E * (q**3 / 3 + q**4 / 4)  # noqa: E731
+            low, high = sorted(mp.polyroots([E, E, 1]))  # V'(q)/q = 1 + ε(q + q²) = 0
+            # A > 0 reaches the saddle at `high` first; A < 0 the level V(high) first
+            negative = float(mp.findroot(lambda q, V=V, h=high: V(q) - V(h), low / 2))
+            high = float(high)
+        for A, inside in ((high - 1e-4, True), (high + 1e-4, False),
+                          (negative + 1e-4, True), (negative - 1e-4, False)):
+            assert math.isnan(m.period(A, e)) != inside, (e, A)
+            assert math.isnan(m.error_estimate(A, e)) != inside, (e, A)
+    for A, e in ((-1.8, -0.1), (2.5, -0.1), (1.0, -0.3), (-0.8, -0.3), (1.5, 0.1)):
+        sign = 1 if A > 0 else -1
+        with mp.workdps(DPS):
+            T, _ = potential_period(
+                lambda q, e=e, s=sign: (s * q)**2 / 2 + mp.mpf(e) * ((s * q)**3 / 3
+                                                                     + (s * q)**4 / 4), abs(A))
+        error = abs(m.period(A, e) / float(T) - 1)
+        assert error <= m.error_estimate(A, e), (A, e, error, m.error_estimate(A, e))

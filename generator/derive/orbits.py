@@ -432,3 +432,41 @@ def _refine(sc: _Scaled, s0: float, kind: str) -> mpmath.mpf:
             raise EdgeError(f"the orbits' edge near {s0:.6g}: the condition does not change "
                             "sign there in 40 digits")
         return root
+
+
+# --- the domain at run time: a force whose orbits depend on ε and A separately ----------------
+
+@dataclass(frozen=True)
+class RuntimeBarrier:
+    """Where no single edge in the expansion variable exists (``y = ε``, the orbits depending
+    on ε and A separately), the data an emitted module needs to decide at each ``(A, ε)``
+    whether the orbit through ``q(0) = A``, ``q'(0) = 0`` exists: ``V'(q)/q = Σ_j g_j(ε) q^j``
+    with ``g_j(ε) = Σ_i coefficients[j][i] ε^i`` (the potential's force over q; ``g_0(0) =
+    ω₀²``).  The orbit exists when ``A`` lies between the nearest nonzero zeros of ``V'`` on
+    either side and ``V(A)`` stays below ``V`` at the nearest one on the other side (the first
+    integral's barrier, as :func:`orbit_domain`)."""
+
+    coefficients: tuple[tuple[float, ...], ...]  # [j][i]: of q^j ε^i in V'(q)/q
+    exact: tuple[str, ...]  # each g_j(ε) as text (the provenance)
+
+
+def runtime_barrier(model: Model) -> RuntimeBarrier | None:
+    """The :class:`RuntimeBarrier` of a user's conservative polynomial force in ``q`` whose
+    coefficients are polynomials in the coupling ε (no other symbol, no velocity term), where
+    :func:`orbit_domain` finds no single edge; None for any other model."""
+    if model.order_factor != 1 or not model.source or any(model.velocity_forcing):
+        return None
+    osc = oscillator(model.source, dict(model.given), model.name)
+    if osc.parameters:
+        return None
+    q, eps = osc.coordinate, sp.Symbol(str(model.coupling))
+    force = sp.expand(osc.force.xreplace({s: eps for s in osc.force.free_symbols
+                                          if str(s) == str(model.coupling)}))
+    if osc.velocity in force.free_symbols or force.free_symbols - {q, eps}:
+        return None
+    if not force.is_polynomial(q, eps) or force.subs(q, 0) != 0:
+        return None
+    over_q = sp.Poly(sp.cancel(force / q), q)
+    rows = [sp.Poly(c, eps) for c in over_q.all_coeffs()[::-1]]
+    return RuntimeBarrier(tuple(tuple(float(c) for c in row.all_coeffs()[::-1]) for row in rows),
+                          tuple(str(row.as_expr()) for row in rows))

@@ -170,6 +170,9 @@ def render_module(module: Module) -> str:
         trig=any(ev["trig"] for ev in evaluators),
         kernels=[_kernel_context(k) for k in module.kernels],
         newton=module.newton,
+        barrier=[", ".join(repr(float(c)) for c in (*row, *[0.0] * (width - len(row))))
+                 for width in [max(map(len, module.barrier), default=0)]
+                 for row in module.barrier],
     )
 
 

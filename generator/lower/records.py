@@ -106,6 +106,9 @@ class Module:
     provenance: Provenance
     kernels: tuple[ArrayKernel, ...] = ()
     newton: bool = False  # emit newton(x0, …) driving the kernels "residual" and "jacobian"
+    barrier: tuple[tuple[float, ...], ...] = ()
+    # NOTE: V'(q)/q = Σ_j g_j(ε) q^j, barrier[j][i] the ε^i coefficient of g_j: where non-empty
+    # the module finds the orbit domain at each (A, ε) (derive.orbits.RuntimeBarrier)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "doc", docstring_text(self.doc))

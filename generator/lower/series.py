@@ -13,7 +13,7 @@ import sympy as sp
 from ..algebra.resum import Pade, Resummed
 from ..derive.cycles import LimitCycle
 from ..derive.lindstedt import SeriesSolution, estimated_radius, nearest_singularity
-from ..derive.orbits import OrbitDomain, orbit_domain
+from ..derive.orbits import OrbitDomain, orbit_domain, runtime_barrier
 from ..numerics.references import mathieu_recurrence
 from .forms import (
     FREE_ARGUMENT_LIMIT,
@@ -39,15 +39,34 @@ from .records import (
 )
 
 
+class OrbitInside(sp.Function):
+    """``_orbit_inside(A, ε)`` of a module with a :class:`RuntimeBarrier`: 1 where the orbit
+    through ``q(0) = A`` exists at that ε, else 0 (the template's compiled root-finder)."""
+
+    def _numbacode(self, printer) -> str:
+        return f"_orbit_inside({', '.join(printer._print(a) for a in self.args)})"
+
+
+class OrbitReach(sp.Function):
+    """``_orbit_reach(A, ε)``: the distance from ε = 0 to the nearest ε (either sign) where
+    the orbit through ``A`` stops existing — a singularity of T(ε) at that A."""
+
+    def _numbacode(self, printer) -> str:
+        return f"_orbit_reach({', '.join(printer._print(a) for a in self.args)})"
+
+
 def _truncation_bound(solution: SeriesSolution, order: int, x: sp.Symbol,
-                      reach: sp.Expr | None, domain: OrbitDomain) -> sp.Expr:
+                      reach: sp.Expr | None, domain: OrbitDomain,
+                      edge: sp.Expr | None = None) -> sp.Expr:
     """A bound on ``|Σ_(j>K) τ_j y^j|`` (in units of 2π/ω₀), :func:`tail_bound` of ``τ_{K+1}``,
     ``τ_{K+2}`` with ``R`` the smaller of ``reach`` (radius less spread) and the distance to
-    the orbits' edge — a singularity of T, where the period diverges."""
+    the orbits' edge — a singularity of T, where the period diverges (``edge``: that distance
+    computed at run time, where the edge depends on the arguments)."""
     g, w0 = solution.ground, solution.model.frequency
     t1 = sp.Abs(exact(g, solution.period[order + 1]) / w0)
     t2 = sp.Abs(exact(g, solution.period[order + 2]) / w0)
     edges = [sp.Float(v, 17) for v in (-domain.lower, domain.upper) if math.isfinite(v)]
+    edges += [edge] if edge is not None else []
     return tail_bound(t1, t2, order, x, ([reach] if reach is not None else []) + edges)
 
 
@@ -79,6 +98,10 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     t = sp.Symbol("t")
     guard = m.orbit_condition.xreplace({sp.Symbol("Y"): x})
     domain = orbit_domain(m)
+    barrier = None if domain.known else runtime_barrier(m)
+    if barrier is not None:  # the edge at each (A, ε): the first integral's, at run time
+        at = (amplitude, y)
+        guard = sp.And(guard, sp.StrictGreaterThan(OrbitInside(*at), 0))
     lo, hi = domain.guard_bounds()
     if math.isfinite(lo):
         guard = sp.And(guard, x > sp.Float(lo, 17))
@@ -109,11 +132,15 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     both_lines, _, ss = harmonics(top, m.odd, s, sines=True)
     name_of = identifier(str(m.coordinate))
     where = ("NaN where no periodic orbit exists" if domain.known else
+             "NaN where no periodic orbit exists (the orbit domain at each eps: the first "
+             "integral's barrier, the zeros of V'(q) found at run time)" if barrier is not None
+             else
              f"NaN where no periodic orbit exists as far as known: no orbit domain ({domain.how})")
     where += ("" if allow_divergent or radius is None else
               " or beyond the radius of convergence"
               + ("" if m.radius is not None else " less its spread, estimated from its τ_j"))
-    estimate = _truncation_bound(solution, order, x, reach, domain) / sp.Abs(total)
+    estimate = _truncation_bound(solution, order, x, reach, domain,
+                                 None if barrier is None else OrbitReach(*at)) / sp.Abs(total)
     evaluators = (
         Evaluator("omega", f"Frequency ω to order {order} ({where}).", params, prelude, guard,
                   (), horner(omega, x)),
@@ -163,12 +190,14 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
         *numeric,
         ("OMEGA_EXACT", tuple(str(c) for c in omega)),
         ("PERIOD_EXACT", tuple(str(c) for c in tau)),
+        *(() if barrier is None else (("ORBIT_BARRIER_EXACT", barrier.exact),)),
     )
     return Module(
         name=m.name,
         doc=f"{m.title}: L–P evaluators to order {order} in {m.variable}.",
         constants=constants,
         evaluators=evaluators,
+        barrier=() if barrier is None else barrier.coefficients,
         provenance=provenance(
             m.name, order, command, allow_divergent=allow_divergent,
             forcing=[[(n, str(c)) for n, c in terms] for terms in m.forcing[: order + 2]],
