@@ -7,11 +7,12 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: demo test test-fast tex lint lock bench figures generated clean
 
-# constraints.txt pins every package of the test and demo environment (make lock refreshes it).
+# constraints.txt pins every package of the test and demo environment (make lock refreshes it);
+# --no-compile: Python compiles what is imported as it imports it, not all of SciPy up front.
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet -c constraints.txt --upgrade pip
-	$(BIN)/pip install --quiet -c constraints.txt -e '.[test]'
+	$(BIN)/pip install --quiet --no-compile -c constraints.txt -e '.[test]'
 	touch $(STAMP)
 
 # Re-pins constraints.txt from pyproject.toml's ranges in a scratch venv: run it on purpose,

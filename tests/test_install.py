@@ -43,7 +43,9 @@ def venv(tmp_path_factory) -> Path:
     base = Path(getattr(sys, "_base_executable", sys.executable))
     _run([base, "-m", "venv", work / "venv"], work)
     # NOTE: the pinned versions of make test (constraints.txt), so the wheel meets what CI had.
-    _run([work / "venv/bin/python", "-m", "pip", "install", "--quiet", "-c",
+    # NOTE: --no-compile: byte-compiling every dependency up front (SymPy, SciPy, matplotlib)
+    # is half the install's time; Python compiles what the tests import as it imports it.
+    _run([work / "venv/bin/python", "-m", "pip", "install", "--quiet", "--no-compile", "-c",
           ROOT / "constraints.txt", wheel], work)
     return work / "venv"
 
