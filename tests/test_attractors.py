@@ -96,3 +96,83 @@ def test_torus_lines_are_dop853s():
         assert min(abs(f - g) for g in reference) < w / 256
     assert nu == pytest.approx(abs(lines[0][1][0] - w), abs=w / 256)
     assert ranges[0][1] == pytest.approx(np.max(sol.y[0]), rel=0.02)
+
+
+def _two_dof_shot(w: float, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The 2-DOF system's period-1 orbit at ``w`` (f = 2/5) by Newton on DOP853's flow map,
+    the monodromy from the variational equation integrated alongside, judged by its residual;
+    the orbit's state and its multipliers."""
+    T = 2 * np.pi / w
+
+    def rhs(t, z):
+        x1, x2, v1, v2 = z[:4]
+        A = np.array([[0, 0, 1, 0], [0, 0, 0, 1],
+                      [-1.5 - 0.6 * x1 - 3 * x1**2, 0.5, -0.05, 0],
+                      [0.5, -2 - 1.5 * x2**2, 0, -0.05]])
+        return np.concatenate([[v1, v2, 0.4 * np.cos(w * t) - 0.05 * v1 - 1.5 * x1 + 0.5 * x2
+                                - 0.3 * x1**2 - x1**3, -0.05 * v2 - 2 * x2 + 0.5 * x1
+                                - 0.5 * x2**3], (A @ z[4:].reshape(4, 4)).ravel()])
+
+    for _ in range(15):
+        end = solve_ivp(rhs, (0, T), np.concatenate([y, np.eye(4).ravel()]), method="DOP853",
+                        rtol=1e-12, atol=1e-13).y[:, -1]
+        r, M = end[:4] - y, end[4:].reshape(4, 4)
+        if np.max(np.abs(r)) < 1e-11:
+            break
+        y = y - np.linalg.solve(M - np.eye(4), r)
+    assert np.max(np.abs(r)) <= 1e-9  # the reference judged by its residual
+    return y, np.linalg.eigvals(M)
+
+
+def _pair_excess(mu: np.ndarray) -> float:
+    """``|μ| − 1`` of the outer complex pair."""
+    return float(np.max(np.abs(mu[np.abs(mu.imag) > 1e-9 * np.abs(mu)]))) - 1
+
+
+def test_neimark_sacker_point_is_where_dop853s_complex_pair_leaves_the_circle():
+    """A short piece of the 2-DOF system's branch through its Neimark–Sacker point near
+    ω = 1.7754 (f = 2/5, the balance at 6 harmonics, seeded by its first harmonics): the point
+    the locator reports against the shot orbit's multipliers — the pair inside the circle
+    2e-3 below, outside 2e-3 above, and |μ| = 1 where Illinois' secant on the shot |μ| − 1
+    puts it."""
+    from lindstedt.analysis.attractors import bifurcations, orbit_multipliers
+    from lindstedt.analysis.continuation import _continue
+    from lindstedt.analysis.polynomial import PolynomialBalance
+    from lindstedt.analysis.systems import driven_system
+
+    system = driven_system(TWO_DOF, {"f": "2/5"})
+    fine = PolynomialBalance(system.equations(), 0.4, 6, False, shape=(1.0, 0.0))
+    top = float(np.sqrt(max(float(m) for m in system.modes())))
+    seed = np.concatenate([fine.vector({0: -0.043, 1: -0.4728}, {1: 0.6775}),
+                           fine.vector({0: -0.0054, 1: 0.4135}, {1: -1.4818})])
+    w0, w1 = 1.7694, 1.7814
+    x, converged, _ = fine.solve(seed, w0)
+    assert converged
+    # the branch is steep here (|dx/dω| ≈ 27): a step of 0.05 in arclength is ~2e-3 in ω
+    cont = _continue(fine, lambda: ([(w0, x, 1.0)], True), w0, w1, 0.05, 10, 5.0, 1e-3, 100,
+                     "test")
+    lam = orbit_multipliers(fine, cont.x, cont.omega, top)
+    (ns,) = bifurcations(fine, cont, lam, top)
+    assert ns.kind == "neimark_sacker" and ns.stable_side == "lower"
+    assert abs(ns.residual) < 1e-9
+    y = fine.state(cont.x[ns.before], cont.omega[ns.before])
+    a, b = ns.omega - 2e-3, ns.omega + 2e-3
+    ya, mu_a = _two_dof_shot(a, y)
+    _, mu_b = _two_dof_shot(b, ya)
+    fa, fb = _pair_excess(mu_a), _pair_excess(mu_b)
+    assert fa < 0 < fb, (fa, fb)  # the pair inside below the reported ω, outside above
+    side = 0
+    for _ in range(30):  # Illinois on the shot |μ| − 1 (sharp: a Krein collision just below)
+        s = b - fb * (b - a) / (fb - fa)
+        ys, mu = _two_dof_shot(s, ya)
+        g = _pair_excess(mu)
+        if abs(g) < 1e-10:
+            break
+        if (g > 0) == (fa > 0):
+            a, fa, ya = s, g, ys
+            fb, side = (fb / 2 if side == -1 else fb), -1
+        else:
+            b, fb = s, g
+            fa, side = (fa / 2 if side == 1 else fa), 1
+    assert abs(g) < 1e-10
+    assert ns.omega == pytest.approx(s, abs=1e-5)
