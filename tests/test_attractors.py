@@ -176,3 +176,39 @@ def test_neimark_sacker_point_is_where_dop853s_complex_pair_leaves_the_circle():
             fa, side = (fa / 2 if side == 1 else fa), 1
     assert abs(g) < 1e-10
     assert ns.omega == pytest.approx(s, abs=1e-5)
+
+
+def test_the_stretch_after_a_neimark_sacker_point_ends_at_the_fold():
+    """The same branch traced on past its fold at ω ≈ 1.9611 and back down: the unstable
+    stretch the Neimark–Sacker point begins (the one a simulation samples at its middle) runs
+    from the point to the fold, not on down the returning branch."""
+    from lindstedt.analysis.attractors import (
+        NEUTRAL,
+        bifurcations,
+        neimark_sacker_stretches,
+        orbit_multipliers,
+    )
+    from lindstedt.analysis.continuation import _continue
+    from lindstedt.analysis.polynomial import PolynomialBalance
+    from lindstedt.analysis.systems import driven_system
+
+    system = driven_system(TWO_DOF, {"f": "2/5"})
+    fine = PolynomialBalance(system.equations(), 0.4, 6, False, shape=(1.0, 0.0))
+    top = float(np.sqrt(max(float(m) for m in system.modes())))
+    seed = np.concatenate([fine.vector({0: -0.043, 1: -0.4728}, {1: 0.6775}),
+                           fine.vector({0: -0.0054, 1: 0.4135}, {1: -1.4818})])
+    w0 = 1.7694
+    x, converged, _ = fine.solve(seed, w0)
+    assert converged
+    cont = _continue(fine, lambda: ([(w0, x, 1.0)], True), w0, 1.97, 0.2, 30, 5.0, 1e-2, 100,
+                     "test")
+    lam = orbit_multipliers(fine, cont.x, cont.omega, top)
+    found = bifurcations(fine, cont, lam, top)
+    assert [e.kind for e in found] == ["neimark_sacker", "fold"], found
+    ns, fold = found
+    assert fold.omega == pytest.approx(1.96106, abs=1e-4)
+    assert cont.omega[-1] < 1.8  # the returning branch, unstable, back below the middle
+    (stretch,) = neimark_sacker_stretches(found, cont, np.all(np.abs(lam) < NEUTRAL, axis=1))
+    a, b, _, point = stretch
+    assert (a, b) == (ns.omega, fold.omega)
+    assert abs(cont.omega[point] - 0.5 * (a + b)) < 0.02

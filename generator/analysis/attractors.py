@@ -369,13 +369,49 @@ def simulate(fine: PolynomialBalance, field: PolynomialField, drive: np.ndarray,
     return Attractor(omega, interval, why, kind, k, nu, lines, ranges, share, start)
 
 
+def neimark_sacker_stretches(found: tuple[Bifurcation, ...], cont: Continuation,
+                             stable: np.ndarray) -> list[tuple[float, float, str, int]]:
+    """The unstable stretch each Neimark–Sacker point of ``found`` begins: along the curve away
+    from its stable side while the points are unstable, up to the first fold (where the curve
+    turns back in ω, its refined ω from ``found``: past it the ω of the stretch repeat on
+    another orbit, and the middle of the span could fall outside where the torus is born);
+    ``(ω from, ω to, why, the unstable point nearest the middle)``."""
+    folds = {(e.piece, e.before): e.omega for e in found if e.kind == "fold"}
+    out = []
+    for e in found:
+        if e.kind != "neimark_sacker" or e.stable_side in ("none", "both"):
+            continue
+        piece = cont.piece_slices()[e.piece]
+        # the unstable run beside the point: along the curve away from the stable side
+        step = 1 if (e.stable_side == "lower") == (cont.omega[e.before + 1]
+                                                   > cont.omega[e.before]) else -1
+        j = e.before + (1 if step == 1 else 0)
+        run: list[int] = []
+        end, sense = None, cont.omega[j] - e.omega
+        while piece.start <= j < piece.stop and not stable[j]:
+            if run and (cont.omega[j] - cont.omega[run[-1]]) * sense < 0:
+                # a fold at run[-1] (the curve's ω turns there)
+                end = folds.get((e.piece, run[-1]))
+                break
+            run.append(j)
+            j += step
+        if not run:
+            continue
+        w = [*cont.omega[run], e.omega] + ([] if end is None else [end])
+        a, b = float(min(w)), float(max(w))
+        out.append((a, b, f"Neimark–Sacker at w = {e.omega:.6g}", int(
+            run[int(np.argmin(np.abs(cont.omega[run] - 0.5 * (a + b))))])))
+    return out
+
+
 def dynamics(fine: PolynomialBalance, field: PolynomialField, drive: np.ndarray,
              cont: Continuation, lam: np.ndarray, lo: float, hi: float, top: float
              ) -> Dynamics:
     """The :class:`Dynamics` of a traced response: its :func:`bifurcations`; then one
     simulation (:func:`simulate`) at the middle of each ω interval where no period-1 orbit is
-    stable and of each unstable stretch a Neimark–Sacker point begins, from the unstable
-    point there nearest that ω (at most :data:`MAX_RUNS`, by ω)."""
+    stable and of each unstable stretch a Neimark–Sacker point begins (up to its first fold:
+    :func:`neimark_sacker_stretches`), from the unstable point there nearest that ω (at most
+    :data:`MAX_RUNS`, by ω)."""
     found = bifurcations(fine, cont, lam, top)
     stable = np.all(np.abs(lam) < NEUTRAL, axis=1)
     gaps = unstable_intervals(cont, stable, lo, hi)
@@ -388,26 +424,9 @@ def dynamics(fine: PolynomialBalance, field: PolynomialField, drive: np.ndarray,
                        else v for v in gap) for gap in gaps)
     jobs: list[tuple[float, float, str, int | None]] = [(a, b, "no stable period-1 orbit", None)
                                                         for a, b in gaps]
-    for e in found:
-        if e.kind != "neimark_sacker" or e.stable_side in ("none", "both"):
-            continue
-        piece = cont.piece_slices()[e.piece]
-        # the unstable run beside the point: along the curve away from the stable side
-        step = 1 if (e.stable_side == "lower") == (cont.omega[e.before + 1]
-                                                   > cont.omega[e.before]) else -1
-        j = e.before + (1 if step == 1 else 0)
-        run = []
-        while piece.start <= j < piece.stop and not stable[j]:
-            run.append(j)
-            j += step
-        if not run:
-            continue
-        w = cont.omega[run]
-        a, b = float(min(e.omega, *w)), float(max(e.omega, *w))
-        if any(abs(a - p) < 1e-9 and abs(b - q) < 1e-9 for p, q, *_ in jobs):
-            continue
-        jobs.append((a, b, f"Neimark–Sacker at w = {e.omega:.6g}", int(
-            run[int(np.argmin(np.abs(w - 0.5 * (a + b))))])))
+    for job in neimark_sacker_stretches(found, cont, stable):
+        if not any(abs(job[0] - p) < 1e-9 and abs(job[1] - q) < 1e-9 for p, q, *_ in jobs):
+            jobs.append(job)
     jobs.sort()
     attractors = []
     for a, b, why, point in jobs[:MAX_RUNS]:
