@@ -24,6 +24,7 @@ LAYERS = {
     "printers": ("charts", "cli", "costs", "curves", "emit", "files", "fuzz", "interrupt", "latex",
                  "messages", "notebook", "readme", "validity"),
     "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "nnm_emitted", "orbits",
+                "orbit_domain_grid",
                 "oscillator", "resum", "sweep", "tongues"),
 }
 LAYER_OF = {f"test_{name}.py": layer for layer, names in LAYERS.items() for name in names}

@@ -440,33 +440,51 @@ def _refine(sc: _Scaled, s0: float, kind: str) -> mpmath.mpf:
 class RuntimeBarrier:
     """Where no single edge in the expansion variable exists (``y = ε``, the orbits depending
     on ε and A separately), the data an emitted module needs to decide at each ``(A, ε)``
-    whether the orbit through ``q(0) = A``, ``q'(0) = 0`` exists: ``V'(q)/q = Σ_j g_j(ε) q^j``
-    with ``g_j(ε) = Σ_i coefficients[j][i] ε^i`` (the potential's force over q; ``g_0(0) =
-    ω₀²``).  The orbit exists when ``A`` lies between the nearest nonzero zeros of ``V'`` on
-    either side and ``V(A)`` stays below ``V`` at the nearest one on the other side (the first
-    integral's barrier, as :func:`orbit_domain`)."""
+    whether the orbit through ``q(0) = A``, ``q'(0) = 0`` exists, for ``q'' + g₀(q) + h(q) q'²
+    = 0``: ``g₀(q)/q = Σ_j g_j(ε) q^j`` with ``g_j(ε) = Σ_i coefficients[j][i] ε^i`` (``g_0(0)
+    = ω₀²``) and ``2H(q) = 2∫₀^q h = Σ_j w_j(ε) q^j`` likewise in ``weight`` (empty: no velocity
+    term, a potential force).  The orbit exists when ``A`` lies between the nearest nonzero
+    zeros of ``g₀`` on either side and ``W(A)`` stays below ``W`` at the nearest one on the
+    other side, or below its limit there where there is none (``W = ∫ 2 g₀ e^{2H}``: the first
+    integral's barrier, as :func:`orbit_domain` and the module's docstring)."""
 
-    coefficients: tuple[tuple[float, ...], ...]  # [j][i]: of q^j ε^i in V'(q)/q
+    coefficients: tuple[tuple[float, ...], ...]  # [j][i]: of q^j ε^i in g₀(q)/q
     exact: tuple[str, ...]  # each g_j(ε) as text (the provenance)
+    weight: tuple[tuple[float, ...], ...] = ()  # [j][i]: of q^j ε^i in 2H(q)
+    weight_exact: tuple[str, ...] = ()
+
+
+def _by_powers(expr: sp.Expr, q: sp.Symbol, eps: sp.Symbol) -> tuple[tuple, tuple]:
+    """``expr``, a polynomial in ``q`` and ``eps``, as rows ``[j][i]`` of ``q^j ε^i`` (floats)
+    and each ``q^j`` coefficient as text."""
+    rows = [sp.Poly(c, eps) for c in sp.Poly(expr, q).all_coeffs()[::-1]]
+    return (tuple(tuple(float(c) for c in row.all_coeffs()[::-1]) for row in rows),
+            tuple(str(row.as_expr()) for row in rows))
 
 
 def runtime_barrier(model: Model) -> RuntimeBarrier | None:
-    """The :class:`RuntimeBarrier` of a user's conservative polynomial force in ``q`` whose
-    coefficients are polynomials in the coupling ε (no other symbol, no velocity term), where
-    :func:`orbit_domain` finds no single edge; None for any other model."""
-    if model.order_factor != 1 or not model.source or any(model.velocity_forcing):
+    """The :class:`RuntimeBarrier` of a user's force ``g₀(q) + h(q) q'²``, both polynomials in
+    ``q`` with coefficients polynomial in the coupling ε (no other symbol, no other velocity
+    term), where :func:`orbit_domain` finds no single edge; None for any other model."""
+    if model.order_factor != 1 or not model.source:
         return None
     osc = oscillator(model.source, dict(model.given), model.name)
     if osc.parameters:
         return None
-    q, eps = osc.coordinate, sp.Symbol(str(model.coupling))
+    q, v, eps = osc.coordinate, osc.velocity, sp.Symbol(str(model.coupling))
     force = sp.expand(osc.force.xreplace({s: eps for s in osc.force.free_symbols
                                           if str(s) == str(model.coupling)}))
-    if osc.velocity in force.free_symbols or force.free_symbols - {q, eps}:
+    if force.free_symbols - {q, v, eps} or not force.is_polynomial(q, v, eps):
         return None
-    if not force.is_polynomial(q, eps) or force.subs(q, 0) != 0:
+    by_degree = sp.Poly(force, v).as_dict()
+    if any(d[0] not in (0, 2) for d in by_degree):
         return None
-    over_q = sp.Poly(sp.cancel(force / q), q)
-    rows = [sp.Poly(c, eps) for c in over_q.all_coeffs()[::-1]]
-    return RuntimeBarrier(tuple(tuple(float(c) for c in row.all_coeffs()[::-1]) for row in rows),
-                          tuple(str(row.as_expr()) for row in rows))
+    g0 = by_degree.get((0,), sp.Integer(0))
+    if g0.subs(q, 0) != 0:
+        return None
+    coefficients, exact = _by_powers(sp.cancel(g0 / q), q, eps)
+    h = by_degree.get((2,), sp.Integer(0))
+    if h == 0:
+        return RuntimeBarrier(coefficients, exact)
+    weight, weight_exact = _by_powers(sp.expand(2 * sp.integrate(h, (q, 0, q))), q, eps)
+    return RuntimeBarrier(coefficients, exact, weight, weight_exact)

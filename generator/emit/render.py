@@ -159,6 +159,13 @@ def _kernel_context(k: ArrayKernel) -> dict:
     }
 
 
+def _rows(table: tuple[tuple[float, ...], ...]) -> list[str]:
+    """The rows of a coefficient table as text, padded with zeros to a common width."""
+    width = max(map(len, table), default=0)
+    return [", ".join(repr(float(c)) for c in (*row, *[0.0] * (width - len(row))))
+            for row in table]
+
+
 def render_module(module: Module) -> str:
     """The numba module of ``module`` (template ``module.py.j2``)."""
     return environment(latex=False).get_template("module.py.j2").render(
@@ -170,9 +177,8 @@ def render_module(module: Module) -> str:
         trig=any(ev["trig"] for ev in evaluators),
         kernels=[_kernel_context(k) for k in module.kernels],
         newton=module.newton,
-        barrier=[", ".join(repr(float(c)) for c in (*row, *[0.0] * (width - len(row))))
-                 for width in [max(map(len, module.barrier), default=0)]
-                 for row in module.barrier],
+        barrier=_rows(module.barrier),
+        barrier_weight=_rows(module.barrier_weight),
     )
 
 

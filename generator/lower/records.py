@@ -109,6 +109,9 @@ class Module:
     barrier: tuple[tuple[float, ...], ...] = ()
     # NOTE: V'(q)/q = Σ_j g_j(ε) q^j, barrier[j][i] the ε^i coefficient of g_j: where non-empty
     # the module finds the orbit domain at each (A, ε) (derive.orbits.RuntimeBarrier)
+    barrier_weight: tuple[tuple[float, ...], ...] = ()
+    # NOTE: 2H(q) = 2∫₀^q h, h the factor of q'² in the force, by powers of q and ε as barrier:
+    # where non-empty the barrier compares W = ∫ 2 g₀ e^{2H} by quadrature, not V
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "doc", docstring_text(self.doc))

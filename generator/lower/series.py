@@ -133,7 +133,7 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     name_of = identifier(str(m.coordinate))
     where = ("NaN where no periodic orbit exists" if domain.known else
              "NaN where no periodic orbit exists (the orbit domain at each eps: the first "
-             "integral's barrier, the zeros of V'(q) found at run time)" if barrier is not None
+             "integral's barrier, the zeros of its force found at run time)" if barrier is not None
              else
              f"NaN where no periodic orbit exists as far as known: no orbit domain ({domain.how})")
     where += ("" if allow_divergent or radius is None else
@@ -191,6 +191,8 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
         ("OMEGA_EXACT", tuple(str(c) for c in omega)),
         ("PERIOD_EXACT", tuple(str(c) for c in tau)),
         *(() if barrier is None else (("ORBIT_BARRIER_EXACT", barrier.exact),)),
+        *(() if barrier is None or not barrier.weight else
+          (("ORBIT_WEIGHT_EXACT", barrier.weight_exact),)),
     )
     return Module(
         name=m.name,
@@ -198,6 +200,7 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
         constants=constants,
         evaluators=evaluators,
         barrier=() if barrier is None else barrier.coefficients,
+        barrier_weight=() if barrier is None else barrier.weight,
         provenance=provenance(
             m.name, order, command, allow_divergent=allow_divergent,
             forcing=[[(n, str(c)) for n, c in terms] for terms in m.forcing[: order + 2]],
