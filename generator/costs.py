@@ -318,15 +318,24 @@ def _values(args: argparse.Namespace) -> dict[str, str]:
 def response_equation_cost(args: argparse.Namespace) -> Cost:
     """``response EQUATION``: the equation lowered (refused in one line before anything runs),
     its range and continuation estimated as the command will run them."""
+    from .analysis.attractors import dynamics_seconds
     from .analysis.polynomial import PolynomialBalance
-    from .analysis.response import equation_continuation_seconds, equation_range, response_equation
+    from .analysis.response import (
+        equation_continuation_seconds,
+        equation_point_seconds,
+        equation_range,
+        response_equation,
+    )
 
     de = response_equation(args.model, _values(args), args.name or "oscillator")
     er = equation_range(de.terms, de.force, args.omega_min, args.omega_max)
     lo, hi = er.omega_range
-    _, seconds = equation_continuation_seconds(de.terms, de.force, args.harmonics, de.odd, lo,
-                                               hi)
+    points, seconds = equation_continuation_seconds(de.terms, de.force, args.harmonics, de.odd,
+                                                    lo, hi)
     fine = PolynomialBalance(de.terms, de.force, args.harmonics, de.odd)
+    # every point's multipliers, the crossings refined and the simulations of analysis.attractors
+    seconds += dynamics_seconds(points, fine.size, 1, lo, hi, er.linear_frequency,
+                                equation_point_seconds(fine.size))
     ends = 0.0
     for w in (lo, hi):
         for r in er.one_harmonic.amplitudes(w):
@@ -336,7 +345,8 @@ def response_equation_cost(args: argparse.Namespace) -> Cost:
                 ends += RESPONSE_EQUATION_ENDS / 2
                 break
     return Cost(RESPONSE_EQUATION_FIXED + ends + seconds, f"--harmonics {args.harmonics}",
-                "continuation, fold refinement and simulated sweeps of the equation")
+                "continuation, fold refinement, Floquet multipliers, bifurcations and simulations "
+                "of the equation")
 
 
 def response_cost(args: argparse.Namespace) -> Cost:
@@ -359,10 +369,17 @@ def response_cost(args: argparse.Namespace) -> Cost:
         return response_equation_cost(args)
     if any(getattr(args, k, None) is None for k in ("eps", "force", "Q")):
         return Cost(RESPONSE_FIXED, "response", "response")  # the command says what is missing
+    from .analysis.attractors import dynamics_seconds
+    from .analysis.response import equation_point_seconds
+
     lo, hi = response_range(args.eps, args.force, args.Q)
-    return Cost(RESPONSE_FIXED + continuation_seconds(args.eps, args.force, args.Q,
-                                                      args.harmonics, lo, hi),
-                f"--harmonics {args.harmonics}", "continuation and simulated sweeps")
+    seconds = continuation_seconds(args.eps, args.force, args.Q, args.harmonics, lo, hi)
+    # eq. 10.60's balance: odd harmonics, 2N unknowns; ω0 = 1
+    point = equation_point_seconds(2 * args.harmonics)
+    return Cost(RESPONSE_FIXED + seconds + dynamics_seconds(seconds / point, 2 * args.harmonics,
+                                                            1, lo, hi, 1.0, point),
+                f"--harmonics {args.harmonics}",
+                "continuation, simulated sweeps, Floquet multipliers and simulations")
 
 
 def sweep_cost(args: argparse.Namespace) -> Cost:

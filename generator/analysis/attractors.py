@@ -63,6 +63,47 @@ QUASI_POWER = 0.995
 # chaotic attractor spreads its power over the band.
 
 
+FLOQUET_SAMPLE_SECONDS = (1.5e-6, 2.5e-8, 2048, 0.6)
+# NOTE: CPU seconds of one point's multipliers per sample of its period, fixed + per unknown
+# (the linearization on the samples, then the 2n-dimensional variational RK4), times
+# (samples/2048)^0.6 above 2048 (the bases of the samples no longer in cache): measured by
+# time.process_time beside a test run on 2 cores, 1.5 µs at 31 unknowns (n = 1, N = 8),
+# 1.7–1.9 µs at 46–62 (n = 2, N = 6, 8), 4.1 µs at 127 (n = 1, N = 32), all at 512–2048
+# samples; 3–4.5 µs at 4096, 8.3 µs at 16384 (n = 1, N = 8).
+SIMULATION_SECONDS = 0.15
+# NOTE: CPU seconds of one simulation (:func:`simulate`) per coordinate: measured 0.06–0.09 s
+# for n = 1 and 2 (degrees 2–7, velocity terms), the compiled RK4 of 556 × 256 steps.
+CROSSINGS_ESTIMATED = 4
+# NOTE: the crossings an estimate allows for, each refined by up to REFINE_STEPS correctors
+# and monodromies (their number is known only once the multipliers are).
+
+
+def floquet_samples(omega: np.ndarray | float, top_frequency: float) -> np.ndarray:
+    """The samples a period :func:`orbit_multipliers` takes at ``omega``:
+    :data:`FLOQUET_SAMPLES` times the power of two above ``top_frequency/ω``."""
+    ratio = np.maximum(1.0, top_frequency / np.asarray(omega, dtype=float))
+    return FLOQUET_SAMPLES * 2 ** np.ceil(np.log2(ratio))
+
+
+def dynamics_seconds(points: float, unknowns: int, coordinates: int, lo: float, hi: float,
+                     top_frequency: float, point_seconds: float) -> float:
+    """CPU seconds the stability and :func:`dynamics` of a traced curve of ``points`` points
+    add, estimated before it is traced: every point's multipliers at the mean samples over
+    ``[lo, hi]`` (:data:`FLOQUET_SAMPLE_SECONDS`), :data:`CROSSINGS_ESTIMATED` refinements
+    of :data:`REFINE_STEPS` steps (a corrector of ``point_seconds`` and a monodromy each) and
+    :data:`MAX_RUNS` simulations (:data:`SIMULATION_SECONDS` a coordinate).
+
+    >>> round(dynamics_seconds(0, 31, 1, 1.0, 2.0, 1.0, 0.0), 2)  # 0.9 s of the simulations
+    1.04
+    """
+    fixed, per_unknown, cached, growth = FLOQUET_SAMPLE_SECONDS
+    samples = floquet_samples(np.linspace(lo, hi, 65), top_frequency)
+    per_point = float(np.mean(samples * np.maximum(1.0, samples / cached) ** growth)) * (
+        fixed + per_unknown * unknowns)
+    return (points * per_point + CROSSINGS_ESTIMATED * REFINE_STEPS * (per_point + point_seconds)
+            + MAX_RUNS * SIMULATION_SECONDS * coordinates)
+
+
 @dataclass(frozen=True)
 class Bifurcation:
     """A point of a traced branch where a Floquet multiplier crosses the unit circle: a fold
@@ -125,10 +166,12 @@ def orbit_multipliers(fine: PolynomialBalance, X: np.ndarray, omega: np.ndarray,
     omega = np.atleast_1d(np.asarray(omega, dtype=float))
     X = np.atleast_2d(X)
     out = np.empty((len(omega), 2 * fine.coordinates), dtype=complex)
-    samples = FLOQUET_SAMPLES * 2 ** np.ceil(np.log2(np.maximum(1.0, top_frequency / omega)))
+    samples = floquet_samples(omega, top_frequency)
     for s in np.unique(samples):
         where_s = np.nonzero(samples == s)[0]
-        for chunk in np.array_split(where_s, max(1, len(where_s) * int(s) // 2**15)):
+        # (chunks of ~2**15 samples in all; never an empty one: one point of 65536 samples)
+        for chunk in np.array_split(where_s, min(len(where_s),
+                                                 max(1, len(where_s) * int(s) // 2**15))):
             lin = [fine.linearization(X[i], omega[i], int(s)) for i in chunk]
             out[chunk] = variational_multipliers(np.array([a for a, _ in lin]),
                                                  np.array([b for _, b in lin]), omega[chunk])

@@ -17,7 +17,7 @@ from ..derive.system import System
 from ..errors import InputError
 from ..numerics.integrate import PolynomialField
 from ..numerics.shooting import PeriodicOrbit, settle_system, shoot_system
-from .attractors import Dynamics, dynamics, orbit_multipliers
+from .attractors import Dynamics, dynamics, dynamics_seconds, orbit_multipliers
 from .continuation import (
     CONTINUATION_HARMONICS,
     CONTINUATION_SECONDS,
@@ -351,8 +351,11 @@ def system_plan(text: str, values: dict[str, str], harmonics: int,
     drives = 2 + SYSTEM_PROBES + sum(lo < w < hi for w in w0)
     searches = drives * (DRIVE_POINTS_TYPICAL if bound is not None else NO_BOUND_POINTS) \
         * equation_point_seconds(system.size * (2 * coarse if odd else 4 * coarse - 1))
+    # every point's multipliers, the crossings refined, the simulations (analysis.attractors)
+    stability = dynamics_seconds(points, unknowns, system.size, lo, hi, w0[-1],
+                                 equation_point_seconds(unknowns))
     return SystemPlan(system, (lo, hi), w0, points, SYSTEM_FIXED_SECONDS + searches
-                      + points * equation_point_seconds(unknowns), drives,
+                      + points * equation_point_seconds(unknowns) + stability, drives,
                       MAX_DRIVE_POINTS if bound is not None else NO_BOUND_POINTS)
 
 
