@@ -31,7 +31,7 @@ from .choose import (
     pareto_front,
     tradeoffs,
 )
-from .emit.render import check_folder, check_target, write_files
+from .emit.render import check_output_file, write_files
 from .errors import InputError
 from .methods.references import reference_period
 from .methods.registry import candidates
@@ -61,12 +61,7 @@ def check_plot_path(path: Path) -> Path:
     path = Path(path)
     if path.suffix.lower() not in FORMATS:
         raise InputError(f"--plot {path}: use one of {', '.join(FORMATS)}")
-    folder = path.parent if str(path.parent) else Path(".")
-    check_folder(folder, "--plot")
-    if not folder.is_dir():
-        raise InputError(f"--plot {path}: folder {folder} does not exist")
-    check_target(path, "--plot", ours=_figure_state)
-    return path
+    return check_output_file(path, "--plot", _figure_state)
 
 
 def _save(fig: plt.Figure, path: Path) -> Path:

@@ -176,17 +176,12 @@ def _csv_state(path: Path) -> str:
 def check_csv_path(text: str) -> Path:
     """``--csv FILE`` before any work: a usable folder, and a file that is new or a CSV this
     tool wrote; else :class:`InputError` (one line, nothing computed or written)."""
-    from ..emit.render import check_folder, check_target
+    from ..emit.render import check_output_file
 
     path = Path(text)
     if not text.strip() or not path.name:
         raise InputError(f"--csv {text!r}: name a file")
-    folder = path.parent if str(path.parent) else Path(".")
-    check_folder(folder, "--csv")
-    if not folder.is_dir():
-        raise InputError(f"--csv {path}: folder {folder} does not exist")
-    check_target(path, "--csv", ours=_csv_state)
-    return path
+    return check_output_file(path, "--csv", _csv_state)
 
 
 def check_outputs(args: argparse.Namespace) -> tuple[Path | None, Path | None]:

@@ -597,6 +597,17 @@ def check_target(target: Path, flag: str, overwrite_edited: bool = False,
                          "--overwrite-edited to replace it and lose the edit)")
 
 
+def check_output_file(path: Path, flag: str, ours: Callable[[Path], str]) -> Path:
+    """One file named by ``flag`` (``--plot``, ``--csv``), before any work: its folder exists
+    and is usable, and the file is new or one this tool wrote (``ours``); else InputError."""
+    folder = path.parent if str(path.parent) else Path(".")
+    check_folder(folder, flag)
+    if not folder.is_dir():
+        raise InputError(f"{flag} {path}: folder {folder} does not exist")
+    check_target(path, flag, ours=ours)
+    return path
+
+
 def check_folder(out: Path, flag: str = "--out") -> None:
     """An output folder that exists or can be created, and is writable: else InputError."""
     if not str(out).strip():
