@@ -143,3 +143,25 @@ def response_system_figure(r: object, path: Path) -> Path:
     rows = -(-len(unique) // min(4, len(unique)))
     fig.tight_layout(rect=(0, 0.035 * rows + 0.01, 1, 1))
     return _save(fig, path)
+
+
+def exchange_figure(flow: object, exchange: object, path: Path) -> Path:
+    """A system's energy exchange (:class:`numerics.references.Exchange` of a
+    :class:`derive.resonance.ResonantFlow`): each resonant mode's amplitude a_k over the slow
+    time from ``exchange.start``, the exchange period marked between two maxima of a₁."""
+    check_plot_path(path)
+    fig, ax = plt.subplots(figsize=(8, 4.2))
+    for k, a in enumerate(exchange.a):
+        ax.plot(exchange.t, a, color=f"C{k}", lw=1.4,
+                label=f"a{k + 1}: mode {flow.modes[k]} (ω₀ = {_value(float(flow.omega[k]))})")
+    if np.isfinite(exchange.period):
+        ax.plot([], [], " ", label=f"exchange period {_value(exchange.period)}")
+    ax.set_xlabel("time t")
+    ax.set_ylabel("amplitude a_k")
+    ax.set_ylim(bottom=0.0)
+    ax.set_title(f"{flow.system.text}\nthe averaged flow to order 1: "
+                 f"{'; '.join(flow.resonances)}", fontsize=8)
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3,
+              frameon=False)  # below the axes, where it hides no curve
+    fig.tight_layout()
+    return _save(fig, path)

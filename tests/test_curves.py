@@ -152,8 +152,56 @@ def test_check_csv_path_names_the_flag():
         check_csv_path("")
 
 
+def test_system_exchange_csv_keeps_the_manley_rowe_invariant(tmp_path, monkeypatch, capsys):
+    """``x1'' + x1 + x1 x2 = 0; x2'' + 4 x2 + x1²/2 = 0`` (1:2): its flow a1' = a1 a2 sinγ/4,
+    a2' = −a1² sinγ/16 keeps a1² + 4 a2² (by hand: d(a1²)/dt = a1² a2 sinγ/2 = −4 d(a2²)/dt);
+    every CSV row holds it, the CSV's maxima of a1 lie one printed period apart, and the
+    figure draws both amplitudes."""
+    from lindstedt import charts_modes
+
+    drawn = []
+    save = charts_modes._save
+    monkeypatch.setattr(charts_modes, "_save",
+                        lambda fig, path: (drawn.append(fig), save(fig, path))[1])
+    path = tmp_path / "x.csv"
+    system = "x1'' + x1 + x1*x2 = 0; x2'' + 4*x2 + x1**2/2 = 0"
+    assert cli.main(["slowflow", system, "--start", "a1=0.05", "--json", "--csv", str(path),
+                     "--plot", str(tmp_path / "x.png")]) == 0
+    period = json.loads(capsys.readouterr().out)["exchange"]["period"]
+    header, rows = _rows(path)
+    assert header == ["t [time]", "a1 [amplitude of resonant mode 1]",
+                      "a2 [amplitude of resonant mode 2]"]
+    assert rows[0] == [0.0, 0.05, 0.1]
+    invariant = 0.05**2 + 4 * 0.1**2
+    for _, a1, a2 in rows:
+        assert a1**2 + 4 * a2**2 == pytest.approx(invariant, rel=1e-8)
+    peaks = [rows[k][0] for k in range(1, len(rows) - 1)
+             if rows[k - 1][1] < rows[k][1] >= rows[k + 1][1]]
+    assert len(peaks) >= 2
+    spacing = rows[1][0] - rows[0][0]
+    assert abs(peaks[1] - peaks[0] - period) <= 2 * spacing
+    (fig,) = drawn
+    assert [line.get_label()[:3] for line in fig.axes[0].lines][:2] == ["a1:", "a2:"]
+
+
+def test_response_csv_of_a_linear_oscillator_is_its_closed_form(tmp_path, capsys):
+    """``x'' + c x' + x = f cos(ωt)``: r = f / sqrt((1 − ω²)² + (cω)²) at every CSV row."""
+    path = tmp_path / "r.csv"
+    assert cli.main(["response", "x'' + 0.1*x' + x = 0.3*cos(w*t)", "--omega", "0.5:1.5",
+                     "--csv", str(path)]) == 0
+    capsys.readouterr()
+    header, rows = _rows(path)
+    assert header == ["branch [piece of the continued balance from 1]",
+                      "omega [drive frequency]", "r [first harmonic sqrt(A1^2 + B1^2)]"]
+    assert {k for k, _, _ in rows} == {1.0} and len(rows) > 50
+    assert min(w for _, w, _ in rows) <= 0.5 and max(w for _, w, _ in rows) >= 1.5  # the range
+    for _, w, r in rows:
+        assert r == pytest.approx(0.3 / math.hypot(1 - w * w, 0.1 * w), rel=1e-10)
+
+
 def test_slowflow_portrait_flags_are_refused_where_they_mean_nothing(capsys):
     for args in (["slowflow", "q'' + q = eps*(1 - q**2)*q'", "--eps", "0.1"],
-                 ["slowflow", "x1'' + x1 = 0; x2'' + 4*x2 + x1**2 = 0", "--plot", "p.png"]):
+                 ["slowflow", "x1'' + x1 = 0; x2'' + 4*x2 + x1**2 = 0", "--eps", "0.1",
+                  "--plot", "p.png"]):
         assert cli.main(args) == 2
         assert len(capsys.readouterr().err.splitlines()) == 1

@@ -12,6 +12,7 @@ import os
 import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import NoReturn
 
 from .. import __version__
 from ..costs import COSTS
@@ -172,3 +173,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     finally:
         terminated()
+
+
+def run() -> NoReturn:
+    """The process's entry point (the ``lindstedt`` script, ``python -m lindstedt``):
+    :func:`main`'s status as the exit status.  An interrupted command leaves by ``os._exit``
+    once its line is out: nothing of the interpreter's shutdown (exit handlers, threads joined,
+    the flag CPython keeps of a KeyboardInterrupt raised inside ``exec``'d code) can turn 130
+    into a death by SIGINT."""
+    status = main()
+    if status == 130:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(130)
+    sys.exit(status)

@@ -574,15 +574,12 @@ def run_slowflow(args: argparse.Namespace) -> int:
     from ..derive.averaging import slow_flow
     from ..derive.models import oscillator, registry_entry
 
-    portrait_flags = [f for f, given in (("--plot", args.plot), ("--csv", args.csv),
-                                         ("--eps", args.eps is not None),
-                                         ("--sigma", args.sigma is not None)) if given]
     if ";" in args.model:  # a system: its modes in internal resonance
         from .system import run_slowflow_system
 
-        if portrait_flags:
-            raise InputError(f"{', '.join(portrait_flags)}: a system's slow flow is printed, "
-                             "not drawn (not built)")
+        if args.eps is not None or args.sigma is not None:
+            raise InputError("--eps/--sigma: a one-coordinate portrait's values; a system's "
+                             "--plot/--csv draw its energy exchange from --start")
         args.order = 1 if args.order is None else args.order
         return run_slowflow_system(args)
     args.order = 2 if args.order is None else args.order
@@ -929,8 +926,10 @@ def arguments_slowflow(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
     p.add_argument("--plot", metavar="FILE",
                    help="also draw the phase portrait into FILE (.png, .svg or .pdf): "
                    "trajectories in the plane (r cos phi, r sin phi) from 8 starts, the limit "
-                   "cycles and fixed points (default: none)")
-    _flag_csv(p, "the portrait's trajectories (trajectory, t, x = r cos phi, y = r sin phi)")
+                   "cycles and fixed points; a SYSTEM: each resonant amplitude a_k over two "
+                   "energy exchanges from --start (default: none)")
+    _flag_csv(p, "the portrait's trajectories (trajectory, t, x = r cos phi, y = r sin phi); "
+              "a SYSTEM: t, a1, a2, ... as drawn")
     p.add_argument("--eps", type=_real, default=None, metavar="EPS",
                    help=f"with --plot/--csv: the value of eps (default {PORTRAIT_EPS})")
     p.add_argument("--sigma", type=_real, default=None, metavar="SIGMA",

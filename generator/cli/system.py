@@ -166,11 +166,11 @@ START_SEED = 0.01
 # the others seeded at 1 % of it (a swing spring set bouncing, its swing growing from a nudge).
 
 
-def resonant_json(flow, start: list[float]) -> dict:
+def resonant_json(flow, exchange) -> dict:
     """``slowflow SYSTEM --json``: the averaged equations (exact SymPy str), the coupled modes
-    (phase-locked: every amplitude steady) and the energy-exchange period from ``start``."""
+    (phase-locked: every amplitude steady) and the energy exchange (a
+    :class:`numerics.references.Exchange`)."""
     from ..derive.resonance import coupled_modes
-    from ..numerics.references import exchange_period
 
     names = [f"a{k}" for k in range(1, len(flow.a) + 1)]
     equations = {}
@@ -186,11 +186,23 @@ def resonant_json(flow, start: list[float]) -> dict:
         "equations": equations,
         "coupled_modes": [{"gamma": str(g), "ratio": str(r), "ratio_value": float(r)}
                           for g, r in coupled_modes(flow)],
-        "exchange": {"start": dict(zip(names, start, strict=True)),
-                     "period": exchange_period(flow, start),
+        "exchange": {"start": dict(zip(names, exchange.start, strict=True)),
+                     "period": exchange.period,
                      "how": "the averaged flow by DOP853 from zero phases: time between two "
                             "maxima of a1"},
     }
+
+
+EXCHANGE_SAMPLES = 801
+# NOTE: the points of `slowflow SYSTEM --plot/--csv`'s amplitudes over two exchanges.
+
+
+def exchange_csv(exchange, path: Path) -> Path:
+    """The CSV of ``slowflow SYSTEM --csv``: the amplitudes a_k at each slow time, as drawn."""
+    n = exchange.a.shape[0]
+    columns = (("t", "time"), *((f"a{k}", f"amplitude of resonant mode {k}")
+                                for k in range(1, n + 1)))
+    return write_csv(path, columns, zip(exchange.t, *exchange.a, strict=True))
 
 
 def resonant_table(data: dict) -> str:
@@ -214,6 +226,7 @@ def run_slowflow_system(args: argparse.Namespace) -> int:
 
     if args.out is not None:
         raise InputError("--out: a system's slow flow is printed, not emitted (not built)")
+    plot, csv = check_outputs(args)
     flow = resonant_flow(parse_system(args.model, _params(args.param)), args.order)
     start = [START_AMPLITUDE * (1 if k == len(flow.a) - 1 else START_SEED)
              for k in range(len(flow.a))]
@@ -231,7 +244,16 @@ def run_slowflow_system(args: argparse.Namespace) -> int:
             raise InputError(f"--start {pair!r}: an amplitude must be > 0 and finite")
         start[names.index(name.strip())] = number
     check_weak(flow, start, bool(args.start))
-    data = resonant_json(flow, start)
+    from ..numerics.references import energy_exchange
+
+    exchange = energy_exchange(flow, start, samples=EXCHANGE_SAMPLES if plot or csv else 0)
+    if plot is not None:
+        from ..charts_modes import exchange_figure
+
+        exchange_figure(flow, exchange, plot)
+    if csv is not None:
+        exchange_csv(exchange, csv)
+    data = resonant_json(flow, exchange)
     print(json.dumps(data) if args.json else resonant_table(data))
     return 0
 

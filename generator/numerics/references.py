@@ -384,17 +384,31 @@ def mode_orbit(system: object, A: float, guess: np.ndarray, amplitude: int = 0,
     return ModeOrbit(start, 2 * u[-1], float(system_energy(system)(start)), converged)
 
 
-def exchange_period(flow: object, start: Sequence[float],
-                    max_steps: int = EXCHANGE_MAX_STEPS) -> float:
-    """The energy-exchange period of a resonant slow flow (a :class:`derive.resonance.
-    ResonantFlow`) from amplitudes ``start`` and zero phases: the time between two successive
-    maxima of the first mode's amplitude, by DOP853 on the averaged equations; NaN if there are
-    not two within ``max_steps`` steps (or the step size collapses where an amplitude nears 0,
-    its phase's rate ~ 1/a).
+@dataclass(frozen=True, eq=False)
+class Exchange:
+    """The energy exchange of a resonant slow flow from amplitudes ``start`` and zero phases:
+    its ``period`` (NaN: not two maxima of ``a₁`` within the steps allowed; inf: beyond
+    floating point) and, where asked, the amplitudes ``a`` (shape ``(n, len(t))``) at slow
+    times ``t`` from 0 over two exchanges (or as far as the steps went)."""
+
+    start: tuple[float, ...]
+    period: float
+    t: np.ndarray
+    a: np.ndarray
+
+
+def energy_exchange(flow: object, start: Sequence[float], max_steps: int = EXCHANGE_MAX_STEPS,
+                    samples: int = 0) -> Exchange:
+    """:class:`Exchange` of a resonant slow flow (a :class:`derive.resonance.ResonantFlow`):
+    the time between two successive maxima of the first mode's amplitude, by DOP853 on the
+    averaged equations; ``samples`` > 0 also samples the amplitudes that many times, the
+    integration carried on to a second exchange (within ``max_steps`` steps in all).  The step
+    size may collapse where an amplitude nears 0 (its phase's rate ~ 1/a): the period is then
+    NaN.
 
     The flow is homogeneous (``a_k'`` of degree d, ``φ_k'`` of degree d − 1 in the amplitudes,
     d the force's lowest degree): ``a(t) → λa(λ^{d−1}t)`` maps solutions to solutions.  So the
-    flow is integrated from ``start / max(start)`` and its period divided by
+    flow is integrated from ``start / max(start)`` and its times divided by
     ``max(start)^{d−1}``: the same steps whatever the amplitude (integrated as given, a large
     start's fast exchange over a fixed span took ~ amplitude^{d−1} steps)."""
     import sympy as sp
@@ -407,21 +421,42 @@ def exchange_period(flow: object, start: Sequence[float],
     y0 = np.array([*(a / scale for a in start), *([0.0] * n)])
     solver = DOP853(lambda t, y: rates(y), 0.0, y0, math.inf, rtol=1e-11, atol=1e-13)
     maxima: list[float] = []
-    before = rates(y0)[0]
+    pieces = []  # each step's dense output, where the amplitudes are sampled
+    before, end = rates(y0)[0], math.inf
     for _ in range(max_steps):
         solver.step()
         if solver.status != "running":
-            return math.nan
+            break
+        if samples:
+            pieces.append(solver.dense_output())
         now = rates(solver.y)[0]
-        if before >= 0 >= now:  # a₁' falls through 0 in this step (solve_ivp's event rule)
+        if before >= 0 >= now and len(maxima) < 2:  # a₁' falls through 0 (solve_ivp's rule)
             dense = solver.dense_output()
             maxima.append(brentq(lambda t, dense=dense: rates(dense(t))[0], solver.t_old,
                                  solver.t, xtol=4 * np.finfo(float).eps))
             if len(maxima) == 2:
-                log = math.log(maxima[1] - maxima[0]) - (flow.degree - 1) * math.log(scale)
-                return math.exp(log) if log < 709 else math.inf
+                end = 2 * maxima[1] - maxima[0]
+        if solver.t >= end or (len(maxima) == 2 and not samples):
+            break
         before = now
-    return math.nan
+    period, shrink = math.nan, (flow.degree - 1) * math.log(scale)
+    if len(maxima) == 2:
+        log = math.log(maxima[1] - maxima[0]) - shrink
+        period = math.exp(log) if log < 709 else math.inf
+    if not pieces:
+        return Exchange(tuple(start), period, np.zeros(0), np.zeros((n, 0)))
+    last = min(end, pieces[-1].t_max)
+    tau = np.linspace(0.0, last, samples)
+    ends = np.array([piece.t_max for piece in pieces])
+    which = np.minimum(np.searchsorted(ends, tau), len(pieces) - 1)
+    a = np.array([pieces[k](t)[:n] for k, t in zip(which, tau, strict=True)]).T * scale
+    return Exchange(tuple(start), period, tau * math.exp(-shrink), a)
+
+
+def exchange_period(flow: object, start: Sequence[float],
+                    max_steps: int = EXCHANGE_MAX_STEPS) -> float:
+    """:class:`Exchange`'s period alone (no samples kept)."""
+    return energy_exchange(flow, start, max_steps).period
 
 
 def simulated_exchange_period(system: object, flow: object, start: Sequence[float],
