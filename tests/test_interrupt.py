@@ -16,7 +16,7 @@ import pytest
 import xarray as xr
 
 LINDSTEDT = [sys.executable, "-m", "lindstedt"]
-GRID = ["stability", "--omega", "0.5:2:180", "--force", "0.3", "--eps", "0.1", "--Q", "20"]
+GRID = ["stability", "--omega", "0.5:2:60", "--force", "0.3", "--eps", "0.1", "--Q", "20"]
 
 
 def _start(args: list[str]) -> subprocess.Popen:
@@ -65,7 +65,7 @@ def test_an_interrupted_sweep_says_what_it_saved_and_resumes(how, tmp_path):
     assert len(lines) == 1 and lines[0].startswith("lindstedt: interrupted: "), err
     assert f"blocks saved in {store}; run the same command to resume" in lines[0]
     saved, total = (int(v) for v in lines[0].split(": ")[2].split()[0].split("/"))
-    assert 1 <= saved < total == 9
+    assert 1 <= saved < total == 3
     assert took < 3.0, took  # at once (a second is the aim; the machine may be loaded)
     with xr.open_zarr(store) as ds:
         assert int(ds["done"].values.sum()) == saved

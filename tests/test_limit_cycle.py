@@ -409,8 +409,10 @@ def test_the_relaxed_products_against_the_textbook_route(text, cycle, order):
 def test_the_derivation_document(tmp_path):
     """`generate` writes the order-by-order equations beside the module: F_j's sin s and cos s
     vanish with the a_(j−1) and W_j it prints (an exact identity), ω_2 = −1/16 and
-    ω_4 = 17/3072 as published, q_j + a_j cos s the series' own q_j; byte-identical when
-    written again; pdflatex compiles it without an overfull line."""
+    ω_4 = 17/3072 as published, q_j + a_j cos s the series' own q_j; pdflatex compiles it
+    without an overfull line.  (Written again it is byte-identical: test_resum's
+    test_generated_limit_cycle_module_is_byte_identical compares every file of a second
+    generation.)"""
     import shutil
     import subprocess
 
@@ -427,10 +429,8 @@ def test_the_derivation_document(tmp_path):
             cos = {**o.q[0], 1: o.q[0].get(1, 0) + nxt.a_prev}
             assert ({n: c for n, c in cos.items() if c}, o.q[1]) == lc.q[o.j]
     assert [o.omega for o in lc.orders[:4]] == [0, F(-1, 16), 0, F(17, 3072)]
-    for folder in ("one", "two"):
-        assert main(["generate", "vdp", "--order", "8", "--out", str(tmp_path / folder)]) == 0
+    assert main(["generate", "vdp", "--order", "8", "--out", str(tmp_path / "one")]) == 0
     tex = (tmp_path / "one" / "van_der_pol_derivation.tex").read_text()
-    assert tex == (tmp_path / "two" / "van_der_pol_derivation.tex").read_text()
     assert r"\omega_{4} = \frac{17}{3072}" in tex and r"W_{2} = -\frac{1}{8}" in tex
     pdflatex = shutil.which("pdflatex")
     if pdflatex is None:

@@ -8,6 +8,7 @@ write); all files are rendered and checked before the first is written.
 
 from __future__ import annotations
 
+import functools
 import glob
 import hashlib
 import importlib.util
@@ -74,8 +75,10 @@ FASTMATH = '{"arcp", "contract", "nsz", "reassoc"}'
 # 10–20 % slower (ufunc and `_into`, three modules, three alternating rounds).
 
 
+@functools.cache
 def environment(latex: bool) -> jinja2.Environment:
-    """Strict environments; LaTeX uses ``\\VAR{}`` / ``\\BLOCK{}`` so TeX braces stay TeX's."""
+    """Strict environments; LaTeX uses ``\\VAR{}`` / ``\\BLOCK{}`` so TeX braces stay TeX's.
+    One of each per process: a template is compiled once, not at every render."""
     options: dict = dict(
         loader=jinja2.FileSystemLoader(template_folder()),
         undefined=jinja2.StrictUndefined,
