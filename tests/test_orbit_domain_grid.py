@@ -42,7 +42,6 @@ class Case:
     g0: Callable  # (q, p) -> g₀
     H: Callable  # (q, p) -> ∫₀^q h
     W: Callable  # (q, p) -> ∫₀^q 2 g₀ e^{2H}
-    xfail: str = ""
 
 
 def _W_velocity(q, e):
@@ -63,12 +62,10 @@ CASES = {
                       lambda q, e: q**2 - e * q**4 / 2),
     "transcendental": Case("q'' + sin(q) + k*q**3 = 0", (-0.05, 0.01),
                            lambda q, k: mp.sin(q) + k * q**3, lambda q, k: 0,
-                           lambda q, k: 2 * (1 - mp.cos(q)) + k * q**4 / 2,
-                           xfail="a transcendental force with a symbolic parameter: no runtime "
-                                 "orbit domain is emitted yet (derive.orbits.runtime_barrier "
-                                 "takes forces polynomial in q, q'^2 and eps only), and "
-                                 "error_estimate falls just below the true error even at "
-                                 "A = 0.3 of the edge (k = -0.05, 0.01)"),
+                           lambda q, k: 2 * (1 - mp.cos(q)) + k * q**4 / 2),
+    "exponential": Case("q'' + q*exp(-a*q) = 0", (0.5, 1.0),
+                        lambda q, a: q * mp.exp(-a * q), lambda q, a: 0,
+                        lambda q, a: 2 * (1 - (1 + a * q) * mp.exp(-a * q)) / a**2),
     "velocity": Case("q'' + q + eps*(q**2 + q*q'**2) = 0", (0.2, -0.3),
                      lambda q, e: q + e * q**2, lambda q, e: e * q**2 / 2, _W_velocity),
 }
@@ -166,12 +163,7 @@ def true_period(case: Case, A, p) -> float:
     return float(fine)
 
 
-def _cases():
-    return [pytest.param(key, marks=pytest.mark.xfail(reason=case.xfail, strict=True))
-            if case.xfail else key for key, case in CASES.items()]
-
-
-@pytest.mark.parametrize("key", _cases())
+@pytest.mark.parametrize("key", list(CASES))
 def test_symbolic_parameter_module_on_a_grid_against_quadrature(modules, key):
     """On a grid of (A, p) per equation: NaN past the edge, finite at 0.3 of it, and
     error_estimate ≥ |period/T − 1| wherever both are finite."""

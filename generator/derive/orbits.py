@@ -488,3 +488,63 @@ def runtime_barrier(model: Model) -> RuntimeBarrier | None:
         return RuntimeBarrier(coefficients, exact)
     weight, weight_exact = _by_powers(sp.expand(2 * sp.integrate(h, (q, 0, q))), q, eps)
     return RuntimeBarrier(coefficients, exact, weight, weight_exact)
+
+
+# --- the domain at run time: a force whose parameters stay symbols ---------------------------
+
+@dataclass(frozen=True)
+class RuntimeScan:
+    """Where the orbit domain depends on parameters left as symbols (the module's arguments
+    ``args``), what the emitted module needs to find it at each call, for the raw equation
+    ``q'' + g₀(q) + h(q) q'² = 0`` in ``u`` (the coordinate): ``g0``, ``two_h`` = 2∫₀ᵘ h (0: a
+    potential force), ``half_w`` = ∫₀ᵘ g₀ e^{2H} in closed form where SymPy finds one (None:
+    the module integrates it by quadrature), and ``y`` the expansion variable at amplitude
+    ``a`` (to turn an edge in the amplitude into a distance in y).  The orbit through ``q(0) =
+    A`` exists when ``g₀`` has the sign of ``q`` near 0 and ``|A|`` is below the edge on its
+    side: the nearest zero of ``g₀`` there, or first where ``W`` reaches its barrier on the
+    other side (the first integral, as :func:`orbit_domain`)."""
+
+    args: tuple[sp.Symbol, ...]
+    u: sp.Symbol
+    a: sp.Symbol
+    g0: sp.Expr
+    two_h: sp.Expr
+    half_w: sp.Expr | None
+    y: sp.Expr
+
+
+def runtime_scan(model: Model, to_args: dict, args: tuple[sp.Symbol, ...],
+                 y: sp.Expr, amplitude: sp.Symbol) -> RuntimeScan | None:
+    """The :class:`RuntimeScan` of a user's equation whose force holds parameters left
+    symbolic (``to_args`` maps the model's symbols to the module's arguments ``args``; ``y``,
+    the expansion variable in them, ``amplitude`` its amplitude symbol), where the force is
+    ``g₀(q) + h(q) q'²`` and ``y`` holds the amplitude (y = A^p or ε A^p: an edge in A is one in
+    y); None for any other model (numbers: :func:`orbit_domain` computes the domain at
+    generate time)."""
+    if not model.source or not y.has(amplitude):
+        return None  # y = ε alone: the reach in ε at each A is runtime_barrier's (polynomials)
+    osc = oscillator(model.source, dict(model.given), model.name)
+    q, v = osc.coordinate, osc.velocity
+    names = {str(s): arg for s, arg in to_args.items() if arg in args} | {
+        str(arg): arg for arg in args}
+    rename = {s: names[str(s)] for s in osc.force.free_symbols - {q, v} if str(s) in names}
+    force = sp.expand(osc.force.xreplace(rename))
+    u, a = sp.Symbol("_u"), sp.Symbol("_a")
+    if force.free_symbols - {q, v, *args} or not force.is_polynomial(v):
+        return None
+    by_degree = sp.Poly(force, v).as_dict()
+    if any(d[0] not in (0, 2) for d in by_degree):
+        return None
+    g0 = by_degree.get((0,), sp.Integer(0)).xreplace({q: u})
+    h = by_degree.get((2,), sp.Integer(0)).xreplace({q: u})
+    if sp.simplify(g0.subs(u, 0)) != 0:
+        return None
+    two_h = sp.Integer(0) if h == 0 else sp.expand(2 * sp.integrate(h, (u, 0, u)))
+    if two_h.has(sp.Integral):
+        return None
+    half_w = None
+    if h == 0:
+        half_w = sp.integrate(g0, (u, 0, u))
+        if half_w.has(sp.Integral, sp.Piecewise):
+            half_w = None
+    return RuntimeScan(tuple(args), u, a, g0, two_h, half_w, y.xreplace({amplitude: a}))

@@ -182,7 +182,17 @@ def render_module(module: Module) -> str:
         newton=module.newton,
         barrier=_rows(module.barrier),
         barrier_weight=_rows(module.barrier_weight),
+        scan=None if module.scan is None else _scan_context(module.scan),
     )
+
+
+def _scan_context(scan) -> dict:
+    """A :class:`derive.orbits.RuntimeScan` as numba source: the parameters, g₀, 2H, W/2 in
+    closed form (None: by quadrature) and the expansion variable at the amplitude ``_a``."""
+    return {"args": ", ".join(str(a) for a in scan.args), "g0": pycode(scan.g0),
+            "two_h": pycode(scan.two_h),
+            "half_w": None if scan.half_w is None else pycode(scan.half_w),
+            "y": pycode(scan.y)}
 
 
 def _signed(c: sp.Expr, factor: str, first: bool) -> str:

@@ -15,6 +15,7 @@ from ..algebra.resum import Resummed
 from ..analysis.mu_exact import MuDampedOrder, MuOrder
 from ..derive.equation import Equation
 from ..derive.lindstedt import Validity
+from ..derive.orbits import RuntimeScan
 
 Assign = tuple[sp.Symbol, sp.Expr]
 
@@ -112,6 +113,9 @@ class Module:
     barrier_weight: tuple[tuple[float, ...], ...] = ()
     # NOTE: 2H(q) = 2∫₀^q h, h the factor of q'² in the force, by powers of q and ε as barrier:
     # where non-empty the barrier compares W = ∫ 2 g₀ e^{2H} by quadrature, not V
+    scan: RuntimeScan | None = None
+    # NOTE: the force with its symbolic parameters: where given the module finds the orbit
+    # domain at each call by a scan for the zeros of g₀ (derive.orbits.RuntimeScan)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "doc", docstring_text(self.doc))

@@ -13,7 +13,7 @@ import sympy as sp
 from ..algebra.resum import Pade, Resummed
 from ..derive.cycles import LimitCycle
 from ..derive.lindstedt import SeriesSolution, estimated_radius, nearest_singularity
-from ..derive.orbits import OrbitDomain, orbit_domain, runtime_barrier
+from ..derive.orbits import OrbitDomain, orbit_domain, runtime_barrier, runtime_scan
 from ..numerics.references import mathieu_recurrence
 from .forms import (
     FREE_ARGUMENT_LIMIT,
@@ -99,8 +99,15 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
     guard = m.orbit_condition.xreplace({sp.Symbol("Y"): x})
     domain = orbit_domain(m)
     barrier = None if domain.known else runtime_barrier(m)
+    others = tuple(a for a in args.values() if a != amplitude)  # the arguments but A
+    scan = None if domain.known or barrier is not None else runtime_scan(
+        m, to_args, others, y, amplitude)
+    at = None
     if barrier is not None:  # the edge at each (A, ε): the first integral's, at run time
         at = (amplitude, y)
+    elif scan is not None:  # the edge at each call, its parameters' values in hand
+        at = (amplitude, *others)
+    if at is not None:
         guard = sp.And(guard, sp.StrictGreaterThan(OrbitInside(*at), 0))
     lo, hi = domain.guard_bounds()
     if math.isfinite(lo):
@@ -135,12 +142,16 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
              "NaN where no periodic orbit exists (the orbit domain at each eps: the first "
              "integral's barrier, the zeros of its force found at run time)" if barrier is not None
              else
+             "NaN where no periodic orbit exists (the orbit domain at each call: the first "
+             "integral's barrier, the zeros of the force nearest 0 scanned for at run time "
+             "on |q| <= 64)" if scan is not None
+             else
              f"NaN where no periodic orbit exists as far as known: no orbit domain ({domain.how})")
     where += ("" if allow_divergent or radius is None else
               " or beyond the radius of convergence"
               + ("" if m.radius is not None else " less its spread, estimated from its τ_j"))
     estimate = _truncation_bound(solution, order, x, reach, domain,
-                                 None if barrier is None else OrbitReach(*at)) / sp.Abs(total)
+                                 None if at is None else OrbitReach(*at)) / sp.Abs(total)
     evaluators = (
         Evaluator("omega", f"Frequency ω to order {order} ({where}).", params, prelude, guard,
                   (), horner(omega, x)),
@@ -201,6 +212,7 @@ def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = F
         evaluators=evaluators,
         barrier=() if barrier is None else barrier.coefficients,
         barrier_weight=() if barrier is None else barrier.weight,
+        scan=scan,
         provenance=provenance(
             m.name, order, command, allow_divergent=allow_divergent,
             forcing=[[(n, str(c)) for n, c in terms] for terms in m.forcing[: order + 2]],
