@@ -372,7 +372,8 @@ def response_cost(args: argparse.Namespace) -> Cost:
     from .analysis.attractors import dynamics_seconds
     from .analysis.response import equation_point_seconds
 
-    lo, hi = response_range(args.eps, args.force, args.Q)
+    lo, hi = response_range(args.eps, args.force, args.Q, getattr(args, "omega_min", None),
+                            getattr(args, "omega_max", None))
     seconds = continuation_seconds(args.eps, args.force, args.Q, args.harmonics, lo, hi)
     # eq. 10.60's balance: odd harmonics, 2N unknowns; ω0 = 1
     point = equation_point_seconds(2 * args.harmonics)

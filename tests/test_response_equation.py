@@ -143,6 +143,26 @@ def test_duffing_as_text_reproduces_the_flags():
     assert mine["parameters"]["drive"] == {"amplitude": 0.3, "frequency": "W"}
 
 
+def test_the_preset_takes_the_equations_range(capsys):
+    """``response --eps --force --Q --omega A:B`` (the preset with the general form's flag):
+    the range given, the folds inside it equal to the written-out equation's over the same
+    range; a reversed range refused in one line."""
+    assert main(["response", "--eps", "0.1", "--force", "0.3", "--Q", "20", "--omega",
+                 "1.2:1.6", "--json"]) == 0
+    preset = json.loads(capsys.readouterr().out)
+    assert main(["response", "x'' + x'/20 + x + x**3/10 = 3/10*cos(w*t)", "--omega", "1.2:1.6",
+                 "--json"]) == 0
+    written = json.loads(capsys.readouterr().out)
+    assert preset["parameters"]["omega_range"] == [1.2, 1.6]
+    assert written["parameters"]["omega_range"] == [1.2, 1.6]
+    assert len(preset["numerical"]["folds"]) == 1  # the upper fold; the lower lies below 1.2
+    assert written["numerical"]["folds"] == pytest.approx(preset["numerical"]["folds"],
+                                                          abs=1e-9)
+    assert main(["response", "--eps", "0.1", "--force", "0.3", "--Q", "20", "--omega",
+                 "1.6:1.2"]) == 2
+    assert capsys.readouterr().err.count("\n") == 1
+
+
 def test_a_softening_spring_as_text_escapes_where_the_flags_do():
     text = "q'' + q'/20 + q - q**3/10 = 3/10*cos(w*t)"
     mine = response_equation_json(text, {}, 8)

@@ -119,11 +119,28 @@ def one_harmonic_folds(eps: float, force: float, Q: float) -> list[float]:
     return sorted({float(w) for w in folds})
 
 
-def response_range(eps: float, force: float, Q: float) -> tuple[float, float]:
+def response_range(eps: float, force: float, Q: float, omega_min: float | None = None,
+                   omega_max: float | None = None) -> tuple[float, float]:
     """The ω range a response curve is drawn on: half the lowest to 1.25 × the highest of
-    ω = 1 and the one-harmonic folds."""
+    ω = 1 and the one-harmonic folds, each end replaced by ``omega_min``/``omega_max`` where
+    given (:func:`given_range`)."""
     folds = one_harmonic_folds(eps, force, Q)
-    return 0.5 * min([1.0, *folds]), 1.25 * max([1.0, *folds])
+    return given_range(0.5 * min([1.0, *folds]), 1.25 * max([1.0, *folds]), omega_min,
+                       omega_max)
+
+
+def given_range(lo: float, hi: float, omega_min: float | None,
+                omega_max: float | None) -> tuple[float, float]:
+    """``(lo, hi)`` with each end replaced by ``--omega A:B``'s where given, checked: finite,
+    > 0 and A below B (one line naming the flag otherwise)."""
+    lo = lo if omega_min is None else omega_min
+    hi = hi if omega_max is None else omega_max
+    for flag, value in (("--omega A", lo), ("--omega B", hi)):
+        if not (math.isfinite(value) and value > 0):
+            raise InputError(f"{flag} = {value!r}: must be finite and > 0")
+    if not lo < hi:
+        raise InputError(f"--omega {lo:g}:{hi:g}: A must lie below B")
+    return lo, hi
 
 
 _poly = np.polynomial.polynomial
@@ -261,13 +278,8 @@ def equation_range(terms: dict[tuple[int, int], float], force: float,
     w0 = linear_frequency(terms)
     one = OneHarmonic(dict(terms), float(force))
     folds = one.folds(0.1 * w0, 10 * w0)
-    lo = 0.5 * min([w0, *folds]) if omega_min is None else omega_min
-    hi = 1.25 * max([w0, *folds]) if omega_max is None else omega_max
-    for flag, value in (("--omega A", lo), ("--omega B", hi)):
-        if not (math.isfinite(value) and value > 0):
-            raise InputError(f"{flag} = {value!r}: must be finite and > 0")
-    if not lo < hi:
-        raise InputError(f"--omega {lo:g}:{hi:g}: A must lie below B")
+    lo, hi = given_range(0.5 * min([w0, *folds]), 1.25 * max([w0, *folds]), omega_min,
+                         omega_max)
     return EquationResponse(one, (lo, hi), [w for w in folds if lo <= w <= hi], w0)
 
 
@@ -508,16 +520,17 @@ def equation_response(text: str, values: dict[str, str], harmonics: int,
 
 
 def duffing_response(eps: float, force: float, Q: float, harmonics: int,
-                     max_seconds: float = CONTINUATION_SECONDS) -> ResponseReport:
+                     max_seconds: float = CONTINUATION_SECONDS, omega_min: float | None = None,
+                     omega_max: float | None = None) -> ResponseReport:
     """The :class:`ResponseReport` of eq. 10.60: its closed forms where they are the method —
     the one-harmonic folds of the cubic (:func:`one_harmonic_folds`), the range
     (:func:`response_range`), the well's barrier and escape bound — and the general path for
-    the rest."""
+    the rest; ``omega_min``/``omega_max`` replace the range's ends where given."""
     d = Drive(eps, force, 1.0, Q)
     if d.damping == 0:
         raise InputError("Q inf: a response curve needs damping (finite Q) for a steady state")
     folds = one_harmonic_folds(eps, force, Q)
-    lo, hi = response_range(eps, force, Q)
+    lo, hi = response_range(eps, force, Q, omega_min, omega_max)
     er = EquationResponse(OneHarmonic(d.terms, float(force)), (lo, hi),
                           [w for w in folds if lo <= w <= hi], 1.0)
     barrier = 1 / math.sqrt(-eps) if eps < 0 else math.inf  # the potential's maxima

@@ -378,9 +378,6 @@ def response_equation_json(text: str, values: dict[str, str], harmonics: int,
                                                   omega_max, max_seconds))
 
 
-RESPONSE_EQUATION_ONLY = ("omega_min", "omega_max")
-
-
 def _response_args(args: argparse.Namespace) -> None:
     """The flags of ``response`` with and without EQUATION, each refused in one line where it
     does not belong."""
@@ -390,10 +387,8 @@ def _response_args(args: argparse.Namespace) -> None:
             raise InputError(f"{', '.join(given)}: with an equation give its parameters with "
                              "--param (e.g. --param eps=1/10) and the drive in the equation")
         return
-    if args.param or args.name or any(getattr(args, k) is not None
-                                      for k in RESPONSE_EQUATION_ONLY):
-        raise InputError("--param/--name/--omega: give an equation (EQUATION) "
-                         "to take them")
+    if args.param or args.name:
+        raise InputError("--param/--name: give an equation (EQUATION) to take them")
     missing = [f"--{k}" for k in DRIVE_FLAGS if getattr(args, k) is None]
     if missing:
         raise InputError(f"the following arguments are required: {', '.join(missing)}")
@@ -409,7 +404,8 @@ def response_report(args: argparse.Namespace, limit: float):
         return equation_response(args.model, _params(args.param), args.harmonics,
                                  args.name or "oscillator", args.omega_min, args.omega_max,
                                  limit)
-    return duffing_response(args.eps, args.force, args.Q, args.harmonics, limit)
+    return duffing_response(args.eps, args.force, args.Q, args.harmonics, limit,
+                            args.omega_min, args.omega_max)
 
 
 def response_csv(r, path: Path) -> Path:
@@ -892,10 +888,10 @@ def arguments_response(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
     p.add_argument("--Q", type=_quality, default=None, metavar="Q",
                    help="quality factor Q > 0 of the damping q'/Q (finite; required without "
                    "EQUATION)")
-    _flag_omega(p, ("A:B",), "with EQUATION: the drive frequencies ω of the curve, from A to "
-                "B, in units of the linear natural frequency ω0 (default: from half the lowest "
-                "of ω0 and the one-harmonic folds to 1.25 × the highest); with a SYSTEM: in "
-                "its own time units (default: half the lowest linear ω0 to 1.5 × the highest)")
+    _flag_omega(p, ("A:B",), "the drive frequencies ω of the curve, from A to B, in units "
+                "of the linear natural frequency ω0 (default: from half the lowest of ω0 and "
+                "the one-harmonic folds to 1.25 × the highest); with a SYSTEM: in its own "
+                "time units (default: half the lowest linear ω0 to 1.5 × the highest)")
     _flag_range_bounds(p, "--omega-min", "--omega-max")
     _flag_harmonics(p, "odd harmonics N of the continued balance (with EQUATION: harmonics "
                     "1..2N-1, with the constant and even ones unless the force is odd)")
