@@ -44,8 +44,8 @@ demo: $(STAMP) tex
 # printers and the emitted modules; each on every core.
 test: $(STAMP) tex
 	$(BIN)/ruff check generator tests benchmarks
-	$(BIN)/python -m pytest -n auto --dist loadgroup -m exact
-	$(BIN)/python -m pytest -n auto --dist loadgroup -m "printers or emitted"
+	$(BIN)/python -m pytest -n auto -m exact
+	$(BIN)/python -m pytest -n auto -m "printers or emitted"
 
 test-fast: $(STAMP)
 	$(BIN)/python -m pytest -n auto -m exact

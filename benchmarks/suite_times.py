@@ -25,8 +25,7 @@ LAYERS = ("exact", "printers or emitted")
 def run_layer(marker: str, report: Path, extra: list[str]) -> tuple[float, int]:
     """One layer as ``make test`` runs it: its wall time and pytest's exit code."""
     start = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "pytest", "-n", "auto", "--dist", "loadgroup",
-                           "-m", marker, "-q",
+    done = subprocess.run([sys.executable, "-m", "pytest", "-n", "auto", "-m", marker, "-q",
                            f"--junitxml={report}", *extra], cwd=ROOT, check=False)
     return time.perf_counter() - start, done.returncode
 

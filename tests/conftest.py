@@ -6,8 +6,7 @@
 * ``emitted``: generated numba modules compiled and checked against references, the wheel in a
   fresh venv, ``make demo``, Dask clusters.
 
-``make test`` runs ``-m exact`` first, then the other two, each on every core (pytest-xdist,
-``--dist loadgroup``: the tests that share a module-scoped fixture on one worker);
+``make test`` runs ``-m exact`` first, then the other two, each on every core (pytest-xdist);
 ``pytest -m exact`` alone takes a minute.  A module's layer is where its slowest test belongs."""
 
 from __future__ import annotations
@@ -36,26 +35,9 @@ def pytest_configure(config: pytest.Config) -> None:
         config.addinivalue_line("markers", f"{layer}: a layer of the suite (tests/conftest.py)")
 
 
-def _shares_a_module_fixture(item: pytest.Item) -> bool:
-    """Whether ``item`` uses a fixture its own module defines for more than one test (a module
-    emitted and compiled once, say)."""
-    info = getattr(item, "_fixtureinfo", None)
-    module = getattr(getattr(item, "module", None), "__name__", None)
-    for defs in (info.name2fixturedefs.values() if info is not None else ()):
-        last = defs[-1]
-        if last.scope != "function" and getattr(last.func, "__module__", None) == module:
-            return True
-    return False
-
-
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     for item in items:
         name = Path(str(item.fspath)).name
         if name not in LAYER_OF:
             raise pytest.UsageError(f"{name}: give it a layer in tests/conftest.py")
         item.add_marker(getattr(pytest.mark, LAYER_OF[name]))
-        if _shares_a_module_fixture(item):
-            # NOTE: with `--dist loadgroup` (make test) the tests sharing a module's fixture
-            # run on one worker, which builds it once; every other test goes where a worker
-            # is free.
-            item.add_marker(pytest.mark.xdist_group(name))

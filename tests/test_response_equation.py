@@ -225,7 +225,7 @@ def test_mixing_as_text_equals_the_flags():
     (["response", "q'' + q + q**3/10 = cos(w*t)/2"], "no damping"),
     (["response", "q'' + w*q'/10 + q + q**3/10 = cos(w*t)/2"], "depends on the drive"),
     (["response", "q'' + q'/10 + q + q**3/10 = cos(w*t)/2", "--eps", "0.1"], "--eps"),
-    (["response", "--eps", "0.1", "--force", "0.3", "--Q", "20", "--omega", "1:2"],
+    (["response", "--eps", "0.1", "--force", "0.3", "--Q", "20", "--param", "a=1"],
      "give an equation"),
     (["subharmonic", "--eps", "0.1", "--force", "0.5"], "required: --omega"),
 ])
