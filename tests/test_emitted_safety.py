@@ -431,27 +431,39 @@ def domain_findings(mod, names: tuple[str, ...], skip: frozenset = frozenset()) 
     return found
 
 
+NEWER = {  # each module's name, and the command (less --out) that emits it
+    "driven_damped": ["generate", "driven", "--damped", "--order", "2"],
+    "van_der_pol": ["generate", "van_der_pol", "--order", "3"],
+    "mathieu_a1": ["mathieu", "a", "--m", "1", "--order", "8"],
+    "vdp_slow_flow": ["slowflow", "van_der_pol", "--name", "vdp"],
+    "tongue_1": ["tongues", "cos(t) + 1/2*cos(2*t)", "--n", "1", "--order", "12"],
+}
+
+
+class _Emitted(dict):
+    """Each module of :data:`NEWER` emitted and loaded when a test first asks for it: a worker
+    compiles only the modules its tests use."""
+
+    def __init__(self, out: Path) -> None:
+        super().__init__()
+        self.out = out
+
+    def __missing__(self, name: str):
+        from lindstedt.emit.render import load_generated
+
+        made = subprocess.run([sys.executable, "-m", "lindstedt", *NEWER[name], "--out",
+                               str(self.out)], capture_output=True, text=True, check=False)
+        assert made.returncode == 0, made.stderr
+        self[name] = load_generated(self.out / f"{name}.py")
+        return self[name]
+
+
 @pytest.fixture(scope="module")
 def newer_modules(tmp_path_factory):
     """The modules emitted on request: the damped μ-expansion (order 2), van der Pol's cycle
     with its resummed evaluators (order 3), Mathieu's a₁, van der Pol's slow flow and the
-    transition curves of a two-harmonic p (order 12)."""
-    out = tmp_path_factory.mktemp("newer")
-    for args in (["generate", "driven", "--damped", "--order", "2"],
-                 ["generate", "van_der_pol", "--order", "3"],
-                 ["mathieu", "a", "--m", "1", "--order", "8", "--out", str(out)],
-                 ["slowflow", "van_der_pol", "--name", "vdp", "--out", str(out)],
-                 ["tongues", "cos(t) + 1/2*cos(2*t)", "--n", "1", "--order", "12", "--out",
-                  str(out)]):
-        if args[0] == "generate":
-            args = [*args, "--out", str(out)]
-        made = subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
-                              text=True, check=False)
-        assert made.returncode == 0, made.stderr
-    from lindstedt.emit.render import load_generated
-    return {name: load_generated(out / f"{name}.py")
-            for name in ("driven_damped", "van_der_pol", "mathieu_a1", "vdp_slow_flow",
-                         "tongue_1")}
+    transition curves of a two-harmonic p (order 12), each made when first used."""
+    return _Emitted(tmp_path_factory.mktemp("newer"))
 
 
 def test_damped_module_is_nan_without_a_warning_outside_its_domain(newer_modules):

@@ -71,17 +71,26 @@ CASES = {
 }
 
 
+class _Modules(dict):
+    """Each case's module, written by ``lindstedt generate`` and loaded when its test first
+    asks (a worker compiles only its own cases')."""
+
+    def __init__(self, out) -> None:
+        super().__init__()
+        self.out = out
+
+    def __missing__(self, key: str):
+        name = "grid_" + key.replace("-", "_")
+        assert main(["generate", CASES[key].text, "--order", str(ORDER), "--out",
+                     str(self.out), "--name", name]) == 0
+        self[key] = load_generated(self.out / f"{name}.py")
+        return self[key]
+
+
 @pytest.fixture(scope="module")
 def modules(tmp_path_factory):
-    """The four modules, each written by ``lindstedt generate`` and loaded once."""
-    out = tmp_path_factory.mktemp("domain_grid")
-    loaded = {}
-    for key, case in CASES.items():
-        name = "grid_" + key.replace("-", "_")
-        assert main(["generate", case.text, "--order", str(ORDER), "--out", str(out),
-                     "--name", name]) == 0
-        loaded[key] = load_generated(out / f"{name}.py")
-    return loaded
+    """The cases' modules, each emitted once for the file when first used."""
+    return _Modules(tmp_path_factory.mktemp("domain_grid"))
 
 
 def _zero(case: Case, p, side: int):

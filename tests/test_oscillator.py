@@ -293,20 +293,29 @@ def emit(text, order, out, name):
     assert main(["generate", text, "--order", str(order), "--out", str(out), "--name", name]) == 0
 
 
+EMITTED_NAMES = {"q'' + q + eps*(q**2 + q**3) = 0": "user_hd",
+                 "theta'' + sin(theta) = 0": "user_pendulum",
+                 "x'' + 4*x + eps*x**3 = 0": "user_rescaled", "q'' + log(1+q) = 0": "user_log"}
+
+
+class _Emitted(dict):
+    """Each module written by ``lindstedt generate`` and loaded when a test first asks for
+    it (a worker compiles only the modules its own tests use)."""
+
+    def __init__(self, out) -> None:
+        super().__init__()
+        self.out = out
+
+    def __missing__(self, text: str):
+        emit(text, EMITTED_ORDER, self.out, EMITTED_NAMES[text])
+        self[text] = load_generated(self.out / f"{EMITTED_NAMES[text]}.py")
+        return self[text]
+
+
 @pytest.fixture(scope="module")
 def emitted(tmp_path_factory):
-    """Modules written by ``lindstedt generate`` (one through the command line), loaded once."""
-    out = tmp_path_factory.mktemp("emitted")
-    modules = {}
-    hd = "q'' + q + eps*(q**2 + q**3) = 0"
-    emit(hd, EMITTED_ORDER, out, "user_hd")
-    modules[hd] = load_generated(out / "user_hd.py")
-    for text, name in (("theta'' + sin(theta) = 0", "user_pendulum"),
-                       ("x'' + 4*x + eps*x**3 = 0", "user_rescaled"),
-                       ("q'' + log(1+q) = 0", "user_log")):
-        emit(text, EMITTED_ORDER, out, name)
-        modules[text] = load_generated(out / f"{name}.py")
-    return modules
+    """The modules of :data:`EMITTED_NAMES`, each generated and loaded once, when first used."""
+    return _Emitted(tmp_path_factory.mktemp("emitted"))
 
 
 def arguments(module) -> list[str]:
