@@ -87,6 +87,8 @@ EDGE_NUMBERS = ("0", "-0", "1", "-1", "0.1", "-0.1", "2", "1e-300", "-1e-300", "
 EDGE_INTEGERS = ("-1", "0", "2.5", "abc", "", "1e3", "0x10", "100000", "9" * 40)
 WRITABLE_PLOTS = ("fig.png", "fig.svg", "fig.pdf")
 BAD_PLOTS = ("fig.txt", "fig", "", "missing/fig.png", "/dev/null/fig.png")
+WRITABLE_CSVS = ("curve.csv", "a.csv")
+BAD_CSVS = ("", "missing/c.csv", "/dev/null/c.csv", ".")
 WRITABLE_FOLDERS = ("out", "a/b", ".")
 BAD_FOLDERS = ("", "/dev/null/x")
 
@@ -262,6 +264,47 @@ RESPONSE_SYSTEM = command_line((
     Opt("--harmonics", maybe(whole(1, 3)), st.sampled_from(("0", "101", "abc")))), plot="slow")
 # NOTE: a driven system's response over a short range at N ≤ 3 harmonics (2–4 s a valid run).
 
+SLOWFLOW_SYSTEM = command_line((
+    Opt(None, st.sampled_from(["x1'' + x1 + x1*x2 = 0; x2'' + 4*x2 + x1**2/2 = 0",
+                               "x1'' + x1 + 0.3*x1*x2 = 0; x2'' + 4.0*x2 + 0.15*x1**2 = 0"]),
+        st.sampled_from(["x1'' + x1 = 0; x2'' + 9*x2 = 0", "x1'' + x1 + x2**3 = 0; x2'' + 2*x2",
+                         "x1'' + x1 + x1*x2 = 0; x2'' + 5*x2 + x1**2 = 0",
+                         "x1'' + x1 + __import__('os') = 0; x2'' + 4*x2 = 0"]), number=False),
+    Opt("--start", maybe(st.sampled_from(["a1=0.02", "a2=0.05"])),
+        st.sampled_from(["a3=1", "a1=-1", "a1=abc", "a1=1e40", "a1=1000", "=1"]),
+        number=False),
+    Opt("--csv", maybe(st.sampled_from(WRITABLE_CSVS)), st.sampled_from(BAD_CSVS),
+        number=False)), plot="fast")
+# NOTE: a system's first-order slow flow in 1:2 resonance, exact and decimal (1–4 s a valid
+# run, its energy exchange drawn and tabulated now and then).
+
+GENERATE_SYSTEM = command_line((
+    Opt(None, st.sampled_from(["x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0",
+                               "x1'' + x1 + 0.5*(x1-x2) + 0.3*x1**3 = 0; "
+                               "x2'' + 1.21*x2 + 0.5*(x2-x1) = 0"]),
+        st.sampled_from(["x1'' + x1 = 0; x2'' + 9*x2 = 0",
+                         "x1'' + x1 + x1**3 = 0; x2'' + 9*x2 + x2**3 = 0", ";",
+                         "x1'' + 2*x1 - x2 + k*x1**3 = 0; x2'' + 2*x2 - x1 = 0"]),
+        number=False),
+    Opt("--mode", whole(1, 2), INTEGER), Opt("--order", maybe(whole(1, 4)), INTEGER),
+    Opt("--name", maybe(st.just("pair")), st.sampled_from(["numpy", "1x", "a-b", ""]),
+        number=False),
+    Opt("--out", st.sampled_from(WRITABLE_FOLDERS), st.sampled_from(BAD_FOLDERS),
+        number=False)))
+# NOTE: a normal mode's module to order ≤ 4 (written, not compiled: 1–5 s a valid run); the
+# stiff systems (1e10–1e30, ~10 s at the default order) have tests of their own.
+
+CHOOSE_BACKBONE = command_line((
+    Opt(None, st.just("backbone"), st.sampled_from(["backbones", ""]), number=False),
+    Opt(None, st.sampled_from(["x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0",
+                               "x1'' + 1.5*x1 - 0.5*x2 + 0.2*x1**3 = 0; "
+                               "x2'' + 1.7*x2 - 0.5*x1 = 0"]),
+        st.sampled_from(["x1'' + x1 = 0; x2'' + 9*x2 = 0", ";",
+                         "x1'' + x1 + x1**3 = 0; x2'' + x2 + x2**3 = 0"]), number=False),
+    Opt("--mode", whole(1, 2), INTEGER), Opt("--tol", real(1e-6, 1e-3), NUMBER),
+    Opt("--range", span(0.01, 0.05, 0.2), SPAN_EDGES)))
+# NOTE: a normal mode's smallest order for a tolerance over a small range (~8 s a valid run).
+
 CLOCK = st.sampled_from([[], ["--json"], ["--bogus"], ["extra"], ["--json", "--json"]])
 
 MODELS = st.sampled_from([[], ["--json"], ["--bogus"], ["extra"], ["--json", "--json"]])
@@ -304,8 +347,9 @@ BUDGET = {"series": (SERIES, 2), "generate": (GENERATE, 2), "driven": (DRIVEN, 4
           "scene": (SCENE, 1), "demo": (DEMO, 1), "models": (MODELS, 1),
           "mathieu": (MATHIEU, 2), "parametric": (PARAMETRIC, 2),
           "slowflow": (SLOWFLOW, 2), "tongues": (TONGUES, 2), "nnm": (NNM, 2),
-          "response SYSTEM": (RESPONSE_SYSTEM, 2)}
-# NOTE: examples (pairs of runs side by side) per command: 54 runs, the file ~60 s on the
+          "response SYSTEM": (RESPONSE_SYSTEM, 2), "slowflow SYSTEM": (SLOWFLOW_SYSTEM, 2),
+          "generate SYSTEM": (GENERATE_SYSTEM, 2), "choose SYSTEM": (CHOOSE_BACKBONE, 1)}
+# NOTE: examples (pairs of runs side by side) per command: 64 runs, the file ~60 s on the
 # 2-core machine with other work loading it (a refusal takes 0.1–3 s, a valid run 2–8 s).
 
 
@@ -341,6 +385,9 @@ test_fuzz_slowflow = _fuzz("slowflow")
 test_fuzz_parametric = _fuzz("parametric")
 test_fuzz_nnm = _fuzz("nnm")
 test_fuzz_response_system = _fuzz("response SYSTEM")
+test_fuzz_slowflow_system = _fuzz("slowflow SYSTEM")
+test_fuzz_generate_system = _fuzz("generate SYSTEM")
+test_fuzz_choose_system = _fuzz("choose SYSTEM")
 
 
 NOT_FUZZED = {"sweep": "a dask cluster per run (tests/test_sweep.py covers its refusals)"}
