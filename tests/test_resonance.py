@@ -6,6 +6,7 @@ pendulum itself."""
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -181,3 +182,15 @@ def test_slowflow_of_a_linear_resonant_system_is_refused_in_one_line():
     out = run("slowflow", "x1'' + x1 = 0; x2'' + 9*x2 = 0")
     assert out.returncode == 2 and out.stdout == ""
     assert len(out.stderr.strip().splitlines()) == 1 and "no nonlinear term" in out.stderr
+
+
+def test_coupled_modes_of_a_decimal_system_with_irrational_frequencies():
+    """x1'' + 1.3 x1 + α x1 x2 = 0; x2'' + 5.2 x2 + β x1² = 0 (ω₀ = √1.3, 2√1.3: 1:2): averaging
+    by hand gives φ1' = α a2 cos γ/(4ω₁), φ2' = β a1² cos γ/(4ω₂ a2), so a locked γ = 0 or π
+    has (a2/a1)² = β ω₁/(2α ω₂) = β/(4α); the coefficients' surds must not stop the roots."""
+    flow = resonant_flow(parse_system("x1'' + 1.3*x1 + 0.37*x1*x2 = 0; "
+                                      "x2'' + 5.2*x2 + 0.21*x1**2 = 0"))
+    found = coupled_modes(flow)
+    assert sorted(float(g) for g, _ in found) == pytest.approx([0.0, math.pi])
+    for _, r in found:
+        assert float(r) == pytest.approx(math.sqrt(0.21 / (4 * 0.37)), rel=1e-14)

@@ -157,9 +157,18 @@ def coupled_modes(flow: ResonantFlow) -> list[tuple[sp.Expr, sp.Expr]]:
     for g in (sp.Integer(0), sp.pi):
         if all(sp.simplify(r.xreplace({gamma: g})) == 0 for r in rates[:2]):
             locked = sp.numer(sp.together(dgamma.xreplace({gamma: g, flow.a[1]: ratio})))
-            roots = sp.Poly(locked, ratio).real_roots() if locked.has(ratio) else []
+            roots = _real_roots(locked, ratio) if locked.has(ratio) else []
             out += [(g, root) for root in roots if root > 0]  # exact: surds or CRootOf
     return out
+
+
+def _real_roots(expr: sp.Expr, x: sp.Symbol) -> list[sp.Expr]:
+    """The real roots of the polynomial ``expr`` in ``x``, exact: SymPy's isolation over the
+    rationals, else (coefficients in surds: a decimal system's irrational ω₀) its solver."""
+    poly = sp.Poly(expr, x)
+    if poly.domain.is_ZZ or poly.domain.is_QQ:
+        return poly.real_roots()
+    return [r for r in sp.solve(expr, x) if r.is_real]
 
 
 def force_ratio(flow: ResonantFlow, start: tuple[float, ...], limit: float = 1.0
