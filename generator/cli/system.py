@@ -65,6 +65,7 @@ def nnm_json(mode) -> dict:
         "coordinates_decimal": {name: [{str(n): decimal_text(c) for n, c in order.items()}
                                        for order in mode.coordinate(i)]
                                 for i, name in enumerate(names)},
+        "mass": [[str(c) for c in mode.system.mass.row(i)] for i in range(len(names))],
     }
 
 

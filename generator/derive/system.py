@@ -1,7 +1,8 @@
 """A system of coupled oscillators from text: one equation per coordinate, separated by ``;``.
 
-``M x'' + C x' + K x + f(x, x') = F cos ωt`` with a diagonal mass ``M`` (each equation holds
-one acceleration), the damping ``C``, the stiffness ``K``, the nonlinear force ``f`` (terms of
+``M x'' + C x' + K x + f(x, x') = F cos ωt`` with a constant mass matrix ``M`` (diagonal: each
+equation holds its own acceleration; full: symmetric positive definite, the coordinates in the
+order their accelerations first appear), the damping ``C``, the stiffness ``K``, the nonlinear force ``f`` (terms of
 degree ≥ 2) and a drive ``F cos ωt`` (``response`` takes it; ``nnm`` and ``slowflow`` take
 ``C = 0``, ``F = 0``), every coefficient exact.  The linear modes are the roots ``λ = ω₀²``
 of ``det(K − λM) = 0``, kept exact: a rational, or an algebraic number (SymPy's ``CRootOf``
@@ -27,14 +28,14 @@ MAX_COORDINATES = 12
 
 @dataclass(frozen=True)
 class System:
-    """``M x'' + K x + f(x, x') = 0``: coordinates in the order of the equations, each an
-    exact rational (``mass``, ``stiffness``) or a polynomial (``force``, the terms of degree
-    ≥ 2 of each equation, divided by its mass)."""
+    """``M x'' + K x + f(x, x') = 0``: coordinates in the order of the equations, the mass
+    matrix ``M`` and the lowered ``M⁻¹K`` exact rationals, the force ``M⁻¹f`` (the terms of
+    degree ≥ 2) polynomials."""
 
     text: str
     coordinates: tuple[sp.Symbol, ...]
     velocities: tuple[sp.Symbol, ...]
-    mass: tuple[sp.Rational, ...]
+    mass: sp.Matrix  # M: constant, symmetric positive definite
     stiffness: sp.Matrix  # M⁻¹K
     force: tuple[sp.Expr, ...]  # M⁻¹ f(x, x'), degree ≥ 2
     damping: sp.Matrix | None = None  # M⁻¹C (None: no linear velocity term)
@@ -65,9 +66,9 @@ class System:
         ``c_min ⟨|ẋ|²⟩ ≤ ½ |F| |V₁|`` with ``⟨|ẋ|²⟩ ≥ ½|V₁|²``: ``ω r₁ ≤ |V₁| ≤ |F|/c_min``.  A
         balance solution meets it too: ``ẋ`` lies in the span the residual is orthogonal to."""
         n = self.size
-        M = sp.diag(*self.mass)
+        M = self.mass
         K = M * self.stiffness
-        g = [sp.expand(self.mass[i] * self.force[i]) for i in range(n)]
+        g = [sp.expand(e) for e in M * sp.Matrix(self.force)]
         if self.damping is None:
             return None, "no damping"
         if any(f.has(*self.velocities) for f in g):
@@ -81,7 +82,7 @@ class System:
         c_min = float(np.linalg.eigvalsh(np.array((C + C.T) / 2, dtype=float)).min())
         if not c_min > 0:
             return None, "the damping M·C is not positive definite"
-        F = math.sqrt(sum(float(self.mass[i] * d) ** 2 for i, d in enumerate(self.drive)))
+        F = math.sqrt(sum(float(d) ** 2 for d in M * sp.Matrix(self.drive)))
         return F / c_min, (f"power balance: |F| = {F:.6g}, c_min = {c_min:.6g}, the "
                            "damping's smallest eigenvalue")
 
@@ -154,15 +155,16 @@ def _read(text: str, driven: bool
     sides = [parse_sides(p.strip(), "equation") for p in parts]
     coordinates = []
     for i, (_, _, orders, _) in enumerate(sides):
-        accelerations = sorted(n for n, k in orders.items() if k == 2)
-        if len(accelerations) != 1:
-            raise InputError(f"system {text!r}: equation {i + 1} holds "
-                             f"{len(accelerations)} accelerations; write each coordinate's "
-                             "equation with its own x'' alone (a diagonal mass)")
-        if accelerations[0] in coordinates:
-            raise InputError(f"system {text!r}: {accelerations[0]}'' leads two equations; one "
-                             "equation per coordinate")
-        coordinates += accelerations
+        accelerations = [n for n, k in orders.items() if k == 2]  # in the text's order
+        if not accelerations:
+            raise InputError(f"system {text!r}: equation {i + 1} holds no acceleration; "
+                             "write each coordinate's equation with its x''")
+        coordinates += [n for n in accelerations if n not in coordinates]
+    if len(coordinates) != len(parts):
+        held = ", ".join(c + "''" for c in coordinates)
+        raise InputError(f"system {text!r}: {len(parts)} equations hold the accelerations of "
+                         f"{len(coordinates)} coordinate{'s' * (len(coordinates) > 1)} "
+                         f"({held}); one equation per coordinate")
     bad = sorted({n for _, _, o, _ in sides for n in o} - set(coordinates))
     if bad:
         raise InputError(f"system {text!r}: {', '.join(bad)} has no equation of its own; each "
@@ -220,7 +222,7 @@ def parse_system(text: str, values: dict[str, str] | None = None,
             raise InputError(f"system {text!r}: the drive vanishes with the values given")
         system = _lowered(text, coordinates, [e for e, _ in exprs], allow_damping=True)
         return replace(system, frequency=frequency, drive=tuple(
-            d / m for (_, d), m in zip(exprs, system.mass, strict=True)))
+            system.mass.solve(sp.Matrix([d for _, d in exprs]))))
     return _lowered(text, coordinates, [e.xreplace(given) for e in exprs],
                     allow_damping=driven)
 
@@ -246,13 +248,10 @@ def _symbolic(text: str, coordinates: list[str], exprs: list[sp.Expr], names: se
     system = _lowered(text, coordinates, [e.xreplace({p: sp.Integer(1) for p in params})
                                           for e in exprs])
     # the checks passed with every symbol at 1; the force is taken again with the symbols
-    force = []
-    for i, e in enumerate(exprs):
-        x = system.coordinates
-        linear = sum(system.stiffness[i, j] * system.mass[i] * x[j] for j in range(len(x)))
-        rest = e - system.mass[i] * symbols[i][2] - linear
-        force.append(sp.expand(rest / system.mass[i]))
-    return replace(system, force=tuple(force))
+    M = system.mass
+    rest = (sp.Matrix(exprs) - M * sp.Matrix([s[2] for s in symbols])
+            - M * system.stiffness * sp.Matrix(system.coordinates))
+    return replace(system, force=tuple(sp.expand(f) for f in M.solve(rest)))
 
 
 def _drive_split(text: str, exprs: list[sp.Expr]
@@ -304,11 +303,11 @@ def _lowered(text: str, coordinates: list[str], exprs: list[sp.Expr],
         if any(not c.is_Rational for c in poly.coeffs()):
             raise InputError(f"system {text!r}: equation {i + 1} has a coefficient that is "
                              "not an exact number")
-        m = poly.coeff_monomial(a[i])
-        rest = sp.expand(poly.as_expr() - m * a[i])
-        if rest.has(*a) or not m.is_Rational or m <= 0:
-            raise InputError(f"system {text!r}: equation {i + 1}: {coordinates[i]}'' must "
-                             "enter linearly with a positive constant mass")
+        m = [poly.coeff_monomial(s) for s in a]
+        rest = sp.expand(poly.as_expr() - sum(c * s for c, s in zip(m, a, strict=True)))
+        if rest.has(*a):
+            raise InputError(f"system {text!r}: equation {i + 1}: the accelerations must "
+                             "enter linearly, each with a constant mass")
         p = sp.Poly(rest, *x, *v)
         if p.coeff_monomial(1) != 0:
             raise InputError(f"system {text!r}: equation {i + 1} has a constant term; the "
@@ -320,10 +319,34 @@ def _lowered(text: str, coordinates: list[str], exprs: list[sp.Expr],
                              "(damping); nnm takes conservative systems (response takes "
                              "damped, driven ones)")
         mass.append(m)
-        rows.append([c / m for c in linear])
-        damp.append([c / m for c in damping])
-        force.append(sp.expand((rest - sum(c * s for c, s in zip(linear, x, strict=True))
-                                - sum(c * s for c, s in zip(damping, v, strict=True))) / m))
-    C = sp.Matrix(damp)
-    return System(text, tuple(x), tuple(v), tuple(mass), sp.Matrix(rows), tuple(force),
+        rows.append(linear)
+        damp.append(damping)
+        force.append(sp.expand(rest - sum(c * s for c, s in zip(linear, x, strict=True))
+                               - sum(c * s for c, s in zip(damping, v, strict=True))))
+    M = _mass_matrix(text, coordinates, sp.Matrix(mass))
+    C = M.solve(sp.Matrix(damp))
+    return System(text, tuple(x), tuple(v), M, M.solve(sp.Matrix(rows)),
+                  tuple(sp.expand(f) for f in M.solve(sp.Matrix(force))),
                   None if C.is_zero_matrix else C)
+
+
+def _mass_matrix(text: str, coordinates: list[str], M: sp.Matrix) -> sp.Matrix:
+    """``M``, checked: a diagonal one positive, a full one symmetric positive definite (its
+    rows the equations, its columns the coordinates in their order)."""
+    n = M.rows
+    if M.is_diagonal():
+        for i in range(n):
+            if M[i, i] <= 0:
+                raise InputError(f"system {text!r}: equation {i + 1}: {coordinates[i]}'' must "
+                                 "enter with a positive constant mass")
+        return M
+    shown = "[" + "; ".join(", ".join(sp.sstr(M[i, j]) for j in range(n))
+                            for i in range(n)) + "]"
+    if M != M.T:
+        raise InputError(f"system {text!r}: the mass matrix {shown} (rows the equations, "
+                         f"columns {', '.join(coordinates)}) is not symmetric; write equation "
+                         "k as row k of M x'' + ... = 0")
+    if not all(M[:k, :k].det() > 0 for k in range(1, n + 1)):
+        raise InputError(f"system {text!r}: the mass matrix {shown} is not positive definite "
+                         "(a kinetic energy ½ x'ᵀ M x' must be positive)")
+    return M

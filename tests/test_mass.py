@@ -1,0 +1,133 @@
+"""A full (symmetric positive definite) mass matrix: the system as written, ``M x'' + K x + f =
+0``, against the same system inverted by hand (exact series, equal), and its emitted modules
+against shooting whose right-hand side solves ``M x'' = −(K x + f)`` in NumPy (another route
+than the parser's exact ``M⁻¹``); the refusals of a mass that is not one."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+
+import numpy as np
+import pytest
+import sympy as sp
+from commands import run
+from lindstedt.derive.nnm import normal_mode
+from lindstedt.derive.system import parse_system
+from scipy.integrate import solve_ivp
+from scipy.optimize import root
+
+FULL = "2*x1'' + x2'' + 3*x1 - x2 + x1**3 = 0; x1'' + 2*x2'' - x1 + 2*x2 = 0"
+# NOTE: M = [[2, 1], [1, 2]], M⁻¹ = [[2, −1], [−1, 2]]/3 by hand: x'' = −M⁻¹(Kx + f) is
+INVERTED = ("x1'' + 7/3*x1 - 4/3*x2 + 2/3*x1**3 = 0; "
+            "x2'' - 5/3*x1 + 5/3*x2 - 1/3*x1**3 = 0")
+# and det(K − λM) = 3λ² − 12λ + 5: λ = 2 ∓ √21/3.
+
+DECIMAL = ("1.2*x1'' + 0.3*x2'' + 2.5*x1 - 1.1*x2 + 0.4*x1**3 = 0; "
+           "0.3*x1'' + 0.8*x2'' - 1.1*x1 + 1.7*x2 + 0.2*x2**3 = 0")
+MASS = np.array([[1.2, 0.3], [0.3, 0.8]])
+STIFFNESS = np.array([[2.5, -1.1], [-1.1, 1.7]])
+RESIDUAL = 1e-11
+
+
+def _force(x: np.ndarray) -> np.ndarray:
+    return np.array([0.4 * x[0] ** 3, 0.2 * x[1] ** 3])
+
+
+@pytest.mark.parametrize("which", [1, 2])
+def test_full_mass_series_equals_the_hand_inverted_system_exactly(which):
+    full, inverted = (normal_mode(parse_system(t), which, 8) for t in (FULL, INVERTED))
+    assert sp.simplify(full.omega0**2 - (2 + (-1) ** which * sp.sqrt(21) / 3)) == 0
+    assert [sp.simplify(a - b) for a, b in zip(full.omega(), inverted.omega(), strict=True)] \
+        == [0] * 9
+    for i in range(2):
+        assert [{n: sp.simplify(c - inverted.coordinate(i)[j][n]) for n, c in order.items()}
+                for j, order in enumerate(full.coordinate(i))] == \
+            [dict.fromkeys(order, 0) for order in inverted.coordinate(i)]
+
+
+def test_mass_matrix_is_kept_and_the_lowered_form_is_m_inverse_k():
+    s = parse_system(FULL)
+    assert s.mass == sp.Matrix([[2, 1], [1, 2]])
+    assert s.stiffness == sp.Matrix([[sp.Rational(7, 3), sp.Rational(-4, 3)],
+                                     [sp.Rational(-5, 3), sp.Rational(5, 3)]])
+    x1 = s.coordinates[0]
+    assert s.force == (2 * x1**3 / 3, -x1**3 / 3)
+
+
+def _shoot(A: float, x2: float, half: float) -> tuple[float, float]:
+    """The orbit through x1(0) = A, every velocity zero, by DOP853 on M x'' = −(K x + f)."""
+    def rhs(t, z):
+        return np.concatenate([z[2:], np.linalg.solve(MASS, -(STIFFNESS @ z[:2] + _force(z[:2])))])
+
+    def at_half(u):
+        sol = solve_ivp(rhs, (0, u[1]), [A, u[0], 0, 0], method="DOP853", rtol=1e-13,
+                        atol=1e-15)
+        return sol.y[2:, -1]
+
+    out = root(at_half, [x2, half], method="hybr", tol=1e-14)
+    residual = np.max(np.abs(at_half(out.x)))
+    assert residual <= RESIDUAL, f"reference shooting: residual {residual:.1e}"
+    return out.x[0], 2 * out.x[1]
+
+
+def _load(path):
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def modules(tmp_path_factory):
+    out = tmp_path_factory.mktemp("mass")
+    for which in (1, 2):
+        done = run("generate", DECIMAL, "--mode", which, "--order", "10", "--out", out)
+        assert done.returncode == 0, done.stderr
+    return {which: _load(out / f"mode{which}.py") for which in (1, 2)}
+
+
+@pytest.mark.parametrize("which, grid", [(1, (0.3, 0.5, 0.7, 0.9)), (2, (0.5, 0.9, 1.3, 1.6))])
+def test_decimal_full_mass_modules_meet_shooting_and_bound_their_error(modules, which, grid):
+    """Each mode's module of a decimal system with a full mass and irrational ω₀: ω and x2(0)
+    against shooting; error_estimate never below the true error, within 10× of it where the
+    error is above rounding."""
+    m = modules[which]
+    lam = sorted(np.linalg.eigvals(np.linalg.solve(MASS, STIFFNESS)).real)
+    assert m.OMEGA0 == pytest.approx(np.sqrt(lam[which - 1]), rel=1e-14)
+    checked = 0
+    for A in grid:
+        others, period = _shoot(A, m.x2(0.0, A), np.pi / m.omega(A))
+        true = abs(m.period(A) / period - 1)
+        assert abs(m.x2(0.0, A) - others) / A <= 10 * max(true, 1e-12)
+        assert m.error_estimate(A) >= true or true < 1e-12, (A, m.error_estimate(A), true)
+        if true > 1e-11:
+            assert m.error_estimate(A) <= 10 * true, (A, m.error_estimate(A), true)
+            checked += 1
+    assert checked >= 2
+    assert abs(m.omega(0.2) - 2 * np.pi / _shoot(0.2, m.x2(0.0, 0.2), np.pi / m.omega(0.2))[1]
+               ) <= 1e-8
+
+
+def test_nnm_of_a_full_mass_prints_decimals_and_its_json_keeps_the_mass(tmp_path):
+    out = run("nnm", DECIMAL, "--order", "6", "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    text = run("nnm", DECIMAL, "--order", "6")
+    assert max(map(len, text.stdout.splitlines())) <= 200
+    assert "0.866769338192" in text.stdout  # ω₀ of mode 1, as a decimal
+    assert data["omega0_decimal"] == "0.866769338192"
+    assert data["mass"] == [["6/5", "3/10"], ["3/10", "4/5"]]
+
+
+@pytest.mark.parametrize("text, says", [
+    ("x1'' + 2*x2'' + x1 = 0; 2*x1'' + x2'' + x2 = 0", "is not positive definite"),
+    ("x1'' + 2*x2'' + x1 = 0; x1'' + x2'' + x2 = 0", "is not symmetric"),
+    ("x1'' + x1 = 0; x1'' + x1 = 0", "one equation per coordinate"),
+    ("-x1'' + x1 = 0; x2'' + x2 = 0", "positive constant mass"),
+    ("x1''*x2 + x1 = 0; x2'' + x2 = 0", "accelerations must enter linearly"),
+])
+def test_a_mass_that_is_not_one_is_refused_in_one_line(text, says):
+    out = run("nnm", text)
+    assert out.returncode == 2 and out.stdout == ""
+    assert len(out.stderr.strip().splitlines()) == 1 and says in out.stderr, out.stderr
