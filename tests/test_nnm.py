@@ -151,7 +151,6 @@ def test_contract_mode_2_order_20_in_q_sqrt3():
     (["x1'' + x1 + x1*x2 = 0; x2'' + 4*x2 + x1**2 = 0"], "1:2 internal resonance"),
     (["x1'' + x1 - x2 + x1**3 = 0; x2'' + x2 - x1 = 0"], "a rigid-body linear mode"),
     (["x1'' - x1 + x1**3 = 0; x2'' + x2 = 0"], "an unstable linear mode"),
-    (["x1'' + x1 + x1**3 = 0"], "one equation per coordinate, separated by ';'"),
     (["x1'' + x1 + x2 = 0; x1'' + x1 = 0"], "2 equations hold the accelerations of 1 coordinate (x1'')"),
     (["x1'' + x1 + x2' = 0; x3'' + x3 = 0"], "x2 has no equation of its own"),
     (["x1'' + x1 + x1'/10 = 0; x2'' + x2 = 0"], "damping"),
@@ -318,3 +317,28 @@ def test_stiff_shooting_and_a_linear_system_answer_in_one_line_or_exactly():
     assert linear.omega() == [sp.sqrt(3)] + [0] * 6  # no nonlinear term: ω = ω0 exactly
     out = run("nnm", "x1'' + x1 + x1**3 = 0; x2'' + x2 + x2**3 = 0")
     assert out.returncode == 2 and "1:1 internal resonance" in out.stderr
+
+
+@pytest.mark.parametrize("text", ["q'' + q + q**3/2 = 0", "q'' + 1.3*q + 0.7*q**2 + q**3 = 0",
+                                  "q'' + 2*q + q**2 - 0.25*q**5 = 0"])
+def test_one_coordinate_normal_mode_is_the_free_lindstedt_series(text):
+    """Free L–P is the normal-mode method at n = 1: the system of one coordinate (the normal
+    mode's left-null-vector recursion in Q or Q(ω₀)) and the one-coordinate kernel (its fast
+    path, in units of ω₀) give the same ω_j, T_j and q_j, exactly."""
+    from lindstedt.derive.models import model_from_text
+
+    K = 8
+    mode = normal_mode(parse_system(text), 1, K)
+    one = derive(model_from_text(text, K), K)
+    g = one.ground.to_sympy
+    assert mode.variable in (sp.sstr(one.model.y), f"y = {sp.sstr(one.model.y)}")
+    w0 = mode.omega0
+    assert [sp.simplify(c - w0 * g(d)) for c, d in zip(mode.omega(), one.omega, strict=True)] \
+        == [0] * (K + 1)
+    assert [sp.simplify(c - g(d) / w0) for c, d in zip(mode.period(), one.period, strict=True)] \
+        == [0] * (K + 1)
+    assert [{n: sp.simplify(c - g(one.q[j].get(n, 0))) for n, c in order.items()}
+            for j, order in enumerate(mode.coordinate(0))] == \
+        [dict.fromkeys(order, 0) for order in mode.coordinate(0)]
+    assert all(set(one.q[j]) <= set(order) | {n for n, c in one.q[j].items() if not c}
+               for j, order in enumerate(mode.coordinate(0)))

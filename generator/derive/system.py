@@ -22,8 +22,9 @@ from ..errors import InputError
 from .equation import TIME, derivative_symbols, parse_expression, parse_sides, renamed
 
 MAX_COORDINATES = 12
-# NOTE: the FPU chains and structures a user writes by hand stay far below; exact eigenvalues
-# of a larger stiffness matrix (a characteristic polynomial of degree > 12) are not sought.
+# NOTE: a bound of the exact ground, not of the record: exact eigenvalues of a larger stiffness
+# matrix (a characteristic polynomial of degree > 12) are not sought; the FPU chains and
+# structures a user writes by hand stay far below.
 
 
 @dataclass(frozen=True)
@@ -109,6 +110,10 @@ class System:
 
     @cached_property
     def _modes(self) -> tuple[sp.Expr, ...]:
+        if self.size > MAX_COORDINATES:
+            raise InputError(f"system {self.text!r}: {self.size} coordinates; exact linear modes "
+                             "(the roots of a characteristic polynomial of degree n) are "
+                             f"sought for at most {MAX_COORDINATES}")
         lam = sp.Symbol("lambda")
         poly = sp.Poly(self.stiffness.charpoly(lam).as_expr(), lam)
         roots: list[sp.Expr] = []
@@ -146,12 +151,6 @@ def _read(text: str, driven: bool
     """The coordinates, each equation (with its drive's amplitude apart when driven), the
     parameters' names and the drive's frequency of ``text``."""
     parts = text.split(";") if isinstance(text, str) else [text]
-    if len(parts) < 2:
-        raise InputError(f"system {text!r}: one equation per coordinate, separated by ';' (a "
-                         "single equation is an oscillator: lindstedt series)")
-    if len(parts) > MAX_COORDINATES:
-        raise InputError(f"system {text!r}: {len(parts)} equations; at most "
-                         f"{MAX_COORDINATES} coordinates")
     sides = [parse_sides(p.strip(), "equation") for p in parts]
     coordinates = []
     for i, (_, _, orders, _) in enumerate(sides):
