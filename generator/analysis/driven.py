@@ -19,7 +19,6 @@ kernel of :mod:`series` (``laurent_*``).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,6 +34,7 @@ from ..algebra.series import (
 from ..display import SHOWN_ROWS, html_table
 from ..errors import InputError
 from ..limits import MAGNITUDES, MU_MAX_ORDER, check_int
+from ..numerics.newton import safeguarded
 from .polynomial import DrivenEquation, HarmonicBalance, PolynomialBalance
 
 DUFFING_TEXT = "q'' + q'/Q + q + eps*q**3 = f*cos(w*t)"
@@ -197,9 +197,10 @@ def one_harmonic_roots(eps: float, force: float, Q: float, omega: np.ndarray) ->
     ``∂²G/∂u²`` (``u = −8(1 − ω²)/(9ε)``) and at a bound above every root: on each piece
     ``G`` is monotone and of one curvature, so a piece whose ends differ in sign holds exactly
     one root — no root is lost, however far apart the roots — and Newton's method kept inside
-    the piece converges to it monotonically (after at most one step).  Each piece starts from
-    the quadratic model of ``G`` at its zero of ``∂G/∂u`` (near a fold that is the root to a
-    few digits) or else from its end where ``G`` and ``∂²G/∂u²`` agree in sign."""
+    the piece (:func:`numerics.newton.safeguarded`) converges to it monotonically (after at
+    most one step).  Each piece starts from the quadratic model of ``G`` at its zero of
+    ``∂G/∂u`` (near a fold that is the root to a few digits) or else from its end where ``G``
+    and ``∂²G/∂u²`` agree in sign."""
     d = Drive(eps, force, 1.0, Q)
     w = np.atleast_1d(np.asarray(omega, dtype=float))
     a = (1 - w) * (1 + w)
@@ -249,32 +250,10 @@ def one_harmonic_roots(eps: float, force: float, Q: float, omega: np.ndarray) ->
             value[k] = _exact_residual(x[k], w[r[i[k]]], eps, force, Q)
         return value, slope
 
-    x = _newton(np.clip(x, lo, hi), lo, hi, residual)
+    x = safeguarded(residual, np.clip(x, lo, hi), lo, hi, ROOT_STEPS)
     rank = np.concatenate([above[p][rows[p]] for p in range(4)]).astype(int)
     roots[r, rank] = x  # the pieces ascend in u: largest first, NaN last
     return roots
-
-
-def _newton(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, G: Callable) -> np.ndarray:
-    """Newton's method on each root ``x`` kept inside its piece ``[lo, hi]``, until its moves stop
-    shrinking or reach rounding; ``G(i, x)`` gives ``G`` and ``∂G/∂u`` of the roots ``i`` at
-    ``x``."""
-    x = x.copy()
-    todo = np.arange(x.size)  # the roots still moving
-    moved = np.full(x.shape, np.inf)
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        for _ in range(ROOT_STEPS):
-            if not todo.size:
-                break
-            xt = x[todo]
-            value, slope = G(todo, xt)
-            new = np.clip(xt - np.where(slope != 0, value / slope, 0.0), lo[todo], hi[todo])
-            move = np.abs(new - xt)
-            x[todo] = new
-            going = (move > 2.0**-52 * new) & (move < moved[todo])
-            moved[todo] = move
-            todo = todo[going]
-    return x
 
 
 def one_harmonic_phase(eps: float, force: float, Q: float, omega: np.ndarray,

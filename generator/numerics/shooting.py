@@ -24,7 +24,7 @@ from .integrate import (
     escape_bound,
     flow_table,
 )
-from .newton import newton
+from .newton import Iteration, iterate, newton
 
 
 @dataclass(frozen=True)
@@ -76,6 +76,27 @@ class ShootingFailure:
     reason: str
     escaped: bool
     bound: float  # the escape bound |q| of these parameters (inf: no well to leave)
+
+
+class _Failed(Exception):
+    """Raised from a shooting's evaluation at a domain event (an escape, an overflow, a failed
+    integration): it carries the failure (``None``: none to report) out of Newton's method."""
+
+    def __init__(self, failure: ShootingFailure | None) -> None:
+        super().__init__()
+        self.failure = failure
+
+
+def _newton_failure(run: Iteration, max_iter: int, tolerance: str,
+                    bound: float) -> ShootingFailure:
+    """Why shooting's Newton (:func:`numerics.newton.iterate`) stopped short of an orbit: a
+    singular ``M − I`` at the iterate it reached, or no convergence (a step that overflowed
+    counts as none: the flow from it would have overflowed)."""
+    if run.why == "singular":
+        return ShootingFailure(f"M - I is singular at Newton's iterate {run.steps} (a Floquet "
+                               "multiplier +1: a fold)", False, bound)
+    return ShootingFailure(f"Newton's method did not converge in {max_iter} iterations "
+                           f"(last step {run.step:.1e}{tolerance})", False, bound)
 
 
 def shoot(eps: float, force: float, omega: float, damping: float, guess: np.ndarray,
@@ -132,31 +153,29 @@ def shoot_table(table: ForceTable, force: float, omega: float, guess: np.ndarray
             + ("; an orbit near this state, if any, is too unstable for single shooting"
                if k == 0 else ""), k == 0, bound)
 
-    step = np.full(2, np.nan)
-    for k in range(max_iter):
+    calls = 0
+
+    def evaluate(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        nonlocal calls
+        k, calls = calls, calls + 1  # the flow of Newton's iterate k
         end, _, at = flow_table(table, force, omega, y, T, steps=steps, bound=bound,
                                 extra=extra)
         if at >= 0:
-            return escape(k, y, at)
+            raise _Failed(escape(k, y, at))
         if not np.all(np.isfinite(end)):  # RK4 overflowed: h is too big for the amplitude
-            return ShootingFailure(
+            raise _Failed(ShootingFailure(
                 f"RK4 overflowed from (q, q') = ({y[0]:.6g}, {y[1]:.6g})"
                 + (f" (Newton's iterate {k})" if k else "") + ": its step is too large for "
-                "this amplitude", False, bound)
-        Mono = end[2:].reshape(2, 2).T
-        r = end[:2] - y
-        try:
-            step = np.linalg.solve(Mono - np.eye(2), -r)
-        except np.linalg.LinAlgError:
-            return ShootingFailure(f"M - I is singular at Newton's iterate {k} (a Floquet "
-                                   "multiplier +1: a fold)", False, bound)
-        y = y + step
-        if np.max(np.abs(step)) < tol * (1 + np.max(np.abs(y))):
-            break
-    else:
-        return ShootingFailure(f"Newton's method did not converge in {max_iter} iterations "
-                               f"(last step {np.max(np.abs(step)):.1e}, tolerance {tol:g})",
-                               False, bound)
+                "this amplitude", False, bound))
+        return end[:2] - y, end[2:].reshape(2, 2).T - np.eye(2)  # M − I
+
+    try:
+        run = iterate(evaluate, guess, tol, max_iter)
+    except _Failed as failed:
+        return failed.failure
+    if not run.converged:
+        return _newton_failure(run, max_iter, f", tolerance {tol:g}", bound)
+    y = run.x
     end, qs, at = flow_table(table, force, omega, y, T, samples=samples, steps=steps,
                              bound=bound, extra=extra)
     if at >= 0:
@@ -228,30 +247,31 @@ def limit_cycle_orbit(table: ForceTable, q0: float, period: float, tol: float = 
     """Newton's method on ``φ_T(q₀, 0) − (q₀, 0) = 0`` in ``(q₀, T)`` (the phase fixed by
     ``q̇(0) = 0``): the Jacobian is ``[M e₁ − e₁, ẏ(T)]`` with the monodromy ``M`` from the one
     compiled RK4 step (Richardson pair).  None when Newton does not converge."""
-    q, T = float(q0), float(period)
-    for _ in range(max_iter):
-        if not (np.isfinite(q) and np.isfinite(T) and T > 0):
-            return None
+    def evaluate(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        q, T = z
+        if not T > 0:
+            raise _Failed(None)
         end, _, escaped = flow_table(table, 0.0, 2 * np.pi / T, np.array([q, 0.0]), T)
         if escaped >= 0 or not np.all(np.isfinite(end)):
-            return None
-        residual = end[:2] - np.array([q, 0.0])
+            raise _Failed(None)
         M = end[2:].reshape(2, 2, order="F")
         g, _, _ = _table_force(end[0], end[1], table.q_powers, table.v_powers,
                                table.coefficients)
-        jacobian = np.column_stack([M[:, 0] - np.array([1.0, 0.0]), [end[1], -g]])
-        try:
-            step = np.linalg.solve(jacobian, -residual)
-        except np.linalg.LinAlgError:
-            return None
-        q, T = q + step[0], T + step[1]
-        if np.max(np.abs(step)) < tol * max(1.0, abs(q), T):
-            end, _, _ = flow_table(table, 0.0, 2 * np.pi / T, np.array([q, 0.0]), T)
-            M = end[2:].reshape(2, 2, order="F")
-            mu = np.linalg.eigvals(M)
-            mu = tuple(sorted((complex(m) for m in mu), key=lambda m: abs(abs(m) - 1)))
-            return LimitCycleOrbit(q, T, mu, float(np.log(abs(np.linalg.det(M))) / T))
-    return None
+        return (end[:2] - np.array([q, 0.0]),
+                np.column_stack([M[:, 0] - np.array([1.0, 0.0]), [end[1], -g]]))
+
+    try:
+        run = iterate(evaluate, np.array([q0, period], dtype=float), tol, max_iter)
+    except _Failed:
+        return None
+    if not run.converged:
+        return None
+    q, T = (float(v) for v in run.x)
+    end, _, _ = flow_table(table, 0.0, 2 * np.pi / T, np.array([q, 0.0]), T)
+    M = end[2:].reshape(2, 2, order="F")
+    mu = np.linalg.eigvals(M)
+    mu = tuple(sorted((complex(m) for m in mu), key=lambda m: abs(abs(m) - 1)))
+    return LimitCycleOrbit(q, T, mu, float(np.log(abs(np.linalg.det(M))) / T))
 
 
 def true_limit_cycle(model: object, eps: float, cycle: int = 0, order: int = 12
@@ -298,27 +318,26 @@ def shoot_system(field: PolynomialField, drive: np.ndarray, omega: float, guess:
                          atol=rtol * 1e-3,
                          t_eval=np.linspace(0.0, T, samples + 1) if dense else None)
 
-    y = np.array(guess, dtype=float)
-    step = np.full(m, np.nan)
+    calls = 0
+
+    def evaluate(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        nonlocal calls
+        k, calls = calls, calls + 1  # the flow of Newton's iterate k
+        sol = flow(y)
+        end = sol.y[:, -1]
+        if not (sol.success and np.all(np.isfinite(end))):
+            raise _Failed(ShootingFailure(f"DOP853 failed from Newton's iterate {k} "
+                                          f"({sol.message})", False, math.inf))
+        return end[:m] - y, end[m:].reshape(m, m, order="F") - np.eye(m)  # M − I
+
+    try:
+        run = iterate(evaluate, guess, tol, max_iter)
+    except _Failed as failed:
+        return failed.failure
+    if not run.converged:
+        return _newton_failure(run, max_iter, "", math.inf)
+    y = run.x
     with np.errstate(over="ignore", invalid="ignore"):
-        for k in range(max_iter):
-            sol = flow(y)
-            end = sol.y[:, -1]
-            if not (sol.success and np.all(np.isfinite(end))):
-                return ShootingFailure(f"DOP853 failed from Newton's iterate {k} "
-                                       f"({sol.message})", False, math.inf)
-            M = end[m:].reshape(m, m, order="F")
-            try:
-                step = np.linalg.solve(M - np.eye(m), -(end[:m] - y))
-            except np.linalg.LinAlgError:
-                return ShootingFailure(f"M - I is singular at Newton's iterate {k} (a Floquet "
-                                       "multiplier +1: a fold)", False, math.inf)
-            y = y + step
-            if np.max(np.abs(step)) < tol * (1 + np.max(np.abs(y))):
-                break
-        else:
-            return ShootingFailure(f"Newton's method did not converge in {max_iter} iterations "
-                                   f"(last step {np.max(np.abs(step)):.1e})", False, math.inf)
         sol = flow(y, dense=True)
     M = sol.y[m:, -1].reshape(m, m, order="F")
     lam = np.linalg.eigvals(M)
