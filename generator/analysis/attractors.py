@@ -16,6 +16,7 @@ import numpy as np
 
 from ..numerics.floquet import variational_multipliers
 from ..numerics.integrate import PolynomialField, record_system
+from ..numerics.newton import secant
 from .continuation import Continuation, _corrector, _tangent, fold_point
 from .polynomial import PolynomialBalance
 
@@ -207,38 +208,25 @@ def _refine(fine: PolynomialBalance, y0: np.ndarray, y1: np.ndarray, g0: float, 
             kind: str, top: float) -> tuple[np.ndarray, np.ndarray, float]:
     """The point between the curve's points ``y0``, ``y1`` where the crossing multiplier of
     ``kind`` has ``|μ| = 1``: Illinois' secant on the chord's fraction, each iterate corrected
-    onto the curve (:func:`continuation._corrector` across the chord); ``(y, μ, |μ| − 1)``."""
+    onto the curve (:func:`continuation._corrector` across the chord;
+    :func:`numerics.newton.secant`, bracketed); ``(y, μ, |μ| − 1)``."""
     chord = y1 - y0
     t = chord / np.linalg.norm(chord)
-    a, b, fa, fb = 0.0, 1.0, g0, g1
     best = (y0, orbit_multipliers(fine, y0[:-1], y0[-1:], top)[0], g0)
-    side = 0
-    for _ in range(REFINE_STEPS):
-        s = b - fb * (b - a) / (fb - fa) if fb != fa else 0.5 * (a + b)
-        if not a < s < b:
-            s = 0.5 * (a + b)
+
+    def crossing(s: float) -> float:
+        nonlocal best
         try:
             y = _corrector(fine, y0 + s * chord, t)
         except np.linalg.LinAlgError:
-            break
+            return math.nan  # stops the secant
         lam = orbit_multipliers(fine, y[:-1], y[-1:], top)[0]
         g = _crossing(lam, kind)
-        if not math.isfinite(g):
-            break
-        if abs(g) < abs(best[2]):
+        if math.isfinite(g) and abs(g) < abs(best[2]):
             best = (y, lam, g)
-        if abs(g) < 1e-11:
-            break
-        if (g > 0) == (fa > 0):  # Illinois: halve the end kept twice
-            a, fa = s, g
-            if side == -1:
-                fb /= 2
-            side = -1
-        else:
-            b, fb = s, g
-            if side == 1:
-                fa /= 2
-            side = 1
+        return g
+
+    secant(crossing, 0.0, 1.0, g0, g1, ftol=1e-11, max_iter=REFINE_STEPS, bracketed=True)
     return best
 
 

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..limits import MAX_DRIVE_POINTS
+from ..numerics.newton import bordered, secant
 from .polynomial import DrivenEquation, PolynomialBalance, amplitude_bound
 
 
@@ -170,17 +171,18 @@ def _tangent(sysm: PolynomialBalance, y: np.ndarray, previous: np.ndarray | None
 
 
 def _corrector(sysm: PolynomialBalance, y: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Newton on ``R(y) = 0`` with ``t·(y − y_pred) = 0``."""
-    y_pred = y.copy()
-    for _ in range(30):
-        x, omega = y[:-1], y[-1]
-        F = np.append(sysm.residual(x, omega), t @ (y - y_pred))
-        J = np.vstack([_extended_jacobian(sysm, y), t])
-        dy = np.linalg.solve(J, -F)
-        y = y + dy
-        if np.max(np.abs(dy)) < 1e-13 * (1 + np.max(np.abs(y))):
-            break
-    return y
+    """Newton on ``R(y) = 0`` with ``t·(y − y_pred) = 0`` (:func:`numerics.newton.bordered`,
+    30 steps): the point it reached; NaN where a step overflowed; ``LinAlgError`` where the
+    bordered Jacobian is singular."""
+    def evaluate(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return sysm.residual(z[:-1], z[-1]), _extended_jacobian(sysm, z)
+
+    run = bordered(evaluate, t, y, 1e-13, 30)
+    if run.why == "singular":
+        raise np.linalg.LinAlgError("Singular matrix")
+    if run.why == "not finite":
+        return np.full_like(run.x, np.nan)
+    return run.x
 
 
 def _refine_fold(sysm: PolynomialBalance, y: np.ndarray, t: np.ndarray, step: float) -> float:
@@ -191,24 +193,26 @@ def _refine_fold(sysm: PolynomialBalance, y: np.ndarray, t: np.ndarray, step: fl
 def fold_point(sysm: PolynomialBalance, y: np.ndarray, t: np.ndarray, step: float
                ) -> np.ndarray:
     """The fold ``(x, ω)`` near the continuation point ``y`` along its tangent ``t``: secant on
-    the step length for ``t_ω = 0`` (each iterate corrected onto the curve), from ``0`` and
-    ``step``."""
-    def t_omega(h: float) -> tuple[float, np.ndarray]:
-        z = _corrector(sysm, y + h * t, t)
-        return _tangent(sysm, z, t)[-1], z
+    the step length for ``t_ω = 0`` (:func:`numerics.newton.secant`, each iterate corrected
+    onto the curve), from ``0`` and ``step``."""
+    return _secant_turn(sysm, y, t, step, t[-1], y)
 
-    h0, h1 = 0.0, step
-    f0, f1 = t[-1], t_omega(step)[0]
-    z = y
-    for _ in range(40):
-        if f1 == f0:
-            break
-        h2 = h1 - f1 * (h1 - h0) / (f1 - f0)
-        f2, z = t_omega(h2)
-        h0, f0, h1, f1 = h1, f1, h2, f2
-        if abs(f2) < 1e-13:
-            break
-    return z
+
+def _secant_turn(fam: object, y: np.ndarray, t: np.ndarray, step: float, f0: float,
+                 z: np.ndarray | None) -> np.ndarray | None:
+    """The point where the tangent's last component vanishes along ``y + h t``: the secant on
+    ``h`` from ``0`` (where it is ``f0``) and ``step`` (40 steps, until ``|t_last| ≤ 1e-13``),
+    each iterate corrected onto the curve; the last one corrected, ``z`` where there is none
+    (the secant's two values equal at once)."""
+    last = [z]
+
+    def t_last(h: float) -> float:
+        last[0] = _corrector(fam, y + h * t, t)
+        return _tangent(fam, last[0], t)[-1]
+
+    f1 = _tangent(fam, _corrector(fam, y + step * t, t), t)[-1]
+    secant(t_last, 0.0, step, f0, f1, ftol=1e-13, max_iter=40)
+    return last[0]
 
 
 CONTINUATION_HARMONICS = 8

@@ -17,7 +17,7 @@ import sympy as sp
 
 from ..errors import InputError
 from ..numerics.integrate import ForceTable, Sweep, escape_bound, sweep_table
-from ..numerics.newton import newton
+from ..numerics.newton import newton, safeguarded
 from ..numerics.shooting import orbit_fold_table
 from .attractors import Dynamics, dynamics, orbit_multipliers
 from .continuation import (
@@ -180,16 +180,18 @@ class OneHarmonic:
         return _poly.polytrim(H, 0)
 
     def amplitudes(self, omega: float) -> np.ndarray:
-        """The positive real roots r of ``H``, ascending (each polished by Newton's method)."""
+        """The positive real roots r of ``H``, ascending (each polished by Newton's method,
+        :func:`numerics.newton.safeguarded`)."""
         H = self.polynomial(omega)
         dH = _poly.polyder(H)
         roots = _poly.polyroots(H)
         scale = 1 + np.abs(roots)
         rs = roots.real[(np.abs(roots.imag) <= 1e-7 * scale) & (roots.real > 0)]
-        for _ in range(3):
-            d = _poly.polyval(rs, dH)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                rs = rs - np.where(d != 0, _poly.polyval(rs, H) / d, 0.0)
+
+        def value_slope(i: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            return _poly.polyval(r, H), _poly.polyval(r, dH)
+
+        rs = safeguarded(value_slope, rs, max_iter=3)  # unbracketed: at most three steps
         return np.sort(rs[rs > 0])
 
     def phase(self, r: float, omega: float) -> float:

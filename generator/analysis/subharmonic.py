@@ -25,7 +25,7 @@ from ..numerics.floquet import hill_multipliers, multipliers_stable, orbit_hill_
 from ..numerics.integrate import ForceTable, duffing_table, steady_state_amplitudes
 from ..numerics.newton import newton
 from ..numerics.shooting import PeriodicOrbit, shoot, shoot_table
-from .continuation import _corrector, _DriveFamily, _tangent
+from .continuation import _corrector, _DriveFamily, _secant_turn, _tangent
 from .driven import Drive
 from .periodic import SHOOTING_TOLERANCES
 from .polynomial import PolynomialBalance, amplitude_bound, driven_form
@@ -513,19 +513,8 @@ def _turn(system: PolynomialBalance, fam: _DriveFamily, p: SubharmonicProblem, y
     first harmonic there has fallen below :data:`BRANCH_SHARE` of the orbit's (its drive
     amplitude then polished on the primary response), a fold otherwise."""
     step = float(np.linalg.norm(y_new - y))
-    z = None
     try:
-        h0, h1 = 0.0, step
-        f0, f1 = t[-1], _tangent(fam, _corrector(fam, y + step * t, t), t)[-1]
-        for _ in range(40):
-            if f1 == f0:
-                break
-            h2 = h1 - f1 * (h1 - h0) / (f1 - f0)
-            z = _corrector(fam, y + h2 * t, t)
-            f2 = _tangent(fam, z, t)[-1]
-            h0, f0, h1, f1 = h1, f1, h2, f2
-            if abs(f2) < 1e-13:
-                break
+        z = _secant_turn(fam, y, t, step, t[-1], None)
     except np.linalg.LinAlgError:
         z = None
     lo, hi = min(y[-1], y_new[-1]), max(y[-1], y_new[-1])

@@ -362,6 +362,8 @@ def fixed_points(flow: SlowFlow, eps: float, values: dict[str, float] | None = N
     found = []
     for r0, p0 in guesses:
         x = np.array([r0 * np.cos(p0), -r0 * np.sin(p0)])
+        # NOTE: Newton's method by hand, not numerics.newton.iterate: derive stands above
+        # numerics in the package's stage list, and a stage imports only stages above it.
         for _ in range(100):
             step = np.linalg.solve(np.asarray(J(*x), dtype=float), np.asarray(f(*x), dtype=float))
             x = x - step

@@ -218,6 +218,8 @@ def escape_bound(eps: float, force: float) -> float:
         return math.inf
     k, f = -float(eps), abs(float(force))
     x = max(math.sqrt(2 / k), (2 * f / k) ** (1 / 3))  # right of the root: g(x) ≥ 0
+    # NOTE: Newton's method by hand, not numerics.newton: integrate stands above newton in the
+    # package's stage list (shooting, below both, imports them), so it cannot import it.
     for _ in range(100):  # Newton on the convex g from the right: monotone
         step = (k * x**3 - x - f) / (3 * k * x * x - 1)
         x -= step

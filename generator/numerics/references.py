@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike
 from scipy.special import ellipj, ellipk
 
 from ..limits import EXCHANGE_MAX_STEPS
+from .newton import newton, secant
 
 
 def duffing_period_exact(A: ArrayLike, eps: ArrayLike) -> np.ndarray:
@@ -92,7 +93,8 @@ def cycle_reference(model: object, eps: float, guess: float = 2.0, period: float
     """The attracting limit cycle of ``q̈ + q = ε f(q, q̇)`` (a :class:`models.SelfExcited`)
     at any ``eps > 0``, relaxation oscillations included: the return map to the maximum of q
     (Poincaré section q̇ = 0), a few plain returns from ``guess`` and then the secant method
-    on ``P(a) − a``; repeated at ``100 rtol`` for :attr:`CycleReference.accuracy`."""
+    on ``P(a) − a`` (:func:`numerics.newton.secant`); repeated at ``100 rtol`` for
+    :attr:`CycleReference.accuracy`."""
     rhs = _cycle_rhs(model, eps)
 
     def solve(tol: float) -> tuple[float, float]:
@@ -100,17 +102,12 @@ def cycle_reference(model: object, eps: float, guess: float = 2.0, period: float
         a = guess
         for _ in range(3):
             a, _ = _cycle_return(rhs, a, tol, t_max)
+        def gap(a: float) -> float:
+            return _cycle_return(rhs, a, tol, t_max)[0] - a
+
         a0, a1 = a, a * (1 + 1e-7)
-        g0, g1 = _cycle_return(rhs, a0, tol, t_max)[0] - a0, _cycle_return(
-            rhs, a1, tol, t_max)[0] - a1
-        for _ in range(30):
-            if g1 == g0 or not math.isfinite(g1):
-                break
-            a0, g0, a1 = a1, g1, a1 - g1 * (a1 - a0) / (g1 - g0)
-            g1 = _cycle_return(rhs, a1, tol, t_max)[0] - a1
-            if abs(a1 - a0) < 1e-15 * abs(a1):
-                break
-        return _cycle_return(rhs, a1, tol, t_max)
+        run = secant(gap, a0, a1, gap(a0), gap(a1), tol=1e-15, max_iter=30)
+        return _cycle_return(rhs, run.x, tol, t_max)
 
     q0, T = solve(rtol)
     _, T_coarse = solve(rtol * 100)
@@ -207,6 +204,9 @@ def mathieu_newton(kind: str, m: int, q: ArrayLike, start: ArrayLike, rows: int,
     a = np.asarray(start, dtype=float) + 0.0 * q
     qq = q * q
     k = rows // 2
+    # NOTE: Newton's steps by hand, not numerics.newton: exactly ``steps`` of them, no stopping
+    # test and no guard, in the order the emitted evaluators unroll them, whose values the
+    # verification compares with these.
     for _ in range(steps):
         one, zero = np.ones_like(a), np.zeros_like(a)
         p_prev, dp_prev, p, dp = one, zero, diag[0][0] + diag[0][1] * q - a, -one
@@ -279,6 +279,8 @@ def mathieu_refined(kind: str, m: int, q: float, dps: int = 30) -> float:
     with mpmath.workdps(dps + 5):
         qq = mpmath.mpf(q)
         a = mpmath.mpf(mathieu_reference(kind, m, q))
+        # NOTE: Newton's steps by hand, not numerics.newton: in mpmath at dps + 5 digits (the
+        # one Newton works in float64), three of them, the third a check.
         for step in range(3):
             p_prev, dp_prev = mpmath.mpf(1), mpmath.mpf(0)
             p, dp = diag[0][0] + diag[0][1] * qq - a, mpmath.mpf(-1)
@@ -362,7 +364,6 @@ def mode_orbit(system: object, A: float, guess: np.ndarray, amplitude: int = 0,
     the same at ``A = 1e-12`` as at ``A = 1`` (an absolute 1e-14 gave periods 1e-4 off there)."""
     from scipy.integrate import solve_ivp
 
-    from .newton import newton
 
     d = system.size
     rhs = system_rhs(system)
