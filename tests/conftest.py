@@ -18,7 +18,8 @@ import pytest
 LAYERS = {
     "exact": ("attractors", "averaging", "branches", "driven", "driven_damped", "driven_equation",
               "equation",
-              "hill", "layout", "lindstedt", "nnm", "parametric", "response", "response_equation",
+              "hill", "layout", "lindstedt", "newton", "nnm", "parametric", "response",
+              "response_equation",
               "response_system",
               "resonance", "series", "subharmonic"),
     "printers": ("charts", "cli", "costs", "curves", "emit", "files", "fuzz", "interrupt", "latex",
