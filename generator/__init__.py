@@ -14,6 +14,9 @@ order; a stage imports only stages above it::
     derive.equation         user text through a whitelist walker over ``ast`` [str -> Equation]
     derive.models           the oscillator registry, a user's Oscillator, its L–P Model
                             [Equation, K -> Model]
+    derive.problem          the one problem record: a text (one equation, a system of any
+                            n, a preset's name) as its equations, read once; a command's
+                            route to a method asks it [str -> Problem]
     derive.orbits           where a free oscillator's family of periodic orbits ends: the first
                             integral's separatrix, to 30 digits [Model -> OrbitDomain]
     derive.lindstedt        L–P series, order-by-order equations, naive expansion; the nearest

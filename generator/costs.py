@@ -227,8 +227,8 @@ def generate_seconds(model: str, size: int) -> float:
     return power_law(*_fit(GENERATE_COSTS, model), size)
 
 
-def generate_cost(args: argparse.Namespace) -> Cost:
-    """Bounds first (no switch lifts them), then the model's own fit."""
+def _generate_bounds(args: argparse.Namespace) -> None:
+    """generate's bounds, for every method: no switch lifts them."""
     if args.model == "driven" and args.order > DRIVEN_MAX_ORDER:
         raise InputError(f"order {args.order}: the exact μ-expansion is emitted up to order "
                          f"{DRIVEN_MAX_ORDER} (its rational functions grow fast)")
@@ -236,15 +236,24 @@ def generate_cost(args: argparse.Namespace) -> Cost:
         raise InputError(f"order {args.order}: generate stops at order {GENERATE_MAX_ORDER} (numba "
                          "compiles that module in about a minute on its first import); "
                          "`lindstedt series` derives higher orders")
+
+
+def generate_mode_cost(args: argparse.Namespace) -> Cost:
+    """``generate SYSTEM --mode M``: the normal mode's series to the radius order, emitted."""
+    from .methods.targets import NNM_RADIUS_ORDER
+
+    _generate_bounds(args)
+    series = nnm_cost(argparse.Namespace(system=args.model,
+                                         order=max(args.order + 2, NNM_RADIUS_ORDER)))
+    return Cost(series.seconds + generate_seconds("duffing", args.order), series.subject,
+                "generating the normal mode's evaluators")
+
+
+def generate_cost(args: argparse.Namespace) -> Cost:
+    """Bounds first (no switch lifts them), then the model's own fit."""
+    _generate_bounds(args)
     harmonic = args.model in ("balance", "fourier")
     size = args.harmonics if harmonic else args.order
-    if ";" in args.model:  # a system's normal mode: its series to the radius order, emitted
-        from .methods.targets import NNM_RADIUS_ORDER
-
-        series = nnm_cost(argparse.Namespace(system=args.model,
-                                             order=max(size + 2, NNM_RADIUS_ORDER)))
-        return Cost(series.seconds + generate_seconds("duffing", size), series.subject,
-                    "generating the normal mode's evaluators")
     if args.model not in GENERATE_COSTS:  # a user's: its derivation, then Duffing's emission
         derivation = series_cost(argparse.Namespace(model=args.model, param=args.param,
                                                     order=size + 2)).seconds
@@ -349,22 +358,25 @@ def response_equation_cost(args: argparse.Namespace) -> Cost:
                 "of the equation")
 
 
+def response_system_cost(args: argparse.Namespace) -> Cost:
+    """``response SYSTEM``: the planned continuation, drive continuations and shots."""
+    from .analysis.systems import system_plan
+
+    plan = system_plan(args.model, _values(args), args.harmonics, args.omega_min,
+                       args.omega_max)
+    given = "".join(f", --param {pair}" for pair in args.param or ())
+    return Cost(plan.seconds, f"--harmonics {args.harmonics}{given}",
+                f"the continuation of about {plan.points:.0f} points, {plan.drives} drive "
+                f"continuations (at most {plan.drive_points} points each) and the shots "
+                "of the system")
+
+
 def response_cost(args: argparse.Namespace) -> Cost:
     """``response``: for an EQUATION :func:`response_equation_cost`; else the fixed part and
     the continuation over the response's ω range at ``--harmonics`` (the fixed part
     alone when ε, f or Q is missing: the command says so)."""
     from .analysis.response import continuation_seconds, response_range
 
-    if getattr(args, "model", None) is not None and ";" in args.model:
-        from .analysis.systems import system_plan
-
-        plan = system_plan(args.model, _values(args), args.harmonics, args.omega_min,
-                           args.omega_max)
-        given = "".join(f", --param {pair}" for pair in args.param or ())
-        return Cost(plan.seconds, f"--harmonics {args.harmonics}{given}",
-                    f"the continuation of about {plan.points:.0f} points, {plan.drives} drive "
-                    f"continuations (at most {plan.drive_points} points each) and the shots "
-                    "of the system")
     if getattr(args, "model", None) is not None:
         return response_equation_cost(args)
     if any(getattr(args, k, None) is None for k in ("eps", "force", "Q")):
@@ -505,16 +517,22 @@ EXCHANGE_STEP_SECONDS = 5e-4
 
 
 def slow_flow_cost(args: argparse.Namespace) -> Cost:
-    """``slowflow``: the fit at ``--order`` (beyond :data:`SLOW_FLOW_MAX_ORDER` the fixed
-    part only: the derivation refuses at once); a SYSTEM's energy exchange adds its bounded
-    integration (:data:`EXCHANGE_MAX_STEPS` steps), the same for every ``--start``."""
-    # NOTE: beyond the bound the derivation refuses at once (its own one-line message)
-    system = ";" in args.model
-    asked = args.order if args.order is not None else 1 if system else 2
+    """``slowflow``: the fit at ``--order`` (default 2; beyond :data:`SLOW_FLOW_MAX_ORDER` the
+    fixed part only: the derivation refuses at once, in its own one-line message)."""
+    return _averaging_cost(args.order if args.order is not None else 2, 0.0)
+
+
+def resonant_flow_cost(args: argparse.Namespace) -> Cost:
+    """``slowflow SYSTEM``: the fit at ``--order`` (default 1) and the energy exchange's
+    bounded integration (:data:`EXCHANGE_MAX_STEPS` steps), the same for every ``--start``."""
+    return _averaging_cost(args.order if args.order is not None else 1,
+                           EXCHANGE_MAX_STEPS * EXCHANGE_STEP_SECONDS)
+
+
+def _averaging_cost(asked: int, exchange: float) -> Cost:
     order = asked if asked <= SLOW_FLOW_MAX_ORDER else 0
-    exchange = EXCHANGE_MAX_STEPS * EXCHANGE_STEP_SECONDS if system else 0.0
     return Cost(power_law(*SLOW_FLOW_FIT, order) + exchange, f"order {asked}",
-                "the slow flow" + " and its energy exchange" * system)
+                "the slow flow" + " and its energy exchange" * bool(exchange))
 
 
 PARAMETRIC_FIT = (2.0, 1.5e-3)
@@ -543,8 +561,10 @@ NNM_FIT = (0.6, 4.6e-5, 2.5)
 
 def nnm_cost(args: argparse.Namespace) -> Cost:
     """``nnm``: the fit :data:`NNM_FIT` in the order and the number of equations."""
+    from .derive.problem import read_problem
+
     fixed, c, e = NNM_FIT
-    d = max(args.system.count(";") + 1, 2)
+    d = max(read_problem(args.system).size, 2)
     return Cost(fixed + c * args.order**3 * (d / 2) ** e, f"order {args.order}, {d} coordinates",
                 "the normal mode's series")
 
@@ -567,5 +587,12 @@ COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "slowflow": slow_flow_cost,
     "nnm": nnm_cost,
 }
+ROUTE_COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
+    "generate normal mode": generate_mode_cost,
+    "response system": response_system_cost,
+    "slowflow resonant flow": resonant_flow_cost,
+}
+# NOTE: the estimators of a command's other methods (cli.COMMANDS' routes), by command and
+# method.
 # NOTE: one estimator per command; `demo` has none: its work is the fixed built-in job
 # (`make demo`), which nothing on its command line scales.

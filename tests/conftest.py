@@ -24,7 +24,8 @@ LAYERS = {
               "resonance", "series", "subharmonic"),
     "printers": ("charts", "cli", "costs", "curves", "emit", "files", "fuzz", "interrupt", "latex",
                  "messages", "notebook", "readme", "validity"),
-    "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "mass", "nnm_emitted", "orbits",
+    "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "mass", "nnm_emitted",
+                "orbits",
                 "orbit_domain_grid",
                 "oscillator", "resum", "sweep", "tongues"),
 }

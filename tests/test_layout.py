@@ -165,3 +165,49 @@ def test_the_import_reader_sees_late_and_relative_imports(tmp_path):
                       "    import lindstedt.sweep\n")
     assert imported(source, set(modules()), "analysis/x.py") == {
         "emit.render", "cli", "choose", "analysis.driven", "sweep"}
+
+
+def test_only_the_parser_splits_a_text_into_equations():
+    """No command, cost or method asks whether a text holds a ';' (or counts them): the one
+    problem record (derive.problem) does, and routes ask the record."""
+    parsers = {"derive.problem", "derive.equation"}
+    found = []
+    for name, path in modules().items():
+        if name in parsers:
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            asks = (isinstance(node, ast.Compare) and _semicolon(node.left)
+                    and isinstance(node.ops[0], ast.In | ast.NotIn))
+            splits = (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+                      and node.func.attr in ("split", "count", "partition")
+                      and any(map(_semicolon, node.args))
+                      and not (isinstance(node.func.value, ast.Name)
+                               and node.func.value.id == "message"))  # an error's own text
+            if asks or splits:
+                found.append(f"{name}:{node.lineno}")
+    assert not found, found
+
+
+def _semicolon(node: ast.AST) -> bool:
+    return isinstance(node, ast.Constant) and node.value == ";"
+
+
+def test_a_command_routes_its_problem_to_the_first_method_that_takes_it():
+    import argparse
+
+    from lindstedt.cli import COMMAND
+    from lindstedt.derive.problem import read_problem
+
+    pair = "x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0"
+    assert read_problem(pair).equations == ("x1'' + 2*x1 - x2 + x1**3/2 = 0",
+                                            "x2'' + 2*x2 - x1 = 0")
+    assert read_problem("vdp").equations == ("q'' + q = eps*(1 - q**2)*q'",)
+    assert read_problem("vdp").preset == "van_der_pol"
+    assert read_problem("driven").size == 0 and read_problem("driven").preset is None
+    for command, system in (("generate", "normal mode"), ("response", "system"),
+                            ("slowflow", "resonant flow")):
+        route = COMMAND[command].route
+        assert route(argparse.Namespace(model=pair)).method == system
+        for one in ("q'' + q + q**3 = 0", "duffing", "driven"):
+            assert route(argparse.Namespace(model=one)).method == command
+    assert COMMAND["response"].route(argparse.Namespace(model=None)).method == "response"

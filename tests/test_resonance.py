@@ -167,10 +167,10 @@ def test_slowflow_system_cost_does_not_grow_with_the_start():
     """The estimate is bounded (the integration is bounded by steps), whatever --start says."""
     import argparse
 
-    from lindstedt.costs import slow_flow_cost
+    from lindstedt.costs import resonant_flow_cost
     from lindstedt.limits import COST_LIMIT_SECONDS
 
-    costs = {slow_flow_cost(argparse.Namespace(model=QUADRATIC_1_2, order=None,
+    costs = {resonant_flow_cost(argparse.Namespace(model=QUADRATIC_1_2, order=None,
                                                start=[f"a1={a}"])).seconds
              for a in ("0.1", "1000", "1e40")}
     assert len(costs) == 1 and 2 < costs.pop() < COST_LIMIT_SECONDS

@@ -290,7 +290,7 @@ def test_a_strong_drive_is_refused_before_the_continuation(monkeypatch, capsys):
 
     from lindstedt.analysis import systems
     from lindstedt.cli import main
-    from lindstedt.costs import response_cost
+    from lindstedt.costs import response_system_cost
     from lindstedt.limits import COST_LIMIT_SECONDS
 
     def forbidden(*args, **kwargs):
@@ -301,4 +301,4 @@ def test_a_strong_drive_is_refused_before_the_continuation(monkeypatch, capsys):
     assert len(err.splitlines()) == 1 and "--param f=1000" in err and "--allow-slow" in err
     args = argparse.Namespace(model=KERSCHEN, param=["f=1/20"], harmonics=3, omega_min=None,
                               omega_max=None)
-    assert response_cost(args).seconds < COST_LIMIT_SECONDS
+    assert response_system_cost(args).seconds < COST_LIMIT_SECONDS

@@ -15,7 +15,8 @@ from dataclasses import dataclass
 from typing import NoReturn
 
 from .. import __version__
-from ..costs import COSTS
+from ..costs import COSTS, ROUTE_COSTS
+from ..derive.problem import Problem, read_problem
 from ..errors import InputError, Interrupted
 from ..limits import COST_LIMIT_SECONDS
 from .choose import (
@@ -38,6 +39,7 @@ from .driven import (
     run_mixing,
     run_parametric,
     run_response,
+    run_response_of_system,
     run_subharmonic,
 )
 from .series import (
@@ -48,6 +50,7 @@ from .series import (
     arguments_slowflow,
     arguments_tongues,
     run_generate,
+    run_generate_mode,
     run_mathieu,
     run_models,
     run_series,
@@ -55,42 +58,96 @@ from .series import (
     run_tongues,
 )
 from .sweep import arguments_sweep, run_sweep
-from .system import arguments_nnm, run_nnm
+from .system import arguments_nnm, run_nnm, run_slowflow_system
 
 
 @dataclass(frozen=True)
-class Command:
-    """One command: its name, the function that adds its arguments (a subparser), the one that
-    runs it, and its cost estimate (:data:`costs.COSTS`, checked before it runs; ``None``: a
-    command too quick to estimate).  The parser, the cost guard and ``--help`` loop over
-    :data:`COMMANDS`."""
+class Route:
+    """One method of a command, as data: the problems it takes (``applies``: ``None``, else
+    why not), the function that runs it and its cost estimate (checked before it runs;
+    ``None``: too quick to estimate)."""
 
-    name: str
-    arguments: Callable[[argparse._SubParsersAction], argparse.ArgumentParser]
+    method: str
+    applies: Callable[[Problem | None], str | None]
     run: Callable[[argparse.Namespace], int]
     cost: Callable[[argparse.Namespace], object] | None
 
 
-COMMANDS: tuple[Command, ...] = tuple(
-    Command(name, arguments, run, COSTS.get(name)) for name, arguments, run in (
-    ("series", arguments_series, run_series),
-    ("mathieu", arguments_mathieu, run_mathieu),
-    ("tongues", arguments_tongues, run_tongues),
-    ("models", arguments_models, run_models),
-    ("generate", arguments_generate, run_generate),
-    ("nnm", arguments_nnm, run_nnm),
-    ("driven", arguments_driven, run_driven),
-    ("response", arguments_response, run_response),
-    ("subharmonic", arguments_subharmonic, run_subharmonic),
-    ("parametric", arguments_parametric, run_parametric),
-    ("mixing", arguments_mixing, run_mixing),
-    ("choose", arguments_choose, run_choose),
-    ("sweep", arguments_sweep, run_sweep),
-    ("clock", arguments_clock, run_clock),
-    ("scene", arguments_scene, run_scene),
-    ("slowflow", arguments_slowflow, run_slowflow),
-    ("demo", arguments_demo, run_demo),
-))
+def _any(problem: Problem | None) -> None:
+    """Every problem the command's parser takes."""
+    return None
+
+
+def _one_coordinate(problem: Problem | None) -> str | None:
+    """One coordinate (an equation, a preset, a name, the notes' driven Duffing's flags): the
+    one-coordinate kernels, the fast path of every method they share with systems."""
+    if problem is None or problem.one_coordinate:
+        return None
+    return f"{problem.size} coordinates"
+
+
+def _coordinates(problem: Problem | None) -> str | None:
+    """A system of equations (one per coordinate)."""
+    return None if problem is not None and problem.size else "no equations"
+
+
+@dataclass(frozen=True)
+class Command:
+    """One command: its name, the function that adds its arguments (a subparser) and its
+    routes, the methods it runs, in order: the first whose problems hold the command's
+    problem (:func:`derive.problem.read_problem` of its ``MODEL``) runs.  The parser, the cost
+    guard and ``--help`` loop over :data:`COMMANDS`."""
+
+    name: str
+    arguments: Callable[[argparse._SubParsersAction], argparse.ArgumentParser]
+    routes: tuple[Route, ...]
+
+    def route(self, args: argparse.Namespace) -> Route:
+        """The method that takes ``args``' problem; one line naming each method's reason
+        where none does."""
+        text = getattr(args, "model", None)
+        problem = read_problem(text) if isinstance(text, str) else None
+        reasons = []
+        for route in self.routes:
+            why = route.applies(problem)
+            if why is None:
+                return route
+            reasons.append(f"{route.method}: {why}")
+        raise InputError(f"{self.name} {text!r}: no method takes it ({'; '.join(reasons)})")
+
+
+def _command(name: str, arguments: Callable, run: Callable, *others: Route) -> Command:
+    """A command whose first method takes one coordinate (else every problem its parser
+    takes, where it has no ``others``), with its estimate :data:`costs.COSTS`."""
+    first = Route(name, _one_coordinate if others else _any, run, COSTS.get(name))
+    return Command(name, arguments, (first, *others))
+
+
+COMMANDS: tuple[Command, ...] = (
+    _command("series", arguments_series, run_series),
+    _command("mathieu", arguments_mathieu, run_mathieu),
+    _command("tongues", arguments_tongues, run_tongues),
+    _command("models", arguments_models, run_models),
+    _command("generate", arguments_generate, run_generate,
+             Route("normal mode", _coordinates, run_generate_mode,
+                   ROUTE_COSTS["generate normal mode"])),
+    _command("nnm", arguments_nnm, run_nnm),
+    _command("driven", arguments_driven, run_driven),
+    _command("response", arguments_response, run_response,
+             Route("system", _coordinates, run_response_of_system,
+                   ROUTE_COSTS["response system"])),
+    _command("subharmonic", arguments_subharmonic, run_subharmonic),
+    _command("parametric", arguments_parametric, run_parametric),
+    _command("mixing", arguments_mixing, run_mixing),
+    _command("choose", arguments_choose, run_choose),
+    _command("sweep", arguments_sweep, run_sweep),
+    _command("clock", arguments_clock, run_clock),
+    _command("scene", arguments_scene, run_scene),
+    _command("slowflow", arguments_slowflow, run_slowflow,
+             Route("resonant flow", _coordinates, run_slowflow_system,
+                   ROUTE_COSTS["slowflow resonant flow"])),
+    _command("demo", arguments_demo, run_demo),
+)
 COMMAND = {c.name: c for c in COMMANDS}
 
 
@@ -104,17 +161,16 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"lindstedt {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for command in COMMANDS:
-        command.arguments(sub).set_defaults(func=command.run)
+        command.arguments(sub)
     return parser
 
 
-def check_cost(args: argparse.Namespace) -> None:
-    """Every command's estimate (lindstedt.costs.COSTS) before it runs: bounds that no switch
-    lifts, then a refusal above COST_LIMIT_SECONDS without --allow-slow."""
-    estimate = COMMAND[args.command].cost
-    if estimate is None:
+def check_cost(route: Route, args: argparse.Namespace) -> None:
+    """The method's estimate (lindstedt.costs) before it runs: bounds that no switch lifts,
+    then a refusal above COST_LIMIT_SECONDS without --allow-slow."""
+    if route.cost is None:
         return
-    cost = estimate(args)
+    cost = route.cost(args)
     if cost.seconds > COST_LIMIT_SECONDS and not getattr(args, "allow_slow", False):
         raise InputError(cost.refusal())
 
@@ -144,8 +200,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     terminated = _terminate_as_interrupt()
     try:
-        check_cost(args)
-        status = args.func(args)
+        route = COMMAND[args.command].route(args)
+        check_cost(route, args)
+        status = route.run(args)
         sys.stdout.flush()  # a reader that went away (`| head`) is noticed here, not at exit
         return status
     except InputError as exc:

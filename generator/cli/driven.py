@@ -419,15 +419,20 @@ def response_csv(r, path: Path) -> Path:
     return write_csv(path, columns, rows)
 
 
+def run_response_of_system(args: argparse.Namespace) -> int:
+    """Run ``lindstedt response SYSTEM`` (:func:`cli.system.run_response_system`) with the
+    flags of ``response``."""
+    from .system import run_response_system
+
+    _response_args(args)
+    return run_response_system(args, math.inf if args.allow_slow else COST_LIMIT_SECONDS)
+
+
 def run_response(args: argparse.Namespace) -> int:
     """Run ``lindstedt response`` (eq. 10.60 or an EQUATION): the response curve over ω, as a
     table, JSON, a figure or CSV, computed once.  Returns the exit status."""
     _response_args(args)
     limit = math.inf if args.allow_slow else COST_LIMIT_SECONDS
-    if args.model is not None and ";" in args.model:
-        from .system import run_response_system
-
-        return run_response_system(args, limit)
     plot, csv = check_outputs(args)
     r = response_report(args, limit)
     if plot is not None and args.model is not None:

@@ -574,14 +574,6 @@ def run_slowflow(args: argparse.Namespace) -> int:
     from ..derive.averaging import slow_flow
     from ..derive.models import oscillator, registry_entry
 
-    if ";" in args.model:  # a system: its modes in internal resonance
-        from .system import run_slowflow_system
-
-        if args.eps is not None or args.sigma is not None:
-            raise InputError("--eps/--sigma: a one-coordinate portrait's values; a system's "
-                             "--plot/--csv draw its energy exchange from --start")
-        args.order = 1 if args.order is None else args.order
-        return run_slowflow_system(args)
     args.order = 2 if args.order is None else args.order
     if args.start:
         raise InputError("--start: a system's flag (equations separated by ';')")
@@ -677,8 +669,6 @@ def run_generate(args: argparse.Namespace) -> int:
     (and LaTeX) of a free oscillator or a limit cycle, or the driven oscillator's
     ``driven``, ``balance`` or ``fourier`` module; print their paths.  Returns the exit status."""
     order = args.order
-    if ";" in args.model:
-        return _generate_system(args)
     if args.mode is not None or args.amplitude is not None:
         raise InputError("--mode/--amplitude: a system's flags (equations separated by ';')")
     if args.model in EMITTED and (args.param or args.name):
@@ -730,7 +720,7 @@ def run_generate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _generate_system(args: argparse.Namespace) -> int:
+def run_generate_mode(args: argparse.Namespace) -> int:
     """``generate SYSTEM --mode M``: the normal mode's module (the flags of free oscillators
     refused beside it)."""
     given = [flag for flag, on in (("--damped", args.damped),

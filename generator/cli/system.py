@@ -225,6 +225,10 @@ def run_slowflow_system(args: argparse.Namespace) -> int:
     from ..derive.resonance import resonant_flow
     from ..derive.system import parse_system
 
+    if args.eps is not None or args.sigma is not None:
+        raise InputError("--eps/--sigma: a one-coordinate portrait's values; a system's "
+                         "--plot/--csv draw its energy exchange from --start")
+    args.order = 1 if args.order is None else args.order
     if args.out is not None:
         raise InputError("--out: a system's slow flow is printed, not emitted (not built)")
     plot, csv = check_outputs(args)

@@ -2,11 +2,12 @@
 
 ``M x'' + C x' + K x + f(x, x') = F cos ωt`` with a constant mass matrix ``M`` (diagonal: each
 equation holds its own acceleration; full: symmetric positive definite, the coordinates in the
-order their accelerations first appear), the damping ``C``, the stiffness ``K``, the nonlinear force ``f`` (terms of
-degree ≥ 2) and a drive ``F cos ωt`` (``response`` takes it; ``nnm`` and ``slowflow`` take
-``C = 0``, ``F = 0``), every coefficient exact.  The linear modes are the roots ``λ = ω₀²``
-of ``det(K − λM) = 0``, kept exact: a rational, or an algebraic number (SymPy's ``CRootOf``
-with its minimal polynomial), never rounded; modes are numbered by increasing linear frequency.
+order their accelerations first appear), the damping ``C``, the stiffness ``K``, the
+nonlinear force ``f`` (terms of degree ≥ 2) and a drive ``F cos ωt`` (``response`` takes it;
+``nnm`` and ``slowflow`` take ``C = 0``, ``F = 0``), every coefficient exact.  The linear
+modes are the roots ``λ = ω₀²`` of ``det(K − λM) = 0``, kept exact: a rational, or an
+algebraic number (SymPy's ``CRootOf`` with its minimal polynomial), never rounded; modes are
+numbered by increasing linear frequency.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import sympy as sp
 
 from ..errors import InputError
 from .equation import TIME, derivative_symbols, parse_expression, parse_sides, renamed
+from .problem import read_problem
 
 MAX_COORDINATES = 12
 # NOTE: a bound of the exact ground, not of the record: exact eigenvalues of a larger stiffness
@@ -150,8 +152,11 @@ def _read(text: str, driven: bool
           ) -> tuple[list[str], list, set[str], sp.Symbol | None]:
     """The coordinates, each equation (with its drive's amplitude apart when driven), the
     parameters' names and the drive's frequency of ``text``."""
-    parts = text.split(";") if isinstance(text, str) else [text]
-    sides = [parse_sides(p.strip(), "equation") for p in parts]
+    parts = read_problem(text).equations if isinstance(text, str) else [text]
+    if not parts:
+        raise InputError(f"system {text!r}: no such preset; write its equations (one per "
+                         "coordinate, separated by ';')")
+    sides = [parse_sides(p, "equation") for p in parts]
     coordinates = []
     for i, (_, _, orders, _) in enumerate(sides):
         accelerations = [n for n, k in orders.items() if k == 2]  # in the text's order

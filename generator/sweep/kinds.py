@@ -556,6 +556,7 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
     from ..analysis.subharmonic import check_n
     from ..analysis.systems import driven_system
     from ..derive.models import oscillator
+    from ..derive.problem import read_problem
     from ..derive.system import system_parameters
 
     if kind not in EQUATION_KINDS:
@@ -565,7 +566,8 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
         check_n(n)
     if not axes:
         raise InputError("sweep EQUATION: give at least one axis, --axis NAME=A:B:N")
-    system = ";" in text
+    # NOTE: a system's map holds a field per coordinate (r_x1, …): another Kind's fields
+    system = not read_problem(text).one_coordinate
     if system:
         if kind != "response":
             raise InputError(f"sweep {kind} SYSTEM: a system's map is response (every periodic "
