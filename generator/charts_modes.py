@@ -9,83 +9,39 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .analysis.curves import FEP_MAX_MODES, FrequencyEnergy
 from .charts import _save, _value, check_plot_path
-from .derive.nnm import normal_mode, radius
-from .derive.system import System
-from .errors import InputError
-from .numerics.references import check_shootable, mode_orbit, system_energy
-
-FEP_ORDER = 24
-# NOTE: the backbone drawn from the series to this order (and its radius estimated from it);
-# the order-12 backbone already meets shooting to 1e-14 at A = 0.3 on Kerschen's system.
-FEP_SHOTS = 8
-# NOTE: orbits shot per mode, from 5 % of the series' reach to 120 % (past it: where only
-# shooting answers), each seeded by the last.
-FEP_MAX_MODES = 4
-RESONANCES = (2, 3)
-# NOTE: the ratios marked: 1:2 (quadratic couplings) and 1:3 (cubic ones), where the n-th
-# harmonic of one mode meets another mode's linear frequency.
 
 
-def nnm_figure(system: System, path: Path, order: int = FEP_ORDER) -> Path:
-    """Frequency against energy of every mode of ``system`` (at most :data:`FEP_MAX_MODES`):
+def nnm_figure(fe: FrequencyEnergy, path: Path) -> Path:
+    """Frequency against energy of every mode (an :class:`analysis.curves.FrequencyEnergy`):
     the series' backbone up to its estimated reach, orbits shot beside it (beyond the reach
-    too), and dotted lines where ``n ω = ω₀`` of another mode (n in :data:`RESONANCES`)."""
+    too), and dotted lines where ``n ω = ω₀`` of another mode."""
     check_plot_path(path)
-    lams = system.modes()
-    if len(lams) > FEP_MAX_MODES:
-        raise InputError(f"--plot: the chart draws systems of up to {FEP_MAX_MODES} modes; "
-                         f"this one has {len(lams)}")
-    check_shootable(system, "--plot")
-    energy = system_energy(system)
     fig, ax = plt.subplots(figsize=(8, 4.8))
-    notes = []
-    for k in range(1, len(lams) + 1):
-        color = f"C{k - 1}"
-        try:
-            mode = normal_mode(system, k, order)
-        except InputError as exc:  # an internal resonance: no series, said in the legend
-            notes.append(f"mode {k}: no series ({str(exc).split(': ', 2)[-1][:60]}…)")
+    for curve in fe.modes:
+        if curve.note is not None:
             continue
-        found = radius(mode)
-        reach = 1.0 if found is None or not found.lower > 0 else found.reach
-        A = np.linspace(reach / 200, 0.95 * reach, 200)
-        omega, _, starts = mode.evaluate(A)
-        E = np.array([energy(x) for x in starts.T])
-        ax.plot(E, omega, "-", color=color, lw=2,
-                label=f"mode {k}: series to order {order} (ω₀ = {mode.omega0})")
-        shots = []
-        guess = None
-        for a in np.linspace(0.05, 1.2, FEP_SHOTS) * reach:
-            if guess is None:
-                _, period, x0 = mode.evaluate(a)
-                guess = np.append(np.delete(x0, mode.amplitude), period / 2)
-            orbit = mode_orbit(system, float(a), guess, mode.amplitude)
-            if not orbit.converged:
-                break
-            guess = np.append(np.delete(orbit.start, mode.amplitude), orbit.period / 2)
-            shots.append((orbit.energy, 2 * np.pi / orbit.period))
-        if shots:
-            ax.plot(*np.array(shots).T, "o", color=color, mfc="none", ms=6,
-                    label=f"mode {k}: orbits shot (DOP853)")
-        edge = energy(mode.evaluate(reach)[2])
-        ax.axvline(edge, color=color, ls="--", lw=0.8,
-                   label=f"mode {k}: the series' estimated reach (A = {_value(reach)})")
-    w0 = np.sqrt([float(x) for x in lams])
-    for i, wi in enumerate(w0, 1):
-        for j, wj in enumerate(w0, 1):
-            for n in RESONANCES:
-                if i != j and wj / n < wi * 2 and wj / n > wi / 2:
-                    ax.axhline(wj / n, color="grey", ls=":", lw=0.8)
-                    ax.annotate(f"{n}ω = ω₀,{j}", (1.0, wj / n), xycoords=("axes fraction",
-                                "data"), ha="right", va="bottom", fontsize=7, color="grey")
+        color = f"C{curve.mode - 1}"
+        ax.plot(curve.E, curve.omega, "-", color=color, lw=2,
+                label=f"mode {curve.mode}: series to order {fe.order} (ω₀ = {curve.omega0})")
+        if len(curve.shots):
+            ax.plot(*curve.shots.T, "o", color=color, mfc="none", ms=6,
+                    label=f"mode {curve.mode}: orbits shot (DOP853)")
+        ax.axvline(curve.edge, color=color, ls="--", lw=0.8,
+                   label=f"mode {curve.mode}: the series' estimated reach "
+                   f"(A = {_value(curve.reach)})")
+    for j, n, w in fe.lines:
+        ax.axhline(w, color="grey", ls=":", lw=0.8)
+        ax.annotate(f"{n}ω = ω₀,{j}", (1.0, w), xycoords=("axes fraction", "data"), ha="right",
+                    va="bottom", fontsize=7, color="grey")
     ax.plot([], [], ":", color="grey", label="internal resonance n ω = ω₀ of another mode")
-    for note in notes:
-        ax.plot([], [], " ", label=note)
+    for curve in fe.modes:
+        if curve.note is not None:
+            ax.plot([], [], " ", label=curve.note)
     ax.set(xscale="log", xlabel="energy E (at the turning point, potential only)",
            ylabel="frequency ω (units of the time in the equations)",
-           title="frequency–energy plot: " + system.text[:70] + ("…" if len(system.text) > 70
-                                                                   else ""))
+           title="frequency–energy plot: " + fe.text[:70] + ("…" if len(fe.text) > 70 else ""))
     ax.title.set_fontsize(9)
     ax.legend(fontsize=7, loc="best")
     fig.tight_layout()

@@ -270,13 +270,14 @@ def test_frequency_energy_plot_puts_the_shot_orbits_on_the_backbones(tmp_path, m
     """Kerschen's system: each mode's series backbone, orbits shot beside it (those inside the
     series' reach lie on it to 1e-9), the reach and the resonance lines in the legend."""
     from lindstedt import charts_modes
+    from lindstedt.analysis.curves import frequency_energy
     from lindstedt.derive.system import parse_system
 
     drawn = []
     monkeypatch.setattr(charts_modes, "_save",
                         lambda fig, path: (drawn.append(fig), charts._save(fig, path))[1])
     system = parse_system("x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0")
-    charts_modes.nnm_figure(system, tmp_path / "fep.png")
+    charts_modes.nnm_figure(frequency_energy(system), tmp_path / "fep.png")
     (fig,) = drawn
     (ax,) = fig.axes
     texts = _texts(fig)

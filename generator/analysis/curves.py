@@ -1,6 +1,7 @@
 """The curves a command draws (``--plot``) and writes (``--csv``), sampled once: a free
 oscillator's ω(y) and T(y)/2π across where its series holds, a limit cycle's amplitude and ω
-against ε, a slow flow's trajectories and fixed points, a normal mode's backbone.  The figures
+against ε, a slow flow's trajectories and fixed points, a normal mode's backbone, a system's
+frequency–energy plot (every mode's backbone beside orbits shot by DOP853).  The figures
 and the CSV files are printers of these records; nothing here draws or formats."""
 
 from __future__ import annotations
@@ -255,3 +256,91 @@ def backbone(mode: NormalModeSeries, points: int = BACKBONE_POINTS) -> Backbone:
     omega, period, _ = mode.evaluate(A)
     return Backbone(mode.mode, str(mode.system.coordinates[mode.amplitude]), reach, A,
                     np.asarray(omega, dtype=float), np.asarray(period, dtype=float))
+
+
+FEP_ORDER = 24
+# NOTE: the backbone drawn from the series to this order (and its radius estimated from it);
+# the order-12 backbone already meets shooting to 1e-14 at A = 0.3 on Kerschen's system.
+FEP_SHOTS = 8
+# NOTE: orbits shot per mode, from 5 % of the series' reach to 120 % (past it: where only
+# shooting answers), each seeded by the last.
+FEP_MAX_MODES = 4
+FEP_POINTS = 200
+RESONANCES = (2, 3)
+# NOTE: the ratios marked: 1:2 (quadratic couplings) and 1:3 (cubic ones), where the n-th
+# harmonic of one mode meets another mode's linear frequency.
+
+
+@dataclass(frozen=True, eq=False)
+class ModeCurve:
+    """One mode of a :class:`FrequencyEnergy`: the series' backbone (energy ``E`` at the
+    turning point, ``omega``) up to 95 % of its ``reach`` in A, the energy ``edge`` at the
+    reach, and orbits shot beside it (``shots``: rows of energy and ω); or, for a mode without
+    a series (an internal resonance), only ``note``, the reason."""
+
+    mode: int
+    omega0: str = ""
+    E: np.ndarray = field(default_factory=lambda: np.empty(0))
+    omega: np.ndarray = field(default_factory=lambda: np.empty(0))
+    reach: float = math.nan
+    edge: float = math.nan
+    shots: np.ndarray = field(default_factory=lambda: np.empty((0, 2)))
+    note: str | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class FrequencyEnergy:
+    """The frequency–energy plot of a system's modes, computed once: each mode's
+    :class:`ModeCurve` from its series to ``order``, and the internal-resonance lines
+    ``n ω = ω₀,j`` near another mode's backbone (``lines``: (j, n, ω₀,j/n), each once)."""
+
+    text: str
+    order: int
+    modes: tuple[ModeCurve, ...]
+    lines: tuple[tuple[int, int, float], ...]
+
+
+def frequency_energy(system: object, order: int = FEP_ORDER) -> FrequencyEnergy:
+    """:class:`FrequencyEnergy` of every mode of ``system`` (a :class:`derive.system.System`
+    of at most :data:`FEP_MAX_MODES` modes, not stiff: its orbits are shot)."""
+    from ..derive.nnm import normal_mode
+    from ..numerics.references import check_shootable, mode_orbit, system_energy
+
+    lams = system.modes()
+    if len(lams) > FEP_MAX_MODES:
+        raise InputError(f"--plot: the chart draws systems of up to {FEP_MAX_MODES} modes; "
+                         f"this one has {len(lams)}")
+    check_shootable(system, "--plot")
+    energy = system_energy(system)
+    curves = []
+    for k in range(1, len(lams) + 1):
+        try:
+            mode = normal_mode(system, k, order)
+        except InputError as exc:  # an internal resonance: no series, said in the legend
+            curves.append(ModeCurve(k, note=f"mode {k}: no series "
+                                    f"({str(exc).split(': ', 2)[-1][:60]}…)"))
+            continue
+        found = radius(mode)
+        reach = 1.0 if found is None or not found.lower > 0 else found.reach
+        A = np.linspace(reach / FEP_POINTS, 0.95 * reach, FEP_POINTS)
+        omega, _, starts = mode.evaluate(A)
+        shots = []
+        guess = None
+        for a in np.linspace(0.05, 1.2, FEP_SHOTS) * reach:
+            if guess is None:
+                _, period, x0 = mode.evaluate(a)
+                guess = np.append(np.delete(x0, mode.amplitude), period / 2)
+            orbit = mode_orbit(system, float(a), guess, mode.amplitude)
+            if not orbit.converged:
+                break
+            guess = np.append(np.delete(orbit.start, mode.amplitude), orbit.period / 2)
+            shots.append((orbit.energy, 2 * np.pi / orbit.period))
+        curves.append(ModeCurve(k, str(mode.omega0), np.array([energy(x) for x in starts.T]),
+                                np.asarray(omega, dtype=float), reach,
+                                float(energy(mode.evaluate(reach)[2])),
+                                np.array(shots).reshape(-1, 2)))
+    w0 = np.sqrt([float(x) for x in lams])
+    lines = tuple(dict.fromkeys((j, n, float(wj / n)) for i, wi in enumerate(w0, 1)
+                                for j, wj in enumerate(w0, 1) for n in RESONANCES
+                                if i != j and wi / 2 < wj / n < wi * 2))
+    return FrequencyEnergy(system.text, order, tuple(curves), lines)

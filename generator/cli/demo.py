@@ -33,7 +33,7 @@ def run_demo(args: argparse.Namespace) -> int:
 
     from ..charts import GALLERY, check_plot_path
     from ..compiler import generate, generate_balance, generate_driven
-    from ..derive.lindstedt import derive
+    from ..derive.lindstedt import derive, validity
     from ..derive.models import model_by_name
     from ..emit.render import check_writable, load_generated
     from ..numerics.references import duffing_period_exact, pendulum_period_exact
@@ -49,7 +49,8 @@ def run_demo(args: argparse.Namespace) -> int:
     drawn = [(name, draw) for name, draw in GALLERY if name in DEMO_FIGURES]
     for name, _ in drawn:
         check_plot_path(figures / name)
-    print(series_table(derive(model_by_name("duffing", 6), 6)))
+    duffing6 = derive(model_by_name("duffing", 6), 6)
+    print(series_table(duffing6, validity(duffing6)))
     print(f"\nwriting the default evaluators and LaTeX into {out}/")
     for name in ("duffing", "pendulum"):
         for path in generate(name, DEMO_ORDER, out, overwrite_edited=args.overwrite_edited):

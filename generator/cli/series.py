@@ -82,9 +82,9 @@ def _polynomial_text(sol, c: object) -> str:
     return text[2:] if text.startswith("+ ") else "-" + text[2:]
 
 
-def series_json(sol, valid=None) -> dict:
-    """The contract of ``lindstedt series MODEL --order K --json`` (keys are stable);
-    ``valid``: the solution's :class:`derive.lindstedt.Validity` when already computed."""
+def series_json(sol, valid) -> dict:
+    """The contract of ``lindstedt series MODEL --order K --json`` (keys are stable) of the
+    solution and its :class:`derive.lindstedt.Validity`."""
     m = sol.model
     data = {
         "model": m.name,
@@ -103,13 +103,10 @@ def series_json(sol, valid=None) -> dict:
     return data
 
 
-def _domain_fields(sol, valid=None) -> dict:
+def _domain_fields(sol, valid) -> dict:
     """Where the series may be used: ``orbit_limit`` (the family of periodic orbits exists
     for lower < y < upper, 30 digits, or ``known`` false with the reason) and, where the
     model states no radius, ``radius_estimate`` (value and spread, from the τ_j)."""
-    from ..derive.lindstedt import validity
-
-    valid = validity(sol) if valid is None else valid
     fields = {"orbit_limit": valid.orbit.as_json()}
     if valid.exact is None and valid.radius is not None:
         fields["radius_estimate"] = {"value": valid.radius, "spread": valid.spread}
@@ -147,11 +144,10 @@ def _coordinate_named(convention: str, name: str) -> str:
                                                  convention)
 
 
-def series_table(sol, valid=None) -> str:
-    """Readable table: where the series holds (its orbits, its radius), then ω_j, T_j/2π and
-    the harmonics of q_j per order (``valid``: the solution's validity when computed)."""
-    from ..derive.lindstedt import validity
-
+def series_table(sol, valid) -> str:
+    """Readable table: where the series holds (its orbits, its radius: ``valid``, the
+    solution's :class:`derive.lindstedt.Validity`), then ω_j, T_j/2π and the harmonics of q_j
+    per order."""
     m = sol.model
     lines = [
         f"{m.name}: {m.title}, expansion variable {m.variable}, order {sol.order}",
@@ -159,7 +155,6 @@ def series_table(sol, valid=None) -> str:
     ]
     if m.frequency != 1:
         lines.append(f"omega in units of omega0 = {m.frequency}, T in units of 2*pi/omega0")
-    valid = validity(sol) if valid is None else valid
     domain = valid.orbit.as_json()
     y = m.variable.partition("=")[0].strip() or m.variable
     lines.append(f"periodic orbits for {domain['lower']} < {y} < {domain['upper']} "

@@ -150,9 +150,10 @@ def run_nnm(args: argparse.Namespace) -> int:
         progress.close()
     data = nnm_json(mode)
     if plot is not None:
-        from ..charts_modes import FEP_ORDER, nnm_figure
+        from ..analysis.curves import FEP_ORDER, frequency_energy
+        from ..charts_modes import nnm_figure
 
-        nnm_figure(system, plot, max(args.order, FEP_ORDER))
+        nnm_figure(frequency_energy(system, max(args.order, FEP_ORDER)), plot)
     if csv is not None:
         from ..analysis.curves import backbone
 
@@ -167,12 +168,10 @@ START_SEED = 0.01
 # the others seeded at 1 % of it (a swing spring set bouncing, its swing growing from a nudge).
 
 
-def resonant_json(flow, exchange) -> dict:
+def resonant_json(flow, coupled, exchange) -> dict:
     """``slowflow SYSTEM --json``: the averaged equations (exact SymPy str), the coupled modes
-    (phase-locked: every amplitude steady) and the energy exchange (a
-    :class:`numerics.references.Exchange`)."""
-    from ..derive.resonance import coupled_modes
-
+    (``coupled``, :func:`derive.resonance.coupled_modes`: phase-locked, every amplitude
+    steady) and the energy exchange (a :class:`numerics.references.Exchange`)."""
     names = [f"a{k}" for k in range(1, len(flow.a) + 1)]
     equations = {}
     for k, name in enumerate(names):
@@ -186,7 +185,7 @@ def resonant_json(flow, exchange) -> dict:
         "variables": "x = sum_k shape_k a_k cos(omega0_k t + phi_k), slowly varying a_k, phi_k",
         "equations": equations,
         "coupled_modes": [{"gamma": str(g), "ratio": str(r), "ratio_value": float(r)}
-                          for g, r in coupled_modes(flow)],
+                          for g, r in coupled],
         "exchange": {"start": dict(zip(names, exchange.start, strict=True)),
                      "period": exchange.period,
                      "how": "the averaged flow by DOP853 from zero phases: time between two "
@@ -222,7 +221,7 @@ def resonant_table(data: dict) -> str:
 
 def run_slowflow_system(args: argparse.Namespace) -> int:
     """``slowflow SYSTEM``: the first-order slow flow of the modes in internal resonance."""
-    from ..derive.resonance import resonant_flow
+    from ..derive.resonance import coupled_modes, resonant_flow
     from ..derive.system import parse_system
 
     if args.eps is not None or args.sigma is not None:
@@ -258,7 +257,7 @@ def run_slowflow_system(args: argparse.Namespace) -> int:
         exchange_figure(flow, exchange, plot)
     if csv is not None:
         exchange_csv(exchange, csv)
-    data = resonant_json(flow, exchange)
+    data = resonant_json(flow, coupled_modes(flow), exchange)
     print(json.dumps(data) if args.json else resonant_table(data))
     return 0
 
