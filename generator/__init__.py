@@ -40,7 +40,8 @@ order; a stage imports only stages above it::
     numerics.integrate      the one integrator: RK4 of any polynomial force table, compiled;
                             flows, sweeps with their jumps, simulations; a system's polynomial
                             force and its compiled field [ForceTable | PolynomialField -> flows]
-    numerics.newton         the one Newton's method for R(x) = 0 [R, J, x -> root]
+    numerics.newton         the one Newton's method for R(x) = 0 and its bordered, secant and
+                            safeguarded variants [(R, J), x -> root]
     numerics.floquet        Floquet multipliers: Hill about q₀, a damped pump over a grid, the
                             full Hill equation, a system's variational monodromy about many
                             orbits at once, the verdict [orbit -> multipliers]

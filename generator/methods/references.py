@@ -21,6 +21,7 @@ from ..analysis.driven import (
     one_harmonic,
 )
 from ..derive.models import Model
+from ..numerics.newton import safeguarded
 from ..numerics.shooting import shoot
 
 Solved = tuple[bool, tuple[dict, dict]]
@@ -156,9 +157,10 @@ def quadrature_period(model: Model, x: np.ndarray) -> np.ndarray:
         u_min = below[-1]
         if np.polynomial.polynomial.polyval(u_min, dV) >= 0:
             continue  # the swing does not turn there: it escapes
-        for _ in range(3):  # Newton polish of the turning point
-            u_min -= (np.polynomial.polynomial.polyval(u_min, shifted)
-                      / np.polynomial.polynomial.polyval(u_min, dV))
+        u_min = float(safeguarded(  # Newton polish of the turning point (3 steps)
+            lambda _, u, V=shifted, dV=dV: (np.polynomial.polynomial.polyval(u, V),
+                                            np.polynomial.polynomial.polyval(u, dV)),
+            np.array([u_min]), max_iter=3)[0])
         # V(1) − V(u) = (1 − u)(u − u_min) S(u), and with u = m + h sin θ the product
         # (1 − u)(u − u_min) = h² cos²θ cancels du = h cos θ dθ: T = 2∫ dθ/√(2 S(u)),
         # smooth, with no difference of nearly equal numbers near the turning points
