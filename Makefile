@@ -69,7 +69,8 @@ figures: $(STAMP)
 	$(BIN)/python -c "from lindstedt.charts import gallery; gallery('docs/figures')"
 	$(BIN)/python -c "from lindstedt.charts import slow_flow_figures; slow_flow_figures('docs/figures')"
 	$(BIN)/python -c "from lindstedt.charts import PARAMETRIC_FIGURE, parametric_figure; \
-	parametric_figure(*PARAMETRIC_FIGURE, 'docs/figures/parametric.png')"
+	from lindstedt.analysis.parametric import parametric_report; \
+	parametric_figure(parametric_report(*PARAMETRIC_FIGURE), 'docs/figures/parametric.png')"
 	$(BIN)/python -c "from lindstedt.charts import ince_strutt_figure; \
 	ince_strutt_figure('docs/figures/ince_strutt.png')"
 	$(BIN)/lindstedt nnm "x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0" \

@@ -19,10 +19,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .analysis.continuation import CONTINUATION_SECONDS
+from .analysis.curves import subharmonic_curve
 from .analysis.driven import Drive
-from .analysis.mixing import mixing_series, tone_label
+from .analysis.mixing import duffing_mixing, tone_label
 from .analysis.response import ResponseReport, one_harmonic_curve
-from .analysis.subharmonic import subharmonic, subharmonic_equation, subharmonic_orbits
 from .choose import (
     DRIVEN_QUANTITIES,
     DrivenTradeoff,
@@ -35,7 +35,6 @@ from .emit.render import check_output_file, write_files
 from .errors import InputError
 from .methods.references import reference_period
 from .methods.registry import candidates
-from .numerics.integrate import ForceTable, duffing_table, steady_state_amplitudes
 from .sweep.kinds import MU_ORDERS, VALIDITY_BALANCE_HARMONICS, validity_errors
 
 FORMATS = (".png", ".svg", ".pdf")
@@ -278,19 +277,19 @@ FULL_HILL_EVERY = 4
 # verdict: dense enough to show where it parts from the q₀ test, sparse enough to read.
 
 
-def subharmonic_figure(eps: float, force: float, path: Path) -> Path:
-    """Amplitude a(ω) of both roots of eq. 10.87 where they exist; the notes' Hill verdict
-    (about q₀) as line style, the true orbit's verdict as markers (o, x), and the full Hill
-    verdict (about the balance orbit) as small markers on the curve every ``FULL_HILL_EVERY``
-    points (filled dot stable, triangle unstable)."""
+def subharmonic_figure(curve: object, path: Path) -> Path:
+    """Amplitude a(ω) of both roots of eq. 10.87 where they exist (an
+    :class:`analysis.curves.SubharmonicCurve`); the notes' Hill verdict (about q₀) as line
+    style, the true orbit's verdict as markers (o, x), and the full Hill verdict (about the
+    balance orbit) as small markers on the curve every ``FULL_HILL_EVERY`` points (filled dot
+    stable, triangle unstable)."""
     check_plot_path(path)
-    omega = np.linspace(1.0, 2.0, 161)
+    omega, eps, force = curve.omega, curve.eps, curve.force
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for sign, color in (("+", "C0"), ("-", "C3")):
         a, hill, true_w, true_a, true_s = [], [], [], [], []
         full_w, full_a, full_s = [], [], []
-        for i, w in enumerate(omega):
-            exists, _, sols = subharmonic(eps, force, float(w))
+        for i, (w, (exists, _, sols)) in enumerate(zip(omega, curve.answers, strict=True)):
             s = next((s for s in sols if s.root == sign), None) if exists else None
             a.append(np.nan if s is None else s.a)
             hill.append(bool(s and s.hill_stable))
@@ -322,13 +321,12 @@ def subharmonic_figure(eps: float, force: float, path: Path) -> Path:
     return _save(fig, path)
 
 
-def subharmonic_orbits_figure(text: str, values: dict[str, str], omega: float | None, n: int,
-                              name: str, path: Path) -> Path:
+def subharmonic_orbits_figure(found: object, text: str, path: Path) -> Path:
     """``subharmonic EQUATION --n N --plot``: q(t) over n drive periods of every orbit found
-    (solid: stable, dashed: unstable, from the shot orbit's balance) beside the primary
-    response (grey) and the drive's phase (dotted, scaled)."""
+    (an :class:`analysis.subharmonic.SubharmonicResponse`; solid: stable, dashed: unstable,
+    from the shot orbit's balance) beside the primary response (grey) and the drive's phase
+    (dotted, scaled)."""
     check_plot_path(path)
-    found = subharmonic_orbits(subharmonic_equation(text, values, omega, n, name))
     p = found.problem
     t = np.linspace(0.0, p.n * 2 * np.pi / p.drive, 801)
 
@@ -355,15 +353,12 @@ def subharmonic_orbits_figure(text: str, values: dict[str, str], omega: float | 
     return _save(fig, path)
 
 
-def mixing_figure(table: ForceTable, drives: list[tuple[float, float]], path: Path,
-                  label: str) -> Path:
-    """Spectrum of the steady state of ``q̈ + g(q, q̇) = Σ f_i cos ω_i t`` (``g`` the
-    ``table``; ``label`` names it in the title): predicted tones (stems) and simulated
-    amplitudes."""
+def mixing_figure(m: object, path: Path, label: str) -> Path:
+    """Spectrum of the steady state of ``q̈ + g(q, q̇) = Σ f_i cos ω_i t`` (an
+    :class:`analysis.mixing.Mixing`; ``label`` names ``g`` in the title): predicted tones
+    (stems) and simulated amplitudes."""
     check_plot_path(path)
-    tones = mixing_series(table, drives).tones
-    sim = steady_state_amplitudes(table, [f for f, _ in drives], [w for _, w in drives],
-                                  [t.frequency for t in tones])
+    tones, sim, drives = m.series.tones, m.fit.amplitudes, m.drives
     fig, ax = plt.subplots(figsize=(8, 4.2))
     for t, s in zip(tones, sim, strict=True):
         ax.vlines(t.frequency, 1e-8, t.predicted, color=f"C{t.order}", lw=2)
@@ -386,8 +381,8 @@ def mixing_figure(table: ForceTable, drives: list[tuple[float, float]], path: Pa
 
 GALLERY = (
     ("response.png", lambda path: response_figure(0.1, 0.3, 20.0, 8, path)),
-    ("subharmonic.png", lambda path: subharmonic_figure(0.1, 0.5, path)),
-    ("mixing.png", lambda path: mixing_figure(duffing_table(0.1, 0.1), [(0.3, 1.3), (0.3, 1.7)],
+    ("subharmonic.png", lambda path: subharmonic_figure(subharmonic_curve(0.1, 0.5), path)),
+    ("mixing.png", lambda path: mixing_figure(duffing_mixing(0.1, 10.0, [(0.3, 1.3), (0.3, 1.7)]),
                                               path, "ε = 0.1, Q = 10.0")),
     ("validity.png", lambda path: validity_figure(path)),
     ("driven_validity.png", lambda path: driven_validity_figure(path)),
@@ -845,25 +840,21 @@ def slow_flow_figures(folder: Path) -> list[Path]:
             slow_flow_transient_figure(folder / "slow_flow_transient.png")]
 
 
-PARAMETRIC_FIGURE = (0.2, 0.01, 1.0, 0.9, 1.12)
-# NOTE: the README's parametric figure (ε, ζ, γ, ω range): the tongue 0.95 < ω < 1.05, both
-# onsets and the subcritical branch inside the range.
+PARAMETRIC_FIGURE = (0.2, 0.01, 1.0, 0.9, 1.12, 221)
+# NOTE: the README's parametric figure (ε, ζ, γ, ω range, points): the tongue 0.95 < ω <
+# 1.05, both onsets and the subcritical branch inside the range.
 
 
-def parametric_figure(eps: float, zeta: float, gamma: float, omega_from: float,
-                      omega_to: float, path: Path) -> Path:
-    """Response r(ω) of ``q̈ + 2ζq̇ + (1 + ε cos 2ωt)q + γq³ = 0`` (the pump at 2ω): the
-    one-harmonic branches (stable solid, unstable dashed), the harmonic balance's first harmonic
-    with its full-Hill verdict (dots), shooting (o stable, x unstable), the tongue's edges."""
-    from .analysis.parametric import Pump, check_omega, onsets, response, tongue_edges
-
+def parametric_figure(report: object, path: Path) -> Path:
+    """Response r(ω) of ``q̈ + 2ζq̇ + (1 + ε cos 2ωt)q + γq³ = 0`` (the pump at 2ω; an
+    :class:`analysis.parametric.ParametricReport`): the one-harmonic branches (stable solid,
+    unstable dashed), the harmonic balance's first harmonic with its full-Hill verdict (dots),
+    shooting (o stable, x unstable), the tongue's edges."""
     check_plot_path(path)
-    p = Pump(eps, zeta, gamma)
-    lo, hi = check_omega(omega_from, "omega-from"), check_omega(omega_to, "omega-to")
-    omega = np.linspace(lo, hi, 221)
-    rows = response(p, omega, shoot_every=20)
+    p, rows, edges = report.pump, report.rows, report.tongue
+    eps, zeta, gamma = p.eps, p.zeta, p.gamma
+    omega = np.linspace(*report.omega_range, report.points)
     fig, ax = plt.subplots(figsize=(7.5, 4.4))
-    edges = tongue_edges(p)
     if edges is not None:
         ax.axvspan(*edges, color="0.92", label="tongue: q = 0 unstable")
         for k, w in enumerate(edges):
@@ -890,7 +881,7 @@ def parametric_figure(eps: float, zeta: float, gamma: float, omega_from: float,
                 for pt in pts if pt.orbit is not None and name != "0"]
         for w, a, s in shot:
             ax.plot(w, a, f"{color}o" if s else f"{color}x", ms=6, mfc="none")
-    for o in onsets(p):
+    for o in report.onsets:
         ax.annotate("super" if o.supercritical else "sub", (o.omega, 0), xytext=(0, 8),
                     textcoords="offset points", ha="center", fontsize=8)
     ax.plot([], [], "ko", ms=6, mfc="none", label="shot orbit, stable")

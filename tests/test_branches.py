@@ -17,8 +17,8 @@ import math
 import numpy as np
 import pytest
 from lindstedt.analysis.driven import Drive
-from lindstedt.analysis.periodic import periodic_orbits
-from lindstedt.cli.driven import driven_json, driven_table
+from lindstedt.analysis.periodic import driven_report, periodic_orbits
+from lindstedt.cli.driven import driven_report_json, driven_table
 from scipy.integrate import solve_ivp
 
 SAME = 1e-7  # two reference orbits are one when their states differ by this, relative
@@ -188,7 +188,7 @@ def test_omega_1491_reports_the_orbits_the_cubic_has_lost():
     """The cubic folds at 1.48939, the true system at 1.493232: at ω = 1.491 it has one root
     (r = 0.2457) and the system three orbits (verified against DOP853 shooting)."""
     d = Drive(0.1, 0.3, 1.491, 20.0)
-    data = driven_json(d, 4, 8)
+    data = driven_report_json(driven_report(d, 4, 8))
     top, middle, small = data["branches"]
     assert abs(top["numerical"]["r"] - 3.995731) < 1e-6 and top["numerical"]["stable"]
     assert np.allclose(top["numerical"]["floquet_moduli"], [0.900, 0.900], atol=5e-4)
@@ -220,7 +220,7 @@ def test_omega_1491_reports_the_orbits_the_cubic_has_lost():
 def test_omega_1489_no_orbit_twice_and_the_middle_one_found():
     """Two of the cubic's roots shoot onto one orbit (A1 = 0.381599, B1 = 3.971954): it is
     reported once, and the true middle orbit (r = 3.959978, unstable) beside it."""
-    data = driven_json(Drive(0.1, 0.3, 1.489, 20.0), 4, 8)
+    data = driven_report_json(driven_report(Drive(0.1, 0.3, 1.489, 20.0), 4, 8))
     top, middle, small = data["branches"]
     assert abs(top["numerical"]["A"]["1"] - 0.381599) < 1e-6
     assert abs(top["numerical"]["B"]["1"] - 3.971954) < 1e-6 and top["numerical"]["stable"]
@@ -241,11 +241,13 @@ def test_softening_folds_and_seeding_against_the_reference():
     reported none: the continuation began on the resonant branch over the barrier and left the
     range without meeting it) and `driven`'s seeding is complete; the fold against the
     reference fold, and its side of the one-harmonic fold (numpy.roots' branch count)."""
-    from lindstedt.cli.driven import response_json
+    from lindstedt.analysis.response import duffing_response
+    from lindstedt.cli.driven import response_report_json
+    from lindstedt.limits import COST_LIMIT_SECONDS
 
     eps, force, Q = -0.1, 0.3, 20.0
     fold = reference_fold(eps, force, Q, 0.8, -1)
-    data = response_json(eps, force, Q, 8)
+    data = response_report_json(duffing_response(eps, force, Q, 8, COST_LIMIT_SECONDS))
     (balance,) = data["harmonic_balance"]["folds"]
     (true,) = data["numerical"]["folds"]
     assert abs(true - fold) < 1e-8 and abs(balance - fold) < 1e-8

@@ -2,15 +2,15 @@
 
 from __future__ import annotations
 
+import importlib
 import itertools
 
 import numpy as np
 import pytest
 from lindstedt import charts, cli
+from lindstedt.analysis.mixing import duffing_mixing
 from lindstedt.charts import check_plot_path, mixing_figure
-from lindstedt.cli import driven as cli_driven
 from lindstedt.errors import InputError
-from lindstedt.numerics.integrate import duffing_table
 from matplotlib.colors import to_rgba
 from scipy.integrate import solve_ivp
 
@@ -41,7 +41,7 @@ def test_mixing_figure_draws_the_true_spectrum(tmp_path, monkeypatch):
     save = charts._save
     monkeypatch.setattr(charts, "_save", lambda fig, path: (drawn.append(fig), save(fig, path))[1])
     a, b = tmp_path / "a.png", tmp_path / "b.png"
-    mixing_figure(duffing_table(MIX_EPS, 1 / MIX_Q), MIX_DRIVES, a, "eps = 0.1")
+    mixing_figure(duffing_mixing(MIX_EPS, MIX_Q, MIX_DRIVES), a, "eps = 0.1")
     (fig,) = drawn
     (ax,) = fig.axes
     # every combination m₁ω₁ + m₂ω₂ of 3 or 5 drive factors, in units of 0.1 (ω = 1.3, 1.7)
@@ -73,7 +73,7 @@ def test_mixing_figure_draws_the_true_spectrum(tmp_path, monkeypatch):
         assert abs(y - truth[k]) < 1e-3 * truth[k] + 5e-10, (k, y, truth[k])  # the fit
     assert ax.get_yscale() == "log"
     assert a.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    mixing_figure(duffing_table(MIX_EPS, 1 / MIX_Q), MIX_DRIVES, b, "eps = 0.1")
+    mixing_figure(duffing_mixing(MIX_EPS, MIX_Q, MIX_DRIVES), b, "eps = 0.1")
     assert a.read_bytes() == b.read_bytes()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "b.png"]  # no temporaries
 
@@ -88,13 +88,16 @@ class Computed(Exception):
     """Raised by the stand-in for a command's computation."""
 
 
-@pytest.mark.parametrize("args,compute", [
-    (["response", "--eps", "0.1", "--force", "0.3", "--Q", "20"], "response_report"),
-    (["subharmonic", "--eps", "0.1", "--force", "0.5", "--omega", "1.2"], "subharmonic_json"),
-    (["mixing", "--eps", "0.1", "--Q", "10", "--drive", "0.3@1.3"], "mixing_json"),
+@pytest.mark.parametrize("args,where,compute", [
+    (["response", "--eps", "0.1", "--force", "0.3", "--Q", "20"], "cli.driven",
+     "response_report"),
+    (["subharmonic", "--eps", "0.1", "--force", "0.5", "--omega", "1.2"],
+     "analysis.subharmonic", "subharmonic"),
+    (["mixing", "--eps", "0.1", "--Q", "10", "--drive", "0.3@1.3"], "analysis.mixing",
+     "duffing_mixing"),
 ])
 def test_cli_refuses_bad_plot_path_before_computing(tmp_path, monkeypatch, capsys, args,
-                                                    compute):
+                                                    where, compute):
     """The computation is replaced by a stand-in that records its call and raises: with a
     good --plot the command reaches it, with a bad one it answers 2 without calling it."""
     calls = []
@@ -103,7 +106,7 @@ def test_cli_refuses_bad_plot_path_before_computing(tmp_path, monkeypatch, capsy
         calls.append(a)
         raise Computed
 
-    monkeypatch.setattr(cli_driven, compute, stand_in)
+    monkeypatch.setattr(importlib.import_module(f"lindstedt.{where}"), compute, stand_in)
     with pytest.raises(Computed):  # a writable figure path: the command computes
         cli.main([*args, "--plot", str(tmp_path / "ok.png")])
     assert len(calls) == 1
@@ -121,12 +124,13 @@ def test_subharmonic_figure_marks_the_full_hill_verdict(tmp_path, monkeypatch):
     """Small markers on each root's curve give the full Hill verdict every FULL_HILL_EVERY ω
     (dot stable, triangle unstable); where it parts from the notes' q₀ test (the line style)
     it is the true orbit's Floquet verdict (shooting from the balance orbit, RK4 monodromy)."""
+    from lindstedt.analysis.curves import subharmonic_curve
     from lindstedt.analysis.subharmonic import subharmonic
 
     drawn = []
     save = charts._save
     monkeypatch.setattr(charts, "_save", lambda fig, path: (drawn.append(fig), save(fig, path))[1])
-    charts.subharmonic_figure(0.1, 0.5, tmp_path / "s.png")
+    charts.subharmonic_figure(subharmonic_curve(0.1, 0.5), tmp_path / "s.png")
     (fig,) = drawn
     (ax,) = fig.axes
     marks = {line.get_label(): line for line in ax.lines if "full Hill" in line.get_label()}

@@ -17,16 +17,23 @@ import math
 import numpy as np
 import pytest
 from lindstedt.analysis.driven import Drive
-from lindstedt.analysis.periodic import periodic_orbits
+from lindstedt.analysis.periodic import driven_report, periodic_orbits
 from lindstedt.analysis.polynomial import driven_equation
 from lindstedt.cli import main
-from lindstedt.cli.driven import driven_equation_json
+from lindstedt.cli.driven import driven_equation_report_json
 from scipy.integrate import solve_ivp
 
 AGREE = 1e-7  # the package's orbit against the reference's (state, relative; r)
 SAME = 1e-6  # two reference orbits are one
 
 ASYMMETRIC = "q'' + q + eps*(q**2 + q**3) + gamma*q'**3 = f*cos(w*t)"
+
+
+def driven_equation_json(text: str, values: dict[str, str], omega: float,
+                         harmonics: int) -> dict:
+    """``driven EQUATION --json``'s contract: the record computed, then printed."""
+    return driven_equation_report_json(
+        driven_report(driven_equation(text, values, omega, "oscillator"), 0, harmonics))
 
 
 def asymmetric(eps, gamma):

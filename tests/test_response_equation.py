@@ -15,20 +15,35 @@ import time
 
 import numpy as np
 import pytest
+from lindstedt.analysis.mixing import duffing_mixing, equation_mixing
+from lindstedt.analysis.response import duffing_response, equation_response
+from lindstedt.analysis.subharmonic import subharmonic
 from lindstedt.cli import main
 from lindstedt.cli.driven import (
     mixing_equation_json,
     mixing_json,
-    response_equation_json,
-    response_json,
+    response_report_json,
     subharmonic_equation_json,
+    subharmonic_equation_response,
     subharmonic_json,
 )
 from lindstedt.costs import response_cost
+from lindstedt.limits import COST_LIMIT_SECONDS
 from scipy.integrate import solve_ivp
 
 ASYMMETRIC = "q'' + 0.05*q' + q + 0.1*q**2 + 0.1*q**3 = 0.3*cos(w*t)"
 FOLD_AGREE = 1e-7
+
+
+def response_equation_json(text: str, values: dict[str, str], harmonics: int) -> dict:
+    """``response EQUATION --json``'s contract: the record computed, then printed."""
+    return response_report_json(equation_response(text, values, harmonics,
+                                                  max_seconds=COST_LIMIT_SECONDS))
+
+
+def response_json(eps: float, force: float, Q: float, harmonics: int) -> dict:
+    """``response --eps --force --Q --json``'s contract: the record computed, then printed."""
+    return response_report_json(duffing_response(eps, force, Q, harmonics, COST_LIMIT_SECONDS))
 
 
 def asymmetric(q, p):
@@ -191,8 +206,9 @@ def _without_added(data):
     ("y'' + y + eps*y**3 = f*cos(W*t)", 1.2),  # W is the drive, 3ω
 ])
 def test_subharmonic_as_text_equals_the_flags(text, omega):
-    mine = subharmonic_equation_json(text, {"eps": "1/10", "f": "1/2"}, omega)
-    assert _without_added(mine) == subharmonic_json(0.1, 0.5, 1.2)
+    found = subharmonic_equation_response(text, {"eps": "1/10", "f": "1/2"}, omega)
+    mine = subharmonic_equation_json(text, "oscillator", *found)
+    assert _without_added(mine) == subharmonic_json(0.1, 0.5, 1.2, subharmonic(0.1, 0.5, 1.2))
     assert mine["parameters"]["values"] == {"eps": "1/10", "f": "1/2"}
 
 
@@ -200,8 +216,9 @@ def test_mixing_as_text_equals_the_flags():
     text = "u'' + u'/Q + u + eps*u**3 = f2*cos(w2*t) + f1*cos(w1*t)"
     values = {"eps": "1/10", "Q": "10", "f1": "3/10", "w1": "13/10", "f2": "1/5",
               "w2": "17/10"}
-    mine = mixing_equation_json(text, values)
-    assert _without_added(mine) == mixing_json(0.1, 10.0, [(0.3, 1.3), (0.2, 1.7)])
+    mine = mixing_equation_json(equation_mixing(text, values), text)
+    assert _without_added(mine) == mixing_json(duffing_mixing(0.1, 10.0, [(0.3, 1.3),
+                                                                          (0.2, 1.7)]))
 
 
 # --- refusals and costs ----------------------------------------------------------------------

@@ -344,3 +344,29 @@ def frequency_energy(system: object, order: int = FEP_ORDER) -> FrequencyEnergy:
                                 for j, wj in enumerate(w0, 1) for n in RESONANCES
                                 if i != j and wi / 2 < wj / n < wi * 2))
     return FrequencyEnergy(system.text, order, tuple(curves), lines)
+
+
+SUBHARMONIC_OMEGA = (1.0, 2.0, 161)
+# NOTE: the notes' 1/3 subharmonic drawn over 1 ≤ ω ≤ 2 (the drive at 3ω) in steps of
+# 0.00625: eq. 10.87's roots exist from ω² = 1 + 3εa²/4-ish up.
+
+
+@dataclass(frozen=True, eq=False)
+class SubharmonicCurve:
+    """eq. 10.87's roots across ω: at each ``omega``, :func:`analysis.subharmonic.subharmonic`'s
+    ``(exists, reason, solutions)`` (each root with its Hill, full-Hill and shot verdicts)."""
+
+    eps: float
+    force: float
+    omega: np.ndarray
+    answers: tuple
+
+
+def subharmonic_curve(eps: float, force: float) -> SubharmonicCurve:
+    """:class:`SubharmonicCurve` of ``ω² q'' + q + εq³ = f cos 3τ`` over
+    :data:`SUBHARMONIC_OMEGA`."""
+    from .subharmonic import subharmonic
+
+    omega = np.linspace(*SUBHARMONIC_OMEGA)
+    return SubharmonicCurve(eps, force, omega,
+                            tuple(subharmonic(eps, force, float(w)) for w in omega))

@@ -228,3 +228,45 @@ def mixing_equation(text: str, values: dict[str, str], name: str = "oscillator"
     form = driven_form(text, values, name, "mixing", MIXING_ANSATZ, False)
     drives = sorted(((f, float(c)) for f, c, _ in form.drives), key=lambda d: (d[1], d[0]))
     return ForceTable.of(form.floats()), drives, form.values
+
+
+@dataclass(frozen=True, eq=False)
+class Mixing:
+    """What ``lindstedt mixing`` computes, once: the force ``table`` and its ``drives``, the
+    predicted tones (:class:`MixingSeries`) and the simulated steady state's fit at them
+    (:class:`numerics.integrate.ToneFit`); ``values`` the parameters given to a user's
+    equation."""
+
+    table: ForceTable
+    drives: tuple[tuple[float, float], ...]
+    series: MixingSeries
+    fit: ToneFit
+    values: tuple = ()
+
+
+def mixing(table: ForceTable, drives: list[tuple[float, float]], values: tuple = ()) -> Mixing:
+    """The tones of ``q̈ + g = Σ f_i cos ω_i t`` predicted and simulated: :class:`Mixing`."""
+    series = mixing_series(table, drives)
+    return Mixing(table, tuple(drives), series,
+                  simulated_fit(table, drives, list(series.tones)), values)
+
+
+def duffing_mixing(eps: float, Q: float, drives: list[tuple[float, float]]) -> Mixing:
+    """:class:`Mixing` of the notes' ``q̈ + q̇/Q + q + εq³``, ε and Q checked first, then
+    every drive's numbers (as :class:`driven.Drive` checks them)."""
+    from ..numerics.integrate import duffing_table
+    from .driven import Drive
+
+    Drive(eps, 1.0, 1.0, Q)
+    for f, w in drives:
+        try:
+            Drive(eps, f, w, Q)
+        except InputError as exc:
+            raise InputError(f"drive {f!r}@{w!r}: {exc}") from None
+    return mixing(duffing_table(eps, 1 / Q), drives)
+
+
+def equation_mixing(text: str, values: dict[str, str], name: str = "oscillator") -> Mixing:
+    """:class:`Mixing` of a user's equation (:func:`mixing_equation`)."""
+    table, drives, given = mixing_equation(text, values, name)
+    return mixing(table, drives, given)

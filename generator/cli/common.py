@@ -143,14 +143,16 @@ def _first_harmonic(A: dict, B: dict) -> float:
     return float(math.hypot(A.get(1, 0.0), B.get(1, 0.0)))
 
 
-def _report(args: argparse.Namespace, compute, draw, table) -> int:
+def _report(args: argparse.Namespace, compute, json_of, draw, table) -> int:
     """The shape of every effect command: check the plot path first (nothing is computed for
-    a figure that cannot be written), compute, draw, print JSON or the table.  matplotlib
-    is imported only for --plot (a refused input answers without it)."""
+    a figure that cannot be written), compute the record once, then its printers: the figure
+    (``draw(record, path)``), JSON or the table (of ``json_of(record)``).  matplotlib is
+    imported only for --plot (a refused input answers without it)."""
     plot = _charts().check_plot_path(Path(args.plot)) if args.plot else None
-    data = compute()
+    record = compute()
+    data = json_of(record)
     if plot is not None:
-        draw(plot)
+        draw(record, plot)
     print(json.dumps(data) if args.json else "\n".join(table(data)))
     return 0
 

@@ -42,14 +42,6 @@ from .common import (
 )
 
 
-def driven_json(d, order: int, harmonics: int) -> dict:
-    """The contract of ``lindstedt driven … --json``: :func:`driven_report_json` of
-    :func:`analysis.periodic.driven_report`."""
-    from ..analysis.periodic import driven_report
-
-    return driven_report_json(driven_report(d, order, harmonics))
-
-
 def driven_report_json(report) -> dict:
     """The JSON of a :class:`analysis.periodic.DrivenReport`, a pure function of it: every
     distinct 1:1 orbit, largest first, each three ways where it can be.
@@ -194,18 +186,6 @@ def driven_table(data: dict) -> str:
     return "\n".join(lines)
 
 
-def driven_equation_json(text: str, values: dict[str, str], omega: float, harmonics: int,
-                         name: str = "oscillator") -> dict:
-    """The contract of ``lindstedt driven EQUATION … --json``:
-    :func:`driven_equation_report_json` of :func:`analysis.periodic.driven_report` on the
-    equation at ``omega``."""
-    from ..analysis.periodic import driven_report
-    from ..analysis.polynomial import driven_equation
-
-    return driven_equation_report_json(
-        driven_report(driven_equation(text, values, omega, name), 0, harmonics))
-
-
 def driven_equation_report_json(report) -> dict:
     """The JSON of a user's :class:`analysis.periodic.DrivenReport`, a pure function of it: every
     distinct 1:1 orbit found, largest first, each by its harmonic balance (``A`` holds the
@@ -306,8 +286,12 @@ def run_driven(args: argparse.Namespace) -> int:
                              "--param (e.g. --param eps=1/10) and the drive in the equation")
         if args.omega is None:
             raise InputError("--omega: the drive frequency is required")
-        data = driven_equation_json(args.model, _params(args.param), args.omega,
-                                    args.harmonics, args.name or "oscillator")
+        from ..analysis.periodic import driven_report
+        from ..analysis.polynomial import driven_equation
+
+        de = driven_equation(args.model, _params(args.param), args.omega,
+                             args.name or "oscillator")
+        data = driven_equation_report_json(driven_report(de, 0, args.harmonics))
         print(json.dumps(data) if args.json else driven_equation_table(data))
         return 0
     if args.param or args.name:
@@ -317,7 +301,9 @@ def run_driven(args: argparse.Namespace) -> int:
         raise InputError(f"the following arguments are required: {', '.join(missing)}")
     d = Drive(args.eps, args.force, args.omega, math.inf if args.Q is None else args.Q)
     check_steady_state(d.eps, d.Q, d.omega)
-    data = driven_json(d, args.order, args.harmonics)
+    from ..analysis.periodic import driven_report
+
+    data = driven_report_json(driven_report(d, args.order, args.harmonics))
     print(json.dumps(data) if args.json else driven_table(data))
     return 0
 
@@ -354,28 +340,6 @@ def response_report_json(r) -> dict:
                       "sweep_down_escape": down.escape,
                       "escape_bound": r.barrier if math.isfinite(r.barrier) else None},
     }
-
-
-def response_json(eps: float, force: float, Q: float, harmonics: int,
-                  max_seconds: float = COST_LIMIT_SECONDS) -> dict:
-    """``response --eps --force --Q --json``: :func:`response_report_json` of
-    :func:`analysis.response.duffing_response` (``max_seconds``: the continuation's cost
-    limit)."""
-    from ..analysis.response import duffing_response
-
-    return response_report_json(duffing_response(eps, force, Q, harmonics, max_seconds))
-
-
-def response_equation_json(text: str, values: dict[str, str], harmonics: int,
-                           name: str = "oscillator", omega_min: float | None = None,
-                           omega_max: float | None = None,
-                           max_seconds: float = COST_LIMIT_SECONDS) -> dict:
-    """``response EQUATION --json``: :func:`response_report_json` of
-    :func:`analysis.response.equation_response`."""
-    from ..analysis.response import equation_response
-
-    return response_report_json(equation_response(text, values, harmonics, name, omega_min,
-                                                  omega_max, max_seconds))
 
 
 def _response_args(args: argparse.Namespace) -> None:
@@ -483,11 +447,11 @@ def _response_table(data: dict) -> list[str]:
     return lines
 
 
-def subharmonic_json(eps: float, force: float, omega: float) -> dict:
-    """The contract of ``lindstedt subharmonic … --json`` (eq. 10.83–10.87)."""
-    from ..analysis.subharmonic import subharmonic
-
-    exists, reason, solutions = subharmonic(eps, force, omega)
+def subharmonic_json(eps: float, force: float, omega: float, closed: tuple) -> dict:
+    """The contract of ``lindstedt subharmonic … --json`` (eq. 10.83–10.87), a pure function
+    of ``closed``, :func:`analysis.subharmonic.subharmonic`'s ``(exists, reason, solutions)``
+    at ``eps``, ``force``, ``omega``."""
+    exists, reason, solutions = closed
     return {
         "parameters": {"eps": eps, "force": force, "omega": omega, "drive": 3 * omega},
         "exists": exists,
@@ -509,22 +473,32 @@ def subharmonic_json(eps: float, force: float, omega: float) -> dict:
     }
 
 
-def subharmonic_equation_json(text: str, values: dict[str, str], omega: float | None,
-                              name: str = "oscillator", n: int = 3) -> dict:
-    """The contract of ``lindstedt subharmonic EQUATION --n N … --json``: every orbit of n
-    drive periods (balance, shooting, Floquet), the primary response and the onset.  For the
-    notes' eq. 10.83 (n = 3, ``q + εq³``, undamped) the closed form's keys of
-    :func:`subharmonic_json` as well."""
-    from ..analysis.subharmonic import subharmonic_equation, subharmonic_orbits
-
-    problem = subharmonic_equation(text, values, omega, n, name)
-    found = subharmonic_orbits(problem)
+def subharmonic_equation_json(text: str, name: str, found, closed: tuple | None) -> dict:
+    """The contract of ``lindstedt subharmonic EQUATION --n N … --json``, a pure function of
+    ``found`` (:class:`analysis.subharmonic.SubharmonicResponse`: every orbit of n drive
+    periods, the primary response and the onset) and, for the notes' eq. 10.83 (n = 3,
+    ``q + εq³``, undamped), ``closed``, its closed form (:func:`subharmonic_json`'s keys as
+    well)."""
+    problem = found.problem
     data = {"equation": text, "name": name, **subharmonic_orbits_json(found)}
     data["parameters"]["values"] = dict(problem.values)
-    if problem.eps is not None:
-        notes = subharmonic_json(problem.eps, problem.force, problem.omega)
+    if closed is not None:
+        notes = subharmonic_json(problem.eps, problem.force, problem.omega, closed)
         data = {**data, **notes, "parameters": {**data["parameters"], **notes["parameters"]}}
     return data
+
+
+def subharmonic_equation_response(text: str, values: dict[str, str], omega: float | None,
+                                  name: str = "oscillator", n: int = 3) -> tuple:
+    """What ``subharmonic EQUATION`` computes, once: the orbits found
+    (:func:`analysis.subharmonic.subharmonic_orbits`) and, for the notes' eq. 10.83, its
+    closed form (``None`` otherwise)."""
+    from ..analysis.subharmonic import subharmonic, subharmonic_equation, subharmonic_orbits
+
+    problem = subharmonic_equation(text, values, omega, n, name)
+    closed = (None if problem.eps is None else
+              subharmonic(problem.eps, problem.force, problem.omega))
+    return subharmonic_orbits(problem), closed
 
 
 def subharmonic_orbits_json(found) -> dict:
@@ -565,25 +539,37 @@ def run_subharmonic(args: argparse.Namespace) -> int:
     or a figure.  Returns the exit status."""
     n = 3 if args.n is None else args.n
     if _equation_args(args, ("eps", "force"), ("eps", "force", "omega")):
-        from ..analysis.subharmonic import subharmonic_equation
-
         values, name = _params(args.param), args.name or "oscillator"
-        problem = subharmonic_equation(args.model, values, args.omega, n, name)
-        if problem.eps is not None:
-            draw = lambda path: _charts().subharmonic_figure(  # noqa: E731
-                problem.eps, problem.force, path)
-        else:
-            draw = lambda path: _charts().subharmonic_orbits_figure(  # noqa: E731
-                args.model, values, args.omega, n, name, path)
-        return _report(args, lambda: subharmonic_equation_json(args.model, values, args.omega,
-                                                               name, n),
-                       draw, _subharmonic_table)
+
+        def draw(record: tuple, path: Path) -> Path:
+            found, closed = record
+            if closed is not None:  # the notes' eq. 10.83: its roots across ω
+                return _subharmonic_curve_figure(found.problem.eps, found.problem.force, path)
+            return _charts().subharmonic_orbits_figure(found, args.model, path)
+
+        return _report(args, lambda: subharmonic_equation_response(args.model, values,
+                                                                   args.omega, name, n),
+                       lambda r: subharmonic_equation_json(args.model, name, *r), draw,
+                       _subharmonic_table)
     if n != 3:
         raise InputError(f"--n {n}: the notes' eq. 10.83 (--eps, --force) is the 1/3 "
                          "subharmonic; give an EQUATION for another n")
-    return _report(args, lambda: subharmonic_json(args.eps, args.force, args.omega),
-                   lambda path: _charts().subharmonic_figure(args.eps, args.force, path),
+    def closed() -> tuple:
+        from ..analysis.subharmonic import subharmonic
+
+        return subharmonic(args.eps, args.force, args.omega)
+
+    return _report(args, closed,
+                   lambda c: subharmonic_json(args.eps, args.force, args.omega, c),
+                   lambda _, path: _subharmonic_curve_figure(args.eps, args.force, path),
                    _subharmonic_table)
+
+
+def _subharmonic_curve_figure(eps: float, force: float, path: Path) -> Path:
+    """eq. 10.87's roots across ω (:func:`analysis.curves.subharmonic_curve`), drawn."""
+    from ..analysis.curves import subharmonic_curve
+
+    return _charts().subharmonic_figure(subharmonic_curve(eps, force), path)
 
 
 def _subharmonic_table(data: dict) -> list[str]:
@@ -640,16 +626,6 @@ def _orbits_table(data: dict) -> list[str]:
             "none: the orbits continue down to f = 0" if on["kind"] == "none" else
             f"f = {on['force']:.8g} ({how})"))
     return lines
-
-
-def parametric_json(eps: float, zeta: float, gamma: float, omega_from: float, omega_to: float,
-                    points: int = 41, harmonics: int = 8) -> dict:
-    """The contract of ``lindstedt parametric … --json``: :func:`parametric_report_json` of
-    :func:`analysis.parametric.parametric_report`."""
-    from ..analysis.parametric import parametric_report
-
-    return parametric_report_json(parametric_report(eps, zeta, gamma, omega_from, omega_to,
-                                                    points, harmonics))
 
 
 def parametric_report_json(report) -> dict:
@@ -732,46 +708,31 @@ def run_parametric(args: argparse.Namespace) -> int:
     table, JSON or a figure.  Returns the exit status."""
     if args.omega_min is None or args.omega_max is None:
         raise InputError("the following arguments are required: --omega A:B[:N]")
-    return _report(args, lambda: parametric_json(args.eps, args.zeta, args.gamma,
-                                                 args.omega_min, args.omega_max, args.points,
-                                                 args.harmonics),
-                   lambda path: _charts().parametric_figure(args.eps, args.zeta, args.gamma,
-                                                            args.omega_min, args.omega_max,
-                                                            path),
+
+    def report():
+        from ..analysis.parametric import parametric_report
+
+        return parametric_report(args.eps, args.zeta, args.gamma, args.omega_min,
+                                 args.omega_max, args.points, args.harmonics)
+
+    return _report(args, report, parametric_report_json,
+                   lambda r, path: _charts().parametric_figure(r, path),
                    _parametric_table)
 
 
-def mixing_json(eps: float, Q: float, drives: list[tuple[float, float]]) -> dict:
-    """The contract of ``lindstedt mixing … --json``: predicted and simulated tones of the
-    notes' ``q̈ + q̇/Q + q + εq³`` (:func:`mixing_tones_json` of its table)."""
-    from ..analysis.driven import Drive
-    from ..numerics.integrate import duffing_table
+def mixing_json(m) -> dict:
+    """The contract of ``lindstedt mixing … --json``, a pure function of a
+    :class:`analysis.mixing.Mixing`: predicted and simulated tones of ``q̈ + g = Σ f_i cos
+    ω_i t``; ``eps`` and ``Q`` among the parameters when ``g`` is the notes' ``q + εq³ +
+    q̇/Q``."""
+    from ..analysis.mixing import tone_label
 
-    Drive(eps, 1.0, 1.0, Q)  # ε and Q first, then every drive's numbers
-    for f, w in drives:
-        try:
-            Drive(eps, f, w, Q)
-        except InputError as exc:
-            raise InputError(f"drive {f!r}@{w!r}: {exc}") from None
-    data = mixing_tones_json(duffing_table(eps, 1 / Q), drives)
-    data["parameters"].update(eps=eps, Q=Q)
-    return data
-
-
-def mixing_tones_json(table, drives: list[tuple[float, float]]) -> dict:
-    """Predicted (:func:`mixing.mixing_series`) and simulated tones of ``q̈ + g = Σ f_i cos
-    ω_i t``, ``g`` the :class:`numerics.ForceTable`; ``eps`` and ``Q`` among the parameters
-    when ``g`` is the notes' ``q + εq³ + q̇/Q``."""
-    from ..analysis.mixing import mixing_series, simulated_fit, tone_label
-
-    series = mixing_series(table, drives)
-    fit = simulated_fit(table, drives, list(series.tones))
-    terms = table.terms
+    series, fit, terms = m.series, m.fit, m.table.terms
     parameters: dict = {}
     if set(terms) <= {(1, 0), (3, 0), (0, 1)} and terms.get((1, 0)) == 1.0:
         parameters = {"eps": terms.get((3, 0), 0.0), "Q": 1 / terms[(0, 1)]}
     return {
-        "parameters": {**parameters, "drives": [{"force": f, "omega": w} for f, w in drives]},
+        "parameters": {**parameters, "drives": [{"force": f, "omega": w} for f, w in m.drives]},
         "expansion_parameter": series.expansion_parameter,
         "converged": series.converged,
         "reason": series.reason,
@@ -785,6 +746,14 @@ def mixing_tones_json(table, drives: list[tuple[float, float]]) -> dict:
     }
 
 
+def mixing_equation_json(m, text: str, name: str = "oscillator") -> dict:
+    """:func:`mixing_json` of a user's equation, with ``equation``, ``name`` and the
+    ``parameters.values`` given."""
+    data = mixing_json(m)
+    data["parameters"]["values"] = dict(m.values)
+    return {"equation": text, "name": name, **data}
+
+
 def _drive(text: str) -> tuple[float, float]:
     try:
         f, w = text.split("@")
@@ -793,37 +762,21 @@ def _drive(text: str) -> tuple[float, float]:
         raise argparse.ArgumentTypeError(f"drive {text!r}: expected F@W, e.g. 0.3@1.3") from None
 
 
-def mixing_equation_json(text: str, values: dict[str, str], name: str = "oscillator") -> dict:
-    """:func:`mixing_tones_json` of a user's equation, any polynomial force with a linear
-    stiffness and damping (drives by ascending frequency), with ``equation``, ``name`` and the
-    ``parameters.values`` given."""
-    from ..analysis.mixing import mixing_equation
-
-    table, drives, given = mixing_equation(text, values, name)
-    data = mixing_tones_json(table, drives)
-    data["parameters"]["values"] = dict(given)
-    return {"equation": text, "name": name, **data}
-
-
 def run_mixing(args: argparse.Namespace) -> int:
     """Run ``lindstedt mixing`` (the notes' Duffing or an EQUATION): the combination tones
-    of a multi-tone drive, as a table, JSON or a figure.  Returns the exit status."""
+    of a multi-tone drive, as a table, JSON or a figure, computed once.  Returns the exit
+    status."""
+    from ..analysis.mixing import duffing_mixing, equation_mixing
+
     if _equation_args(args, ("eps", "Q", "drive"), ("eps", "Q", "drive")):
-        from ..analysis.mixing import mixing_equation
-
         values, name = _params(args.param), args.name or "oscillator"
-        table, drives, _ = mixing_equation(args.model, values, name)
-        return _report(args, lambda: mixing_equation_json(args.model, values, name),
-                       lambda path: _charts().mixing_figure(table, drives, path, args.model),
+        return _report(args, lambda: equation_mixing(args.model, values, name),
+                       lambda m: mixing_equation_json(m, args.model, name),
+                       lambda m, path: _charts().mixing_figure(m, path, args.model),
                        _mixing_table)
-
-    def draw(path: Path) -> Path:
-        from ..numerics.integrate import duffing_table
-
-        return _charts().mixing_figure(duffing_table(args.eps, 1 / args.Q), args.drive, path,
-                                       f"ε = {args.eps}, Q = {args.Q}")
-
-    return _report(args, lambda: mixing_json(args.eps, args.Q, args.drive), draw,
+    return _report(args, lambda: duffing_mixing(args.eps, args.Q, args.drive), mixing_json,
+                   lambda m, path: _charts().mixing_figure(m, path,
+                                                           f"ε = {args.eps}, Q = {args.Q}"),
                    _mixing_table)
 
 
