@@ -1,11 +1,15 @@
-"""Pseudo-arclength continuation of a balance system, through its folds: in the drive
-frequency ω (a curve in ω with its pieces) or in the drive amplitude f from rest at one ω
-(the seeds of every orbit), and the crossings of a traced curve with a level."""
+"""The one pseudo-arclength continuation of the package (:class:`Arclength`: the predictor,
+the corrector, the step control and the fold detection), parameterised by what it follows: the
+drive frequency ω (:func:`_continue`: a curve in ω with its pieces, through its folds), the
+drive amplitude f from rest at one ω (:func:`continue_in_drive`: the seeds of every orbit), or
+an onset's drive amplitude (``subharmonic.subharmonic_onset``: f followed down to a fold or a
+branch point); and the crossings of a traced curve with a level."""
 
 from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,6 +59,63 @@ RETAKES = 3
 # a point; three bound a corrector that keeps failing somewhere by work, not by the clock.
 
 
+class Arclength:
+    """The one pseudo-arclength predictor–corrector of the package, on a family ``fam`` of
+    balances in one free parameter λ — what it follows: ω (a :class:`PolynomialBalance`
+    itself: ``residual``, ``jacobian`` and ``d_omega`` in ``(x, ω)``), the drive amplitude f
+    at one ω (:class:`DriveFamily`), or an onset's drive amplitude (the same, f decreasing).
+    ``y = (x, λ)`` and its unit tangent ``t``; each :meth:`attempt` predicts ``y + h t``,
+    corrects (:func:`_corrector`) and takes the point where it converged, did not turn the
+    tangent by more than ~25°, and landed within ``2h``, then grows the step
+    (``grow(y, h)``); else it retakes the step at half the length while ``h`` is above
+    ``floor``: the ω continuation (``take_at_floor``) takes a step at or below the floor as
+    it is (a narrow resonance's sharp turn; a singular or overflowing step raises
+    ``LinAlgError``), any other gives up where the halved step falls below the floor
+    (:attr:`stuck`).  A fold is where the tangent's λ
+    component changes sign over a taken step (:attr:`fold`; its point:
+    :func:`fold_point`)."""
+
+    def __init__(self, fam: object, y: np.ndarray, t: np.ndarray, step: float, floor: float,
+                 grow: Callable[[np.ndarray, float], float],
+                 take_at_floor: bool = False) -> None:
+        self.fam, self.y, self.t, self.h = fam, y, t, step
+        self.floor, self.grow, self.take_at_floor = floor, grow, take_at_floor
+        self.previous: tuple[np.ndarray, np.ndarray, float] | None = None  # (y, t, h) before
+        self.fold = False  # the last step taken passed a fold
+        self.stuck = False  # no step above the floor converges
+
+    def attempt(self) -> bool:
+        """One corrector step from :attr:`y`: whether it was taken (:attr:`y`, :attr:`t`,
+        :attr:`previous`, :attr:`fold` then moved on), or retaken at half the length (or,
+        below the floor, :attr:`stuck`)."""
+        fam, y, t, h = self.fam, self.y, self.t, self.h
+        try:
+            y_new = _corrector(fam, y + h * t, t)
+            t_new = _tangent(fam, y_new, t)
+        except np.linalg.LinAlgError:
+            if self.take_at_floor and h <= self.floor:
+                raise
+            return self._retake()
+        finite = bool(np.all(np.isfinite(y_new)) and np.all(np.isfinite(t_new)))
+        if not finite and self.take_at_floor:  # the ω continuation: refused
+            raise np.linalg.LinAlgError("the balance overflowed")
+        # a step that turns the tangent by more than ~25°, lands far or does not converge is
+        # retaken at half the length (a narrow resonance's sharp turn)
+        if not (finite and t_new @ t >= 0.9 and np.linalg.norm(y_new - y) <= 2 * h
+                and np.max(np.abs(fam.residual(y_new[:-1], y_new[-1])))
+                <= 1e-9 * (1 + np.max(np.abs(y_new)))) \
+                and not (self.take_at_floor and h <= self.floor):
+            return self._retake()
+        self.previous, self.fold = (y, t, h), bool(t_new[-1] * t[-1] < 0)
+        self.y, self.t, self.h = y_new, t_new, self.grow(y_new, h)
+        return True
+
+    def _retake(self) -> bool:
+        self.h /= 2
+        self.stuck = not self.take_at_floor and self.h < self.floor
+        return False
+
+
 def _continue(sysm: PolynomialBalance, end_solutions, omega_start: float,
               omega_stop: float, step: float, estimate: float, seconds: float,
               per_point: float, max_points: int, where: str) -> Continuation:
@@ -84,14 +145,12 @@ def _continue(sysm: PolynomialBalance, end_solutions, omega_start: float,
                 visited[k] = True
                 omega0, x0, direction = ends[k]
                 y = np.append(x0, omega0)
-                t = _tangent(sysm, y, None)
-                if t[-1] * direction < 0:
-                    t = -t
+                path = Arclength(sysm, y, _oriented(sysm, y, direction), step,
+                                 step * MIN_STEP, lambda _, h: min(step, 1.5 * h), True)
                 starts.append(len(points))
                 points.append(y)
                 y_start, away = y, False
-                y_old, h = None, step
-                while y_old is None or lo <= y[-1] <= hi:
+                while path.previous is None or lo <= y[-1] <= hi:
                     # a closed curve (an isola) ends where it meets its start again
                     gap = np.linalg.norm(y - y_start)
                     away = away or gap > 3 * step
@@ -110,29 +169,12 @@ def _continue(sysm: PolynomialBalance, end_solutions, omega_start: float,
                                          f"{len(points)} points in (its estimate: "
                                          f"{estimate:.0f}): the corrector does not converge "
                                          "there")
-                    try:
-                        y_new = _corrector(sysm, y + h * t, t)
-                        t_new = _tangent(sysm, y_new, t)
-                    except np.linalg.LinAlgError:
-                        if h <= step * MIN_STEP:
-                            raise
-                        h /= 2
+                    if not path.attempt():
                         continue
-                    if not (np.all(np.isfinite(y_new)) and np.all(np.isfinite(t_new))):
-                        raise np.linalg.LinAlgError("the balance overflowed")
-                    # a step that turns the tangent by more than ~25°, lands far or does not
-                    # converge is retaken at half the length (a narrow resonance's sharp turn)
-                    if h > step * MIN_STEP and not (
-                            t_new @ t >= 0.9 and np.linalg.norm(y_new - y) <= 2 * h
-                            and np.max(np.abs(sysm.residual(y_new[:-1], y_new[-1])))
-                            <= 1e-9 * (1 + np.max(np.abs(y_new)))):
-                        h /= 2
-                        continue
-                    if t_new[-1] * t[-1] < 0:
-                        folds.append(_refine_fold(sysm, y, t, h))
-                    y_old, y, t = y, y_new, t_new
+                    if path.fold:
+                        folds.append(_refine_fold(sysm, *path.previous))
+                    y = path.y
                     points.append(y)
-                    h = min(step, 1.5 * h)
                 if lo <= y[-1] <= hi:  # closed: the same start taken the other way is done
                     for j, e in enumerate(ends):
                         if e[0] == omega0 and np.array_equal(e[1], x0):
@@ -140,6 +182,7 @@ def _continue(sysm: PolynomialBalance, end_solutions, omega_start: float,
                     continue
                 # the end it left by: the nearest solution there is reached
                 edge = lo if y[-1] < lo else hi
+                y_old = path.previous[0]
                 s_edge = (edge - y_old[-1]) / (y[-1] - y_old[-1])
                 x_edge = y_old[:-1] + s_edge * (y[:-1] - y_old[:-1])
                 at_edge = [j for j, e in enumerate(ends) if e[0] == edge]
@@ -168,6 +211,13 @@ def _tangent(sysm: PolynomialBalance, y: np.ndarray, previous: np.ndarray | None
     if previous is not None and t @ previous < 0:
         t = -t
     return t
+
+
+def _oriented(fam: object, y: np.ndarray, direction: float) -> np.ndarray:
+    """The first tangent of a path from ``y``: its parameter component along ``direction``
+    (``+1`` increasing, ``−1`` decreasing; left as it comes where it is 0)."""
+    t = _tangent(fam, y, None)
+    return -t if t[-1] * direction < 0 else t
 
 
 def _corrector(sysm: PolynomialBalance, y: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -247,9 +297,9 @@ def _crossings(w: np.ndarray, x: np.ndarray) -> list[np.ndarray]:
 
 # --- a user's driven oscillator: every orbit at one ω, from a continuation in the drive -------
 
-class _DriveFamily:
+class DriveFamily:
     """A :class:`driven.PolynomialBalance` at fixed ω as a family in the drive amplitude f:
-    the interface :func:`_tangent` and :func:`_corrector` take, with f in ω's place."""
+    the interface :class:`Arclength` follows, with f in ω's place."""
 
     def __init__(self, system: PolynomialBalance, omega: float) -> None:
         self.system, self.omega = system, omega
@@ -283,26 +333,36 @@ def continue_in_drive(system: PolynomialBalance, omega: float, bound: float | No
     first harmonic exceeds ``bound`` (:func:`driven.amplitude_bound`; then every orbit at the
     drive lies on the traced part, up to isolated branches the curve does not pass) or after
     ``max_points`` points (:data:`DRIVE_RETAKES` corrector steps each, halved ones included).
-    The step adapts: halved where the corrector fails or the tangent turns by more than ~25°,
-    grown by 1.5 where it does not, up to 1 % of the curve's scale and, near ``±f``, to half
-    the distance from it (down to 1e-4 of the scale)."""
-    fam = _DriveFamily(system, omega)
+    The step adapts (:class:`Arclength`): halved where the corrector fails or the tangent
+    turns by more than ~25° (down to 1e-9 of the curve's scale), doubled where it does not,
+    up to :data:`DRIVE_STEP` of the scale (of the point's size far out) and, near ``±f``,
+    to twice the distance from it (down to 1e-3 of the scale)."""
+    fam = DriveFamily(system, omega)
     m = system.size
     k1 = int(np.nonzero(system.orders == 1)[0][0])
     sin1 = system.n_cos + int(np.nonzero(system.orders[system.orders > 0] == 1)[0][0])
     scale = abs(system.force) + (bound if bound is not None else 10.0)
     h_max, h_floor, h_min = scale * DRIVE_STEP, scale * 1e-3, scale * 1e-9
-    h = h_max / 4
     y = np.zeros(m + 1)
     attempts = 0
+
+    def grow(y: np.ndarray, h: float) -> float:
+        # near ±f the steps shrink with the distance to it, so that a fold of the curve
+        # just beyond ±f (two crossings close together) leaves points on both sides
+        near = min(abs(y[-1] - system.force), abs(y[-1] + system.force))
+        # far out (the drive or the higher harmonics grown past the scale) the steps grow
+        # with the distance from rest: a crossing of ±f lies only where near is small
+        reach = max(h_max, DRIVE_STEP * float(np.max(np.abs(y))))
+        return min(DRIVE_GROWTH * h, reach, max(h_floor, 2.0 * near))
+
     with np.errstate(over="ignore", invalid="ignore"):
-        t = _tangent(fam, y, None)
-        if t[-1] < 0:
-            t = -t
+        t = _oriented(fam, y, 1.0)
         if abs(t[-1]) < 1e-8:  # ω at a linear resonance, undamped: q = 0 is degenerate
-            t = _first_direction(fam, y, h, k1, sin1)
+            t = _first_direction(fam, y, h_max / 4, k1, sin1)
+        path = Arclength(fam, y, t, h_max / 4, h_min, grow)
         points = [y]
         while True:
+            y = path.y
             r = system.first_harmonic(y[:-1])
             if bound is not None and r > bound:
                 return _drive_curve(points, True, f"continued in the drive amplitude from 0 "
@@ -313,34 +373,14 @@ def continue_in_drive(system: PolynomialBalance, omega: float, bound: float | No
                                     "steps)" + ("" if bound is None else
                                                 f" (bound {bound:.4g})"))
             attempts += 1
-            try:
-                y_new = _corrector(fam, y + h * t, t)
-                t_new = _tangent(fam, y_new, t)
-            except np.linalg.LinAlgError:
-                y_new = t_new = None
-            good = (y_new is not None and np.all(np.isfinite(y_new))
-                    and np.all(np.isfinite(t_new))
-                    and np.max(np.abs(fam.residual(y_new[:-1], y_new[-1])))
-                    <= 1e-9 * (1 + np.max(np.abs(y_new)))
-                    and np.linalg.norm(y_new - y) <= 2 * h and t_new @ t > 0.9)
-            if not good:
-                h /= 2
-                if h < h_min:
-                    return _drive_curve(points, False, f"the continuation in the drive failed "
-                                        f"at r = {r:.4g}, f = {y[-1]:.4g} (no step converges)")
-                continue
-            y, t = y_new, t_new
-            points.append(y)
-            # near ±f the steps shrink with the distance to it, so that a fold of the curve
-            # just beyond ±f (two crossings close together) leaves points on both sides
-            near = min(abs(y[-1] - system.force), abs(y[-1] + system.force))
-            # far out (the drive or the higher harmonics grown past the scale) the steps grow
-            # with the distance from rest: a crossing of ±f lies only where near is small
-            reach = max(h_max, DRIVE_STEP * float(np.max(np.abs(y))))
-            h = min(DRIVE_GROWTH * h, reach, max(h_floor, 2.0 * near))
+            if path.attempt():
+                points.append(path.y)
+            elif path.stuck:
+                return _drive_curve(points, False, f"the continuation in the drive failed "
+                                    f"at r = {r:.4g}, f = {y[-1]:.4g} (no step converges)")
 
 
-def _first_direction(fam: _DriveFamily, y: np.ndarray, h: float, k1: int,
+def _first_direction(fam: DriveFamily, y: np.ndarray, h: float, k1: int,
                      sin1: int) -> np.ndarray:
     """Where ``[J | −e₁]`` is singular at rest (an undamped harmonic at its linear resonance,
     the response growing like ``f^(1/3)``), the curve's first direction: the first of ±cos ωt,

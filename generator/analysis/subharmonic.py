@@ -25,7 +25,7 @@ from ..numerics.floquet import hill_multipliers, multipliers_stable, orbit_hill_
 from ..numerics.integrate import ForceTable, duffing_table, steady_state_amplitudes
 from ..numerics.newton import newton
 from ..numerics.shooting import PeriodicOrbit, shoot, shoot_table
-from .continuation import _corrector, _DriveFamily, _secant_turn, _tangent
+from .continuation import Arclength, DriveFamily, _oriented, _secant_turn
 from .driven import Drive
 from .periodic import SHOOTING_TOLERANCES
 from .polynomial import PolynomialBalance, amplitude_bound, driven_form
@@ -462,51 +462,42 @@ BRANCH_SHARE = 0.25
 
 def subharmonic_onset(system: PolynomialBalance, p: SubharmonicProblem,
                       starts: list[np.ndarray]) -> Onset:
-    """Continue each orbit in the drive amplitude (pseudo-arclength, f decreasing) to where it
-    ends: a fold (f turns back; refined by the secant on the tangent's f-component), a branch
-    point off the primary response (f turns back where the first harmonic passes 0; refined
-    by bisection on the sign of the balance Jacobian's determinant along the primary), or
-    f = 0; the smallest such f over the orbits."""
-    fam = _DriveFamily(system, p.omega)
+    """Continue each orbit in the drive amplitude (:class:`continuation.Arclength`, f
+    decreasing) to where it ends: a fold (f turns back; refined by the secant on the
+    tangent's f-component), a branch point off the primary response (f turns back where the
+    first harmonic passes 0; refined by bisection on the sign of the balance Jacobian's
+    determinant along the primary), or f = 0; the smallest such f over the orbits."""
+    fam = DriveFamily(system, p.omega)
     best = Onset(math.inf, "none")
     for x in starts:
         y = np.append(x, p.force)
         r_start = _first(system, x)
         size = 1 + float(np.max(np.abs(x))) + abs(p.force)
-        h = size / 200
         low = None
         with np.errstate(all="ignore"):
             try:
-                t = _tangent(fam, y, None)
+                path = Arclength(fam, y, _oriented(fam, y, -1.0), size / 200, size * 1e-10,
+                                 lambda _, h, top=size / 50: min(1.5 * h, top))  # f falling
             except np.linalg.LinAlgError:
                 continue
-            t = -t if t[-1] > 0 else t  # toward smaller f
             for _ in range(ONSET_POINTS):
-                try:
-                    y_new = _corrector(fam, y + h * t, t)
-                    t_new = _tangent(fam, y_new, t)
-                except np.linalg.LinAlgError:
-                    y_new = None
-                if y_new is None or not np.all(np.isfinite(y_new)) \
-                        or np.linalg.norm(y_new - y) > 2 * h or t_new @ t < 0.9:
-                    h /= 2
-                    if h < size * 1e-10:
+                if not path.attempt():
+                    if path.stuck:
                         break
                     continue
-                if y_new[-1] <= 0:
+                if path.y[-1] <= 0:
                     low = Onset(0.0, "none")
                     break
-                if t_new[-1] > 0 and t[-1] <= 0:  # f turned back between y and y_new
-                    low = _turn(system, fam, p, y, t, y_new, r_start)
+                if path.fold:  # f turned back over the last step
+                    y, t, _ = path.previous
+                    low = _turn(system, fam, p, y, t, path.y, r_start)
                     break
-                y, t = y_new, t_new
-                h = min(1.5 * h, size / 50)
         if low is not None and low.force < best.force:
             best = low
     return best
 
 
-def _turn(system: PolynomialBalance, fam: _DriveFamily, p: SubharmonicProblem, y: np.ndarray,
+def _turn(system: PolynomialBalance, fam: DriveFamily, p: SubharmonicProblem, y: np.ndarray,
           t: np.ndarray, y_new: np.ndarray, r_start: float) -> Onset:
     """The onset where the continuation turned back between ``y`` and ``y_new``: the point
     where the tangent's f-component vanishes (secant on the step), a branch point when the
