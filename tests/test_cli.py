@@ -246,3 +246,13 @@ def test_spans_are_checked_in_one_line(args, says):
     assert out.returncode == 2 and out.stdout == ""
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1 and says in lines[0], out.stderr
+
+
+def test_every_command_prints_its_help():
+    """``lindstedt COMMAND --help`` formats for every command (argparse expands % in a help
+    text: a stray one was a traceback)."""
+    from lindstedt.cli import COMMANDS, build_parser
+
+    commands = build_parser()._subparsers._group_actions[0].choices
+    for command in COMMANDS:
+        assert command.name in commands[command.name].format_help()

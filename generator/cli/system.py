@@ -286,15 +286,18 @@ def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser("nnm", help="a nonlinear normal mode of coupled oscillators as an exact "
                        "series: the backbone ω(A), T(A) and the mode's shape",
                        description="The Lindstedt–Poincaré series of one nonlinear normal mode "
-                       "of a conservative system x'' + Kx + f(x) = 0 (one equation per "
-                       "coordinate, separated by ';'): ω and T against the amplitude A and "
+                       "of a conservative system M x'' + Kx + f(x) = 0 (one equation per "
+                       "coordinate, separated by ';'; M constant, diagonal or symmetric "
+                       "positive definite; one equation or a preset's name is a system of one "
+                       "coordinate): ω and T against the amplitude A and "
                        "every coordinate's Fourier coefficients, exact (ω0 an algebraic "
                        "number, never rounded). An internal resonance with another mode is "
                        "refused, naming it.")
     p.add_argument("system", metavar="SYSTEM",
                    help="equations such as \"x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 "
-                   "= 0\" (x'' the accelerations, one per equation; every other name a "
-                   "parameter: a value with --param, or left a symbol in the nonlinear terms)")
+                   "= 0\" (x'' the accelerations: each equation its own, or a full mass "
+                   "matrix's row; every other name a parameter: a value with --param, or "
+                   "left a symbol in the nonlinear terms)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE",
                    help="an exact value for a parameter, e.g. beta=1/10 (repeatable; those in "
                    "the linear part need one, those in the nonlinear terms may stay symbols: "
@@ -316,7 +319,7 @@ def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    "--order if higher) beside orbits shot by DOP853, the series' reach, the "
                    "internal-resonance lines (default: none)")
     _flag_csv(p, "the mode's backbone (A, omega, period) summed from its series to --order, "
-              "up to 95 % of the series' estimated reach (to A = 0.95 without an estimate)")
+              "up to 95 %% of the series' estimated reach (to A = 0.95 without an estimate)")
     _flag_allow_slow(p, deprecated_force=False)
     return p
 
