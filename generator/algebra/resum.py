@@ -19,11 +19,271 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from fractions import Fraction
+from typing import Any
 
 import flint
 import numpy as np
 
 from ..errors import InputError
+
+# --- the one power-series toolkit ------------------------------------------------------------
+# A truncated power series ``Σ a_k x^k`` is the list of its coefficients, low to high, over any
+# exact ring the package uses: Fraction, FLINT's fmpq and fmpq_mpoly, SymPy's numbers and
+# expressions, the elements of a derivation's ``Ground`` (SymPy's number fields, K[params]).
+# Each operation is written once, with the ring's own +, −, × and the inverse of one element
+# (:func:`ring_inverse`); ``tidy`` (default: none) is applied to each coefficient made (e.g.
+# SymPy's radsimp for algebraic numbers).  The partial sums (Horner exact, in floats, and the
+# truncation estimate) and the radius of convergence estimated from the coefficients live
+# here too.
+
+
+def _kept(tidy: Callable[[Any], Any] | None) -> Callable[[Any], Any]:
+    return (lambda c: c) if tidy is None else tidy
+
+
+def ring_inverse(x: Any) -> Any:
+    """``1/x`` of a nonzero ring element: a field's (Fraction, fmpq, a number field's ANP, a
+    SymPy number), a constant of FLINT's ``fmpq_mpoly``, or a constant polynomial of SymPy's
+    ``K[params]`` (which inverts a constant only through its domain)."""
+    if type(x) is int:
+        return Fraction(1, x)
+    try:
+        return x ** -1
+    except ValueError:
+        ring = x.ring
+        if not x.is_ground:
+            raise
+        return ring.ground_new(ring.domain.quo(ring.domain.one, x.LC))
+
+
+def series_mul(a: Sequence[Any], b: Sequence[Any], n: int | None = None,
+               tidy: Callable[[Any], Any] | None = None) -> list[Any]:
+    """The product ``Σ_i a_i b_(k−i)`` truncated to ``n`` terms (default ``len(a)``); a
+    coefficient past either list's end is zero."""
+    n = len(a) if n is None else n
+    tidy = _kept(tidy)
+    zero = a[0] * 0
+    return [tidy(sum((a[i] * b[k - i] for i in range(max(0, k - len(b) + 1), min(k, len(a) - 1)
+                                                      + 1)), zero))
+            for k in range(n)]
+
+
+def series_reciprocal(a: Sequence[Any], n: int | None = None, *, inverse: Any = None,
+                      tidy: Callable[[Any], Any] | None = None) -> list[Any]:
+    """``1 / Σ a_k x^k`` to ``n`` terms (default ``len(a)``): ``p_0 = 1/a_0`` (``inverse``, when
+    the caller has it in its own form; else :func:`ring_inverse`), then
+    ``p_k = −p_0 Σ_(i=1..k) a_i p_(k−i)``."""
+    n = len(a) if n is None else n
+    tidy = _kept(tidy)
+    p = [ring_inverse(a[0]) if inverse is None else inverse]
+    zero = a[0] * 0
+    for k in range(1, n):
+        acc = sum((a[i] * p[k - i] for i in range(1, min(k, len(a) - 1) + 1)), zero)
+        p.append(tidy(-p[0] * acc))
+    return p
+
+
+def series_sqrt(a: Sequence[Any], n: int | None = None, *, root: Any = None,
+                tidy: Callable[[Any], Any] | None = None) -> list[Any]:
+    """``√(Σ a_k x^k)`` to ``n`` terms (default ``len(a)``): ``s_0 = root``, a square root of
+    ``a_0`` (default 1, when ``a_0 = 1``), then ``2 s_0 s_k = a_k − Σ_(0<i<k) s_i s_(k−i)``."""
+    n = len(a) if n is None else n
+    tidy = _kept(tidy)
+    if root is None:
+        root = a[0] ** 0
+        if a[0] != root:
+            raise ValueError("series_sqrt: a_0 is not 1; give its square root")
+    scale = ring_inverse(root + root)
+    zero = a[0] * 0
+    s = [root]
+    for k in range(1, n):
+        acc = a[k] if k < len(a) else zero
+        for i in range(1, k):
+            acc = acc - s[i] * s[k - i]
+        s.append(tidy(acc * scale))
+    return s
+
+
+def binomial_series(alpha: Fraction, n: int) -> list[Fraction]:
+    """``(1 + x)^α`` to ``n`` terms: ``binom(α, j)``, exact for rational ``α``."""
+    out, c = [], Fraction(1)
+    for j in range(n):
+        out.append(c)
+        c = c * (alpha - j) / (j + 1)
+    return out
+
+
+_RATIONAL = (int, Fraction, flint.fmpq)
+
+
+def series_compose(outer: Sequence[Any], inner: Sequence[Any], n: int | None = None, *,
+                   tidy: Callable[[Any], Any] | None = None) -> list[Any]:
+    """``Σ_j c_j inner(x)^j`` to ``n`` terms (default ``len(outer)``; ``inner(0) = 0``).
+
+    Over QQ (ints, Fractions, fmpq; no ``tidy``) by Horner's rule in FLINT's truncated
+    products, returned as Fractions; over any other ring as the sum of ``c_j`` times the powers
+    of ``inner``, each power by :func:`series_mul`."""
+    n = len(outer) if n is None else n
+    if inner and inner[0]:
+        raise ValueError("compose: the inner series must vanish at 0")
+    outer = list(outer[:n])
+    if tidy is None and all(isinstance(c, _RATIONAL) for c in (*outer, *inner)):
+        g = flint.fmpq_poly([_fmpq(c) for c in inner[:n]])
+        acc = flint.fmpq_poly([])
+        for c in reversed(outer):
+            acc = acc.mul_low(g, n) + _fmpq(c)
+        return [_fraction(acc[i]) for i in range(n)]
+    tidy = _kept(tidy)
+    total, power = [0] * n, [1] + [0] * (n - 1)
+    for j, c in enumerate(outer):
+        if j:
+            power = series_mul(power, inner, n, tidy)
+        total = [tidy(t + c * q) for t, q in zip(total, power, strict=True)]
+    return total
+
+
+def horner_exact(coeffs: Sequence[Any], x: Any) -> Any:
+    """``Σ c_k x^k`` (coefficients low to high) by Horner's rule in the ring's own arithmetic
+    (Fractions: exactly)."""
+    acc = x * 0
+    for c in reversed(coeffs):
+        acc = acc * x + c
+    return acc
+
+
+def horner_float(coeffs: Sequence[Any], x: np.ndarray) -> np.ndarray:
+    """``Σ c_k x^k`` (coefficients low to high) at float ``x`` by Horner's rule, each
+    coefficient rounded to float64 first."""
+    acc = np.zeros_like(x)
+    for c in reversed(coeffs):
+        acc = acc * x + float(c)
+    return acc
+
+
+def partial_sum(coefficients: Sequence, x: float) -> tuple[float, float, int]:
+    """The partial sum at ``x``, its change over the last two nonzero terms (the truncation
+    error estimate) and the order K of the smallest such change (the best reachable)."""
+    total, last, changes = 0.0, [], []
+    for k, c in enumerate(coefficients):
+        term = float(c) * x**k
+        total += term
+        if c:
+            last.append(abs(term))
+            changes.append((sum(last[-2:]), k))
+    if len(changes) < 2:
+        return total, 0.0, len(coefficients) - 1
+    best = min(changes[1:])
+    return total, changes[-1][0], best[1]
+
+
+@dataclass(frozen=True)
+class Singularity:
+    """The nearest singularities of a series, estimated from its coefficients: at ``radius``
+    and ``±angle`` (radians) in the plane of ``variable``; ``spread``: the error bar of
+    ``radius`` — how far the extrapolations from the last orders lie apart, or, if more, how
+    far the fit of one degree more in 1/n lies from it (the first neglected term)."""
+
+    variable: str
+    radius: float
+    angle: float
+    spread: float
+    method: str
+
+
+def nearest_singularity(coefficients: Sequence[Fraction], variable: str = "eps",
+                        degree: int | None = 1) -> Singularity | None:
+    """Domb–Sykes (ratios c_n/c_(n−1), for one real singularity: a tail of one sign or of
+    alternating signs) or Mercer–Roberts (a complex-conjugate pair: B_n² = (c_(n+1)c_(n−1) −
+    c_n²)/(c_n c_(n−2) − c_(n−1)²) → 1/R², cos θ from the same), each estimate extrapolated
+    linearly in 1/n over the last orders — or by a polynomial of ``degree`` in 1/n (the
+    ratios of an algebraic branch point go as 1 + a/n + b/n² + …); ``degree=None`` takes the
+    degree 1..3 whose fits over the last orders spread least.  A series with zero odd terms is
+    read in the square of ``variable``.  None with fewer than 12 usable coefficients."""
+    import mpmath
+    import sympy as sp
+
+    c = list(coefficients)
+    if len(c) > 2 and all(x == 0 for x in c[1::2]):
+        c, variable = c[::2], f"{variable}**2"
+    c = [mpmath.mpf(x.numerator) / x.denominator if isinstance(x, Fraction)
+         else mpmath.mpf(sp.N(x, 40)) for x in c]  # an algebraic number: 40 digits
+    while c and c[-1] == 0:
+        c.pop()
+    if len(c) < 12:
+        return None
+    tail = c[len(c) // 2:]
+    signs = [mpmath.sign(x) for x in tail]
+    real = all(s == signs[0] for s in signs) or all(
+        signs[k] == -signs[k + 1] for k in range(len(signs) - 1))
+    ns, radii, angles = [], [], []
+    for n in range(max(3, len(c) // 2), len(c) - 1):
+        if real:
+            if c[n - 1] == 0:
+                continue
+            ratio = abs(c[n] / c[n - 1])
+            radii.append(1 / ratio)
+            angles.append(0.0 if signs[0] == signs[-1] and all(
+                s == signs[0] for s in signs) else math.pi)
+        else:
+            den = c[n] * c[n - 2] - c[n - 1] ** 2
+            if den == 0 or c[n] == 0:
+                continue
+            b2 = (c[n + 1] * c[n - 1] - c[n] ** 2) / den
+            if b2 <= 0:
+                continue
+            b = mpmath.sqrt(b2)
+            cos_t = (c[n - 1] * b / c[n] + c[n + 1] / (b * c[n])) / 2
+            radii.append(1 / b)
+            angles.append(float(mpmath.acos(max(-1, min(1, cos_t)))))
+        ns.append(n)
+    if len(ns) < 4:
+        return None
+
+    def extrapolate(values: list, lo: int, degree: int) -> float:
+        x = [1 / mpmath.mpf(n) for n in ns[lo:]]
+        y = [mpmath.mpf(v) for v in values[lo:]]
+        if degree == 1:
+            mx, my = sum(x) / len(x), sum(y) / len(y)
+            sxx = sum((a - mx) ** 2 for a in x)
+            slope = sum((a - mx) * (b - my) for a, b in zip(x, y, strict=True)) / sxx
+            return float(my - slope * mx)
+        with mpmath.workdps(50):  # least squares in x·n_lo ∈ (0, 1]: well conditioned
+            A = mpmath.matrix([[(a * ns[lo]) ** d for d in range(degree + 1)] for a in x])
+            return float(mpmath.lu_solve(A.T * A, A.T * mpmath.matrix(y))[0])
+
+    half = len(ns) // 2
+    degrees = [degree] if degree is not None else [
+        d for d in (1, 2, 3) if len(ns) - half >= d + 2]
+    best = None
+    for d in degrees:
+        try:
+            fits = [extrapolate(radii, lo, d) for lo in range(0, half + 1)]
+        except ZeroDivisionError:  # too few distinct orders for this degree
+            continue
+        if best is None or max(fits) - min(fits) < best[1]:
+            best = (d, max(fits) - min(fits), fits)
+    if best is None:
+        return None
+    chosen, spread, fits = best
+    angle_fits = [extrapolate(angles, lo, chosen) for lo in range(0, half + 1)]
+    radius, angle = fits[-1], angle_fits[-1] if not real else angles[-1]
+    if chosen < 3 and len(ns) - half >= chosen + 3:
+        # NOTE: the fits' spread alone missed the error of the linear fit of a complex pair
+        # (Mathieu's a_1 at order 100: 1.1e-3 for an error of 1.8e-3 against DLMF Table
+        # 28.6.1); the quadratic fit's distance (4.5e-3) bounds it on every row of the table.
+        spread = max(spread, abs(extrapolate(radii, half, chosen + 1) - radius))
+    method = "Domb–Sykes" if real else "Mercer–Roberts"
+    if degree is None:
+        method += f", degree {chosen} in 1/n"
+    return Singularity(variable, radius, float(angle), float(spread), method)
+
+
+def series_radius(coefficients: Sequence) -> float:
+    """The estimated radius of convergence in the series' own variable (inf if too short)."""
+    est = nearest_singularity(coefficients, "x", None)
+    if est is None:
+        return math.inf
+    return math.sqrt(est.radius) if est.variable == "x**2" else est.radius
 
 
 @dataclass(frozen=True)
@@ -47,26 +307,12 @@ class Pade:
 
     def exact(self, x: Fraction) -> Fraction:
         """The approximant at a rational ``x``, exactly."""
-        return _horner_exact(self.numerator, x) / _horner_exact(self.denominator, x)
+        return horner_exact(self.numerator, x) / horner_exact(self.denominator, x)
 
 
-def _horner_exact(coeffs: Sequence[Fraction], x: Fraction) -> Fraction:
-    acc = Fraction(0)
-    for c in reversed(coeffs):
-        acc = acc * x + c
-    return acc
-
-
-def horner_float(coeffs: Sequence[Fraction], x: np.ndarray) -> np.ndarray:
-    """``Σ c_k x^k`` (coefficients low to high) at float ``x`` by Horner's rule, each
-    coefficient rounded to float64 first."""
-    acc = np.zeros_like(x)
-    for c in reversed(coeffs):
-        acc = acc * x + float(c)
-    return acc
-
-
-def _fmpq(c: Fraction) -> flint.fmpq:
+def _fmpq(c: Fraction | int | flint.fmpq) -> flint.fmpq:
+    if isinstance(c, flint.fmpq):
+        return c
     return flint.fmpq(c.numerator, c.denominator)
 
 
@@ -135,11 +381,8 @@ def w_substitution(R: Fraction, p: Fraction, order: int) -> list[Fraction]:
     n = order + 1
     k = 1 - p * p / (R * R)
     root = [Fraction(0)] * n  # √(1 − k w²) = Σ binom(1/2, i) (−k)^i w^(2i)
-    coeff = Fraction(1)
-    for i in range(0, (n + 1) // 2):
-        if 2 * i < n:
-            root[2 * i] = coeff * (-k) ** i
-        coeff = coeff * (Fraction(1, 2) - i) / (i + 1)
+    for i, coeff in enumerate(binomial_series(Fraction(1, 2), (n + 1) // 2)):
+        root[2 * i] = coeff * (-k) ** i
     num = [Fraction(0)] * n  # w (R √(…) − p w)
     for i in range(n - 1):
         num[i + 1] += R * root[i]
@@ -153,16 +396,9 @@ def w_substitution(R: Fraction, p: Fraction, order: int) -> list[Fraction]:
 
 def compose(coefficients: Sequence[Fraction], inner: Sequence[Fraction], order: int
             ) -> list[Fraction]:
-    """``Σ c_k inner(w)^k`` to ``w^order`` (``inner(0) = 0``), exactly: Horner in FLINT's
-    truncated products."""
-    if inner and inner[0] != 0:
-        raise ValueError("compose: the inner series must vanish at 0")
-    n = order + 1
-    g = flint.fmpq_poly([_fmpq(Fraction(c)) for c in inner[:n]])
-    acc = flint.fmpq_poly([])
-    for c in reversed(list(coefficients[:n])):
-        acc = acc.mul_low(g, n) + _fmpq(Fraction(c))
-    return [_fraction(acc[i]) for i in range(n)]
+    """``Σ c_k inner(w)^k`` to ``w^order`` (``inner(0) = 0``), exactly
+    (:func:`series_compose`)."""
+    return series_compose(coefficients, inner, order + 1)
 
 
 def w_of(x: np.ndarray, R: float, p: float) -> np.ndarray:
@@ -329,7 +565,7 @@ def _singularity(radius: float, angle: float) -> tuple[Fraction, Fraction]:
 def _over_one_minus_w(c: Sequence[Fraction], R: Fraction, p: Fraction) -> list[Fraction]:
     """The series of ``ω²/(1 − w)`` in ``w`` from ω's in ``x``, exactly."""
     N = len(c) - 1
-    squared = [sum((c[i] * c[k - i] for i in range(k + 1)), Fraction(0)) for k in range(N + 1)]
+    squared = series_mul(c, c)
     in_w = compose(squared, w_substitution(R, p, N), N)
     return [sum(in_w[: k + 1], Fraction(0)) for k in range(N + 1)]  # / (1 − w)
 

@@ -12,6 +12,7 @@ from typing import Any
 import sympy as sp
 from sympy.polys.domains import QQ
 
+from ..algebra.resum import binomial_series, series_compose, series_mul, series_reciprocal
 from ..algebra.series import (
     Ground,
     RelaxedProduct,
@@ -58,24 +59,12 @@ class LimitCycle:
         A = [q[0].get(1, 0) for q in self.q]
         B = [q[1].get(1, 0) for q in self.q]
         exact = all(isinstance(c, (int, Fraction)) for c in (*A, *B))
-        tidy = (lambda c: c) if exact else (lambda c: sp.radsimp(sp.expand(c)))
-
-        def mul(a: list, b: list) -> list:
-            return [tidy(sum((a[i] * b[k - i] for i in range(k + 1)), start=0 * a[0]))
-                    for k in range(n)]
-
-        inverse = [1 / A[0] if exact else sp.radsimp(1 / sp.sympify(A[0]))]
-        for k in range(1, n):  # 1/A₁ term by term: Σ_i A_i inv_(k−i) = 0
-            inverse.append(tidy(-inverse[0] * sum(A[i] * inverse[k - i]
-                                                  for i in range(1, k + 1))))
-        ratio = mul(B, inverse)
-        u = mul(ratio, ratio)
-        root, power, binomial = [1] + [0] * (n - 1), [1] + [0] * (n - 1), Fraction(1)
-        for j in range(1, n):  # u = O(ε²): (n − 1)//2 terms would do; n is cheap
-            power = mul(power, u)
-            binomial *= (Fraction(1, 2) - j + 1) / j
-            root = [tidy(r + binomial * p) for r, p in zip(root, power, strict=True)]
-        return tuple(mul(A, root))
+        fix = None if exact else (lambda c: sp.radsimp(sp.expand(c)))
+        first = 1 / A[0] if exact else sp.radsimp(1 / sp.sympify(A[0]))
+        ratio = series_mul(B, series_reciprocal(A, n, inverse=first, tidy=fix), n, fix)
+        u = series_mul(ratio, ratio, n, fix)  # u = O(ε²)
+        root = series_compose(binomial_series(Fraction(1, 2), n), u, n, tidy=fix)
+        return tuple(series_mul(A, root, n, fix))
 
 
 DOCUMENTED_ORDERS = 6

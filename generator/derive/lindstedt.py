@@ -14,7 +14,7 @@ it; the first-harmonic convention would give other coefficients).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 from fractions import Fraction
 from math import factorial
@@ -22,6 +22,10 @@ from typing import Any
 
 import sympy as sp
 
+from ..algebra.resum import Singularity as Singularity
+from ..algebra.resum import nearest_singularity
+from ..algebra.resum import partial_sum as partial_sum
+from ..algebra.resum import series_radius as series_radius
 from ..algebra.series import (
     Basis,
     Ground,
@@ -602,131 +606,6 @@ def naive_expression(naive: NaiveSolution, j: int) -> sp.Expr:
     return (m.amplitude * m.order_factor**j) * sum(
         c * t**mp * trig[f](n * t) for (mp, n, f), c in naive.terms[j].items()
     )
-
-
-@dataclass(frozen=True)
-class Singularity:
-    """The nearest singularities of a series, estimated from its coefficients: at ``radius``
-    and ``±angle`` (radians) in the plane of ``variable``; ``spread``: the error bar of
-    ``radius`` — how far the extrapolations from the last orders lie apart, or, if more, how
-    far the fit of one degree more in 1/n lies from it (the first neglected term)."""
-
-    variable: str
-    radius: float
-    angle: float
-    spread: float
-    method: str
-
-
-def nearest_singularity(coefficients: Sequence[Fraction], variable: str = "eps",
-                        degree: int | None = 1) -> Singularity | None:
-    """Domb–Sykes (ratios c_n/c_(n−1), for one real singularity: a tail of one sign or of
-    alternating signs) or Mercer–Roberts (a complex-conjugate pair: B_n² = (c_(n+1)c_(n−1) −
-    c_n²)/(c_n c_(n−2) − c_(n−1)²) → 1/R², cos θ from the same), each estimate extrapolated
-    linearly in 1/n over the last orders — or by a polynomial of ``degree`` in 1/n (the
-    ratios of an algebraic branch point go as 1 + a/n + b/n² + …); ``degree=None`` takes the
-    degree 1..3 whose fits over the last orders spread least.  A series with zero odd terms is
-    read in the square of ``variable``.  None with fewer than 12 usable coefficients."""
-    import mpmath
-
-    c = list(coefficients)
-    if len(c) > 2 and all(x == 0 for x in c[1::2]):
-        c, variable = c[::2], f"{variable}**2"
-    c = [mpmath.mpf(x.numerator) / x.denominator if isinstance(x, Fraction)
-         else mpmath.mpf(sp.N(x, 40)) for x in c]  # an algebraic number: 40 digits
-    while c and c[-1] == 0:
-        c.pop()
-    if len(c) < 12:
-        return None
-    tail = c[len(c) // 2:]
-    signs = [mpmath.sign(x) for x in tail]
-    real = all(s == signs[0] for s in signs) or all(
-        signs[k] == -signs[k + 1] for k in range(len(signs) - 1))
-    ns, radii, angles = [], [], []
-    for n in range(max(3, len(c) // 2), len(c) - 1):
-        if real:
-            if c[n - 1] == 0:
-                continue
-            ratio = abs(c[n] / c[n - 1])
-            radii.append(1 / ratio)
-            angles.append(0.0 if signs[0] == signs[-1] and all(
-                s == signs[0] for s in signs) else math.pi)
-        else:
-            den = c[n] * c[n - 2] - c[n - 1] ** 2
-            if den == 0 or c[n] == 0:
-                continue
-            b2 = (c[n + 1] * c[n - 1] - c[n] ** 2) / den
-            if b2 <= 0:
-                continue
-            b = mpmath.sqrt(b2)
-            cos_t = (c[n - 1] * b / c[n] + c[n + 1] / (b * c[n])) / 2
-            radii.append(1 / b)
-            angles.append(float(mpmath.acos(max(-1, min(1, cos_t)))))
-        ns.append(n)
-    if len(ns) < 4:
-        return None
-
-    def extrapolate(values: list, lo: int, degree: int) -> float:
-        x = [1 / mpmath.mpf(n) for n in ns[lo:]]
-        y = [mpmath.mpf(v) for v in values[lo:]]
-        if degree == 1:
-            mx, my = sum(x) / len(x), sum(y) / len(y)
-            sxx = sum((a - mx) ** 2 for a in x)
-            slope = sum((a - mx) * (b - my) for a, b in zip(x, y, strict=True)) / sxx
-            return float(my - slope * mx)
-        with mpmath.workdps(50):  # least squares in x·n_lo ∈ (0, 1]: well conditioned
-            A = mpmath.matrix([[(a * ns[lo]) ** d for d in range(degree + 1)] for a in x])
-            return float(mpmath.lu_solve(A.T * A, A.T * mpmath.matrix(y))[0])
-
-    half = len(ns) // 2
-    degrees = [degree] if degree is not None else [
-        d for d in (1, 2, 3) if len(ns) - half >= d + 2]
-    best = None
-    for d in degrees:
-        try:
-            fits = [extrapolate(radii, lo, d) for lo in range(0, half + 1)]
-        except ZeroDivisionError:  # too few distinct orders for this degree
-            continue
-        if best is None or max(fits) - min(fits) < best[1]:
-            best = (d, max(fits) - min(fits), fits)
-    if best is None:
-        return None
-    chosen, spread, fits = best
-    angle_fits = [extrapolate(angles, lo, chosen) for lo in range(0, half + 1)]
-    radius, angle = fits[-1], angle_fits[-1] if not real else angles[-1]
-    if chosen < 3 and len(ns) - half >= chosen + 3:
-        # NOTE: the fits' spread alone missed the error of the linear fit of a complex pair
-        # (Mathieu's a_1 at order 100: 1.1e-3 for an error of 1.8e-3 against DLMF Table
-        # 28.6.1); the quadratic fit's distance (4.5e-3) bounds it on every row of the table.
-        spread = max(spread, abs(extrapolate(radii, half, chosen + 1) - radius))
-    method = "Domb–Sykes" if real else "Mercer–Roberts"
-    if degree is None:
-        method += f", degree {chosen} in 1/n"
-    return Singularity(variable, radius, float(angle), float(spread), method)
-
-
-def partial_sum(coefficients: Sequence, x: float) -> tuple[float, float, int]:
-    """The partial sum at ``x``, its change over the last two nonzero terms (the truncation
-    error estimate) and the order K of the smallest such change (the best reachable)."""
-    total, last, changes = 0.0, [], []
-    for k, c in enumerate(coefficients):
-        term = float(c) * x**k
-        total += term
-        if c:
-            last.append(abs(term))
-            changes.append((sum(last[-2:]), k))
-    if len(changes) < 2:
-        return total, 0.0, len(coefficients) - 1
-    best = min(changes[1:])
-    return total, changes[-1][0], best[1]
-
-
-def series_radius(coefficients: Sequence) -> float:
-    """The estimated radius of convergence in the series' own variable (inf if too short)."""
-    est = nearest_singularity(coefficients, "x", None)
-    if est is None:
-        return math.inf
-    return math.sqrt(est.radius) if est.variable == "x**2" else est.radius
 
 
 def estimated_radius(solution: SeriesSolution, to_args: dict,

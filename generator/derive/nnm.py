@@ -30,10 +30,16 @@ import numpy as np
 import sympy as sp
 from sympy.polys.domains import QQ
 
+from ..algebra.resum import (
+    horner_float,
+    nearest_singularity,
+    ring_inverse,
+    series_reciprocal,
+    series_sqrt,
+)
 from ..algebra.series import Basis, Ground, from_fourier, to_fourier
 from ..errors import InputError
 from ..limits import check_int
-from .lindstedt import nearest_singularity
 from .system import System
 
 NNM_MAX_ORDER = 200
@@ -96,9 +102,9 @@ class NormalModeSeries:
 
     @cached_property
     def _ratios(self) -> tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]]:
-        root = _sqrt_series(self._ratio(), self.ground)
+        root = series_sqrt(self._ratio())
         return (tuple(map(self._exact, root)),
-                tuple(map(self._exact, _inverse_series(root, self.ground))))
+                tuple(map(self._exact, series_reciprocal(root))))
 
     @cached_property
     def _omega(self) -> tuple[sp.Expr, ...]:
@@ -117,9 +123,9 @@ class NormalModeSeries:
         at t = 0 (rows), where the orbit starts (a seed for shooting, a point to plot)."""
         A = np.asarray(A, dtype=float)
         y = A**self.step
-        omega = np.polyval([float(c) for c in self.omega()][::-1], y)
-        period = 2 * np.pi * np.polyval([float(c) for c in self.period()][::-1], y)
-        starts = np.array([A * np.polyval([float(sum(o.values())) for o in orders][::-1], y)
+        omega = horner_float(self.omega(), y)
+        period = 2 * np.pi * horner_float(self.period(), y)
+        starts = np.array([A * horner_float([sum(o.values()) for o in orders], y)
                            for orders in map(self.coordinate, range(self.system.size))])
         return omega, period, starts
 
@@ -129,42 +135,6 @@ class NormalModeSeries:
         top = self.order if order is None else order
         return [{n: self._exact(c) for n, c in sorted(orders[i].items()) if c}
                 for orders in self.coefficients[: top + 1]]
-
-
-def _sqrt_series(a: list[Any], g: Ground) -> list[Any]:
-    """``√(Σ a_k y^k)`` with ``a_0 = 1``: ``s_0 = 1``, ``2 s_k = a_k − Σ_{0<i<k} s_i s_(k−i)``."""
-    half = g.scalar(sp.Rational(1, 2))
-    s = [g.scalar(1)]
-    for k in range(1, len(a)):
-        acc = a[k]
-        for i in range(1, k):
-            acc = acc - s[i] * s[k - i]
-        s.append(acc * half)
-    return s
-
-
-def _inverse_series(s: list[Any], g: Ground) -> list[Any]:
-    """``1 / Σ s_k y^k`` with ``s_0 = 1``."""
-    p = [g.scalar(1)]
-    for k in range(1, len(s)):
-        acc = g.scalar(0)
-        for i in range(1, k + 1):
-            acc = acc - s[i] * p[k - i]
-        p.append(acc)
-    return p
-
-
-def _inverse(x: Any) -> Any:
-    """``1/x`` of a nonzero number of the ground: a field element, or a constant polynomial of
-    ``K[params]`` (the matrices of the recursion hold numbers only: the linear part has
-    values)."""
-    try:
-        return x ** -1
-    except ValueError:  # SymPy's K[params] inverts a constant through its domain
-        ring = x.ring
-        if not x.is_ground:
-            raise
-        return ring.ground_new(ring.domain.quo(ring.domain.one, x.LC))
 
 
 def _echelon(rows: list[list[Any]], width: int) -> tuple[list[list[Any]], list[int]]:
@@ -179,7 +149,7 @@ def _echelon(rows: list[list[Any]], width: int) -> tuple[list[list[Any]], list[i
         if pick is None:
             continue
         rows[r], rows[pick] = rows[pick], rows[r]
-        inv = _inverse(rows[r][col])
+        inv = ring_inverse(rows[r][col])
         rows[r] = [v * inv for v in rows[r]]
         for i in range(len(rows)):
             if i != r and rows[i][col]:

@@ -11,7 +11,7 @@ import numpy as np
 import sympy as sp
 from numba import njit
 
-from ..algebra.resum import pade
+from ..algebra.resum import pade, series_compose, series_mul
 from ..errors import InputError
 from ..lower.documents import (
     FOURIER_AGM_STEPS,
@@ -171,21 +171,6 @@ def cn_fourier(t: np.ndarray, x: np.ndarray, harmonics: int, out: np.ndarray) ->
 
 # --- derivation: the period series re-expanded --------------------------------------------------
 
-def _mul(a: list[Fraction], b: list[Fraction]) -> list[Fraction]:
-    """Product of power series truncated to ``len(a)`` terms."""
-    return [sum(a[i] * b[n - i] for i in range(n + 1)) for n in range(len(a))]
-
-
-def _compose(outer: list[Fraction], inner: list[Fraction]) -> list[Fraction]:
-    """``outer(inner(t))`` truncated to ``len(outer)`` terms (``inner`` has no constant)."""
-    total = [Fraction(0)] * len(outer)
-    power = [Fraction(1)] + [Fraction(0)] * (len(outer) - 1)
-    for c in outer:
-        total = [s + c * p for s, p in zip(total, power, strict=True)]
-        power = _mul(power, inner)
-    return total
-
-
 def resummed_coefficients(tau: list[Fraction]) -> list[Fraction]:
     """``c_n`` of ``(T/2π)(x(m)) / √(1 − 2m)``, ``x(m) = 2m/(1 − 2m) = Σ_{n≥1} 2^n m^n``,
     exactly; the first k + 1 terms use ``τ_0..τ_k``."""
@@ -194,7 +179,7 @@ def resummed_coefficients(tau: list[Fraction]) -> list[Fraction]:
     for n in range(1, k + 1):  # (1 − 2m)^(−1/2) = Σ binom(2n, n) (m/2)^n·2^n
         inv_sqrt.append(inv_sqrt[-1] * Fraction(2 * n - 1, n))
     xm = [Fraction(0)] + [Fraction(2**n) for n in range(1, k + 1)]
-    return _mul(_compose(tau, xm), inv_sqrt)
+    return series_mul(series_compose(tau, xm), inv_sqrt)
 
 
 def modified_coefficients(omega: list[Fraction]) -> list[Fraction]:
@@ -202,9 +187,9 @@ def modified_coefficients(omega: list[Fraction]) -> list[Fraction]:
     ``α = (3x/4)/(1 + 3x/4)``, which stays below 1 for every ``x > 0``; returns ``g``'s
     coefficients exactly (``x(α) = (4/3) Σ_{n≥1} α^n``)."""
     k = len(omega) - 1
-    w2 = _mul(omega, omega)
-    h = _mul(w2, [Fraction(-3, 4) ** n for n in range(k + 1)])  # ω² / (1 + 3x/4)
-    return _compose(h, [Fraction(0)] + [Fraction(4, 3)] * k)
+    w2 = series_mul(omega, omega)
+    h = series_mul(w2, [Fraction(-3, 4) ** n for n in range(k + 1)])  # ω² / (1 + 3x/4)
+    return series_compose(h, [Fraction(0)] + [Fraction(4, 3)] * k)
 
 
 def _pade(tau: list[Fraction], k: int) -> tuple[np.ndarray, np.ndarray]:

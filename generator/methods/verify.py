@@ -4,7 +4,6 @@ on a grid out to where it holds."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from fractions import Fraction
 
@@ -12,13 +11,14 @@ import numpy as np
 
 from ..algebra.resum import (
     Resummed,
+    nearest_singularity,
     resum_frequency,
     resum_harmonic,
     resum_relaxation,
     resum_series,
+    series_radius,
     van_der_pol_relaxation,
 )
-from ..derive.lindstedt import nearest_singularity
 from ..errors import InputError
 from ..lower.records import (
     ResummedCurve,
@@ -317,7 +317,7 @@ TONGUE_RADII = 3.0
 TONGUE_RANGE = 10.0
 TONGUE_GRID = 240
 # NOTE: each curve is verified on 240 points of (0, ε_max], ε_max = 3 × its estimated radius
-# (lindstedt.nearest_singularity; TONGUE_RANGE without an estimate), capped at 10: past a few
+# (algebra.resum.series_radius; TONGUE_RANGE without an estimate), capped at 10: past a few
 # radii no near-diagonal Padé of an order-30 series holds 1e-10.  At each point |tr M| − 2
 # must change sign between δ ∓ b (b = the tolerance, or half the distance to another curve if
 # less: the curves of tongue n split at ε^n only), which puts a boundary within the
@@ -357,9 +357,7 @@ def resum_tongue(text: str, n: int, order: int, tolerance: float = TONGUE_TOLERA
     series = transition_curves(harmonics, n, order).curves
     tops, forms = [], []
     for curve in series:
-        est = nearest_singularity(list(curve.delta), "eps", None)
-        radius = (math.sqrt(est.radius) if est.variable == "eps**2" else est.radius
-                  ) if est else TONGUE_RANGE
+        radius = series_radius(curve.delta)  # inf when too short for an estimate
         tops.append(min(TONGUE_RADII * radius, TONGUE_RANGE))
         forms.append(resum_series(list(curve.delta), tops[-1]))
     curves = []
