@@ -16,12 +16,13 @@ from pathlib import Path
 import pytest
 
 LAYERS = {
-    "exact": ("attractors", "averaging", "branches", "driven", "driven_damped", "driven_equation",
+    "exact": ("attractors", "averaging", "branches", "continuation", "driven", "driven_damped",
+              "driven_equation",
               "equation",
               "hill", "layout", "lindstedt", "newton", "nnm", "parametric", "response",
               "response_equation",
               "response_system",
-              "resonance", "series", "subharmonic"),
+              "resonance", "series", "subharmonic", "toolkit"),
     "printers": ("charts", "cli", "costs", "curves", "emit", "files", "fuzz", "interrupt", "latex",
                  "messages", "notebook", "readme", "validity"),
     "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "mass", "nnm_emitted",
