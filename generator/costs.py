@@ -375,7 +375,8 @@ def response_cost(args: argparse.Namespace) -> Cost:
     """``response``: for an EQUATION :func:`response_equation_cost`; else the fixed part and
     the continuation over the response's ω range at ``--harmonics`` (the fixed part
     alone when ε, f or Q is missing: the command says so)."""
-    from .analysis.response import continuation_seconds, response_range
+    from .analysis.driven import Drive
+    from .analysis.response import equation_continuation_seconds, response_range
 
     if getattr(args, "model", None) is not None:
         return response_equation_cost(args)
@@ -386,7 +387,9 @@ def response_cost(args: argparse.Namespace) -> Cost:
 
     lo, hi = response_range(args.eps, args.force, args.Q, getattr(args, "omega_min", None),
                             getattr(args, "omega_max", None))
-    seconds = continuation_seconds(args.eps, args.force, args.Q, args.harmonics, lo, hi)
+    d = Drive(args.eps, args.force, lo, args.Q)
+    seconds = equation_continuation_seconds(d.terms, args.force, args.harmonics, True, lo, hi,
+                                            where=d.equation.where)[1]
     # eq. 10.60's balance: odd harmonics, 2N unknowns; ω0 = 1
     point = equation_point_seconds(2 * args.harmonics)
     return Cost(RESPONSE_FIXED + seconds + dynamics_seconds(seconds / point, 2 * args.harmonics,

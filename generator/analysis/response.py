@@ -309,8 +309,12 @@ def equation_continuation_seconds(terms: dict[tuple[int, int], float], force: fl
 def continue_equation(de: DrivenEquation, harmonics: int, omega_start: float,
                       omega_stop: float, step: float = 0.02, max_points: int = MAX_POINTS,
                       max_seconds: float = CONTINUATION_SECONDS) -> Continuation:
-    """:func:`continue_balance` for a user's :class:`driven.DrivenEquation` (its ω ignored):
-    the :class:`driven.PolynomialBalance` with ``harmonics`` traced in ω through its folds,
+    """The balance of a :class:`driven.DrivenEquation` (its ω ignored; eq. 10.60's is
+    :attr:`driven.Drive.equation`, odd harmonics ``1, 3, …, 2N − 1``): the
+    :class:`driven.PolynomialBalance` with ``harmonics`` traced in ω through any number of
+    folds (a softening spring's curve is two pieces: the small-amplitude branch up to its fold
+    and back down the middle branch, and the resonant branch, which leaves the range at its
+    low end over the barrier),
     starting from every balance solution at the two ends that the continuation in the drive
     amplitude from rest reaches (:func:`continue_in_drive`, as ``driven EQUATION`` seeds),
     the smallest at ``omega_start`` first."""
@@ -332,32 +336,6 @@ def continue_equation(de: DrivenEquation, harmonics: int, omega_start: float,
     return _continue(fine, lambda: _equation_ends(de, fine, omega_start, omega_stop),
                      omega_start, omega_stop, step, estimate, seconds,
                      equation_point_seconds(fine.size), max_points, where)
-
-
-def continuation_seconds(eps: float, force: float, Q: float, harmonics: int, lo: float,
-                         hi: float) -> float:
-    """The estimated wall time of :func:`continue_balance`: :func:`equation_continuation_seconds`
-    of eq. 10.60's force table; :class:`InputError` for a curve over MAX_POINTS steps.  No
-    estimate of its own: the name ``costs.response_cost`` imports (it can call
-    ``equation_continuation_seconds(Drive(eps, force, lo, Q).terms, force, harmonics, True, lo,
-    hi)[1]`` and this name go)."""
-    d = Drive(eps, force, lo, Q)
-    return equation_continuation_seconds(d.terms, force, harmonics, True, lo, hi,
-                                         where=d.equation.where)[1]
-
-
-def continue_balance(eps: float, force: float, Q: float, harmonics: int, omega_start: float,
-                     omega_stop: float, step: float = 0.02, max_points: int = MAX_POINTS,
-                     max_seconds: float = CONTINUATION_SECONDS) -> Continuation:
-    """:func:`continue_equation` on eq. 10.60's force table (:attr:`driven.Drive.equation`, no
-    continuation of its own): the balance with odd harmonics ``1, 3, …, 2N − 1`` traced over
-    ``[omega_start, omega_stop]`` through any number of folds.  A softening spring's curve is
-    two pieces: the small-amplitude branch up to its fold and back down the middle branch, and
-    the resonant branch, which leaves the range at its low end over the barrier."""
-    d = Drive(eps, force, omega_start, Q)
-    Drive(eps, force, omega_stop, Q)
-    return continue_equation(d.equation, harmonics, omega_start, omega_stop, step, max_points,
-                             max_seconds)
 
 
 def equation_solutions(de: DrivenEquation, fine: PolynomialBalance, omega: float
