@@ -121,8 +121,9 @@ def _continue(sysm: PolynomialBalance, end_solutions, omega_start: float,
               per_point: float, max_points: int, where: str) -> Continuation:
     """The pseudo-arclength loop of :func:`analysis.response.continue_equation` on any balance
     with ``residual``, ``jacobian`` and ``d_omega`` in ``(x, ω)``: from each of
-    ``end_solutions()`` (``(ω, x, direction)``: at the two ends, the first at ``omega_start``, or a point inside the range
-    taken both ways; and whether they are complete) not reached yet, until ω leaves the range
+    ``end_solutions()`` (``(ω, x, direction)``: at the two ends, the first at
+    ``omega_start``, or a point inside the range taken both ways; and whether they are
+    complete) not reached yet, until ω leaves the range
     or the piece closes on its start (an isola); the step halves where a step turns or fails
     (:data:`MIN_STEP`); ``estimate`` points of ``per_point`` seconds, ``seconds`` in all,
     bound its points (twice the larger of ``seconds`` and :data:`CONTINUATION_SECONDS` in
