@@ -11,7 +11,7 @@ import numpy as np
 import sympy as sp
 from numba import njit
 
-from ..algebra.resum import pade, series_compose, series_mul
+from ..algebra.resum import binomial_series, pade, series_compose, series_mul
 from ..errors import InputError
 from ..lower.documents import (
     FOURIER_AGM_STEPS,
@@ -175,9 +175,8 @@ def resummed_coefficients(tau: list[Fraction]) -> list[Fraction]:
     """``c_n`` of ``(T/2π)(x(m)) / √(1 − 2m)``, ``x(m) = 2m/(1 − 2m) = Σ_{n≥1} 2^n m^n``,
     exactly; the first k + 1 terms use ``τ_0..τ_k``."""
     k = len(tau) - 1
-    inv_sqrt = [Fraction(1)]
-    for n in range(1, k + 1):  # (1 − 2m)^(−1/2) = Σ binom(2n, n) (m/2)^n·2^n
-        inv_sqrt.append(inv_sqrt[-1] * Fraction(2 * n - 1, n))
+    # (1 − 2m)^(−1/2) = Σ binom(−1/2, n) (−2m)^n
+    inv_sqrt = [c * (-2) ** n for n, c in enumerate(binomial_series(Fraction(-1, 2), k + 1))]
     xm = [Fraction(0)] + [Fraction(2**n) for n in range(1, k + 1)]
     return series_mul(series_compose(tau, xm), inv_sqrt)
 
