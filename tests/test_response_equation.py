@@ -273,3 +273,22 @@ def test_response_equation_json_keys_keep_the_contract(capsys):
     assert {"folds", "sweep_up_jump", "sweep_down_jump", "sweep_resolution", "sweep_up_escape",
             "sweep_down_escape"} <= data["numerical"].keys()
     assert len(data["numerical"]["folds"]) == 1  # only the upper fold lies in [1.3, 1.6]
+
+
+@pytest.mark.parametrize("eps, force, Q", [(0.1, 0.3, 185.0), (1.0, 0.05, 185.0),
+                                           (0.01, 0.05, 1e4), (0.1, 0.3, 20.0)])
+def test_a_high_q_equation_keeps_its_upper_fold(eps, force, Q):
+    """Eq. 10.60's one-harmonic folds through the general equation's H(r) (the response
+    EQUATION path) against the cubic's discriminant in closed form (another route): the upper
+    fold far out (ω = 3.963 at Q = 185, 6.6 at Q = 1e4) was lost, and the range with it.
+    Relative 1e-5: H = P_c² + P_s² − f² cancels (ω²r)² ~ 1e4 down to f² ~ 1e-3 there, where the
+    cubic in u = r² does not."""
+    from lindstedt.analysis.driven import Drive
+    from lindstedt.analysis.response import equation_range, one_harmonic_folds, response_range
+
+    d = Drive(eps, force, 1.0, Q)
+    er = equation_range(d.terms, force)
+    closed = one_harmonic_folds(eps, force, Q)
+    assert len(er.one_harmonic_folds) == len(closed) == 2
+    np.testing.assert_allclose(er.one_harmonic_folds, closed, rtol=1e-5)
+    np.testing.assert_allclose(er.omega_range, response_range(eps, force, Q), rtol=1e-5)
