@@ -9,8 +9,11 @@ order; a stage imports only stages above it::
                             relaxed (online) products of ε-series of Trig sums, the Laurent form
                             in e^{is} over complex128 for the numeric methods
                             [coefficients -> Trig]
-    algebra.resum           Padé approximants over QQ, Andersen & Geer's w-variable; spurious
-                            poles, neighbour spread (past the radius) [[c_k] -> Resummed]
+    algebra.resum           the one power-series toolkit (product, reciprocal, square root,
+                            binomial series, composition; Horner exact and in floats, partial
+                            sums; the nearest singularity and the radius), Padé approximants
+                            over QQ, Andersen & Geer's w-variable; spurious poles, neighbour
+                            spread (past the radius) [[c_k] -> Resummed]
     derive.equation         user text through a whitelist walker over ``ast`` [str -> Equation]
     derive.models           the oscillator registry, a user's Oscillator, its L–P Model
                             [Equation, K -> Model]
@@ -19,8 +22,8 @@ order; a stage imports only stages above it::
                             route to a method asks it [str -> Problem]
     derive.orbits           where a free oscillator's family of periodic orbits ends: the first
                             integral's separatrix, to 30 digits [Model -> OrbitDomain]
-    derive.lindstedt        L–P series, order-by-order equations, naive expansion; the nearest
-                            singularity and the radius of a series [Model, K -> SeriesSolution]
+    derive.lindstedt        L–P series, order-by-order equations, naive expansion
+                            [Model, K -> SeriesSolution]
     derive.cycles           the limit cycles of q'' + q = ε f(q, q'), each with its stability,
                             exact in Q or Q(a₀) [SelfExcited, K -> LimitCycle]
     derive.hill             Hill's equation x'' + (δ + ε p(t))x = 0: transition curves out of

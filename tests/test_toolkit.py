@@ -11,8 +11,6 @@ import numpy as np
 import pytest
 import sympy as sp
 from flint import fmpq, fmpq_mpoly_ctx
-from sympy.polys.domains import QQ
-
 from lindstedt.algebra.resum import (
     binomial_series,
     horner_exact,
@@ -26,6 +24,7 @@ from lindstedt.algebra.resum import (
     series_reciprocal,
     series_sqrt,
 )
+from sympy.polys.domains import QQ
 
 N = 12
 K = QQ.algebraic_field(sp.sqrt(2))
