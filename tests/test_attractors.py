@@ -212,3 +212,29 @@ def test_the_stretch_after_a_neimark_sacker_point_ends_at_the_fold():
     a, b, _, point = stretch
     assert (a, b) == (ns.omega, fold.omega)
     assert abs(cont.omega[point] - 0.5 * (a + b)) < 0.02
+
+
+def _record(x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return np.vstack([x, v])
+
+
+def test_a_record_that_outruns_the_step_or_keeps_growing_gets_no_attractor():
+    """classify on synthetic records (known answers): a motion at 13 rad per unit time where
+    RK4 steps 0.0245 (ωh = 0.32) is "unresolved" — RK4's own damping would pass for a bound;
+    an oscillation whose amplitude climbs by 20 % over the record is "growing"; the same one
+    steady is period-1 (its spectrum on the drive's harmonics)."""
+    from lindstedt.analysis.attractors import RECORD_SAMPLES, classify
+
+    omega, periods = 1.0, 64
+    t = np.arange(periods * RECORD_SAMPLES + 1) * 2 * np.pi / omega / RECORD_SAMPLES
+    fast = 13.0
+    kind, *_ = classify(_record(np.cos(fast * t)[None], -fast * np.sin(fast * t)[None]),
+                        omega, RECORD_SAMPLES, periods, 1)
+    assert kind == "unresolved"
+    grow = 1 + 0.2 * t / t[-1]
+    kind, *_ = classify(_record((grow * np.cos(1.5 * t))[None], (-1.5 * grow * np.sin(
+        1.5 * t))[None]), omega, RECORD_SAMPLES, periods, 1)
+    assert kind == "growing"
+    kind, *_ = classify(_record(np.cos(t)[None], -np.sin(t)[None]), omega, RECORD_SAMPLES,
+                        periods, 1)
+    assert kind == "period-1"

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import functools
 import importlib.util
+import math
 
 import numpy as np
 import pytest
@@ -165,3 +166,26 @@ def test_mems_allow_divergent_lifts_the_guard_and_a_bound_of_zero_is_refused(mon
     with pytest.raises(InputError, match="every amplitude would be NaN"):
         lowering.lower_nnm(series, 4, "m", "test")
     assert lowering.lower_nnm(series, 4, "m", "test", allow_divergent=True)
+
+
+SWINGING = ("1.2*x1'' + 0.3*x2'' + 2.5*x1 - 0.7*x2 + 0.9*x1**3 = 0; "
+            "0.3*x1'' + 0.8*x2'' - 0.7*x1 + 1.6*x2 + 0.4*x2**3 + 0.2*x1**2*x2 = 0")
+# NOTE: mode 2's ω_j swing in size from order to order: no singularity fits them (no radius
+# estimate), and the module used to answer at every amplitude (T(3) = 33.8 against a shot
+# 0.981).
+
+
+def test_a_mode_without_a_radius_estimate_still_has_a_bound(tmp_path):
+    """No estimate: the bound is the smallest coefficient ratio; NaN beyond it, and inside it
+    error_estimate is never below the period's true error (shooting)."""
+    out = run("generate", SWINGING, "--mode", "2", "--order", "6", "--out", tmp_path)
+    assert out.returncode == 0, out.stderr
+    m = _load(tmp_path / "mode2.py", "swinging2")
+    assert math.isnan(m.RADIUS) and 0 < m.RADIUS_LOWER < 1
+    reach = math.sqrt(m.RADIUS_LOWER)
+    assert np.isnan(m.period(3.0)) and np.isnan(m.period(1.01 * reach))
+    series = normal_mode(parse_system(SWINGING), 2, 8)
+    for A in (0.5 * reach, 0.9 * reach):
+        period, starts = _evaluate(series, A)
+        true = abs(m.period(A) / _shoot(SWINGING, A, starts[1:], period / 2)[1] - 1)
+        assert m.error_estimate(A) >= true or true < 1e-12, (A, m.error_estimate(A), true)

@@ -9,6 +9,7 @@ lines and amplitude range."""
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -37,6 +38,12 @@ REFINE_STEPS = 30
 TRANSIENT_PERIODS = 300
 RECORD_PERIODS = 256
 RECORD_SAMPLES = 32
+RECORD_SUBSTEPS = 8
+RESOLVED_STEP = 0.15
+# NOTE: RK4 at 32 × 8 steps a drive period; where the motion's rate max|ẋ|/max|x| times the
+# step passes 0.15 (its local frequency at the turning points ~2.5 times more), RK4's own
+# damping, ~(ωh)⁶/144 a step, rivals a physical one: a negative damping pumping x1 to
+# |x1| = 26 at ω ≈ 13 looked bounded and "chaotic" when it grows without end.
 # NOTE: one simulation per interval: 300 drive periods of transient (a torus born at a
 # Neimark–Sacker point attracts at the rate of the damping, |μ| ≈ e^(−cT/2) ≈ 0.95 a period
 # for c = 0.05 near ω = 2: 1e-7 after 300), then 256 periods at 32 samples each (RK4 of 256
@@ -57,6 +64,11 @@ LINE_FLOOR = 1e-4
 # NOTE: the spectral lines reported per coordinate: the 8 largest local maxima of the Hann-
 # windowed spectrum above 1e-4 of the largest, each frequency refined by the parabola through
 # the log-magnitude of three bins (~1e-3 of a bin for a clean line).
+GROWTH = 1.1
+# NOTE: "growing" (no bounded steady state reached) where the largest coordinate's range grows
+# from each quarter of the record to the next and the last is 10 % above the first: a
+# negative damping that the nonlinear force does not saturate pumps without end (such a record
+# was called chaotic); a chaotic attractor's range does not climb steadily.
 COMBINATIONS = (5, 8)
 QUASI_POWER = 0.995
 # NOTE: quasi-periodic where 99.5 % of the windowed spectrum's power lies within two bins of
@@ -125,8 +137,9 @@ class Bifurcation:
 class Attractor:
     """What RK4 from a slightly pushed unstable orbit at ``omega`` settles on after
     :data:`TRANSIENT_PERIODS`, over :data:`RECORD_PERIODS`: its kind (``period-k``,
-    ``quasi-periodic``, ``chaotic``, ``escaped``), each coordinate's main spectral lines
-    (ω-units, amplitude) and range; the second frequency of a torus."""
+    ``quasi-periodic``, ``chaotic``, ``growing``, ``unresolved``, ``escaped``), each
+    coordinate's main spectral lines (ω-units, amplitude) and range; the second frequency of
+    a torus."""
 
     omega: float
     interval: tuple[float, float]
@@ -346,11 +359,18 @@ def classify(record: np.ndarray, omega: float, samples: int, periods: int, n: in
     ``period-k`` where its stroboscopic points repeat after ``k`` periods
     (:data:`PERIOD_TOLERANCE`); else ``quasi-periodic`` where :data:`QUASI_POWER` of its
     spectrum lies on the lines ``m ω + n ν`` (:data:`COMBINATIONS`), ν the largest line off
-    the harmonics of ω, and ``chaotic`` where it does not.  ``(kind, k, ν, lines, ranges,
-    power on the lines)``."""
+    the harmonics of ω, and ``chaotic`` where it does not; ``growing`` where the amplitude
+    still climbs through the record (:data:`GROWTH`: no bounded steady state);
+    ``unresolved`` where the motion outruns RK4's step (:data:`RESOLVED_STEP`): no verdict.
+    ``(kind, k, ν, lines, ranges, power on the lines)``."""
     x = record[:n]
     ranges = tuple((float(np.min(c)), float(np.max(c))) for c in x)
     scale = max(b - a for a, b in ranges) or 1.0
+    step = 2 * np.pi / omega / (samples * RECORD_SUBSTEPS)
+    rate = max(float(np.max(np.abs(v)) / max(np.max(np.abs(c)), 1e-300))
+               for c, v in zip(x, record[n:2 * n], strict=True))
+    if rate * step > RESOLVED_STEP:
+        return "unresolved", None, None, (), ranges, 0.0
     strobe = record[:, ::samples]
     for k in range(1, MAX_PERIOD + 1):
         if np.max(np.abs(strobe[:, k:] - strobe[:, :-k])) < PERIOD_TOLERANCE * scale:
@@ -363,6 +383,9 @@ def classify(record: np.ndarray, omega: float, samples: int, periods: int, n: in
     bin_w = omega / periods
     if k is not None:
         return f"period-{k}", k, None, lines, ranges, 1.0
+    spans = [float(np.max(np.ptp(q, axis=1))) for q in np.array_split(body, 4, axis=1)]
+    if all(a < b for a, b in itertools.pairwise(spans)) and spans[-1] > GROWTH * spans[0]:
+        return "growing", None, None, lines, ranges, 0.0
     # ν: the largest line of the largest coordinate not within two bins of a harmonic of ω
     main = int(np.argmax([b - a for a, b in ranges]))
     off = [f for f, _ in spectra[main][0]
@@ -391,7 +414,7 @@ def simulate(fine: PolynomialBalance, field: PolynomialField, drive: np.ndarray,
     y0 = fine.state(x, omega)
     y0 = y0 + PUSH * (1 + np.max(np.abs(y0))) * np.ones_like(y0)
     record = record_system(field, drive, omega, y0, TRANSIENT_PERIODS, RECORD_PERIODS,
-                             RECORD_SAMPLES)
+                           RECORD_SAMPLES, RECORD_SUBSTEPS)
     start = tuple(float(r) for r in fine.first_harmonics(x))
     if record is None:
         return Attractor(omega, interval, why, "escaped", None, None, (), (), 0.0, start)
@@ -474,7 +497,8 @@ def dynamics(fine: PolynomialBalance, field: PolynomialField, drive: np.ndarray,
     note = ("complete about period-1 orbits (those of the drive's period) only"
             + (f"; {len(odd)} other attractor{'s' * (len(odd) != 1)} found by simulation ("
                + ", ".join(f"{x.kind} at w = {x.omega:.4g}" for x in odd)
-               + "): a steady state that is not a period-1 orbit" if odd else "")
+               + "): a steady state that is not a period-1 orbit, or none where it grows or "
+               "outruns the simulation's step" if odd else "")
             + (f"; {skipped} interval{'s' * (skipped != 1)} not simulated (at most {MAX_RUNS})"
                if skipped else ""))
     return Dynamics(found, tuple(attractors), gaps, note)

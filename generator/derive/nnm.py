@@ -360,27 +360,34 @@ class ModeRadius:
         return self.lower ** (1 / self.step)
 
 
+MIN_RATIOS = 6
+# NOTE: terms past ω₀ below which a series gives no bound at all (no estimate, too few
+# ratios): the emitted module then says "no radius estimate".
+
+
 def radius(mode: NormalModeSeries) -> ModeRadius | None:
     """The estimated radius of convergence of ω in ``y`` (:func:`nearest_singularity`) with a
-    real, positive lower bound; None when the series is too short for an estimate (or ends:
-    a polynomial ω converges everywhere).  The bound is the estimate less its spread where the
-    spread is below :data:`RELIABLE_SPREAD` of it, else the smaller of the estimate and the
-    smallest ratio ``|c_(n−1)/c_n|`` over the last half of the coefficients: swinging ratios
-    pass below their limit, which is the radius."""
+    real, positive lower bound; None when the series ends (a polynomial ω converges
+    everywhere) or holds fewer than :data:`MIN_RATIOS` terms past ω₀.  Where no singularity
+    fits the coefficients (they swing: no estimate), the bound is the smallest ratio alone.
+    The bound is the estimate less its spread where the spread is below
+    :data:`RELIABLE_SPREAD` of it, else the smaller of the estimate and the smallest ratio
+    ``|c_(n−1)/c_n|`` over the last half of the coefficients: swinging ratios pass below
+    their limit, which is the radius."""
     coefficients = mode.omega_over_omega0()
     est = nearest_singularity(coefficients, "y", None)
-    if est is None:
-        return None
     values = [float(sp.N(c, 30)) for c in coefficients]
-    square = est.variable.endswith("**2")  # read in y², the radius converted back to y
-    if square:
-        values = values[::2]
     while values and values[-1] == 0:
         values.pop()
+    if est is None and sum(1 for v in values[1:] if v) < MIN_RATIOS:
+        return None  # a series that ends (a polynomial ω) or too short to say
+    square = est.variable.endswith("**2") if est is not None else not any(values[1::2])
+    if square:  # read in y², the radius converted back to y
+        values = values[::2]
     ratios = [abs(values[n - 1] / values[n]) for n in range(max(2, len(values) // 2),
                                                            len(values))
               if values[n] and values[n - 1]]
-    r, spread = est.radius, est.spread
+    r, spread = (est.radius, est.spread) if est is not None else (math.nan, math.inf)
     if math.isfinite(r) and r > 0 and math.isfinite(spread) and spread < RELIABLE_SPREAD * r:
         lower, how = r - spread, "the estimate less its spread"
     else:
