@@ -358,6 +358,11 @@ def response_equation_cost(args: argparse.Namespace) -> Cost:
                 "of the equation")
 
 
+def _count(points: float) -> str:
+    """A count a person reads: whole below a million, else two digits and an exponent."""
+    return f"{points:.0f}" if points < 1e6 else f"{points:.2g}"
+
+
 def response_system_cost(args: argparse.Namespace) -> Cost:
     """``response SYSTEM``: the planned continuation, drive continuations and shots."""
     from .analysis.systems import system_plan
@@ -366,7 +371,7 @@ def response_system_cost(args: argparse.Namespace) -> Cost:
                        args.omega_max)
     given = "".join(f", --param {pair}" for pair in args.param or ())
     return Cost(plan.seconds, f"--harmonics {args.harmonics}{given}",
-                f"the continuation of about {plan.points:.0f} points, {plan.drives} drive "
+                f"the continuation of about {_count(plan.points)} points, {plan.drives} drive "
                 f"continuations (at most {plan.drive_points} points each) and the shots "
                 "of the system")
 

@@ -124,10 +124,21 @@ def test_nnm_of_a_full_mass_prints_decimals_and_its_json_keeps_the_mass(tmp_path
     ("x1'' + 2*x2'' + x1 = 0; 2*x1'' + x2'' + x2 = 0", "is not positive definite"),
     ("x1'' + 2*x2'' + x1 = 0; x1'' + x2'' + x2 = 0", "is not symmetric"),
     ("x1'' + x1 = 0; x1'' + x1 = 0", "one equation per coordinate"),
-    ("-x1'' + x1 = 0; x2'' + x2 = 0", "positive constant mass"),
+    ("-x1'' + x1 = 0; x2'' + x2 = 0", "mode 1 has ω0² = -1"),  # x1'' - x1 = 0, negated
+    ("x1'' + x1 = 0;", "equation 2 is empty"),
     ("x1''*x2 + x1 = 0; x2'' + x2 = 0", "accelerations must enter linearly"),
 ])
 def test_a_mass_that_is_not_one_is_refused_in_one_line(text, says):
     out = run("nnm", text)
     assert out.returncode == 2 and out.stdout == ""
     assert len(out.stderr.strip().splitlines()) == 1 and says in out.stderr, out.stderr
+
+
+def test_an_equation_written_negated_is_the_same_system():
+    """``-x1'' - 2*x1 + x2 - x1**3/2 = 0`` is Kerschen's first equation times −1: the same
+    modes and series, exactly (it was refused as a negative mass)."""
+    kerschen = "x1'' + 2*x1 - x2 + x1**3/2 = 0; x2'' + 2*x2 - x1 = 0"
+    negated = "-x1'' - 2*x1 + x2 - x1**3/2 = 0; x2'' + 2*x2 - x1 = 0"
+    for which in (1, 2):
+        a, b = (normal_mode(parse_system(t), which, 6) for t in (kerschen, negated))
+        assert a.omega() == b.omega() and a.period() == b.period()

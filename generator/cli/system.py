@@ -345,6 +345,8 @@ def response_system_json(r) -> dict:
         "parameters": {
             "frequency": str(r.system.frequency),
             "drive": {name: str(d) for name, d in zip(names, r.system.drive, strict=True)},
+            "drive_written": {name: str(d) for name, d in zip(names, r.system.written_drive,
+                                                              strict=True)},
             "omega_range": list(r.omega_range),
             "linear_frequencies": list(r.linear_frequencies),
             "harmonics": r.harmonics,
@@ -401,11 +403,12 @@ def response_system_table(data: dict) -> list[str]:
     p = data["parameters"]
     names = data["coordinates"]
     lo, hi = p["omega_range"]
-    drive = ", ".join(f"{k}: {v}" for k, v in p["drive"].items() if v != "0")
+    drive = ", ".join(f"{k}: {v}" for k, v in p["drive_written"].items() if v != "0")
     lines = [f"response of {data['system']}",
              f"  {p['frequency']} in {interval(lo, hi)}; linear omega0 = "
              + ", ".join(f"{w:.6g}" for w in p["linear_frequencies"])
-             + f"; drive amplitude {drive}; balance of {p['harmonics']} harmonics"]
+             + f"; drive amplitude (as written) {drive}; balance of {p['harmonics']} "
+             "harmonics"]
     for k, b in enumerate(data["branches"], 1):
         stable = sum(b["stable"])
         peak = ", ".join(f"{n} {max(b['amplitudes'][n]):.4g}" for n in names)

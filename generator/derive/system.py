@@ -51,6 +51,11 @@ class System:
         return len(self.coordinates)
 
     @property
+    def written_drive(self) -> tuple[sp.Rational, ...]:
+        """The drive's amplitudes as the equations write them, ``F = M·(M⁻¹F)``."""
+        return tuple(self.mass * sp.Matrix(self.drive)) if self.drive else ()
+
+    @property
     def conservative(self) -> bool:
         """No velocity in any force and no drive (time-reversible: the cosine ansatz of
         ``nnm`` holds)."""
@@ -156,6 +161,10 @@ def _read(text: str, driven: bool
     if not parts:
         raise InputError(f"system {text!r}: no such preset; write its equations (one per "
                          "coordinate, separated by ';')")
+    for i, part in enumerate(parts):
+        if not part:
+            raise InputError(f"system {text!r}: equation {i + 1} is empty (a ';' with nothing "
+                             "beside it)")
     sides = [parse_sides(p, "equation") for p in parts]
     coordinates = []
     for i, (_, _, orders, _) in enumerate(sides):
@@ -174,6 +183,12 @@ def _read(text: str, driven: bool
         raise InputError(f"system {text!r}: {', '.join(bad)} has no equation of its own; each "
                          "coordinate needs its acceleration (x'') and its equation")
     exprs = [renamed(lhs - rhs, coordinates) for lhs, rhs, _, _ in sides]
+    # NOTE: "-x1'' - 2*x1 + … = 0" is "x1'' + 2*x1 - … = 0": an equation whose own
+    # acceleration enters with a negative number is taken negated (its row of M positive)
+    for i, c in enumerate(coordinates):
+        own = sp.expand(exprs[i]).coeff(derivative_symbols(c)[2])
+        if own.is_Rational and own < 0:
+            exprs[i] = -exprs[i]
     names = {n for _, _, _, ns in sides for n in ns if n.rstrip("_") not in coordinates}
     frequency = None
     if TIME in names:
