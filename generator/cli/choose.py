@@ -379,8 +379,9 @@ def arguments_choose(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
     p.add_argument("--mode", type=_positive, default=None, metavar="M",
                    help="backbone: the system's mode, by increasing linear frequency "
                    "(default 1)")
-    _flag_equation(p, "\"q'' + q + eps*q**5 = 0\" (period only: a free oscillator with a "
-                   "polynomial force, judged by quadrature; y is then its expansion variable)")
+    _flag_equation(p, "\"q'' + q + eps*q**5 = 0\" (period: a free oscillator with a "
+                   "polynomial force, judged by quadrature; y is then its expansion variable; "
+                   "backbone: a SYSTEM, equations separated by ';')")
     p.add_argument("--tol", type=_real, metavar="TOL",
                    help="tolerance > 0 (period, q: relative, required; amplitudes, response: "
                    "absolute, default 1e-4)")

@@ -859,7 +859,8 @@ def arguments_generate(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
     p = sub.add_parser(
         "generate", help="write a numba evaluator module and LaTeX tables and derivation",
         description="Write a numba evaluator module (and for duffing, pendulum, driven its "
-        "LaTeX tables and derivation) into --out.")
+        "LaTeX tables and derivation) into --out; for a SYSTEM (equations separated by ';') "
+        "the module of one nonlinear normal mode (--mode).")
     _flag_oscillator(p, emitted=True)
     _flag_order(p, f"highest order K (duffing, pendulum; driven up to {DRIVEN_MAX_ORDER})")
     p.add_argument("--out", default="out", metavar="DIR",

@@ -157,8 +157,9 @@ def arguments_sweep(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    "subharmonic); validity: the μ-expansion's error (Duffing's only)")
     p.add_argument("model", metavar="EQUATION", nargs="?", default=None,
                    help="a driven equation such as \"q'' + 0.05*q' + q + eps*(alpha*q**2 + "
-                   "q**3) = f*cos(w*t)\"; default: Duffing's q'' + q'/Q + q + εq³ = f cos ωt "
-                   "with --omega, --force, --eps, --Q")
+                   "q**3) = f*cos(w*t)\", or a SYSTEM of them separated by ';' (response "
+                   "only: every coordinate's r); default: Duffing's q'' + q'/Q + q + εq³ = "
+                   "f cos ωt with --omega, --force, --eps, --Q")
     p.add_argument("--axis", type=_named_axis, action="append", metavar="NAME=VALUES",
                    help="with EQUATION: a parameter swept, e.g. w=0.8:1.6:41 or alpha=0,1/2,1 "
                    "(A:B:N, v1,v2,… or one value; repeatable; the store's coordinates take "
