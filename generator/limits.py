@@ -72,13 +72,14 @@ EXCHANGE_MAX_STEPS = 20_000
 # NOTE: DOP853 steps of a resonant slow flow's energy exchange (rescaled to unit amplitude, so
 # the count does not grow with it): two exchanges take 10–300 steps on the documented systems,
 # ~0.3 ms each; a start that finds no two maxima in 20 000 (about 6 s) reports NaN.
-WEAK_NONLINEARITY = 1.0
+WEAK_NONLINEARITY = 0.1
 # NOTE: the first-order slow flow of a system's resonant modes averages a weak nonlinear force
-# over the linear modes' fast oscillation.  Where the nonlinear force at the start's peak
-# coordinates reaches the slowest mode's linear restoring force ω0²·a, it can cancel it: the
-# motion is no slowly modulated linear mode and no time scales separate; `slowflow SYSTEM
-# --start` refuses there (its error grows like that ratio well before: 1.5 % at 0.3 for the
-# swing spring, tests/test_resonance.py).
+# over the linear modes' fast oscillation; its error grows like the ratio of the nonlinear
+# force at the start's peak coordinates to the slowest mode's linear restoring force ω0²·a
+# (1.5 % at 0.3 for the swing spring, tests/test_resonance.py; for x1'' + x1 + 0.3 x1² x2 +
+# 0.2 x1³, x2'' + 9 x2 + …: 1 % at 0.05, 6 % at 0.2, and at 0.8 the printed exchange period
+# was one fast period where the full equations exchange nothing). `slowflow SYSTEM --start`
+# refuses above 0.1.
 
 # --- work -------------------------------------------------------------------------------------
 

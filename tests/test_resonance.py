@@ -148,8 +148,8 @@ def test_exchange_period_at_a_large_amplitude_takes_the_steps_of_a_small_one():
 @pytest.mark.parametrize("value", ["1000", "1e40"])
 def test_slowflow_start_beyond_the_weak_nonlinearity_is_refused(value, capsys):
     """At a₁ = a₂ = a the peaks are x₁ = x₂ = a and the forces x₁x₂ = x₁² = a² against
-    ω0₁²·a = a: a times the linear force, so a ≤ 1 (by hand); refused in one line that says
-    so, before any integration; a = 0.5 runs."""
+    ω0₁²·a = a: a times the linear force, so a ≤ 0.1, the bound (by hand); refused in one
+    line that says so, before any integration; a = 0.05 runs."""
     from lindstedt.cli import main
 
     status = main(["slowflow", QUADRATIC_1_2, "--start", f"a1={value}", "--start",
@@ -159,8 +159,8 @@ def test_slowflow_start_beyond_the_weak_nonlinearity_is_refused(value, capsys):
     line, = out.err.strip().splitlines()
     assert f"--start a1={float(value):g}, a2={float(value):g}" in line
     assert f"is {float(value):.3g} times" in line and "weak nonlinearity" in line
-    assert "largest is ≤ 1" in line and "finite" not in line
-    assert main(["slowflow", QUADRATIC_1_2, "--start", "a1=0.5", "--start", "a2=0.5"]) == 0
+    assert "largest is ≤ 0.1" in line and "finite" not in line
+    assert main(["slowflow", QUADRATIC_1_2, "--start", "a1=0.05", "--start", "a2=0.05"]) == 0
 
 
 def test_slowflow_system_cost_does_not_grow_with_the_start():
