@@ -6,7 +6,8 @@ order; a stage imports only stages above it::
     algebra.series          the one Fourier kernel: exact P(C) + S·R(C) over QQ (FLINT
                             fmpq_poly), a number field Q(θ) (fmpq_poly parts) and QQ[params]
                             (fmpq_mpoly), the odd-cosine fast path,
-                            relaxed (online) products of ε-series of Trig sums, the Laurent form
+                            the one lazy-series engine (coefficients on demand, each once:
+                            terms, maps, sums, Cauchy and relaxed products), the Laurent form
                             in e^{is} over complex128 for the numeric methods
                             [coefficients -> Trig]
     algebra.resum           the one power-series toolkit (product, reciprocal, square root,
@@ -94,13 +95,12 @@ order; a stage imports only stages above it::
                             a template lays out [-> records]
     lower.forms             Horner/Estrin, the Chebyshev recurrence, AGM steps, argument guards,
                             the scaled variable x = εA^k [Expr -> Expr]
-    lower.series            free oscillators, limit cycles, resummations, Mathieu, tongues
-                            [solution -> Module]
+    lower.series            a family of periodic orbits of any number of coordinates (a free
+                            oscillator, a normal mode: ω, T, the motion, the error's bound,
+                            NaN outside its orbits and radius), limit cycles, resummations,
+                            Mathieu, tongues [solution -> Module]
     lower.driven            the μ-expansion's branches (Cardano), damped, the harmonic-balance
                             system [orders -> Module]
-    lower.system            a nonlinear normal mode's backbone ω(A), T(A), shape x_i(t, A)
-                            and truncation error's bound, NaN past the radius' lower bound
-                            [NormalModeSeries -> Module]
     lower.documents         the derivations' LaTeX records, the AGM period, a chosen formula,
                             the slow flow [solution -> Unit]
     emit.render             strict Jinja2 environments, provenance, one-unit writes

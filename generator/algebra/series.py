@@ -15,7 +15,7 @@ SymPy polynomial domain such as ``QQ[A]`` (:class:`DensePoly`, :class:`MPoly`).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cache
@@ -663,43 +663,95 @@ def trig_power(cosines: dict[int, sp.Expr], sines: dict[int, sp.Expr], power: in
 # fixed one order late), and :meth:`RelaxedProduct.forget` remakes just those.
 
 
-class TrigSeries:
-    """An ε-series of :class:`Trig` sums over QQ, known to some order."""
+class LazySeries:
+    """A power series whose coefficients are computed on demand, each once and kept (until
+    :meth:`forget`): the one engine of the perturbation series — the L–P kernel's forces
+    (:mod:`derive.lindstedt`), a normal mode's monomials (:mod:`derive.nnm`), a limit cycle's
+    ε-products (:mod:`derive.cycles`).  A coefficient is whatever the series holds: a
+    :class:`Trig`, a polynomial in C of the kernel, a scalar."""
 
-    def coeff(self, i: int) -> Trig:
-        """The :class:`Trig` coefficient of ``ε^i``."""
+    def __init__(self) -> None:
+        self.cache: dict[int, Any] = {}
+
+    def coeff(self, i: int) -> Any:
+        """The coefficient of the ``i``-th power, made once and kept."""
+        if i not in self.cache:
+            self.cache[i] = self.compute(i)
+        return self.cache[i]
+
+    def compute(self, i: int) -> Any:
         raise NotImplementedError
 
     def forget(self, i: int) -> None:
-        """Coefficient ``i`` of an input changed: drop what was made from it."""
+        """Coefficient ``i`` of an input changed: drop the one made from it."""
+        self.cache.pop(i, None)
 
 
-class TrigTerms(TrigSeries):
+class Terms(LazySeries):
     """A series given term by term (``terms[i]``; the caller appends and replaces)."""
 
-    def __init__(self, terms: list[Trig]) -> None:
+    def __init__(self, terms: list) -> None:
+        super().__init__()
         self.terms = terms
 
-    def coeff(self, i: int) -> Trig:
-        """``terms[i]``, the coefficient of ``ε^i`` as given."""
+    def coeff(self, i: int) -> Any:
+        """``terms[i]``, as given."""
         return self.terms[i]
 
 
-class TrigMap(TrigSeries):
-    """``fn`` applied to each coefficient of ``source`` (a derivative), each made once."""
+class Mapped(LazySeries):
+    """``fn`` applied to each coefficient of ``source`` (a derivative, a factor)."""
 
-    def __init__(self, source: TrigSeries, fn: Any) -> None:
-        self.source, self.fn, self.cache = source, fn, {}
+    def __init__(self, source: LazySeries, fn: Callable[[Any], Any]) -> None:
+        super().__init__()
+        self.source, self.fn = source, fn
 
-    def coeff(self, i: int) -> Trig:
-        """``fn`` of the source's coefficient ``i``, made once and kept."""
-        if i not in self.cache:
-            self.cache[i] = self.fn(self.source.coeff(i))
-        return self.cache[i]
+    def compute(self, i: int) -> Any:
+        return self.fn(self.source.coeff(i))
 
-    def forget(self, i: int) -> None:
-        """Coefficient ``i`` of the source changed: drop the one made from it."""
-        self.cache.pop(i, None)
+
+class Linear(LazySeries):
+    """``first + Σ c_k·node_k``: exact scalars ``c_k`` times series; ``first`` (the constant
+    term, or ``None``) added to coefficient 0, ``zero`` the empty coefficient."""
+
+    def __init__(self, terms: list[tuple[Any, LazySeries]], zero: Any,
+                 first: Any = None) -> None:
+        super().__init__()
+        self.terms, self.zero, self.first = terms, zero, first
+
+    def compute(self, i: int) -> Any:
+        acc = self.first if i == 0 and self.first is not None else self.zero
+        for c, node in self.terms:
+            acc = acc + node.coeff(i) * c
+        return acc
+
+
+class Product(LazySeries):
+    """``a · b`` by the Cauchy sum ``Σ_k a_k b_(i−k)`` (a square, ``a is b``: half the
+    products), each coefficient once; ``post`` is applied to each (the odd basis' factor
+    ``C² = v``: a shift).  :class:`RelaxedProduct` is its online, packed form for Trig sums."""
+
+    def __init__(self, a: LazySeries, b: LazySeries,
+                 post: Callable[[Any], Any] | None = None) -> None:
+        super().__init__()
+        self.a, self.b, self.post = a, b, post
+
+    def compute(self, i: int) -> Any:
+        a, b = self.a, self.b
+        if a is b:
+            acc = None
+            for x in range((i + 1) // 2):
+                term = a.coeff(x) * a.coeff(i - x)
+                acc = term if acc is None else acc + term
+            acc = acc * 2 if acc is not None else None
+            if i % 2 == 0:
+                sq = a.coeff(i // 2) * a.coeff(i // 2)
+                acc = sq if acc is None else acc + sq
+        else:
+            acc = a.coeff(0) * b.coeff(i)
+            for x in range(1, i + 1):
+                acc = acc + a.coeff(x) * b.coeff(i - x)
+        return acc if self.post is None else self.post(acc)
 
 
 PACKED_FROM = 2
@@ -707,15 +759,15 @@ PACKED_FROM = 2
 # product (2 and 4 measured alike: van der Pol to order 100, 6.0–6.1 s against 6.1–6.3).
 
 
-class RelaxedProduct(TrigSeries):
+class RelaxedProduct(Product):
     """``a · b`` (``a is b``: a square), online: coefficient ``i`` may be asked for once ``a``
     and ``b`` are final to order ``i − 1`` (their coefficient ``i`` may change later:
-    :meth:`forget`)."""
+    :meth:`forget` drops the product's coefficient ``i``, whose pairs ``(0, i)`` and ``(i, 0)``
+    are remade on request; the squares use only final coefficients)."""
 
-    def __init__(self, a: TrigSeries, b: TrigSeries) -> None:
-        self.a, self.b = a, b
+    def __init__(self, a: LazySeries, b: LazySeries) -> None:
+        super().__init__(a, b)
         self.blocks: dict[int, list] = {}  # (part, numerator, denominator) from the squares
-        self.cache: dict[int, Trig] = {}
         self.started = 1  # squares of output index ≤ started are made
 
     def coeff(self, i: int) -> Trig:
@@ -726,10 +778,7 @@ class RelaxedProduct(TrigSeries):
             return self.cache[i]
         a, b = self.a, self.b
         if not a.coeff(0).ground.is_rational:  # no integer packing off QQ: the Cauchy sum
-            out = a.coeff(0) * b.coeff(i)
-            for k in range(1, i + 1):
-                out = out + a.coeff(k) * b.coeff(i - k)
-            self.cache[i] = out
+            self.cache[i] = out = self.compute(i)
             return out
         while self.started < i:
             self.started += 1
@@ -742,12 +791,6 @@ class RelaxedProduct(TrigSeries):
             out = Trig(out.cos_part + cos, out.sin_part + sin, out.ground)
         self.cache[i] = out
         return out
-
-    def forget(self, i: int) -> None:
-        """Coefficient ``i`` of an input changed: drop the product's coefficient ``i``, whose
-        pairs ``(0, i)`` and ``(i, 0)`` are remade on request (the squares use only final
-        coefficients)."""
-        self.cache.pop(i, None)
 
     def _squares(self, n: int) -> None:
         """The squares whose lowest output index is ``n``: ``m | n``, ``t = n/m − 1 ≥ 1``."""

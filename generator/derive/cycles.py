@@ -15,11 +15,11 @@ from sympy.polys.domains import QQ
 from ..algebra.resum import binomial_series, series_compose, series_mul, series_reciprocal
 from ..algebra.series import (
     Ground,
+    LazySeries,
+    Mapped,
     RelaxedProduct,
+    Terms,
     Trig,
-    TrigMap,
-    TrigSeries,
-    TrigTerms,
     solve_trig,
 )
 from ..errors import InputError
@@ -209,22 +209,22 @@ def derive_limit_cycle(model: Any, order: int, cycle: int = 0) -> LimitCycle:
     qs = [cos_s * a0_g]
     W, omega = [g.scalar(1)], [g.scalar(1)]
     # the series: q, q', q'', ω, X = (ω² − 1)/ε (X_k = W_(k+1)), and the products of f
-    q = TrigTerms(qs)
-    slope_q = TrigMap(q, Trig.derivative)
-    curvature = TrigMap(slope_q, Trig.derivative)
-    omegas = TrigTerms([constant(g.scalar(1))])
-    X = TrigTerms([])
-    nodes: list[TrigSeries] = [slope_q, curvature]
-    products: dict[tuple[str, int], TrigSeries] = {("q", 1): q}
+    q = Terms(qs)
+    slope_q = Mapped(q, Trig.derivative)
+    curvature = Mapped(slope_q, Trig.derivative)
+    omegas = Terms([constant(g.scalar(1))])
+    X = Terms([])
+    nodes: list[LazySeries] = [slope_q, curvature]
+    products: dict[tuple[str, int], LazySeries] = {("q", 1): q}
 
-    def product(a: TrigSeries, b: TrigSeries) -> RelaxedProduct:
+    def product(a: LazySeries, b: LazySeries) -> RelaxedProduct:
         node = RelaxedProduct(a, b)
         nodes.append(node)
         return node
 
     products[("v", 1)] = product(omegas, slope_q)  # [ε^i] ω q'
 
-    def power(kind: str, n: int) -> TrigSeries:  # each power made once, by squaring
+    def power(kind: str, n: int) -> LazySeries:  # each power made once, by squaring
         if (kind, n) not in products:
             half = power(kind, n // 2)
             products[(kind, n)] = product(half, half) if n % 2 == 0 else \

@@ -29,6 +29,11 @@ from ..algebra.resum import series_radius as series_radius
 from ..algebra.series import (
     Basis,
     Ground,
+    LazySeries,
+    Linear,
+    Mapped,
+    Product,
+    Terms,
     solve_oscillator,
     to_fourier,
 )
@@ -231,131 +236,43 @@ class _Elementary:
         self.c[m] = acc.left_shift(1) * scale  # (C·P)(C·s) = v·(P s)
 
 
-class _Series:
-    """A power series in y whose coefficients are polynomials in the kernel's basis, computed
-    one coefficient at a time (order j needs index j − k of an order-k force, all from
-    ``u_0..u_(j-1)``).  ``odd``: in the odd basis, stored over C (``C·P(v)``); else even,
-    plain in ``v`` (in the full basis every node is plain in C)."""
-
-    odd: bool
-
-    def __init__(self) -> None:
-        self.cache: list = []
-
-    def coeff(self, i: int) -> Any:
-        while len(self.cache) <= i:
-            self.cache.append(self.compute(len(self.cache)))
-        return self.cache[i]
-
-    def compute(self, i: int) -> Any:
-        raise NotImplementedError
-
-
-class _Solution(_Series):
-    """``u`` itself: ``P_i``, appended by :func:`derive` as each order is solved."""
-
-    def __init__(self, P: list, odd: bool) -> None:
-        super().__init__()
-        self.P, self.odd = P, odd
-
-    def coeff(self, i: int) -> Any:
-        return self.P[i]
-
-
-class _Product(_Series):
-    """``[y^i] a·b = Σ a_x b_(i−x)`` (half the products for a square); two odd factors give
-    ``C²·(…) = v·(…)``, a shift in the odd basis."""
-
-    def __init__(self, a: _Series, b: _Series, basis: Basis) -> None:
-        super().__init__()
-        self.a, self.b = a, b
-        self.odd = a.odd != b.odd
-        self.shift = 1 if basis.odd and a.odd and b.odd else 0
-
-    def compute(self, i: int) -> Any:
-        a, b = self.a, self.b
-        if a is b:
-            acc = None
-            for x in range((i + 1) // 2):
-                term = a.coeff(x) * a.coeff(i - x)
-                acc = term if acc is None else acc + term
-            acc = acc * 2 if acc is not None else None
-            if i % 2 == 0:
-                sq = a.coeff(i // 2) * a.coeff(i // 2)
-                acc = sq if acc is None else acc + sq
-        else:
-            acc = a.coeff(0) * b.coeff(i)
-            for x in range(1, i + 1):
-                acc = acc + a.coeff(x) * b.coeff(i - x)
-        return acc.left_shift(self.shift) if self.shift else acc
-
-
-class _Sum(_Series):
-    """``c₀ + Σ c_k·node_k`` with exact scalars (every node of one parity)."""
-
-    def __init__(self, constant: Any, terms: list[tuple[Any, _Series]], ground: Ground,
-                 odd: bool) -> None:
-        super().__init__()
-        self.constant, self.terms, self.ground, self.odd = constant, terms, ground, odd
-
-    def compute(self, i: int) -> Any:
-        acc = self.ground.poly([self.constant] if i == 0 and self.constant else [])
-        for c, node in self.terms:
-            acc = acc + node.coeff(i) * c
-        return acc
-
-
-class _Slope2(_Series):
+def _slope_squared(P: list, W: list, basis: Basis, ground: Ground) -> LazySeries:
     """``Y = ω² u'²``: ``u' = −sin s·du/dC`` gives ``u'² = (1 − C²)(du/dC)²``, a cosine sum
-    (even), and ``ω² = Σ W_i y^i`` is known below the order being solved."""
+    (even), and ``ω² = Σ W_i y^i`` is known below the order being solved.  ``du/dC`` in the
+    odd basis: ``d/dC Σ p_k C^(2k+1) = Σ (2k+1) p_k v^k`` (even, plain in v)."""
+    one, zero = ground.scalar(1), ground.scalar(0)
+    # (1 − C²) in the basis: 1 − v (odd: even functions live in v) or 1 − C²
+    sine2 = ground.poly([one, -one] if basis.odd else [one, zero, -one])
 
-    def __init__(self, P: list, W: list, basis: Basis, ground: Ground) -> None:
-        super().__init__()
-        self.odd = False
-        self.P, self.W, self.basis, self.ground = P, W, basis, ground
-        one, zero = ground.scalar(1), ground.scalar(0)
-        # (1 − C²) in the basis: 1 − v (odd: even functions live in v) or 1 − C²
-        self.sine2 = ground.poly([one, -one] if basis.odd else [one, zero, -one])
-        self.R = _Derivative(P, basis, ground)
-        self.R2 = _Product(self.R, self.R, Basis(False))  # R is even in the odd basis
+    def slope(p: Any) -> Any:
+        cs = p.coeffs()
+        if basis.odd:
+            return ground.poly([c * (2 * k + 1) for k, c in enumerate(cs)])
+        return ground.poly([c * k for k, c in enumerate(cs)][1:])
 
-    def compute(self, i: int) -> Any:
-        acc = self.R2.coeff(i)
-        for x in range(1, i + 1):
-            if self.W[x]:
-                acc = acc + self.R2.coeff(i - x) * self.W[x]
-        return acc * self.sine2
-
-
-class _Derivative(_Series):
-    """``R = du/dC``: in the odd basis ``d/dC Σ p_k C^(2k+1) = Σ (2k+1) p_k v^k`` (even)."""
-
-    def __init__(self, P: list, basis: Basis, ground: Ground) -> None:
-        super().__init__()
-        self.P, self.basis, self.ground, self.odd = P, basis, ground, False
-
-    def compute(self, i: int) -> Any:
-        cs = self.P[i].coeffs()
-        if self.basis.odd:
-            return self.ground.poly([c * (2 * k + 1) for k, c in enumerate(cs)])
-        return self.ground.poly([c * k for k, c in enumerate(cs)][1:])
+    R = Mapped(Terms(P), slope)
+    return Mapped(Product(Product(R, R), Terms(W)), lambda c: c * sine2)
 
 
 class _Forces:
-    """Every polynomial force ``Σ c u^a (ω u')^b`` of the model as series nodes, in Horner
-    form with shared subexpressions: ``u·H(u², Y)`` for odd forces (``u⁵ + 2u³Y + uY²/3``
-    costs three and a half convolutions an order, not seven and a half by power tables),
-    ``H(u, Y)`` otherwise, ``Y = ω²u'²``."""
+    """Every polynomial force ``Σ c u^a (ω u')^b`` of the model as series nodes
+    (:class:`algebra.series.LazySeries`), in Horner form with shared subexpressions:
+    ``u·H(u², Y)`` for odd forces (``u⁵ + 2u³Y + uY²/3`` costs three and a half convolutions
+    an order, not seven and a half by power tables), ``H(u, Y)`` otherwise, ``Y = ω²u'²``.
+    In the odd basis a node is stored over C (``C·P(v)``, odd) or plain in ``v`` (even): the
+    product of two odd nodes is ``C²·(…) = v·(…)``, a shift; in the full basis every node is
+    plain in C."""
 
     def __init__(self, model: Model, P: list, W: list, basis: Basis, ground: Ground) -> None:
         self.basis, self.ground = basis, ground
-        self.u = _Solution(P, basis.odd)
+        self.u = Terms(P)  # u itself: P_i, appended by derive as each order is solved
+        self.odd: dict[LazySeries, bool] = {self.u: basis.odd}
         self.memo: dict = {}
-        self.Y: _Slope2 | None = None
+        self.Y: LazySeries | None = None
         self.P, self.W = P, W
         z, y = sp.symbols("z y")
         self.z, self.y = z, y
-        self.by_order: list[_Series | None] = []
+        self.by_order: list[LazySeries | None] = []
         for k in range(max(len(model.forcing), len(model.velocity_forcing))):
             poly = sp.Integer(0)
             for n, c in (model.forcing[k] if k < len(model.forcing) else ()):
@@ -371,28 +288,40 @@ class _Forces:
             return self.z ** ((a - 1) // 2) * self.y ** (b // 2)
         return self.z**a * self.y ** (b // 2)
 
-    def _compile(self, poly: sp.Expr) -> _Series:
+    def _compile(self, poly: sp.Expr) -> LazySeries:
         if not poly.free_symbols & {self.z, self.y}:  # c·u (odd basis, a = 1)
-            return _Sum(None, [(self.ground.scalar(poly), self.u)], self.ground, self.u.odd)
+            return self._linear([(self.ground.scalar(poly), self.u)])
         node = self._node(sp.horner(poly, self.z, self.y))
         return self._product(self.u, node) if self.basis.odd else node
 
-    def _product(self, a: _Series, b: _Series) -> _Series:
+    def _linear(self, terms: list[tuple[Any, LazySeries]], constant: Any = None
+                ) -> LazySeries:
+        """``constant + Σ c·node`` (every node of one parity)."""
+        node = Linear(terms, self.ground.poly([]),
+                      self.ground.poly([constant]) if constant else None)
+        self.odd[node] = self.odd[terms[0][1]]
+        return node
+
+    def _product(self, a: LazySeries, b: LazySeries) -> LazySeries:
         key = ("*", *sorted((id(a), id(b))))
         if key not in self.memo:
-            self.memo[key] = _Product(a, b, self.basis)
+            shift = self.basis.odd and self.odd[a] and self.odd[b]
+            node = Product(a, b, (lambda c: c.left_shift(1)) if shift else None)
+            self.odd[node] = self.odd[a] != self.odd[b]
+            self.memo[key] = node
         return self.memo[key]
 
-    def _leaf(self, symbol: sp.Symbol) -> _Series:
+    def _leaf(self, symbol: sp.Symbol) -> LazySeries:
         if symbol == self.y:
             if self.Y is None:
-                self.Y = _Slope2(self.P, self.W, self.basis, self.ground)
+                self.Y = _slope_squared(self.P, self.W, self.basis, self.ground)
+                self.odd[self.Y] = False
             return self.Y
         if self.basis.odd:  # z = u²: even
             return self._product(self.u, self.u)
         return self.u
 
-    def _node(self, expr: sp.Expr) -> _Series:
+    def _node(self, expr: sp.Expr) -> LazySeries:
         """A series node for a polynomial expression in z, y (memoised by expression)."""
         if expr in self.memo:
             return self.memo[expr]
@@ -415,19 +344,19 @@ class _Forces:
             for other in nodes[1:]:
                 node = self._product(node, other)
             if scalar != 1:
-                node = _Sum(None, [(self.ground.scalar(scalar), node)], self.ground, node.odd)
+                node = self._linear([(self.ground.scalar(scalar), node)])
         elif expr.is_Add:
             constant, terms = None, []
             for f in expr.args:
                 if f.free_symbols & {self.z, self.y}:
                     inner = self._node(f)
-                    if isinstance(inner, _Sum) and inner.constant is None:
+                    if isinstance(inner, Linear) and inner.first is None:
                         terms.extend(inner.terms)
                     else:
                         terms.append((self.ground.scalar(1), inner))
                 else:
                     constant = self.ground.scalar(f)
-            node = _Sum(constant, terms, self.ground, terms[0][1].odd)
+            node = self._linear(terms, constant)
         else:
             raise ValueError(f"force {expr}: not a polynomial in u and u'²")
         self.memo[expr] = node

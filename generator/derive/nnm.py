@@ -37,7 +37,7 @@ from ..algebra.resum import (
     series_reciprocal,
     series_sqrt,
 )
-from ..algebra.series import Basis, Ground, from_fourier, to_fourier
+from ..algebra.series import Basis, Ground, LazySeries, Product, Terms, from_fourier, to_fourier
 from ..errors import InputError
 from ..limits import check_int
 from .system import System
@@ -184,27 +184,23 @@ def _null_vector(matrix: list[list[Any]], one: Any) -> list[Any]:
     return v
 
 
-class _Products:
+class _Monomials:
     """The y-series of every monomial of the coordinates, built as prefix products
-    ``u_i1·u_i2·…`` whose coefficients are computed on demand and cached (each once)."""
+    ``u_i1·u_i2·…`` (:class:`algebra.series.Product`, each coefficient once)."""
 
-    def __init__(self, series: list[list[Any]], g: Ground) -> None:
-        self.series, self.g = series, g
-        self.cache: dict[tuple[int, ...], list[Any]] = {}
+    def __init__(self, series: list[list[Any]]) -> None:
+        self.nodes: dict[tuple[int, ...], LazySeries] = {
+            (i,): Terms(terms) for i, terms in enumerate(series)}
+
+    def node(self, factors: tuple[int, ...]) -> LazySeries:
+        """The series of ``Π u_i`` over ``factors``."""
+        if factors not in self.nodes:
+            self.nodes[factors] = Product(self.node(factors[:-1]), self.node(factors[-1:]))
+        return self.nodes[factors]
 
     def coeff(self, factors: tuple[int, ...], m: int) -> Any:
         """The ``y^m`` coefficient (a polynomial in ``C = cos τ``) of ``Π u_i``."""
-        if len(factors) == 1:
-            return self.series[factors[0]][m]
-        known = self.cache.setdefault(factors, [])
-        while len(known) <= m:
-            k = len(known)
-            head, last = factors[:-1], factors[-1]
-            acc = self.g.poly([])
-            for i in range(k + 1):
-                acc = acc + self.coeff(head, i) * self.series[last][k - i]
-            known.append(acc)
-        return known[m]
+        return self.node(factors).coeff(m)
 
 
 def normal_mode(system: System, mode: int, order: int, amplitude: int = 0,
@@ -258,7 +254,7 @@ def normal_mode(system: System, mode: int, order: int, amplitude: int = 0,
     step = 2 if degrees and all(p % 2 for p in degrees) else 1
     coefficients: list[list[dict[int, Any]]] = [[{1: v} if v else {} for v in phi]]
     series = [[from_fourier(c, ALL_HARMONICS, g)] for c in coefficients[0]]
-    products = _Products(series, g)
+    products = _Monomials(series)
     omega2 = [lam_g]
     right_sides: list[dict[int, tuple[Any, ...]]] = []
     for j in range(1, order + 1):
