@@ -142,3 +142,119 @@ def test_an_equation_written_negated_is_the_same_system():
     for which in (1, 2):
         a, b = (normal_mode(parse_system(t), which, 6) for t in (kerschen, negated))
         assert a.omega() == b.omega() and a.period() == b.period()
+
+
+# --- the system as written in floating point, sparse: from a text and from a model folder ---
+
+def _chain(n: int) -> tuple:
+    """A fixed–fixed chain of n unit masses and unit springs: K tridiagonal (2, −1), whose
+    frequencies are 2 sin(kπ / (2(n + 1))) (the closed form, another route than an
+    eigensolver)."""
+    import scipy.sparse as sparse
+
+    K = sparse.diags([-np.ones(n - 1), 2 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1])
+    exact = 2 * np.sin(np.arange(1, n + 1) * np.pi / (2 * (n + 1)))
+    return sparse.identity(n), K, exact
+
+
+def test_text_system_as_written_in_floating_point():
+    w = parse_system(DECIMAL).matrices
+    assert np.allclose(w.mass.toarray(), MASS, rtol=0, atol=1e-15)
+    assert np.allclose(w.stiffness.toarray(), STIFFNESS, rtol=0, atol=1e-15)
+    assert w.damping is None and w.drive is None and w.force.degree == 3
+    x = np.array([0.37, -1.21])
+    assert np.allclose(w.force(x), _force(x), rtol=1e-15)
+    # ∂f/∂x by hand: diag(1.2 x1², 0.6 x2²)
+    assert np.allclose(w.force.jacobian(x).toarray(), np.diag([1.2 * x[0] ** 2,
+                                                               0.6 * x[1] ** 2]), rtol=1e-15)
+    lam = sp.Matrix(STIFFNESS.tolist()).applyfunc(sp.nsimplify)
+    M = sp.Matrix(MASS.tolist()).applyfunc(sp.nsimplify)
+    mu = sp.Symbol("mu")
+    truth = sorted(float(sp.sqrt(r)) for r in sp.Poly((lam - mu * M).det(), mu).nroots(n=30))
+    assert np.allclose(w.frequencies(2), truth, rtol=1e-14)
+
+
+def test_driven_damped_text_system_keeps_c_and_f_as_written():
+    s = parse_system("2*x1'' + 0.1*x1' + 3*x1 - x2 + x1**2*x2' = 0.5*cos(w*t); "
+                     "x2'' + 0.2*x2' + 2*x2 - x1 = 0", driven=True)
+    w = s.matrices
+    assert np.allclose(w.damping.toarray(), np.diag([0.1, 0.2]), rtol=0, atol=1e-15)
+    assert np.allclose(w.drive, [0.5, 0.0], rtol=0, atol=1e-15)
+    x, v = np.array([0.3, -0.7]), np.array([1.1, 0.4])
+    assert np.allclose(w.force(x, v), [x[0] ** 2 * v[1], 0.0], rtol=1e-15)
+    assert not s.conservative
+
+
+def test_model_folder_reads_into_the_same_record(tmp_path):
+    from lindstedt.derive.nnm import normal_mode
+    from lindstedt.derive.system import read_model
+    from lindstedt.errors import InputError
+    from scipy.io import mmwrite
+    from scipy.sparse import coo_array
+
+    mmwrite(tmp_path / "M.mtx", coo_array(MASS))
+    mmwrite(tmp_path / "K.mtx", coo_array(STIFFNESS))
+    # 0.4 x1³ written as two terms that add up, 0.2 x2³ as one
+    (tmp_path / "nonlinear.txt").write_text("# i j k l c\n0 0 0 0 0.25\n0 0 0 0 0.15\n"
+                                            "1 1 1 1 0.2\n")
+    s = read_model(tmp_path)
+    assert not s.exact and s.size == 2 and s.conservative
+    x = np.array([-0.8, 0.45])
+    assert np.allclose(s.matrices.force(x), _force(x), rtol=1e-15)
+    assert np.allclose(s.matrices.frequencies(2), parse_system(DECIMAL).matrices.frequencies(2),
+                       rtol=1e-14)
+    with pytest.raises(InputError, match="no exact linear modes"):
+        normal_mode(s, 1, 4)
+
+
+def test_large_chain_model_frequencies_by_shift_invert(tmp_path):
+    from lindstedt.derive.system import read_model
+    from scipy.io import mmwrite
+
+    n = 20000
+    M, K, exact = _chain(n)
+    mmwrite(tmp_path / "M.mtx", M)
+    mmwrite(tmp_path / "K.mtx", K)
+    (tmp_path / "nonlinear.txt").write_text(f"{n - 1} {n - 1} {n - 1} {n - 1} 2.5\n"
+                                            "3 2 4 -1\n")
+    (tmp_path / "drive.txt").write_text("0 1.5\n0 0.5\n")
+    s = read_model(tmp_path)
+    w = s.matrices
+    assert w.mass.nnz == n and w.stiffness.nnz == 3 * n - 2  # nothing dense
+    assert np.allclose(w.frequencies(4), exact[:4], rtol=1e-9)
+    assert w.drive[0] == 2.0 and not s.conservative
+    x = np.linspace(-1, 1, n)
+    f = w.force(x)
+    assert f[n - 1] == 2.5 * x[n - 1] ** 3 and f[3] == -x[2] * x[4]
+    assert np.count_nonzero(f) == 2
+    J = w.force.jacobian(x)
+    assert J.nnz <= 3 and J[3, 2] == -x[4] and J[3, 4] == -x[2]
+
+
+@pytest.mark.parametrize("files, message", [
+    ({"M.mtx": None}, "K.mtx is missing"),
+    ({"M.mtx": None, "K.mtx": [[2.0, -1.0], [-1.5, 2.0]]}, "K.mtx is not symmetric"),
+    ({"M.mtx": [[1.0, 0.0], [0.0, 0.0]], "K.mtx": None}, r"M\[1,1\] = 0"),
+    ({"M.mtx": None, "K.mtx": [[2.0]]}, "K.mtx is 1×1 and M.mtx 2×2"),
+    ({"M.mtx": None, "K.mtx": None, "nonlinear.txt": "0 0 2 1.0\n"},
+     "nonlinear.txt line 1: index 2 outside 0..1"),
+    ({"M.mtx": None, "K.mtx": None, "nonlinear.txt": "0 0 1.0\n"},
+     "nonlinear.txt line 1: 3 fields; 4 or 5 expected"),
+    ({"M.mtx": None, "K.mtx": None, "drive.txt": "1 inf\n"},
+     "drive.txt line 1: the coefficient inf is not finite"),
+    ({"M.mtx": "not a matrix\n", "K.mtx": None}, "M.mtx: not a Matrix Market matrix"),
+])
+def test_model_folder_refusals_name_the_file(tmp_path, files, message):
+    from lindstedt.derive.system import read_model
+    from lindstedt.errors import InputError
+    from scipy.io import mmwrite
+    from scipy.sparse import coo_array
+
+    defaults = {"M.mtx": [[1.0, 0.0], [0.0, 1.0]], "K.mtx": [[2.0, -1.0], [-1.0, 2.0]]}
+    for name, content in files.items():
+        if isinstance(content, str):
+            (tmp_path / name).write_text(content)
+        else:
+            mmwrite(tmp_path / name, coo_array(np.array(content or defaults[name])))
+    with pytest.raises(InputError, match=message):
+        read_model(tmp_path)

@@ -8,15 +8,24 @@ nonlinear force ``f`` (terms of degree ≥ 2) and a drive ``F cos ωt`` (``respo
 modes are the roots ``λ = ω₀²`` of ``det(K − λM) = 0``, kept exact: a rational, or an
 algebraic number (SymPy's ``CRootOf`` with its minimal polynomial), never rounded; modes are
 numbered by increasing linear frequency.
+
+The same record holds the system as written in floating point, with sparse matrices
+(:class:`Matrices`: ``M``, ``C``, ``K`` in CSR, the force as a table of terms, ``F``), for
+every system — derived from the exact one (:attr:`System.matrices`) or read from a finite-element
+code's files (:func:`read_model`, no exact form: ``System.exact`` is false, and the methods
+that need exact modes say so).  Nothing of size n² is formed for it: memory grows with the
+nonzeros.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from functools import cached_property
+from pathlib import Path
 
 import numpy as np
+import scipy.sparse as sparse
 import sympy as sp
 
 from ..errors import InputError
@@ -29,6 +38,93 @@ MAX_COORDINATES = 12
 # structures a user writes by hand stay far below.
 
 
+DENSE_MODES = 200
+# NOTE: up to this many coordinates the linear modes come from a dense generalized eigenvalue
+# problem (every mode, LAPACK); above it from shift-invert Lanczos about 0 (ARPACK, the lowest
+# few), which needs only M, K and a sparse factorization of K.
+
+
+@dataclass(frozen=True)
+class Polynomial:
+    """A polynomial force of ``n`` coordinates as a table of terms, in floating point: term
+    ``t`` adds ``coefficient[t] · Π_k z[factors[t, k]]`` to component ``equation[t]``, where
+    ``z = (x, x')`` (an index ``k < n`` is ``x_k``, ``n + k`` is ``x'_k``) and ``factors`` is
+    padded with ``-1`` (no factor).  Repeated terms add up."""
+
+    size: int
+    equation: np.ndarray  # (T,) int
+    factors: np.ndarray  # (T, d) int, −1 padding
+    coefficient: np.ndarray  # (T,) float
+
+    @property
+    def degree(self) -> int:
+        """The highest degree of a term (0: no term)."""
+        return int((self.factors >= 0).sum(axis=1).max()) if len(self.coefficient) else 0
+
+    def __call__(self, x: np.ndarray, v: np.ndarray | None = None) -> np.ndarray:
+        """``f(x, x')``: the force at one state (velocities zero where not given)."""
+        z = np.concatenate([x, np.zeros(self.size) if v is None else v, [1.0]])
+        terms = self.coefficient * np.prod(z[self.factors], axis=1)  # −1 picks the 1
+        return np.bincount(self.equation, terms, minlength=self.size)
+
+    def jacobian(self, x: np.ndarray) -> sparse.csr_array:
+        """``∂f/∂x`` at ``x`` (velocities zero), sparse: one entry per term and factor."""
+        z = np.concatenate([x, np.zeros(self.size), [1.0]])
+        rows, cols, vals = [], [], []
+        for k in range(self.factors.shape[1]):
+            column = self.factors[:, k]
+            rest = np.delete(self.factors, k, axis=1)
+            keep = (column >= 0) & (column < self.size)
+            rows.append(self.equation[keep])
+            cols.append(column[keep])
+            vals.append((self.coefficient * np.prod(z[rest], axis=1))[keep])
+        shape = (self.size, self.size)
+        if not rows:
+            return sparse.csr_array(shape)
+        return sparse.csr_array((np.concatenate(vals), (np.concatenate(rows),
+                                                        np.concatenate(cols))), shape=shape)
+
+
+@dataclass(frozen=True)
+class Matrices:
+    """``M x'' + C x' + K x + f(x, x') = F cos ωt`` as written, in floating point: ``M``,
+    ``C``, ``K`` sparse (CSR; ``C`` ``None`` without linear damping), ``f`` a
+    :class:`Polynomial` (degree ≥ 2), ``F`` (``None``: not driven)."""
+
+    mass: sparse.csr_array
+    stiffness: sparse.csr_array
+    force: Polynomial
+    damping: sparse.csr_array | None = None
+    drive: np.ndarray | None = None
+
+    @property
+    def size(self) -> int:
+        """The number of coordinates."""
+        return self.mass.shape[0]
+
+    def frequencies(self, count: int) -> np.ndarray:
+        """The ``count`` lowest linear frequencies ω₀ (``K φ = ω₀² M φ``), ascending:
+        dense (every mode) up to :data:`DENSE_MODES` coordinates, else shift-invert Lanczos
+        about 0; refused where a mode is not an oscillation (ω₀² ≤ 0)."""
+        n = self.size
+        if not 1 <= count <= n:
+            raise InputError(f"{count} modes: the model has {n} coordinates")
+        if n <= DENSE_MODES or count >= n - 1:
+            from scipy.linalg import eigh
+
+            lam = eigh(self.stiffness.toarray(), self.mass.toarray(), eigvals_only=True)
+        else:
+            from scipy.sparse.linalg import eigsh
+
+            lam = eigsh(self.stiffness.tocsc(), count, self.mass.tocsc(), sigma=0,
+                        which="LM", return_eigenvectors=False)
+        lam = np.sort(lam)[:count]
+        if not lam[0] > 0:
+            raise InputError(f"the lowest linear mode has ω0² = {lam[0]:.6g}: no oscillation "
+                             "about the origin (every ω0² must be > 0)")
+        return np.sqrt(lam)
+
+
 @dataclass(frozen=True)
 class System:
     """``M x'' + K x + f(x, x') = 0``: coordinates in the order of the equations, the mass
@@ -38,12 +134,51 @@ class System:
     text: str
     coordinates: tuple[sp.Symbol, ...]
     velocities: tuple[sp.Symbol, ...]
-    mass: sp.Matrix  # M: constant, symmetric positive definite
-    stiffness: sp.Matrix  # M⁻¹K
+    mass: sp.Matrix | None  # M: constant, symmetric positive definite (None: no exact form)
+    stiffness: sp.Matrix | None  # M⁻¹K
     force: tuple[sp.Expr, ...]  # M⁻¹ f(x, x'), degree ≥ 2
     damping: sp.Matrix | None = None  # M⁻¹C (None: no linear velocity term)
     drive: tuple[sp.Rational, ...] = ()  # M⁻¹F: the amplitude of cos(ωt) in each equation
     frequency: sp.Symbol | None = None  # ω's name in the drive
+    written: Matrices | None = field(default=None, compare=False)
+    # the floating-point form where it was read so (read_model: then mass, stiffness and
+    # force are None, no exact form); else made from the exact one on first use
+
+    @property
+    def exact(self) -> bool:
+        """Whether the system has its exact form (a text): the ground of exact modes."""
+        return self.stiffness is not None
+
+    @cached_property
+    def matrices(self) -> Matrices:
+        """The system as written in floating point, sparse: ``M``, ``C = M·(M⁻¹C)``,
+        ``K = M·(M⁻¹K)``, ``f = M·(M⁻¹f)`` as a table of terms, ``F``."""
+        if self.written is not None:
+            return self.written
+        M = self.mass
+        n = self.size
+
+        def csr(A: sp.Matrix) -> sparse.csr_array:
+            return sparse.csr_array(np.array(A, dtype=float).reshape(n, n))
+
+        state = (*self.coordinates, *self.velocities)
+        rows, factors, coefficients = [], [], []
+        for i, f in enumerate(M * sp.Matrix(self.force)):
+            f = sp.expand(f)
+            if f == 0:
+                continue
+            for powers, c in sp.Poly(f, *state).terms():
+                rows.append(i)
+                factors.append([k for k, p in enumerate(powers) for _ in range(p)])
+                coefficients.append(float(c))
+        width = max((len(f) for f in factors), default=0)
+        table = Polynomial(n, np.array(rows, dtype=np.int64),
+                           np.array([f + [-1] * (width - len(f)) for f in factors],
+                                    dtype=np.int64).reshape(len(rows), width),
+                           np.array(coefficients, dtype=float))
+        return Matrices(csr(M), csr(M * self.stiffness), table,
+                        None if self.damping is None else csr(M * self.damping),
+                        np.array(self.written_drive, dtype=float) if self.drive else None)
 
     @property
     def size(self) -> int:
@@ -59,6 +194,10 @@ class System:
     def conservative(self) -> bool:
         """No velocity in any force and no drive (time-reversible: the cosine ansatz of
         ``nnm`` holds)."""
+        if not self.exact:
+            w = self.matrices
+            return (w.damping is None and w.drive is None
+                    and not np.any(w.force.factors >= self.size))
         return (self.damping is None and not self.drive
                 and not any(f.has(*self.velocities) for f in self.force))
 
@@ -117,6 +256,10 @@ class System:
 
     @cached_property
     def _modes(self) -> tuple[sp.Expr, ...]:
+        if not self.exact:
+            raise InputError(f"{self.text}: a model read in floating point has no exact "
+                             "linear modes (they are sought for a system written as text); "
+                             "its frequencies are System.matrices.frequencies(k)")
         if self.size > MAX_COORDINATES:
             raise InputError(f"system {self.text!r}: {self.size} coordinates; exact linear modes "
                              "(the roots of a characteristic polynomial of degree n) are "
@@ -369,3 +512,120 @@ def _mass_matrix(text: str, coordinates: list[str], M: sp.Matrix) -> sp.Matrix:
         raise InputError(f"system {text!r}: the mass matrix {shown} is not positive definite "
                          "(a kinetic energy ½ x'ᵀ M x' must be positive)")
     return M
+
+
+MODEL_FILES = ("M.mtx", "K.mtx", "C.mtx", "nonlinear.txt", "drive.txt")
+# NOTE: a model folder, as a finite-element code writes it: M, K and optional C in Matrix
+# Market (scipy.io.mmwrite), the nonlinear terms and the optional drive as text, 0-based.
+SYMMETRY = 1e-12
+# NOTE: M and K are symmetric to this fraction of their largest entry (an assembled matrix
+# written with 16 digits is symmetric to rounding).
+
+
+def read_model(folder: str | Path) -> System:
+    """The :class:`System` ``M x'' + C x' + K x + f(x) = F cos ωt`` of a model folder (its
+    floating-point form only): ``M.mtx``, ``K.mtx`` and optional ``C.mtx`` in Matrix Market,
+    ``nonlinear.txt`` (a term a line, 0-based: ``i j k c`` adds ``c·x_j·x_k`` to ``f_i``,
+    ``i j k l c`` adds ``c·x_j·x_k·x_l``; ``#`` starts a comment; repeated terms add up) and
+    optional ``drive.txt`` (``i F_i``).  Refused in one line naming the file: a missing or
+    unreadable one, shapes that differ, ``M`` or ``K`` not symmetric, a mass not positive on
+    its diagonal, an index out of range, a number that is not finite."""
+    from scipy.io import mmread
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise InputError(f"--model {folder}: no such folder")
+
+    def matrix(name: str, needed: bool) -> sparse.csr_array | None:
+        path = folder / name
+        if not path.is_file():
+            if needed:
+                raise InputError(f"--model {folder}: {name} is missing (the folder holds "
+                                 f"{', '.join(MODEL_FILES[:2])}, optionally "
+                                 f"{', '.join(MODEL_FILES[2:])})")
+            return None
+        try:
+            A = sparse.csr_array(mmread(path))
+        except (ValueError, OSError) as exc:
+            raise InputError(f"--model {folder}: {name}: not a Matrix Market matrix "
+                             f"({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})"
+                             ) from None
+        if A.shape[0] != A.shape[1] or A.shape[0] == 0:
+            raise InputError(f"--model {folder}: {name} is {A.shape[0]}×{A.shape[1]}; a "
+                             "square matrix, one row per coordinate")
+        if not np.all(np.isfinite(A.data)):
+            raise InputError(f"--model {folder}: {name} holds a number that is not finite")
+        return A
+
+    M, K, C = matrix("M.mtx", True), matrix("K.mtx", True), matrix("C.mtx", False)
+    n = M.shape[0]
+    for name, A in (("K.mtx", K), ("C.mtx", C)):
+        if A is not None and A.shape[0] != n:
+            raise InputError(f"--model {folder}: {name} is {A.shape[0]}×{A.shape[0]} and M.mtx "
+                             f"{n}×{n}: one size for every matrix")
+    for name, A in (("M.mtx", M), ("K.mtx", K)):
+        scale = float(abs(A).max()) if A.nnz else 0.0
+        if A.nnz and float(abs(A - A.T).max()) > SYMMETRY * scale:
+            raise InputError(f"--model {folder}: {name} is not symmetric")
+    diagonal = M.diagonal()
+    if not np.all(diagonal > 0):
+        k = int(np.argmin(diagonal > 0))
+        raise InputError(f"--model {folder}: M.mtx: M[{k},{k}] = {diagonal[k]:g}; a mass "
+                         "matrix is positive on its diagonal")
+    force = _terms(folder / "nonlinear.txt", n)
+    drive = _drive(folder / "drive.txt", n)
+    names = sp.symbols(f"x0:{n}")
+    velocities = tuple(sp.Symbol(f"{x}_") for x in names)
+    return System(f"model {folder}", tuple(names), velocities, None, None, (),
+                  written=Matrices(M, K, force, C, drive))
+
+
+def _numbers(path: Path, n: int, widths: tuple[int, ...]) -> list[tuple[int, list[float]]]:
+    """The lines of ``path`` (comments and blank lines skipped) as ``(line, numbers)``, each
+    with one of ``widths`` fields, the leading ones indices in ``0 … n − 1``."""
+    try:
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"--model {path.parent}: {path.name}: {exc}") from None
+    out = []
+    for number, line in enumerate(text.splitlines(), 1):
+        fields = line.split("#")[0].split()
+        if not fields:
+            continue
+        where = f"--model {path.parent}: {path.name} line {number}"
+        if len(fields) not in widths:
+            raise InputError(f"{where}: {len(fields)} fields; "
+                             + " or ".join(str(w) for w in widths) + " expected")
+        try:
+            indices = [int(f) for f in fields[:-1]]
+            value = float(fields[-1])
+        except ValueError:
+            raise InputError(f"{where}: {line.strip()!r} is not indices and a number") from None
+        if not math.isfinite(value):
+            raise InputError(f"{where}: the coefficient {fields[-1]} is not finite")
+        bad = [i for i in indices if not 0 <= i < n]
+        if bad:
+            raise InputError(f"{where}: index {bad[0]} outside 0..{n - 1}")
+        out.append((number, [*indices, value]))
+    return out
+
+
+def _terms(path: Path, n: int) -> Polynomial:
+    """``nonlinear.txt``'s terms (none where the file is absent: a linear model)."""
+    rows = _numbers(path, n, (4, 5)) if path.is_file() else []
+    width = max((len(r) - 2 for _, r in rows), default=0)
+    return Polynomial(
+        n, np.array([int(r[0]) for _, r in rows], dtype=np.int64),
+        np.array([[int(i) for i in r[1:-1]] + [-1] * (width + 1 - (len(r) - 1))
+                  for _, r in rows], dtype=np.int64).reshape(len(rows), width),
+        np.array([r[-1] for _, r in rows], dtype=float))
+
+
+def _drive(path: Path, n: int) -> np.ndarray | None:
+    """``drive.txt``'s amplitudes ``F_i`` (``None`` where the file is absent)."""
+    if not path.is_file():
+        return None
+    F = np.zeros(n)
+    for _, (i, value) in _numbers(path, n, (2,)):
+        F[int(i)] += value
+    return F
