@@ -17,7 +17,8 @@ from lindstedt.analysis.driven import (
     harmonic_balance,
     mu_expansion,
 )
-from lindstedt.analysis.response import continue_equation, one_harmonic_curve
+from lindstedt.analysis.response import one_harmonic_curve
+from lindstedt.analysis.systems import continue_balance
 from lindstedt.compiler import generate_balance
 from lindstedt.emit.render import load_generated
 from lindstedt.numerics.integrate import sweep
@@ -50,7 +51,7 @@ def main() -> None:
         ("one-harmonic curve, all branches + stability, 1e5 w",
          best(lambda: one_harmonic_curve(0.1, 0.3, 20.0, np.linspace(0.5, 2, 100_000))), 0.1),
         ("harmonic balance continuation N = 8, both folds",
-         best(lambda: continue_equation(Drive(0.1, 0.3, 0.6, 20.0).equation, 8, 0.6, 1.9), 1), 1.0),
+         best(lambda: continue_balance(Drive(0.1, 0.3, 0.6, 20.0).equation, 8, 0.6, 1.9), 1), 1.0),
         ("sweep simulation, 1e4 periods (compiled)",
          best(lambda: sweep(0.1, 0.3, 0.05, 0.6, 1.9)), 2.0),
         ("shooting + Floquet, one orbit",

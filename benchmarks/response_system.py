@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 from lindstedt.analysis.polynomial import PolynomialBalance
-from lindstedt.analysis.systems import SystemBalance, system_response
+from lindstedt.analysis.systems import SystemBalance, driven_problem, response
 from lindstedt.derive.system import parse_system
 from lindstedt.numerics.floquet import variational_multipliers
 from lindstedt.numerics.integrate import PolynomialField
@@ -90,7 +90,7 @@ def main() -> None:
 
     for N in (4, 8):
         start = time.perf_counter()
-        r = system_response(SYSTEM, VALUES, N)
+        r = response(driven_problem(SYSTEM, VALUES), N)
         inproc = time.perf_counter() - start
         worst = max(c.error for c in r.checks)
         print(f"response SYSTEM, N = {N}: {len(r.cont.omega)} points, folds "

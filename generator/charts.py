@@ -18,11 +18,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .analysis.continuation import CONTINUATION_SECONDS
 from .analysis.curves import subharmonic_curve
 from .analysis.driven import Drive
 from .analysis.mixing import duffing_mixing, tone_label
-from .analysis.response import ResponseReport, one_harmonic_curve
+from .analysis.response import one_harmonic_curve
+from .analysis.systems import Response, notes_problem, response
 from .choose import (
     DRIVEN_QUANTITIES,
     DrivenTradeoff,
@@ -179,18 +179,18 @@ def _settled(sweep: object, folds: Sequence[float]) -> np.ndarray:
     return ok
 
 
-def _response_panel(ax: plt.Axes, r: ResponseReport, title: str) -> None:
+def _response_panel(ax: plt.Axes, r: Response, title: str) -> None:
     """The continued N-harmonic balance (its first-harmonic amplitude r, each piece), the
     simulated sweeps up and down (max |q| of each settled drive period, the rest marked as
-    transient by :func:`_settled`) and the balance's folds of a
-    :class:`analysis.response.ResponseReport`, against ω/ω₀."""
-    w0 = r.er.linear_frequency
+    transient by :func:`_settled`) and the balance's folds of one equation's
+    :class:`analysis.systems.Response`, against ω/ω₀."""
+    w0 = r.linear_frequencies[0]
     amp = np.array([_first(r.fine, x) for x in r.cont.x])
     for k, piece in enumerate(r.cont.piece_slices()):  # a softening spring's: two pieces
         ax.plot(r.cont.omega[piece] / w0, amp[piece], "k-", lw=0.7,
                 label=f"harmonic balance N = {r.fine.harmonics} (r)" if k == 0 else None)
     transient = []
-    for s, color, way in ((r.up, "C3", "up"), (r.down, "C2", "down")):
+    for s, color, way in zip(r.sweeps, ("C3", "C2"), ("up", "down"), strict=True):
         ok = _settled(s, r.cont.folds)
         ax.plot(s.omega[ok] / w0, s.amplitude[ok], ".", color=color, ms=1.5,
                 label=f"simulated sweep {way} (max |q|)")
@@ -205,19 +205,15 @@ def _response_panel(ax: plt.Axes, r: ResponseReport, title: str) -> None:
     ax.legend(fontsize=7, loc="upper left", markerscale=4)
 
 
-def response_figure(eps: float, force: float, Q: float, harmonics: int, path: Path,
-                    max_seconds: float = CONTINUATION_SECONDS, report=None) -> Path:
-    """Response r(ω) of eq. 10.60 (:func:`analysis.response.duffing_response`, or ``report``
-    when computed): the cubic's one-harmonic branches (stable solid, unstable dashed) beside
-    :func:`_response_panel`; the linear curves of Fig. 1 (``max_seconds``: the cost limit)."""
-    from .analysis.response import duffing_response
-
+def response_figure(report: Response, path: Path) -> Path:
+    """Response r(ω) of eq. 10.60 (its :class:`analysis.systems.Response`): the cubic's
+    one-harmonic branches (stable solid, unstable dashed) beside :func:`_response_panel`; the
+    linear curves of Fig. 1."""
     check_plot_path(path)
-    if report is None:
-        report = duffing_response(eps, force, Q, harmonics, max_seconds)
-    lo, hi = report.er.omega_range
+    notes = dict(report.notes)
+    lo, hi = report.omega_range
     omega = np.linspace(lo, hi, 2000)
-    curve = one_harmonic_curve(eps, force, Q, omega)
+    curve = one_harmonic_curve(notes["eps"], notes["force"], notes["Q"], omega)
     fig, (ax, lin) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [3, 2]})
     count = np.isfinite(curve.r).sum(axis=1)
     jumps = np.concatenate([[False], count[1:] != count[:-1]])  # branches appear/vanish here
@@ -242,27 +238,20 @@ def response_figure(eps: float, force: float, Q: float, harmonics: int, path: Pa
     return _save(fig, path)
 
 
-def response_equation_figure(text: str, values: dict[str, str], harmonics: int, path: Path,
-                             name: str = "oscillator", omega_min: float | None = None,
-                             omega_max: float | None = None,
-                             max_seconds: float = CONTINUATION_SECONDS, report=None) -> Path:
-    """Response r(ω) of a user's damped driven oscillator
-    (:func:`analysis.response.equation_response`, or ``report`` when computed): the
-    one-harmonic amplitudes beside :func:`_response_panel`."""
-    from .analysis.response import equation_response
-
+def response_equation_figure(report: Response, path: Path, text: str) -> Path:
+    """Response r(ω) of a user's damped driven oscillator (its
+    :class:`analysis.systems.Response`): the one-harmonic amplitudes beside
+    :func:`_response_panel`."""
     check_plot_path(path)
-    if report is None:
-        report = equation_response(text, values, harmonics, name, omega_min, omega_max,
-                                   max_seconds)
-    lo, hi = report.er.omega_range
+    lo, hi = report.omega_range
+    w0 = report.linear_frequencies[0]
     fig, ax = plt.subplots(figsize=(8, 4.2))
     omega = np.linspace(lo, hi, 600)
-    one = [(w / report.er.linear_frequency, r) for w in omega
-           for r in report.er.one_harmonic.amplitudes(float(w))]
+    one = [(w / w0, r) for w in omega
+           for r in report.balance.one_harmonic.amplitudes(float(w))]
     if one:
         ax.plot(*np.array(one).T, "C0.", ms=1.5, label="one harmonic (r)")
-    _response_panel(ax, report, f"{text}  (ω₀ = {_value(report.er.linear_frequency)})")
+    _response_panel(ax, report, f"{text}  (ω₀ = {_value(w0)})")
     fig.tight_layout()
     return _save(fig, path)
 
@@ -379,8 +368,14 @@ def mixing_figure(m: object, path: Path, label: str) -> Path:
     return _save(fig, path)
 
 
+def _notes_response(eps: float, force: float, Q: float, harmonics: int) -> Response:
+    """The response of eq. 10.60 the gallery draws (:func:`analysis.systems.response`)."""
+    de, closed = notes_problem(eps, force, Q)
+    return response(de, harmonics, closed=closed)
+
+
 GALLERY = (
-    ("response.png", lambda path: response_figure(0.1, 0.3, 20.0, 8, path)),
+    ("response.png", lambda path: response_figure(_notes_response(0.1, 0.3, 20.0, 8), path)),
     ("subharmonic.png", lambda path: subharmonic_figure(subharmonic_curve(0.1, 0.5), path)),
     ("mixing.png", lambda path: mixing_figure(duffing_mixing(0.1, 10.0, [(0.3, 1.3), (0.3, 1.7)]),
                                               path, "ε = 0.1, Q = 10.0")),

@@ -112,8 +112,8 @@ FIXED_COSTS = {
 # benchmarks/command_costs.py (measured 3.3–14.6 s under load).
 
 RESPONSE_FIXED = 6.0
-# NOTE: `lindstedt response`: start-up, the Floquet fold refinements and the two simulated sweeps
-# (compiled RK4, 10⁴ drive periods each), on top of the continuation's own estimate.
+# NOTE: `lindstedt response` before its problem is known (a flag missing: the command says
+# which): start-up; with the problem, analysis.systems.response_plan estimates the work.
 
 SWEEP_START = 15.0
 # NOTE: start-up, a LocalCluster's start and warm-up, the store (15–17 s measured for small
@@ -303,18 +303,6 @@ def driven_cost(args: argparse.Namespace) -> Cost:
                 "the μ-expansion on every branch")
 
 
-RESPONSE_EQUATION_FIXED = 10.0
-# NOTE: `lindstedt response EQUATION`, on top of its continuation's estimate: start-up with
-# SymPy's parse twice (~2.5 s), the one-harmonic folds (~0.3 s), the ends' Newton solves, each
-# fold refined on the true orbit (~0.1–0.5 s each) and the two sweeps on the table's integrator
-# (0.1–1 s each; a force of degree 7 with velocity terms 2 s), bounded from measured 3–6 s.
-RESPONSE_EQUATION_ENDS = 2 * DRIVEN_EQUATION_CONTINUATION
-# NOTE: where a balance at an end of the range does not converge from its one-harmonic root, its
-# seeds come from the continuation in the drive amplitude, which stops itself after
-# limits.MAX_DRIVE_POINTS points (12 s at most): counted only when the estimate meets an end
-# whose balance does not converge (see response_equation_cost).
-
-
 def _values(args: argparse.Namespace) -> dict[str, str]:
     """``--param NAME=VALUE`` pairs as a dict (the command checks them)."""
     values: dict[str, str] = {}
@@ -324,83 +312,34 @@ def _values(args: argparse.Namespace) -> dict[str, str]:
     return values
 
 
-def response_equation_cost(args: argparse.Namespace) -> Cost:
-    """``response EQUATION``: the equation lowered (refused in one line before anything runs),
-    its range and continuation estimated as the command will run them."""
-    from .analysis.attractors import dynamics_seconds
-    from .analysis.polynomial import PolynomialBalance
-    from .analysis.response import (
-        equation_continuation_seconds,
-        equation_point_seconds,
-        equation_range,
-        response_equation,
-    )
-
-    de = response_equation(args.model, _values(args), args.name or "oscillator")
-    er = equation_range(de.terms, de.force, args.omega_min, args.omega_max)
-    lo, hi = er.omega_range
-    points, seconds = equation_continuation_seconds(de.terms, de.force, args.harmonics, de.odd,
-                                                    lo, hi)
-    fine = PolynomialBalance(de.terms, de.force, args.harmonics, de.odd)
-    # every point's multipliers, the crossings refined and the simulations of analysis.attractors
-    seconds += dynamics_seconds(points, fine.size, 1, lo, hi, er.linear_frequency,
-                                equation_point_seconds(fine.size))
-    ends = 0.0
-    for w in (lo, hi):
-        for r in er.one_harmonic.amplitudes(w):
-            x = fine.vector({1: r * math.cos(er.one_harmonic.phase(r, w))},
-                            {1: r * math.sin(er.one_harmonic.phase(r, w))})
-            if not fine.solve(x, w)[1]:
-                ends += RESPONSE_EQUATION_ENDS / 2
-                break
-    return Cost(RESPONSE_EQUATION_FIXED + ends + seconds, f"--harmonics {args.harmonics}",
-                "continuation, fold refinement, Floquet multipliers, bifurcations and simulations "
-                "of the equation")
-
-
 def _count(points: float) -> str:
     """A count a person reads: whole below a million, else two digits and an exponent."""
     return f"{points:.0f}" if points < 1e6 else f"{points:.2g}"
 
 
-def response_system_cost(args: argparse.Namespace) -> Cost:
-    """``response SYSTEM``: the planned continuation, drive continuations and shots."""
-    from .analysis.systems import system_plan
-
-    plan = system_plan(args.model, _values(args), args.harmonics, args.omega_min,
-                       args.omega_max)
-    given = "".join(f", --param {pair}" for pair in args.param or ())
-    return Cost(plan.seconds, f"--harmonics {args.harmonics}{given}",
-                f"the continuation of about {_count(plan.points)} points, {plan.drives} drive "
-                f"continuations (at most {plan.drive_points} points each) and the shots "
-                "of the system")
-
-
 def response_cost(args: argparse.Namespace) -> Cost:
-    """``response``: for an EQUATION :func:`response_equation_cost`; else the fixed part and
-    the continuation over the response's ω range at ``--harmonics`` (the fixed part
-    alone when ε, f or Q is missing: the command says so)."""
-    from .analysis.driven import Drive
-    from .analysis.response import equation_continuation_seconds, response_range
+    """``response`` (eq. 10.60 by its flags, an EQUATION or a SYSTEM): the problem lowered
+    (refused in one line before anything runs) and its :func:`analysis.systems.response_plan`:
+    the continuation, the drive continuations, the Floquet multipliers and the rest, as the
+    command will run them (the fixed part alone when ε, f or Q is missing: the command says
+    so)."""
+    from .analysis.systems import driven_problem, notes_problem, response_plan
 
+    closed = None
     if getattr(args, "model", None) is not None:
-        return response_equation_cost(args)
-    if any(getattr(args, k, None) is None for k in ("eps", "force", "Q")):
+        problem = driven_problem(args.model, _values(args), args.name or "oscillator")
+    elif any(getattr(args, k, None) is None for k in ("eps", "force", "Q")):
         return Cost(RESPONSE_FIXED, "response", "response")  # the command says what is missing
-    from .analysis.attractors import dynamics_seconds
-    from .analysis.response import equation_point_seconds
-
-    lo, hi = response_range(args.eps, args.force, args.Q, getattr(args, "omega_min", None),
-                            getattr(args, "omega_max", None))
-    d = Drive(args.eps, args.force, lo, args.Q)
-    seconds = equation_continuation_seconds(d.terms, args.force, args.harmonics, True, lo, hi,
-                                            where=d.equation.where)[1]
-    # eq. 10.60's balance: odd harmonics, 2N unknowns; ω0 = 1
-    point = equation_point_seconds(2 * args.harmonics)
-    return Cost(RESPONSE_FIXED + seconds + dynamics_seconds(seconds / point, 2 * args.harmonics,
-                                                            1, lo, hi, 1.0, point),
-                f"--harmonics {args.harmonics}",
-                "continuation, simulated sweeps, Floquet multipliers and simulations")
+    else:
+        problem, closed = notes_problem(args.eps, args.force, args.Q)
+    plan = response_plan(problem, args.harmonics, getattr(args, "omega_min", None),
+                         getattr(args, "omega_max", None), closed, ends=True)
+    given = "".join(f", --param {pair}" for pair in args.param or ())
+    drives = (f", {plan.drives} drive continuations (at most {plan.drive_points} points "
+              "each)" if plan.drives else "")
+    return Cost(plan.seconds, f"--harmonics {args.harmonics}{given}",
+                f"the continuation of about {_count(plan.points)} points{drives}, Floquet "
+                "multipliers, bifurcations, simulations and checks")
 
 
 def sweep_cost(args: argparse.Namespace) -> Cost:
@@ -597,7 +536,7 @@ COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
 }
 ROUTE_COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "generate normal mode": generate_mode_cost,
-    "response system": response_system_cost,
+    "response system": response_cost,
     "slowflow resonant flow": resonant_flow_cost,
 }
 # NOTE: the estimators of a command's other methods (cli.COMMANDS' routes), by command and

@@ -42,9 +42,9 @@ def _shot_multipliers(w: float, f: float, guess: np.ndarray) -> np.ndarray:
 
 
 def test_period_doubling_of_the_quadratic_oscillator_is_dop853s_multiplier_minus_one():
-    from lindstedt.analysis.response import equation_response
+    from lindstedt.analysis.systems import driven_problem, response
 
-    r = equation_response(QUADRATIC, {"f": "3/10"}, 6, omega_min=1.8, omega_max=2.2)
+    r = response(driven_problem(QUADRATIC, {"f": "3/10"}), 6, omega_min=1.8, omega_max=2.2)
     found = [b for b in r.dynamics.bifurcations if b.kind == "period_doubling"]
     assert len(found) == 2, r.dynamics.bifurcations
     for b in found:

@@ -184,10 +184,12 @@ def test_response_figure_labels_and_settled_sweeps(tmp_path, monkeypatch):
     point drawn as data is a steady state — within 0.5 % of the max |q| of an orbit of the
     continued harmonic balance at its ω (interpolated along each monotone stretch of the
     curve) — while the start-up and jump transients are drawn apart as "not settled"."""
-    from lindstedt.analysis.response import duffing_response
+    from lindstedt.analysis.systems import notes_problem, response
 
+    de, closed = notes_problem(0.1, 0.3, 20.0)
+    r = response(de, 8, closed=closed)
     drawn = _drawn(monkeypatch)
-    charts.response_figure(0.1, 0.3, 20.0, 8, tmp_path / "r.png")
+    charts.response_figure(r, tmp_path / "r.png")
     (fig,) = drawn
     ax = fig.axes[0]
     assert "ω/ω₀" in ax.get_xlabel() and "r" in ax.get_ylabel() and "max |q|" in ax.get_ylabel()
@@ -195,7 +197,6 @@ def test_response_figure_labels_and_settled_sweeps(tmp_path, monkeypatch):
     assert "fold of the balance" in labels and "sweep not settled (transient)" in labels
     assert "f = 0.3" in ax.get_title() and "Q = 20" in ax.get_title()
     _digits_ok(_texts(fig))
-    r = duffing_response(0.1, 0.3, 20.0, 8)
     t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
     stretches = []
     for piece in r.cont.piece_slices():

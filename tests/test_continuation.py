@@ -20,7 +20,8 @@ from lindstedt.analysis.continuation import (
 )
 from lindstedt.analysis.driven import Drive
 from lindstedt.analysis.polynomial import PolynomialBalance
-from lindstedt.analysis.response import continue_equation, one_harmonic_folds
+from lindstedt.analysis.response import one_harmonic_folds
+from lindstedt.analysis.systems import continue_balance
 
 EPS, F, Q = 0.1, 0.3, 20.0
 
@@ -91,7 +92,7 @@ def test_the_undamped_duffing_curve_in_omega_is_the_closed_form():
 def test_the_damped_duffing_curve_in_omega_folds_where_the_cubic_does():
     """eq. 10.60 at one harmonic: every point on ``r²[(1 − ω² + ¾εr²)² + ω²/Q²] = f²`` and the
     folds those of the cubic's discriminant (:func:`response.one_harmonic_folds`)."""
-    cont = continue_equation(Drive(EPS, F, 0.6, Q).equation, 1, 0.6, 1.9)
+    cont = continue_balance(Drive(EPS, F, 0.6, Q).equation, 1, 0.6, 1.9)
     r2 = np.sum(cont.x**2, axis=1)
     w = cont.omega
     G = r2 * ((1 - w**2 + 0.75 * EPS * r2) ** 2 + w**2 / Q**2) - F**2

@@ -47,7 +47,7 @@ def test_every_command_but_the_demo_has_an_estimate_and_the_slow_ones_a_switch()
     # a user's equation far below its ω0: every point's multipliers take 512·2^⌈log2(ω0/ω)⌉
     # samples a period (analysis.attractors.dynamics_seconds), the continuation alone ~3 s
     (["response", "x'' + 0.05*x' + x + x**2 = f*cos(w*t)", "--param", "f=3/10", "--omega",
-      "0.005:2.2"], "--harmonics 8: about"),
+      "0.005:2.2"], "--harmonics 8, --param f=3/10: about"),
     (["sweep", "stability", "--omega", "0.5:1.5:40000", "--force", "0.3", "--eps", "0.1",
       "--Q", "20", "--out", "map.zarr"], "a grid of 40,000 points: about"),
     (["generate", "q'' + q + eps*(alpha*q**2 + q**3) = 0", "--order", "100", "--out", "gen"],

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from lindstedt.analysis.driven import Drive, amplitude_residual, amplitude_slope
 from lindstedt.analysis.response import (
-    continue_equation,
     one_harmonic_curve,
     one_harmonic_folds,
 )
+from lindstedt.analysis.systems import continue_balance
 from lindstedt.numerics.integrate import duffing_table, sweep
 from lindstedt.numerics.shooting import orbit_fold, shoot
 
@@ -53,7 +53,7 @@ def test_folds_are_double_roots_and_change_the_branch_count():
 
 
 def test_balance_folds_are_true_folds_with_floquet_multiplier_one():
-    cont = continue_equation(Drive(EPS, F, 0.6, Q).equation, 8, 0.6, 1.9)
+    cont = continue_balance(Drive(EPS, F, 0.6, Q).equation, 8, 0.6, 1.9)
     assert len(cont.folds) == 2
     for w in cont.folds:
         x = cont.x[int(np.argmin(np.abs(cont.omega - w)))]
@@ -80,7 +80,7 @@ def test_sweep_jumps_near_the_folds():
     the lower fold: each jump just beyond that fold, the amplitude on either side on the branch
     the cubic (numpy.roots) says it is on."""
     lo, hi = one_harmonic_folds(EPS, F, Q)
-    cont = continue_equation(Drive(EPS, F, 0.6, Q).equation, 8, 0.6, 1.9)
+    cont = continue_balance(Drive(EPS, F, 0.6, Q).equation, 8, 0.6, 1.9)
     up = sweep(EPS, F, 1 / Q, 0.6, 1.9)
     down = sweep(EPS, F, 1 / Q, 1.9, 0.6)
     resolution = 0.01  # Δω of the jump window at 10⁴ periods, and the slow-passage lag
@@ -226,7 +226,7 @@ def test_continuation_refuses_what_it_cannot_finish(eps, force, Q, harmonics, ne
     from lindstedt.errors import InputError
 
     with pytest.raises(InputError, match=needle):
-        continue_equation(Drive(eps, force, 0.5, Q).equation, harmonics, 0.5, 2.0)
+        continue_balance(Drive(eps, force, 0.5, Q).equation, harmonics, 0.5, 2.0)
 
 
 def test_mixing_bounds_and_escapes():

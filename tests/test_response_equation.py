@@ -16,8 +16,8 @@ import time
 import numpy as np
 import pytest
 from lindstedt.analysis.mixing import duffing_mixing, equation_mixing
-from lindstedt.analysis.response import duffing_response, equation_response
 from lindstedt.analysis.subharmonic import subharmonic
+from lindstedt.analysis.systems import driven_problem, notes_problem, response
 from lindstedt.cli import main
 from lindstedt.cli.driven import (
     mixing_equation_json,
@@ -37,13 +37,15 @@ FOLD_AGREE = 1e-7
 
 def response_equation_json(text: str, values: dict[str, str], harmonics: int) -> dict:
     """``response EQUATION --json``'s contract: the record computed, then printed."""
-    return response_report_json(equation_response(text, values, harmonics,
-                                                  max_seconds=COST_LIMIT_SECONDS))
+    return response_report_json(response(driven_problem(text, values), harmonics,
+                                         max_seconds=COST_LIMIT_SECONDS))
 
 
 def response_json(eps: float, force: float, Q: float, harmonics: int) -> dict:
     """``response --eps --force --Q --json``'s contract: the record computed, then printed."""
-    return response_report_json(duffing_response(eps, force, Q, harmonics, COST_LIMIT_SECONDS))
+    de, closed = notes_problem(eps, force, Q)
+    return response_report_json(response(de, harmonics, max_seconds=COST_LIMIT_SECONDS,
+                                         closed=closed))
 
 
 def asymmetric(q, p):
@@ -135,10 +137,10 @@ def test_folds_of_an_asymmetric_spring_against_the_reference():
 def _fold_state(data, w):
     """The balance's state at the fold ``w`` (the package's seed for its own refinement)."""
     from lindstedt.analysis.polynomial import PolynomialBalance, driven_equation
-    from lindstedt.analysis.response import continue_equation
+    from lindstedt.analysis.systems import continue_balance
 
     de = driven_equation(ASYMMETRIC, {}, 1.0)
-    cont = continue_equation(de, 8, *data["parameters"]["omega_range"])
+    cont = continue_balance(de, 8, *data["parameters"]["omega_range"])
     x = cont.x[int(np.argmin(np.abs(cont.omega - w)))]
     return PolynomialBalance(de.terms, de.force, 8, de.odd).state(x, w)
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from commands import run
 from lindstedt.analysis.polynomial import PolynomialBalance
-from lindstedt.analysis.systems import system_response
+from lindstedt.analysis.systems import driven_problem, response
 from lindstedt.derive.system import parse_system
 from scipy.integrate import solve_ivp
 
@@ -25,7 +25,7 @@ QUADRATIC = ("x1'' + 0.05*x1' + 1.5*x1 - 0.5*x2 + 0.3*x1**2 + x1**3 = f*cos(w*t)
 
 @pytest.fixture(scope="module")
 def kerschen():
-    return system_response(KERSCHEN, {"f": "3/10"}, harmonics=6)
+    return response(driven_problem(KERSCHEN, {"f": "3/10"}), 6)
 
 
 def _at(r, piece, omega):
@@ -56,7 +56,7 @@ def _simulated(text, values, omega, start, periods):
 
 
 def test_linear_system_matches_complex_amplitudes_and_multipliers_exactly():
-    r = system_response(LINEAR, {"f": "1/10"}, harmonics=2)
+    r = response(driven_problem(LINEAR, {"f": "1/10"}), 2)
     K = np.array([[2.0, -1.0], [-1.0, 2.0]])
     F = np.array([0.1, 0.0])
     exact = np.array([np.abs(np.linalg.solve(K - w**2 * np.eye(2) + 0.1j * w * np.eye(2), F))
@@ -221,7 +221,7 @@ ISOLA_VALUES = {"c": "1/50", "a": "1/2", "b": "1", "W2": "10", "f": "17/1000"}
 
 
 def test_an_isola_between_the_probes_is_found_and_is_a_true_attractor():
-    r = system_response(ISOLA, ISOLA_VALUES, harmonics=6)
+    r = response(driven_problem(ISOLA, ISOLA_VALUES), 6)
     assert r.closed.count(True) == 1
     k = r.closed.index(True)
     piece = r.cont.piece_slices()[k]
@@ -246,14 +246,14 @@ def _searched() -> str:
     backbones reach at half the lowest ω0 of a 2-DOF system (where the drive curve winds
     through superharmonic resonances) and a one-coordinate equation's curve traced
     in ω through its folds."""
-    from lindstedt.analysis.response import continue_equation, response_equation
-    from lindstedt.analysis.systems import SystemBalance, driven_system
+    from lindstedt.analysis.response import response_equation
+    from lindstedt.analysis.systems import SystemBalance, continue_balance, driven_system
 
     sb = SystemBalance.of(driven_system(QUADRATIC, {"f": "2/5"}), 3)
     found, complete, note = sb.solutions(0.5 * sb.linear_frequencies[0])
     seeds = [[x.tolist() for x in found], complete, note]
     de = response_equation("q'' + 0.1*q' + q + 0.3*q**2 + q**3 = 0.3*cos(w*t)", {}, "q")
-    c = continue_equation(de, 3, 0.5, 2.0)
+    c = continue_balance(de, 3, 0.5, 2.0)
     return json.dumps({"seeds": seeds, "omega": c.omega.tolist(), "x": c.x.tolist(),
                        "folds": c.folds, "pieces": c.pieces})
 
@@ -290,15 +290,15 @@ def test_a_strong_drive_is_refused_before_the_continuation(monkeypatch, capsys):
 
     from lindstedt.analysis import systems
     from lindstedt.cli import main
-    from lindstedt.costs import response_system_cost
+    from lindstedt.costs import response_cost
     from lindstedt.limits import COST_LIMIT_SECONDS
 
     def forbidden(*args, **kwargs):
         raise AssertionError("the response ran before its estimate refused it")
-    monkeypatch.setattr(systems, "system_response", forbidden)
+    monkeypatch.setattr(systems, "response", forbidden)
     assert main(["response", KERSCHEN, "--param", "f=1000", "--harmonics", "2"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "--param f=1000" in err and "--allow-slow" in err
     args = argparse.Namespace(model=KERSCHEN, param=["f=1/20"], harmonics=3, omega_min=None,
-                              omega_max=None)
-    assert response_system_cost(args).seconds < COST_LIMIT_SECONDS
+                              omega_max=None, name=None)
+    assert response_cost(args).seconds < COST_LIMIT_SECONDS

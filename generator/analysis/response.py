@@ -1,9 +1,11 @@
-"""Frequency response of ``q̈ + q̇/Q + q + εq³ = f cos ωt``: branches, folds, hysteresis (§10.4).
+"""One equation's response curve before it is traced: the one-harmonic balance of any
+polynomial force, its amplitudes and folds, the ω range, the continuation's estimate, the
+equation lowered for a curve in ω, the seeds at one ω (§10.4).
 
-One harmonic: ``r²[(1 − ω² + ¾εr²)² + ω²/Q²] = f²`` is a cubic ``G(u) = 0`` in ``u = r²``.
-A branch is stable where ``∂G/∂u > 0`` (the slow flow of ``a, b`` has a saddle where it is
-negative, between the folds); the folds solve ``G = ∂G/∂u = 0``.  N harmonics: the balance of
-:class:`driven.BalanceSystem` continued in ω by pseudo-arclength through its folds.
+Eq. 10.60, ``q̈ + q̇/Q + q + εq³ = f cos ωt``: at one harmonic ``r²[(1 − ω² + ¾εr²)² +
+ω²/Q²] = f²`` is a cubic ``G(u) = 0`` in ``u = r²``.  A branch is stable where ``∂G/∂u > 0``
+(the slow flow of ``a, b`` has a saddle where it is negative, between the folds); the folds
+solve ``G = ∂G/∂u = 0``.  The curve traced: :func:`systems.response`.
 """
 
 from __future__ import annotations
@@ -16,25 +18,15 @@ import numpy as np
 import sympy as sp
 
 from ..errors import InputError
-from ..numerics.integrate import ForceTable, Sweep, escape_bound, sweep_table
 from ..numerics.newton import DIFFERENCE_STEP, newton, safeguarded
-from ..numerics.shooting import orbit_fold_table
-from .attractors import Dynamics, dynamics, orbit_multipliers
-from .continuation import (
-    CONTINUATION_SECONDS,
-    MAX_POINTS,
-    MAX_Q,
-    Continuation,
-    _continue,
-    drive_crossings,
-)
+from .continuation import MAX_POINTS, drive_crossings
 from .driven import (
     Drive,
     amplitude_residual,
     amplitude_slope,
     one_harmonic_roots,
 )
-from .polynomial import DrivenEquation, PolynomialBalance, check_harmonics
+from .polynomial import DrivenEquation, PolynomialBalance
 
 _u, _w, _e, _f, _g = sp.symbols("u w e f g")  # u = r², w = ω², g = 1/Q
 _G = _u * ((1 - _w + sp.Rational(3, 4) * _e * _u) ** 2 + _w * _g**2) - _f**2
@@ -317,38 +309,6 @@ def equation_continuation_seconds(terms: dict[tuple[int, int], float], force: fl
     return estimate, estimate * equation_point_seconds(unknowns)
 
 
-def continue_equation(de: DrivenEquation, harmonics: int, omega_start: float,
-                      omega_stop: float, step: float = 0.02, max_points: int = MAX_POINTS,
-                      max_seconds: float = CONTINUATION_SECONDS) -> Continuation:
-    """The balance of a :class:`driven.DrivenEquation` (its ω ignored; eq. 10.60's is
-    :attr:`driven.Drive.equation`, odd harmonics ``1, 3, …, 2N − 1``): the
-    :class:`driven.PolynomialBalance` with ``harmonics`` traced in ω through any number of
-    folds (a softening spring's curve is two pieces: the small-amplitude branch up to its fold
-    and back down the middle branch, and the resonant branch, which leaves the range at its
-    low end over the barrier),
-    starting from every balance solution at the two ends that the continuation in the drive
-    amplitude from rest reaches (:func:`continue_in_drive`, as ``driven EQUATION`` seeds),
-    the smallest at ``omega_start`` first."""
-    check_harmonics(harmonics)
-    fine = PolynomialBalance(de.terms, de.force, harmonics, de.odd)
-    lo, hi = sorted((omega_start, omega_stop))
-    where = de.where
-    damping = abs(de.terms.get((0, 1), 0.0))
-    if 0 < damping < 1 / MAX_Q:
-        raise InputError(f"{where}: the damping {damping:.0e}*q' makes the resonance "
-                         f"{damping:.0e} wide in ω, too narrow for the continuation to follow "
-                         f"in double precision; at least {1 / MAX_Q:.0e} (Q up to {MAX_Q:.0e})")
-    estimate, seconds = equation_continuation_seconds(de.terms, de.force, harmonics, de.odd,
-                                                      lo, hi, step, max_points, where)
-    if seconds > max_seconds:
-        raise InputError(f"harmonics {harmonics}: about {seconds:.0f} s of continuation "
-                         f"({estimate:.0f} points) for {where}; the limit is "
-                         f"{max_seconds:.0f} s, ask for fewer")
-    return _continue(fine, lambda: _equation_ends(de, fine, omega_start, omega_stop),
-                     omega_start, omega_stop, step, estimate, seconds,
-                     equation_point_seconds(fine.size), max_points, where)
-
-
 def equation_solutions(de: DrivenEquation, fine: PolynomialBalance, omega: float
                        ) -> tuple[list[np.ndarray], bool]:
     """Every balance solution at ``omega`` that the continuation in the drive amplitude from
@@ -371,38 +331,6 @@ def polished(coarse: PolynomialBalance, seeds: list[np.ndarray], complete: bool,
         if all(np.linalg.norm(y - xb) > 1e-6 * (1 + np.linalg.norm(xb)) for y in out):
             out.append(xb)
     out.sort(key=fine.first_harmonic)
-    return out, complete
-
-
-def _equation_ends(de: DrivenEquation, fine: PolynomialBalance, omega_start: float,
-                   omega_stop: float) -> tuple[list[tuple[float, np.ndarray, float]], bool]:
-    """:func:`_end_solutions` for a user's equation: Newton's method on the balance from every
-    one-harmonic root (:class:`OneHarmonic`) at each end; where one of them does not converge,
-    the solutions the continuation in the drive amplitude crosses there
-    (:func:`equation_solutions`)."""
-    out: list[tuple[float, np.ndarray, float]] = []
-    complete = True
-    one = OneHarmonic(dict(de.terms), de.force)
-    k1 = int(np.nonzero(fine.orders == 1)[0][0])
-    s1 = fine.n_cos + int(np.nonzero(fine.orders[fine.orders > 0] == 1)[0][0])
-    for omega, direction in ((omega_start, np.sign(omega_stop - omega_start)),
-                             (omega_stop, np.sign(omega_start - omega_stop))):
-        found: list[np.ndarray] = []
-        for r in one.amplitudes(omega):
-            x = np.zeros(fine.size)
-            phi = one.phase(r, omega)
-            x[k1], x[s1] = r * math.cos(phi), r * math.sin(phi)
-            x, converged, _ = fine.solve(x, omega)
-            if not converged:
-                found, whole = equation_solutions(de, fine, omega)
-                complete = complete and whole
-                break
-            if all(np.linalg.norm(y - x) > 1e-6 * (1 + np.linalg.norm(x)) for y in found):
-                found.append(x)
-        found.sort(key=fine.first_harmonic)
-        out.extend((omega, x, float(direction)) for x in found)
-    if not out or out[0][0] != omega_start:
-        raise np.linalg.LinAlgError(f"no balance converged at ω = {omega_start:.4g}")
     return out, complete
 
 
@@ -443,91 +371,3 @@ def response_equation(text: str, values: dict[str, str], name: str = "oscillator
                          "the velocity, e.g. q'/Q): no steady state to draw a response curve of")
     linear_frequency(de.terms)
     return de
-
-
-@dataclass(frozen=True)
-class ResponseReport:
-    """A response curve, computed once for the JSON, the table and the figure: the equation
-    (eq. 10.60 is one, :attr:`driven.Drive.equation`), its range and one-harmonic folds, the
-    continued balance, the true orbit's folds, the simulated sweeps up and down.
-
-    ``barrier``: the ``|q|`` past which a sweep has left every steady state — the potential's
-    maximum ``1/√−ε`` of a softening eq. 10.60, else :data:`ESCAPE_FACTOR` × the largest balance
-    solution on the range; ``bound`` the escape bound of the sweeps and the shooting (the
-    notes': :func:`numerics.integrate.escape_bound`); ``notes``: eq. 10.60's parameters as
-    numbers, ``()`` for a user's equation."""
-
-    de: DrivenEquation
-    er: EquationResponse
-    cont: Continuation
-    fine: PolynomialBalance
-    table: ForceTable
-    barrier: float
-    bound: float
-    up: Sweep
-    down: Sweep
-    true_folds: tuple[tuple[float, tuple[float, ...]], ...]  # (ω, sorted |Floquet multipliers|)
-    notes: tuple[tuple[str, float], ...] = ()
-    dynamics: Dynamics | None = None  # bifurcations on the branches, attractors simulated
-
-
-def response_report(de: DrivenEquation, er: EquationResponse, harmonics: int,
-                    max_seconds: float = CONTINUATION_SECONDS, barrier: float | None = None,
-                    bound: float | None = None,
-                    notes: tuple[tuple[str, float], ...] = ()) -> ResponseReport:
-    """The :class:`ResponseReport` of ``de`` over ``er``'s range: the continuation
-    (:func:`continue_equation`), each balance fold polished into the true orbit's
-    (:func:`numerics.shooting.orbit_fold_table`), the simulated sweeps both ways, escapes
-    detected past ``barrier`` (default :data:`ESCAPE_FACTOR` × the largest balance); the
-    bifurcations along the curve and the attractors off it (:func:`attractors.dynamics`)."""
-    lo, hi = er.omega_range
-    cont = continue_equation(de, harmonics, lo, hi, max_seconds=max_seconds)
-    table = ForceTable.of(de.terms)
-    if barrier is None:
-        barrier = ESCAPE_FACTOR * float(np.max(np.sum(np.abs(cont.x), axis=1)))
-    bound = barrier if bound is None else bound
-    fine = PolynomialBalance(de.terms, de.force, harmonics, de.odd)
-    true_folds = []
-    for w in cont.folds:  # the true orbit's fold near each of the balance's
-        x = cont.x[int(np.argmin(np.abs(cont.omega - w)))]
-        found = orbit_fold_table(table, de.force, w, fine.state(x, w), bound=bound)
-        if found is not None:
-            true_folds.append((found[0], tuple(sorted(float(abs(m)) for m in found[2]))))
-    lam = orbit_multipliers(fine, cont.x, cont.omega, er.linear_frequency)
-    return ResponseReport(
-        de, er, cont, fine, table, barrier, bound,
-        sweep_table(table, de.force, lo, hi, barrier=barrier, bound=bound),
-        sweep_table(table, de.force, hi, lo, barrier=barrier, bound=bound),
-        tuple(sorted(true_folds)), notes,
-        dynamics(fine, fine.field, np.array([de.force]), cont, lam, lo, hi,
-                 er.linear_frequency))
-
-
-def equation_response(text: str, values: dict[str, str], harmonics: int,
-                      name: str = "oscillator", omega_min: float | None = None,
-                      omega_max: float | None = None,
-                      max_seconds: float = CONTINUATION_SECONDS) -> ResponseReport:
-    """``response EQUATION``'s :class:`ResponseReport` over :func:`equation_range`."""
-    de = response_equation(text, values, name)
-    er = equation_range(de.terms, de.force, omega_min, omega_max)
-    return response_report(de, er, harmonics, max_seconds)
-
-
-def duffing_response(eps: float, force: float, Q: float, harmonics: int,
-                     max_seconds: float = CONTINUATION_SECONDS, omega_min: float | None = None,
-                     omega_max: float | None = None) -> ResponseReport:
-    """The :class:`ResponseReport` of eq. 10.60: its closed forms where they are the method —
-    the one-harmonic folds of the cubic (:func:`one_harmonic_folds`), the range
-    (:func:`response_range`), the well's barrier and escape bound — and the general path for
-    the rest; ``omega_min``/``omega_max`` replace the range's ends where given."""
-    d = Drive(eps, force, 1.0, Q)
-    if d.damping == 0:
-        raise InputError("Q inf: a response curve needs damping (finite Q) for a steady state")
-    folds = one_harmonic_folds(eps, force, Q)
-    lo, hi = response_range(eps, force, Q, omega_min, omega_max)
-    er = EquationResponse(OneHarmonic(d.terms, float(force)), (lo, hi),
-                          [w for w in folds if lo <= w <= hi], 1.0)
-    barrier = 1 / math.sqrt(-eps) if eps < 0 else math.inf  # the potential's maxima
-    return response_report(d.equation, er, harmonics, max_seconds, barrier,
-                           escape_bound(eps, force),
-                           (("eps", float(eps)), ("force", float(force)), ("Q", float(Q))))

@@ -310,23 +310,24 @@ def run_driven(args: argparse.Namespace) -> int:
 
 def response_report_json(r) -> dict:
     """The contract of ``lindstedt response … --json``, a pure function of a
-    :class:`analysis.response.ResponseReport`: the equation and its force table, the folds
-    three ways (one harmonic, the continued N-harmonic balance, the true orbit's with its
-    Floquet moduli), the sweeps' jumps and escapes; eq. 10.60's ``parameters`` also hold
+    :class:`analysis.systems.Response` of one equation: the equation and its force table, the
+    folds three ways (one harmonic, the continued N-harmonic balance, the true orbit's with
+    its Floquet moduli), the sweeps' jumps and escapes; eq. 10.60's ``parameters`` also hold
     ``eps``, ``force`` and ``Q`` as numbers."""
-    de, er, cont, up, down = r.de, r.er, r.cont, r.up, r.down
-    lo, hi = er.omega_range
+    de, cont = r.equation, r.cont
+    up, down = r.sweeps
+    lo, hi = r.omega_range
     true_folds = [(w, list(m)) for w, m in r.true_folds]
     return {
         "equation": de.text,
         "name": de.name,
         "parameters": {**dict(r.notes), "harmonics": r.fine.harmonics,
                        "omega_range": [lo, hi], "values": dict(de.values),
-                       "linear_frequency": er.linear_frequency,
+                       "linear_frequency": r.linear_frequencies[0],
                        "drive": {"amplitude": de.force, "frequency": de.frequency}},
         "force": [{"q": a, "dq": b, "c": c} for (a, b), c in sorted(de.terms.items())],
         "odd": de.odd,
-        "one_harmonic": {"folds": [float(w) for w in er.one_harmonic_folds]},
+        "one_harmonic": {"folds": [float(w) for w in r.one_harmonic_folds]},
         "harmonic_balance": {"harmonics": r.fine.harmonics,
                              "folds": [float(w) for w in cont.folds],
                              "complete": cont.complete, "about": "period-1 orbits"},
@@ -360,16 +361,16 @@ def _response_args(args: argparse.Namespace) -> None:
 
 def response_report(args: argparse.Namespace, limit: float):
     """The one computation of ``response`` (eq. 10.60 or an EQUATION): its
-    :class:`analysis.response.ResponseReport`, which the JSON, the table, the figure and the
-    CSV print."""
-    from ..analysis.response import duffing_response, equation_response
+    :class:`analysis.systems.Response`, which the JSON, the table, the figure and the CSV
+    print."""
+    from ..analysis.systems import driven_problem, notes_problem, response
 
     if args.model is not None:
-        return equation_response(args.model, _params(args.param), args.harmonics,
-                                 args.name or "oscillator", args.omega_min, args.omega_max,
-                                 limit)
-    return duffing_response(args.eps, args.force, args.Q, args.harmonics, limit,
-                            args.omega_min, args.omega_max)
+        return response(driven_problem(args.model, _params(args.param),
+                                       args.name or "oscillator"), args.harmonics,
+                        args.omega_min, args.omega_max, limit)
+    de, closed = notes_problem(args.eps, args.force, args.Q)
+    return response(de, args.harmonics, args.omega_min, args.omega_max, limit, closed)
 
 
 def response_csv(r, path: Path) -> Path:
@@ -400,11 +401,9 @@ def run_response(args: argparse.Namespace) -> int:
     plot, csv = check_outputs(args)
     r = response_report(args, limit)
     if plot is not None and args.model is not None:
-        _charts().response_equation_figure(args.model, _params(args.param), args.harmonics,
-                                           plot, args.name or "oscillator", report=r)
+        _charts().response_equation_figure(r, plot, args.model)
     elif plot is not None:
-        _charts().response_figure(args.eps, args.force, args.Q, args.harmonics, plot,
-                                  report=r)
+        _charts().response_figure(r, plot)
     if csv is not None:
         response_csv(r, csv)
     data = response_report_json(r)

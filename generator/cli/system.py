@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import textwrap
 from pathlib import Path
 
@@ -21,6 +22,7 @@ from .common import (
     _flag_order,
     _params,
     _positive,
+    _rational,
     check_outputs,
     dynamics_json,
     dynamics_lines,
@@ -32,13 +34,72 @@ CONVENTION = ("at t = 0 every velocity is zero and {a}(0) = A (a turning point);
               "x_i = A sum_j y^j sum_n c[j][n] cos(n*omega*t)")
 
 
-def nnm_json(mode) -> dict:
-    """The contract of ``lindstedt nnm … --json``: ω₀, the expansion variable, ω and T/2π
-    per order and every coordinate's Fourier coefficients, each exact (SymPy's str), and
-    beside each its decimal (``*_decimal``, 12 significant digits) and ω₀'s minimal
-    polynomial (``None`` for a rational ω₀)."""
+def _monomial(powers: tuple[tuple[str, int], ...]) -> str:
+    """SymPy's spelling of a monomial: ``"A**2*alpha"``, ``"1"`` for the constant."""
+    return "*".join(n if e == 1 else f"{n}**{e}" for n, e in powers) or "1"
+
+
+def _ground_text(ground, c: object) -> str | dict:
+    """An exact coefficient of a free oscillator's ground: ``"p/q"``, or for ``QQ[A, params]``
+    an object mapping each monomial (SymPy's ``str``: ``"A**2*alpha"``, ``"1"``) to its exact
+    ``"p/q"``, formatted from FLINT's terms (no SymPy on the way)."""
+    if ground.is_rational:
+        return _rational(c)
+    return dict(sorted((_monomial(m), _rational(v)) for m, v in ground.terms(c)))
+
+
+def _decimal(c: object) -> str:
+    """A rational's 12 significant digits, from its own integers (no SymPy)."""
+    return f"{int(c.p) / int(c.q):.12g}"
+
+
+def periodic_json(series, valid=None) -> dict:
+    """The JSON of a family of periodic orbits' series, the contract of ``series MODEL
+    --json`` (a free oscillator's :class:`derive.lindstedt.SeriesSolution`, ``valid`` its
+    :class:`derive.lindstedt.Validity`) and of ``nnm SYSTEM --json`` (a
+    :class:`derive.nnm.NormalModeSeries`); keys are stable.  Both: ``kind``, ``order``,
+    ``variable``, ω and T/2π per order (``omega``, ``period``), every coordinate's Fourier
+    coefficients (``coordinates``, harmonic → coefficient per order), the ``amplitude``
+    coordinate, ``omega0`` and the ``convention``, each exact, and beside each number its
+    decimal (``*_decimal``, 12 significant digits) where the coefficients are numbers.  One
+    coordinate adds ``model``, ``title``, ``q`` (its coefficients), ``radius`` (exact) or
+    ``radius_estimate``, ``orbit_limit`` and, for a user's equation, ``equation`` and
+    ``units`` (ω in units of ω₀); a system adds ``mode``, ``system``, ``lambda`` (ω₀²),
+    every mode's ω₀², ω₀'s minimal polynomial, the ``parameters`` left symbols and the
+    ``mass``."""
+    from ..derive.lindstedt import SeriesSolution
+
+    if isinstance(series, SeriesSolution):
+        m, g = series.model, series.ground
+        name = str(m.coordinate)
+        q = [{str(n): _ground_text(g, c) for n, c in sorted(qj.items())} for qj in series.q]
+        data = {
+            "kind": "series", "model": m.name, "title": m.title, "order": series.order,
+            "variable": m.variable,
+            "omega": [_ground_text(g, c) for c in series.omega],
+            "period": [_ground_text(g, c) for c in series.period],
+            "q": q, "coordinates": {name: q}, "amplitude": name,
+            "convention": series.convention,
+            "radius": None if m.radius is None else str(m.radius),
+            "radius_value": valid.radius if valid.exact is not None else None,
+            "orbit_limit": valid.orbit.as_json(),
+            "omega0": str(m.frequency),
+        }
+        if valid.exact is None and valid.radius is not None:
+            data["radius_estimate"] = {"value": valid.radius, "spread": valid.spread}
+        if m.source:
+            data.update(equation=m.source,
+                        units="omega in units of omega0, period in units of 2*pi/omega0")
+        if g.is_rational:
+            data.update(
+                omega_decimal=[_decimal(c) for c in series.omega],
+                period_decimal=[_decimal(c) for c in series.period],
+                coordinates_decimal={name: [{str(n): _decimal(c) for n, c in sorted(qj.items())}
+                                            for qj in series.q]})
+        return data
     from ..lower.printers import decimal_text, minimal_polynomial
 
+    mode = series
     names = [str(x) for x in mode.system.coordinates]
     root = minimal_polynomial(mode.omega0, "x")
     return {
@@ -70,46 +131,115 @@ def nnm_json(mode) -> dict:
 
 
 TEXT_WIDTH = 200
-# NOTE: no line of nnm's table is longer; --exact prints a long exact number on lines of its
+# NOTE: no line of the table is longer; --exact prints a long exact number on lines of its
 # own, broken at this width.
 SHORT_EXACT = 24
 # NOTE: as lower.printers.EXACT_WIDTH (not imported: the table must not load SymPy).
+CELL = 28
+# NOTE: the width of the ω_j and (T/2π)_j columns; a longer cell lists the orders one to a line.
 
 
-def _shown(exact: str, decimal: str, full: bool) -> str:
-    """The exact form when it is short or ``full`` (--exact), else the decimal."""
-    return exact if full or len(exact) <= SHORT_EXACT else decimal
+def _exact_text(value: str | dict) -> str:
+    """An exact JSON value as a reader writes it: ``3/8``, an integer without ``/1``, a
+    polynomial's ``{monomial: "p/q"}`` as ``3*a/8 - a**2/4``."""
+    if isinstance(value, str):
+        return value.removesuffix("/1") if value.endswith("/1") else value
+    terms = []
+    for monomial, c in value.items():
+        p, _, q = c.partition("/")
+        sign, p = ("-", p[1:]) if p.startswith("-") else ("+", p)
+        body = p if monomial == "1" else monomial if p == "1" else f"{p}*{monomial}"
+        terms.append(f"{sign} {body}" + (f"/{q}" if q and q != "1" else ""))
+    text = " ".join(terms) or "0"
+    return text[2:] if text.startswith("+ ") else "-" + text[2:]
 
 
-def nnm_table(data: dict, exact: bool = False) -> str:
-    """The readable table: ω_j, (T/2π)_j and each coordinate's harmonics per order; a long
-    exact number as its decimal (12 significant digits) unless ``exact`` (--exact), which
-    lists the exact forms one to a line instead; no line over :data:`TEXT_WIDTH`."""
+def _shown(exact: str | dict, decimal: str | None, full: bool) -> str:
+    """The exact form when it is short, ``full`` (--exact) or has no decimal, else the
+    decimal."""
+    text = _exact_text(exact)
+    return text if full or decimal is None or len(text) <= SHORT_EXACT else decimal
+
+
+def _short(x: float) -> str:
+    """A float as its shortest text, an integer without ``.0`` (``2``, ``1.5``)."""
+    return str(int(x)) if float(x).is_integer() else repr(float(x))
+
+
+def _radius_line(data: dict, y: str) -> str:
+    """The table's line on the radius of convergence of a free oscillator's series in ``y``."""
+    if data["radius"] is not None:
+        value = data["radius_value"]
+        shown = "" if value is None or data["radius"] == _short(value) else f" = {value:.12g}"
+        return f"the series converges for |{y}| < {data['radius']}{shown} (the radius, exact)"
+    if "radius_estimate" in data:
+        r = data["radius_estimate"]
+        return (f"the series converges for |{y}| < {r['value']:.6g} (the radius estimated "
+                f"from tau_j to order {data['order']}, spread {r['spread']:.2g})")
+    return ("radius of convergence not estimated (symbolic coefficients, or order < 2: "
+            "raise --order, give the parameters values)")
+
+
+def _coordinate_named(convention: str, name: str) -> str:
+    """The convention in the user's coordinate: ``theta(0) = A, theta'(0) = 0, …``."""
+    return convention if name == "q" else re.sub(r"\bq(_j)?(?=\(|'\()", name + r"\1",
+                                                 convention)
+
+
+def _header(data: dict, exact: bool) -> list[str]:
+    """The table's first lines: what the series is, its convention and where it holds (one
+    coordinate: its orbits and radius; a system: every mode's ω₀²)."""
+    if data["kind"] == "series":
+        y = data["variable"].partition("=")[0].strip() or data["variable"]
+        domain = data["orbit_limit"]
+        return [
+            f"{data['model']}: {data['title']}, expansion variable {data['variable']}, order "
+            f"{data['order']}",
+            f"convention: {_coordinate_named(data['convention'], data['amplitude'])}",
+            *([f"omega in units of omega0 = {data['omega0']}, T in units of 2*pi/omega0"]
+              if data["omega0"] != "1" else []),
+            f"periodic orbits for {domain['lower']} < {y} < {domain['upper']} "
+            f"({domain['how']})" if domain["known"] else
+            f"orbit domain not computed: {domain['how']}",
+            _radius_line(data, y)]
     w0 = _shown(data["omega0"], data["omega0_decimal"], exact)
     if w0 != data["omega0"]:
         w0 += f" (a root of {data['omega0_minimal_polynomial']})"
     squares = ", ".join(_shown(e, d, exact) for e, d in zip(
         data["linear_frequencies_squared"], data["linear_frequencies_squared_decimal"],
         strict=True))
-    lines = [f"mode {data['mode']} of {data['system']}",
-             f"omega0 = {w0} (omega0^2 of every mode: {squares}), expansion variable "
-             f"{data['variable']}, order {data['order']}",
-             f"convention: {data['convention']}"]
-    cells = [(_shown(w, wd, exact), _shown(t, td, exact)) for w, wd, t, td in zip(
-        data["omega"], data["omega_decimal"], data["period"], data["period_decimal"],
-        strict=True)]
-    if exact and any(len(w) > 28 or len(t) > 28 for w, t in cells):
+    return [f"mode {data['mode']} of {data['system']}",
+            f"omega0 = {w0} (omega0^2 of every mode: {squares}), expansion variable "
+            f"{data['variable']}, order {data['order']}",
+            f"convention: {data['convention']}"]
+
+
+def periodic_table(data: dict, exact: bool = False) -> str:
+    """The readable table of :func:`periodic_json`'s ``data``, for one coordinate or a
+    system: where the series holds, then ω_j and (T/2π)_j per order and each coordinate's
+    harmonics per order; a long exact number as its decimal (12 significant digits) where
+    the data holds one, unless ``exact`` (--exact), which lists the exact forms one to a
+    line instead; no line over :data:`TEXT_WIDTH`."""
+    lines = _header(data, exact)
+    decimals = {key: data.get(f"{key}_decimal") for key in ("omega", "period", "coordinates")}
+
+    def decimal(key: str, j: int) -> str | None:
+        return None if decimals[key] is None else decimals[key][j]
+
+    cells = [(_shown(w, decimal("omega", j), exact), _shown(t, decimal("period", j), exact))
+             for j, (w, t) in enumerate(zip(data["omega"], data["period"], strict=True))]
+    if any(len(w) > CELL or len(t) > CELL for w, t in cells):
         for j, (w, t) in enumerate(cells):
             lines += [f"omega_{j} = {w}", f"(T/2pi)_{j} = {t}"]
     else:
-        lines.append(f"{'j':>3}  {'omega_j':>28}  {'(T/2pi)_j':>28}")
-        lines += [f"{j:>3}  {w:>28}  {t:>28}" for j, (w, t) in enumerate(cells)]
+        lines.append(f"{'j':>3}  {'omega_j':>{CELL}}  {'(T/2pi)_j':>{CELL}}")
+        lines += [f"{j:>3}  {w:>{CELL}}  {t:>{CELL}}" for j, (w, t) in enumerate(cells)]
     for name, orders in data["coordinates"].items():
         lines.append(f"{name}: harmonic n -> coefficient, per order")
-        for j, (order, decimals) in enumerate(zip(orders, data["coordinates_decimal"][name],
-                                                  strict=True)):
-            lines.append(f"{j:>3}  " + ", ".join(f"{n}: {_shown(c, decimals[n], exact)}"
-                                                  for n, c in order.items()))
+        shown = (decimals["coordinates"] or {}).get(name, [{}] * len(orders))
+        for j, order in enumerate(orders):
+            lines.append(f"{j:>3}  " + ", ".join(
+                f"{n}: {_shown(c, shown[j].get(n), exact)}" for n, c in order.items()))
     return "\n".join(piece for line in lines for piece in textwrap.wrap(
         line, TEXT_WIDTH, subsequent_indent="     ", break_on_hyphens=False) or [""])
 
@@ -148,7 +278,7 @@ def run_nnm(args: argparse.Namespace) -> int:
         mode = normal_mode(system, args.mode, args.order, amplitude, progress)
     finally:
         progress.close()
-    data = nnm_json(mode)
+    data = periodic_json(mode)
     if plot is not None:
         from ..analysis.curves import FEP_ORDER, frequency_energy
         from ..charts_modes import nnm_figure
@@ -158,7 +288,7 @@ def run_nnm(args: argparse.Namespace) -> int:
         from ..analysis.curves import backbone
 
         backbone_csv(backbone(mode), csv)
-    print(json.dumps(data) if args.json else nnm_table(data, args.exact))
+    print(json.dumps(data) if args.json else periodic_table(data, args.exact))
     return 0
 
 
@@ -325,7 +455,7 @@ def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def response_system_json(r) -> dict:
-    """``response SYSTEM --json``: a :class:`analysis.systems.SystemResponse` as data: each
+    """``response SYSTEM --json``: a :class:`analysis.systems.Response` as data: each
     traced branch (ω, every coordinate's first-harmonic amplitude, the largest Floquet |λ|,
     stable or not), the folds, the sweeps' jumps, the points shot as true orbits and how the
     branches were searched."""
@@ -460,11 +590,11 @@ def response_system_csv(r, path: Path) -> Path:
 def run_response_system(args: argparse.Namespace, limit: float) -> int:
     """Run ``lindstedt response SYSTEM``: every branch of the driven, damped system's response
     over ω, as a table, JSON or a figure."""
-    from ..analysis.systems import system_response
+    from ..analysis.systems import driven_problem, response
 
     plot, csv = check_outputs(args)
-    r = system_response(args.model, _params(args.param), args.harmonics, args.omega_min,
-                        args.omega_max, limit)
+    r = response(driven_problem(args.model, _params(args.param)), args.harmonics,
+                 args.omega_min, args.omega_max, limit)
     if plot is not None:
         from ..charts_modes import response_system_figure
 
