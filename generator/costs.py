@@ -325,15 +325,14 @@ def response_cost(args: argparse.Namespace) -> Cost:
     so)."""
     from .analysis.systems import driven_problem, notes_problem, response_plan
 
-    closed = None
     if getattr(args, "model", None) is not None:
         problem = driven_problem(args.model, _values(args), args.name or "oscillator")
     elif any(getattr(args, k, None) is None for k in ("eps", "force", "Q")):
         return Cost(RESPONSE_FIXED, "response", "response")  # the command says what is missing
     else:
-        problem, closed = notes_problem(args.eps, args.force, args.Q)
+        problem, _ = notes_problem(args.eps, args.force, args.Q)
     plan = response_plan(problem, args.harmonics, getattr(args, "omega_min", None),
-                         getattr(args, "omega_max", None), closed, ends=True)
+                         getattr(args, "omega_max", None), ends=True)
     given = "".join(f", --param {pair}" for pair in args.param or ())
     drives = (f", {plan.drives} drive continuations (at most {plan.drive_points} points "
               "each)" if plan.drives else "")

@@ -20,7 +20,7 @@ from lindstedt.analysis.continuation import (
 )
 from lindstedt.analysis.driven import Drive
 from lindstedt.analysis.polynomial import PolynomialBalance
-from lindstedt.analysis.response import one_harmonic_folds
+from lindstedt.analysis.response import OneHarmonic
 from lindstedt.analysis.systems import continue_balance
 
 EPS, F, Q = 0.1, 0.3, 20.0
@@ -91,13 +91,13 @@ def test_the_undamped_duffing_curve_in_omega_is_the_closed_form():
 
 def test_the_damped_duffing_curve_in_omega_folds_where_the_cubic_does():
     """eq. 10.60 at one harmonic: every point on ``r²[(1 − ω² + ¾εr²)² + ω²/Q²] = f²`` and the
-    folds those of the cubic's discriminant (:func:`response.one_harmonic_folds`)."""
+    folds those of the cubic's discriminant (:attr:`response.OneHarmonic.folds`)."""
     cont = continue_balance(Drive(EPS, F, 0.6, Q).equation, 1, 0.6, 1.9)
     r2 = np.sum(cont.x**2, axis=1)
     w = cont.omega
     G = r2 * ((1 - w**2 + 0.75 * EPS * r2) ** 2 + w**2 / Q**2) - F**2
     assert np.max(np.abs(G)) < 1e-12
-    exact = one_harmonic_folds(EPS, F, Q)
+    exact = OneHarmonic(Drive(EPS, F, 1.0, Q).terms, F).folds
     assert len(exact) == 2
     assert cont.folds == pytest.approx(exact, abs=1e-10)
 

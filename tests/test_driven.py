@@ -278,7 +278,8 @@ def reference_grid() -> list[tuple[float, float, float, np.ndarray]]:
     """Hardening and softening, damped and not, ε down to 1e-12 and 0, the force across three
     decades; ω on a grid through ω = 1 and at 1e-3, 1e-5 and 1e-7 (relative) on both sides of
     every fold."""
-    from lindstedt.analysis.response import one_harmonic_folds
+    from lindstedt.analysis.driven import Drive
+    from lindstedt.analysis.response import OneHarmonic
 
     base = np.concatenate([np.geomspace(0.2, 5, 41), [1.0, 1 - 1e-9, 1 + 1e-9]])
     grid = []
@@ -286,7 +287,7 @@ def reference_grid() -> list[tuple[float, float, float, np.ndarray]]:
                                            [math.inf, 20.0, 3.0, 0.05]):
         omega = base
         if eps:
-            folds = np.array(one_harmonic_folds(eps, force, Q))
+            folds = np.array(OneHarmonic(Drive(eps, force, 1.0, Q).terms, force).folds)
             if len(folds):
                 near = np.array([-1e-3, -1e-5, -1e-7, 0.0, 1e-7, 1e-5, 1e-3])
                 omega = np.concatenate([omega, (folds[:, None] * (1 + near)).ravel()])

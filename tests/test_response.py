@@ -3,21 +3,55 @@
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 import sys
 
 import numpy as np
 import pytest
 from lindstedt.analysis.driven import Drive, amplitude_residual, amplitude_slope
-from lindstedt.analysis.response import (
-    one_harmonic_curve,
-    one_harmonic_folds,
-)
+from lindstedt.analysis.response import OneHarmonic, first_harmonic, one_harmonic_curve
 from lindstedt.analysis.systems import continue_balance
 from lindstedt.numerics.integrate import duffing_table, sweep
 from lindstedt.numerics.shooting import orbit_fold, shoot
 
 EPS, F, Q = 0.1, 0.3, 20.0
+REFERENCE_FOLDS = {
+    (0.1, 0.3, 20.0): (1.1618653039085556, 1.4893933393651175),
+    (-0.1, 0.3, 20.0): (0.8039032157810019,),
+    (0.1, 0.3, 185.0): (1.164938605148117, 3.963272238735694),
+    (1.0, 0.05, 185.0): (1.1103722095597486, 2.9199877180685214),
+    (0.01, 0.05, 1e4): (1.0247962306602898, 6.618470884248357),
+    (2.0, 30.0, 3.0): (4.669026606847833, 10.523414823985),
+    (0.1, 1.0, math.inf): (1.340520021069047,),
+    (-0.1, -1.0, math.inf): (0.4505619525803768,),
+}
+# NOTE: eq. 10.60's one-harmonic folds from the cubic's discriminant in closed form (SymPy's
+# resultant in u = r², its roots in ω² polished by Newton on the cubic written factored, as
+# lindstedt 0.x computed them for eq. 10.60 alone), to the last printed digit.
+
+
+def one_harmonic_folds(eps, force, Q):
+    """The folds of eq. 10.60's one-harmonic balance (the one fold finder for any force)."""
+    return OneHarmonic(Drive(eps, force, 1.0, Q).terms, force).folds
+
+
+def discriminant_folds(eps, force, Q, lo, hi, points=200_001):
+    """Independent: where the discriminant of the cubic ``a u³ + b u² + c u + d`` in ``u = r²``
+    (``18abcd − 4b³d + b²c² − 4ac³ − 27a²d²``) changes sign on a fine ω grid with a positive
+    double root, refined by bisection (brentq)."""
+    from scipy.optimize import brentq
+
+    def disc(w):
+        s = 1 - w * w
+        a, b, c, d = 9 / 16 * eps**2, 1.5 * eps * s, s * s + w * w / Q**2, -force**2
+        return 18 * a * b * c * d - 4 * b**3 * d + b * b * c * c - 4 * a * c**3 \
+            - 27 * a * a * d * d
+
+    grid = np.linspace(lo, hi, points)
+    values = disc(grid)
+    return [brentq(disc, grid[i], grid[i + 1], xtol=1e-15, rtol=1e-15)
+            for i in np.nonzero(np.sign(values[:-1]) != np.sign(values[1:]))[0]]
 
 
 def cubic_roots(omega):
@@ -41,6 +75,7 @@ def test_curve_equals_numpy_roots_and_stability():
 def test_folds_are_double_roots_and_change_the_branch_count():
     folds = one_harmonic_folds(EPS, F, Q)
     assert len(folds) == 2
+    assert folds == REFERENCE_FOLDS[EPS, F, Q]  # to the last bit
     d = Drive(EPS, F, 1.0, Q)
     for w in folds:
         assert len(cubic_roots(w - 1e-7)) + len(cubic_roots(w + 1e-7)) == 4  # 1 | 3
@@ -50,6 +85,54 @@ def test_folds_are_double_roots_and_change_the_branch_count():
                 key=lambda x: abs(amplitude_residual(x, w, d)))
         assert abs(amplitude_residual(u, w, d)) < 1e-12
         assert abs(amplitude_slope(u, w, d)) < 1e-12
+
+
+@pytest.mark.parametrize("params", sorted(REFERENCE_FOLDS, key=str))
+def test_the_one_fold_finder_reproduces_the_cubics_folds(params):
+    """The resultant of any polynomial force's G(u, w) and ∂G/∂u, polished by Newton: eq.
+    10.60's folds as the cubic's closed form gave them, within two units in the last place."""
+    got = one_harmonic_folds(*params)
+    assert len(got) == len(REFERENCE_FOLDS[params])
+    np.testing.assert_allclose(got, REFERENCE_FOLDS[params], rtol=5e-16, atol=0)
+
+
+@pytest.mark.parametrize("force, apart, rtol", [(0.057, 6.5e-4, 1e-14), (0.0541, 1.3e-6, 1e-11)])
+def test_folds_closer_than_a_grid_step_are_told_apart(force, apart, rtol):
+    """Just above the cusp (f ≈ 0.05406 at ε = 0.1, Q = 20, where hysteresis begins) the two
+    folds lie 0.065 % and 1.3e-6 of ω apart, within one step of a 0.3 % grid (which found
+    neither): both found, each where the discriminant of the cubic changes sign (brentq on a
+    5e-7 grid, independent; near the cusp the discriminant's own rounding limits it)."""
+    eps, Q = 0.1, 20.0
+    got = one_harmonic_folds(eps, force, Q)
+    assert len(got) == 2 and got[1] / got[0] - 1 == pytest.approx(apart, rel=0.05)
+    ref = discriminant_folds(eps, force, Q, 1.0, 1.1)
+    assert len(ref) == 2
+    np.testing.assert_allclose(got, ref, rtol=rtol)
+
+
+def test_first_harmonic_coefficients_are_the_quadratures():
+    """``C_ab``, ``S_ab`` exact against the 64-point quadrature of cos^a θ (−sin θ)^b."""
+    theta = 2 * np.pi * np.arange(64) / 64
+    for a in range(9):
+        for b in range(9):
+            wave = np.cos(theta) ** a * (-np.sin(theta)) ** b
+            cos, sin = first_harmonic(a, b)
+            assert abs(2 * np.mean(wave * np.cos(theta)) - float(cos)) < 1e-13
+            assert abs(2 * np.mean(wave * np.sin(theta)) - float(sin)) < 1e-13
+
+
+def test_a_quintic_force_folds_where_its_amplitude_polynomial_is_double():
+    """q'' + q'/20 + q + q³/10 − q⁵/100 (hardening then softening): at each fold the
+    one-harmonic amplitude polynomial H(r) of numpy has a double positive root (a root of
+    H and H')."""
+    terms = {(1, 0): 1.0, (0, 1): 0.05, (3, 0): 0.1, (5, 0): -0.01}
+    one = OneHarmonic(terms, 0.2)
+    assert len(one.folds) >= 2
+    for w in one.folds:
+        H = one.polynomial(w)
+        near = [r for r in np.polynomial.polynomial.polyroots(np.polynomial.polynomial.polyder(H))
+                if abs(r.imag) < 1e-6 and r.real > 0]
+        assert min(abs(np.polynomial.polynomial.polyval(r.real, H)) for r in near) < 1e-9
 
 
 def test_balance_folds_are_true_folds_with_floquet_multiplier_one():

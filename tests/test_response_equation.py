@@ -16,6 +16,7 @@ import time
 import numpy as np
 import pytest
 from lindstedt.analysis.mixing import duffing_mixing, equation_mixing
+from lindstedt.analysis.response import response_equation
 from lindstedt.analysis.subharmonic import subharmonic
 from lindstedt.analysis.systems import driven_problem, notes_problem, response
 from lindstedt.cli import main
@@ -277,20 +278,19 @@ def test_response_equation_json_keys_keep_the_contract(capsys):
     assert len(data["numerical"]["folds"]) == 1  # only the upper fold lies in [1.3, 1.6]
 
 
-@pytest.mark.parametrize("eps, force, Q", [(0.1, 0.3, 185.0), (1.0, 0.05, 185.0),
-                                           (0.01, 0.05, 1e4), (0.1, 0.3, 20.0)])
-def test_a_high_q_equation_keeps_its_upper_fold(eps, force, Q):
-    """Eq. 10.60's one-harmonic folds through the general equation's H(r) (the response
-    EQUATION path) against the cubic's discriminant in closed form (another route): the upper
-    fold far out (ω = 3.963 at Q = 185, 6.6 at Q = 1e4) was lost, and the range with it.
-    Relative 1e-5: H = P_c² + P_s² − f² cancels (ω²r)² ~ 1e4 down to f² ~ 1e-3 there, where the
-    cubic in u = r² does not."""
-    from lindstedt.analysis.driven import Drive
-    from lindstedt.analysis.response import equation_range, one_harmonic_folds, response_range
+@pytest.mark.parametrize("eps, force, Q, folds", [
+    (0.1, 0.3, 185.0, (1.164938605148117, 3.963272238735694)),
+    (1.0, 0.05, 185.0, (1.1103722095597486, 2.9199877180685214)),
+    (0.01, 0.05, 1e4, (1.0247962306602898, 6.618470884248357)),
+    (0.1, 0.3, 20.0, (1.1618653039085556, 1.4893933393651175))])
+def test_a_high_q_equation_keeps_its_upper_fold(eps, force, Q, folds):
+    """Eq. 10.60 written out as a user's equation (the response EQUATION path): its range
+    holds both one-harmonic folds, each the cubic's closed form's (tests/test_response.py's
+    references, to two units in the last place): the upper fold far out (ω = 3.963 at
+    Q = 185, 6.6 at Q = 1e4) was once lost, and the range with it."""
+    from lindstedt.analysis.response import response_range
 
-    d = Drive(eps, force, 1.0, Q)
-    er = equation_range(d.terms, force)
-    closed = one_harmonic_folds(eps, force, Q)
-    assert len(er.one_harmonic_folds) == len(closed) == 2
-    np.testing.assert_allclose(er.one_harmonic_folds, closed, rtol=1e-5)
-    np.testing.assert_allclose(er.omega_range, response_range(eps, force, Q), rtol=1e-5)
+    de = response_equation(f"q'' + q'/{Q!r} + q + {eps!r}*q**3 = {force!r}*cos(w*t)", {})
+    span = response_range(de.terms, de.force)
+    np.testing.assert_allclose(span.one_harmonic_folds, folds, rtol=5e-16, atol=0)
+    assert span.omega_range == (0.5 * min(1.0, folds[0]), 1.25 * folds[1])

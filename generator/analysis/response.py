@@ -13,30 +13,16 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, replace
+from fractions import Fraction
 
+import flint
 import numpy as np
-import sympy as sp
 
 from ..errors import InputError
-from ..numerics.newton import DIFFERENCE_STEP, newton, safeguarded
+from ..numerics.newton import newton, safeguarded
 from .continuation import MAX_POINTS, drive_crossings
-from .driven import (
-    Drive,
-    amplitude_residual,
-    amplitude_slope,
-    one_harmonic_roots,
-)
+from .driven import Drive, amplitude_slope, one_harmonic_roots
 from .polynomial import DrivenEquation, PolynomialBalance
-
-_u, _w, _e, _f, _g = sp.symbols("u w e f g")  # u = r², w = ω², g = 1/Q
-_G = _u * ((1 - _w + sp.Rational(3, 4) * _e * _u) ** 2 + _w * _g**2) - _f**2
-
-
-@functools.cache
-def _fold_polynomial() -> sp.Poly:
-    """The resultant in u of G and ∂G/∂u (the cubic's discriminant), a polynomial in ω² whose
-    positive roots with a positive double root u are the folds; derived once, on first use."""
-    return sp.Poly(sp.resultant(_G, sp.diff(_G, _u), _u), _w)
 
 
 @dataclass(frozen=True)
@@ -62,65 +48,6 @@ def one_harmonic_curve(eps: float, force: float, Q: float, omega: np.ndarray) ->
     return ResponseCurve(w, r, stable & np.isfinite(r))
 
 
-def one_harmonic_folds(eps: float, force: float, Q: float) -> list[float]:
-    """Fold frequencies (ascending) to full double precision: ``G = ∂G/∂u = 0``.
-
-    Candidates from the roots in ω² of the discriminant, polished by Newton's method on the
-    2×2 system in ``(u, ω)``.
-    """
-    d = Drive(eps, force, 1.0, Q)
-    if eps == 0:
-        return []
-    values = {_e: eps, _f: force, _g: d.damping}
-    # SymPy's floats do not overflow: scale by the largest coefficient before rounding to
-    # float64 (ε = 1e100 puts ε⁴f² far beyond 1e308, yet the roots in ω² are ordinary)
-    exact = [sp.Float(c.subs(values), 30) for c in _fold_polynomial().all_coeffs()]
-    scale = max(abs(c) for c in exact)
-    coeffs = [float(c / scale) for c in exact] if scale != 0 else []
-    if not coeffs or not all(np.isfinite(coeffs)):
-        raise InputError(f"eps {eps:g}, force {force:g}, Q {Q:g}: the fold polynomial's "
-                         "coefficients leave double precision")
-    folds = []
-    for w2 in np.roots(coeffs):
-        if abs(w2.imag) > 1e-8 * (1 + abs(w2)) or w2.real <= 0:
-            continue
-        omega = float(np.sqrt(w2.real))
-        # the double root u of the cubic: ∂G/∂u = 0 is quadratic in u
-        a = 1 - omega**2
-        us = np.roots([27 / 16 * eps**2, 3 * eps * a, a * a + omega**2 * d.damping**2])
-        us = [float(x.real) for x in us if abs(x.imag) < 1e-8 * (1 + abs(x)) and x.real > 0]
-        if not us:
-            continue
-        u = min(us, key=lambda x: abs(amplitude_residual(x, omega, d)))
-
-        def system(z: np.ndarray) -> np.ndarray:
-            return np.array([amplitude_residual(z[0], z[1], d), amplitude_slope(z[0], z[1], d)])
-
-        def jacobian(z: np.ndarray) -> np.ndarray:
-            u, w = z
-            A = 1 - w**2 + 0.75 * eps * u
-            Gw = u * (-4 * w * A + 2 * w * d.damping**2)
-            Guu = 2 * A * 0.75 * eps + 1.5 * eps * A + 1.5 * eps * u * 0.75 * eps
-            Guw = 2 * A * (-2 * w) + 2 * w * d.damping**2 + 1.5 * eps * u * (-2 * w)
-            return np.array([[amplitude_slope(u, w, d), Gw], [Guu, Guw]])
-
-        # singular (a cusp, or the scale of u swamps ω): Newton stops, the check below judges
-        (u, omega), _, _ = newton(system, jacobian, np.array([u, omega]), 1e-15, 20)
-        if u > 0 and abs(amplitude_residual(u, omega, d)) < 1e-9 * (1 + force**2):
-            folds.append(float(omega))
-    return sorted({float(w) for w in folds})
-
-
-def response_range(eps: float, force: float, Q: float, omega_min: float | None = None,
-                   omega_max: float | None = None) -> tuple[float, float]:
-    """The ω range a response curve is drawn on: half the lowest to 1.25 × the highest of
-    ω = 1 and the one-harmonic folds, each end replaced by ``omega_min``/``omega_max`` where
-    given (:func:`given_range`)."""
-    folds = one_harmonic_folds(eps, force, Q)
-    return given_range(0.5 * min([1.0, *folds]), 1.25 * max([1.0, *folds]), omega_min,
-                       omega_max)
-
-
 def given_range(lo: float, hi: float, omega_min: float | None,
                 omega_max: float | None) -> tuple[float, float]:
     """``(lo, hi)`` with each end replaced by ``--omega A:B``'s where given, checked: finite,
@@ -135,32 +62,56 @@ def given_range(lo: float, hi: float, omega_min: float | None,
     return lo, hi
 
 
+def first_harmonic(a: int, b: int) -> tuple[Fraction, Fraction]:
+    """``(C_ab, S_ab)``: the cos θ and sin θ coefficients of ``cos^a θ (−sin θ)^b``, exact.
+
+    With ``z = e^{iθ}``, ``cos^a θ (−sin θ)^b = i^b (z + 1/z)^a (z − 1/z)^b / 2^(a+b)``; the
+    coefficient of ``z`` in the product of the binomials is ``K = Σ_k C(a, n − k) C(b, k)
+    (−1)^k``, ``n = (a + b − 1)/2``, so an even ``a + b`` has no first harmonic, an even
+    ``b`` gives ``C = (−1)^(b/2) K/2^(a+b−1)`` and an odd one ``S = −(−1)^((b−1)/2)
+    K/2^(a+b−1)``.
+
+    >>> first_harmonic(3, 0), first_harmonic(0, 1)  # ¾ q³ on cos θ; q̇ = −ω r sin θ
+    ((Fraction(3, 4), Fraction(0, 1)), (Fraction(0, 1), Fraction(-1, 1)))
+    """
+    if (a + b) % 2 == 0:
+        return Fraction(0), Fraction(0)
+    n = (a + b - 1) // 2
+    K = sum(math.comb(a, n - k) * math.comb(b, k) * (-1) ** k for k in range(b + 1)
+            if 0 <= n - k <= a)
+    size = Fraction(K, 2 ** (a + b - 1))
+    if b % 2 == 0:
+        return (-1) ** (b // 2) * size, Fraction(0)
+    return Fraction(0), -((-1) ** ((b - 1) // 2)) * size
+
+
 _poly = np.polynomial.polynomial
+
 
 @dataclass(frozen=True)
 class OneHarmonic:
     """``q = r cos(ωt − φ)`` in ``q̈ + g(q, q̇) = f cos ωt`` (a polynomial ``g``, its table
-    ``terms``): the first harmonic of ``q̈ + g`` is ``(P_c(r), P_s(r))`` with
-    ``P_c = −ω²r + Σ c ω^b C_ab r^(a+b)``, ``P_s = Σ c ω^b S_ab r^(a+b)`` (``C_ab``, ``S_ab``
-    the cos θ, sin θ coefficients of ``cos^a θ (−sin θ)^b``), and ``H(r) = P_c² + P_s² − f²``
-    vanishes at the amplitudes: for eq. 10.60 exactly the cubic ``G`` of the module's header
-    (in ``r``), so the same folds."""
+    ``terms``): the first harmonic of ``q̈ + g`` is ``(P_c, P_s)`` with ``P_c = −ω²r + Σ c ω^b
+    C_ab r^(a+b)``, ``P_s = Σ c ω^b S_ab r^(a+b)`` (:func:`first_harmonic`: only odd ``a + b``
+    contribute, ``P_c`` even ``b``, ``P_s`` odd ``b``), so that ``P_c = r p_c(u, w)``,
+    ``P_s = rω p_s(u, w)`` in ``u = r²``, ``w = ω²``, and the amplitudes are the roots of
+    ``G(u, w) = u (p_c² + w p_s²) − f²``, a polynomial in both: for eq. 10.60 exactly the
+    cubic ``r²[(1 − ω² + ¾εr²)² + ω²/Q²] = f²`` (§10.4)."""
 
     terms: dict[tuple[int, int], float]
     force: float
 
     @functools.cached_property
     def _harmonics(self) -> list[tuple[int, int, float, float, float]]:
-        theta = 2 * np.pi * np.arange(64) / 64
         out = []
         for (a, b), c in sorted(self.terms.items()):
-            wave = np.cos(theta) ** a * (-np.sin(theta)) ** b
-            out.append((a, b, c, 2 * float(np.mean(wave * np.cos(theta))),
-                        2 * float(np.mean(wave * np.sin(theta)))))
+            cos, sin = first_harmonic(a, b)
+            out.append((a, b, c, float(cos), float(sin)))
         return out
 
     def polynomial(self, omega: float) -> np.ndarray:
-        """``H(r)`` at ``omega``: its coefficients, lowest power first, trimmed."""
+        """``H(r) = P_c² + P_s² − f²`` at ``omega``: its coefficients, lowest power first,
+        trimmed."""
         d = max(a + b for a, b, *_ in self._harmonics)
         pc, ps = np.zeros(d + 1), np.zeros(d + 1)
         pc[1] = -omega**2
@@ -193,54 +144,115 @@ class OneHarmonic:
         ps = sum(c * omega**b * sin * r ** (a + b) for a, b, c, _, sin in self._harmonics)
         return math.atan2(-ps, pc)
 
-    def folds(self, lo: float, hi: float, points: int = 1500) -> list[float]:
-        """The ω in ``[lo, hi]`` where two amplitudes meet (``H = ∂H/∂r = 0``): where the
-        number of roots changes on a geometric grid, each polished by Newton's method in
-        ``(r, ω)`` from the closest pair at the grid point that has it.  Two folds within one
-        step of the grid (0.3 % of ω) are not told apart."""
-        grid = np.geomspace(lo, hi, points)
-        counts = [len(self.amplitudes(w)) for w in grid]
-        out = []
-        for i in range(points - 1):
-            if counts[i] == counts[i + 1]:
-                continue
-            j = i if counts[i] > counts[i + 1] else i + 1  # the side with the pair
-            rs = self.amplitudes(grid[j])
-            if len(rs) < 2:
-                continue
-            k = int(np.argmin(np.diff(rs)))
-            fold = self._polish_fold(np.array([0.5 * (rs[k] + rs[k + 1]), grid[j]]))
-            if fold is not None and grid[i] * (1 - 1e-3) <= fold <= grid[i + 1] * (1 + 1e-3):
-                out.append(fold)
-        return sorted(out)
+    @functools.cached_property
+    def _amplitude_polynomials(self) -> tuple[flint.fmpq_mpoly, flint.fmpq_mpoly]:
+        """``p_c(u, w)`` and ``p_s(u, w)``, exact: the terms' floats as the rationals they
+        are."""
+        ctx = flint.fmpq_mpoly_ctx.get(("u", "w"), "lex")
+        u, w = ctx.gens()
+        pc, ps = -w, ctx.constant(0)
+        for (a, b), c in sorted(self.terms.items()):
+            cos, sin = first_harmonic(a, b)
+            term = _rational(Fraction(c)) * u ** ((a + b - 1) // 2)
+            if cos:
+                pc += _rational(cos) * term * w ** (b // 2)
+            if sin:
+                ps += _rational(sin) * term * w ** ((b - 1) // 2)
+        return pc, ps
 
-    def _polish_fold(self, z: np.ndarray) -> float | None:
-        """``H = ∂H/∂r = 0`` by Newton's method in ``(r, ω)`` from ``z``, exact in r (H is a
-        polynomial), a central difference in ω: its ω, or ``None`` where Newton leaves
-        ``r, ω > 0`` or overflows.  (Differences in r as well let a start beside a fold at
-        r ≈ 14 leap to another fold: eq. 10.60 at Q = 185 lost its upper fold, ω = 3.963.)"""
-        def F(z: np.ndarray) -> np.ndarray:
-            if not (z[0] > 0 and z[1] > 0):
-                return np.full(2, np.nan)
-            H = self.polynomial(z[1])
-            return np.array([_poly.polyval(z[0], H), _poly.polyval(z[0], _poly.polyder(H))])
+    @functools.cached_property
+    def folds(self) -> tuple[float, ...]:
+        """Every ω > 0 where two amplitudes meet, ascending: ``G = ∂G/∂u = 0``.  Candidates are
+        the positive roots in ``w = ω²`` of the resultant in ``u`` of ``G`` and ``∂G/∂u``
+        (exact, FLINT; for eq. 10.60 the cubic's discriminant), each with its double root
+        ``u > 0`` (the root of ``∂G/∂u`` where ``|G|`` is least), polished by Newton's method
+        in ``(u, ω)`` (:func:`numerics.newton.newton`) on ``G`` written as ``u (p_c² +
+        ω² p_s²) − f²`` (``p_c`` holds ``ω0² − ω²``: no cancellation of large terms near a
+        fold far up a resonance)."""
+        pc, ps = self._amplitude_polynomials
+        u_, w_ = pc.context().gens()
+        G = u_ * (pc * pc + w_ * ps * ps) - _rational(Fraction(self.force)) ** 2
+        R = G.resultant(G.derivative("u"), "u").to_dict()
+        top = max((j for _, j in R), default=0)
+        exact = [R.get((0, j), flint.fmpq(0)) for j in range(top, -1, -1)]
+        scale = max(abs(c) for c in exact)
+        if top == 0 or scale == 0:
+            return ()
+        # the exact coefficients scaled before rounding: ε = 1e100 puts ε⁴f² beyond 1e308
+        coeffs = [float(c / scale) for c in exact]
+        slope_u = _array(G.derivative("u"))
+        C, S = _array(pc), _array(ps)
+        parts = [(A, _poly.polyder(A, axis=0), _poly.polyder(A, axis=1),
+                  _poly.polyder(A, 2, axis=0), _poly.polyder(_poly.polyder(A, axis=0), axis=1))
+                 for A in (C, S)]
+        f2 = self.force**2
 
-        def J(z: np.ndarray) -> np.ndarray:
-            r, w = z
-            H, h = self.polynomial(w), DIFFERENCE_STEP * w
-            Hw = _poly.polysub(self.polynomial(w + h), self.polynomial(w - h)) / (2 * h)
-            dH = _poly.polyder(H)
-            return np.array([[_poly.polyval(r, dH), _poly.polyval(r, Hw)],
-                             [_poly.polyval(r, _poly.polyder(dH)),
-                              _poly.polyval(r, _poly.polyder(Hw))]])
+        def values(z: np.ndarray) -> tuple[float, ...]:
+            """G, G_u, G_ω, G_uu, G_uω at ``z = (u, ω)``."""
+            u, om = z
+            w = om * om
+            (P, Pu, Pw, Puu, Puw), (T, Tu, Tw, Tuu, Tuw) = (
+                [float(_poly.polyval2d(u, w, A)) for A in part] for part in parts)
+            Pw, Puw, Tw, Tuw = 2 * om * Pw, 2 * om * Puw, 2 * om * Tw, 2 * om * Tuw  # d/dω
+            inner = P * P + w * T * T
+            inner_u = 2 * P * Pu + 2 * w * T * Tu
+            inner_w = 2 * P * Pw + 2 * om * T * T + 2 * w * T * Tw
+            inner_uu = 2 * Pu * Pu + 2 * P * Puu + 2 * w * (Tu * Tu + T * Tuu)
+            inner_uw = (2 * Pw * Pu + 2 * P * Puw + 4 * om * T * Tu
+                        + 2 * w * (Tw * Tu + T * Tuw))
+            return (u * inner - f2, inner + u * inner_u, u * inner_w, 2 * inner_u + u * inner_uu,
+                    inner_w + u * inner_uw)
 
-        z, _, _ = newton(F, J, z, 1e-15, 40)
-        return float(z[1]) if np.all(np.isfinite(z)) and z[0] > 0 and z[1] > 0 else None
+        def system(z: np.ndarray) -> np.ndarray:
+            return np.array(values(z)[:2])
 
-    def extent(self, lo: float, hi: float, folds: list[float]) -> float:
-        """The largest amplitude on ``[lo, hi]`` (a grid and the folds)."""
-        grid = np.concatenate([np.linspace(lo, hi, 400), folds])
+        def jacobian(z: np.ndarray) -> np.ndarray:
+            _, Gu, Gw, Guu, Guw = values(z)
+            return np.array([[Gu, Gw], [Guu, Guw]])
+
+        out: list[float] = []
+        with np.errstate(over="ignore", invalid="ignore"):
+            for w2 in np.roots(coeffs):
+                if abs(w2.imag) > 1e-8 * (1 + abs(w2)) or w2.real <= 0:
+                    continue
+                omega = math.sqrt(w2.real)
+                slope = _poly.polytrim(_poly.polyval(w2.real, slope_u.T), 0)  # ∂G/∂u in u
+                if len(slope) < 2:
+                    continue
+                us = [x.real for x in _poly.polyroots(slope)
+                      if abs(x.imag) < 1e-8 * (1 + abs(x)) and x.real > 0]
+                if not us:
+                    continue
+                u = min(us, key=lambda x: abs(values((x, omega))[0]))
+                # singular (a cusp, or the scale of u swamps ω): Newton stops, the check judges
+                (u, omega), _, _ = newton(system, jacobian, np.array([u, omega]), 1e-15, 20)
+                if u > 0 and omega > 0 and abs(values((u, omega))[0]) < 1e-9 * (1 + f2):
+                    out.append(float(omega))
+        folds: list[float] = []
+        for w in sorted(out):
+            if not folds or w - folds[-1] > 1e-12 * w:
+                folds.append(w)
+        return tuple(folds)
+
+    def extent(self, lo: float, hi: float) -> float:
+        """The largest amplitude on ``[lo, hi]`` (a grid and the folds in it)."""
+        grid = np.concatenate([np.linspace(lo, hi, 400),
+                               [w for w in self.folds if lo <= w <= hi]])
         return float(max((r for w in grid for r in self.amplitudes(w)), default=0.0))
+
+
+def _rational(x: Fraction) -> flint.fmpq:
+    return flint.fmpq(x.numerator, x.denominator)
+
+
+def _array(p: flint.fmpq_mpoly) -> np.ndarray:
+    """The coefficients of ``p(u, w)`` as floats, ``[i, j]`` of ``u^i w^j``."""
+    terms = p.to_dict()
+    out = np.zeros((1 + max((i for i, _ in terms), default=0),
+                    1 + max((j for _, j in terms), default=0)))
+    for (i, j), c in terms.items():
+        out[i, j] = float(c)
+    return out
 
 
 EQUATION_POINT_SECONDS = (2e-3, 1e-6)
@@ -256,12 +268,13 @@ def equation_point_seconds(unknowns: int) -> float:
 
 
 @dataclass(frozen=True)
-class EquationResponse:
-    """What ``lindstedt response EQUATION`` computes before its sweeps."""
+class ResponseRange:
+    """The ω range of one equation's response curve: its one-harmonic balance, the range, the
+    one-harmonic folds in it and the linear ω0."""
 
     one_harmonic: OneHarmonic
     omega_range: tuple[float, float]
-    one_harmonic_folds: list[float]
+    one_harmonic_folds: tuple[float, ...]
     linear_frequency: float
 
 
@@ -274,18 +287,18 @@ def linear_frequency(terms: dict[tuple[int, int], float]) -> float:
     return math.sqrt(c)
 
 
-def equation_range(terms: dict[tuple[int, int], float], force: float,
+def response_range(terms: dict[tuple[int, int], float], force: float,
                    omega_min: float | None = None,
-                   omega_max: float | None = None) -> EquationResponse:
-    """The ω range of a response curve: as for eq. 10.60, half the lowest to 1.25 × the highest
-    of ω₀ and the one-harmonic folds (looked for in ``[ω₀/10, 10ω₀]``), each end replaced by
-    ``omega_min``/``omega_max`` where given."""
+                   omega_max: float | None = None) -> ResponseRange:
+    """The ω range of a response curve: half the lowest to 1.25 × the highest of ω₀ and the
+    one-harmonic folds (:attr:`OneHarmonic.folds`), each end replaced by
+    ``omega_min``/``omega_max`` where given (:func:`given_range`)."""
     w0 = linear_frequency(terms)
     one = OneHarmonic(dict(terms), float(force))
-    folds = one.folds(0.1 * w0, 10 * w0)
+    folds = one.folds
     lo, hi = given_range(0.5 * min([w0, *folds]), 1.25 * max([w0, *folds]), omega_min,
                          omega_max)
-    return EquationResponse(one, (lo, hi), [w for w in folds if lo <= w <= hi], w0)
+    return ResponseRange(one, (lo, hi), tuple(w for w in folds if lo <= w <= hi), w0)
 
 
 def equation_continuation_seconds(terms: dict[tuple[int, int], float], force: float,
@@ -295,8 +308,7 @@ def equation_continuation_seconds(terms: dict[tuple[int, int], float], force: fl
     """``(points, seconds)`` the continuation of :func:`continue_equation` is estimated at (its
     length ``(hi − lo) + π r_max`` over ``step``, r_max from the one-harmonic amplitudes), or
     :class:`InputError` above ``max_points``."""
-    one = OneHarmonic(dict(terms), float(force))
-    r_max = one.extent(lo, hi, one.folds(lo, hi, 400))
+    r_max = OneHarmonic(dict(terms), float(force)).extent(lo, hi)
     estimate = ((hi - lo) + np.pi * r_max) / step
     if not estimate <= max_points:
         where = f"force {force:g}" if where is None else where

@@ -45,13 +45,12 @@ from .response import (
     OneHarmonic,
     equation_continuation_seconds,
     equation_point_seconds,
-    equation_range,
     equation_solutions,
     given_range,
     linear_frequency,
-    one_harmonic_folds,
     polished,
     response_equation,
+    response_range,
 )
 
 SYSTEM_PROBES = 6
@@ -382,13 +381,10 @@ def _shot_checks(sb: SystemBalance, cont: Continuation, amplitudes: np.ndarray,
 @dataclass(frozen=True)
 class ClosedForms:
     """What the notes' eq. 10.60 knows in closed form, data of its response: its parameters
-    (``notes``: ε, f, Q as numbers), the one-harmonic folds of the cubic in ``u = r²``
-    (:func:`response.one_harmonic_folds`), the potential's barrier ``1/√−ε`` (``inf``
-    hardening) and the escape bound past which nothing returns
-    (:func:`numerics.integrate.escape_bound`)."""
+    (``notes``: ε, f, Q as numbers), the potential's barrier ``1/√−ε`` (``inf`` hardening)
+    and the escape bound past which nothing returns (:func:`numerics.integrate.escape_bound`)."""
 
     notes: tuple[tuple[str, float], ...]
-    folds: tuple[float, ...]
     barrier: float
     escape: float
 
@@ -402,8 +398,7 @@ def notes_problem(eps: float, force: float, Q: float) -> tuple[DrivenEquation, C
         raise InputError("Q inf: a response curve needs damping (finite Q) for a steady state")
     barrier = 1 / math.sqrt(-eps) if eps < 0 else math.inf  # the potential's maxima
     return d.equation, ClosedForms((("eps", float(eps)), ("force", float(force)),
-                                    ("Q", float(Q))), tuple(one_harmonic_folds(eps, force, Q)),
-                                   barrier, escape_bound(eps, force))
+                                    ("Q", float(Q))), barrier, escape_bound(eps, force))
 
 
 def driven_problem(text: str, values: dict[str, str], name: str = "oscillator"
@@ -623,11 +618,11 @@ RESPONSE_ENDS_SECONDS = 2 * 6.0
 
 def response_plan(problem: System | DrivenEquation, harmonics: int,
                   omega_min: float | None = None, omega_max: float | None = None,
-                  closed: ClosedForms | None = None, ends: bool = False) -> ResponsePlan:
+                  ends: bool = False) -> ResponsePlan:
     """The :class:`ResponsePlan` of :func:`response` (its refusals, in one line, first).
 
     One equation: the range from half the lowest to 1.25 × the highest of ω0 and the
-    one-harmonic folds (:func:`response.equation_range`; eq. 10.60's from ``closed``), the
+    one-harmonic folds (:func:`response.response_range`), the
     curve's length ``(B − A) + π r_max`` over the step 0.02, r_max the largest one-harmonic
     amplitude on the range, refused above :data:`continuation.MAX_POINTS`; with ``ends``, the
     ends where Newton from a one-harmonic root does not converge counted as drive
@@ -637,13 +632,8 @@ def response_plan(problem: System | DrivenEquation, harmonics: int,
     check_harmonics(harmonics)
     if isinstance(problem, DrivenEquation):
         de = problem
-        if closed is None:
-            er = equation_range(de.terms, de.force, omega_min, omega_max)
-            (lo, hi), folds, w0 = er.omega_range, er.one_harmonic_folds, er.linear_frequency
-        else:
-            lo, hi = given_range(0.5 * min([1.0, *closed.folds]),
-                                 1.25 * max([1.0, *closed.folds]), omega_min, omega_max)
-            folds, w0 = [w for w in closed.folds if lo <= w <= hi], 1.0
+        span = response_range(de.terms, de.force, omega_min, omega_max)
+        (lo, hi), folds, w0 = span.omega_range, span.one_harmonic_folds, span.linear_frequency
         points, seconds = equation_continuation_seconds(de.terms, de.force, harmonics, de.odd,
                                                         lo, hi, where=de.where)
         unknowns = 2 * harmonics if de.odd else 4 * harmonics - 1
@@ -824,7 +814,7 @@ def response(problem: System | DrivenEquation, harmonics: int = 6,
     One equation: its one-harmonic folds, each balance fold polished into the true orbit's
     (:func:`numerics.shooting.orbit_fold_table`) and the simulated sweeps both ways (escapes
     past the barrier)."""
-    plan = response_plan(problem, harmonics, omega_min, omega_max, closed)
+    plan = response_plan(problem, harmonics, omega_min, omega_max)
     sb = SystemBalance.of(problem, harmonics)
     (lo, hi), w0, fine = plan.omega_range, plan.linear_frequencies, sb.fine
     one = sb.one_harmonic is not None
