@@ -29,7 +29,7 @@ from lindstedt.derive.lindstedt import derive, period_series, solution_expressio
 from lindstedt.derive.models import A, duffing, eps, t
 from lindstedt.emit.render import load_generated
 from lindstedt.lower.records import Evaluator
-from lindstedt.lower.series import lower_free
+from lindstedt.lower.series import lower_periodic
 from sympy.codegen.rewriting import create_expand_pow_optimization, optimize
 from sympy.printing.c import C99CodePrinter
 from timing import best
@@ -141,7 +141,7 @@ def main() -> None:
     generate("duffing", K, tmp)
     mod = load_generated(tmp / "duffing.py")
     sol = derive(duffing(), K + 2)
-    ir = lower_free(sol, "bench")
+    ir = lower_periodic(sol, "bench")
     sol_k = derive(duffing(), K)
     f_period = sp.lambdify((A, eps), period_series(sol_k), "numpy")
     f_q = sp.lambdify((t, A, eps), solution_expression(sol_k), "numpy")

@@ -23,8 +23,8 @@ import tempfile
 import time
 
 import sympy as sp
-from lindstedt.cli.series import series_json
-from lindstedt.derive.lindstedt import derive
+from lindstedt.cli.system import periodic_json
+from lindstedt.derive.lindstedt import derive, validity
 from lindstedt.derive.models import series_model
 
 EQUATIONS = ("q'' + q + eps*(alpha*q**2 + q**3) = 0", "q'' + q + eps*q**3 = 0",
@@ -72,7 +72,7 @@ def main() -> None:
         sol = derive(model, args.order)
         derived = time.perf_counter() - start
         start = time.perf_counter()
-        json.dumps(series_json(sol))
+        json.dumps(periodic_json(sol, validity(sol)))
         output = time.perf_counter() - start
         start = time.perf_counter()
         sympy_output(sol)

@@ -91,8 +91,8 @@ order; a stage imports only stages above it::
                             [series | SlowFlow -> SeriesCurves, CycleCurves, Portrait, Backbone]
     lower.printers          NumbaPrinter(PythonCodePrinter), LaTeX rationals, a series'
                             validity in words [Expr -> str]
-    lower.records           the IR records (Module, Evaluator, Derivation, PeriodFormula, Unit)
-                            a template lays out [-> records]
+    lower.records           the IR records (Module, Evaluator, SeriesTables, SeriesDerivation,
+                            PeriodFormula, Unit) a template lays out [-> records]
     lower.forms             Horner/Estrin, the Chebyshev recurrence, AGM steps, argument guards,
                             the scaled variable x = εA^k [Expr -> Expr]
     lower.series            a family of periodic orbits of any number of coordinates (a free

@@ -22,10 +22,16 @@ from lindstedt.compiler import generate
 from lindstedt.derive.lindstedt import derive
 from lindstedt.derive.models import duffing
 from lindstedt.emit import render as emit
-from lindstedt.emit.render import check_writable, load_generated, render_latex, render_module
+from lindstedt.emit.render import (
+    check_writable,
+    load_generated,
+    render_derivation,
+    render_module,
+    render_tables,
+)
 from lindstedt.errors import InputError
-from lindstedt.lower.documents import lower_derivation
-from lindstedt.lower.series import lower_free
+from lindstedt.lower.documents import lower_series_derivation, lower_tables
+from lindstedt.lower.series import lower_periodic
 from lindstedt.methods import targets as methods
 
 SET = ("duffing.py", "duffing_tables.tex", "duffing_derivation.tex")
@@ -220,15 +226,15 @@ def test_demo_refuses_a_foreign_file_before_writing_anything(tmp_path):
 HOSTILE = ['x\nimport os; os.system("touch PWNED")', 'x"""; open("PWNED", "w")#', "x\\", 'x"',
            "x\r\n%\\input{/etc/passwd}", "x\u2028y\x00z", "\\\\\n\n"]
 SOLUTION = derive(duffing(), 3)
-MODULE = lower_free(SOLUTION, "x")
-DERIVATION = lower_derivation(SOLUTION, 3)
+MODULE = lower_periodic(SOLUTION, "x")
+DOCUMENTS = (lower_tables(SOLUTION, 3), lower_series_derivation(SOLUTION, 3))
 # NOTE: the command reaches the module and the LaTeX only through the provenance: the fuzz
-# below renders one lowering with each raw command put in it (lower_free's own folding to one
-# line left out: the printers must hold without it); HOSTILE's cases lower afresh.
+# below renders one lowering with each raw command put in it (lower_periodic's own folding to
+# one line left out: the printers must hold without it); HOSTILE's cases lower afresh.
 
 
 def _check_text(command: str, module=None) -> str:
-    module = module if module is not None else lower_free(SOLUTION, command)
+    module = module if module is not None else lower_periodic(SOLUTION, command)
     text = render_module(module)
     tree = ast.parse(text)
     assert isinstance(tree.body[0], ast.Expr)  # the docstring first, then imports
@@ -236,7 +242,8 @@ def _check_text(command: str, module=None) -> str:
                               ast.Expr)) for n in tree.body)
     head = text.splitlines()[:4]  # the fifth, the body hash, is added when written
     assert all(line.startswith("# ") for line in head) and head[2].startswith("# command: ")
-    for tex in render_latex(DERIVATION, module.provenance).values():
+    for tex in (*render_tables(DOCUMENTS[0], module.provenance).values(),
+                *render_derivation(DOCUMENTS[1], module.provenance).values()):
         assert all(line.startswith("% ") for line in tex.splitlines()[:4])
     return text
 

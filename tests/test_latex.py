@@ -14,9 +14,10 @@ import sympy as sp
 from lindstedt.compiler import generate, generate_driven, generate_limit_cycle
 from lindstedt.derive.lindstedt import derive
 from lindstedt.derive.models import model_by_name, series_model
-from lindstedt.emit.render import latex_context
-from lindstedt.lower.documents import lower_derivation
+from lindstedt.emit.render import derivation_context, tables_context
+from lindstedt.lower.documents import lower_series_derivation, lower_tables
 from lindstedt.lower.printers import (
+    EXACT_WIDTH,
     LATEX_LINE_DIGITS,
     LINE_EM,
     latex_digits,
@@ -109,16 +110,25 @@ def test_common_factors_are_pulled_out_of_a_sum():
 
 # --- the documents --------------------------------------------------------------------------
 
-def tex_rational(cell: str) -> sp.Rational:
-    """The exact value of a table cell ``-\frac{p}{q}`` or ``p`` (digits grouped)."""
-    m = re.fullmatch(r"(-?)(?:\\frac\{(\d+)\}\{(\d+)\}|(\d+))", ungrouped(cell))
+DECIMAL = r"-?\d+\.\d+( \\cdot 10\^\{-?\d+\})?"
+# NOTE: a table's long exact number, as its decimal (lower.printers.readable)
+
+
+def tex_number(cell: str) -> sp.Rational | sp.Float:
+    r"""The value of a table cell: exact ``-\frac{p}{q}`` or ``p`` (digits grouped), or a
+    decimal ``-1.25 \cdot 10^{-3}`` (a Float of its 12 digits)."""
+    text = ungrouped(cell)
+    if re.fullmatch(DECIMAL, text):
+        mantissa, _, power = text.partition(r" \cdot 10^{")
+        return sp.Float(mantissa, 15) * sp.Integer(10) ** int(power.rstrip("}") or 0)
+    m = re.fullmatch(r"(-?)(?:\\frac\{(\d+)\}\{(\d+)\}|(\d+))", text)
     assert m, cell
     sign, p, q, whole = m.groups()
     value = sp.Integer(whole) if whole else sp.Rational(int(p), int(q))
     return -value if sign else value
 
 
-def fourier_table(tex: str) -> dict[tuple[int, int], sp.Rational]:
+def fourier_table(tex: str) -> dict[tuple[int, int], sp.Rational | sp.Float]:
     """``{(j, n): coefficient}`` read from the Fourier table's blocks of a tables .tex."""
     section = tex[tex.index(r"\subsection*{Fourier coefficients"):]
     cells = {}
@@ -133,19 +143,27 @@ def fourier_table(tex: str) -> dict[tuple[int, int], sp.Rational]:
                 assert len(row) == len(harmonics), line
                 for n, cell in zip(harmonics, row, strict=True):
                     if cell:
-                        cells[int(j), n] = tex_rational(cell.removeprefix(r"\padmath{")[:-1])
+                        cells[int(j), n] = tex_number(cell.removeprefix(r"\padmath{")[:-1])
     return cells
 
 
 @pytest.mark.parametrize("model", ["duffing", "pendulum"])
 def test_fourier_table_is_j_by_n_with_the_exact_coefficients(model):
     """The committed table: rows j = 0..K, columns n = 1, 3, …, 2K + 1, each entry the
-    coefficient of cos ns in q_j of the series (Python API); blocks fit the page."""
+    coefficient of cos ns in q_j of the series (Python API), exact where it is short and to
+    12 significant digits where it is long; blocks fit the page."""
     tex = (GENERATED / f"{model}_tables.tex").read_text()
     order = int(re.search(r"order: (\d+)", tex)[1])
     solution = derive(model_by_name(model, order), order)
     exact = {(j, n): sp.Rational(str(c)) for j, qj in enumerate(solution.q) for n, c in qj.items()}
-    assert fourier_table(tex) == exact
+    table = fourier_table(tex)
+    assert set(table) == set(exact)
+    for key, value in table.items():
+        if isinstance(value, sp.Float):
+            assert abs(value / exact[key] - 1) <= 6e-12, (key, value, exact[key])
+        else:
+            assert value == exact[key], key
+    assert any(isinstance(v, sp.Float) for v in table.values())  # order 12: long numbers
     assert {j for j, _ in exact} == set(range(order + 1))
     assert {n for _, n in exact} == set(range(1, 2 * order + 2, 2))
     if model == "duffing":  # q_1 = (cos 3s - cos s)/32: the notes' first order
@@ -157,12 +175,14 @@ def test_fourier_table_is_j_by_n_with_the_exact_coefficients(model):
 
 def test_a_long_series_runs_several_terms_to_a_line():
     """T and ω of Duffing to order 12 (13 terms) take a few lines, order 2 one line."""
-    ctx = latex_context(lower_derivation(derive(model_by_name("duffing", 12), 12), 12))
+    ctx = tables_context(lower_tables(derive(model_by_name("duffing", 12), 12), 12))
     assert 2 <= len(ctx["period"]) <= 4 and 2 <= len(ctx["frequency"]) <= 4
     assert all(line.count("y^{") >= 2 for line in ctx["period"][:-1])
-    short = latex_context(lower_derivation(derive(model_by_name("duffing", 2), 2), 2))
+    sol = derive(model_by_name("duffing", 2), 2)
+    short = tables_context(lower_tables(sol, 2))
     assert len(short["period"]) == 1 and len(short["frequency"]) == 1
-    assert len(short["orders"][0]["solution"]) == 1  # q_1: two terms, one line
+    steps = derivation_context(lower_series_derivation(sol, 2))["orders"]
+    assert len(steps[0]["solution"][0]["lines"]) == 1  # q_1: two terms, one line
 
 
 # --- pdflatex -------------------------------------------------------------------------------
@@ -229,30 +249,24 @@ def test_tex_compiles_without_overfull_lines(written, name, tmp_path):
                                     for p in sorted(GENERATED.glob("*_tables.tex")))])
 def test_no_number_in_a_table_is_split(written, name):
     """A table cell holds each number on one line (\\padmath shrinks a wide one to its
-    column): no stacked digits, and every cell's digits are the exact coefficient's."""
+    column): no stacked digits; every cell exact, or a long number's decimal to at most 12
+    significant digits."""
     rows = [line for line in written[name].read_text().splitlines()
             if not line.startswith(("%", r"\newcommand"))]
     cells = [c for row in rows for c in re.findall(r"\\padmath\{(.*?)\}(?= &| \\\\)", row)]
     assert len(cells) > 20
     assert not any(LINES[0] in c for c in cells)
-    long_ones = [c for c in cells if len(ungrouped(c)) > LATEX_LINE_DIGITS]
+    # NOTE: a long exact number is printed as a 12-digit decimal (the exact forms are in
+    # --json and the module): short ones stay exact (p/q within EXACT_WIDTH characters).
     exact = r"-?(\\frac\{\d+\}\{\d+\}|\d+)"
-    if "kerschen" in name:
-        # NOTE: a normal mode's long exact numbers are printed as 12-digit decimals (the exact
-        # forms are in --json): short ones stay exact, and no cell is longer than a line.
-        decimal = r"-?\d+\.\d+( \\cdot 10\^\{-?\d+\})?"
-        assert not long_ones, long_ones
-        assert any(re.fullmatch(decimal, ungrouped(c)) for c in cells)
-        for cell in cells:
-            assert re.fullmatch(f"{exact}|{decimal}", ungrouped(cell)), cell
-            if re.fullmatch(decimal, ungrouped(cell)):  # 12 significant digits at most
-                mantissa = ungrouped(cell).split(" ")[0].lstrip("-").replace(".", "")
-                assert len(mantissa.lstrip("0")) <= 12, cell
-        return
-    if name.startswith("order-high/"):
-        assert long_ones  # order 40: numbers far longer than a stacked line
+    assert any(re.fullmatch(DECIMAL, ungrouped(c)) for c in cells)
     for cell in cells:
-        assert re.fullmatch(exact, ungrouped(cell)), cell
+        assert re.fullmatch(f"{exact}|{DECIMAL}", ungrouped(cell)), cell
+        if re.fullmatch(DECIMAL, ungrouped(cell)):  # 12 significant digits at most
+            mantissa = ungrouped(cell).split(" ")[0].lstrip("-").replace(".", "")
+            assert len(mantissa.lstrip("0")) <= 12, cell
+        else:
+            assert len(str(tex_number(cell))) <= EXACT_WIDTH, cell
 
 
 def test_every_kind_of_tex_is_compiled(written):
@@ -274,7 +288,7 @@ def test_one_notation_and_no_raw_input(written, name):
 
 def test_the_expansion_variable_is_y_and_headers_use_the_coordinate(written):
     duffing = written["order-high/duffing_tables.tex"].read_text()
-    assert r"y = \varepsilon A^2" in duffing and "x = " not in duffing
+    assert r"y = \varepsilon A^{2}" in duffing and "x = " not in duffing
     swing = written["order-high/swing_tables.tex"].read_text()
     assert r"$\theta(0) = A$" in swing and "q(0)" not in swing
     assert r"\ddot{\theta} + \sin\theta = 0" in swing

@@ -219,25 +219,30 @@ def test_the_derivation_document_s_equations_hold_exactly():
     harmonic, the secular condition ``ψ·(R_j1 + Ω_j φ) = 0``, ``ψ`` a left null vector, and
     the turning point ``x₁(0) = A`` (order j ≥ 1 sums to 0), all checked in exact arithmetic
     over Q(√3) on the record the LaTeX is rendered from."""
-    from lindstedt.lower.system import mode_derivation
+    from lindstedt.lower.documents import lower_series_derivation
 
     for text, mode in ((KERSCHEN, 2), (SYMMETRIC, 1),
                        ("x1'' + 3*x1 - x2 + x1**2 = 0; x2'' + x2 - x1/2 = 0", 2)):
-        d = mode_derivation(normal_mode(parse_system(text), mode, 5), 5, "m")
-        L, lam = d.stiffness, d.lam
-        phi, psi = sp.Matrix(d.right), sp.Matrix(d.left)
+        d = lower_series_derivation(normal_mode(parse_system(text), mode, 5), 5)
+        L, lam = d.linear.stiffness, d.linear.lam
+        phi, psi = sp.Matrix(d.linear.right), sp.Matrix(d.linear.left)
+        assert d.weights == d.linear.right  # Ω_j enters along φ
         assert sp.simplify((L - lam * sp.eye(2)) * phi) == sp.zeros(2, 1)
         assert sp.simplify(psi.T * (L - lam * sp.eye(2))) == sp.zeros(1, 2)
         assert len(d.orders) == 5
         for o in d.orders:
+            right = [dict(r) for r in o.right]
+            solved = [dict(c) for c in o.solution]
             amplitude = 0
-            for n, R, c in o.harmonics:
-                lhs = (L - n * n * lam * sp.eye(2)) * sp.Matrix(c)
-                rhs = sp.Matrix(R) + (o.omega_squared * phi if n == 1 else sp.zeros(2, 1))
+            for n in sorted({n for part in (*right, *solved) for n in part}):
+                R = sp.Matrix([part.get(n, 0) for part in right])
+                c = sp.Matrix([part.get(n, 0) for part in solved])
+                lhs = (L - n * n * lam * sp.eye(2)) * c
+                rhs = R + (o.value * phi if n == 1 else sp.zeros(2, 1))
                 assert sp.simplify(lhs - rhs) == sp.zeros(2, 1), (text, o.j, n)
                 if n == 1:
                     assert sp.simplify(psi.dot(rhs)) == 0
-                    assert sp.simplify(psi.dot(sp.Matrix(R)) - o.secular) == 0
+                    assert sp.simplify(psi.dot(R) - o.secular) == 0
                 amplitude += c[0]
             assert sp.simplify(amplitude) == 0
 

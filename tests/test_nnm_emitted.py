@@ -7,6 +7,7 @@ import functools
 import importlib.util
 import math
 
+import mpmath
 import numpy as np
 import pytest
 import sympy as sp
@@ -95,10 +96,10 @@ def _mems_series(which: int):
 def mems1(tmp_path_factory):
     """Mode 1's order-8 module, the one whose guard was ``if not (False)``: NaN everywhere."""
     from lindstedt.emit.render import render_module
-    from lindstedt.lower.system import lower_nnm
+    from lindstedt.lower.series import lower_periodic
 
     path = tmp_path_factory.mktemp("mems") / "mems1.py"
-    path.write_text(render_module(lower_nnm(_mems_series(1), 8, "mems1", "test")))
+    path.write_text(render_module(lower_periodic(_mems_series(1), "test", 8, "mems1")))
     return _load(path, "mems1")
 
 
@@ -152,20 +153,20 @@ def test_mems_mode_2_series_meets_shooting_inside_its_bound():
 def test_mems_allow_divergent_lifts_the_guard_and_a_bound_of_zero_is_refused(monkeypatch):
     from lindstedt.derive.nnm import ModeRadius
     from lindstedt.errors import InputError
-    from lindstedt.lower import system as lowering
+    from lindstedt.lower import series as lowering
 
     series = _mems_series(1)
-    guarded = lowering.lower_nnm(series, 4, "m", "test")
-    free = lowering.lower_nnm(series, 4, "m", "test", allow_divergent=True)
+    guarded = lowering.lower_periodic(series, "test", 4, "m")
+    free = lowering.lower_periodic(series, "test", 4, "m", allow_divergent=True)
     assert dict(free.constants)["ALLOW_DIVERGENT"] is True
     lower = dict(guarded.constants)["RADIUS_LOWER"]
     assert any(abs(float(f) - lower) < 1e-9 for f in guarded.evaluators[0].guard.atoms(
         sp.Float)) and not any(abs(float(f) - lower) < 1e-9 for f in
                                free.evaluators[0].guard.atoms(sp.Float))
-    monkeypatch.setattr(lowering, "radius", lambda mode: ModeRadius(1.0, 5.0, 0.0, "test", 2))
+    monkeypatch.setattr(lowering, "mode_radius", lambda mode: ModeRadius(1.0, 5.0, 0.0, "test", 2))
     with pytest.raises(InputError, match="every amplitude would be NaN"):
-        lowering.lower_nnm(series, 4, "m", "test")
-    assert lowering.lower_nnm(series, 4, "m", "test", allow_divergent=True)
+        lowering.lower_periodic(series, "test", 4, "m")
+    assert lowering.lower_periodic(series, "test", 4, "m", allow_divergent=True)
 
 
 SWINGING = ("1.2*x1'' + 0.3*x2'' + 2.5*x1 - 0.7*x2 + 0.9*x1**3 = 0; "
@@ -189,3 +190,33 @@ def test_a_mode_without_a_radius_estimate_still_has_a_bound(tmp_path):
         period, starts = _evaluate(series, A)
         true = abs(m.period(A) / _shoot(SWINGING, A, starts[1:], period / 2)[1] - 1)
         assert m.error_estimate(A) >= true or true < 1e-12, (A, m.error_estimate(A), true)
+
+
+def test_one_lowering_of_a_one_coordinate_oscillator_as_a_series_and_as_a_mode(tmp_path):
+    """Free L–P is the normal-mode method at n = 1, and one lowering emits both: Duffing
+    q'' + q + q³/2 = 0 lowered from its one-coordinate series and from its one-coordinate
+    normal mode gives the same period, frequency and motion; the period meets the elliptic
+    integral (T = 4K(m)/√(1 + x), x = A²/2, m = x/(2(1 + x))) within error_estimate."""
+    from lindstedt.derive.lindstedt import derive
+    from lindstedt.derive.models import model_from_text
+    from lindstedt.emit.render import render_module
+    from lindstedt.lower.series import lower_periodic
+
+    text, K = "q'' + q + q**3/2 = 0", 10
+    as_series = lower_periodic(derive(model_from_text(text, K + 2), K + 2), "test")
+    as_mode = lower_periodic(normal_mode(parse_system(text), 1, K + 2), "test", K, "one_mode")
+    (tmp_path / "one_series.py").write_text(render_module(as_series))
+    (tmp_path / "one_mode.py").write_text(render_module(as_mode))
+    series, mode = _load(tmp_path / "one_series.py", "one_series"), _load(
+        tmp_path / "one_mode.py", "one_mode")
+    assert mode.ORDER == series.ORDER == K and hasattr(series, "qdot")
+    A = np.array([0.1, 0.4, 0.8])
+    x = A**2 / 2
+    exact = np.array([float(4 * mpmath.ellipk(v / (2 * (1 + v))) / mpmath.sqrt(1 + v))
+                      for v in x])
+    for m in (series, mode):
+        assert np.all(np.abs(m.period(A) / exact - 1) <= np.maximum(m.error_estimate(A), 1e-14))
+        np.testing.assert_allclose(m.omega(A) * exact / (2 * np.pi), 1, rtol=1e-6)
+    np.testing.assert_allclose(mode.period(A), series.period(A), rtol=1e-14)
+    t = np.linspace(0, 7, 15)
+    np.testing.assert_allclose(mode.q(t, 0.8), series.q(t, 0.8), rtol=0, atol=1e-14)

@@ -8,7 +8,7 @@ from pathlib import Path
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
 # well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
 from .common import _flag_overwrite_edited, _out_folder
-from .series import series_table
+from .system import periodic_json, periodic_table
 
 DEMO_ORDER = 12
 # NOTE: the demo's free evaluators: order 12 keeps T(A) within 1e-6 for |εA²| ≤ 0.3 and the
@@ -50,7 +50,7 @@ def run_demo(args: argparse.Namespace) -> int:
     for name, _ in drawn:
         check_plot_path(figures / name)
     duffing6 = derive(model_by_name("duffing", 6), 6)
-    print(series_table(duffing6, validity(duffing6)))
+    print(periodic_table(periodic_json(duffing6, validity(duffing6))))
     print(f"\nwriting the default evaluators and LaTeX into {out}/")
     for name in ("duffing", "pendulum"):
         for path in generate(name, DEMO_ORDER, out, overwrite_edited=args.overwrite_edited):

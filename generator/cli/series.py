@@ -6,7 +6,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import re
 import sys
 from fractions import Fraction
 from pathlib import Path
@@ -35,149 +34,18 @@ from .common import (
     _params,
     _positive,
     _positive_real,
-    _rational,
     _real,
     check_outputs,
     sp_text,
     write_csv,
 )
-
-
-def _monomial(powers: tuple[tuple[str, int], ...]) -> str:
-    """SymPy's spelling of a monomial: ``"A**2*alpha"``, ``"1"`` for the constant."""
-    return "*".join(n if e == 1 else f"{n}**{e}" for n, e in powers) or "1"
-
-
-def _coefficient(sol, c: object) -> str | dict:
-    """``"p/q"``, or for coefficients in ``QQ[A, params]`` an object mapping each monomial
-    (SymPy's ``str``: ``"A**2*alpha"``, ``"1"``) to its exact ``"p/q"``, formatted from
-    FLINT's terms (no SymPy on the way)."""
-    if sol.ground.is_rational:
-        return _rational(c)
-    return dict(sorted((_monomial(m), _rational(v)) for m, v in sol.ground.terms(c)))
-
-
-def _polynomial_text(sol, c: object) -> str:
-    """A coefficient in ``QQ[A, params]`` as SymPy writes it (``3*A**2*alpha/8 - A/4``, in
-    SymPy's order), formatted from FLINT's terms."""
-    names = sorted({n for powers, _ in sol.ground.terms(c) for n, _ in powers})
-
-    def order(term: tuple) -> tuple:  # SymPy's: lex on the names (sorted), descending
-        powers = dict(term[0])
-        return tuple(-powers.get(n, 0) for n in names)
-
-    terms = sorted(sol.ground.terms(c), key=order)
-    out = []
-    for powers, v in terms:
-        p, q = abs(int(v.p)), int(v.q)
-        body = _monomial(powers) if powers else ""
-        if body:
-            body = (body if p == 1 else f"{p}*{body}") + (f"/{q}" if q != 1 else "")
-        else:
-            body = f"{p}/{q}" if q != 1 else f"{p}"
-        out.append(("- " if v < 0 else "+ ") + body)
-    if not out:
-        return "0"
-    text = " ".join(out)
-    return text[2:] if text.startswith("+ ") else "-" + text[2:]
-
-
-def series_json(sol, valid) -> dict:
-    """The contract of ``lindstedt series MODEL --order K --json`` (keys are stable) of the
-    solution and its :class:`derive.lindstedt.Validity`."""
-    m = sol.model
-    data = {
-        "model": m.name,
-        "order": sol.order,
-        "variable": m.variable,
-        "omega": [_coefficient(sol, c) for c in sol.omega],
-        "period": [_coefficient(sol, c) for c in sol.period],
-        "q": [{str(n): _coefficient(sol, c) for n, c in sorted(qj.items())} for qj in sol.q],
-        "convention": sol.convention,
-        "radius": None if m.radius is None else str(m.radius),
-    }
-    data.update(_domain_fields(sol, valid))
-    if m.source:
-        data.update(equation=m.source, omega0=str(m.frequency),
-                    units="omega in units of omega0, period in units of 2*pi/omega0")
-    return data
-
-
-def _domain_fields(sol, valid) -> dict:
-    """Where the series may be used: ``orbit_limit`` (the family of periodic orbits exists
-    for lower < y < upper, 30 digits, or ``known`` false with the reason) and, where the
-    model states no radius, ``radius_estimate`` (value and spread, from the τ_j)."""
-    fields = {"orbit_limit": valid.orbit.as_json()}
-    if valid.exact is None and valid.radius is not None:
-        fields["radius_estimate"] = {"value": valid.radius, "spread": valid.spread}
-    return fields
-
-
-def _radius_line(valid, y: str) -> str:
-    """The table's line on the radius of convergence of the series in ``y``."""
-    if valid.exact is not None:
-        shown = str(valid.exact)
-        value = "" if shown == _short(valid.radius) else f" = {valid.radius:.12g}"
-        return f"the series converges for |{y}| < {shown}{value} (the radius, exact)"
-    if valid.radius is not None:
-        return (f"the series converges for |{y}| < {valid.radius:.6g} (the radius estimated "
-                f"from tau_j to order {valid.order}, spread {valid.spread:.2g})")
-    return ("radius of convergence not estimated (symbolic coefficients, or order < 2: "
-            "raise --order, give the parameters values)")
-
-
-def _number(c: object) -> str:
-    """An exact rational as a reader writes it: ``3/8``, an integer as ``1`` (the JSON keeps
-    ``"p/q"`` for scripts)."""
-    return f"{c.p}" if c.q == 1 else f"{c.p}/{c.q}"
+from .system import _short, periodic_json, periodic_table
 
 
 def _human(c: object) -> str:
     """:func:`_fraction_text` as a reader writes it: an integer without ``/1``."""
     text = _fraction_text(c)
     return text.removesuffix("/1") if text.endswith("/1") and "/" not in text[:-2] else text
-
-
-def _coordinate_named(convention: str, name: str) -> str:
-    """The convention in the user's coordinate: ``theta(0) = A, theta'(0) = 0, …``."""
-    return convention if name == "q" else re.sub(r"\bq(_j)?(?=\(|'\()", name + r"\1",
-                                                 convention)
-
-
-def series_table(sol, valid) -> str:
-    """Readable table: where the series holds (its orbits, its radius: ``valid``, the
-    solution's :class:`derive.lindstedt.Validity`), then ω_j, T_j/2π and the harmonics of q_j
-    per order."""
-    m = sol.model
-    lines = [
-        f"{m.name}: {m.title}, expansion variable {m.variable}, order {sol.order}",
-        f"convention: {_coordinate_named(sol.convention, str(m.coordinate))}",
-    ]
-    if m.frequency != 1:
-        lines.append(f"omega in units of omega0 = {m.frequency}, T in units of 2*pi/omega0")
-    domain = valid.orbit.as_json()
-    y = m.variable.partition("=")[0].strip() or m.variable
-    lines.append(f"periodic orbits for {domain['lower']} < {y} < {domain['upper']} "
-                 f"({domain['how']})" if domain["known"] else
-                 f"orbit domain not computed: {domain['how']}")
-    lines.append(_radius_line(valid, y))
-    if sol.ground.is_rational:
-        lines.append(f"{'j':>3}  {'omega_j':>24}  {'(T/2pi)_j':>24}  "
-                     f"{m.coordinate}_j: harmonic n -> coefficient")
-        for j in range(sol.order + 1):
-            harmonics = ", ".join(f"{n}: {_number(c)}" for n, c in sorted(sol.q[j].items()))
-            lines.append(f"{j:>3}  {_number(sol.omega[j]):>24}  "
-                         f"{_number(sol.period[j]):>24}  {harmonics}")
-        return "\n".join(lines)
-    def g(c: object) -> str:
-        return _polynomial_text(sol, c)
-
-    for j in range(sol.order + 1):  # symbolic coefficients: one block an order
-        lines.append(f"j = {j}: omega_j = {g(sol.omega[j])}")
-        lines.append(f"       (T/2pi)_j = {g(sol.period[j])}")
-        for n, c in sorted(sol.q[j].items()):
-            lines.append(f"       q_j[cos {n}s] = {g(c)}")
-    return "\n".join(lines)
 
 
 def limit_cycle_json(lc) -> dict:
@@ -228,11 +96,6 @@ def _cycles_json(cycles) -> list[dict]:
     return [{"amplitude0": str(c.amplitude), "slope": str(c.slope), "stability": c.stability,
              "expandable": c.slope != 0, "amplitude0_value": float(c.amplitude)}
             for c in cycles]
-
-
-def _short(x: float) -> str:
-    """A float as its shortest text, an integer without ``.0`` (``2``, ``1.5``)."""
-    return str(int(x)) if float(x).is_integer() else repr(float(x))
 
 
 def _cycles_text(model, listed: list[dict]) -> str:
@@ -347,8 +210,8 @@ def run_series(args: argparse.Namespace) -> int:
         sol = derive(model, args.order, progress)
         progress.close()
         valid = validity(sol)
-        data = series_json(sol, valid)
-        text = "" if args.json else series_table(sol, valid)  # build only what is printed
+        data = periodic_json(sol, valid)
+        text = "" if args.json else periodic_table(data, args.exact)  # only what is printed
         omega = [sol.ground.to_fraction(c) for c in sol.omega] if sol.ground.is_rational \
             else None
         if plot or csv:
@@ -705,7 +568,8 @@ def run_generate(args: argparse.Namespace) -> int:
         if args.resum_order is not None:
             raise InputError(f"--resum-order: {model.name} has no limit cycle; only a limit "
                              "cycle's frequency is resummed from a longer series")
-        check_emitted_names(model)  # before the derivation: a clash is known at once
+        check_emitted_names([str(model.coordinate)], [n for n, _ in model.parameters])
+        # before the derivation: a clash is known at once
         progress = ProgressBar(f"deriving {model.name} to order {order + 2}")
         paths = compiler.generate(model, order, out, args.allow_divergent, progress,
                                   overwrite_edited=args.overwrite_edited)
@@ -770,6 +634,9 @@ def arguments_series(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    "(Domb–Sykes or Mercer–Roberts, extrapolated in 1/n; their spread over the "
                    "last orders); with --json a key 'singularities'")
     _flag_json(p)
+    p.add_argument("--exact", action="store_true",
+                   help="the table shows every number exactly (default: a long exact "
+                   "rational as its decimal to 12 significant digits; --json holds both)")
     p.add_argument("--plot", metavar="FILE",
                    help="also draw into FILE (.png, .svg or .pdf) ω and T against the "
                    "expansion variable y, with the orbits' edge and the radius of convergence "

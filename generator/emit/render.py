@@ -43,14 +43,13 @@ from ..lower.printers import (
 from ..lower.records import (
     ArrayKernel,
     CycleDerivation,
-    Derivation,
     Evaluator,
-    ModeDerivation,
-    ModeTables,
     Module,
     MuDampedDerivation,
     MuDerivation,
     Provenance,
+    SeriesDerivation,
+    SeriesTables,
     SlowFlowDocument,
     Unit,
 )
@@ -199,14 +198,18 @@ def _signed(c: sp.Expr, factor: str, first: bool) -> str:
     """``+ \\frac{p}{q} factor`` with the sign pulled out (LaTeX; no number is split)."""
     if c.is_Float:  # a long exact number shown as its decimal
         sign = "-" if c < 0 else ("" if first else "+")
-        return f"{sign} {latex_expr(abs(c))}\\,{factor}".strip()
+        spaced = f"\\,{factor}" if factor else ""
+        return f"{sign} {latex_expr(abs(c))}{spaced}".strip()
     if not c.is_Rational:  # a polynomial in the symbolic parameters: bracketed, as it is
+        spaced = f"\\,{factor}" if factor else ""
         return (f"{'' if first else '+'} \\left({latex_coefficient(c, stack=False)}\\right)"
-                f"\\,{factor}").strip()
+                f"{spaced}").strip()
     c = sp.Rational(c)
     sign = "-" if c < 0 else ("" if first else "+")
     mag = abs(c)
     body = "" if mag == 1 and factor else latex_rational(mag, stack=False)
+    if not factor:
+        return f"{sign} {body}".strip()
     return f"{sign} {body}\\,{factor}".strip() if body else f"{sign} {factor}".strip()
 
 
@@ -273,66 +276,181 @@ def _fourier_columns(q: tuple) -> list[tuple[str, dict[int, str]]]:
             for n in harmonics]
 
 
-def latex_context(d: Derivation) -> dict:
-    """Everything the two LaTeX templates use, as strings."""
-    variable = {"duffing": r"y = \varepsilon A^2", "pendulum": r"y = \theta_0^2"}.get(
-        d.model, latex_expr(d.y) if d.y.is_Symbol else f"y = {latex_expr(d.y)}"
-    )
-    y = variable.split("=")[0].strip()  # a symbol: powers y^{j} of it are valid TeX
-    qs = latex_expr(d.coordinate)
-    coefficients = [(header, {j: latex_coefficient(c, stack=False) for j, c in enumerate(cs)})
-                    for header, cs in ((r"$\omega_j$", d.omega), (r"$\tau_j$", d.period))]
-    # table cells: a number is never split; \padmath shrinks one wider than its column
+def _part(name: str, j: str) -> str:
+    """The order-``j`` part of a coordinate named ``name`` in LaTeX: ``q_{j}``, and for a
+    name with a subscript ``x_{1}`` the entry ``x_{1,j}``."""
+    if name.endswith("}") and "_{" in name:
+        return f"{name[:-1]},{j}}}"
+    return f"{name}_{{{j}}}"
+
+
+def _variable(y: sp.Expr) -> tuple[str, str]:
+    """The expansion variable as the documents state it (``y = \\varepsilon A^{2}``, or the
+    amplitude itself) and the symbol its powers are written in."""
+    if y.is_Symbol:
+        return latex_expr(y), latex_expr(y)
+    return f"y = {latex_expr(y)}", "y"
+
+
+def _convention(coordinates: tuple, amplitude: sp.Symbol, value: sp.Expr) -> str:
+    """The amplitude convention as LaTeX: the amplitude coordinate at ``value`` and every
+    velocity zero at t = 0, so each order's part of that coordinate vanishes there."""
+    amp = latex_expr(amplitude)
+    velocities = ", ".join(f"$\\dot {latex_expr(x)}(0) = 0$" for x in coordinates)
+    return (f"${amp}(0) = {latex_expr(value)}$, {velocities}, so "
+            f"${_part(amp, 'j')}(0) = 0$ for $j \\ge 1$")
+
+
+def tables_context(d: SeriesTables) -> dict:
+    """Everything ``tables.tex.j2`` uses, as strings: a long exact number as its decimal
+    (:func:`printers.readable`), in the cells and in the series of ω and T."""
+    variable, y = _variable(d.y)
 
     def powers(coeffs: tuple) -> list[str]:
-        return [_signed(coeffs[j], f"{y}^{{{j}}}" if j > 1 else y, first=False)
+        return [_signed(readable(coeffs[j]), f"{y}^{{{j}}}" if j > 1 else y, first=False)
                 for j in range(1, d.order + 1) if coeffs[j] != 0]
 
+    def cells(cs: tuple) -> dict[int, str]:
+        return {j: latex_coefficient(readable(c), stack=False) for j, c in enumerate(cs)}
+
     rest = f"+ O({y}^{{{d.order + 1}}})"
-    amp = latex_expr(d.amplitude)
-    orders = []
-    for t in d.orders:
-        scale = latex_expr(d.amplitude * d.order_factor**t.j)
-        secular = _signed(t.resonant, scale, first=True) + f" + 2{amp}\\,\\omega_{{{t.j}}}"
-        orders.append({
-            "j": t.j,
-            "forcing": _lines([f"\\left({secular}\\right)\\cos s",
-                               *_harmonic_terms(dict(t.forcing), scale, leading=False)],
-                              f"{qs}_{{{t.j}}}'' + {qs}_{{{t.j}}} = F_{{{t.j}}}(s) ="),
-            "secular": _fit(secular + " = 0", ""),
-            "omega": _fit(_signed(t.omega, latex_expr(d.order_factor**t.j), first=True),
-                          rf"\Longrightarrow\quad \omega_{{{t.j}}} ="),
-            "solution": _lines(_harmonic_terms(dict(t.q), scale, leading=True),
-                               f"{qs}_{{{t.j}}}(s) ="),
-        })
+    w0 = latex_expr(readable(d.omega0))
+    root = minimal_polynomial(d.omega0, "omega_0") if is_long(d.omega0) else None
+    unit = d.omega0 == 1
     return {
-        "title": f"{_model_text(d.model)}: ${d.latex}$",
-        "q": qs,
+        "title": d.title,
+        "equations": list(d.equations),
+        "omega0": w0, "omega0_root": "" if root is None else latex_expr(root),
+        "variable": variable, "y": y, "order": d.order,
+        "convention": _convention(tuple(x for x, _ in d.coordinates), d.amplitude,
+                                  d.amplitude_value),
+        "validity": "" if d.validity is None else latex_validity(d.validity, y),
+        "coefficients": _table_blocks([(r"$\omega_j$", cells(d.omega)),
+                                       (r"$\tau_j$", cells(d.period))]),
+        "frequency": _series("" if unit else w0 + r"\Bigl(", powers(d.omega),
+                             rest + ("" if unit else r"\Bigr)"), r"\omega ="),
+        "period": _series(r"2\pi\Bigl(" if unit else r"\frac{2\pi}{" + w0 + r"}\Bigl(",
+                          powers(d.period), rest + r"\Bigr)", "T ="),
+        "scale": (f"{y}^{{j+1}}" if d.y == d.amplitude_value else
+                  f"{latex_expr(d.amplitude_value)}\\,{y}^j"),
+        "coordinates": [{"name": latex_expr(x), "blocks": _table_blocks(_fourier_columns(
+            tuple(tuple((n, readable(c)) for n, c in qj) for qj in q)))}
+                        for x, q in d.coordinates],
+    }
+
+
+def render_tables(d: SeriesTables, p: Provenance) -> dict[str, str]:
+    """``{name_tables.tex: text}``: a family of periodic orbits' coefficient tables, one
+    coordinate or several."""
+    text = environment(latex=True).get_template("tables.tex.j2").render(
+        banner=banner(p, "%"), **tables_context(d))
+    return {f"{p.model}_tables.tex": text}
+
+
+def _vector(values: tuple) -> str:
+    return (r"\begin{pmatrix}" + r" \\ ".join(latex_expr(readable(v)) for v in values)
+            + r"\end{pmatrix}")
+
+
+def _times(c: sp.Expr, factor: str) -> str:
+    """``+ c\\,factor`` with the sign pulled out: a number as :func:`_signed`, an expression
+    in the amplitude (``2A``) as it prints."""
+    c = readable(c)
+    if c.is_number:
+        return _signed(c, factor, first=False)
+    return f"+ {latex_expr(c)}\\,{factor}"
+
+
+def derivation_context(d: SeriesDerivation) -> dict:
+    """Everything ``derivation.tex.j2`` uses, as strings: per order the right side's lines
+    per coordinate (its resonant ``cos s`` term with the unknown frequency correction), the
+    secular condition and its solution, the periodic solution's lines; a long exact number
+    as its decimal."""
+    variable, y = _variable(d.y)
+    names = [latex_expr(x) for x in d.coordinates]
+    strained = d.linear is None  # one coordinate: ω strained directly, no Ω = ω²
+    orders = []
+    for o in d.orders:
+        scale = latex_expr(d.unit * d.order_factor**o.j)
+        scale = "" if scale == "1" else scale
+        unknown = f"{d.unknown}_{{{o.j}}}"
+        right = []
+        for i, name in enumerate(names):
+            terms = []
+            for n, c in o.right[i]:
+                c = readable(c)
+                if n == 1:  # the resonant term: known part and the unknown correction
+                    known = [_signed(c, scale, first=True)] if c != 0 else []
+                    weight = readable(d.weights[i])
+                    if weight != 0:
+                        known.append(_times(weight, unknown).removeprefix("+ ")
+                                     if not known else _times(weight, unknown))
+                    if known:
+                        terms.append(r"\left(" + " ".join(known) + r"\right)\cos s")
+                elif c != 0:
+                    terms.append(_signed(c, scale + _trig("cos", n), first=False))
+            if terms and terms[0].startswith("+ "):
+                terms[0] = terms[0][2:]
+            part = _part(name, str(o.j))
+            lhs = (f"{part}'' + {part} = F_{{{o.j}}}(s)" if strained else
+                   rf"F_{{{o.j}}}(s)\big|_{{{name}}}")
+            right.append({"lhs": lhs, "lines": _lines(terms or ["0"], lhs + " =")})
+        weight = sum((a * b for a, b in zip(d.linear.left if d.linear else (1,), d.weights,
+                                            strict=True)), sp.Integer(0))
+        secular = _signed(readable(o.secular), scale, first=True) + " " + _times(weight, unknown)
+        head = "" if strained else (rf"\psi\cdot R_{{{o.j},1}} + \Omega_{{{o.j}}}\,"
+                               r"\psi\cdot\varphi = ")
+        factor = latex_expr(d.order_factor**o.j)
+        value = _signed(readable(o.value), "" if factor == "1" else factor, first=True)
+        solution = []
+        for i, name in enumerate(names):
+            part = _part(name, str(o.j))
+            lhs = f"{part}(s)"
+            terms = _harmonic_terms({n: readable(c) for n, c in o.solution[i]}, scale,
+                                    leading=True)
+            solution.append({"lhs": lhs, "lines": _lines(terms or ["0"], lhs + " =")})
+        orders.append({
+            "j": o.j, "right": right,
+            "secular": _fit(head + secular + " = 0", ""),
+            "value": _fit(f"{unknown} = {value}", r"\Longrightarrow\quad"),
+            "start": f"{_part(latex_expr(d.amplitude), str(o.j))}(0) = 0",
+            "solution": solution,
+        })
+    linear = None
+    if d.linear is not None:
+        L = d.linear.stiffness
+        linear = {
+            "stiffness": r"\begin{pmatrix}" + r" \\ ".join(
+                " & ".join(latex_expr(L[i, k]) for k in range(L.cols))
+                for i in range(L.rows)) + r"\end{pmatrix}",
+            "lam": latex_expr(readable(d.linear.lam)), "right": _vector(d.linear.right),
+            "left": _vector(d.linear.left),
+            "psi_phi": latex_expr(readable(sp.expand(sum(
+                a * b for a, b in zip(d.linear.left, d.linear.right, strict=True))))),
+        }
+    q = names[0]
+    return {
+        "title": d.title,
+        "equations": list(d.equations),
+        "linear": linear,
+        "parts": ", ".join(_part(x, "j") for x in names),
+        "q": q,
+        "coupling": "" if d.coupling == 1 or not strained else r"\varepsilon^j",
         "variable": variable,
         "y": y,
         "order": d.order,
-        "convention": (f"${qs}(0) = {amp}$, $\\dot {qs}(0) = 0$, "
-                       f"so ${qs}_j(0) = 0$ for $j \\ge 1$"),
-        "coupling": "" if d.coupling == 1 else r"\varepsilon^j",
-        "coefficients": _table_blocks(coefficients),
-        "fourier": _table_blocks(_fourier_columns(d.q)),
-        "period": _series(r"2\pi\Bigl(", powers(d.period), rest + r"\Bigr)", "T ="),
-        "frequency": _series("", powers(d.omega), rest, r"\omega ="),
+        "convention": _convention(d.coordinates, d.amplitude, d.amplitude_value),
+        "validity": "" if d.validity is None else latex_validity(d.validity, y),
         "orders": orders,
-        "validity": latex_validity(d.validity, y),
     }
 
 
-def render_latex(d: Derivation, p: Provenance) -> dict[str, str]:
-    """``{file name: text}`` of the tables and the derivation document."""
-    env = environment(latex=True)
-    ctx = latex_context(d)
-    head = banner(p, "%")
-    return {
-        f"{p.model}_tables.tex": env.get_template("tables.tex.j2").render(banner=head, **ctx),
-        f"{p.model}_derivation.tex": env.get_template("derivation.tex.j2").render(
-            banner=head, **ctx),
-    }
+def render_derivation(d: SeriesDerivation, p: Provenance) -> dict[str, str]:
+    """``{name_derivation.tex: text}``: a family of periodic orbits' L–P derivation order by
+    order, one coordinate or several."""
+    text = environment(latex=True).get_template("derivation.tex.j2").render(
+        banner=banner(p, "%"), **derivation_context(d))
+    return {f"{p.model}_derivation.tex": text}
 
 
 def _display(expr: sp.Expr, lhs: str = "", rhs: str = "") -> list[str]:
@@ -464,69 +582,6 @@ def render_cycle_derivation(d: CycleDerivation, p: Provenance) -> dict[str, str]
     return {f"{p.model}_derivation.tex": tex}
 
 
-def render_mode_tables(d: ModeTables, p: Provenance) -> dict[str, str]:
-    """``{name_tables.tex: text}``: a normal mode's frequency, period and coefficient tables."""
-    y = "y"
-    variable = f"y = {latex_expr(d.variable)}" if d.variable != sp.Symbol("A") else "A"
-    if variable == "A":
-        y = "A"
-
-    def powers(coeffs: tuple) -> list[str]:
-        return [_signed(readable(coeffs[j]), f"{y}^{{{j}}}" if j > 1 else y, first=False)
-                for j in range(1, d.order + 1) if coeffs[j] != 0]
-
-    rest = f"+ O({y}^{{{d.order + 1}}})"
-    w0 = latex_expr(readable(d.omega0))
-    root = minimal_polynomial(d.omega0, "omega_0") if is_long(d.omega0) else None
-    head = banner(p, "%")
-    ctx = {
-        "title": f"Nonlinear normal mode {d.mode}",
-        "equations": [latex_expr(e) + " = 0" for e in d.equations],
-        "omega0": w0, "omega0_root": "" if root is None else latex_expr(root),
-        "variable": variable, "y": y, "order": d.order,
-        "amplitude": latex_expr(d.amplitude),
-        "frequency": _series(w0 + r"\Bigl(", powers(d.omega), rest + r"\Bigr)", r"\omega ="),
-        "period": _series(r"\frac{2\pi}{" + w0 + r"}\Bigl(", powers(d.period),
-                          rest + r"\Bigr)", "T ="),
-        "coordinates": [{"name": latex_expr(x), "blocks": _table_blocks(_fourier_columns(
-            tuple(tuple((n, readable(c)) for n, c in qj) for qj in q)))}
-                        for x, q in d.coordinates],
-    }
-    text = environment(latex=True).get_template("mode_tables.tex.j2").render(banner=head, **ctx)
-    return {f"{p.model}_tables.tex": text}
-
-
-def render_mode_derivation(d: ModeDerivation, p: Provenance) -> dict[str, str]:
-    """``{name_derivation.tex: text}``: a normal mode's L–P derivation, order by order."""
-    y = "A" if d.variable == sp.Symbol("A") else "y"
-    variable = "A" if y == "A" else f"y = {latex_expr(d.variable)}"
-    names = [latex_expr(x) for x in d.coordinates]
-
-    def number(c: sp.Expr) -> str:  # a long exact number as its decimal
-        return latex_expr(readable(c))
-
-    def vector(values: tuple) -> str:
-        return r"\begin{pmatrix}" + r" \\ ".join(number(v) for v in values) \
-            + r"\end{pmatrix}"
-
-    matrix = r"\begin{pmatrix}" + r" \\ ".join(
-        " & ".join(latex_expr(d.stiffness[i, k]) for k in range(d.stiffness.cols))
-        for i in range(d.stiffness.rows)) + r"\end{pmatrix}"
-    orders = [{
-        "j": o.j, "omega": number(o.omega_squared), "secular": number(o.secular),
-        "rows": [{"n": n, "x": names[i], "r": number(r[i]), "c": number(c[i])}
-                 for n, r, c in o.harmonics for i in range(len(names)) if r[i] != 0 or c[i] != 0],
-    } for o in d.orders]
-    tex = environment(latex=True).get_template("mode_derivation.tex.j2").render(
-        banner=banner(p, "%"), title=f"Nonlinear normal mode {d.mode}",
-        equations=[latex_expr(e) + " = 0" for e in d.equations], stiffness=matrix,
-        lam=number(d.lam), right=vector(d.right), left=vector(d.left), y=y,
-        variable=variable, amplitude=latex_expr(d.amplitude),
-        psi_phi=number(sp.expand(sum(a * b for a, b in zip(d.left, d.right, strict=True)))),
-        orders=orders)
-    return {f"{p.model}_derivation.tex": tex}
-
-
 def _model_text(name: str) -> str:
     """A model's name as a title's words: ``van_der_pol`` → ``Van der pol``."""
     return name.replace("_", " ").capitalize()
@@ -535,11 +590,10 @@ def _model_text(name: str) -> str:
 def render(unit: Unit) -> dict[str, str]:
     """``{file name: text}`` of a unit: its module, then each document beside it."""
     files = {f"{unit.module.name}.py": render_module(unit.module)}
-    renderers = {Derivation: render_latex, MuDerivation: render_mu_derivation,
+    renderers = {SeriesTables: render_tables, SeriesDerivation: render_derivation,
+                 MuDerivation: render_mu_derivation,
                  MuDampedDerivation: render_mu_damped_derivation,
-                 SlowFlowDocument: render_slow_flow,
-                 CycleDerivation: render_cycle_derivation, ModeTables: render_mode_tables,
-                 ModeDerivation: render_mode_derivation}
+                 SlowFlowDocument: render_slow_flow, CycleDerivation: render_cycle_derivation}
     for doc in unit.documents:
         files.update(renderers[type(doc)](doc, unit.module.provenance))
     return files

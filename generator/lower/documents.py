@@ -1,5 +1,6 @@
-"""Lowering to documents and single evaluators: the derivations' LaTeX records, the
-Fourier (AGM) period, a chosen period formula and the slow flow."""
+"""Lowering to documents and single evaluators: the derivations' LaTeX records (a family of
+periodic orbits' tables and derivation, one coordinate or a normal mode's several; a limit
+cycle's), the Fourier (AGM) period, a chosen period formula and the slow flow."""
 
 from __future__ import annotations
 
@@ -19,19 +20,23 @@ from ..derive.cycles import LimitCycle
 from ..derive.equation import parse_equation
 from ..derive.lindstedt import SeriesSolution, order_terms, validity
 from ..derive.models import Model
+from ..derive.nnm import NormalModeSeries
+from ..derive.system import System
 from ..errors import InputError
 from .forms import _LOCAL, LOCAL_NAMES, MODULE_NAMES, agm_steps, harmonics
-from .printers import exact, latex_equation
+from .printers import exact, latex_equation, latex_expr
 from .records import (
     ArrayKernel,
     Assign,
     CycleDerivation,
     CycleOrderPieces,
-    Derivation,
+    DerivationOrder,
     Evaluator,
+    LinearPart,
     Module,
-    OrderPieces,
     PeriodFormula,
+    SeriesDerivation,
+    SeriesTables,
     SlowFlowDocument,
     Unit,
     provenance,
@@ -116,22 +121,83 @@ def _equation_latex(m: Model) -> str:
                                               rhs=eq.rhs.xreplace(values)))
 
 
-def lower_derivation(solution: SeriesSolution, order: int) -> Derivation:
-    """The document of ``solution`` at order ``K ≤ solution.order``."""
-    m, g = solution.model, solution.ground
-    pieces = []
-    for j in range(1, order + 1):
-        t = order_terms(solution, j, lambda c: exact(g, c))
-        pieces.append(OrderPieces(j, t.resonant, t.omega, tuple(sorted(t.forcing.items())),
-                                  tuple(sorted(t.q.items()))))
-    return Derivation(
-        model=m.name, latex=_equation_latex(m), y=m.y, coordinate=m.coordinate,
-        amplitude=m.amplitude, order_factor=m.order_factor, coupling=m.coupling, order=order,
-        omega=tuple(exact(g, c) for c in solution.omega[: order + 1]),
-        period=tuple(exact(g, c) for c in solution.period[: order + 1]),
-        q=tuple(tuple((n, exact(g, c)) for n, c in sorted(solution.q[j].items()))
-                for j in range(order + 1)),
-        orders=tuple(pieces), validity=validity(solution))
+def _title(name: str) -> str:
+    """A model's name as a title's words: ``van_der_pol`` → ``Van der pol``."""
+    return name.replace("_", " ").capitalize()
+
+
+def _system_equations(system: System) -> tuple[str, ...]:
+    """A system's equations as mathematics: ``ẍ_i + (Lx)_i + g_i(x) = 0``."""
+    dots = [sp.Symbol(rf"\ddot{{{sp.latex(x)}}}") for x in system.coordinates]
+    L = system.stiffness * sp.Matrix(system.coordinates)
+    return tuple(latex_expr(sp.expand(dots[i] + L[i] + system.force[i])) + " = 0"
+                 for i in range(system.size))
+
+
+def lower_tables(series: SeriesSolution | NormalModeSeries, order: int) -> SeriesTables:
+    """The tables' record of a free oscillator's series or a normal mode's to ``order``:
+    ``ω_j/ω₀``, ``τ_j ω₀`` and every coordinate's coefficients, exact."""
+    if isinstance(series, SeriesSolution):
+        m, g = series.model, series.ground
+        return SeriesTables(
+            _title(m.name), (_equation_latex(m),), m.frequency, m.y, order,
+            tuple(exact(g, c) for c in series.omega[: order + 1]),
+            tuple(exact(g, c) for c in series.period[: order + 1]),
+            ((m.coordinate, tuple(tuple((n, exact(g, c)) for n, c in sorted(qj.items()))
+                                  for qj in series.q[: order + 1])),),
+            m.coordinate, m.amplitude, validity(series))
+    system = series.system
+    return SeriesTables(
+        f"Nonlinear normal mode {series.mode}", _system_equations(system), series.omega0,
+        sp.Symbol("A") ** series.step, order,
+        tuple(series.omega_over_omega0()[: order + 1]),
+        tuple(series.period_times_omega0()[: order + 1]),
+        tuple((x, tuple(tuple(sorted(o.items())) for o in series.coordinate(i, order)))
+              for i, x in enumerate(system.coordinates)),
+        system.coordinates[series.amplitude], sp.Symbol("A"))
+
+
+def lower_series_derivation(series: SeriesSolution | NormalModeSeries, order: int
+                            ) -> SeriesDerivation:
+    """The derivation's record of a free oscillator's series (§10.3: ``F_j``, the secular
+    condition's ω_j, ``q_j``) or a normal mode's (``R_jn``, ``Ω_j`` from
+    ``ψ·(R_j1 + Ω_j φ) = 0``, ``c_jn``) at orders 1 to ``order``."""
+    if isinstance(series, SeriesSolution):
+        m, g = series.model, series.ground
+        orders = []
+        for j in range(1, order + 1):
+            t = order_terms(series, j, lambda c: exact(g, c))
+            orders.append(DerivationOrder(
+                j, (((1, t.resonant), *sorted(t.forcing.items())),), t.resonant, t.omega,
+                (tuple(sorted(t.q.items())),)))
+        return SeriesDerivation(
+            _title(m.name), (_equation_latex(m),), (m.coordinate,), m.coordinate, m.amplitude,
+            m.amplitude, m.y, m.coupling, m.order_factor, order, r"\omega", (2 * m.amplitude,),
+            tuple(orders), validity=validity(series))
+    system = series.system
+    value = series.ground.to_sympy
+    zero = series.ground.scalar(0)
+    size = system.size
+    orders = []
+    for j in range(1, min(order, len(series.right_sides)) + 1):
+        rhs = series.right_sides[j - 1]
+        solved = series.coefficients[j]
+        secular = sum((p * r for p, r in zip(series.left, rhs.get(1, ()), strict=False)),
+                      zero)
+        orders.append(DerivationOrder(
+            j, tuple(tuple((n, value(r[i])) for n, r in sorted(rhs.items()))
+                     for i in range(size)),
+            value(secular), value(series.omega_squared[j]),
+            tuple(tuple((n, value(c)) for n, c in sorted(solved[i].items()) if c)
+                  for i in range(size))))
+    phi = tuple(value(c.get(1, zero)) for c in series.coefficients[0])
+    return SeriesDerivation(
+        f"Nonlinear normal mode {series.mode}", _system_equations(system),
+        system.coordinates, system.coordinates[series.amplitude], sp.Symbol("A"), sp.Integer(1),
+        sp.Symbol("A") ** series.step, sp.Symbol("A") ** series.step, sp.Integer(1),
+        order, r"\Omega", phi, tuple(orders),
+        linear=LinearPart(system.stiffness, series.lam, phi,
+                          tuple(value(v) for v in series.left)))
 
 
 def _rational_items(d: dict) -> tuple[tuple[int, sp.Rational], ...]:
@@ -204,3 +270,4 @@ def lower_slow_flow(flow: SlowFlow, command: str) -> Unit:
                            tuple(e.xreplace({R_SLOW: r, PHI_SLOW: phi}) for e in flow.radial),
                            tuple(e.xreplace({R_SLOW: r, PHI_SLOW: phi}) for e in flow.phase))
     return Unit(module, (doc,))
+

@@ -12,7 +12,6 @@ from fractions import Fraction
 import sympy as sp
 from sympy.logic.boolalg import BooleanFunction
 
-from ..derive.models import Model
 from ..errors import InputError
 from .printers import Polynomial
 from .records import Assign
@@ -59,32 +58,39 @@ def harmonics(top: int, odd: bool, s: sp.Expr, sines: bool) -> tuple[list[Assign
 MODULE_NAMES = frozenset({
     "math", "np", "numba", "njit", "vectorize", "overload", "types", "TRIG_LIMIT", "SIN_KERNEL",
     "COS_KERNEL", "ORDER", "MODEL", "VARIABLE", "CONVENTION", "RADIUS", "ALLOW_DIVERGENT",
-    "RADIUS_SPREAD", "RADIUS_LOWER", "ORBIT_LIMIT", "ORBIT_LIMIT_EXACT",
-    "OMEGA", "PERIOD", "Q", "OMEGA_EXACT", "PERIOD_EXACT", "omega", "period", "error_estimate",
+    "RADIUS_SPREAD", "RADIUS_LOWER", "ORBIT_LIMIT", "ORBIT_LIMIT_EXACT", "MODE", "SYSTEM",
+    "OMEGA0", "OMEGA0_EXACT", "OMEGA", "PERIOD", "Q", "OMEGA_EXACT", "PERIOD_EXACT", "omega",
+    "period", "error_estimate",
 })
 LOCAL_NAMES = frozenset({"out", "i", "t"})
-# NOTE: the names an emitted free module defines at its top and uses inside its functions
-# (templates/module.py.j2 and :func:`lower_free`); `_`-names need no entry, since a user's
-# names never start with '_', and lower_free renames its x, w, s, T away from a user's.
+# NOTE: the names an emitted periodic-orbit module defines at its top and uses inside its
+# functions (templates/module.py.j2 and :func:`lower_periodic`); `_`-names need no entry,
+# since a user's names never start with '_', and lower_periodic renames its x, w, s, T away
+# from a user's.
 _LOCAL = re.compile(r"[csw]_\d+|.*_in|.*_into")
+AMPLITUDE_NAMES = frozenset({"A", "eps", "theta0"})
+# NOTE: the built-in arguments of the evaluators: a parameter of these names is the argument.
 
 
-def check_emitted_names(model: Model) -> None:
+def check_emitted_names(coordinates: list[str], parameters: list[str],
+                        velocities: bool = True) -> None:
     """A user's parameter or coordinate that would clash with a name of the emitted module is
-    refused (a parameter named ``x`` would be overwritten by the expansion variable)."""
-    coordinate = str(model.coordinate)
+    refused (a parameter named ``x`` would be overwritten by the expansion variable): each
+    coordinate (and its velocity ``<name>dot`` where ``velocities``) defines a function, each
+    parameter is an argument."""
     taken = MODULE_NAMES | LOCAL_NAMES | frozenset(dir(builtins)) | frozenset(keyword.kwlist)
-    for name, _ in model.parameters:
-        if name in ("A", "eps", "theta0"):
+    functions = [*coordinates, *(c + "dot" for c in coordinates if velocities)]
+    for name in parameters:
+        if name in AMPLITUDE_NAMES:
             continue
-        if name in taken or _LOCAL.fullmatch(name) or name in (coordinate,
-                                                                coordinate + "dot"):
+        if name in taken or _LOCAL.fullmatch(name) or name in functions:
             raise InputError(f"parameter {name!r}: the emitted module uses this name; rename "
                              "the parameter")
-    for name in (coordinate, coordinate + "dot"):
-        if name in taken or _LOCAL.fullmatch(name):
-            raise InputError(f"coordinate {coordinate!r}: the emitted module would define "
-                             f"{name!r}, which it uses already; rename the coordinate")
+    for coordinate in coordinates:
+        for name in (coordinate, *([coordinate + "dot"] if velocities else [])):
+            if name in taken or _LOCAL.fullmatch(name) or name in parameters:
+                raise InputError(f"coordinate {coordinate!r}: the emitted module would define "
+                                 f"{name!r}, which it uses already; rename the coordinate")
 
 
 def _extreme(kind: type[sp.Min] | type[sp.Max], args: list[sp.Expr]) -> sp.Expr:

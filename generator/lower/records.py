@@ -211,83 +211,75 @@ class PeriodFormula:
 # --- documents: the LaTeX beside a module, as SymPy objects (printed by emit) ---------------
 
 @dataclass(frozen=True)
-class OrderPieces:
-    """The ``y^j`` equation of a free oscillator: its forcing, resonant part, ω_j, q_j."""
+class SeriesTables:
+    """The tables of a family of periodic orbits' L–P series to ``order`` (``tables.tex.j2``),
+    one coordinate or several: the equations, ``ω = ω₀ Σ ω_j y^j``, ``T = (2π/ω₀) Σ τ_j y^j``
+    and each coordinate's coefficient of ``A y^j cos ns`` per order, exact (the printer shows
+    a long one as its decimal)."""
 
-    j: int
-    resonant: sp.Expr
-    omega: sp.Expr
-    forcing: tuple[tuple[int, sp.Expr], ...]
-    q: tuple[tuple[int, sp.Expr], ...]
-
-
-@dataclass(frozen=True)
-class Derivation:
-    """The tables and the order-by-order derivation of a free oscillator's series to
-    ``order`` (templates ``tables.tex.j2``, ``derivation.tex.j2``)."""
-
-    model: str
-    latex: str  # the equation of motion, as the model typesets it
-    y: sp.Expr
-    coordinate: sp.Symbol
-    amplitude: sp.Expr
-    order_factor: sp.Expr
-    coupling: sp.Expr
-    order: int
-    omega: tuple[sp.Expr, ...]
-    period: tuple[sp.Expr, ...]
-    q: tuple[tuple[tuple[int, sp.Expr], ...], ...]
-    orders: tuple[OrderPieces, ...]
-    validity: Validity  # the orbits' range and the radius of convergence
-
-
-@dataclass(frozen=True)
-class ModeTables:
-    """The tables of a nonlinear normal mode (template ``mode_tables.tex.j2``): the system's
-    equations, ``ω = ω₀ Σ s_j y^j``, ``T = (2π/ω₀) Σ p_j y^j`` and each coordinate's Fourier
-    coefficients per order, exact."""
-
-    model: str
-    mode: int
-    equations: tuple[sp.Expr, ...]  # each equation's left side (= 0), accelerations as ẍ
+    title: str
+    equations: tuple[str, ...]  # LaTeX, each as its model or system typesets it
     omega0: sp.Expr
-    variable: sp.Expr  # y as a power of A
+    y: sp.Expr  # the expansion variable, in the amplitude (and ε)
     order: int
-    omega: tuple[sp.Expr, ...]  # s_j
-    period: tuple[sp.Expr, ...]  # p_j
+    omega: tuple[sp.Expr, ...]  # ω_j/ω₀
+    period: tuple[sp.Expr, ...]  # τ_j ω₀
     coordinates: tuple[tuple[sp.Symbol, tuple[tuple[tuple[int, sp.Expr], ...], ...]], ...]
-    amplitude: sp.Symbol
+    amplitude: sp.Symbol  # the coordinate at its turning point at t = 0
+    amplitude_value: sp.Expr  # its value there: A, θ₀
+    validity: Validity | None = None  # a free oscillator's orbits and radius
 
 
 @dataclass(frozen=True)
-class ModeOrder:
-    """Order ``j`` of a normal mode's derivation: ``Ω_j`` from the secular condition (with
-    ``ψ·R_j1``), and per harmonic ``n`` the right side ``R_jn`` and the solution ``c_jn``, one
-    entry per coordinate, exact."""
+class DerivationOrder:
+    """Order ``j`` of an L–P derivation: per coordinate the known part of the right side by
+    harmonic (``(n, R_jn)``), the secular condition's known part (``ψ·R_j1``), the frequency
+    correction it fixes (ω_j of one coordinate, Ω_j of a system) and the solution by harmonic
+    (``(n, c_jn)``), exact."""
 
     j: int
-    omega_squared: sp.Expr
-    secular: sp.Expr  # ψ·R_j1
-    harmonics: tuple[tuple[int, tuple[sp.Expr, ...], tuple[sp.Expr, ...]], ...]  # (n, R, c)
+    right: tuple[tuple[tuple[int, sp.Expr], ...], ...]
+    secular: sp.Expr
+    value: sp.Expr
+    solution: tuple[tuple[tuple[int, sp.Expr], ...], ...]
 
 
 @dataclass(frozen=True)
-class ModeDerivation:
-    """A nonlinear normal mode's L–P derivation order by order (template
-    ``mode_derivation.tex.j2``): the equations, ``L = M⁻¹K``, ``λ = ω₀²``, the shapes ``φ``
-    (right) and ``ψ`` (left) of ``L − λ``, the amplitude coordinate, then each order."""
+class LinearPart:
+    """A system's linear part ``ẍ + Lx``: ``L = M⁻¹K``, ``λ = ω₀²`` of the mode, the mode's
+    shape ``φ`` (right null vector of ``L − λ``) and ``ψ`` (left)."""
 
-    model: str
-    mode: int
-    equations: tuple[sp.Expr, ...]
     stiffness: sp.Matrix
     lam: sp.Expr
-    variable: sp.Expr  # y as a power of A
-    amplitude: sp.Symbol
+    right: tuple[sp.Expr, ...]
+    left: tuple[sp.Expr, ...]
+
+
+@dataclass(frozen=True)
+class SeriesDerivation:
+    """The order-by-order L–P derivation of a family of periodic orbits
+    (``derivation.tex.j2``), one coordinate or several.  With ``s = ωt``, order ``j`` of
+    ``x = Σ_j coupling^j x_j(s)`` (each ``x_j``'s coefficients per ``unit·order_factor^j``)
+    solves a linear equation whose right side's resonant ``cos s`` part,
+    ``secular + weights·unknown_j``, must vanish (along ``ψ``): one coordinate's ω_j
+    (weights ``2A``, ``unit`` A), a system's ``Ω_j`` of ``Ω = ω²`` (weights ``φ``, ``linear``
+    given, ``unit`` 1: the coefficients of ``u = x/A``)."""
+
+    title: str
+    equations: tuple[str, ...]
     coordinates: tuple[sp.Symbol, ...]
-    right: tuple[sp.Expr, ...]  # φ
-    left: tuple[sp.Expr, ...]  # ψ
-    orders: tuple[ModeOrder, ...]
+    amplitude: sp.Symbol
+    amplitude_value: sp.Expr  # the amplitude coordinate at t = 0: A, θ₀
+    unit: sp.Expr
+    y: sp.Expr
+    coupling: sp.Expr
+    order_factor: sp.Expr
+    order: int
+    unknown: str  # the frequency correction's LaTeX name: \omega, \Omega
+    weights: tuple[sp.Expr, ...]
+    orders: tuple[DerivationOrder, ...]
+    validity: Validity | None = None
+    linear: LinearPart | None = None
 
 
 @dataclass(frozen=True)
@@ -354,9 +346,8 @@ class Unit:
     """What one command writes: a module and the documents beside it."""
 
     module: Module
-    documents: tuple[Derivation | MuDerivation | MuDampedDerivation
-                     | SlowFlowDocument | CycleDerivation | ModeTables | ModeDerivation,
-                     ...] = ()
+    documents: tuple[SeriesTables | SeriesDerivation | MuDerivation | MuDampedDerivation
+                     | SlowFlowDocument | CycleDerivation, ...] = ()
 
 
 # --- the slow flow (averaging) ---------------------------------------------------------------

@@ -1,11 +1,13 @@
-"""Lowering the exact series: a free oscillator's ω, T and q (with the radius and orbit
-guards), limit cycles, their resummations, Mathieu's characteristic values and Hill's
-tongues."""
+"""Lowering the exact series: a family of periodic orbits of any number of coordinates (a free
+oscillator's ω, T, q and q̇ with its orbit domain, a nonlinear normal mode's backbone and
+shape; the radius guard, the truncation error's bound), limit cycles, their resummations,
+Mathieu's characteristic values and Hill's tongues."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 from fractions import Fraction
 
 import sympy as sp
@@ -13,7 +15,11 @@ import sympy as sp
 from ..algebra.resum import Pade, Resummed
 from ..derive.cycles import LimitCycle
 from ..derive.lindstedt import SeriesSolution, estimated_radius, nearest_singularity
-from ..derive.orbits import OrbitDomain, orbit_domain, runtime_barrier, runtime_scan
+from ..derive.models import Model
+from ..derive.nnm import NormalModeSeries
+from ..derive.nnm import radius as mode_radius
+from ..derive.orbits import orbit_domain, runtime_barrier, runtime_scan
+from ..errors import InputError
 from ..numerics.references import mathieu_recurrence
 from .forms import (
     FREE_ARGUMENT_LIMIT,
@@ -55,174 +61,294 @@ class OrbitReach(sp.Function):
         return f"_orbit_reach({', '.join(printer._print(a) for a in self.args)})"
 
 
-def _truncation_bound(solution: SeriesSolution, order: int, x: sp.Symbol,
-                      reach: sp.Expr | None, domain: OrbitDomain,
-                      edge: sp.Expr | None = None) -> sp.Expr:
-    """A bound on ``|Σ_(j>K) τ_j y^j|`` (in units of 2π/ω₀), :func:`tail_bound` of ``τ_{K+1}``,
-    ``τ_{K+2}`` with ``R`` the smaller of ``reach`` (radius less spread) and the distance to
-    the orbits' edge — a singularity of T, where the period diverges (``edge``: that distance
-    computed at run time, where the edge depends on the arguments)."""
-    g, w0 = solution.ground, solution.model.frequency
-    t1 = sp.Abs(exact(g, solution.period[order + 1]) / w0)
-    t2 = sp.Abs(exact(g, solution.period[order + 2]) / w0)
-    edges = [sp.Float(v, 17) for v in (-domain.lower, domain.upper) if math.isfinite(v)]
-    edges += [edge] if edge is not None else []
-    return tail_bound(t1, t2, order, x, ([reach] if reach is not None else []) + edges)
+@dataclass(frozen=True)
+class Reach:
+    """How far a series' evaluators answer: ``bound``, the radius of convergence's lower bound
+    in ``y`` the guard holds ``|y|`` below (None: no radius to guard), the radius stated
+    (``radius``, ``spread``; NaN where unknown), ``lower`` where the bound is stated apart
+    from them, ``noun`` (what the bound is, in words) and ``empty``, why no amplitude would
+    be inside (then the lowering refuses unless the series may diverge)."""
+
+    bound: sp.Expr | None
+    radius: float
+    spread: float
+    noun: str
+    lower: float | None = None
+    empty: str = ""
 
 
-def lower_free(solution: SeriesSolution, command: str, allow_divergent: bool = False) -> Module:
-    """Evaluators ω, T, q, q̇ and the truncation-error estimate of a free oscillator.
+@dataclass(frozen=True)
+class PeriodicSeries:
+    """A family of periodic orbits as its L–P series, for any number of coordinates: what the
+    lowering and the documents read of a free oscillator's :class:`SeriesSolution` (one
+    coordinate, §10.3's q = A Σ_j y^j q_j(s)) or of a nonlinear normal mode's
+    :class:`NormalModeSeries` (x_i = A Σ_j y^j Σ_n c cos ns), exact, summed to ``order``.
 
-    ``solution`` must be derived two orders above the emitted order K: ``τ_{K+1}`` feeds
-    :func:`error_estimate`.  Outside the orbit condition the ufuncs return NaN, and beyond
-    the radius of convergence too unless ``allow_divergent``.
-    """
-    m = solution.model
-    order = solution.order - 2
-    if order < 0:
-        raise ValueError("lower_free needs a solution derived to order K + 2")
-    check_emitted_names(m)
-    g = solution.ground
-    args = {name: sp.Symbol(identifier(name)) for name, _ in m.parameters}
-    to_args = {sym: args[name] for name, sym in m.parameters}
-    user = {str(m.coordinate), str(m.coordinate) + "dot", *args}
+    ``omega[j]`` and ``tau[j]`` are ω_j (ω₀ included) and τ_j of T/2π (to ``order + 2``: the
+    truncation error's two terms); ``coordinates`` each coordinate's ``{n: c}`` of
+    ``cos ns`` per order; ``y`` the expansion variable in the ``parameters`` (the arguments
+    after ``t``: ``A`` for a mode, ``A, eps, …`` for an oscillator).  A free oscillator adds
+    ``model`` (its analytic force, for the first integral's orbit domain) with ``to_args``
+    (its symbols as the arguments) and its velocity ``qdot``; a mode adds ``identity``, the
+    constants naming it."""
+
+    name: str
+    title: str
+    order: int
+    variable: str
+    convention: str
+    y: sp.Expr
+    amplitude: sp.Expr
+    parameters: tuple[sp.Symbol, ...]
+    omega: tuple[sp.Expr, ...]
+    tau: tuple[sp.Expr, ...]
+    coordinates: tuple[tuple[str, tuple[dict[int, sp.Expr], ...]], ...]
+    odd: bool
+    reach: Reach
+    inputs: dict
+    identity: tuple[tuple[str, object], ...] = ()
+    model: Model | None = None
+    to_args: dict | None = None
+
+
+MODE_CONVENTION = "at t = 0 every velocity is zero and {a}(0) = A (a turning point)"
+# NOTE: a normal mode's amplitude convention (the free oscillator's is its own CONVENTION).
+
+
+def periodic_series(series: SeriesSolution | NormalModeSeries, order: int | None = None,
+                    name: str | None = None) -> PeriodicSeries:
+    """The :class:`PeriodicSeries` of a free oscillator's ``SeriesSolution`` (summed to its
+    order less 2 unless ``order``) or a normal mode's ``NormalModeSeries`` (``name`` the
+    module's; its radius from :func:`derive.nnm.radius`)."""
+    if isinstance(series, SeriesSolution):
+        m, g = series.model, series.ground
+        order = series.order - 2 if order is None else order
+        args = {p: sp.Symbol(identifier(p)) for p, _ in m.parameters}
+        to_args = {sym: args[p] for p, sym in m.parameters}
+        found = (m.radius, 0.0) if m.radius is not None else estimated_radius(
+            series, to_args, lambda c: exact(g, c))
+        radius, spread = found if found is not None else (None, 0.0)
+        reach = Reach(
+            None if radius is None else radius - sp.Float(spread, 17) if spread else radius,
+            float(radius) if radius is not None and radius.is_number else float("nan"),
+            float(spread), "the radius of convergence" + (
+                "" if m.radius is not None else " less its spread, estimated from its τ_j"))
+        return PeriodicSeries(
+            m.name, m.title, order, m.variable, series.convention, m.y.xreplace(to_args),
+            m.amplitude.xreplace(to_args), tuple(args.values()),
+            tuple(m.frequency * exact(g, c) for c in series.omega[: order + 1]),
+            tuple(exact(g, c) / m.frequency for c in series.period[: order + 3]),
+            ((identifier(str(m.coordinate)),
+              tuple({n: exact(g, c) for n, c in qj.items()} for qj in series.q[: order + 1])),),
+            m.odd, reach,
+            {"forcing": [[(n, str(c)) for n, c in terms] for terms in m.forcing[: order + 2]],
+             **({"elementary": [(n, str(a), str(w)) for n, a, w in m.elementary]}
+                if m.elementary else {}),
+             **({"equation": m.source, "frequency": str(m.frequency), "given": m.given,
+                 "velocity_forcing": [[(a, b, str(c)) for a, b, c in terms]
+                                      for terms in m.velocity_forcing[: order + 2]]}
+                if m.source else {})},
+            model=m, to_args=to_args)
+    system = series.system
+    order = series.order - 2 if order is None else order
+    name = name or f"mode{series.mode}"
+    names = [identifier(str(x)) for x in system.coordinates]
+    A = sp.Symbol("A")
+    found = mode_radius(series)
+    positive = found is not None and found.lower > 0
+    reach = Reach(
+        sp.Float(found.lower, 17) if positive else None,
+        float("nan") if found is None else found.estimate,
+        float("nan") if found is None else found.spread,
+        "the lower bound of the radius of convergence estimated from the exact ω_j",
+        float("nan") if found is None else found.lower,
+        "" if found is None or positive else found.how)
+    return PeriodicSeries(
+        name, f"Nonlinear normal mode {series.mode} of {system.text}", order, series.variable,
+        MODE_CONVENTION.format(a=names[series.amplitude]), A**series.step, A, (A,),
+        tuple(series.omega()[: order + 1]), tuple(series.period()[: order + 3]),
+        tuple((x, tuple(series.coordinate(i, order))) for i, x in enumerate(names)),
+        series.step == 2, reach,
+        {"system": system.text, "mode": series.mode, "amplitude": names[series.amplitude]},
+        identity=(("MODE", series.mode), ("SYSTEM", system.text),
+                  ("OMEGA0", float(sp.N(series.omega0, DIGITS))),
+                  ("OMEGA0_EXACT", str(series.omega0))))
+
+
+DIGITS = 30
+# NOTE: an irrational coefficient (in Q(√λ) or Q(λ)) reaches the module as the double nearest
+# its 30-digit value; a rational one, or a polynomial in parameters, as itself (the printer
+# rounds each number once).
+
+
+def _rounded(c: sp.Expr) -> sp.Expr:
+    return sp.Float(sp.N(c, DIGITS), 17) if c.is_number and not c.is_Rational else c
+
+
+def lower_periodic(series: SeriesSolution | NormalModeSeries, command: str,
+                   order: int | None = None, name: str | None = None,
+                   allow_divergent: bool = False) -> Module:
+    """Evaluators ``omega``, ``period``, each coordinate's motion ``x(t, …)`` (a free
+    oscillator's velocity ``xdot`` too) and ``error_estimate`` of a family of periodic orbits
+    (:func:`periodic_series`), summed to ``order`` (default: the series' order less 2).
+
+    The series must be derived two orders above it: ``τ_{K+1}``, ``τ_{K+2}`` feed the error's
+    bound.  Outside the arguments' ranges, outside the orbit domain (a free oscillator's first
+    integral, where known) and beyond the radius' lower bound (unless ``allow_divergent``)
+    every evaluator returns NaN; a bound that leaves no amplitude is refused."""
+    p = periodic_series(series, order, name)
+    order = p.order
+    if order < 0 or len(p.tau) < order + 3:
+        raise ValueError("lower_periodic needs a series derived to order K + 2")
+    m, reach = p.model, p.reach
+    if reach.empty and not allow_divergent:
+        raise InputError(f"{p.title}: the radius of convergence of its ω series has no "
+                         f"positive lower bound ({reach.empty}): every amplitude would be NaN; "
+                         "derive a longer series (--order) or emit it unguarded with "
+                         "--allow-divergent")
+    velocities = m is not None
+    names = [x for x, _ in p.coordinates]
+    params = p.parameters
+    check_emitted_names(names, [str(a) for a in params], velocities)
+    user = {*names, *(x + "dot" for x in names if velocities), *map(str, params)}
     # a user's name keeps its meaning: an internal name it would shadow takes a leading '_'
     # (which no user name has); the built-in models keep x, w, s, T, byte for byte
     x, w, s, total = (sp.Symbol(n if n not in user else "_" + n) for n in ("x", "w", "s", "T"))
-    y = m.y.xreplace(to_args)
-    amplitude = m.amplitude.xreplace(to_args)
-    # ω₀ = 1 but for a user's linear frequency: ω = ω₀ Σ ω_j y^j, T = (2π/ω₀) Σ τ_j y^j
-    omega = [m.frequency * exact(g, c) for c in solution.omega[: order + 1]]
-    tau = [exact(g, c) / m.frequency for c in solution.period[: order + 1]]
-    params = tuple(args.values())
+    omega = [_rounded(c) for c in p.omega]
+    tau = [_rounded(c) for c in p.tau]
     t = sp.Symbol("t")
-    guard = m.orbit_condition.xreplace({sp.Symbol("Y"): x})
-    domain = orbit_domain(m)
-    barrier = None if domain.known else runtime_barrier(m)
-    others = tuple(a for a in args.values() if a != amplitude)  # the arguments but A
-    scan = None if domain.known or barrier is not None else runtime_scan(
-        m, to_args, others, y, amplitude)
-    at = None
-    if barrier is not None:  # the edge at each (A, ε): the first integral's, at run time
-        at = (amplitude, y)
-    elif scan is not None:  # the edge at each call, its parameters' values in hand
-        at = (amplitude, *others)
-    if at is not None:
-        guard = sp.And(guard, sp.StrictGreaterThan(OrbitInside(*at), 0))
-    lo, hi = domain.guard_bounds()
-    if math.isfinite(lo):
-        guard = sp.And(guard, x > sp.Float(lo, 17))
-    if math.isfinite(hi):
-        guard = sp.And(guard, x < sp.Float(hi, 17))
-    found = (m.radius, 0.0) if m.radius is not None else estimated_radius(
-        solution, to_args, lambda c: exact(g, c))
-    radius, spread = found if found is not None else (None, 0.0)
-    reach = None if radius is None else radius - sp.Float(spread, 17) if spread else radius
-    if reach is not None and not allow_divergent:
-        guard = sp.And(guard, sp.Abs(x) < reach)
-    scaled = scaled_variable(y, params, x)
-    steps, ranges = scaled if scaled is not None else (((x, y),), free_ranges(y, params))
+    guard: sp.Basic = sp.true
+    edges: list[sp.Expr] = []
+    barrier = scan = None
+    where = ""
+    if m is not None:  # the first integral's orbit domain: one coordinate's
+        guard = m.orbit_condition.xreplace({sp.Symbol("Y"): x})
+        domain = orbit_domain(m)
+        barrier = None if domain.known else runtime_barrier(m)
+        others = tuple(a for a in params if a != p.amplitude)  # the arguments but A
+        scan = None if domain.known or barrier is not None else runtime_scan(
+            m, p.to_args, others, p.y, p.amplitude)
+        at = None
+        if barrier is not None:  # the edge at each (A, ε): the first integral's, at run time
+            at = (p.amplitude, p.y)
+        elif scan is not None:  # the edge at each call, its parameters' values in hand
+            at = (p.amplitude, *others)
+        if at is not None:
+            guard = sp.And(guard, sp.StrictGreaterThan(OrbitInside(*at), 0))
+            edges.append(OrbitReach(*at))
+        lo, hi = domain.guard_bounds()
+        if math.isfinite(lo):
+            guard = sp.And(guard, x > sp.Float(lo, 17))
+        if math.isfinite(hi):
+            guard = sp.And(guard, x < sp.Float(hi, 17))
+        edges[:0] = [sp.Float(v, 17) for v in (-domain.lower, domain.upper) if math.isfinite(v)]
+        where = (
+            "NaN where no periodic orbit exists" if domain.known else
+            "NaN where no periodic orbit exists (the orbit domain at each eps: the first "
+            "integral's barrier, the zeros of its force found at run time)"
+            if barrier is not None else
+            "NaN where no periodic orbit exists (the orbit domain at each call: the first "
+            "integral's barrier, the zeros of the force nearest 0 scanned for at run time "
+            "on |q| <= 64)" if scan is not None else
+            f"NaN where no periodic orbit exists as far as known: no orbit domain ({domain.how})")
+    guarded = reach.bound is not None and not allow_divergent
+    if guarded:
+        guard = sp.And(guard, sp.Abs(x) < reach.bound)
+    if where:
+        where += f" or beyond {reach.noun}" if guarded else ""
+    else:
+        where = (f"NaN beyond {reach.noun}" if guarded else
+                 "no radius guard: --allow-divergent" if allow_divergent else
+                 "no radius estimate: the series is too short or ends")
+    scaled = scaled_variable(p.y, params, x)
+    steps, ranges = scaled if scaled is not None else (((x, p.y),), free_ranges(p.y, params))
     flag = "inside" if "inside" not in user else "_inside"
     entry, inside = argument_entry(ranges, flag)
-    prelude, guard_t = (*entry, *steps), guard
-    guard = sp.And(inside, guard)
-    entry, inside = argument_entry((*ranges, (t, sp.Abs(t) <= FREE_ARGUMENT_LIMIT, 0)), flag)
-    prelude_t, guard_t = (*entry, *steps), sp.And(inside, guard_t)
-
-    top = max((max(qj) for qj in solution.q[: order + 1] if qj), default=1)
-    harmonic = {
-        n: horner([exact(g, solution.q[j].get(n, g.scalar(0))) for j in range(order + 1)], x)
-        for n in range(top + 1)
-    }
-    harmonic = {n: h for n, h in harmonic.items() if h != 0}
-    cos_lines, cs, _ = harmonics(top, m.odd, s, sines=False)
-    both_lines, _, ss = harmonics(top, m.odd, s, sines=True)
-    name_of = identifier(str(m.coordinate))
-    where = ("NaN where no periodic orbit exists" if domain.known else
-             "NaN where no periodic orbit exists (the orbit domain at each eps: the first "
-             "integral's barrier, the zeros of its force found at run time)" if barrier is not None
-             else
-             "NaN where no periodic orbit exists (the orbit domain at each call: the first "
-             "integral's barrier, the zeros of the force nearest 0 scanned for at run time "
-             "on |q| <= 64)" if scan is not None
-             else
-             f"NaN where no periodic orbit exists as far as known: no orbit domain ({domain.how})")
-    where += ("" if allow_divergent or radius is None else
-              " or beyond the radius of convergence"
-              + ("" if m.radius is not None else " less its spread, estimated from its τ_j"))
-    estimate = _truncation_bound(solution, order, x, reach, domain,
-                                 None if at is None else OrbitReach(*at)) / sp.Abs(total)
+    prelude = (*entry, *steps)
+    entry, inside_t = argument_entry((*ranges, (t, sp.Abs(t) <= FREE_ARGUMENT_LIMIT, 0)), flag)
+    prelude_t = (*entry, *steps)
+    guard, guard_t = sp.And(inside, guard), sp.And(inside_t, guard)
+    frequency = horner(omega, x)
+    motions: list[Evaluator] = []
+    for coordinate, orders in p.coordinates:
+        top = max((max(o) for o in orders if o), default=1)
+        harmonic = {n: horner([_rounded(o.get(n, sp.Integer(0))) for o in orders], x)
+                    for n in range(top + 1)}
+        harmonic = {n: h for n, h in harmonic.items() if h != 0}
+        cos_lines, cs, _ = harmonics(top, p.odd, s, sines=False)
+        motions.append(Evaluator(
+            coordinate,
+            f"{coordinate}(t) with s = ωt, harmonics by the Chebyshev recurrence ({where}).",
+            (t, *params), prelude_t, guard_t, ((w, frequency), (s, w * t), *cos_lines),
+            p.amplitude * sum(h * cs[n] for n, h in sorted(harmonic.items()))))
+        if velocities:
+            both_lines, _, ss = harmonics(top, p.odd, s, sines=True)
+            motions.append(Evaluator(
+                f"{coordinate}dot", f"d{coordinate}/dt ({where}).", (t, *params), prelude_t,
+                guard_t, ((w, frequency), (s, w * t), *both_lines),
+                -p.amplitude * w * sum(n * h * ss[n] for n, h in sorted(harmonic.items()))))
+    limits = ([] if reach.bound is None else [reach.bound]) + edges
+    estimate = tail_bound(sp.Abs(tau[order + 1]), sp.Abs(tau[order + 2]), order, x,
+                          limits) / sp.Abs(total)
+    radius_words = ("the smaller of the radius less its spread and the distance to the "
+                    "orbits' edge" if m is not None else "the radius' lower bound")
     evaluators = (
         Evaluator("omega", f"Frequency ω to order {order} ({where}).", params, prelude, guard,
-                  (), horner(omega, x)),
+                  (), frequency),
         Evaluator("period", f"Period T = 2π Σ τ_j y^j to order {order} ({where}).", params,
-                  prelude, guard, (), 2 * sp.pi * horner(tau, x)),
-        Evaluator(
-            name_of,
-            f"{name_of}(t) with s = ωt, harmonics by the Chebyshev recurrence ({where}).",
-            (t, *params), prelude_t, guard_t,
-            ((w, horner(omega, x)), (s, w * t), *cos_lines),
-            amplitude * sum(h * cs[n] for n, h in sorted(harmonic.items())),
-        ),
-        Evaluator(
-            f"{name_of}dot", f"d{name_of}/dt ({where}).", (t, *params), prelude_t, guard_t,
-            ((w, horner(omega, x)), (s, w * t), *both_lines),
-            -amplitude * w * sum(n * h * ss[n] for n, h in sorted(harmonic.items())),
-        ),
+                  prelude, guard, (), 2 * sp.pi * horner(tau[: order + 1], x)),
+        *motions,
         Evaluator(
             "error_estimate",
             "Relative truncation error of period(), a bound on the omitted tail: "
             "|τ_{K+1}| |y|^(K+1) + c |y|^(K+2) / (1 - r|y|), its terms growing at most by "
-            "r = max(1/R, |τ_{K+2}/τ_{K+1}|) an order, R the smaller of the radius less its "
-            "spread and the distance to the orbits' edge, c = max(|τ_{K+2}|, r|τ_{K+1}|); "
-            "over the truncated sum (inf from r|y| = 1 on: no bound there).",
-            params, prelude, guard, ((total, horner(tau, x)),), estimate,
+            f"r = max(1/R, |τ_{{K+2}}/τ_{{K+1}}|) an order, R {radius_words}, "
+            "c = max(|τ_{K+2}|, r|τ_{K+1}|); over the truncated sum (inf from r|y| = 1 on: no "
+            "bound there).",
+            params, prelude, guard, ((total, horner(tau[: order + 1], x)),), estimate,
         ),
     )
-    numeric = ()  # the coefficients as floats, where they are numbers (no symbolic parameter)
-    if g.is_rational:
-        Q = tuple(
-            tuple(float(g.to_sympy(solution.q[j].get(n, g.scalar(0)))) for n in range(top + 1))
-            for j in range(order + 1)
-        )
-        numeric = (("OMEGA", tuple(float(c) for c in omega)),
-                   ("PERIOD", tuple(float(c) for c in tau)), ("Q", Q))
+    numeric: tuple = ()  # the coefficients as floats, where they are numbers
+    if all(c.is_number for c in (*p.omega, *p.tau)):
+        numeric = (("OMEGA", tuple(float(c) for c in p.omega)),
+                   ("PERIOD", tuple(float(c) for c in p.tau[: order + 1])))
+        if len(p.coordinates) == 1:  # Q[j][n]: the one coordinate's cos ns in y^j
+            orders = p.coordinates[0][1]
+            top = max((max(o) for o in orders if o), default=1)
+            numeric += (("Q", tuple(tuple(float(o.get(n, 0)) for n in range(top + 1))
+                                    for o in orders)),)
+    domain_constants: tuple = ()
+    if m is not None:
+        domain_constants = (("ORBIT_LIMIT", (domain.lower, domain.upper)),
+                            ("ORBIT_LIMIT_EXACT", (domain.lower_text, domain.upper_text)))
     constants = (
         ("ORDER", order),
-        ("MODEL", m.name),
-        ("VARIABLE", m.variable),
-        ("CONVENTION", solution.convention),
-        ("RADIUS", float(radius) if radius is not None and radius.is_number
-         else float("nan")),
-        ("RADIUS_SPREAD", float(spread)),
-        ("ORBIT_LIMIT", (domain.lower, domain.upper)),
-        ("ORBIT_LIMIT_EXACT", (domain.lower_text, domain.upper_text)),
+        ("MODEL", p.name),
+        ("VARIABLE", p.variable),
+        ("CONVENTION", p.convention),
+        ("RADIUS", reach.radius),
+        ("RADIUS_SPREAD", reach.spread),
+        *(() if reach.lower is None else (("RADIUS_LOWER", reach.lower),)),
+        *domain_constants,
         ("ALLOW_DIVERGENT", allow_divergent),
         *numeric,
-        ("OMEGA_EXACT", tuple(str(c) for c in omega)),
-        ("PERIOD_EXACT", tuple(str(c) for c in tau)),
+        ("OMEGA_EXACT", tuple(str(c) for c in p.omega)),
+        ("PERIOD_EXACT", tuple(str(c) for c in p.tau[: order + 1])),
         *(() if barrier is None else (("ORBIT_BARRIER_EXACT", barrier.exact),)),
         *(() if barrier is None or not barrier.weight else
           (("ORBIT_WEIGHT_EXACT", barrier.weight_exact),)),
+        *p.identity,
     )
     return Module(
-        name=m.name,
-        doc=f"{m.title}: L–P evaluators to order {order} in {m.variable}.",
+        name=p.name,
+        doc=f"{p.title}: L–P evaluators to order {order} in {p.variable}.",
         constants=constants,
         evaluators=evaluators,
         barrier=() if barrier is None else barrier.coefficients,
         barrier_weight=() if barrier is None else barrier.weight,
         scan=scan,
-        provenance=provenance(
-            m.name, order, command, allow_divergent=allow_divergent,
-            forcing=[[(n, str(c)) for n, c in terms] for terms in m.forcing[: order + 2]],
-            **({"elementary": [(n, str(a), str(w)) for n, a, w in m.elementary]}
-               if m.elementary else {}),
-            **({"equation": m.source, "frequency": str(m.frequency), "given": m.given,
-                "velocity_forcing": [[(a, b, str(c)) for a, b, c in terms]
-                                     for terms in m.velocity_forcing[: order + 2]]}
-               if m.source else {}),
-        ),
+        provenance=provenance(p.name, order, command, allow_divergent=allow_divergent,
+                              **p.inputs),
     )
 
 

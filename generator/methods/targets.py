@@ -36,9 +36,10 @@ from ..limits import FOURIER_MAX_HARMONICS, check_int
 from ..lower.documents import (
     lower_choice,
     lower_cycle_derivation,
-    lower_derivation,
     lower_fourier,
+    lower_series_derivation,
     lower_slow_flow,
+    lower_tables,
 )
 from ..lower.driven import lower_balance, lower_driven, lower_driven_damped
 from ..lower.records import (
@@ -51,8 +52,7 @@ from ..lower.records import (
     ResummedTongue,
     Unit,
 )
-from ..lower.series import lower_free, lower_limit_cycle, lower_mathieu, lower_tongue
-from ..lower.system import lower_nnm, mode_derivation, mode_tables
+from ..lower.series import lower_limit_cycle, lower_mathieu, lower_periodic, lower_tongue
 from ..numerics.shooting import shoot
 from .verify import resum_cycle, resum_mathieu, resum_tongue
 
@@ -167,8 +167,9 @@ def _free_derive(r: FreeRequest, progress: Progress | None) -> SeriesSolution:
 
 
 def _free_lower(solution: SeriesSolution, r: FreeRequest) -> Unit:
-    module = lower_free(solution, r.command, r.allow_divergent)
-    return Unit(module, (lower_derivation(solution, r.order),))
+    module = lower_periodic(solution, r.command, allow_divergent=r.allow_divergent)
+    return Unit(module, (lower_tables(solution, r.order),
+                         lower_series_derivation(solution, r.order)))
 
 
 def _cycle_files(r: CycleRequest) -> tuple[str, ...]:
@@ -346,6 +347,7 @@ NNM: Target[NormalModeRequest, NormalModeSeries] = Target(
     lambda r: (f"{r.name}.py", f"{r.name}_tables.tex", f"{r.name}_derivation.tex"),
     lambda r, progress: normal_mode(r.system, r.mode, max(r.order + 2, NNM_RADIUS_ORDER),
                                     r.amplitude, progress),
-    lambda series, r: Unit(lower_nnm(series, r.order, r.name, r.command, r.allow_divergent),
-                           (mode_tables(series, r.order, r.name),
-                            mode_derivation(series, r.order, r.name))))
+    lambda series, r: Unit(lower_periodic(series, r.command, r.order, r.name,
+                                          r.allow_divergent),
+                           (lower_tables(series, r.order),
+                            lower_series_derivation(series, r.order))))
