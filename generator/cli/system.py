@@ -8,6 +8,7 @@ import json
 import math
 import re
 import textwrap
+from functools import partial
 from pathlib import Path
 
 from ..errors import InputError
@@ -71,63 +72,59 @@ def periodic_json(series, valid=None) -> dict:
 
     if isinstance(series, SeriesSolution):
         m, g = series.model, series.ground
-        name = str(m.coordinate)
-        q = [{str(n): _ground_text(g, c) for n, c in sorted(qj.items())} for qj in series.q]
-        data = {
-            "kind": "series", "model": m.name, "title": m.title, "order": series.order,
-            "variable": m.variable,
-            "omega": [_ground_text(g, c) for c in series.omega],
-            "period": [_ground_text(g, c) for c in series.period],
-            "q": q, "coordinates": {name: q}, "amplitude": name,
-            "convention": series.convention,
-            "radius": None if m.radius is None else str(m.radius),
-            "radius_value": valid.radius if valid.exact is not None else None,
-            "orbit_limit": valid.orbit.as_json(),
-            "omega0": str(m.frequency),
-        }
+        names = [str(m.coordinate)]
+        omega, period, orders = series.omega, series.period, [series.q]
+        text = partial(_ground_text, g)
+        decimal = _decimal if g.is_rational else None
+        amplitude, aliases = names[0], {"q": names[0]}  # its coefficients, also as "q"
+        head = {"kind": "series", "model": m.name, "title": m.title, "order": series.order,
+                "variable": m.variable, "omega0": str(m.frequency),
+                "convention": series.convention}
+        extra = {"radius": None if m.radius is None else str(m.radius),
+                 "radius_value": valid.radius if valid.exact is not None else None,
+                 "orbit_limit": valid.orbit.as_json()}
         if valid.exact is None and valid.radius is not None:
-            data["radius_estimate"] = {"value": valid.radius, "spread": valid.spread}
+            extra["radius_estimate"] = {"value": valid.radius, "spread": valid.spread}
         if m.source:
-            data.update(equation=m.source,
-                        units="omega in units of omega0, period in units of 2*pi/omega0")
-        if g.is_rational:
-            data.update(
-                omega_decimal=[_decimal(c) for c in series.omega],
-                period_decimal=[_decimal(c) for c in series.period],
-                coordinates_decimal={name: [{str(n): _decimal(c) for n, c in sorted(qj.items())}
-                                            for qj in series.q]})
-        return data
-    from ..lower.printers import decimal_text, minimal_polynomial
+            extra.update(equation=m.source,
+                         units="omega in units of omega0, period in units of 2*pi/omega0")
+    else:
+        from ..lower.printers import decimal_text, minimal_polynomial
 
-    mode = series
-    names = [str(x) for x in mode.system.coordinates]
-    root = minimal_polynomial(mode.omega0, "x")
-    return {
-        "kind": "nnm", "mode": mode.mode, "omega0": str(mode.omega0),
-        "variable": mode.variable, "order": mode.order,
-        "omega": [str(c) for c in mode.omega()],
-        "period": [str(c) for c in mode.period()],
-        "coordinates": {name: [{str(n): str(c) for n, c in order.items()}
-                               for order in mode.coordinate(i)]
-                        for i, name in enumerate(names)},
-        "system": mode.system.text, "amplitude": names[mode.amplitude],
-        "lambda": str(mode.lam),
-        "linear_frequencies_squared": [str(x) for x in mode.system.modes()],
-        "convention": CONVENTION.format(a=names[mode.amplitude]),
-        "parameters": sorted({str(s) for f in mode.system.force for s in f.free_symbols}
-                             - set(names) - {str(v) for v in mode.system.velocities}),
-        "period_units": "T/(2*pi): period[j] is the coefficient of y^j",
-        "omega0_decimal": decimal_text(mode.omega0),
-        "omega0_minimal_polynomial": None if root is None else str(root),
-        "lambda_decimal": decimal_text(mode.lam),
-        "linear_frequencies_squared_decimal": [decimal_text(x) for x in mode.system.modes()],
-        "omega_decimal": [decimal_text(c) for c in mode.omega()],
-        "period_decimal": [decimal_text(c) for c in mode.period()],
-        "coordinates_decimal": {name: [{str(n): decimal_text(c) for n, c in order.items()}
-                                       for order in mode.coordinate(i)]
-                                for i, name in enumerate(names)},
-        "mass": [[str(c) for c in mode.system.mass.row(i)] for i in range(len(names))],
-    }
+        system = series.system
+        names = [str(x) for x in system.coordinates]
+        omega, period = series.omega(), series.period()
+        orders = [series.coordinate(i) for i in range(len(names))]
+        text, decimal = str, decimal_text
+        amplitude, aliases = names[series.amplitude], {}
+        root = minimal_polynomial(series.omega0, "x")
+        head = {"kind": "nnm", "mode": series.mode, "order": series.order,
+                "variable": series.variable, "omega0": str(series.omega0),
+                "convention": CONVENTION.format(a=names[series.amplitude])}
+        extra = {
+            "system": system.text, "lambda": str(series.lam),
+            "linear_frequencies_squared": [str(x) for x in system.modes()],
+            "parameters": sorted({str(s) for f in system.force for s in f.free_symbols}
+                                 - set(names) - {str(v) for v in system.velocities}),
+            "period_units": "T/(2*pi): period[j] is the coefficient of y^j",
+            "omega0_decimal": decimal_text(series.omega0),
+            "omega0_minimal_polynomial": None if root is None else str(root),
+            "lambda_decimal": decimal_text(series.lam),
+            "linear_frequencies_squared_decimal": [decimal_text(x) for x in system.modes()],
+            "mass": [[str(c) for c in system.mass.row(i)] for i in range(len(names))]}
+
+    def per_order(form) -> dict:
+        return {name: [{str(n): form(c) for n, c in sorted(o.items())} for o in coordinate]
+                for name, coordinate in zip(names, orders, strict=True)}
+
+    data = {**head, "omega": [text(c) for c in omega], "period": [text(c) for c in period],
+            "coordinates": per_order(text), "amplitude": amplitude}
+    if decimal is not None:
+        data.update(omega_decimal=[decimal(c) for c in omega],
+                    period_decimal=[decimal(c) for c in period],
+                    coordinates_decimal=per_order(decimal))
+    data.update({key: data["coordinates"][name] for key, name in aliases.items()})
+    return {**data, **extra}
 
 
 TEXT_WIDTH = 200
