@@ -556,3 +556,24 @@ def test_a_symbolic_eps_module_finds_its_orbit_domain_at_each_eps(emitted):
                                                                      + (s * q)**4 / 4), abs(A))
         error = abs(m.period(A, e) / float(T) - 1)
         assert error <= m.error_estimate(A, e), (A, e, error, m.error_estimate(A, e))
+
+
+def test_series_table_shows_a_long_rational_as_its_decimal_and_exact_on_request(capsys):
+    """``series duffing --order 12``'s table: a long τ_j as 12 significant digits of the
+    exact rational in --json (Fraction, not the printer's float), every number exact with
+    --exact; the JSON's decimals are the same digits."""
+    import json
+    from fractions import Fraction
+
+    assert main(["series", "duffing", "--order", "12", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    tau = Fraction(data["period"][12])
+    assert len(data["period"][12]) > 24
+    digits = f"{float(tau):.12g}"
+    assert abs(float(data["period_decimal"][12]) / float(tau) - 1) < 1e-11
+    assert main(["series", "duffing", "--order", "12"]) == 0
+    table = capsys.readouterr().out
+    row = next(line.split() for line in table.splitlines() if line.split()[:1] == ["12"])
+    assert abs(float(row[2]) / float(tau) - 1) < 1e-11 and row[2] == digits
+    assert main(["series", "duffing", "--order", "12", "--exact"]) == 0
+    assert data["period"][12] in capsys.readouterr().out
