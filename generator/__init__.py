@@ -67,13 +67,14 @@ order; a stage imports only stages above it::
                             stable or one loses stability by Neimark–Sacker, the attractor a
                             simulation settles on (period-k, quasi-periodic, chaotic), its
                             spectral lines and ranges [branches, multipliers -> Dynamics]
-    analysis.response       one-harmonic curves and folds, the balance continued over an ω range
-                            (the notes' and any polynomial force)
-                            [Drive | equation, ω range -> folds]
-    analysis.systems        a driven, damped system's every branch: the balance of every
-                            coordinate continued in ω, sought from rest and from the backbones,
-                            Floquet verdicts, folds, jumps, shooting checks
-                            [System, ω range -> SystemResponse]
+    analysis.response       one equation's one-harmonic balance of any polynomial force: its
+                            amplitudes, its folds (a resultant, exact), the ω range, the seeds
+                            [equation, ω range -> folds, range]
+    analysis.systems        the response of n ≥ 1 coordinates: every branch of the balance
+                            continued in ω, sought at the ends and probes (one-harmonic roots,
+                            the drive from rest, the backbones), Floquet verdicts, folds,
+                            jumps; true folds and sweeps, or shooting checks
+                            [equation | System, ω range -> Response]
     analysis.periodic       every distinct periodic orbit at one drive: seeds, balance,
                             shooting, Floquet; the report of `driven`
                             [Drive | equation -> orbits]
@@ -124,22 +125,24 @@ order; a stage imports only stages above it::
                             equation's or driven system's parameters as axes [point -> fields]
     sweep.store             grids in blocks on dask.distributed, into a resumable Zarr store
                             [kind, axes -> Dataset]
-    charts                  matplotlib figures [results -> PNG/SVG/PDF]
+    charts                  matplotlib figures, the response of any number of coordinates
+                            among them [results -> PNG/SVG/PDF]
     charts_modes            the frequency–energy plot of a system's normal modes: backbones
-                            from the series beside shot orbits; a driven system's response
-                            [System, SystemResponse -> PNG/SVG/PDF]
+                            from the series beside shot orbits; a resonant system's energy
+                            exchange [System -> PNG/SVG/PDF]
     charts_series           a free oscillator's ω and T against its amplitude variable with the
                             orbit edge and the radius marked; a limit cycle against ε; a slow
                             flow's phase portrait [curves -> PNG/SVG/PDF]
     costs                   each command's estimated wall time and bounds [arguments -> Cost]
     cli.common              what every command shares: light constants, argument types and
                             flags, the report shape [argv -> Namespace]
-    cli.system              nnm, slowflow and response of a system [NormalModeSeries,
-                            ResonantFlow, SystemResponse -> JSON, tables]
+    cli.system              nnm and slowflow of a system [NormalModeSeries, ResonantFlow ->
+                            JSON, tables]
     cli.series              series, mathieu, tongues, slowflow, models, generate
                             [records -> JSON, tables]
-    cli.driven              driven, response, subharmonic, parametric, mixing
-                            [records -> JSON, tables]
+    cli.driven              driven, subharmonic, parametric, mixing [records -> JSON, tables]
+    cli.response            response of any number of coordinates [Response -> JSON, table,
+                            CSV]
     cli.choose              choose, clock, scene [Choice -> JSON, tables]
     cli.sweep               sweep [Dataset -> summary]
     cli.demo                the demo [-> out/]

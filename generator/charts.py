@@ -18,10 +18,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .analysis.curves import subharmonic_curve
+from .analysis.curves import FEP_MAX_MODES, subharmonic_curve
 from .analysis.driven import Drive
 from .analysis.mixing import duffing_mixing, tone_label
-from .analysis.response import one_harmonic_curve
+from .analysis.response import ResponseCurve
 from .analysis.systems import Response, notes_problem, response
 from .choose import (
     DRIVEN_QUANTITIES,
@@ -179,80 +179,127 @@ def _settled(sweep: object, folds: Sequence[float]) -> np.ndarray:
     return ok
 
 
-def _response_panel(ax: plt.Axes, r: Response, title: str) -> None:
-    """The continued N-harmonic balance (its first-harmonic amplitude r, each piece), the
-    simulated sweeps up and down (max |q| of each settled drive period, the rest marked as
-    transient by :func:`_settled`) and the balance's folds of one equation's
-    :class:`analysis.systems.Response`, against ω/ω₀."""
-    w0 = r.linear_frequencies[0]
-    amp = np.array([_first(r.fine, x) for x in r.cont.x])
-    for k, piece in enumerate(r.cont.piece_slices()):  # a softening spring's: two pieces
-        ax.plot(r.cont.omega[piece] / w0, amp[piece], "k-", lw=0.7,
-                label=f"harmonic balance N = {r.fine.harmonics} (r)" if k == 0 else None)
+def _balance_panel(ax: plt.Axes, r: Response, i: int, scale: float) -> None:
+    """Coordinate ``i`` of a :class:`analysis.systems.Response` against ω/``scale``: its
+    first-harmonic amplitude along every traced branch, stable solid and unstable dashed, the
+    points shot as true orbits as circles, the folds, the linear ω₀ dotted, the sweeps' jumps
+    as arrows."""
+    for k, piece in enumerate(r.cont.piece_slices()):
+        w, a, s = r.cont.omega[piece] / scale, r.amplitudes[piece, i], r.stable[piece]
+        for flag, style in ((True, "-"), (False, "--")):
+            shown = np.where(s == flag, a, np.nan)
+            # a stretch's ends meet the next one's: no gap at a change of stability
+            edge = np.nonzero(np.diff(s.astype(int)))[0]
+            shown[edge + (0 if flag else 1)] = a[edge + (0 if flag else 1)]
+            shown[edge + (1 if flag else 0)] = a[edge + (1 if flag else 0)]
+            ax.plot(w, shown, style, color=f"C{k % 10}", lw=1.6 if flag else 1.0,
+                    label=(f"branch {k + 1}" + (" (isola)" if r.closed[k] else "")
+                           + (": stable" if flag else ": unstable (Floquet |λ| > 1)")))
+    for c in r.checks:
+        if c.shot:
+            ax.plot(c.omega / scale, c.shot[i], "o", mfc="none", mec="k", ms=6,
+                    label="orbit shot (DOP853)")
+    for w in r.cont.folds:
+        ax.axvline(w / scale, color="grey", lw=0.5, ls="-", alpha=0.5)
+    for w in r.linear_frequencies:
+        ax.axvline(w / scale, color="grey", lw=0.8, ls=":")
+    for way, w, before, after in r.jumps:
+        ax.annotate("", xy=(w / scale, r.amplitudes[after, i]),
+                    xytext=(w / scale, r.amplitudes[before, i]),
+                    arrowprops={"arrowstyle": "->", "color": "C3" if way == "up" else "C4",
+                                "lw": 1.2})
+        ax.plot([], [], "-", color="C3" if way == "up" else "C4", label=f"sweep {way}: jump")
+
+
+def _one_harmonic_lines(ax: plt.Axes, curve: ResponseCurve, scale: float) -> None:
+    """The one-harmonic branches (``∂G/∂u > 0`` solid, else dashed), largest first; no line
+    across a change of the branch count."""
+    count = np.isfinite(curve.r).sum(axis=1)
+    jumps = np.concatenate([[False], count[1:] != count[:-1]])  # branches appear/vanish here
+    for k in range(curve.r.shape[1]):
+        r = np.where(jumps, np.nan, curve.r[:, k])
+        ax.plot(curve.omega / scale, np.where(curve.stable[:, k], r, np.nan), "C0-", lw=2,
+                alpha=0.35, label="one harmonic, stable (r)")
+        ax.plot(curve.omega / scale, np.where(~curve.stable[:, k], r, np.nan), "C0--",
+                lw=1.5, alpha=0.35, label="one harmonic, unstable (r)")
+
+
+def _sweep_points(ax: plt.Axes, r: Response, scale: float) -> None:
+    """The simulated sweeps up and down: max |q| of each settled drive period, the rest
+    marked as transient by :func:`_settled`."""
     transient = []
     for s, color, way in zip(r.sweeps, ("C3", "C2"), ("up", "down"), strict=True):
         ok = _settled(s, r.cont.folds)
-        ax.plot(s.omega[ok] / w0, s.amplitude[ok], ".", color=color, ms=1.5,
+        ax.plot(s.omega[ok] / scale, s.amplitude[ok], ".", color=color, ms=1.5,
                 label=f"simulated sweep {way} (max |q|)")
         transient += [s.omega[~ok], s.amplitude[~ok]]
-    ax.plot(np.concatenate(transient[::2]) / w0, np.concatenate(transient[1::2]), ".",
+    ax.plot(np.concatenate(transient[::2]) / scale, np.concatenate(transient[1::2]), ".",
             color="0.8", ms=1, zorder=0, label="sweep not settled (transient)")
-    for k, w in enumerate(r.cont.folds):
-        ax.axvline(w / w0, color="grey", ls=":", lw=1,
-                   label="fold of the balance" if k == 0 else None)
-    _label(ax, "omega", "amplitude: r (lines), max |q| (sweeps)")
-    ax.set_title(title)
-    ax.legend(fontsize=7, loc="upper left", markerscale=4)
 
 
-def response_figure(report: Response, path: Path) -> Path:
-    """Response r(ω) of eq. 10.60 (its :class:`analysis.systems.Response`): the cubic's
-    one-harmonic branches (stable solid, unstable dashed) beside :func:`_response_panel`; the
-    linear curves of Fig. 1."""
-    check_plot_path(path)
-    notes = dict(report.notes)
-    lo, hi = report.omega_range
-    omega = np.linspace(lo, hi, 2000)
-    curve = one_harmonic_curve(notes["eps"], notes["force"], notes["Q"], omega)
-    fig, (ax, lin) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [3, 2]})
-    count = np.isfinite(curve.r).sum(axis=1)
-    jumps = np.concatenate([[False], count[1:] != count[:-1]])  # branches appear/vanish here
-    for k in range(3):
-        r = np.where(jumps, np.nan, curve.r[:, k])
-        ax.plot(omega, np.where(curve.stable[:, k], r, np.nan), "C0-", lw=2,
-                label="one harmonic, stable (r)" if k == 0 else None)
-        ax.plot(omega, np.where(~curve.stable[:, k], r, np.nan), "C0--", lw=1.5,
-                label="one harmonic, unstable (r)" if k == 1 else None)
-    _response_panel(ax, report, "q̈ + q̇/Q + q + εq³ = f cos ωt  ("
-                    + ", ".join(_named(n, v) for n, v in report.notes) + ")")
+def _linear_panel(ax: plt.Axes) -> None:
+    """The linear oscillator's response, exact and Lorentzian near ω₀ (the notes' Fig. 1)."""
     w = np.linspace(0.5, 1.5, 1000)
     for i, q in enumerate((2, 5, 10)):
-        lin.plot(w, 1 / np.sqrt((1 - w**2) ** 2 + w**2 / q**2), f"C{i}-",
-                 label=f"Q = {q}, exact")
-        lin.plot(w, 1 / np.sqrt(4 * (1 - w) ** 2 + 1 / q**2), f"C{i}:",
-                 label=f"Q = {q}, Lorentzian near ω₀")
-    _label(lin, "omega", "r/f (linear: r = max |q|)")
-    lin.set_title("linear oscillator q̈ + q̇/Q + q = f cos ωt")
-    lin.legend(fontsize=7)
-    fig.tight_layout()
-    return _save(fig, path)
+        ax.plot(w, 1 / np.sqrt((1 - w**2) ** 2 + w**2 / q**2), f"C{i}-",
+                label=f"Q = {q}, exact")
+        ax.plot(w, 1 / np.sqrt(4 * (1 - w) ** 2 + 1 / q**2), f"C{i}:",
+                label=f"Q = {q}, Lorentzian near ω₀")
+    _label(ax, "omega", "r/f (linear: r = max |q|)")
+    ax.set_title("linear oscillator q̈ + q̇/Q + q = f cos ωt")
+    ax.legend(fontsize=7)
 
 
-def response_equation_figure(report: Response, path: Path, text: str) -> Path:
-    """Response r(ω) of a user's damped driven oscillator (its
-    :class:`analysis.systems.Response`): the one-harmonic amplitudes beside
-    :func:`_response_panel`."""
+def response_figure(r: Response, path: Path) -> Path:
+    """A driven oscillator's response (:class:`analysis.systems.Response`, any number of
+    coordinates): one panel per coordinate (at most :data:`analysis.curves.FEP_MAX_MODES`),
+    its first-harmonic amplitude over ω along every traced branch, stable solid and unstable
+    dashed, the folds, the sweeps' jumps as arrows, the points shot as true orbits as circles,
+    the linear ω₀ as dotted lines; where the record holds them, the one-harmonic branches and
+    the simulated sweeps (one equation, against ω/ω₀), and beside eq. 10.60 the linear
+    oscillator's curves (the notes' Fig. 1)."""
     check_plot_path(path)
-    lo, hi = report.omega_range
-    w0 = report.linear_frequencies[0]
-    fig, ax = plt.subplots(figsize=(8, 4.2))
-    omega = np.linspace(lo, hi, 600)
-    one = [(w / w0, r) for w in omega
-           for r in report.balance.one_harmonic.amplitudes(float(w))]
-    if one:
-        ax.plot(*np.array(one).T, "C0.", ms=1.5, label="one harmonic (r)")
-    _response_panel(ax, report, f"{text}  (ω₀ = {_value(w0)})")
-    fig.tight_layout()
+    names = list(r.coordinates)[:FEP_MAX_MODES]
+    notes = dict(r.notes)
+    one = r.sweeps is not None
+    scale = r.linear_frequencies[0] if len(r.coordinates) == 1 else 1.0
+    if notes:
+        fig, (ax, lin) = plt.subplots(1, 2, figsize=(11, 4.2),
+                                      gridspec_kw={"width_ratios": [3, 2]})
+        axes = np.array([[ax]])
+        _linear_panel(lin)
+    else:
+        fig, axes = plt.subplots(len(names), 1, figsize=(8, 2.6 * len(names) + 0.6 + 1.0 * one),
+                                 sharex=True, squeeze=False)
+    for i, (ax, name) in enumerate(zip(axes[:, 0], names, strict=True)):
+        if r.one_harmonic_curve is not None:
+            _one_harmonic_lines(ax, r.one_harmonic_curve, scale)
+        if one:
+            _sweep_points(ax, r, scale)
+        _balance_panel(ax, r, i, scale)
+        ax.set_ylabel(f"r of {name}" + (", max |q| (sweeps)" if one else ""))
+        if i == 0:
+            ax.plot([], [], ":", color="grey", label="linear ω₀")
+            ax.plot([], [], "-", color="grey", lw=0.5, label="fold")
+            handles, labels = ax.get_legend_handles_labels()
+            unique = dict(zip(labels, handles, strict=False))
+    text = r.system.text if r.system is not None else r.equation.text
+    title = text if len(text) <= 90 else text[:89] + "…"
+    title = ("q̈ + q̇/Q + q + εq³ = f cos ωt  (" + ", ".join(_named(*p) for p in r.notes) + ")"
+             if notes else title + f"  (ω₀ = {_value(scale)})" if one else title)
+    if len(r.coordinates) == 1:
+        _label(axes[-1, 0], "omega")
+    else:
+        axes[-1, 0].set_xlabel(f"drive frequency {r.system.frequency} (ω)")
+    axes[0, 0].set_title(f"response: {title}", fontsize=8)
+    # the legend below the panels, where it hides no curve
+    columns = min(4, len(unique))
+    fig.legend(unique.values(), unique.keys(), fontsize=7, loc="lower center", ncol=columns,
+               frameon=False, markerscale=4 if one else 1)
+    rows = -(-len(unique) // columns)
+    # a system's panels keep 3.5 % of the height a row; one equation's a fixed 0.13 in
+    bottom = (0.13 * rows + 0.05) / fig.get_size_inches()[1] if one else 0.035 * rows + 0.01
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     return _save(fig, path)
 
 

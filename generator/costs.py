@@ -535,7 +535,6 @@ COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
 }
 ROUTE_COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "generate normal mode": generate_mode_cost,
-    "response system": response_cost,
     "slowflow resonant flow": resonant_flow_cost,
 }
 # NOTE: the estimators of a command's other methods (cli.COMMANDS' routes), by command and

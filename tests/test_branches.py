@@ -242,13 +242,13 @@ def test_softening_folds_and_seeding_against_the_reference():
     range without meeting it) and `driven`'s seeding is complete; the fold against the
     reference fold, and its side of the one-harmonic fold (numpy.roots' branch count)."""
     from lindstedt.analysis.systems import notes_problem, response
-    from lindstedt.cli.driven import response_report_json
+    from lindstedt.cli.response import response_json
     from lindstedt.limits import COST_LIMIT_SECONDS
 
     eps, force, Q = -0.1, 0.3, 20.0
     fold = reference_fold(eps, force, Q, 0.8, -1)
     de, closed = notes_problem(eps, force, Q)
-    data = response_report_json(response(de, 8, max_seconds=COST_LIMIT_SECONDS, closed=closed))
+    data = response_json(response(de, 8, max_seconds=COST_LIMIT_SECONDS, closed=closed))
     (balance,) = data["harmonic_balance"]["folds"]
     (true,) = data["numerical"]["folds"]
     assert abs(true - fold) < 1e-8 and abs(balance - fold) < 1e-8

@@ -89,7 +89,7 @@ class Computed(Exception):
 
 
 @pytest.mark.parametrize("args,where,compute", [
-    (["response", "--eps", "0.1", "--force", "0.3", "--Q", "20"], "cli.driven",
+    (["response", "--eps", "0.1", "--force", "0.3", "--Q", "20"], "cli.response",
      "response_report"),
     (["subharmonic", "--eps", "0.1", "--force", "0.5", "--omega", "1.2"],
      "analysis.subharmonic", "subharmonic"),
@@ -180,10 +180,11 @@ def _digits_ok(texts):
 
 
 def test_response_figure_labels_and_settled_sweeps(tmp_path, monkeypatch):
-    """The response chart: ω/ω₀ and r on the axes, the folds in the legend, and every sweep
-    point drawn as data is a steady state — within 0.5 % of the max |q| of an orbit of the
-    continued harmonic balance at its ω (interpolated along each monotone stretch of the
-    curve) — while the start-up and jump transients are drawn apart as "not settled"."""
+    """The response chart: ω/ω₀ and r on the axes, the folds and the Floquet verdicts in the
+    legend, and every sweep point drawn as data is a steady state — within 0.5 % of the
+    max |q| of an orbit of the continued harmonic balance at its ω (interpolated along each
+    monotone stretch of the curve) — while the start-up and jump transients are drawn apart
+    as "not settled"."""
     from lindstedt.analysis.systems import notes_problem, response
 
     de, closed = notes_problem(0.1, 0.3, 20.0)
@@ -193,8 +194,9 @@ def test_response_figure_labels_and_settled_sweeps(tmp_path, monkeypatch):
     (fig,) = drawn
     ax = fig.axes[0]
     assert "ω/ω₀" in ax.get_xlabel() and "r" in ax.get_ylabel() and "max |q|" in ax.get_ylabel()
-    labels = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert "fold of the balance" in labels and "sweep not settled (transient)" in labels
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert {"fold", "sweep not settled (transient)", "branch 1: stable",
+            "branch 1: unstable (Floquet |λ| > 1)", "one harmonic, stable (r)"} <= set(labels)
     assert "f = 0.3" in ax.get_title() and "Q = 20" in ax.get_title()
     _digits_ok(_texts(fig))
     t = np.linspace(0, 2 * np.pi, 400, endpoint=False)

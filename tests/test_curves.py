@@ -191,11 +191,11 @@ def test_response_csv_of_a_linear_oscillator_is_its_closed_form(tmp_path, capsys
                      "--csv", str(path)]) == 0
     capsys.readouterr()
     header, rows = _rows(path)
-    assert header == ["branch [piece of the continued balance from 1]",
-                      "omega [drive frequency]", "r [first harmonic sqrt(A1^2 + B1^2)]"]
-    assert {k for k, _, _ in rows} == {1.0} and len(rows) > 50
-    assert min(w for _, w, _ in rows) <= 0.5 and max(w for _, w, _ in rows) >= 1.5  # the range
-    for _, w, r in rows:
+    assert header[:3] == ["branch [piece of the continued balance from 1]",
+                          "omega [drive frequency]", "r [first harmonic sqrt(A1^2 + B1^2)]"]
+    assert {row[0] for row in rows} == {1.0} and len(rows) > 50
+    assert min(row[1] for row in rows) <= 0.5 and max(row[1] for row in rows) >= 1.5  # range
+    for _, w, r, *_ in rows:
         assert r == pytest.approx(0.3 / math.hypot(1 - w * w, 0.1 * w), rel=1e-10)
 
 

@@ -204,7 +204,7 @@ def test_a_command_routes_its_problem_to_the_first_method_that_takes_it():
     assert read_problem("vdp").equations == ("q'' + q = eps*(1 - q**2)*q'",)
     assert read_problem("vdp").preset == "van_der_pol"
     assert read_problem("driven").size == 0 and read_problem("driven").preset is None
-    for command, system in (("generate", "normal mode"), ("response", "system"),
+    for command, system in (("generate", "normal mode"), ("response", "response"),
                             ("slowflow", "resonant flow")):
         route = COMMAND[command].route
         assert route(argparse.Namespace(model=pair)).method == system

@@ -200,6 +200,28 @@ def test_response_contract_and_bad_input():
         assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1
 
 
+def test_one_equations_json_holds_both_shapes():
+    """One equation's record prints the keys of a system's response too (each branch's
+    points with their Floquet verdict, the folds, the search), beside its own: the branch
+    points are the continued balance's, the folds the same."""
+    from lindstedt.analysis.systems import notes_problem, response
+    from lindstedt.cli.response import response_json
+
+    de, closed = notes_problem(EPS, F, Q)
+    data = response_json(response(de, 4, 0.8, 1.6, closed=closed))
+    assert {"kind", "system", "coordinates", "branches", "folds", "completeness",
+            "equation", "one_harmonic", "harmonic_balance", "numerical"} <= data.keys()
+    assert data["folds"] == data["harmonic_balance"]["folds"]
+    (branch,) = data["branches"]
+    r = np.array(branch["amplitudes"]["q"])
+    w = np.array(branch["omega"])
+    # a one-harmonic root lies within O(ε) of each balance point away from the folds
+    i = int(np.argmin(np.abs(w - 0.9)))
+    assert abs(r[i] / np.sqrt(cubic_roots(w[i])[0]) - 1) < 0.02
+    assert branch["stable"][i] and branch["multiplier"][i] < 1
+    assert {"bound", "how"} <= data["completeness"].keys()
+
+
 @pytest.mark.parametrize("omega", [np.array([0.0]), np.array([np.nan])])
 def test_curve_bad_frequency(omega):
     from lindstedt.errors import InputError

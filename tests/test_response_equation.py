@@ -23,11 +23,11 @@ from lindstedt.cli import main
 from lindstedt.cli.driven import (
     mixing_equation_json,
     mixing_json,
-    response_report_json,
     subharmonic_equation_json,
     subharmonic_equation_response,
     subharmonic_json,
 )
+from lindstedt.cli.response import response_json as printed_json
 from lindstedt.costs import response_cost
 from lindstedt.limits import COST_LIMIT_SECONDS
 from scipy.integrate import solve_ivp
@@ -38,14 +38,14 @@ FOLD_AGREE = 1e-7
 
 def response_equation_json(text: str, values: dict[str, str], harmonics: int) -> dict:
     """``response EQUATION --json``'s contract: the record computed, then printed."""
-    return response_report_json(response(driven_problem(text, values), harmonics,
+    return printed_json(response(driven_problem(text, values), harmonics,
                                          max_seconds=COST_LIMIT_SECONDS))
 
 
 def response_json(eps: float, force: float, Q: float, harmonics: int) -> dict:
     """``response --eps --force --Q --json``'s contract: the record computed, then printed."""
     de, closed = notes_problem(eps, force, Q)
-    return response_report_json(response(de, harmonics, max_seconds=COST_LIMIT_SECONDS,
+    return printed_json(response(de, harmonics, max_seconds=COST_LIMIT_SECONDS,
                                          closed=closed))
 
 

@@ -27,11 +27,12 @@ from .polynomial import DrivenEquation, PolynomialBalance
 
 @dataclass(frozen=True)
 class ResponseCurve:
-    """One-harmonic amplitudes ``r`` (NaN where a branch does not exist), largest first."""
+    """One-harmonic amplitudes ``r`` (NaN where a branch does not exist), largest first, and
+    whether ``∂G/∂u > 0`` there (the notes' stability of the slow flow's fixed point)."""
 
     omega: np.ndarray  # (n,)
-    r: np.ndarray  # (n, 3)
-    stable: np.ndarray  # (n, 3) bool
+    r: np.ndarray  # (n, branches)
+    stable: np.ndarray  # (n, branches) bool
 
 
 def one_harmonic_curve(eps: float, force: float, Q: float, omega: np.ndarray) -> ResponseCurve:
@@ -143,6 +144,18 @@ class OneHarmonic:
                                  for a, b, c, cos, _ in self._harmonics)
         ps = sum(c * omega**b * sin * r ** (a + b) for a, b, c, _, sin in self._harmonics)
         return math.atan2(-ps, pc)
+
+    def curve(self, omega: np.ndarray) -> ResponseCurve:
+        """Every amplitude at each of ``omega`` (:meth:`amplitudes`), largest first, with
+        ``∂G/∂u > 0`` (``H'(r) = 2r ∂G/∂u``: the sign of ``H'`` at the root)."""
+        roots = [self.amplitudes(float(w))[::-1] for w in omega]
+        width = max((len(rs) for rs in roots), default=0)
+        r = np.full((len(roots), width), np.nan)
+        stable = np.zeros((len(roots), width), dtype=bool)
+        for i, (w, rs) in enumerate(zip(omega, roots, strict=True)):
+            r[i, :len(rs)] = rs
+            stable[i, :len(rs)] = _poly.polyval(rs, _poly.polyder(self.polynomial(w))) > 0
+        return ResponseCurve(np.asarray(omega, dtype=float), r, stable)
 
     @functools.cached_property
     def _amplitude_polynomials(self) -> tuple[flint.fmpq_mpoly, flint.fmpq_mpoly]:

@@ -43,6 +43,7 @@ from .polynomial import DrivenEquation, PolynomialBalance, check_harmonics
 from .response import (
     ESCAPE_FACTOR,
     OneHarmonic,
+    ResponseCurve,
     equation_continuation_seconds,
     equation_point_seconds,
     equation_solutions,
@@ -378,6 +379,11 @@ def _shot_checks(sb: SystemBalance, cont: Continuation, amplitudes: np.ndarray,
     return tuple(sorted(shots, key=lambda c: (c.piece, c.omega)))
 
 
+CURVE_POINTS = 600
+# NOTE: the frequencies one equation's one-harmonic curve is solved at for the figure (~0.1 ms
+# each: a polynomial's roots).
+
+
 @dataclass(frozen=True)
 class ClosedForms:
     """What the notes' eq. 10.60 knows in closed form, data of its response: its parameters
@@ -711,6 +717,7 @@ class Response:
     checks: tuple[BranchCheck, ...] = ()
     sweep_jumps: tuple[SweepJump, ...] = ()  # the jumps, each at its fold's ω exactly
     one_harmonic_folds: tuple[float, ...] | None = None
+    one_harmonic_curve: ResponseCurve | None = None  # on CURVE_POINTS frequencies
     sweeps: tuple[Sweep, Sweep] | None = None  # up, down
     true_folds: tuple[tuple[float, tuple[float, ...]], ...] | None = None  # (ω, sorted |μ|)
     barrier: float | None = None
@@ -908,7 +915,9 @@ def response(problem: System | DrivenEquation, harmonics: int = 6,
     sweeps = (sweep_table(table, de.force, lo, hi, barrier=barrier, bound=escape),
               sweep_table(table, de.force, hi, lo, barrier=barrier, bound=escape))
     return Response(**common, complete=complete and cont.complete, jumps=jumps,
-                    one_harmonic_folds=plan.one_harmonic_folds, sweeps=sweeps,
+                    one_harmonic_folds=plan.one_harmonic_folds,
+                    one_harmonic_curve=sb.one_harmonic.curve(np.linspace(lo, hi, CURVE_POINTS)),
+                    sweeps=sweeps,
                     true_folds=tuple(sorted(true_folds)), barrier=barrier, escape=escape,
                     notes=() if closed is None else closed.notes)
 

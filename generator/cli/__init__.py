@@ -1,8 +1,8 @@
 """The ``lindstedt`` command line.  Bad input: one line on stderr, exit status 2.
 
 One module per command family (:mod:`.series`, :mod:`.system`, :mod:`.driven`,
-:mod:`.choose`, :mod:`.sweep`, :mod:`.demo`), each with its commands' arguments, JSON contracts
-and tables;
+:mod:`.response`, :mod:`.choose`, :mod:`.sweep`, :mod:`.demo`), each with its commands'
+arguments, JSON contracts and tables;
 :data:`COMMANDS` here lists them for the parser, the cost guard and ``--help``."""
 
 from __future__ import annotations
@@ -33,15 +33,13 @@ from .driven import (
     arguments_driven,
     arguments_mixing,
     arguments_parametric,
-    arguments_response,
     arguments_subharmonic,
     run_driven,
     run_mixing,
     run_parametric,
-    run_response,
-    run_response_of_system,
     run_subharmonic,
 )
+from .response import arguments_response, run_response
 from .series import (
     arguments_generate,
     arguments_mathieu,
@@ -133,9 +131,7 @@ COMMANDS: tuple[Command, ...] = (
                    ROUTE_COSTS["generate normal mode"])),
     _command("nnm", arguments_nnm, run_nnm),
     _command("driven", arguments_driven, run_driven),
-    _command("response", arguments_response, run_response,
-             Route("system", _coordinates, run_response_of_system,
-                   ROUTE_COSTS["response system"])),
+    _command("response", arguments_response, run_response),
     _command("subharmonic", arguments_subharmonic, run_subharmonic),
     _command("parametric", arguments_parametric, run_parametric),
     _command("mixing", arguments_mixing, run_mixing),

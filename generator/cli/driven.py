@@ -1,5 +1,5 @@
-"""The driven commands: ``driven``, ``response``, ``subharmonic``, ``parametric`` and
-``mixing``: their arguments, JSON contracts and tables."""
+"""The driven commands: ``driven``, ``subharmonic``, ``parametric`` and ``mixing``: their
+arguments, JSON contracts and tables (``response``: :mod:`.response`)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import math
 from pathlib import Path
 
 from ..errors import InputError
-from ..limits import COST_LIMIT_SECONDS, PARAMETRIC_MAX_POINTS
+from ..limits import PARAMETRIC_MAX_POINTS
 
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
 # well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
@@ -19,7 +19,6 @@ from .common import (
     _equation_args,
     _first_harmonic,
     _flag_allow_slow,
-    _flag_csv,
     _flag_drive,
     _flag_equation,
     _flag_harmonics,
@@ -34,11 +33,6 @@ from .common import (
     _quality,
     _real,
     _report,
-    check_outputs,
-    dynamics_json,
-    dynamics_lines,
-    interval,
-    write_csv,
 )
 
 
@@ -306,144 +300,6 @@ def run_driven(args: argparse.Namespace) -> int:
     data = driven_report_json(driven_report(d, args.order, args.harmonics))
     print(json.dumps(data) if args.json else driven_table(data))
     return 0
-
-
-def response_report_json(r) -> dict:
-    """The contract of ``lindstedt response … --json``, a pure function of a
-    :class:`analysis.systems.Response` of one equation: the equation and its force table, the
-    folds three ways (one harmonic, the continued N-harmonic balance, the true orbit's with
-    its Floquet moduli), the sweeps' jumps and escapes; eq. 10.60's ``parameters`` also hold
-    ``eps``, ``force`` and ``Q`` as numbers."""
-    de, cont = r.equation, r.cont
-    up, down = r.sweeps
-    lo, hi = r.omega_range
-    true_folds = [(w, list(m)) for w, m in r.true_folds]
-    return {
-        "equation": de.text,
-        "name": de.name,
-        "parameters": {**dict(r.notes), "harmonics": r.fine.harmonics,
-                       "omega_range": [lo, hi], "values": dict(de.values),
-                       "linear_frequency": r.linear_frequencies[0],
-                       "drive": {"amplitude": de.force, "frequency": de.frequency}},
-        "force": [{"q": a, "dq": b, "c": c} for (a, b), c in sorted(de.terms.items())],
-        "odd": de.odd,
-        "one_harmonic": {"folds": [float(w) for w in r.one_harmonic_folds]},
-        "harmonic_balance": {"harmonics": r.fine.harmonics,
-                             "folds": [float(w) for w in cont.folds],
-                             "complete": cont.complete, "about": "period-1 orbits"},
-        "completeness": {"complete": cont.complete, "about": "period-1 orbits",
-                         "note": None if r.dynamics is None else r.dynamics.note},
-        **({} if r.dynamics is None else dynamics_json(r.dynamics, ["q"])),
-        "numerical": {"folds": [w for w, _ in true_folds],
-                      "fold_floquet_moduli": [m for _, m in true_folds],
-                      "sweep_up_jump": up.jump, "sweep_down_jump": down.jump,
-                      "sweep_resolution": up.resolution, "sweep_up_escape": up.escape,
-                      "sweep_down_escape": down.escape,
-                      "escape_bound": r.barrier if math.isfinite(r.barrier) else None},
-    }
-
-
-def _response_args(args: argparse.Namespace) -> None:
-    """The flags of ``response`` with and without EQUATION, each refused in one line where it
-    does not belong."""
-    if args.model is not None:
-        given = [f"--{k}" for k in DRIVE_FLAGS if getattr(args, k) is not None]
-        if given:
-            raise InputError(f"{', '.join(given)}: with an equation give its parameters with "
-                             "--param (e.g. --param eps=1/10) and the drive in the equation")
-        return
-    if args.param or args.name:
-        raise InputError("--param/--name: give an equation (EQUATION) to take them")
-    missing = [f"--{k}" for k in DRIVE_FLAGS if getattr(args, k) is None]
-    if missing:
-        raise InputError(f"the following arguments are required: {', '.join(missing)}")
-
-
-def response_report(args: argparse.Namespace, limit: float):
-    """The one computation of ``response`` (eq. 10.60 or an EQUATION): its
-    :class:`analysis.systems.Response`, which the JSON, the table, the figure and the CSV
-    print."""
-    from ..analysis.systems import driven_problem, notes_problem, response
-
-    if args.model is not None:
-        return response(driven_problem(args.model, _params(args.param),
-                                       args.name or "oscillator"), args.harmonics,
-                        args.omega_min, args.omega_max, limit)
-    de, closed = notes_problem(args.eps, args.force, args.Q)
-    return response(de, args.harmonics, args.omega_min, args.omega_max, limit, closed)
-
-
-def response_csv(r, path: Path) -> Path:
-    """``response --csv``: every point of the continued balance, branch by branch (the
-    curve drawn), its first-harmonic amplitude."""
-    columns = (("branch", "piece of the continued balance from 1"),
-               ("omega", "drive frequency"), ("r", "first harmonic sqrt(A1^2 + B1^2)"))
-    rows = ((k, w, _first_harmonic(*r.fine.amplitudes(x)))
-            for k, piece in enumerate(r.cont.piece_slices(), 1)
-            for w, x in zip(r.cont.omega[piece], r.cont.x[piece], strict=True))
-    return write_csv(path, columns, rows)
-
-
-def run_response_of_system(args: argparse.Namespace) -> int:
-    """Run ``lindstedt response SYSTEM`` (:func:`cli.system.run_response_system`) with the
-    flags of ``response``."""
-    from .system import run_response_system
-
-    _response_args(args)
-    return run_response_system(args, math.inf if args.allow_slow else COST_LIMIT_SECONDS)
-
-
-def run_response(args: argparse.Namespace) -> int:
-    """Run ``lindstedt response`` (eq. 10.60 or an EQUATION): the response curve over ω, as a
-    table, JSON, a figure or CSV, computed once.  Returns the exit status."""
-    _response_args(args)
-    limit = math.inf if args.allow_slow else COST_LIMIT_SECONDS
-    plot, csv = check_outputs(args)
-    r = response_report(args, limit)
-    if plot is not None and args.model is not None:
-        _charts().response_equation_figure(r, plot, args.model)
-    elif plot is not None:
-        _charts().response_figure(r, plot)
-    if csv is not None:
-        response_csv(r, csv)
-    data = response_report_json(r)
-    print(json.dumps(data) if args.json else "\n".join(_response_table(data)))
-    return 0
-
-
-def _response_table(data: dict) -> list[str]:
-    """The table of ``response``, from its JSON."""
-    p = data["parameters"]
-    given = ", ".join(f"{k} = {v}" for k, v in p["values"].items())
-    harmonics = data["harmonic_balance"]["harmonics"]
-    lo, hi = p["omega_range"]
-    lines = [f"{data['equation']}: {given}{'; ' if given else ''}{p['drive']['frequency']} in "
-             f"{interval(lo, hi)} (omega0 = {p['linear_frequency']:.6g})"]
-    num = data["numerical"]
-    for label, folds in (("one harmonic", data["one_harmonic"]["folds"]),
-                         (f"harmonic balance N={harmonics}", data["harmonic_balance"]["folds"]),
-                         ("true orbit (Floquet +1)", num["folds"])):
-        lines.append(f"{label:>26}: folds " + (", ".join(f"{w:.12f}" for w in folds) or "none"))
-    for way in ("up", "down"):
-        value, escape = num[f"sweep_{way}_jump"], num[f"sweep_{way}_escape"]
-        if escape is not None and "eps" in p:
-            text = (f"escapes the well at {escape:.4f} (over the barrier |q| = "
-                    f"{num['escape_bound']:.3g}: no steady state beyond)")
-        elif escape is not None:
-            text = (f"escapes at {escape:.4f} (|q| past {num['escape_bound']:.3g}, 10 times "
-                    "every balance solution's: no steady state beyond)")
-        elif value is not None:
-            text = f"jumps at {value:.4f} (sweep step {num['sweep_resolution']:.1e} per period)"
-        else:
-            text = "no jump"
-        lines.append(f"{'sweep ' + way:>26}: {text}")
-    lines += dynamics_lines(data) if "bifurcations" in data else []
-    if not data["harmonic_balance"]["complete"]:
-        lines.append("warning: a balance at an end of the range did not converge from its "
-                     "one-harmonic root: pieces of the curve may be missing")
-    if data.get("completeness", {}).get("note"):
-        lines.append(data["completeness"]["note"])
-    return lines
 
 
 def subharmonic_json(eps: float, force: float, omega: float, closed: tuple) -> dict:
@@ -819,43 +675,6 @@ def arguments_driven(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
     _flag_order(p, "μ-expansion order K")
     _flag_harmonics(p, "odd harmonics N of harmonic balance")
     _flag_json(p)
-    _flag_allow_slow(p, deprecated_force=False)
-    return p
-
-
-def arguments_response(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    """``lindstedt response``'s arguments."""
-    p = sub.add_parser("response", help="folds and hysteresis of the damped driven oscillator",
-                       description="Response curve over ω: folds three ways, sweep jumps. "
-                       "q'' + q'/Q + q + eps q^3 = f cos(w t) (--eps, --force, --Q), or your "
-                       "own damped equation q'' + g(q, q') = f*cos(w*t), g a polynomial, with "
-                       "--param for every parameter but w; or a SYSTEM of coupled damped "
-                       "oscillators, one equation per coordinate separated by ';', driven by "
-                       "f*cos(w*t) on one or more of them: every branch (a bound on the "
-                       "amplitude says none is missed), Floquet stability, folds, sweep jumps, "
-                       "each branch checked by shooting.")
-    _flag_equation(p, "\"q'' + 0.05*q' + q + eps*(q**2 + q**3) = f*cos(w*t)\" (a "
-                   "polynomial force with damping, one drive f*cos(w*t) whose w the curve "
-                   "varies), or a system \"x1'' + 0.05*x1' + 2*x1 - x2 + x1**3/2 = "
-                   "f*cos(w*t); x2'' + 0.05*x2' + 2*x2 - x1 = 0\"",
-                   "Duffing's q'' + q'/Q + q + εq³ = f cos ωt with --eps, --force, "
-                   "--Q", "every parameter but w "
-                   "needs one")
-    _flag_drive(p, required=False, omega=None, Q=None, notes=True)
-    p.add_argument("--Q", type=_quality, default=None, metavar="Q",
-                   help="quality factor Q > 0 of the damping q'/Q (finite; required without "
-                   "EQUATION)")
-    _flag_omega(p, ("A:B",), "the drive frequencies ω of the curve, from A to B, in units "
-                "of the linear natural frequency ω0 (default: from half the lowest of ω0 and "
-                "the one-harmonic folds to 1.25 × the highest); with a SYSTEM: in its own "
-                "time units (default: half the lowest linear ω0 to 1.5 × the highest)")
-    _flag_range_bounds(p, "--omega-min", "--omega-max")
-    _flag_harmonics(p, "odd harmonics N of the continued balance (with EQUATION: harmonics "
-                    "1..2N-1, with the constant and even ones unless the force is odd)")
-    _flag_json(p)
-    _flag_plot(p)
-    _flag_csv(p, "the branches of the continued balance (branch, omega, r; a SYSTEM: each "
-              "coordinate's r, the largest Floquet modulus, stable)")
     _flag_allow_slow(p, deprecated_force=False)
     return p
 
