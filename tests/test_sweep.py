@@ -31,8 +31,8 @@ from lindstedt.numerics.shooting import shoot
 from lindstedt.sweep.kinds import (
     MU_ORDERS,
     WarmUp,
-    equation_kind,
     kernel_signatures,
+    kind_of,
     validity_errors,
 )
 from lindstedt.sweep.store import (
@@ -424,7 +424,7 @@ def test_equation_sweep_stable_r_is_the_attractor_dop853_reaches_from_rest():
     (serially here): at every point the steady state DOP853 reaches from rest is one of the
     stored stable orbits (its r within 1e-6), and a point with three orbits holds one unstable
     between two stable (the fold's hysteresis)."""
-    kind = equation_kind("response", SWEPT, {"eps": "1/10", "f": "3/10"}, ["w", "alpha"])
+    kind = kind_of("response", SWEPT, {"eps": "1/10", "f": "3/10"}, ["w", "alpha"])
     ds = serial_sweep(kind, {"w": [0.9, 1.3, 1.5], "alpha": [0.0, 0.5]})
     assert ds["r"].dims == ("w", "alpha", "branch")
     for i, w in enumerate(ds["w"].values):
@@ -446,7 +446,7 @@ def test_equation_subharmonic_sweep_against_the_command():
     from lindstedt.analysis.subharmonic import subharmonic_equation, subharmonic_orbits
 
     text = "x'' + 0.05*x' + x + x**2 = f*cos(W*t)"
-    kind = equation_kind("subharmonic", text, {"f": "1/2"}, ["W"], n=2)
+    kind = kind_of("subharmonic", text, {"f": "1/2"}, ["W"], n=2)
     ds = serial_sweep(kind, {"W": [1.6, 2.0, 2.4]})
     for i, W in enumerate(ds["W"].values):
         found = subharmonic_orbits(subharmonic_equation(text, {"f": "1/2"}, W / 2, 2),
@@ -466,7 +466,7 @@ def test_system_sweep_linear_points_are_the_complex_amplitudes_exactly():
     with the cubic on, a point inside the fold (ω = 1.14, between the folds 1.1189 and 1.1648
     that test_response_system checks by shooting) holds two stable orbits around an unstable
     one."""
-    kind = equation_kind("response", SYSTEM, {"f": "1/10", "k": "0"}, ["w", "c"])
+    kind = kind_of("response", SYSTEM, {"f": "1/10", "k": "0"}, ["w", "c"])
     ds = serial_sweep(kind, {"w": [0.7, 1.0, 1.5, 2.2], "c": [0.05, 0.2]})
     K = np.array([[2.0, -1.0], [-1.0, 2.0]])
     for i, w in enumerate(ds["w"].values):
@@ -478,7 +478,7 @@ def test_system_sweep_linear_points_are_the_complex_amplitudes_exactly():
             assert abs(ds["r_x2"].values[i, j, 0] - abs(X[1])) < 1e-12
             assert ds["floquet"].values[i, j, 0] == pytest.approx(np.exp(-np.pi * c / w),
                                                                   rel=1e-8)
-    hard = equation_kind("response", SYSTEM, {"f": "3/10", "k": "1/2", "c": "1/20"}, ["w"])
+    hard = kind_of("response", SYSTEM, {"f": "3/10", "k": "1/2", "c": "1/20"}, ["w"])
     ds = serial_sweep(hard, {"w": [1.14]})
     assert ds["orbits"].values[0] == 3
     assert list(ds["stable"].values[0][:3]) == [1, 0, 1]
@@ -503,6 +503,24 @@ def test_equation_sweep_refusals(tmp_path, capsys, argv, says):
     err = capsys.readouterr().err.strip()
     assert says in err and len(err.splitlines()) == 1, err
     assert not store.exists()
+
+
+def test_one_table_says_which_problems_each_kind_takes():
+    """:data:`sweep.kinds.KINDS`: every kind takes the notes' axes; response, stability and
+    subharmonic a user's equation; response alone a system; each refusal in one line naming
+    the kinds that do take it."""
+    from lindstedt.derive.problem import read_problem
+    from lindstedt.sweep.kinds import KINDS
+
+    one, pair = read_problem(SWEPT), read_problem(SYSTEM)
+    takes = {name: tuple(k.why_not(p) is None for p in (None, one, pair))
+             for name, k in KINDS.items()}
+    assert takes == {"response": (True, True, True), "stability": (True, True, False),
+                     "subharmonic": (True, True, False), "validity": (True, False, False)}
+    assert "with an equation use response, stability, subharmonic" in \
+        KINDS["validity"].why_not(one)
+    assert "a system's map is response" in KINDS["stability"].why_not(pair)
+    assert kind_of("stability").name == "stability" and kind_of("stability").builtin
 
 
 def test_validity_takes_no_equation(tmp_path, capsys):
@@ -656,7 +674,7 @@ def test_a_vanishing_drive_is_the_rest_state_of_the_damped_system(scheduler, tmp
     equation is refused at (c = 0: no steady state) is noted by the command."""
     from lindstedt.cli import main
 
-    kind = equation_kind("response", SYSTEM, {"c": "1/20", "k": "1/2"}, ["f", "w"])
+    kind = kind_of("response", SYSTEM, {"c": "1/20", "k": "1/2"}, ["f", "w"])
     ds = serial_sweep(kind, {"f": [0.0, 1e-7, 0.05], "w": [1.0, 1.7]})
     for j, w in enumerate([1.0, 1.7]):
         rest = ds.isel(f=0, w=j)
@@ -668,7 +686,7 @@ def test_a_vanishing_drive_is_the_rest_state_of_the_damped_system(scheduler, tmp
         assert float(ds.floquet.isel(f=1, w=j, branch=0)) == pytest.approx(
             float(rest.floquet[0]), rel=1e-6)
         assert 0 < float(ds.r.isel(f=1, w=j, branch=0)) < 1e-5
-    scalar = equation_kind("response", SWEPT, {"eps": "1/10", "alpha": "0"}, ["f", "w"])
+    scalar = kind_of("response", SWEPT, {"eps": "1/10", "alpha": "0"}, ["f", "w"])
     one = serial_sweep(scalar, {"f": [0.0], "w": [0.8]}).isel(f=0, w=0)
     assert int(one.orbits) == 1 and float(one.r[0]) == 0.0 and int(one.stable[0]) == 1
     assert float(one.floquet[0]) == pytest.approx(math.exp(-math.pi * 0.05 / 0.8), rel=1e-12)

@@ -36,7 +36,7 @@ def run_sweep(args: argparse.Namespace) -> int:
         from ..charts import check_plot_path
 
         check_plot_path(Path(args.plot))
-    from ..sweep.kinds import equation_kind
+    from ..sweep.kinds import kind_of
     from ..sweep.store import run_sweep, summary
 
     builtin = {name: getattr(args, name) for name in ("omega", "force", "eps", "Q")
@@ -49,7 +49,7 @@ def run_sweep(args: argparse.Namespace) -> int:
         axes = dict(args.axis or [])
         if len(axes) != len(args.axis or []):
             raise InputError("--axis: each parameter once")
-        kind = equation_kind(args.kind, args.model, _params(args.param), list(axes),
+        kind = kind_of(args.kind, args.model, _params(args.param), list(axes),
                              3 if args.n is None else args.n, args.name or "oscillator")
     else:
         if args.axis or args.param or args.name or args.n is not None:

@@ -1,7 +1,7 @@
 """Maps of the driven oscillator ``q̈ + q̇/Q + q + εq³ = f cos ωt`` over parameter grids.
 
 A grid is a few named axes (``omega``, ``force``, ``eps``, ``Q``), each a list of values; a
-*kind* of map (:data:`KINDS`) says which axes it takes, what it computes at one point and
+*kind* of map (:class:`Kind`) says which axes it takes, what it computes at one point and
 what it stores:
 
 * ``response``: the steady amplitude ``r = √(A₁² + B₁²)`` of every 1:1 branch (harmonic
@@ -21,8 +21,9 @@ what it stores:
 Every point is computed by the existing solvers of :mod:`driven`, :mod:`response` and
 :mod:`numerics`; nothing here solves anything itself.
 
-A user's equation (:func:`equation_kind`) makes a kind of its own: any of its parameters an
-axis, every orbit stored with its r and Floquet verdict.
+One table (:data:`KINDS`) says which problems each kind takes: the notes' axes, a user's
+equation, a system; with an equation or a system (:func:`kind_of`) a kind is made of its
+own: any of its parameters an axis, every orbit stored with its r and Floquet verdict.
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ from ..analysis.subharmonic import SUBHARMONIC_HARMONICS, subharmonic
 from ..errors import InputError
 
 if TYPE_CHECKING:
-    pass
+    from ..derive.problem import Problem
 
 # NOTE: xarray and zarr are imported where the client uses them: every worker imports this
 # module to run its blocks and needs neither (~1.3 s of each worker's start-up, measured).
@@ -288,23 +289,13 @@ VALIDITY = Kind(
     32, "mu_error", (("judge_harmonics", JUDGE_HARMONICS),))
 # NOTE: 32 points: ~25 ms a point (μ-expansion to order 10 five times, three balances).
 
-KINDS: Mapping[str, Kind] = {k.name: k for k in (RESPONSE, STABILITY, SUBHARMONIC, VALIDITY)}
-
-
-def kind_named(name: str) -> Kind:
-    """The :class:`Kind` called ``name``, or :class:`InputError` listing the kinds."""
-    if name not in KINDS:
-        raise InputError(f"sweep kind {name!r}: use one of {', '.join(KINDS)}")
-    return KINDS[name]
-
-
 # --- computing blocks ----------------------------------------------------------------------------
 
 def compute_block(kind: str | Kind, values: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
     """Every field of ``kind`` (a :class:`Kind` or the name of a built-in one) on the block
     spanned by ``values`` (one array per axis): the task each worker runs, and the serial
     loop's body."""
-    kind = kind if isinstance(kind, Kind) else KINDS[kind]
+    kind = kind if isinstance(kind, Kind) else kind_named(kind)
     shape = tuple(v.size for v in values)
     sizes = kind.extra_sizes
     out = {f.name: np.full(shape + tuple(sizes[d] for d in f.dims), f.fill, dtype=f.dtype)
@@ -331,7 +322,7 @@ def warm_up(kind: str | Kind) -> dict[str, int]:
     """Run the kind's warm-up point: loads (or compiles, once, into numba's on-disk cache)
     every kernel its tasks call, so that no task pays for it. Returns
     :func:`kernel_signatures`."""
-    kind = kind if isinstance(kind, Kind) else KINDS[kind]
+    kind = kind if isinstance(kind, Kind) else kind_named(kind)
     compute_block(kind, tuple(np.array([dict(kind.warm_up)[a]]) for a in kind.axes))
     return kernel_signatures()
 
@@ -541,17 +532,97 @@ def _equation_subharmonic(spec: EquationSpec, **axis: float) -> dict:
     return {"exists": int(found.exists), **_branches(shot, len(found.orbits))}
 
 
-EQUATION_KINDS = ("response", "stability", "subharmonic")
-# NOTE: with an equation, response and stability are one map (every orbit shot, its Floquet
-# verdict); validity is the notes' μ-expansion's and takes no equation.
+@dataclass(frozen=True)
+class KindOfMap:
+    """One kind of map for every problem it takes: the notes' Duffing over its axes
+    (``notes``: a fixed :class:`Kind`), one user's equation and a system (each a builder of
+    the :class:`Kind` of that problem, its parameters the axes; ``None``: refused, and
+    :meth:`why_not` says why)."""
+
+    name: str
+    notes: Kind | None
+    equation: Callable[..., Kind] | None = None
+    system: Callable[..., Kind] | None = None
+
+    def why_not(self, problem: Problem | None) -> str | None:
+        """``None`` where this kind takes ``problem`` (``None``: the notes' flags), else why
+        not, in one line."""
+        if problem is None:
+            return None if self.notes is not None else f"sweep {self.name}: give an equation"
+        if problem.one_coordinate and self.equation is None:
+            takes = ", ".join(k.name for k in KINDS.values() if k.equation is not None)
+            return (f"sweep {self.name} EQUATION: the {self.name} map is the notes' "
+                    f"(μ-expansion of q + eps q^3); with an equation use {takes}")
+        if not problem.one_coordinate and self.system is None:
+            takes = ", ".join(k.name for k in KINDS.values() if k.system is not None)
+            return (f"sweep {self.name} SYSTEM: a system's map is {takes} (every periodic "
+                    "response with its Floquet verdict)")
+        return None
 
 
-def equation_kind(kind: str, text: str, values: Mapping[str, str],
-                  axes: Sequence[str], n: int = 3, name: str = "oscillator") -> Kind:
-    """The :class:`Kind` of ``sweep KIND EQUATION --axis NAME=… --param NAME=…``: the axes are
-    parameters of the equation (its drive frequency included), every other parameter has a
-    value in ``values``; refused in one line: an axis that names no parameter, a parameter
-    both an axis and a value, a parameter with neither, a kind that takes no equation."""
+def _orbits_kind(kind: str, text: str, spec: EquationSpec, axes: tuple[str, ...],
+                 common: tuple[Field, ...], settings: tuple, frequency: str) -> Kind:
+    """One equation's ``response`` or ``stability`` map (one map: every orbit shot, its
+    Floquet verdict)."""
+    return Kind(kind, f"every 1:1 orbit of {text} with its Floquet verdict", axes,
+                (_EQUATION_BRANCH,), common, functools.partial(_equation_response, spec),
+                tuple((a, 1.0) for a in axes), 4, "r_stable_max", settings, builtin=False,
+                positive=(frequency,))
+
+
+def _subharmonic_kind(kind: str, text: str, spec: EquationSpec, axes: tuple[str, ...],
+                      common: tuple[Field, ...], settings: tuple, frequency: str) -> Kind:
+    """One equation's orbits of n drive periods."""
+    return Kind("subharmonic", f"orbits of {spec.n} drive periods of {text}", axes,
+                (_EQUATION_BRANCH,), (Field("exists", "an orbit of n drive periods was found",
+                                            "int8", flag=True), *common),
+                functools.partial(_equation_subharmonic, spec), tuple((a, 1.0) for a in axes),
+                4, "stable_orbits", settings, builtin=False, positive=(frequency,))
+
+
+def _system_kind(kind: str, text: str, spec: EquationSpec, axes: tuple[str, ...],
+                 common: tuple[Field, ...], settings: tuple, frequency: str,
+                 coordinates: tuple[str, ...] = ()) -> Kind:
+    """A system's map: every periodic response with the Floquet verdict of its variational
+    equation, ``r`` over every coordinate and ``r_<x>`` each coordinate's."""
+    each = tuple(Field(f"r_{x}", f"r of {x} = sqrt(A1^2 + B1^2) of each orbit (in r's "
+                       "order)", dims=("branch",)) for x in coordinates)
+    clash = sorted(set(axes) & {f.name for f in each})
+    if clash:
+        raise InputError(f"--axis {clash[0]}: the store holds a field of that name; rename "
+                         "the parameter in the system")
+    return Kind(kind, f"every periodic response of the system {text} (harmonic balance, "
+                "r over every coordinate) with the Floquet verdict of its variational "
+                "equation", axes, (_EQUATION_BRANCH,), (*common, *each),
+                functools.partial(_system_response, spec), tuple((a, 1.0) for a in axes), 4,
+                "r_stable_max", settings, builtin=False, positive=(frequency,))
+
+
+_EQUATION_BRANCH = ("branch", tuple(range(1, EQUATION_BRANCHES + 1)))
+
+KINDS: Mapping[str, KindOfMap] = {k.name: k for k in (
+    KindOfMap("response", RESPONSE, _orbits_kind, _system_kind),
+    KindOfMap("stability", STABILITY, _orbits_kind),
+    KindOfMap("subharmonic", SUBHARMONIC, _subharmonic_kind),
+    KindOfMap("validity", VALIDITY),
+)}
+# NOTE: the one table of kinds: with an equation, response and stability are one map (every
+# orbit shot, its Floquet verdict); validity is the notes' μ-expansion's and takes no equation;
+# a system's map is response.
+
+
+def kind_named(name: str) -> Kind:
+    """The notes' :class:`Kind` called ``name``, or :class:`InputError` listing the kinds."""
+    return kind_of(name)
+
+
+def kind_of(kind: str, text: str | None = None, values: Mapping[str, str] | None = None,
+            axes: Sequence[str] = (), n: int = 3, name: str = "oscillator") -> Kind:
+    """The :class:`Kind` of ``sweep KIND [PROBLEM]`` from :data:`KINDS`: without ``text`` the
+    notes' (over omega, force, eps, Q); with an equation or a system, its parameters the axes
+    (its drive frequency included), every other parameter a value in ``values``; refused in
+    one line: a kind that does not take the problem (:meth:`KindOfMap.why_not`), an axis that
+    names no parameter, a parameter both an axis and a value, a parameter with neither."""
     from ..analysis.polynomial import driven_form
     from ..analysis.subharmonic import check_n
     from ..analysis.systems import driven_system
@@ -559,19 +630,23 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
     from ..derive.problem import read_problem
     from ..derive.system import system_parameters
 
-    if kind not in EQUATION_KINDS:
-        raise InputError(f"sweep {kind} EQUATION: the {kind} map is the notes' (μ-expansion "
-                         f"of q + eps q^3); with an equation use {', '.join(EQUATION_KINDS)}")
+    if kind not in KINDS:
+        raise InputError(f"sweep kind {kind!r}: use one of {', '.join(KINDS)}")
+    entry = KINDS[kind]
+    problem = None if text is None else read_problem(text)
+    why = entry.why_not(problem)
+    if why is not None:
+        raise InputError(why)
+    if problem is None:
+        return entry.notes
+    values = dict(values or {})
     if kind == "subharmonic":
         check_n(n)
     if not axes:
         raise InputError("sweep EQUATION: give at least one axis, --axis NAME=A:B:N")
     # NOTE: a system's map holds a field per coordinate (r_x1, …): another Kind's fields
-    system = not read_problem(text).one_coordinate
+    system = not problem.one_coordinate
     if system:
-        if kind != "response":
-            raise InputError(f"sweep {kind} SYSTEM: a system's map is response (every periodic "
-                             "response with its Floquet verdict)")
         parameters, frequency = system_parameters(text)
         if frequency is None:
             raise InputError(f"system {text!r}: no drive; sweep response SYSTEM needs "
@@ -601,19 +676,17 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
         raise InputError(f"--axis {clash[0]}: the store holds a field of that name; rename the "
                          "parameter in the equation")
     if system:
-        coordinates = driven_system(text, {**dict(values),
-                                           **{a: "1" for a in axes if a != frequency}}
-                                    ).coordinates
+        coordinates = tuple(str(x) for x in driven_system(
+            text, {**values, **{a: "1" for a in axes if a != frequency}}).coordinates)
     else:
         frequency = _frequency_name(osc, text, name)
-        form = driven_form(text, {**dict(values), **{a: "1" for a in axes if a != frequency}},
+        form = driven_form(text, {**values, **{a: "1" for a in axes if a != frequency}},
                            name, f"sweep {kind}", "a polynomial force and one drive "
                            "f*cos(w*t)", True)
-    if not system and len(form.drives) != 1:
-        raise InputError(f"{name} ({text}): sweep {kind} takes one drive f*cos(w*t), not "
-                         f"{len(form.drives)}")
+        if len(form.drives) != 1:
+            raise InputError(f"{name} ({text}): sweep {kind} takes one drive f*cos(w*t), not "
+                             f"{len(form.drives)}")
     spec = EquationSpec(kind, text, tuple(sorted(values.items())), frequency, n, name)
-    branch = ("branch", tuple(range(1, EQUATION_BRANCHES + 1)))
     common = (
         Field("orbits", "distinct periodic orbits found (shooting)", "int8",
               unset="not computed, or the equation is refused at this point (e.g. a damping "
@@ -626,28 +699,10 @@ def equation_kind(kind: str, text: str, values: Mapping[str, str],
         Field("r_stable_min", "smallest stable r"))
     settings = (("equation", text), ("values", dict(sorted(values.items()))), ("n", n),
                 ("orbit_harmonics", ORBIT_HARMONICS))
-    warm = tuple((a, 1.0) for a in axes)
-    if kind == "subharmonic":
-        return Kind("subharmonic", f"orbits of {n} drive periods of {text}", tuple(axes),
-                    (branch,), (Field("exists", "an orbit of n drive periods was found", "int8",
-                                      flag=True), *common),
-                    functools.partial(_equation_subharmonic, spec), warm, 4, "stable_orbits",
-                    settings, builtin=False, positive=(frequency,))
     if system:
-        each = tuple(Field(f"r_{x}", f"r of {x} = sqrt(A1^2 + B1^2) of each orbit (in r's "
-                           "order)", dims=("branch",)) for x in coordinates)
-        clash = sorted(set(axes) & {f.name for f in each})
-        if clash:
-            raise InputError(f"--axis {clash[0]}: the store holds a field of that name; rename "
-                             "the parameter in the system")
-        return Kind(kind, f"every periodic response of the system {text} (harmonic balance, "
-                    "r over every coordinate) with the Floquet verdict of its variational "
-                    "equation", tuple(axes), (branch,), (*common, *each),
-                    functools.partial(_system_response, spec), warm, 4, "r_stable_max",
-                    settings, builtin=False, positive=(frequency,))
-    return Kind(kind, f"every 1:1 orbit of {text} with its Floquet verdict", tuple(axes),
-                (branch,), common, functools.partial(_equation_response, spec), warm, 4,
-                "r_stable_max", settings, builtin=False, positive=(frequency,))
+        return entry.system(kind, text, spec, tuple(axes), common, settings, frequency,
+                            coordinates)
+    return entry.equation(kind, text, spec, tuple(axes), common, settings, frequency)
 
 
 def _frequency_name(osc: object, text: str, name: str) -> str:
