@@ -200,6 +200,25 @@ def test_response_contract_and_bad_input():
         assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1
 
 
+def test_the_presets_name_takes_the_notes_flags(capsys):
+    """``response duffing --eps --force --Q`` is ``response --eps --force --Q`` (the preset
+    of the same problem), its JSON the same to the last bit; without a flag both say which is
+    missing, in one line."""
+    from lindstedt.cli import main
+
+    flags = ["--eps", "0.1", "--force", "0.3", "--Q", "20", "--harmonics", "4", "--omega",
+             "0.8:1.6", "--json"]
+    assert main(["response", "duffing", *flags]) == 0
+    named = json.loads(capsys.readouterr().out)
+    assert main(["response", *flags]) == 0
+    assert json.loads(capsys.readouterr().out) == named
+    assert named["parameters"]["omega_range"] == [0.8, 1.6] and named["coordinates"] == ["q"]
+    for argv in (["response", "duffing", "--eps", "0.1"], ["response", "--eps", "0.1"]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and "--force, --Q" in err, err
+
+
 def test_one_equations_json_holds_both_shapes():
     """One equation's record prints the keys of a system's response too (each branch's
     points with their Floquet verdict, the folds, the search), beside its own: the branch

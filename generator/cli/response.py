@@ -240,8 +240,10 @@ def response_csv(r, path: Path) -> Path:
 
 def _response_args(args: argparse.Namespace) -> None:
     """The flags of ``response`` with and without EQUATION, each refused in one line where it
-    does not belong."""
-    if args.model is not None:
+    does not belong: the notes' flags go with no problem or with its preset's name."""
+    from ..analysis.systems import notes_preset
+
+    if not notes_preset(args.model):
         given = [f"--{k}" for k in DRIVE_FLAGS if getattr(args, k) is not None]
         if given:
             raise InputError(f"{', '.join(given)}: with an equation give its parameters with "
@@ -257,10 +259,10 @@ def _response_args(args: argparse.Namespace) -> None:
 def response_report(args: argparse.Namespace, limit: float):
     """The one computation of ``response`` (eq. 10.60 or an EQUATION): its
     :class:`analysis.systems.Response`, which the JSON, the table, the figure and the CSV
-    print (eq. 10.60 by its flags, without a problem)."""
-    from ..analysis.systems import driven_problem, notes_problem, response
+    print (eq. 10.60 by its flags, without a problem or with its preset's name)."""
+    from ..analysis.systems import driven_problem, notes_preset, notes_problem, response
 
-    if args.model is not None:
+    if not notes_preset(args.model):
         return response(driven_problem(args.model, _params(args.param),
                                        args.name or "oscillator"), args.harmonics,
                         args.omega_min, args.omega_max, limit)
@@ -269,9 +271,9 @@ def response_report(args: argparse.Namespace, limit: float):
 
 
 def run_response(args: argparse.Namespace) -> int:
-    """Run ``lindstedt response`` (eq. 10.60 by its flags, an EQUATION or a SYSTEM): the
-    response curve over ω, computed once, as a table, JSON, a figure or CSV.  Returns the exit
-    status."""
+    """Run ``lindstedt response`` (eq. 10.60 by its flags, with or without its preset's
+    name, an EQUATION or a SYSTEM): the response curve over ω, computed once, as a table,
+    JSON, a figure or CSV.  Returns the exit status."""
     _response_args(args)
     limit = math.inf if args.allow_slow else COST_LIMIT_SECONDS
     plot, csv = check_outputs(args)
@@ -289,7 +291,8 @@ def arguments_response(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
     """``lindstedt response``'s arguments."""
     p = sub.add_parser("response", help="folds and hysteresis of the damped driven oscillator",
                        description="Response curve over ω: folds three ways, sweep jumps. "
-                       "q'' + q'/Q + q + eps q^3 = f cos(w t) (--eps, --force, --Q), or your "
+                       "q'' + q'/Q + q + eps q^3 = f cos(w t) (--eps, --force, --Q, with or "
+                       "without its preset's name duffing), or your "
                        "own damped equation q'' + g(q, q') = f*cos(w*t), g a polynomial, with "
                        "--param for every parameter but w; or a SYSTEM of coupled damped "
                        "oscillators, one equation per coordinate separated by ';', driven by "
