@@ -304,3 +304,8 @@ def test_normal_mode_tables_hold_the_exact_series(written):
     assert r"\frac{1}{32}\,y" in text  # ω = √3(1 + y/32 + …)
     assert r"\frac{25}{4992}" in text
     assert r"\ddot{x_{1}}" in text and "**" not in text.split("\\begin{document}")[1]
+    from lindstedt.derive.nnm import normal_mode, radius
+    from lindstedt.derive.system import parse_system
+
+    found = radius(normal_mode(parse_system(KERSCHEN), 2, 24))  # as generate derives it
+    assert f"its lower bound ${found.lower:.6g}$" in text and f"{found.estimate:.6g}" in text

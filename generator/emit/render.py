@@ -301,6 +301,19 @@ def _convention(coordinates: tuple, amplitude: sp.Symbol, value: sp.Expr) -> str
             f"${_part(amp, 'j')}(0) = 0$ for $j \\ge 1$")
 
 
+def _mode_reach(radius: tuple[float, float, float] | None, y: str) -> str:
+    """Where a normal mode's series holds, as a LaTeX sentence: the radius of its ω series
+    estimated from the ω_j, and the lower bound its evaluators stop at."""
+    if radius is None:
+        return "No radius of convergence is estimated: the series of $\\omega$ ends or is short."
+    estimate, spread, lower = radius
+    stated = ("no singularity fits the $\\omega_j$" if math.isnan(estimate) else
+              f"the series of $\\omega$ converges for $|{y}| < {estimate:.6g}$ (the radius of "
+              f"convergence estimated from the $\\omega_j$, spread ${spread:.2g}$)")
+    return (f"Validity: {stated}; its lower bound ${lower:.6g}$ is where the emitted "
+            "evaluators' guard stops them.")
+
+
 def tables_context(d: SeriesTables) -> dict:
     """Everything ``tables.tex.j2`` uses, as strings: a long exact number as its decimal
     (:func:`printers.readable`), in the cells and in the series of ω and T."""
@@ -324,7 +337,8 @@ def tables_context(d: SeriesTables) -> dict:
         "variable": variable, "y": y, "order": d.order,
         "convention": _convention(tuple(x for x, _ in d.coordinates), d.amplitude,
                                   d.amplitude_value),
-        "validity": "" if d.validity is None else latex_validity(d.validity, y),
+        "validity": latex_validity(d.validity, y) if d.validity is not None else
+        _mode_reach(d.radius, y),
         "coefficients": _table_blocks([(r"$\omega_j$", cells(d.omega)),
                                        (r"$\tau_j$", cells(d.period))]),
         "frequency": _series("" if unit else w0 + r"\Bigl(", powers(d.omega),

@@ -21,6 +21,7 @@ from ..derive.equation import parse_equation
 from ..derive.lindstedt import SeriesSolution, order_terms, validity
 from ..derive.models import Model
 from ..derive.nnm import NormalModeSeries
+from ..derive.nnm import radius as mode_radius
 from ..derive.system import System
 from ..errors import InputError
 from .forms import _LOCAL, LOCAL_NAMES, MODULE_NAMES, agm_steps, harmonics
@@ -147,6 +148,7 @@ def lower_tables(series: SeriesSolution | NormalModeSeries, order: int) -> Serie
                                   for qj in series.q[: order + 1])),),
             m.coordinate, m.amplitude, validity(series))
     system = series.system
+    found = mode_radius(series)
     return SeriesTables(
         f"Nonlinear normal mode {series.mode}", _system_equations(system), series.omega0,
         sp.Symbol("A") ** series.step, order,
@@ -154,7 +156,8 @@ def lower_tables(series: SeriesSolution | NormalModeSeries, order: int) -> Serie
         tuple(series.period_times_omega0()[: order + 1]),
         tuple((x, tuple(tuple(sorted(o.items())) for o in series.coordinate(i, order)))
               for i, x in enumerate(system.coordinates)),
-        system.coordinates[series.amplitude], sp.Symbol("A"))
+        system.coordinates[series.amplitude], sp.Symbol("A"),
+        radius=None if found is None else (found.estimate, found.spread, found.lower))
 
 
 def lower_series_derivation(series: SeriesSolution | NormalModeSeries, order: int

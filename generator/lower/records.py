@@ -228,6 +228,9 @@ class SeriesTables:
     amplitude: sp.Symbol  # the coordinate at its turning point at t = 0
     amplitude_value: sp.Expr  # its value there: A, θ₀
     validity: Validity | None = None  # a free oscillator's orbits and radius
+    radius: tuple[float, float, float] | None = None
+    # NOTE: a mode's ω series: the radius estimated in y, its spread and the lower bound its
+    # module stops at (derive.nnm.radius); NaN where not estimated
 
 
 @dataclass(frozen=True)
