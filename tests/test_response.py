@@ -72,6 +72,19 @@ def test_curve_equals_numpy_roots_and_stability():
     assert list(curve.stable[i]) == [True, False, True]
 
 
+def test_any_forces_curve_is_the_cubics_closed_form():
+    """:meth:`OneHarmonic.curve` (the roots of any force's H(r), ∂G/∂u > 0 as the verdict)
+    equals eq. 10.60's vectorised closed form (:func:`one_harmonic_curve`), branch by
+    branch."""
+    omega = np.linspace(0.6, 1.8, 301)
+    closed = one_harmonic_curve(EPS, F, Q, omega)
+    general = OneHarmonic(Drive(EPS, F, 1.0, Q).terms, F).curve(omega)
+    width = general.r.shape[1]
+    assert width == 3
+    np.testing.assert_allclose(general.r, closed.r[:, :width], rtol=1e-10)
+    assert (general.stable == closed.stable[:, :width]).all()
+
+
 def test_folds_are_double_roots_and_change_the_branch_count():
     folds = one_harmonic_folds(EPS, F, Q)
     assert len(folds) == 2

@@ -706,8 +706,9 @@ class Response:
     branches were searched (``note``).
 
     Present where computed: a system's jumps checked by DOP853 at each fold (``sweep_jumps``)
-    and points shot as true orbits (``checks``); one equation's one-harmonic balance and its
-    folds, the simulated sweeps up and down (``sweeps``), the true orbit's folds
+    and points shot as true orbits (``checks``); one equation's one-harmonic folds and curve
+    (its roots on :data:`CURVE_POINTS` frequencies), the simulated sweeps up and down
+    (``sweeps``), the true orbit's folds
     (``true_folds``, by :func:`numerics.shooting.orbit_fold_table`) and ``barrier``, the
     ``|q|`` past which a sweep has left every steady state (the potential's maximum ``1/√−ε``
     of a softening eq. 10.60, else :data:`response.ESCAPE_FACTOR` × the largest balance
