@@ -74,6 +74,8 @@ def periodic_json(series, valid=None) -> dict:
         text = partial(_ground_text, g)
         decimal = _decimal if g.is_rational else None
         amplitude, aliases = names[0], {"q": names[0]}  # its coefficients, also as "q"
+        leading = ("model", "order", "variable", "omega", "period", "q", "convention",
+                   "radius", "orbit_limit", "radius_estimate", "equation", "omega0", "units")
         head = {"kind": "series", "model": m.name, "title": m.title, "order": series.order,
                 "variable": m.variable, "omega0": str(m.frequency),
                 "convention": series.convention}
@@ -94,6 +96,12 @@ def periodic_json(series, valid=None) -> dict:
         orders = [series.coordinate(i) for i in range(len(names))]
         text, decimal = str, decimal_text
         amplitude, aliases = names[series.amplitude], {}
+        leading = ("kind", "mode", "omega0", "variable", "order", "omega", "period",
+                   "coordinates", "system", "amplitude", "lambda",
+                   "linear_frequencies_squared", "convention", "parameters", "period_units",
+                   "omega0_decimal", "omega0_minimal_polynomial", "lambda_decimal",
+                   "linear_frequencies_squared_decimal", "omega_decimal", "period_decimal",
+                   "coordinates_decimal", "mass")
         root = minimal_polynomial(series.omega0, "x")
         head = {"kind": "nnm", "mode": series.mode, "order": series.order,
                 "variable": series.variable, "omega0": str(series.omega0),
@@ -120,8 +128,9 @@ def periodic_json(series, valid=None) -> dict:
         data.update(omega_decimal=[decimal(c) for c in omega],
                     period_decimal=[decimal(c) for c in period],
                     coordinates_decimal=per_order(decimal))
-    data.update({key: data["coordinates"][name] for key, name in aliases.items()})
-    return {**data, **extra}
+    data.update({key: data["coordinates"][name] for key, name in aliases.items()}, **extra)
+    # NOTE: each command's keys in the order it has always printed them, the shared ones after
+    return {**{key: data[key] for key in leading if key in data}, **data}
 
 
 TEXT_WIDTH = 200
@@ -130,16 +139,31 @@ TEXT_WIDTH = 200
 SHORT_EXACT = 24
 # NOTE: as lower.printers.EXACT_WIDTH (not imported: the table must not load SymPy).
 CELL = 28
-# NOTE: the width of the ω_j and (T/2π)_j columns; a longer cell lists the orders one to a line.
+ROW_CELL = 24
+# NOTE: the width of the ω_j and (T/2π)_j columns, narrower where one coordinate's harmonics
+# share the row; a longer cell lists the orders one block each.
+
+
+def _powers(monomial: str) -> dict[str, int]:
+    """``"A**2*alpha"`` → ``{"A": 2, "alpha": 1}`` (``"1"`` → ``{}``)."""
+    return {name: int(e or 1) for name, e in
+            re.findall(r"([A-Za-z_][A-Za-z0-9_]*)(?:\*\*(\d+))?", monomial)}
 
 
 def _exact_text(value: str | dict) -> str:
     """An exact JSON value as a reader writes it: ``3/8``, an integer without ``/1``, a
-    polynomial's ``{monomial: "p/q"}`` as ``3*a/8 - a**2/4``."""
+    polynomial's ``{monomial: "p/q"}`` as SymPy writes it, ``-21*A**4/256 + A**3/12``
+    (lex on the names, descending powers)."""
     if isinstance(value, str):
         return value.removesuffix("/1") if value.endswith("/1") else value
+    names = sorted({name for monomial in value for name in _powers(monomial)})
+
+    def order(item: tuple[str, str]) -> tuple[int, ...]:
+        powers = _powers(item[0])
+        return tuple(-powers.get(name, 0) for name in names)
+
     terms = []
-    for monomial, c in value.items():
+    for monomial, c in sorted(value.items(), key=order):
         p, _, q = c.partition("/")
         sign, p = ("-", p[1:]) if p.startswith("-") else ("+", p)
         body = p if monomial == "1" else monomial if p == "1" else f"{p}*{monomial}"
@@ -211,29 +235,45 @@ def _header(data: dict, exact: bool) -> list[str]:
 def periodic_table(data: dict, exact: bool = False) -> str:
     """The readable table of :func:`periodic_json`'s ``data``, for one coordinate or a
     system: where the series holds, then ω_j and (T/2π)_j per order and each coordinate's
-    harmonics per order; a long exact number as its decimal (12 significant digits) where
-    the data holds one, unless ``exact`` (--exact), which lists the exact forms one to a
-    line instead; no line over :data:`TEXT_WIDTH`."""
+    harmonics per order — one coordinate's beside ω_j and (T/2π)_j on each order's row
+    (narrower columns, :data:`ROW_CELL`), a system's in a block per coordinate.  A long
+    exact number is shown as its decimal (12 significant digits) where the data holds one,
+    unless ``exact`` (--exact); a cell still wider than its column lists the orders one
+    block each instead of rows; no line over :data:`TEXT_WIDTH`."""
     lines = _header(data, exact)
     decimals = {key: data.get(f"{key}_decimal") for key in ("omega", "period", "coordinates")}
+    beside = len(data["coordinates"]) == 1
+    width = ROW_CELL if beside else CELL
 
     def decimal(key: str, j: int) -> str | None:
         return None if decimals[key] is None else decimals[key][j]
 
+    def harmonics(name: str, j: int) -> list[tuple[str, str]]:
+        shown = (decimals["coordinates"] or {}).get(name)
+        return [(n, _shown(c, None if shown is None else shown[j].get(n), exact))
+                for n, c in data["coordinates"][name][j].items()]
+
     cells = [(_shown(w, decimal("omega", j), exact), _shown(t, decimal("period", j), exact))
              for j, (w, t) in enumerate(zip(data["omega"], data["period"], strict=True))]
-    if any(len(w) > CELL or len(t) > CELL for w, t in cells):
-        for j, (w, t) in enumerate(cells):
-            lines += [f"omega_{j} = {w}", f"(T/2pi)_{j} = {t}"]
-    else:
-        lines.append(f"{'j':>3}  {'omega_j':>{CELL}}  {'(T/2pi)_j':>{CELL}}")
-        lines += [f"{j:>3}  {w:>{CELL}}  {t:>{CELL}}" for j, (w, t) in enumerate(cells)]
+    rows = not any(len(w) > width or len(t) > width for w, t in cells)
+    if rows:
+        lines.append(f"{'j':>3}  {'omega_j':>{width}}  {'(T/2pi)_j':>{width}}" + "".join(
+            f"  {name}_j: harmonic n -> coefficient" for name in data["coordinates"] if beside))
+    for j, (w, t) in enumerate(cells):
+        if rows:
+            lines.append(f"{j:>3}  {w:>{width}}  {t:>{width}}" + "".join(
+                "  " + ", ".join(f"{n}: {c}" for n, c in harmonics(name, j))
+                for name in data["coordinates"] if beside))
+            continue
+        lines += [f"j = {j}: omega_j = {w}", f"       (T/2pi)_j = {t}"]
+        lines += [f"       {name}_j[cos {n}s] = {c}" for name in data["coordinates"] if beside
+                  for n, c in harmonics(name, j)]
     for name, orders in data["coordinates"].items():
+        if beside:
+            break
         lines.append(f"{name}: harmonic n -> coefficient, per order")
-        shown = (decimals["coordinates"] or {}).get(name, [{}] * len(orders))
-        for j, order in enumerate(orders):
-            lines.append(f"{j:>3}  " + ", ".join(
-                f"{n}: {_shown(c, shown[j].get(n), exact)}" for n, c in order.items()))
+        lines += [f"{j:>3}  " + ", ".join(f"{n}: {c}" for n, c in harmonics(name, j))
+                  for j in range(len(orders))]
     return "\n".join(piece for line in lines for piece in textwrap.wrap(
         line, TEXT_WIDTH, subsequent_indent="     ", break_on_hyphens=False) or [""])
 
