@@ -7,13 +7,20 @@
   fresh venv, ``make demo``, Dask clusters.
 
 ``make test`` runs ``-m exact`` first, then the other two, each on every core (pytest-xdist);
-``pytest -m exact`` alone takes a minute.  A module's layer is where its slowest test belongs."""
+``pytest -m exact`` alone takes a minute.  A module's layer is where its slowest test belongs.
+
+An emitted module compiles once per run of the suite, whichever test, worker or folder loads
+it: numba's cache of emitted modules is kept by their text in one folder that every worker
+shares (tests/commands.py, ``EmittedCache``)."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
+from commands import CACHE_VARIABLE, EmittedCache
+from numba.core.caching import CacheImpl
 
 LAYERS = {
     "exact": ("attractors", "averaging", "branches", "continuation", "driven", "driven_damped",
@@ -44,3 +51,18 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         if name not in LAYER_OF:
             raise pytest.UsageError(f"{name}: give it a layer in tests/conftest.py")
         item.add_marker(getattr(pytest.mark, LAYER_OF[name]))
+
+
+@pytest.fixture(scope="session", autouse=True)
+def emitted_cache(tmp_path_factory: pytest.TempPathFactory):
+    """numba's cache of emitted modules for this run: ``numba-cache`` under the run's temporary
+    folder, the one that pytest-xdist's workers' folders are made in (a fresh folder each run,
+    so each distinct module is compiled in every run)."""
+    base = tmp_path_factory.getbasetemp()
+    folder = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "numba-cache"
+    folder.mkdir(exist_ok=True)
+    os.environ[CACHE_VARIABLE] = str(folder)
+    CacheImpl._locator_classes.insert(0, EmittedCache)
+    yield folder
+    CacheImpl._locator_classes.remove(EmittedCache)
+    del os.environ[CACHE_VARIABLE]

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
 from fractions import Fraction
 
 import mpmath
 import numpy as np
 import pytest
+from commands import run as lindstedt
 from lindstedt.choose import choose_period
 from lindstedt.errors import InputError
 from lindstedt.methods.kernels import resummed_coefficients
@@ -59,9 +59,7 @@ def test_agm_period_against_mpmath_elliptic_k(steps, x, tol):
 
 
 def test_choose_contract_and_bad_input():
-    run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "period", "--tol", "1e-8",
-                          "--range", "0:1000", "--json"],
-                         capture_output=True, text=True, check=False)
+    run = lindstedt("choose", "period", "--tol", "1e-8", "--range", "0:1000", "--json")
     data = json.loads(run.stdout)
     assert {"method", "order", "max_error", "ns_per_point", "verified_on"} <= data.keys()
     assert data["max_error"] <= 1e-8
@@ -69,8 +67,7 @@ def test_choose_contract_and_bad_input():
                          (["--tol", "1e-3", "--range", "-1.5:0"], "separatrix"),
                          (["--tol", "1e-19", "--range", "0:1"], "best reachable"),
                          (["--tol", "nan", "--range", "0:1"], "not finite")):
-        bad = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "period", *args],
-                             capture_output=True, text=True, check=False)
+        bad = lindstedt("choose", "period", *args)
         assert bad.returncode == 2 and needle in bad.stderr, bad.stderr
 
 
@@ -145,9 +142,8 @@ def test_driven_and_spring_scenes():
 def test_choose_emits_just_the_chosen_evaluator(tmp_path):
     from lindstedt.emit.render import load_generated
 
-    run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "period", "--tol", "1e-8",
-                          "--range", "0:1000", "--out", str(tmp_path), "--json"],
-                         capture_output=True, text=True, check=False)
+    run = lindstedt("choose", "period", "--tol", "1e-8", "--range", "0:1000", "--out",
+                    str(tmp_path), "--json")
     data = json.loads(run.stdout)
     assert data["emitted"] == [str(tmp_path / "chosen_period.py")]
     mod = load_generated(tmp_path / "chosen_period.py")
@@ -235,9 +231,7 @@ def test_choose_amplitudes_meets_the_tolerance_against_shooting():
     # the truth it was judged against is the true orbit on the largest branch
     orbit = shoot(0.1, 0.3, 1.3, 0.05, np.array([2.9, 1.2]))
     assert abs(orbit.A[1] - c.truth.A[0, 0]) < 1e-9
-    run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "amplitudes", "--eps",
-                          "0.1", "--force", "1", "--json"], capture_output=True, text=True,
-                         check=False)
+    run = lindstedt("choose", "amplitudes", "--eps", "0.1", "--force", "1", "--json")
     assert run.returncode == 2 and "--omega" in run.stderr
 
 
@@ -298,9 +292,7 @@ def test_choose_response_over_a_range_holds_between_the_points():
                          (["--omega", "2:1"], "reversed"),
                          (["--omega", "1", "--tol", "1e-17"], "best reachable"),
                          (["--omega", "-1"], "must be > 0")):
-        bad = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "response", "--eps",
-                              "0.1", "--force", "1", *args], capture_output=True, text=True,
-                             check=False)
+        bad = lindstedt("choose", "response", "--eps", "0.1", "--force", "1", *args)
         assert bad.returncode == 2 and needle in bad.stderr, bad.stderr
 
 
@@ -367,9 +359,8 @@ def test_choose_q_emits_the_exact_fourier_module(tmp_path):
     cn off the grid, its omega is 2π/T with T = 4K(m)/√(1+x) (mpmath), NaN past the separatrix."""
     from lindstedt.emit.render import load_generated
 
-    run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "q", "--tol", "1e-10",
-                          "--range", "-0.95:0", "--out", str(tmp_path), "--json"],
-                         capture_output=True, text=True, check=False)
+    run = lindstedt("choose", "q", "--tol", "1e-10", "--range", "-0.95:0", "--out", str(tmp_path),
+                    "--json")
     data = json.loads(run.stdout)
     assert data["method"] == "fourier" and data["emitted"] == [str(tmp_path / "fourier.py")]
     mod = load_generated(tmp_path / "fourier.py")
@@ -394,10 +385,8 @@ def test_choose_emits_the_driven_module_it_verified(tmp_path):
     from lindstedt.emit.render import load_generated
     from lindstedt.numerics.shooting import shoot
 
-    run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "response", "--eps", "0.1",
-                          "--force", "1", "--omega", "0.8:1.2", "--tol",
-                          "1e-4", "--out", str(tmp_path), "--json"],
-                         capture_output=True, text=True, check=False)
+    run = lindstedt("choose", "response", "--eps", "0.1", "--force", "1", "--omega", "0.8:1.2",
+                    "--tol", "1e-4", "--out", str(tmp_path), "--json")
     data = json.loads(run.stdout)
     assert data["method"] == "mu_expansion" and data["max_error"] <= 1e-4
     assert str(tmp_path / "driven.py") in data["emitted"]
@@ -480,9 +469,7 @@ def test_choose_period_for_an_equation_refuses_with_a_reason():
     with pytest.raises(InputError, match="give every parameter a value"):
         choose_period(1e-8, 0.0, 0.5,
                       model=model_from_text("q'' + q + eps*(alpha*q**2 + q**3) = 0", 60))
-    cmd = [sys.executable, "-m", "lindstedt", "choose", "q", "q'' + q + eps*q**5 = 0",
-           "--tol", "1e-8", "--range", "0:0.5"]
-    done = subprocess.run(cmd, capture_output=True, text=True)
+    done = lindstedt("choose", "q", "q'' + q + eps*q**5 = 0", "--tol", "1e-8", "--range", "0:0.5")
     assert done.returncode == 2 and done.stdout == ""
     assert done.stderr.count("\n") == 1 and "only the period" in done.stderr
 
@@ -538,10 +525,8 @@ def test_choose_emits_the_damped_module_for_a_finite_Q(tmp_path):
     from lindstedt.emit.render import load_generated
     from lindstedt.numerics.shooting import shoot
 
-    run = subprocess.run([sys.executable, "-m", "lindstedt", "choose", "amplitudes", "--eps",
-                          "0.1", "--force", "0.3", "--Q", "20", "--omega", "0.8", "--tol",
-                          "1e-4", "--out", str(tmp_path), "--json"],
-                         capture_output=True, text=True, check=False)
+    run = lindstedt("choose", "amplitudes", "--eps", "0.1", "--force", "0.3", "--Q", "20",
+                    "--omega", "0.8", "--tol", "1e-4", "--out", str(tmp_path), "--json")
     assert run.returncode == 0, run.stderr
     data = json.loads(run.stdout)
     assert data["method"] == "mu_expansion_damped" and data["max_error"] <= 1e-4

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from commands import cached_env, run
 
 ROOT = Path(__file__).resolve().parent.parent
 GENERATED = ROOT / "generated"
@@ -339,13 +340,12 @@ def test_every_emitted_function_refuses_what_it_cannot_handle(tmp_path):
                   "--out", str(tmp_path)],
                  ["tongues", "cos(t) + 1/2*cos(2*t)", "--n", "1", "--order", "12", "--out",
                   str(tmp_path)]):
-        made = subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
-                              text=True, check=False)
+        made = run(*args)
         assert made.returncode == 0, made.stderr
     folders = {**{k: GENERATED for k in COMMITTED}, **{k: tmp_path for k in EMITTED}}
     child = subprocess.run(
         [sys.executable, __file__, json.dumps({k: str(v) for k, v in folders.items()})],
-        capture_output=True, text=True, check=False, timeout=3600)
+        capture_output=True, text=True, check=False, timeout=3600, env=cached_env())
     last = (child.stderr.strip().splitlines() or ["(nothing)"])[-1]
     assert child.returncode == 0, (f"the child exited with {child.returncode} during: {last}\n"
                                    f"{child.stderr[-3000:]}")
@@ -451,8 +451,7 @@ class _Emitted(dict):
     def __missing__(self, name: str):
         from lindstedt.emit.render import load_generated
 
-        made = subprocess.run([sys.executable, "-m", "lindstedt", *NEWER[name], "--out",
-                               str(self.out)], capture_output=True, text=True, check=False)
+        made = run(*NEWER[name], "--out", self.out)
         assert made.returncode == 0, made.stderr
         self[name] = load_generated(self.out / f"{name}.py")
         return self[name]
