@@ -4,7 +4,7 @@
                                                [--repeat 3]
 
 ``derive_limit_cycle`` multiplies its ε-series online in squares of orders packed into one
-integer polynomial (``series.RelaxedProduct``); the baseline below is the algorithm it replaced:
+integer polynomial (``lazy.RelaxedProduct``); the baseline below is the algorithm it replaced:
 every ``[ε^i]`` of ``q^n`` and ``(ω q')^n`` summed term by term (i Trig products at order i),
 the order whose amplitude arrives late made again.  Both give the same ω, amplitude and q_j
 (checked before any time is printed, at every order both run).  Medians of ``--repeat`` runs,

@@ -5,11 +5,12 @@ order; a stage imports only stages above it::
 
     algebra.series          the one Fourier kernel: exact P(C) + S·R(C) over QQ (FLINT
                             fmpq_poly), a number field Q(θ) (fmpq_poly parts) and QQ[params]
-                            (fmpq_mpoly), the odd-cosine fast path,
-                            the one lazy-series engine (coefficients on demand, each once:
-                            terms, maps, sums, Cauchy and relaxed products), the Laurent form
-                            in e^{is} over complex128 for the numeric methods
+                            (fmpq_mpoly), the odd-cosine fast path, the Laurent form in
+                            e^{is} over complex128 for the numeric methods
                             [coefficients -> Trig]
+    algebra.lazy            the one lazy-series engine: coefficients on demand, each once —
+                            terms, maps, sums, Cauchy products, the relaxed (online, packed)
+                            product of ε-series of Trig sums [series -> coefficient i]
     algebra.resum           the one power-series toolkit (product, reciprocal, square root,
                             binomial series, composition; Horner exact and in floats, partial
                             sums; the nearest singularity and the radius), Padé approximants

@@ -12,16 +12,9 @@ from typing import Any
 import sympy as sp
 from sympy.polys.domains import QQ
 
+from ..algebra.lazy import LazySeries, Mapped, RelaxedProduct, Terms
 from ..algebra.resum import binomial_series, series_compose, series_mul, series_reciprocal
-from ..algebra.series import (
-    Ground,
-    LazySeries,
-    Mapped,
-    RelaxedProduct,
-    Terms,
-    Trig,
-    solve_trig,
-)
+from ..algebra.series import Ground, Trig, solve_trig
 from ..errors import InputError
 from .models import check_order
 

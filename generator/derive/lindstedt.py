@@ -22,21 +22,12 @@ from typing import Any
 
 import sympy as sp
 
+from ..algebra.lazy import LazySeries, Linear, Mapped, Product, Terms
 from ..algebra.resum import Singularity as Singularity
 from ..algebra.resum import nearest_singularity
 from ..algebra.resum import partial_sum as partial_sum
 from ..algebra.resum import series_radius as series_radius
-from ..algebra.series import (
-    Basis,
-    Ground,
-    LazySeries,
-    Linear,
-    Mapped,
-    Product,
-    Terms,
-    solve_oscillator,
-    to_fourier,
-)
+from ..algebra.series import Basis, Ground, solve_oscillator, to_fourier
 from ..display import SHOWN_ORDERS, latex_aligned, latex_sum, latex_text, more
 from ..errors import InputError
 from .models import Model, check_order, t
@@ -256,7 +247,7 @@ def _slope_squared(P: list, W: list, basis: Basis, ground: Ground) -> LazySeries
 
 class _Forces:
     """Every polynomial force ``Σ c u^a (ω u')^b`` of the model as series nodes
-    (:class:`algebra.series.LazySeries`), in Horner form with shared subexpressions:
+    (:class:`algebra.lazy.LazySeries`), in Horner form with shared subexpressions:
     ``u·H(u², Y)`` for odd forces (``u⁵ + 2u³Y + uY²/3`` costs three and a half convolutions
     an order, not seven and a half by power tables), ``H(u, Y)`` otherwise, ``Y = ω²u'²``.
     In the odd basis a node is stored over C (``C·P(v)``, odd) or plain in ``v`` (even): the

@@ -30,6 +30,7 @@ import numpy as np
 import sympy as sp
 from sympy.polys.domains import QQ
 
+from ..algebra.lazy import LazySeries, Product, Terms
 from ..algebra.resum import (
     horner_float,
     nearest_singularity,
@@ -37,7 +38,7 @@ from ..algebra.resum import (
     series_reciprocal,
     series_sqrt,
 )
-from ..algebra.series import Basis, Ground, LazySeries, Product, Terms, from_fourier, to_fourier
+from ..algebra.series import Basis, Ground, from_fourier, to_fourier
 from ..errors import InputError
 from ..limits import check_int
 from .system import System
@@ -186,7 +187,7 @@ def _null_vector(matrix: list[list[Any]], one: Any) -> list[Any]:
 
 class _Monomials:
     """The y-series of every monomial of the coordinates, built as prefix products
-    ``u_i1·u_i2·…`` (:class:`algebra.series.Product`, each coefficient once)."""
+    ``u_i1·u_i2·…`` (:class:`algebra.lazy.Product`, each coefficient once)."""
 
     def __init__(self, series: list[list[Any]]) -> None:
         self.nodes: dict[tuple[int, ...], LazySeries] = {
