@@ -62,7 +62,8 @@ order; a stage imports only stages above it::
     analysis.mu_exact       the μ-expansion (undamped, damped) and the balance equations,
                             exactly, for LaTeX and emission [K -> exact orders]
     analysis.continuation   pseudo-arclength through folds, in ω or in the drive amplitude from
-                            rest; crossings of a level [system -> curve]
+                            rest; crossings of a level; where a branch is born (the one Onset:
+                            a drive amplitude, a tongue's edge) [system -> curve]
     analysis.attractors     along every traced branch: folds, period doublings, Neimark–Sacker
                             points (refined by secant on |μ| − 1); where no period-1 orbit is
                             stable or one loses stability by Neimark–Sacker, the attractor a

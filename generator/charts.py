@@ -924,7 +924,7 @@ def parametric_figure(report: object, path: Path) -> Path:
         for w, a, s in shot:
             ax.plot(w, a, f"{color}o" if s else f"{color}x", ms=6, mfc="none")
     for o in report.onsets:
-        ax.annotate("super" if o.supercritical else "sub", (o.omega, 0), xytext=(0, 8),
+        ax.annotate("super" if o.supercritical else "sub", (o.value, 0), xytext=(0, 8),
                     textcoords="offset points", ha="center", fontsize=8)
     ax.plot([], [], "ko", ms=6, mfc="none", label="shot orbit, stable")
     ax.plot([], [], "kx", ms=6, label="shot orbit, unstable")

@@ -157,10 +157,10 @@ def test_onsets_super_and_subcritical_by_shooting(gamma):
     p = Pump(0.2, 0.01, gamma)
     lo, hi = tongue_edges(p)
     first, second = onsets(p)
-    assert (first.omega, second.omega) == (lo, hi)
+    assert (first.value, second.value) == (lo, hi)
     for o in (first, second):
-        inside = lo < o.omega + 0.01 < hi
-        w = o.omega + (0.01 if o.supercritical == inside else -0.01)
+        inside = lo < o.value + 0.01 < hi
+        w = o.value + (0.01 if o.supercritical == inside else -0.01)
         pt = next(x for x in one_harmonic(p, w) if x.branch == o.branch)
         orbit = shoot_orbit(p, w, {1: pt.a}, {1: pt.b})
         assert orbit.stable == o.supercritical

@@ -120,9 +120,9 @@ def test_the_onset_bounds_the_orbits(found):
     """Just above the onset force orbits exist; just below, none of the seeds finds one."""
     problem, response = found
     onset = response.onset
-    assert onset.kind in {"fold", "bifurcation"} and 0 < onset.force < problem.force
+    assert onset.kind in {"fold", "bifurcation"} and 0 < onset.value < problem.force
     for factor, exists in ((1.02, True), (0.98, False)):
-        other = subharmonic_orbits(type(problem)(problem.terms, onset.force * factor,
+        other = subharmonic_orbits(type(problem)(problem.terms, onset.value * factor,
                                                  problem.omega, problem.n, problem.values),
                                    onset=False)
         assert other.exists is exists, factor
@@ -209,8 +209,8 @@ def test_a_branch_point_onset_is_the_primary_period_doubling():
     onset = subharmonic_orbits(problem).onset
     assert onset.kind == "bifurcation"
     start = subharmonic_orbits(problem, onset=False).primary.orbit.initial
-    below = _primary_multipliers(problem, onset.force * (1 - 1e-5), start)
-    above = _primary_multipliers(problem, onset.force * (1 + 1e-5), start)
+    below = _primary_multipliers(problem, onset.value * (1 - 1e-5), start)
+    above = _primary_multipliers(problem, onset.value * (1 + 1e-5), start)
     assert min(below.real) > -1 > min(above.real)
     assert np.all(np.abs(below.imag) < 1e-9) and np.all(np.abs(above.imag) < 1e-9)
 

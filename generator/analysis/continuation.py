@@ -59,6 +59,23 @@ RETAKES = 3
 # a point; three bound a corrector that keeps failing somewhere by work, not by the clock.
 
 
+@dataclass(frozen=True)
+class Onset:
+    """Where a branch of orbits is born as one parameter is followed: ``parameter`` (``force``,
+    the drive amplitude, followed down at one ω; ``omega``, the pump frequency at a tongue's
+    edge) at ``value``, and how: a ``fold`` (two orbits are born), a ``bifurcation`` off
+    another state (the primary response, or rest at a tongue's edge: ``supercritical`` where
+    the branch grows into the region where that state is unstable, else subcritical), or
+    ``none`` (the orbits reach ``value`` = 0).  ``branch`` names the branch where there are
+    several."""
+
+    parameter: str
+    value: float
+    kind: str  # fold | bifurcation | none
+    branch: str | None = None
+    supercritical: bool | None = None
+
+
 class Arclength:
     """The one pseudo-arclength predictor–corrector of the package, on a family ``fam`` of
     balances in one free parameter λ — what it follows: ω (a :class:`PolynomialBalance`

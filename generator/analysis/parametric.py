@@ -42,6 +42,7 @@ from ..limits import MAGNITUDES, MAX_HARMONICS, PARAMETRIC_MAX_POINTS, check_int
 from ..numerics.floquet import multipliers_stable, orbit_hill_multipliers
 from ..numerics.integrate import ForceTable
 from ..numerics.shooting import PeriodicOrbit, shoot_table
+from .continuation import Onset
 from .polynomial import PolynomialBalance
 
 _a, _b, _w, _e, _z, _g = sp.symbols("a b omega epsilon zeta gamma")
@@ -161,17 +162,6 @@ def outside_model(p: Pump, r: float) -> str:
             f"{ONE_HARMONIC_NONLINEARITY:g} (not weakly nonlinear)")
 
 
-@dataclass(frozen=True)
-class Onset:
-    """Where a nontrivial branch leaves ``r = 0``: the tongue edge ``omega``, the branch, and
-    whether it grows into the tongue (supercritical: the zero state loses stability to it) or out
-    of it (subcritical: unstable, born where the zero state is still stable)."""
-
-    omega: float
-    branch: str
-    supercritical: bool
-
-
 def onsets(p: Pump) -> tuple[Onset, ...]:
     """The two onsets, lower edge first: for ``γ > 0`` "+" at ``ω₋`` (supercritical) and "−" at
     ``ω₊`` (subcritical); for ``γ < 0`` "+" at ``ω₋`` (subcritical) and "−" at ``ω₊``
@@ -180,7 +170,8 @@ def onsets(p: Pump) -> tuple[Onset, ...]:
     if edges is None or p.gamma == 0:
         return ()
     hard = p.gamma > 0
-    return (Onset(edges[0], "+", hard), Onset(edges[1], "-", not hard))
+    return (Onset("omega", edges[0], "bifurcation", "+", hard),
+            Onset("omega", edges[1], "bifurcation", "-", not hard))
 
 
 @dataclass(frozen=True)

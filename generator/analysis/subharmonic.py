@@ -25,7 +25,7 @@ from ..numerics.floquet import hill_multipliers, multipliers_stable, orbit_hill_
 from ..numerics.integrate import ForceTable, duffing_table, steady_state_amplitudes
 from ..numerics.newton import newton
 from ..numerics.shooting import PeriodicOrbit, shoot, shoot_table
-from .continuation import Arclength, DriveFamily, _oriented, _secant_turn
+from .continuation import Arclength, DriveFamily, Onset, _oriented, _secant_turn
 from .driven import Drive
 from .periodic import SHOOTING_TOLERANCES
 from .polynomial import PolynomialBalance, amplitude_bound, driven_form
@@ -264,16 +264,6 @@ class SubharmonicOrbit:
 
 
 @dataclass(frozen=True)
-class Onset:
-    """The smallest drive amplitude at this ω with a 1/n orbit, from continuing the orbits in
-    the drive amplitude down: a fold (two orbits are born), a bifurcation off the primary
-    response (the first harmonic grows from 0), or none (they reach f = 0)."""
-
-    force: float
-    kind: str  # "fold", "bifurcation" or "none"
-
-
-@dataclass(frozen=True)
 class SubharmonicResponse:
     """Every 1/n orbit the seeds reach at one drive, distinct up to the drive-period shifts
     (each orbit has n copies, shifted by one drive period), largest ``r`` first; the primary
@@ -468,7 +458,7 @@ def subharmonic_onset(system: PolynomialBalance, p: SubharmonicProblem,
     first harmonic passes 0; refined by bisection on the sign of the balance Jacobian's
     determinant along the primary), or f = 0; the smallest such f over the orbits."""
     fam = DriveFamily(system, p.omega)
-    best = Onset(math.inf, "none")
+    best = Onset("force", math.inf, "none")
     for x in starts:
         y = np.append(x, p.force)
         r_start = _first(system, x)
@@ -486,13 +476,13 @@ def subharmonic_onset(system: PolynomialBalance, p: SubharmonicProblem,
                         break
                     continue
                 if path.y[-1] <= 0:
-                    low = Onset(0.0, "none")
+                    low = Onset("force", 0.0, "none")
                     break
                 if path.fold:  # f turned back over the last step
                     y, t, _ = path.previous
                     low = _turn(system, fam, p, y, t, path.y, r_start)
                     break
-        if low is not None and low.force < best.force:
+        if low is not None and low.value < best.value:
             best = low
     return best
 
@@ -514,8 +504,8 @@ def _turn(system: PolynomialBalance, fam: DriveFamily, p: SubharmonicProblem, y:
     r_turn = min(_first(system, z[:-1]), _first(system, y[:-1]), _first(system, y_new[:-1]))
     if r_turn < BRANCH_SHARE * r_start:
         f = _branch_point(system, p, min(lo, z[-1]), max(hi, z[-1]))
-        return Onset(float(z[-1]) if f is None else f, "bifurcation")
-    return Onset(float(z[-1]), "fold")
+        return Onset("force", float(z[-1]) if f is None else f, "bifurcation")
+    return Onset("force", float(z[-1]), "fold")
 
 
 def _branch_point(system: PolynomialBalance, p: SubharmonicProblem, lo: float,

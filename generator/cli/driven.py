@@ -382,7 +382,7 @@ def subharmonic_orbits_json(found) -> dict:
             "amplitude": math.hypot(primary.A.get(p.n, 0.0), primary.B.get(p.n, 0.0)),
             "stable": primary.stable,
             "floquet_moduli": None if primary.orbit is None else moduli(primary.orbit)},
-        "onset": None if found.onset is None else {"force": found.onset.force,
+        "onset": None if found.onset is None else {"force": found.onset.value,
                                                    "kind": found.onset.kind},
         "seeds": found.seeds,
         "note": found.note,
@@ -508,8 +508,8 @@ def parametric_report_json(report) -> dict:
         "tongue": None if edges is None else {
             "lower": edges[0], "upper": edges[1],
             "lower_in_range": lo <= edges[0] <= hi, "upper_in_range": lo <= edges[1] <= hi},
-        "onsets": [{"omega": o.omega, "branch": o.branch, "supercritical": o.supercritical,
-                    **where(o.omega, 0.0)} for o in report.onsets],
+        "onsets": [{"omega": o.value, "branch": o.branch, "supercritical": o.supercritical,
+                    **where(o.value, 0.0)} for o in report.onsets],
         "fold": None if top is None else {"omega": top[0], "r": top[1], **where(*top)},
         "branches": [{
             "branch": r.one.branch, "omega": r.one.omega,
