@@ -323,9 +323,9 @@ def response_cost(args: argparse.Namespace) -> Cost:
     the continuation, the drive continuations, the Floquet multipliers and the rest, as the
     command will run them (the fixed part alone when ε, f or Q is missing: the command says
     so)."""
-    from .analysis.systems import driven_problem, notes_preset, notes_problem, response_plan
+    from .analysis.systems import driven_problem, notes_problem, response_plan
 
-    if not notes_preset(getattr(args, "model", None)):
+    if getattr(args, "model", None) is not None:
         problem = driven_problem(args.model, _values(args), args.name or "oscillator")
     elif any(getattr(args, k, None) is None for k in ("eps", "force", "Q")):
         return Cost(RESPONSE_FIXED, "response", "response")  # the command says what is missing

@@ -256,3 +256,22 @@ def test_every_command_prints_its_help():
     commands = build_parser()._subparsers._group_actions[0].choices
     for command in COMMANDS:
         assert command.name in commands[command.name].format_help()
+
+
+@pytest.mark.parametrize("command", [
+    ("driven", "--eps", "0.1", "--force", "0.3", "--omega", "1.2"),
+    ("subharmonic", "--eps", "0.1", "--force", "2", "--omega", "3"),
+    ("mixing", "--eps", "0.1", "--Q", "20", "--drive", "0.2@1.1", "--drive", "0.2@1.3"),
+])
+def test_the_duffing_preset_takes_the_notes_flags(command):
+    """``COMMAND duffing --eps …`` is the notes' driven Duffing, as ``COMMAND --eps …``: the
+    preset's name takes every flag its form without MODEL takes (the same JSON), and without
+    them it is refused as that form is."""
+    name, *flags = command
+    plain = run(name, *flags, "--json")
+    preset = run(name, "duffing", *flags, "--json")
+    assert plain.returncode == preset.returncode == 0, preset.stderr
+    assert json.loads(preset.stdout) == json.loads(plain.stdout)
+    bare = run(name, "duffing")
+    assert bare.returncode == 2 and bare.stderr.count("\n") == 1
+    assert "required" in bare.stderr

@@ -379,21 +379,9 @@ def _shot_checks(sb: SystemBalance, cont: Continuation, amplitudes: np.ndarray,
     return tuple(sorted(shots, key=lambda c: (c.piece, c.omega)))
 
 
-NOTES_PRESET = "duffing"
-# NOTE: the preset whose driven, damped form is the notes' eq. 10.60: `response duffing` takes
-# the flags --eps, --force and --Q, as `response` without a problem does.
 CURVE_POINTS = 600
 # NOTE: the frequencies one equation's one-harmonic curve is solved at for the figure (~0.1 ms
 # each: a polynomial's roots).
-
-
-def notes_preset(text: str | None) -> bool:
-    """Whether ``text`` is the notes' problem: none, or the preset :data:`NOTES_PRESET`."""
-    if text is None:
-        return True
-    from ..derive.problem import read_problem
-
-    return read_problem(text).preset == NOTES_PRESET
 
 
 @dataclass(frozen=True)

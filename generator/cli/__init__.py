@@ -16,7 +16,7 @@ from typing import NoReturn
 
 from .. import __version__
 from ..costs import COSTS, ROUTE_COSTS
-from ..derive.problem import Problem, read_problem
+from ..derive.problem import NOTES_PRESET, Problem, read_problem
 from ..errors import InputError, Interrupted
 from ..limits import COST_LIMIT_SECONDS
 from .choose import (
@@ -99,12 +99,17 @@ class Command:
     name: str
     arguments: Callable[[argparse._SubParsersAction], argparse.ArgumentParser]
     routes: tuple[Route, ...]
+    notes: bool = False  # without MODEL: the notes' driven Duffing, eq. 10.60, by its flags
 
     def route(self, args: argparse.Namespace) -> Route:
         """The method that takes ``args``' problem; one line naming each method's reason
-        where none does."""
+        where none does.  Where the command's problem without MODEL is the notes' driven
+        Duffing, its preset's name (``duffing``) stands for it: the same flags, the same
+        answer."""
         text = getattr(args, "model", None)
         problem = read_problem(text) if isinstance(text, str) else None
+        if self.notes and problem is not None and problem.preset == NOTES_PRESET:
+            args.model, problem = None, None
         reasons = []
         for route in self.routes:
             why = route.applies(problem)
@@ -114,11 +119,12 @@ class Command:
         raise InputError(f"{self.name} {text!r}: no method takes it ({'; '.join(reasons)})")
 
 
-def _command(name: str, arguments: Callable, run: Callable, *others: Route) -> Command:
+def _command(name: str, arguments: Callable, run: Callable, *others: Route,
+             notes: bool = False) -> Command:
     """A command whose first method takes one coordinate (else every problem its parser
     takes, where it has no ``others``), with its estimate :data:`costs.COSTS`."""
     first = Route(name, _one_coordinate if others else _any, run, COSTS.get(name))
-    return Command(name, arguments, (first, *others))
+    return Command(name, arguments, (first, *others), notes)
 
 
 COMMANDS: tuple[Command, ...] = (
@@ -130,13 +136,13 @@ COMMANDS: tuple[Command, ...] = (
              Route("normal mode", _coordinates, run_generate_mode,
                    ROUTE_COSTS["generate normal mode"])),
     _command("nnm", arguments_nnm, run_nnm),
-    _command("driven", arguments_driven, run_driven),
-    _command("response", arguments_response, run_response),
-    _command("subharmonic", arguments_subharmonic, run_subharmonic),
+    _command("driven", arguments_driven, run_driven, notes=True),
+    _command("response", arguments_response, run_response, notes=True),
+    _command("subharmonic", arguments_subharmonic, run_subharmonic, notes=True),
     _command("parametric", arguments_parametric, run_parametric),
-    _command("mixing", arguments_mixing, run_mixing),
+    _command("mixing", arguments_mixing, run_mixing, notes=True),
     _command("choose", arguments_choose, run_choose),
-    _command("sweep", arguments_sweep, run_sweep),
+    _command("sweep", arguments_sweep, run_sweep, notes=True),
     _command("clock", arguments_clock, run_clock),
     _command("scene", arguments_scene, run_scene),
     _command("slowflow", arguments_slowflow, run_slowflow,

@@ -241,9 +241,7 @@ def response_csv(r, path: Path) -> Path:
 def _response_args(args: argparse.Namespace) -> None:
     """The flags of ``response`` with and without EQUATION, each refused in one line where it
     does not belong: the notes' flags go with no problem or with its preset's name."""
-    from ..analysis.systems import notes_preset
-
-    if not notes_preset(args.model):
+    if args.model is not None:
         given = [f"--{k}" for k in DRIVE_FLAGS if getattr(args, k) is not None]
         if given:
             raise InputError(f"{', '.join(given)}: with an equation give its parameters with "
@@ -260,9 +258,9 @@ def response_report(args: argparse.Namespace, limit: float):
     """The one computation of ``response`` (eq. 10.60 or an EQUATION): its
     :class:`analysis.systems.Response`, which the JSON, the table, the figure and the CSV
     print (eq. 10.60 by its flags, without a problem or with its preset's name)."""
-    from ..analysis.systems import driven_problem, notes_preset, notes_problem, response
+    from ..analysis.systems import driven_problem, notes_problem, response
 
-    if not notes_preset(args.model):
+    if args.model is not None:
         return response(driven_problem(args.model, _params(args.param),
                                        args.name or "oscillator"), args.harmonics,
                         args.omega_min, args.omega_max, limit)

@@ -15,6 +15,9 @@ from dataclasses import dataclass
 
 SEPARATOR = ";"
 # NOTE: between the equations of a system; the walker refuses it inside an equation.
+NOTES_PRESET = "duffing"
+# NOTE: the preset whose driven, damped form is the notes' eq. 10.60, the problem of driven,
+# response, subharmonic, mixing and sweep without MODEL: its name there takes the notes' flags.
 
 
 @dataclass(frozen=True)
