@@ -6,13 +6,12 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 from fractions import Fraction as F
 
 import mpmath as mp
 import numpy as np
 import pytest
+from commands import run
 from lindstedt.cli import main
 from lindstedt.derive.hill import fourier_of_text, mathieu_series, tongue_tip, transition_curves
 from lindstedt.errors import InputError
@@ -176,9 +175,8 @@ def test_grid_verdicts_against_solve_ivp(zeta):
 
 
 def test_the_cli_json():
-    out = subprocess.run([sys.executable, "-m", "lindstedt", "tongues", "cos(t) + sin(2*t)",
-                          "--n", "2", "--order", "6", "--json", "--eps", "0.1"],
-                         capture_output=True, text=True, check=True)
+    out = run("tongues", "cos(t) + sin(2*t)", "--n", "2", "--order", "6", "--json", "--eps", "0.1")
+    assert out.returncode == 0, out.stderr
     data = json.loads(out.stdout)
     assert data["variable"] == "eps" and data["delta0"] == "1/1" and data["period"] == "2*pi"
     assert len(data["curves"]) == 2 and all(len(c["series"]) == 7 for c in data["curves"])
@@ -198,8 +196,7 @@ def test_the_cli_json():
     ["cos(t)", "--tol", "1e-3"], ["cos(t)", "--plot", "chart.txt"],
 ])
 def test_bad_input_is_one_line_and_exit_2(args):
-    done = subprocess.run([sys.executable, "-m", "lindstedt", "tongues", *args],
-                          capture_output=True, text=True, check=False)
+    done = run("tongues", *args)
     assert done.returncode == 2 and done.stdout == "", args
     assert done.stderr.count("\n") == 1 and done.stderr.startswith("lindstedt: error:"), args
 
@@ -328,8 +325,7 @@ def test_emit_refuses_in_one_line(tmp_path):
                  ["tongues", "cos(t)", "--order", "8", "--out", str(tmp_path / "new")],
                  ["tongues", "cos(t)", "--out", " "],
                  ["tongues", "cos(t)", "--eps", "0.1", "--out", str(tmp_path / "new")]):
-        done = subprocess.run([sys.executable, "-m", "lindstedt", *args],
-                              capture_output=True, text=True, check=False)
+        done = run(*args)
         assert done.returncode == 2 and done.stdout == "", args
         assert done.stderr.count("\n") == 1 and done.stderr.startswith("lindstedt: error:"), \
             (args, done.stderr)
