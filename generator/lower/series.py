@@ -182,6 +182,7 @@ DIGITS = 30
 
 
 def _rounded(c: sp.Expr) -> sp.Expr:
+    """``c`` as the module receives it (:data:`DIGITS`)."""
     return sp.Float(sp.N(c, DIGITS), 17) if c.is_number and not c.is_Rational else c
 
 
