@@ -37,11 +37,14 @@ order; a stage imports only stages above it::
     derive.nnm              nonlinear normal modes as exact L–P series in Q or Q(ω₀²), the
                             secular condition by the left null vector, internal resonances
                             refused [System, mode, K -> NormalModeSeries]
-    derive.resonance        the first-order slow flow of a system's modes in internal
-                            resonance, exact; its coupled modes [System -> ResonantFlow]
-    derive.averaging        the slow flow of q'' + q = ε f (+ ε F cos ωt): near-identity
-                            averaging to any order in van der Pol's variables, exact (R_k, Φ_k
-                            of dr/dt, dφ/dt) [Oscillator, K -> SlowFlow]
+    derive.resonance        a system's modes in internal resonance, named, their shapes; of
+                            their slow flow the coupled modes and how weak the nonlinearity
+                            is [System -> modes]
+    derive.averaging        the slow flow of q'' + q = ε f (+ ε F cos ωt) and of a system's
+                            modes in internal resonance: near-identity averaging over one
+                            angle in van der Pol's variables, to any order (a system: the
+                            first), exact (R_k, Φ_k of each mode's da/dt, dφ/dt)
+                            [Oscillator | System, K -> SlowFlow]
     numerics.integrate      the one integrator: RK4 of any polynomial force table, compiled;
                             flows, sweeps with their jumps, simulations; a system's polynomial
                             force and its compiled field [ForceTable | PolynomialField -> flows]
@@ -138,7 +141,7 @@ order; a stage imports only stages above it::
     costs                   each command's estimated wall time and bounds [arguments -> Cost]
     cli.common              what every command shares: light constants, argument types and
                             flags, the report shape [argv -> Namespace]
-    cli.system              nnm and slowflow of a system [NormalModeSeries, ResonantFlow ->
+    cli.system              nnm and slowflow of a system [NormalModeSeries, SlowFlow ->
                             JSON, tables]
     cli.series              series, mathieu, tongues, slowflow, models, generate
                             [records -> JSON, tables]

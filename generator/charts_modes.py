@@ -49,8 +49,8 @@ def nnm_figure(fe: FrequencyEnergy, path: Path) -> Path:
 
 
 def exchange_figure(flow: object, exchange: object, path: Path) -> Path:
-    """A system's energy exchange (:class:`numerics.references.Exchange` of a
-    :class:`derive.resonance.ResonantFlow`): each resonant mode's amplitude a_k over the slow
+    """A system's energy exchange (:class:`numerics.references.Exchange` of a resonant
+    :class:`derive.averaging.SlowFlow`): each resonant mode's amplitude a_k over the slow
     time from ``exchange.start``, the exchange period marked between two maxima of a₁."""
     check_plot_path(path)
     fig, ax = plt.subplots(figsize=(8, 4.2))

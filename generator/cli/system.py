@@ -385,7 +385,8 @@ def resonant_table(data: dict) -> str:
 
 def run_slowflow_system(args: argparse.Namespace) -> int:
     """``slowflow SYSTEM``: the first-order slow flow of the modes in internal resonance."""
-    from ..derive.resonance import coupled_modes, resonant_flow
+    from ..derive.averaging import slow_flow
+    from ..derive.resonance import coupled_modes
     from ..derive.system import parse_system
 
     if args.eps is not None or args.sigma is not None:
@@ -395,7 +396,7 @@ def run_slowflow_system(args: argparse.Namespace) -> int:
     if args.out is not None:
         raise InputError("--out: a system's slow flow is printed, not emitted (not built)")
     plot, csv = check_outputs(args)
-    flow = resonant_flow(parse_system(args.model, _params(args.param)), args.order)
+    flow = slow_flow(parse_system(args.model, _params(args.param)), args.order)
     start = [START_AMPLITUDE * (1 if k == len(flow.a) - 1 else START_SEED)
              for k in range(len(flow.a))]
     for pair in args.start or ():

@@ -27,10 +27,29 @@ Drive: a term ``ε F cos ωt`` (or ``sin ωt``) is taken near resonance, ``ω = 
 time ``τ = ωt`` (``ω² q'' + q = ε f(q, ω q') + ε F cos τ``, with ``1/ω²`` expanded in ε), so the
 slow flow lives in the frame rotating with the drive and its fixed points are the steady
 states; it is reported in ``t`` (``d/dt = ω d/dτ``, truncated at the same order).
+
+A system's modes in internal resonance (``ω_j = n ω_i``, the small divisors that make ``nnm``
+refuse) are the same averaging over one angle.  Their frequencies are integer multiples
+``r_k`` of a base ``ω_b = ω_min/L`` (L the lcm of the ratios' denominators), so in ``τ = ω_b t``
+every fast angle is ``r_k τ``.  In the resonant modes' coordinates ``x = Σ_k φ_k q_k`` (the
+other modes unexcited at this order), ``q_k'' + r_k² q_k = ε g_k`` with
+``g_k = −ψ_k·g(Σ φ_j q_j)/ω_b²``, ``g`` the force's lowest degree d and ``ψ_k`` the left
+eigenvectors of ``M⁻¹K`` (``ψ_k·φ_k = 1``); the bookkeeping ε is the amplitude scale to the
+power d − 1, absorbed into the amplitudes.  Van der Pol's variables per mode,
+``q_k = u_k cos r_kτ + v_k sin r_kτ``, ``q_k' = r_k(−u_k sin r_kτ + v_k cos r_kτ)``, give the
+standard form ``u_k' = −(ε/r_k) g_k sin r_kτ``, ``v_k' = (ε/r_k) g_k cos r_kτ``: 2m components
+over ``QQ[u_1, v_1, …, u_m, v_m, params]`` (ω₀² rational: the shapes ``φ, ψ`` and ``g_k`` are),
+averaged as above with multi-indices in the Taylor terms.  The mean over τ keeps exactly the
+terms ``e^{i Σ m_k θ_k}`` with ``Σ m_k ω_k = 0``, the resonant combinations of the slow phases
+(Nayfeh & Mook, *Nonlinear Oscillations*, §6.5).  Per mode ``u_k = a_k cos φ_k``,
+``v_k = −a_k sin φ_k`` (``q_k = a_k cos(ω_k t + φ_k)``), in ``t`` (``d/dt = ω_b d/dτ``).  A
+system's flow is of the first order, where the resonance enters: the next needs the
+non-resonant modes.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
@@ -44,10 +63,13 @@ from ..errors import InputError
 from ..limits import SLOW_FLOW_MAX_ORDER as MAX_ORDER
 from ..limits import check_int
 from .models import Oscillator
+from .resonance import _shapes, resonant_modes
+from .system import System
 
 U, V = sp.Symbol("_u"), sp.Symbol("_v")  # van der Pol's variables ("_": no user name clashes)
 R, PHI = sp.Symbol("r", positive=True), sp.Symbol("phi")
 SIGMA = sp.Symbol("sigma")  # the detuning of a drive, ω = 1 + ε σ
+EPS = sp.Symbol("eps")
 METHOD = "the slow flow"
 RESERVED = frozenset({"r", "phi", "u", "v", "x"})
 # NOTE: the polar and Cartesian variables and the emitted kernels' state vector x.
@@ -55,12 +77,18 @@ RESERVED = frozenset({"r", "phi", "u", "v", "x"})
 
 @dataclass(frozen=True)
 class SlowFlow:
-    """The averaged equations of ``q̈ + q = ε f`` to order ``order`` (see the module docstring).
+    """The averaged equations of one oscillator ``q̈ + q = ε f`` to order ``order``, or of a
+    system's m modes in internal resonance to the first order (see the module docstring).
 
-    ``radial[k−1]``, ``phase[k−1]``: ``R_k(r, φ)`` and ``Φ_k(r, φ)`` (SymPy, exact rationals or
-    polynomials in ``parameters``); ``cartesian[k−1]``: ``G_k = (U_k, V_k)`` in ``(_u, _v)`` (the
-    τ-time flow); ``transform[j−1]``: ``w_j = (w_u, w_v)`` as SymPy expressions in ``_u, _v`` and
-    ``tau`` (j < order), the near-identity transformation back to ``q``.
+    ``radial[k·order + j − 1]``, ``phase[k·order + j − 1]``: ``R_j`` and ``Φ_j`` of mode k + 1,
+    ``da_k/dt = Σ_j ε^j R_j``, ``dφ_k/dt = Σ_j ε^j Φ_j`` in the symbols ``a``, ``phi`` (SymPy,
+    exact; one oscillator: ``radial[j−1]``, ``phase[j−1]`` in ``r``, ``phi``); ``small``: ε's
+    symbol, 1 for a system (absorbed into the amplitudes); ``cartesian[j−1]``: ``G_j``, the flow
+    of ``(u_1, v_1, …)`` (one oscillator: ``(U_j, V_j)`` in ``(_u, _v)``); ``transform[j−1]``:
+    ``w_j`` as SymPy expressions in ``_u, _v`` and ``tau`` (j < order), the near-identity
+    transformation back to ``q``.  A system's record adds the modes (1-based), their exact ω₀,
+    shapes, the resonances named and the force's lowest degree d (the flow is of order
+    (amplitude)^(d − 1)).
     """
 
     name: str
@@ -71,42 +99,192 @@ class SlowFlow:
     driven: bool
     radial: tuple[sp.Expr, ...]
     phase: tuple[sp.Expr, ...]
-    cartesian: tuple[tuple[sp.Expr, sp.Expr], ...]
+    cartesian: tuple[tuple[sp.Expr, ...], ...]
     transform: tuple[tuple[sp.Expr, sp.Expr], ...]
+    a: tuple[sp.Symbol, ...] = (R,)
+    phi: tuple[sp.Symbol, ...] = (PHI,)
+    small: sp.Expr = EPS
+    system: System | None = None
+    modes: tuple[int, ...] = (1,)
+    omega: tuple[sp.Expr, ...] = (sp.S.One,)
+    shapes: tuple[tuple[sp.Expr, ...], ...] = ((sp.S.One,),)
+    resonances: tuple[str, ...] = ()
+    degree: int = 0  # a system's force's lowest degree (0: one oscillator, ε explicit)
 
     @cached_property
-    def rates(self) -> tuple[sp.Expr, sp.Expr]:
-        """``(dr/dt, dφ/dt)`` as SymPy expressions in ``r, phi, eps`` and the parameters."""
-        eps = sp.Symbol("eps")
-        return (sp.Add(*(eps ** (k + 1) * c for k, c in enumerate(self.radial))),
-                sp.Add(*(eps ** (k + 1) * c for k, c in enumerate(self.phase))))
+    def amplitude(self) -> tuple[sp.Expr, ...]:
+        """``da_k/dt`` of each mode (one oscillator: ``(dr/dt,)``)."""
+        return self._rates(self.radial)
+
+    @cached_property
+    def rates(self) -> tuple[sp.Expr, ...]:
+        """``(da_1/dt, …, da_m/dt, dφ_1/dt, …, dφ_m/dt)``; one oscillator ``(dr/dt, dφ/dt)``
+        in ``r, phi, eps`` and the parameters."""
+        return (*self.amplitude, *self._rates(self.phase))
+
+    def _rates(self, parts: tuple[sp.Expr, ...]) -> tuple[sp.Expr, ...]:
+        K = self.order
+        return tuple(sp.Add(*(self.small ** (j + 1) * parts[k * K + j] for j in range(K)))
+                     for k in range(len(self.a)))
 
 
-def slow_flow(osc: Oscillator, order: int) -> SlowFlow:
-    """The slow flow of ``osc`` (``q'' + q = eps*f(q, q')``, optionally ``+ eps*F*cos(w*t)``) to
-    order ``order``, or a one-line :class:`InputError` naming what does not fit."""
-    check_int(order, 1, MAX_ORDER,
-              f"order {order!r}: the slow flow is derived to orders 1 … {MAX_ORDER}")
-    g, params, driven = _right_side(osc, order)
-    symbols = (U, V, *params)
-    ground = _ground(symbols)
-    F = _standard_form(g, ground, symbols, order)
+def slow_flow(problem: Oscillator | System, order: int) -> SlowFlow:
+    """The slow flow of ``problem`` to order ``order``: one oscillator
+    (``q'' + q = eps*f(q, q')``, optionally ``+ eps*F*cos(w*t)``) or a system's modes in
+    internal resonance (order 1); a one-line :class:`InputError` names what does not fit."""
+    if isinstance(problem, System):
+        setup = _resonant_right_side(problem, order)
+    else:
+        check_int(order, 1, MAX_ORDER,
+                  f"order {order!r}: the slow flow is derived to orders 1 … {MAX_ORDER}")
+        setup = _oscillator_right_side(problem, order)
+    ground = _ground((*setup.slow, *setup.params))
+    F = _standard_form(setup, ground, order)
     G, W = _average(F, ground, order)
     to_sp = ground.to_sympy
     Gs = [tuple(sp.expand(to_sp(_mean(c))) for c in Gk) for Gk in G]
+    if setup.system is not None:
+        return _resonant_record(setup, Gs)
+    driven = setup.driven
     if driven:  # τ = ωt: d/dt = (1 + εσ) d/dτ, truncated
         Gs = [tuple(sp.expand(a + (SIGMA * b if k else 0)) for a, b in
                     zip(Gs[k], Gs[k - 1] if k else (0, 0), strict=True))
               for k in range(order)]
     radial, phase = zip(*(_polar(Gk) for Gk in Gs), strict=True)
+    osc = setup.oscillator
     if not driven and any(e.has(PHI) for e in radial + phase):
         raise AssertionError(f"{osc.name}: an autonomous slow flow depends on φ")
     tau = sp.Symbol("tau")
     transform = tuple(tuple(_trig_expr(c, ground, tau) for c in Wj) for Wj in W[: order - 1])
     return SlowFlow(name=osc.name, source=osc.equation.text, order=order,
-                    coordinate=str(osc.coordinate), parameters=params, driven=driven,
+                    coordinate=str(osc.coordinate), parameters=setup.params, driven=driven,
                     radial=tuple(radial), phase=tuple(phase),
                     cartesian=tuple(Gs), transform=transform)
+
+
+@dataclass(frozen=True)
+class _Setup:
+    """The right sides ``g[k][i]`` (the ε^k part of mode i's) as polynomials in ``qs``,
+    ``qps`` (``q_i``, ``dq_i/dτ``), ``_cos``, ``_sin`` (of τ: a drive), the modes' multiples
+    ``ratios`` of the base frequency, the slow variables ``(u_1, v_1, …)`` and parameters."""
+
+    g: dict[int, tuple[sp.Expr, ...]]
+    qs: tuple[sp.Symbol, ...]
+    qps: tuple[sp.Symbol, ...]
+    ratios: tuple[int, ...]
+    slow: tuple[sp.Symbol, ...]
+    params: tuple[sp.Symbol, ...]
+    driven: bool = False
+    oscillator: Oscillator | None = None
+    system: System | None = None
+    base: sp.Expr = sp.S.One  # ω_b
+    modes: tuple[int, ...] = ()
+    omega: tuple[sp.Expr, ...] = ()
+    shapes: tuple[tuple[sp.Expr, ...], ...] = ()
+    resonances: tuple[str, ...] = ()
+    degree: int = 0
+
+
+def _oscillator_right_side(osc: Oscillator, order: int) -> _Setup:
+    g, params, driven = _right_side(osc, order)
+    return _Setup({k: (gk,) for k, gk in g.items()}, (sp.Symbol("_q"),), (sp.Symbol("_qp"),),
+                  (1,), (U, V), params, driven, oscillator=osc)
+
+
+def _resonant_right_side(system: System, order: int) -> _Setup:
+    """A system's resonant modes in the base time ``τ = ω_b t``: ``g_k = −ψ_k·g/ω_b²`` of the
+    lowest-degree force ``g`` at ``x = Σ φ_j q_j``, or a one-line refusal."""
+    if order != 1:
+        raise InputError(f"--order {order}: a system's resonant slow flow is derived to the "
+                         "first order (where the resonance enters); higher orders are not "
+                         "built")
+    if not system.conservative:
+        raise InputError(f"system {system.text!r}: a velocity-dependent force; the resonant "
+                         "slow flow takes conservative systems")
+    if all(f == 0 for f in system.force):
+        raise InputError(f"system {system.text!r}: no nonlinear term: a linear system's modes "
+                         "are independent and exchange no energy, so there is no slow flow to "
+                         "average; lindstedt nnm SYSTEM --mode M gives each mode")
+    modes, names = resonant_modes(system)
+    if not modes:
+        raise InputError(f"system {system.text!r}: no internal resonance (no ω0 an integer "
+                         "multiple of another); lindstedt nnm SYSTEM --mode M gives each mode")
+    lams = system.modes()
+    for k in modes:
+        if not lams[k].is_Rational:
+            raise InputError(f"system {system.text!r}: mode {k + 1}'s ω0² = {lams[k]} is "
+                             "irrational; the resonant slow flow is averaged exactly where "
+                             "each resonant ω0² is rational")
+    low = min(lams[k] for k in modes)
+    squares = [lams[k] / low for k in modes]
+    roots = [sp.sqrt(s) for s in squares]
+    if not all(r.is_Rational for r in roots):
+        raise InputError(f"system {system.text!r}: its resonant modes form groups of "
+                         "incommensurate frequencies (ω0 ratios "
+                         f"{', '.join(str(r) for r in roots)}); the slow flow is averaged over "
+                         "one angle, where the resonant ω0 are rational multiples of one another")
+    L = math.lcm(*(int(r.q) for r in roots))
+    ratios = tuple(int(r * L) for r in roots)
+    base2 = low / L**2  # ω_b²
+    degree = min(len(powers) and sum(powers) for f in system.force if f != 0
+                 for powers in sp.Poly(f, *system.coordinates).monoms())
+    shapes, lefts = zip(*(_shapes(system, lams[k]) for k in modes), strict=True)
+    m = len(modes)
+    qs = sp.symbols(f"_q1:{m + 1}")
+    x = sp.zeros(system.size, 1)
+    for k in range(m):
+        x += shapes[k] * qs[k]
+    lowest = [sp.Add(*(t for t in sp.Add.make_args(sp.expand(f))
+                       if sp.Poly(t, *system.coordinates).total_degree() == degree))
+              for f in system.force]
+    force = sp.Matrix([f.xreplace(dict(zip(system.coordinates, x, strict=True)))
+                       for f in lowest])
+    g = tuple(sp.expand(-(lefts[k].T * force)[0] / base2) for k in range(m))
+    params = tuple(sorted(set().union(*(e.free_symbols for e in g)) - set(qs), key=str))
+    slow = tuple(s for k in range(1, m + 1) for s in sp.symbols(f"_u{k} _v{k}"))
+    return _Setup({1: g}, qs, sp.symbols(f"_qp1:{m + 1}"), ratios, slow, params,
+                  system=system, base=sp.sqrt(base2), modes=tuple(k + 1 for k in modes),
+                  omega=tuple(sp.sqrt(lams[k]) for k in modes),
+                  shapes=tuple(tuple(s) for s in shapes), resonances=tuple(names),
+                  degree=degree)
+
+
+def _resonant_record(setup: _Setup, Gs: list[tuple[sp.Expr, ...]]) -> SlowFlow:
+    """A system's first-order flow in ``t`` and, per mode, in amplitude and phase: with
+    ``u = a cos φ``, ``v = −a sin φ``, ``ω_k da_k/dt = −⟨f_k sin θ_k⟩`` and
+    ``ω_k a_k dφ_k/dt = −⟨f_k cos θ_k⟩`` (``f_k = ω_b² g_k``), the means as sums of
+    ``e^{i Σ m_j φ_j}`` made real."""
+    m = len(setup.modes)
+    a = sp.symbols(f"a1:{m + 1}", positive=True)
+    phi = sp.symbols(f"phi1:{m + 1}", real=True)
+    E = [sp.exp(sp.I * p) for p in phi]
+    cos = [(e + 1 / e) / 2 for e in E]
+    sin = [(e - 1 / e) / (2 * sp.I) for e in E]
+    polar = {}
+    for k in range(m):
+        polar[setup.slow[2 * k]] = a[k] * cos[k]
+        polar[setup.slow[2 * k + 1]] = -a[k] * sin[k]
+    (G,) = Gs
+    square = setup.base**2
+    amplitude, phase = [], []
+    for k in range(m):
+        Uk, Vk = (e.xreplace(polar) for e in G[2 * k: 2 * k + 2])
+        r = setup.ratios[k]
+        mean_sin = -r * square * (cos[k] * Uk - sin[k] * Vk)  # ⟨f_k sin θ_k⟩
+        mean_cos = r * square * (sin[k] * Uk + cos[k] * Vk)  # ⟨f_k cos θ_k⟩
+        real_sin, real_cos = (sp.simplify(sp.expand_complex(sp.expand(e)))
+                              for e in (mean_sin, mean_cos))
+        amplitude.append(sp.simplify(-real_sin / setup.omega[k]))
+        phase.append(sp.simplify(-real_cos / (setup.omega[k] * a[k])))
+    system = setup.system
+    return SlowFlow(name="system", source=system.text, order=1,
+                    coordinate=", ".join(str(c) for c in system.coordinates),
+                    parameters=setup.params, driven=False, radial=tuple(amplitude),
+                    phase=tuple(phase),
+                    cartesian=(tuple(sp.expand(setup.base * e) for e in G),), transform=(),
+                    a=a, phi=phi, small=sp.Integer(1), system=system, modes=setup.modes,
+                    omega=setup.omega, shapes=setup.shapes, resonances=setup.resonances,
+                    degree=setup.degree)
 
 
 def _right_side(osc: Oscillator, order: int
@@ -187,38 +365,63 @@ def _ground(symbols: tuple[sp.Symbol, ...]) -> Ground:
     return Ground(QQ.poly_ring(*symbols))
 
 
-def _standard_form(g: dict[int, sp.Expr], ground, symbols, order: int
-                   ) -> list[tuple[Trig, Trig]]:
-    """``F_k = (−g_k sin τ, g_k cos τ)`` for ``k = 1 … order`` as Trig sums."""
+def _harmonic(ground: Ground, r: int) -> tuple[Trig, Trig]:
+    """``(cos rτ, sin rτ)`` as Trig sums."""
+    zero = ground.poly([])
+    if r == 1:
+        return (Trig(ground.poly([ground.scalar(0), ground.scalar(1)]), zero, ground),
+                Trig(zero, ground.poly([ground.scalar(1)]), ground))
+    one = ground.scalar(1)
+    return Trig.from_fourier({r: one}, {}, ground), Trig.from_fourier({}, {r: one}, ground)
+
+
+def _standard_form(setup: _Setup, ground: Ground, order: int) -> list[tuple[Trig, ...]]:
+    """``F_k = (−g_k,1 sin r_1τ / r_1, g_k,1 cos r_1τ / r_1, …)`` for ``k = 1 … order``: per
+    mode ``q = u cos rτ + v sin rτ``, ``q' = r(v cos rτ − u sin rτ)``, as Trig sums."""
     zero = ground.poly([])
 
     def const(value) -> Trig:
         return Trig(ground.poly([ground.scalar(value)]), zero, ground)
 
-    C = Trig(ground.poly([ground.scalar(0), ground.scalar(1)]), zero, ground)
-    S = Trig(zero, ground.poly([ground.scalar(1)]), ground)
-    q = C * ground.scalar(U) + S * ground.scalar(V)
-    qp = C * ground.scalar(V) - S * ground.scalar(U)
-    powers: dict[tuple[str, int], Trig] = {}
+    harmonics = [_harmonic(ground, r) for r in setup.ratios]
+    C, S = _harmonic(ground, 1)  # the drive's cos τ, sin τ
+    bases = {}
+    for i, (r, (Ci, Si)) in enumerate(zip(setup.ratios, harmonics, strict=True)):
+        u, v = (ground.scalar(s) for s in setup.slow[2 * i: 2 * i + 2])
+        bases[setup.qs[i]] = Ci * u + Si * v
+        qp = Ci * v - Si * u
+        bases[setup.qps[i]] = qp if r == 1 else qp * ground.scalar(r)
+    cs, ss = sp.Symbol("_cos"), sp.Symbol("_sin")
+    bases[cs], bases[ss] = C, S
+    gens = (*setup.qs, *setup.qps, cs, ss)
+    powers: dict[tuple[sp.Symbol, int], Trig] = {}
 
-    def power(kind: str, base: Trig, n: int) -> Trig:
+    def power(name: sp.Symbol, n: int) -> Trig:
         if n == 0:
             return const(1)
-        if (kind, n) not in powers:
-            powers[kind, n] = power(kind, base, n - 1) * base
-        return powers[kind, n]
+        if (name, n) not in powers:
+            powers[name, n] = power(name, n - 1) * bases[name]
+        return powers[name, n]
 
-    qs, qps, cs, ss = (sp.Symbol(n) for n in ("_q", "_qp", "_cos", "_sin"))
     out = []
     for k in range(1, order + 1):
-        gk = Trig(zero, zero, ground)
-        if k in g:
-            poly = sp.Poly(g[k], qs, qps, cs, ss)
-            for (a, b, i, j), coeff in sorted(poly.as_dict().items()):
-                term = power("q", q, a) * power("p", qp, b) * power("c", C, i) * \
-                    power("s", S, j)
-                gk = gk + term * ground.scalar(coeff)
-        out.append((gk * S * ground.scalar(-1), gk * C))
+        row: list[Trig] = []
+        for i, (r, (Ci, Si)) in enumerate(zip(setup.ratios, harmonics, strict=True)):
+            gk = Trig(zero, zero, ground)
+            if k in setup.g and setup.g[k][i] != 0:
+                poly = sp.Poly(setup.g[k][i], *gens)
+                for exps, coeff in sorted(poly.as_dict().items()):
+                    term = None
+                    for name, n in zip(gens, exps, strict=True):
+                        if n:
+                            term = power(name, n) if term is None else term * power(name, n)
+                    gk = gk + (const(1) if term is None else term) * ground.scalar(coeff)
+            if r == 1:
+                row += [gk * Si * ground.scalar(-1), gk * Ci]
+            else:
+                row += [gk * Si * ground.scalar(Fraction(-1, r)),
+                        gk * Ci * ground.scalar(Fraction(1, r))]
+        out.append(tuple(row))
     return out
 
 
@@ -244,51 +447,69 @@ def _antiderivative(T: Trig) -> Trig:
 
 
 def _partial(T: Trig, index: int) -> Trig:
-    """``∂/∂x_index`` (0 = u, 1 = v) of a Trig sum over ``QQ[u, v, …]`` (C is FLINT's gen 0)."""
+    """``∂/∂x_index`` (``x = (u_1, v_1, …)``) of a Trig sum over ``QQ[u_1, v_1, …]`` (C is
+    FLINT's gen 0)."""
     return Trig(MPoly(T.cos_part.p.derivative(index + 1)),
                 MPoly(T.sin_part.p.derivative(index + 1)), T.ground)
 
 
-def _average(F: list[tuple[Trig, Trig]], ground, order: int
-             ) -> tuple[list[tuple[Trig, Trig]], list[tuple[Trig, Trig]]]:
-    """``G_k`` and ``w_k`` (k = 1 … order) by the order-ε^k equations of the module docstring;
-    ``F(y + W)`` by Taylor's formula in ``(u, v)``."""
-    zero = Trig(ground.poly([]), ground.poly([]), ground)
-    G: list[tuple[Trig, Trig]] = []
-    W: list[tuple[Trig, Trig]] = []
-    derivs: dict[tuple[int, int, int], tuple[Trig, Trig]] = {}
+def _multi_indices(dim: int, n: int):
+    """Every ``α ∈ N^dim`` with ``|α| ≤ n``, the first index outermost."""
+    if dim == 1:
+        yield from ((a,) for a in range(n + 1))
+        return
+    for a in range(n + 1):
+        for rest in _multi_indices(dim - 1, n - a):
+            yield (a, *rest)
 
-    def d(m: int, a: int, b: int) -> tuple[Trig, Trig]:  # ∂_u^a ∂_v^b F_m / (a! b!)
-        key = (m, a, b)
+
+def _lowered(alpha: tuple[int, ...]) -> tuple[int, tuple[int, ...]] | None:
+    """``(i, α − e_i)`` for the first nonzero index ``i`` of ``α`` (None: ``α = 0``)."""
+    for i, e in enumerate(alpha):
+        if e:
+            return i, (*alpha[:i], e - 1, *alpha[i + 1:])
+    return None
+
+
+def _average(F: list[tuple[Trig, ...]], ground, order: int
+             ) -> tuple[list[tuple[Trig, ...]], list[tuple[Trig, ...]]]:
+    """``G_k`` and ``w_k`` (k = 1 … order) by the order-ε^k equations of the module docstring;
+    ``F(y + W)`` by Taylor's formula in the slow variables ``(u_1, v_1, …)``."""
+    dim = len(F[0])
+    zero = Trig(ground.poly([]), ground.poly([]), ground)
+    G: list[tuple[Trig, ...]] = []
+    W: list[tuple[Trig, ...]] = []
+    derivs: dict[tuple[int, tuple[int, ...]], tuple[Trig, ...]] = {}
+
+    def d(m: int, alpha: tuple[int, ...]) -> tuple[Trig, ...]:  # ∂^α F_m / α!
+        key = (m, alpha)
         if key not in derivs:
-            if a == b == 0:
+            lower = _lowered(alpha)
+            if lower is None:
                 derivs[key] = F[m - 1]
-            elif a:
-                prev = d(m, a - 1, b)
-                derivs[key] = tuple(_partial(c, 0) * ground.scalar(Fraction(1, a))
-                                    for c in prev)
             else:
-                prev = d(m, 0, b - 1)
-                derivs[key] = tuple(_partial(c, 1) * ground.scalar(Fraction(1, b))
-                                    for c in prev)
+                i, prev = lower
+                derivs[key] = tuple(_partial(c, i) * ground.scalar(Fraction(1, alpha[i]))
+                                    for c in d(m, prev))
         return derivs[key]
 
     for k in range(1, order + 1):
-        monomials: dict[tuple[int, int], list[Trig]] = {}  # [W_u^a W_v^b]_n, n < k
-        rhs = [zero, zero]
+        monomials: dict[tuple[int, ...], list[Trig]] = {}  # [Π W_i^α_i]_n, n < k
+        rhs = [zero] * dim
         for m in range(1, k + 1):
             n = k - m  # the order still needed from the Taylor terms
-            for a in range(n + 1):
-                for b in range(n + 1 - a):  # W = O(ε): W_u^a W_v^b starts at ε^(a+b)
-                    mono = _w_monomial(a, b, k, W, monomials, ground)[n]
-                    dm = d(m, a, b)
-                    rhs = [rhs[i] + dm[i] * mono for i in range(2)]
+            for alpha in _multi_indices(dim, n):  # W = O(ε): W^α starts at ε^|α|
+                mono = _w_monomial(alpha, k, W, monomials, ground)[n]
+                dm = d(m, alpha)
+                rhs = [rhs[i] + dm[i] * mono for i in range(dim)]
         for i in range(1, k):
             Gj = G[k - i - 1]
             wi = W[i - 1]
-            for comp in range(2):
-                rhs[comp] = rhs[comp] - (_partial(wi[comp], 0) * Gj[0]
-                                         + _partial(wi[comp], 1) * Gj[1])
+            for comp in range(dim):
+                acc = _partial(wi[comp], 0) * Gj[0]
+                for x in range(1, dim):
+                    acc = acc + _partial(wi[comp], x) * Gj[x]
+                rhs[comp] = rhs[comp] - acc
         Gk = tuple(_constant(c) for c in rhs)
         G.append(Gk)
         if k < order:
@@ -296,25 +517,26 @@ def _average(F: list[tuple[Trig, Trig]], ground, order: int
     return G, W
 
 
-def _w_monomial(a: int, b: int, k: int, W: list[tuple[Trig, Trig]],
-                monomials: dict[tuple[int, int], list[Trig]], ground) -> list[Trig]:
-    """``[W_u^a W_v^b]_n`` for ``n < k`` from the known ``w_1 … w_(k−1)`` (cached)."""
-    if (a, b) not in monomials:
+def _w_monomial(alpha: tuple[int, ...], k: int, W: list[tuple[Trig, ...]],
+                monomials: dict[tuple[int, ...], list[Trig]], ground) -> list[Trig]:
+    """``[Π W_i^α_i]_n`` for ``n < k`` from the known ``w_1 … w_(k−1)`` (cached)."""
+    if alpha not in monomials:
         zero = Trig(ground.poly([]), ground.poly([]), ground)
-        if a == b == 0:
+        lower = _lowered(alpha)
+        if lower is None:
             one = Trig(ground.poly([ground.scalar(1)]), ground.poly([]), ground)
-            monomials[a, b] = [one] + [zero] * (k - 1)
+            monomials[alpha] = [one] + [zero] * (k - 1)
         else:
-            comp, base = ((0, _w_monomial(a - 1, b, k, W, monomials, ground)) if a
-                          else (1, _w_monomial(a, b - 1, k, W, monomials, ground)))
+            comp, prev = lower
+            base = _w_monomial(prev, k, W, monomials, ground)
             out = []
             for n in range(k):
                 acc = zero
                 for j in range(1, min(n, len(W)) + 1):
                     acc = acc + W[j - 1][comp] * base[n - j]
                 out.append(acc)
-            monomials[a, b] = out
-    return monomials[a, b]
+            monomials[alpha] = out
+    return monomials[alpha]
 
 
 def _polar(Gk: tuple[sp.Expr, sp.Expr]) -> tuple[sp.Expr, sp.Expr]:
@@ -338,12 +560,21 @@ def _trig_expr(T: Trig, ground, tau: sp.Symbol) -> sp.Expr:
                   *(ground.to_sympy(b) * sp.sin(n * tau) for n, b in sorted(sin.items())))
 
 
+def _one_oscillator(flow: SlowFlow, what: str) -> None:
+    """Refuse a system's flow where the one oscillator's ``(r, φ)`` is meant."""
+    if flow.system is not None:
+        raise InputError(f"system {flow.source!r}: {what} takes one oscillator's slow flow "
+                         "(r, phi); a system's resonant modes have coupled_modes and "
+                         "numerics.references.energy_exchange")
+
+
 def fixed_points(flow: SlowFlow, eps: float, values: dict[str, float] | None = None,
                  guesses: tuple[tuple[float, float], ...] = ((1.0, 0.0),)
                  ) -> list[tuple[float, float]]:
     """Fixed points ``(r, φ)`` of a driven slow flow (the steady states), by Newton's method in
     van der Pol's variables from each guess; for an autonomous flow the positive roots ``r`` of
     ``dr/dt`` (the limit cycles) with ``φ`` the phase rate ``dφ/dt`` there."""
+    _one_oscillator(flow, "fixed_points")
     subs = {sp.Symbol("eps"): eps, **{sp.Symbol(k): v for k, v in (values or {}).items()}}
     if not flow.driven:
         dr, dphi = (e.subs(subs) for e in flow.rates)
@@ -383,6 +614,7 @@ def transient(flow: SlowFlow, eps: float, q0: float, p0: float, times: np.ndarra
     Shape ``(2, len(times))``.  Error ``O(ε^order)`` over ``t = O(1/ε)``."""
     from scipy.integrate import solve_ivp
 
+    _one_oscillator(flow, "transient")
     eps_s, tau = sp.Symbol("eps"), sp.Symbol("tau")
     subs = {eps_s: eps, **{sp.Symbol(k): v for k, v in (values or {}).items()}}
     sigma = float(subs.get(SIGMA, 0.0)) if flow.driven else 0.0
@@ -443,6 +675,7 @@ def cycle_series(flow: SlowFlow) -> list[CycleSeries]:
     """Every positive root ``r₀`` of ``R_1`` where ``R_1'(r₀) ≠ 0`` (rational roots; an
     irrational one is kept as SymPy's exact algebraic number), continued order by order:
     ``r_i`` from the ε^i part of ``(dr/dt)/ε``, linear in ``r_i`` with slope ``R_1'(r₀)``."""
+    _one_oscillator(flow, "cycle_series")
     if flow.driven:
         raise InputError(f"{flow.name}: a driven flow's fixed points depend on the drive; "
                          "use fixed_points with values")

@@ -1,47 +1,17 @@
-"""The slow flow of a system's modes in internal resonance, by first-order averaging, exact.
-
-Where the linear frequencies are commensurate (``ω_j = n ω_i``, the small divisors that make
-``nnm`` refuse), the modes exchange energy instead of each carrying a normal mode. In the
-resonant modes' coordinates ``x = Σ_k φ_k q_k`` (the other modes unexcited at this order),
-``q_k'' + ω_k² q_k = f_k(q)``, ``f_k = −ψ_k·g(Σ φ q)`` with the lowest-degree force ``g`` and
-the left eigenvectors ``ψ_k`` (``ψ_k·φ_k = 1``).  With ``q_k = a_k cos θ_k``,
-``q_k' = −a_k ω_k sin θ_k`` and ``θ_k = ω_k t + φ_k``, van der Pol's variables obey
-
-    a_k' = −(1/ω_k) f_k sin θ_k,      a_k φ_k' = −(1/ω_k) f_k cos θ_k,
-
-and averaging over the fast angles keeps exactly the terms ``e^{i Σ m_k θ_k}`` with
-``Σ m_k ω_k = 0``: the resonant combinations of the slow phases.  Each average is computed in
-``z_k = e^{iθ_k}`` as a Laurent polynomial, exact (ω_k in Q or Q(√λ)).
+"""A system's modes in internal resonance: which modes (``ω_j = n ω_i``, the small divisors
+that make ``nnm`` refuse), their right and left shapes, and of their slow flow
+(:func:`derive.averaging.slow_flow`, a :class:`~derive.averaging.SlowFlow` of the resonant
+modes) the phase-locked coupled modes and how weak the nonlinearity is at given amplitudes.
 """
 
 from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
 
 import sympy as sp
 
-from ..errors import InputError
 from .system import System
-
-
-@dataclass(frozen=True)
-class ResonantFlow:
-    """The first-order slow flow of the modes ``modes`` (1-based) in internal resonance:
-    ``da_k/dt = amplitude[k]``, ``dφ_k/dt = phase[k]`` in the symbols ``a``, ``phi`` (exact
-    SymPy), the modes' exact ``ω`` and shapes, and the resonances named."""
-
-    system: System
-    modes: tuple[int, ...]
-    omega: tuple[sp.Expr, ...]
-    shapes: tuple[tuple[sp.Expr, ...], ...]
-    a: tuple[sp.Symbol, ...]
-    phi: tuple[sp.Symbol, ...]
-    amplitude: tuple[sp.Expr, ...]
-    phase: tuple[sp.Expr, ...]
-    resonances: tuple[str, ...]
-    degree: int  # the force's lowest degree: the flow is of order (amplitude)^(degree − 1)
 
 
 def resonant_modes(system: System) -> tuple[list[int], list[str]]:
@@ -67,66 +37,7 @@ def _shapes(system: System, lam: sp.Expr) -> tuple[sp.Matrix, sp.Matrix]:
     return right, left / sp.simplify((left.T * right)[0])
 
 
-def resonant_flow(system: System, order: int = 1) -> ResonantFlow:
-    """The first-order averaged flow of the resonant modes of ``system`` (``order`` 1 only)."""
-    if order != 1:
-        raise InputError(f"--order {order}: a system's resonant slow flow is derived to the "
-                         "first order (where the resonance enters); higher orders are not "
-                         "built")
-    if not system.conservative:
-        raise InputError(f"system {system.text!r}: a velocity-dependent force; the resonant "
-                         "slow flow takes conservative systems")
-    if all(f == 0 for f in system.force):
-        raise InputError(f"system {system.text!r}: no nonlinear term: a linear system's modes "
-                         "are independent and exchange no energy, so there is no slow flow to "
-                         "average; lindstedt nnm SYSTEM --mode M gives each mode")
-    modes, names = resonant_modes(system)
-    if not modes:
-        raise InputError(f"system {system.text!r}: no internal resonance (no ω0 an integer "
-                         "multiple of another); lindstedt nnm SYSTEM --mode M gives each mode")
-    lams = system.modes()
-    omega = [sp.sqrt(lams[k]) for k in modes]
-    base = min(omega)
-    ratios = [sp.nsimplify(w / base) for w in omega]
-    degree = min(len(powers) and sum(powers) for f in system.force if f != 0
-                 for powers in sp.Poly(f, *system.coordinates).monoms())
-    shapes, lefts = zip(*(_shapes(system, lams[k]) for k in modes), strict=True)
-    n = len(modes)
-    a = sp.symbols(f"a1:{n + 1}", positive=True)
-    phi = sp.symbols(f"phi1:{n + 1}", real=True)
-    z = sp.symbols(f"z1:{n + 1}")
-    q = [a[k] * (z[k] + 1 / z[k]) / 2 for k in range(n)]
-    x = sp.zeros(system.size, 1)
-    for k in range(n):
-        x += shapes[k] * q[k]
-    lowest = [sum(t for t in sp.Add.make_args(sp.expand(f)) if sp.Poly(t, *system.coordinates)
-                  .total_degree() == degree) for f in system.force]
-    g = sp.Matrix([f.xreplace(dict(zip(system.coordinates, x, strict=True))) for f in lowest])
-
-    def average(expr: sp.Expr) -> sp.Expr:
-        """The fast-angle mean of a Laurent polynomial in the z_k: the resonant terms, with
-        z_k → e^{iφ_k}, as a real expression."""
-        poly = sp.Poly(sp.expand(expr * sp.Mul(*(zk**(3 * degree) for zk in z))), *z)
-        kept = sp.S.Zero
-        for powers, c in poly.terms():
-            m = [p - 3 * degree for p in powers]
-            if sum(mk * r for mk, r in zip(m, ratios, strict=True)) == 0:
-                kept += c * sp.exp(sp.I * sum(mk * p for mk, p in zip(m, phi, strict=True)))
-        return sp.simplify(sp.expand_complex(sp.expand(kept)))
-
-    amplitude, phase = [], []
-    for k in range(n):
-        f = -(lefts[k].T * g)[0]
-        sin_k = (z[k] - 1 / z[k]) / (2 * sp.I)
-        cos_k = (z[k] + 1 / z[k]) / 2
-        amplitude.append(sp.simplify(-average(f * sin_k) / omega[k]))
-        phase.append(sp.simplify(-average(f * cos_k) / (omega[k] * a[k])))
-    return ResonantFlow(system, tuple(k + 1 for k in modes), tuple(omega),
-                        tuple(tuple(s) for s in shapes), a, phi, tuple(amplitude), tuple(phase),
-                        tuple(names), degree)
-
-
-def _combinations(flow: ResonantFlow) -> set[sp.Expr]:
+def _combinations(flow) -> set[sp.Expr]:
     """The resonant combinations ``Σ m_k φ_k`` the flow depends on (up to sign)."""
     found = set()
     for e in (*flow.amplitude, *flow.phase):
@@ -136,7 +47,7 @@ def _combinations(flow: ResonantFlow) -> set[sp.Expr]:
     return found
 
 
-def coupled_modes(flow: ResonantFlow) -> list[tuple[sp.Expr, sp.Expr]]:
+def coupled_modes(flow) -> list[tuple[sp.Expr, sp.Expr]]:
     """The phase-locked solutions (the coupled modes) of a two-mode flow with one resonant
     combination ``γ``: pairs ``(γ, a₂/a₁)`` where every ``a_k' = 0`` and ``γ' = 0``, exact
     (the flow is homogeneous in the amplitudes: a ratio fixes a ray of them).  Empty where
@@ -171,7 +82,7 @@ def _real_roots(expr: sp.Expr, x: sp.Symbol) -> list[sp.Expr]:
     return [r for r in sp.solve(expr, x) if r.is_real]
 
 
-def force_ratio(flow: ResonantFlow, start: tuple[float, ...], limit: float = 1.0
+def force_ratio(flow, start: tuple[float, ...], limit: float = 1.0
                 ) -> tuple[float, float]:
     """How weak the nonlinearity is at amplitudes ``start``: ``(log₁₀ ρ, λ)`` with
     ``ρ = max_i Σ_terms |c| Π_j X_j^{p_j} / (ω_min² max_i X_i)`` — every nonlinear term of
@@ -180,8 +91,9 @@ def force_ratio(flow: ResonantFlow, start: tuple[float, ...], limit: float = 1.0
     reaches ``limit`` (ρ grows with λ: every term has degree ≥ 2).  In logarithms: any finite
     amplitude, no overflow.
 
+    >>> from lindstedt.derive.averaging import slow_flow
     >>> from lindstedt.derive.system import parse_system
-    >>> flow = resonant_flow(parse_system("x'' + x + x*y = 0; y'' + 4*y + x**2 = 0"))
+    >>> flow = slow_flow(parse_system("x'' + x + x*y = 0; y'' + 4*y + x**2 = 0"), 1)
     >>> [round(v, 12) for v in force_ratio(flow, (0.5, 0.25))]  # x² = 0.25 against 1·0.5
     [-0.301029995664, 2.0]
     """
