@@ -35,6 +35,23 @@ def test_van_der_pol_first_and_second_order_flow():
     assert flow.phase[1].subs(R, 2) == sp.Rational(-1, 16)
 
 
+def test_one_oscillator_is_the_one_mode_case_of_the_record():
+    """One mode, ω₀ = 1, the symbols r, φ: da/dt = dr/dt = Σ ε^k R_k and the rates are
+    (dr/dt, dφ/dt); the system-only fields are empty, and a system's flow is refused where
+    (r, φ) is meant."""
+    from lindstedt.derive.system import parse_system
+
+    flow = slow_flow(oscillator(VDP), 3)
+    assert flow.a == (R,) and flow.phi == (PHI,) and flow.modes == (1,) and flow.system is None
+    assert flow.amplitude == (sum(EPS ** (k + 1) * flow.radial[k] for k in range(3)),)
+    assert flow.rates == (*flow.amplitude, sum(EPS ** (k + 1) * flow.phase[k] for k in range(3)))
+    system = slow_flow(parse_system("x'' + x + x*y = 0; y'' + 4*y + x**2 = 0"), 1)
+    assert len(system.cartesian[0]) == 4 and system.transform == ()
+    for use in (lambda: cycle_series(system), lambda: fixed_points(system, 0.1)):
+        with pytest.raises(InputError, match="one oscillator's slow flow"):
+            use()
+
+
 def _omega_series(flow, a0) -> list[sp.Rational]:
     """ω = 1 + dφ/dt at the root r* = a0 + ε r1 + … of dr/dt, as a series in ε (exact):
     r_i from the ε^i part of (dr/dt)/ε, linear in r_i with slope R_1'(a0)."""

@@ -53,6 +53,7 @@ import math
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 import sympy as sp
@@ -63,8 +64,9 @@ from ..errors import InputError
 from ..limits import SLOW_FLOW_MAX_ORDER as MAX_ORDER
 from ..limits import check_int
 from .models import Oscillator
-from .resonance import _shapes, resonant_modes
-from .system import System
+
+if TYPE_CHECKING:
+    from .system import System
 
 U, V = sp.Symbol("_u"), sp.Symbol("_v")  # van der Pol's variables ("_": no user name clashes)
 R, PHI = sp.Symbol("r", positive=True), sp.Symbol("phi")
@@ -132,12 +134,12 @@ def slow_flow(problem: Oscillator | System, order: int) -> SlowFlow:
     """The slow flow of ``problem`` to order ``order``: one oscillator
     (``q'' + q = eps*f(q, q')``, optionally ``+ eps*F*cos(w*t)``) or a system's modes in
     internal resonance (order 1); a one-line :class:`InputError` names what does not fit."""
-    if isinstance(problem, System):
-        setup = _resonant_right_side(problem, order)
-    else:
+    if isinstance(problem, Oscillator):
         check_int(order, 1, MAX_ORDER,
                   f"order {order!r}: the slow flow is derived to orders 1 … {MAX_ORDER}")
         setup = _oscillator_right_side(problem, order)
+    else:
+        setup = _resonant_right_side(problem, order)
     ground = _ground((*setup.slow, *setup.params))
     F = _standard_form(setup, ground, order)
     G, W = _average(F, ground, order)
@@ -194,6 +196,9 @@ def _oscillator_right_side(osc: Oscillator, order: int) -> _Setup:
 def _resonant_right_side(system: System, order: int) -> _Setup:
     """A system's resonant modes in the base time ``τ = ω_b t``: ``g_k = −ψ_k·g/ω_b²`` of the
     lowest-degree force ``g`` at ``x = Σ φ_j q_j``, or a one-line refusal."""
+    from .resonance import _shapes, resonant_modes  # NOTE: here, not above: SciPy's sparse
+    # matrices (derive.system) would load with every one-oscillator command
+
     if order != 1:
         raise InputError(f"--order {order}: a system's resonant slow flow is derived to the "
                          "first order (where the resonance enters); higher orders are not "
