@@ -400,7 +400,7 @@ class Exchange:
 
 def energy_exchange(flow: object, start: Sequence[float], max_steps: int = EXCHANGE_MAX_STEPS,
                     samples: int = 0) -> Exchange:
-    """:class:`Exchange` of a resonant slow flow (a :class:`derive.resonance.ResonantFlow`):
+    """:class:`Exchange` of a resonant slow flow (a :class:`derive.averaging.SlowFlow` of modes):
     the time between two successive maxima of the first mode's amplitude, by DOP853 on the
     averaged equations; ``samples`` > 0 also samples the amplitudes that many times, the
     integration carried on to a second exchange (within ``max_steps`` steps in all).  The step
