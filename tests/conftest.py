@@ -53,13 +53,19 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         item.add_marker(getattr(pytest.mark, LAYER_OF[name]))
 
 
-@pytest.fixture(scope="session", autouse=True)
-def emitted_cache(tmp_path_factory: pytest.TempPathFactory):
-    """numba's cache of emitted modules for this run: ``numba-cache`` under the run's temporary
-    folder, the one that pytest-xdist's workers' folders are made in (a fresh folder each run,
-    so each distinct module is compiled in every run)."""
+@pytest.fixture(scope="session")
+def run_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The run's temporary folder, which every pytest-xdist worker of the run shares (each
+    worker's own folder is made in it): a fresh one each run."""
     base = tmp_path_factory.getbasetemp()
-    folder = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "numba-cache"
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
+@pytest.fixture(scope="session", autouse=True)
+def emitted_cache(run_folder: Path):
+    """numba's cache of emitted modules for this run: ``numba-cache`` in the run's folder (so
+    each distinct module is compiled once in every run)."""
+    folder = run_folder / "numba-cache"
     folder.mkdir(exist_ok=True)
     os.environ[CACHE_VARIABLE] = str(folder)
     CacheImpl._locator_classes.insert(0, EmittedCache)

@@ -1,12 +1,13 @@
 """The package as a user gets it: a wheel built from the source, installed into a fresh venv
 (not editable), used from folders outside the checkout; and `make demo` in a clean clone.
 
-One venv serves every test here (building it costs ~1 min, mostly unpacking the dependencies
-from pip's cache).
+One venv serves every test here, on whichever pytest-xdist worker runs it (building it costs
+~1 min, mostly unpacking the dependencies from pip's cache).
 """
 
 from __future__ import annotations
 
+import fcntl
 import shutil
 import subprocess
 import sys
@@ -15,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from commands import cached_env
 from scipy.special import ellipk
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -22,17 +24,31 @@ SOURCES = ("pyproject.toml", "README.md", "generator", "templates")
 # NOTE: what the build needs; copied, so that building leaves nothing in the checkout.
 
 
-def _run(cmd: list, cwd: Path, timeout: float = 900) -> subprocess.CompletedProcess:
+def _run(cmd: list, cwd: Path, timeout: float = 900, env: dict | None = None
+         ) -> subprocess.CompletedProcess:
     out = subprocess.run([str(c) for c in cmd], cwd=cwd, capture_output=True, text=True,
-                         timeout=timeout, check=False)
+                         timeout=timeout, check=False, env=env)
     assert out.returncode == 0, f"{cmd}\n{out.stdout[-2000:]}\n{out.stderr[-4000:]}"
     return out
 
 
 @pytest.fixture(scope="module")
-def venv(tmp_path_factory) -> Path:
-    """A fresh venv holding the wheel of this checkout and its dependencies."""
-    work = tmp_path_factory.mktemp("install")
+def venv(run_folder) -> Path:
+    """A fresh venv holding the wheel of this checkout and its dependencies, built once in the
+    run's folder: a pytest-xdist worker that needs it while another builds it waits for it."""
+    work = run_folder / "install"
+    work.mkdir(exist_ok=True)
+    with open(work / "lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+        if not (work / "built").exists():
+            _build(work)
+            (work / "built").touch()
+    return work / "venv"
+
+
+def _build(work: Path) -> None:
+    """The wheel of this checkout, built from a copy of its sources, installed into
+    ``work/venv``."""
     src = work / "src"
     src.mkdir()
     for name in SOURCES:
@@ -47,7 +63,6 @@ def venv(tmp_path_factory) -> Path:
     # is half the install's time; Python compiles what the tests import as it imports it.
     _run([work / "venv/bin/python", "-m", "pip", "install", "--quiet", "--no-compile", "-c",
           ROOT / "constraints.txt", wheel], work)
-    return work / "venv"
 
 
 def test_import_name_is_lindstedt_and_nothing_called_generator(venv, tmp_path):
@@ -100,9 +115,10 @@ def test_make_demo_in_a_clean_clone_leaves_git_status_clean(venv, tmp_path):
     _run(["git", "clone", "--quiet", ROOT, clone], tmp_path)
     stamp = venv / ".installed"
     stamp.touch()
-    # NOTE: -o: the venv is ready; make must not reinstall the clone into it.
+    # NOTE: -o: the venv is ready; make must not reinstall the clone into it.  The demo's
+    # modules are the committed ones (generated/): compiled once for the whole suite.
     _run(["make", "--no-print-directory", "demo", f"VENV={venv}", "-o", stamp], clone,
-         timeout=1800)
+         timeout=1800, env=cached_env())
     status = _run(["git", "status", "--porcelain", "--ignored=no"], clone).stdout
     assert status == ""
     written = {p.relative_to(clone / "out").as_posix() for p in (clone / "out").rglob("*")}
