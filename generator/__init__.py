@@ -141,10 +141,14 @@ order; a stage imports only stages above it::
     costs                   each command's estimated wall time and bounds [arguments -> Cost]
     cli.common              what every command shares: light constants, argument types and
                             flags, the report shape [argv -> Namespace]
-    cli.system              nnm and slowflow of a system [NormalModeSeries, SlowFlow ->
-                            JSON, tables]
-    cli.series              series, mathieu, tongues, slowflow, models, generate
+    cli.system              nnm; the JSON and table of a family of periodic orbits of any
+                            number of coordinates [NormalModeSeries, SeriesSolution -> JSON,
+                            tables]
+    cli.series              series, mathieu, tongues, models, generate
                             [records -> JSON, tables]
+    cli.slowflow            slowflow of one oscillator or of a system's resonant modes: one
+                            contract, one table, the portrait or the energy exchange
+                            [SlowFlow -> JSON, table, CSV]
     cli.driven              driven, subharmonic, parametric, mixing [records -> JSON, tables]
     cli.response            response of any number of coordinates [Response -> JSON, table,
                             CSV]

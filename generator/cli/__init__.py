@@ -45,18 +45,17 @@ from .series import (
     arguments_mathieu,
     arguments_models,
     arguments_series,
-    arguments_slowflow,
     arguments_tongues,
     run_generate,
     run_generate_mode,
     run_mathieu,
     run_models,
     run_series,
-    run_slowflow,
     run_tongues,
 )
+from .slowflow import arguments_slowflow, run_resonant_modes, run_slowflow
 from .sweep import arguments_sweep, run_sweep
-from .system import arguments_nnm, run_nnm, run_slowflow_system
+from .system import arguments_nnm, run_nnm
 
 
 @dataclass(frozen=True)
@@ -146,7 +145,7 @@ COMMANDS: tuple[Command, ...] = (
     _command("clock", arguments_clock, run_clock),
     _command("scene", arguments_scene, run_scene),
     _command("slowflow", arguments_slowflow, run_slowflow,
-             Route("resonant flow", _coordinates, run_slowflow_system,
+             Route("resonant flow", _coordinates, run_resonant_modes,
                    ROUTE_COSTS["slowflow resonant flow"])),
     _command("demo", arguments_demo, run_demo),
 )

@@ -6,7 +6,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import sys
 from fractions import Fraction
 from pathlib import Path
 
@@ -36,7 +35,6 @@ from .common import (
     _positive_real,
     _real,
     check_outputs,
-    sp_text,
     write_csv,
 )
 from .system import _short, periodic_json, periodic_table
@@ -388,122 +386,6 @@ def run_tongues(args: argparse.Namespace) -> int:
     return 0
 
 
-def slow_flow_json(flow) -> dict:
-    """The contract of ``lindstedt slowflow … --json``: ``radial[k-1]`` and ``phase[k-1]`` are
-    R_k and Φ_k of dr/dt = Σ eps^k R_k, dphi/dt = Σ eps^k Φ_k (SymPy text in r, phi and the
-    parameters), for q = r cos(t + phi) (a drive: q = r cos(w t + phi), w = 1 + eps*sigma);
-    ``cycles``: each limit cycle (a root of dr/dt) of an autonomous flow without symbolic
-    parameters, its radius r* (to eps^(K-1)) and frequency ω (to eps^K) as series in eps."""
-    return {
-        "equation": flow.source, "name": flow.name, "order": flow.order, "variable": "eps",
-        "parameters": [str(p) for p in flow.parameters], "driven": flow.driven,
-        "convention": ("q = r cos(w t + phi), q' = -r w sin(w t + phi) + O(eps), "
-                       "w = 1 + eps*sigma" if flow.driven else
-                       "q = r cos(t + phi), q' = -r sin(t + phi) + O(eps)")
-        + "; mean-free near-identity transformation",
-        "radial": [sp_text(e) for e in flow.radial],
-        "phase": [sp_text(e) for e in flow.phase],
-        "cycles": [{"radius": [sp_text(c) for c in cyc.radius],
-                    "averaged_radius": [sp_text(c) for c in cyc.radius],
-                    "radius_meaning": SLOWFLOW_RADIUS,
-                    "omega": [sp_text(c) for c in cyc.omega],
-                    "stable_for": "eps > 0" if cyc.slope < 0 else "eps < 0"}
-                   for cyc in _cycles(flow)],
-    }
-
-
-SLOWFLOW_RADIUS = ("r, the averaged amplitude: van der Pol's radius after the mean-free "
-                   "near-identity transformation (the slow flow's variable), not q(0) (series' "
-                   "q0: the displacement where the velocity vanishes) nor the orbit's first "
-                   "harmonic (series' first_harmonic); the three agree at order eps and differ "
-                   "at eps^2 (Rayleigh: r 2 + 5/64 eps^2, q0 2 + 17/96, first harmonic "
-                   "2 + 9/64)")
-
-
-def _cycles(flow) -> list:
-    """The limit cycles of an autonomous flow with numeric coefficients (none otherwise)."""
-    from ..derive.averaging import cycle_series
-
-    return [] if flow.driven or flow.parameters else cycle_series(flow)
-
-
-def run_slowflow(args: argparse.Namespace) -> int:
-    """``lindstedt slowflow EQUATION|NAME --order K``: the averaged equations, exact."""
-    from ..derive.averaging import slow_flow
-    from ..derive.models import oscillator, registry_entry
-
-    args.order = 2 if args.order is None else args.order
-    if args.start:
-        raise InputError("--start: a system's flag (equations separated by ';')")
-    if (args.eps is not None or args.sigma is not None) and not (args.plot or args.csv):
-        raise InputError("--eps/--sigma: the portrait's values; give --plot or --csv")
-    plot, csv = check_outputs(args)
-    text, name = args.model, args.name or "oscillator"
-    if (entry := registry_entry(text)) is not None:  # a name or its alias (vdp)
-        text, name = entry.equation, args.name or entry.name
-    out = _out_folder(args.out) if args.out is not None else None
-    osc = oscillator(text, _params(args.param), name)
-    flow = slow_flow(osc, args.order)
-    drawn = None
-    if plot or csv:
-        from ..analysis.curves import portrait
-
-        if args.sigma is not None and not flow.driven:
-            raise InputError("--sigma: the detuning of a drive; this flow is not driven")
-        drawn = portrait(flow, PORTRAIT_EPS if args.eps is None else args.eps,
-                         {"sigma": args.sigma or 0.0} if flow.driven else {})
-    written = []
-    if out is not None:  # written before anything is printed: a refusal prints nothing
-        from ..compiler import generate_slow_flow
-
-        params = "".join(f" --param {k}={v}" for k, v in sorted(_params(args.param).items()))
-        command = f'lindstedt slowflow "{text}" --name {name} --order {args.order}{params}'
-        written = generate_slow_flow(osc, args.order, command, out,
-                                     overwrite_edited=args.overwrite_edited)
-    if plot is not None:
-        from ..charts_series import portrait_figure
-
-        portrait_figure(drawn, plot)
-    if csv is not None:
-        portrait_csv(drawn, csv)
-    if args.json:
-        print(json.dumps(slow_flow_json(flow)))
-    else:
-        frame = "q = r cos(w t + phi), w = 1 + eps*sigma" if flow.driven else \
-            "q = r cos(t + phi)"
-        print(f"{flow.name}: {flow.source}, the slow flow to order {flow.order} ({frame})")
-        print("dr/dt = sum_k eps^k R_k, dphi/dt = sum_k eps^k Phi_k")
-        for k in range(flow.order):
-            print(f"R_{k + 1}   = {sp_text(flow.radial[k])}")
-            print(f"Phi_{k + 1} = {sp_text(flow.phase[k])}")
-        for cyc in _cycles(flow):
-            print(f"limit cycle (dr/dt = 0, attracting for "
-                  f"{'eps > 0' if cyc.slope < 0 else 'eps < 0'}): r = sum_j eps^j r_j, "
-                  "omega = sum_j eps^j omega_j")
-            print("  r_j:     " + ", ".join(sp_text(c) for c in cyc.radius))
-            print("  (r: the averaged amplitude, van der Pol's radius after the mean-free "
-                  "near-identity transformation; series' q(0) and first harmonic equal it at "
-                  "order eps, not beyond)")
-            print("  omega_j: " + ", ".join(sp_text(c) for c in cyc.omega))
-    for path in written:
-        print(f"  {path}", file=sys.stderr if args.json else sys.stdout)
-    return 0
-
-
-PORTRAIT_EPS = 0.1
-# NOTE: the ε of `slowflow --plot/--csv` without --eps: small enough for the averaged flow to
-# hold over the slow times drawn, at any order.
-
-
-def portrait_csv(p, path: Path) -> Path:
-    """The CSV of ``slowflow --csv``: every trajectory of :class:`analysis.curves.Portrait`,
-    point by point, as drawn."""
-    columns = (("trajectory", "number from 1"), ("t", "time"), ("x", "r cos(phi)"),
-               ("y", "r sin(phi)"))
-    return write_csv(path, columns, ((k, *point) for k, tr in enumerate(p.trajectories, 1)
-                                     for point in tr.T))
-
-
 def run_models(args: argparse.Namespace) -> int:
     """Run ``lindstedt models``: the registry's named oscillators with their equations and
     aliases, as a table or JSON.  Returns the exit status."""
@@ -749,44 +631,5 @@ def arguments_generate(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
     p.add_argument("--amplitude", metavar="NAME",
                    help="a SYSTEM's coordinate at x = A at t = 0 (default: the first)")
     _flag_allow_slow(p)
-    _flag_overwrite_edited(p)
-    return p
-
-
-def arguments_slowflow(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    """``lindstedt slowflow``'s arguments."""
-    p = sub.add_parser("slowflow", help="the slow flow (averaging) of q'' + q = eps*f, free, "
-                       "self-excited or driven; of a system's modes in internal resonance",
-                       description="Average q'' + q = eps*f(q, q') (+ eps*F*cos(w*t), w = 1 + "
-                       "eps*sigma) to order K: dr/dt and dphi/dt exactly, for q = r cos(t + "
-                       "phi); with --out the compiled right sides and the LaTeX of the flow. A "
-                       "SYSTEM (equations separated by ';') whose linear frequencies are "
-                       "commensurate: the first-order slow flow of the resonant modes, its "
-                       "coupled modes and the energy-exchange period.")
-    _flag_oscillator(p)
-    p.add_argument("--order", type=_positive, default=None, metavar="K",
-                   help="the order in eps, 1..6 (default 2; a SYSTEM: 1, the only one built)")
-    p.add_argument("--start", action="append", metavar="NAME=VALUE",
-                   help="a SYSTEM: the starting amplitude a_k of a resonant mode for the "
-                   "energy exchange, e.g. a1=0.001 (repeatable; default: the highest mode at "
-                   "0.1, the others at 0.001)")
-    _flag_json(p, "the contract {equation, name, order, variable, parameters, driven, "
-               "convention, radial, phase, cycles}; a SYSTEM: {kind, system, modes, omega0, "
-               "resonances, equations, coupled_modes, exchange}")
-    p.add_argument("--out", metavar="DIR", help="also write <name>_slow_flow.py (numba "
-                   "slow_flow, slow_flow_jacobian, slow_flow_cartesian) and "
-                   "<name>_slow_flow.tex into DIR")
-    p.add_argument("--plot", metavar="FILE",
-                   help="also draw the phase portrait into FILE (.png, .svg or .pdf): "
-                   "trajectories in the plane (r cos phi, r sin phi) from 8 starts, the limit "
-                   "cycles and fixed points; a SYSTEM: each resonant amplitude a_k over two "
-                   "energy exchanges from --start (default: none)")
-    _flag_csv(p, "the portrait's trajectories (trajectory, t, x = r cos phi, y = r sin phi); "
-              "a SYSTEM: t, a1, a2, ... as drawn")
-    p.add_argument("--eps", type=_real, default=None, metavar="EPS",
-                   help=f"with --plot/--csv: the value of eps (default {PORTRAIT_EPS})")
-    p.add_argument("--sigma", type=_real, default=None, metavar="SIGMA",
-                   help="with --plot/--csv, a driven flow: the detuning sigma of w = 1 + "
-                   "eps*sigma (default 0)")
     _flag_overwrite_edited(p)
     return p

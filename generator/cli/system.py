@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import re
 import textwrap
 from functools import partial
@@ -324,126 +323,6 @@ def run_nnm(args: argparse.Namespace) -> int:
         backbone_csv(backbone(mode), csv)
     print(json.dumps(data) if args.json else periodic_table(data, args.exact))
     return 0
-
-
-START_AMPLITUDE = 0.1
-START_SEED = 0.01
-# NOTE: the default start of the energy exchange: the highest resonant mode at amplitude 0.1,
-# the others seeded at 1 % of it (a swing spring set bouncing, its swing growing from a nudge).
-
-
-def resonant_json(flow, coupled, exchange) -> dict:
-    """``slowflow SYSTEM --json``: the averaged equations (exact SymPy str), the coupled modes
-    (``coupled``, :func:`derive.resonance.coupled_modes`: phase-locked, every amplitude
-    steady) and the energy exchange (a :class:`numerics.references.Exchange`)."""
-    names = [f"a{k}" for k in range(1, len(flow.a) + 1)]
-    equations = {}
-    for k, name in enumerate(names):
-        equations[f"{name}'"] = str(flow.amplitude[k])
-        equations[f"phi{k + 1}'"] = str(flow.phase[k])
-    return {
-        "kind": "slowflow", "system": flow.system.text, "order": 1,
-        "modes": list(flow.modes), "omega0": [str(w) for w in flow.omega],
-        "resonances": list(flow.resonances),
-        "shapes": [[str(v) for v in shape] for shape in flow.shapes],
-        "variables": "x = sum_k shape_k a_k cos(omega0_k t + phi_k), slowly varying a_k, phi_k",
-        "equations": equations,
-        "coupled_modes": [{"gamma": str(g), "ratio": str(r), "ratio_value": float(r)}
-                          for g, r in coupled],
-        "exchange": {"start": dict(zip(names, exchange.start, strict=True)),
-                     "period": exchange.period,
-                     "how": "the averaged flow by DOP853 from zero phases: time between two "
-                            "maxima of a1"},
-    }
-
-
-EXCHANGE_SAMPLES = 801
-# NOTE: the points of `slowflow SYSTEM --plot/--csv`'s amplitudes over two exchanges.
-
-
-def exchange_csv(exchange, path: Path) -> Path:
-    """The CSV of ``slowflow SYSTEM --csv``: the amplitudes a_k at each slow time, as drawn."""
-    n = exchange.a.shape[0]
-    columns = (("t", "time"), *((f"a{k}", f"amplitude of resonant mode {k}")
-                                for k in range(1, n + 1)))
-    return write_csv(path, columns, zip(exchange.t, *exchange.a, strict=True))
-
-
-def resonant_table(data: dict) -> str:
-    """The readable slow flow of a system's resonant modes."""
-    lines = [f"{data['system']}: internal resonance {'; '.join(data['resonances'])}",
-             f"the slow flow to order 1 ({data['variables']})"]
-    lines += [f"  {k} = {v}" for k, v in data["equations"].items()]
-    for c in data["coupled_modes"]:
-        lines.append(f"coupled mode: resonant angle {c['gamma']}, a2/a1 = {c['ratio']} "
-                     f"({c['ratio_value']:.6g})")
-    ex = data["exchange"]
-    start = ", ".join(f"{k} = {v:g}" for k, v in ex["start"].items())
-    lines.append(f"energy exchange from {start}: period {ex['period']:.6g}")
-    return "\n".join(lines)
-
-
-def run_slowflow_system(args: argparse.Namespace) -> int:
-    """``slowflow SYSTEM``: the first-order slow flow of the modes in internal resonance."""
-    from ..derive.averaging import slow_flow
-    from ..derive.resonance import coupled_modes
-    from ..derive.system import parse_system
-
-    if args.eps is not None or args.sigma is not None:
-        raise InputError("--eps/--sigma: a one-coordinate portrait's values; a system's "
-                         "--plot/--csv draw its energy exchange from --start")
-    args.order = 1 if args.order is None else args.order
-    if args.out is not None:
-        raise InputError("--out: a system's slow flow is printed, not emitted (not built)")
-    plot, csv = check_outputs(args)
-    flow = slow_flow(parse_system(args.model, _params(args.param)), args.order)
-    start = [START_AMPLITUDE * (1 if k == len(flow.a) - 1 else START_SEED)
-             for k in range(len(flow.a))]
-    for pair in args.start or ():
-        name, _, value = pair.partition("=")
-        names = [f"a{k}" for k in range(1, len(flow.a) + 1)]
-        if name.strip() not in names:
-            raise InputError(f"--start {pair!r}: write NAME=VALUE with NAME one of "
-                             f"{', '.join(names)}")
-        try:
-            number = float(value)
-        except ValueError:
-            raise InputError(f"--start {pair!r}: {value!r} is not a number") from None
-        if not 0 < number < math.inf:
-            raise InputError(f"--start {pair!r}: an amplitude must be > 0 and finite")
-        start[names.index(name.strip())] = number
-    check_weak(flow, start, bool(args.start))
-    from ..numerics.references import energy_exchange
-
-    exchange = energy_exchange(flow, start, samples=EXCHANGE_SAMPLES if plot or csv else 0)
-    if plot is not None:
-        from ..charts_modes import exchange_figure
-
-        exchange_figure(flow, exchange, plot)
-    if csv is not None:
-        exchange_csv(exchange, csv)
-    data = resonant_json(flow, coupled_modes(flow), exchange)
-    print(json.dumps(data) if args.json else resonant_table(data))
-    return 0
-
-
-def check_weak(flow, start: list[float], given: bool) -> None:
-    """Refuse a start (``given`` by --start, else the default) where the nonlinear force
-    reaches the linear one (limits.WEAK_NONLINEARITY): the first-order slow flow assumes a
-    weak nonlinearity."""
-    from ..derive.resonance import force_ratio
-    from ..limits import WEAK_NONLINEARITY
-
-    log_ratio, factor = force_ratio(flow, tuple(start), WEAK_NONLINEARITY)
-    if log_ratio <= math.log10(WEAK_NONLINEARITY):
-        return
-    values = ", ".join(f"a{k}={a:g}" for k, a in enumerate(start, 1))
-    ratio = f"{10**log_ratio:.3g}" if log_ratio < 300 else f"1e{log_ratio:.0f}"
-    raise InputError(
-        f"{'--start' if given else 'the default start'} {values}: the nonlinear force there "
-        f"is {ratio} times the slowest mode's linear restoring force ω0²·a, where the "
-        f"first-order slow flow needs a weak nonlinearity (below {WEAK_NONLINEARITY:g}×): "
-        f"scale the amplitudes so that the largest is ≤ {max(start) * factor:.3g}")
 
 
 def arguments_nnm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
