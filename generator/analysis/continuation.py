@@ -136,7 +136,7 @@ class Arclength:
 def _continue(sysm: PolynomialBalance, end_solutions, omega_start: float,
               omega_stop: float, step: float, estimate: float, seconds: float,
               per_point: float, max_points: int, where: str) -> Continuation:
-    """The pseudo-arclength loop of :func:`analysis.response.continue_equation` on any balance
+    """The pseudo-arclength loop of :func:`analysis.systems.continue_balance` on any balance
     with ``residual``, ``jacobian`` and ``d_omega`` in ``(x, ω)``: from each of
     ``end_solutions()`` (``(ω, x, direction)``: at the two ends, the first at
     ``omega_start``, or a point inside the range taken both ways; and whether they are

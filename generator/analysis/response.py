@@ -318,9 +318,9 @@ def equation_continuation_seconds(terms: dict[tuple[int, int], float], force: fl
                                   harmonics: int, odd: bool, lo: float, hi: float,
                                   step: float = 0.02, max_points: int = MAX_POINTS,
                                   where: str | None = None) -> tuple[float, float]:
-    """``(points, seconds)`` the continuation of :func:`continue_equation` is estimated at (its
-    length ``(hi − lo) + π r_max`` over ``step``, r_max from the one-harmonic amplitudes), or
-    :class:`InputError` above ``max_points``."""
+    """``(points, seconds)`` one equation's continuation (:func:`analysis.systems.
+    continue_balance`) is estimated at (its length ``(hi − lo) + π r_max`` over ``step``,
+    r_max from the one-harmonic amplitudes), or :class:`InputError` above ``max_points``."""
     r_max = OneHarmonic(dict(terms), float(force)).extent(lo, hi)
     estimate = ((hi - lo) + np.pi * r_max) / step
     if not estimate <= max_points:
