@@ -71,15 +71,14 @@ def test_an_interrupted_sweep_says_what_it_saved_and_resumes(how, tmp_path):
         assert int(ds["done"].values.sum()) == saved
     time.sleep(0.5)
     assert not _workers_left(p.pid)  # the workers went with it
-    # the same command, as the line says (one worker: a second adds only its start-up)
-    resumed = subprocess.run([*LINDSTEDT, "sweep", *GRID, "--out", str(store), "--workers", "1",
-                              "--json"], capture_output=True, text=True, check=True)
+    resumed = subprocess.run([*LINDSTEDT, "sweep", *GRID, "--out", str(store), "--json"],
+                             capture_output=True, text=True, check=True)
     assert '"complete": true' in resumed.stdout
     if how != "ctrl-c":
         return
     fresh = tmp_path / "fresh.zarr"
-    subprocess.run([*LINDSTEDT, "sweep", *GRID, "--out", str(fresh), "--workers", "1"],
-                   capture_output=True, check=True)
+    subprocess.run([*LINDSTEDT, "sweep", *GRID, "--out", str(fresh)], capture_output=True,
+                   check=True)
     with xr.open_zarr(store) as a, xr.open_zarr(fresh) as b:
         for name in ("orbits", "stable_orbits", "r", "floquet"):
             assert np.array_equal(a[name].values, b[name].values, equal_nan=True), name
