@@ -275,3 +275,20 @@ def test_the_duffing_preset_takes_the_notes_flags(command):
     bare = run(name, "duffing")
     assert bare.returncode == 2 and bare.stderr.count("\n") == 1
     assert "required" in bare.stderr
+
+
+@pytest.mark.parametrize("p, q", [(1, 3), (-7, 10**330), (10**400, 3), (146243431169, 10**332),
+                                  (-2**70, 3**50), (3, 2**1074), (0, 1)])
+def test_a_long_rational_reads_as_its_twelve_digits_even_beyond_double_range(p, q):
+    """The tables' decimal of an exact coefficient (series at order 300 reaches 1e-330): never
+    0 for a nonzero number, never a subnormal's false digits; against mpmath at 30 digits."""
+    import mpmath
+    from flint import fmpq
+    from lindstedt.cli.system import _decimal
+
+    text = _decimal(fmpq(p, q))
+    with mpmath.workdps(30):
+        truth = mpmath.mpf(p) / q
+        assert (text == "0") == (p == 0)
+        if p:
+            assert abs(mpmath.mpf(text) / truth - 1) < 5e-12

@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import re
+import sys
 import textwrap
 from functools import partial
 from pathlib import Path
@@ -46,8 +48,21 @@ def _ground_text(ground, c: object) -> str | dict:
 
 
 def _decimal(c: object) -> str:
-    """A rational's 12 significant digits, from its own integers (no SymPy)."""
-    return f"{int(c.p) / int(c.q):.12g}"
+    """A rational's 12 significant digits, from its own integers (no SymPy): in double
+    precision where it is a normal double, else (order 300's 1e-330, a denominator past
+    1e308) by decimal arithmetic, never a 0 or a subnormal's false digits."""
+    p, q = int(c.p), int(c.q)
+    try:
+        x = p / q
+    except OverflowError:
+        x = math.inf
+    if p == 0 or (math.isfinite(x) and abs(x) >= sys.float_info.min):
+        return f"{x:.12g}"
+    from decimal import Decimal, localcontext
+
+    with localcontext() as ctx:
+        ctx.prec = 12
+        return f"{Decimal(p) / Decimal(q):.12g}"
 
 
 def periodic_json(series, valid=None) -> dict:
