@@ -235,6 +235,8 @@ def test_large_chain_model_frequencies_by_shift_invert(tmp_path):
     ({"M.mtx": None}, "K.mtx is missing"),
     ({"M.mtx": None, "K.mtx": [[2.0, -1.0], [-1.5, 2.0]]}, "K.mtx is not symmetric"),
     ({"M.mtx": [[1.0, 0.0], [0.0, 0.0]], "K.mtx": None}, r"M\[1,1\] = 0"),
+    ({"M.mtx": [[1.0, 2.0], [2.0, 1.0]], "K.mtx": None},
+     r"M.mtx is not positive definite \(its smallest eigenvalue is -1"),
     ({"M.mtx": None, "K.mtx": [[2.0]]}, "K.mtx is 1×1 and M.mtx 2×2"),
     ({"M.mtx": None, "K.mtx": None, "nonlinear.txt": "0 0 2 1.0\n"},
      "nonlinear.txt line 1: index 2 outside 0..1"),

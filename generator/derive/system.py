@@ -517,6 +517,9 @@ def _mass_matrix(text: str, coordinates: list[str], M: sp.Matrix) -> sp.Matrix:
 MODEL_FILES = ("M.mtx", "K.mtx", "C.mtx", "nonlinear.txt", "drive.txt")
 # NOTE: a model folder, as a finite-element code writes it: M, K and optional C in Matrix
 # Market (scipy.io.mmwrite), the nonlinear terms and the optional drive as text, 0-based.
+LANCZOS_STEPS = 5000
+# NOTE: the iterations the smallest eigenvalue of a large mass matrix may take (a lumped or
+# consistent FE mass matrix, well conditioned, needs tens).
 SYMMETRY = 1e-12
 # NOTE: M and K are symmetric to this fraction of their largest entry (an assembled matrix
 # written with 16 digits is symmetric to rounding).
@@ -534,44 +537,45 @@ def read_model(folder: str | Path) -> System:
 
     folder = Path(folder)
     if not folder.is_dir():
-        raise InputError(f"--model {folder}: no such folder")
+        raise InputError(f"model {folder}: no such folder")
 
     def matrix(name: str, needed: bool) -> sparse.csr_array | None:
         path = folder / name
         if not path.is_file():
             if needed:
-                raise InputError(f"--model {folder}: {name} is missing (the folder holds "
+                raise InputError(f"model {folder}: {name} is missing (the folder holds "
                                  f"{', '.join(MODEL_FILES[:2])}, optionally "
                                  f"{', '.join(MODEL_FILES[2:])})")
             return None
         try:
             A = sparse.csr_array(mmread(path))
         except (ValueError, OSError) as exc:
-            raise InputError(f"--model {folder}: {name}: not a Matrix Market matrix "
+            raise InputError(f"model {folder}: {name}: not a Matrix Market matrix "
                              f"({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})"
                              ) from None
         if A.shape[0] != A.shape[1] or A.shape[0] == 0:
-            raise InputError(f"--model {folder}: {name} is {A.shape[0]}×{A.shape[1]}; a "
+            raise InputError(f"model {folder}: {name} is {A.shape[0]}×{A.shape[1]}; a "
                              "square matrix, one row per coordinate")
         if not np.all(np.isfinite(A.data)):
-            raise InputError(f"--model {folder}: {name} holds a number that is not finite")
+            raise InputError(f"model {folder}: {name} holds a number that is not finite")
         return A
 
     M, K, C = matrix("M.mtx", True), matrix("K.mtx", True), matrix("C.mtx", False)
     n = M.shape[0]
     for name, A in (("K.mtx", K), ("C.mtx", C)):
         if A is not None and A.shape[0] != n:
-            raise InputError(f"--model {folder}: {name} is {A.shape[0]}×{A.shape[0]} and M.mtx "
+            raise InputError(f"model {folder}: {name} is {A.shape[0]}×{A.shape[0]} and M.mtx "
                              f"{n}×{n}: one size for every matrix")
     for name, A in (("M.mtx", M), ("K.mtx", K)):
         scale = float(abs(A).max()) if A.nnz else 0.0
         if A.nnz and float(abs(A - A.T).max()) > SYMMETRY * scale:
-            raise InputError(f"--model {folder}: {name} is not symmetric")
+            raise InputError(f"model {folder}: {name} is not symmetric")
     diagonal = M.diagonal()
     if not np.all(diagonal > 0):
         k = int(np.argmin(diagonal > 0))
-        raise InputError(f"--model {folder}: M.mtx: M[{k},{k}] = {diagonal[k]:g}; a mass "
+        raise InputError(f"model {folder}: M.mtx: M[{k},{k}] = {diagonal[k]:g}; a mass "
                          "matrix is positive on its diagonal")
+    _check_definite(folder, M)
     force = _terms(folder / "nonlinear.txt", n)
     drive = _drive(folder / "drive.txt", n)
     names = sp.symbols(f"x0:{n}")
@@ -580,19 +584,46 @@ def read_model(folder: str | Path) -> System:
                   written=Matrices(M, K, force, C, drive))
 
 
+def _check_definite(folder: Path, M: sparse.csr_array) -> None:
+    """Refuse a mass matrix that is not positive definite (a kinetic energy ½ x'ᵀ M x' must be
+    positive): Cholesky up to :data:`DENSE_MODES` coordinates, else its smallest eigenvalue by
+    Lanczos (a bounded number of iterations)."""
+    from scipy.sparse.linalg import ArpackNoConvergence, eigsh
+
+    n = M.shape[0]
+    if n <= DENSE_MODES:
+        try:
+            np.linalg.cholesky(M.toarray())
+            return
+        except np.linalg.LinAlgError:
+            lowest = float(np.linalg.eigvalsh(M.toarray())[0])
+    else:
+        try:
+            lowest = float(eigsh(M, 1, which="SA", maxiter=LANCZOS_STEPS,
+                                 return_eigenvectors=False)[0])
+        except ArpackNoConvergence:
+            raise InputError(f"model {folder}: M.mtx: its smallest eigenvalue did not converge "
+                             f"in {LANCZOS_STEPS} Lanczos steps: positive definiteness is not "
+                             "confirmed") from None
+        if lowest > 0:
+            return
+    raise InputError(f"model {folder}: M.mtx is not positive definite (its smallest eigenvalue "
+                     f"is {lowest:.6g}; a kinetic energy ½ x'ᵀ M x' must be positive)")
+
+
 def _numbers(path: Path, n: int, widths: tuple[int, ...]) -> list[tuple[int, list[float]]]:
     """The lines of ``path`` (comments and blank lines skipped) as ``(line, numbers)``, each
     with one of ``widths`` fields, the leading ones indices in ``0 … n − 1``."""
     try:
         text = path.read_text()
     except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"--model {path.parent}: {path.name}: {exc}") from None
+        raise InputError(f"model {path.parent}: {path.name}: {exc}") from None
     out = []
     for number, line in enumerate(text.splitlines(), 1):
         fields = line.split("#")[0].split()
         if not fields:
             continue
-        where = f"--model {path.parent}: {path.name} line {number}"
+        where = f"model {path.parent}: {path.name} line {number}"
         if len(fields) not in widths:
             raise InputError(f"{where}: {len(fields)} fields; "
                              + " or ".join(str(w) for w in widths) + " expected")
