@@ -296,3 +296,14 @@ def test_slowflow_refuses_a_resonance_it_cannot_average_over_one_angle():
         bad = run("slowflow", text)
         assert bad.returncode == 2 and bad.stdout == "", bad.stderr
         assert len(bad.stderr.strip().splitlines()) == 1, bad.stderr
+
+
+def test_a_one_to_one_resonance_is_named_by_both_commands():
+    """Two modes with one ω0 (a 1:1 resonance): nnm and slowflow both refuse in one line and
+    say the same thing — the shapes are not unique and its slow flow is not built."""
+
+    text = "x1'' + x1 + x1**3 + x1*x2**2 = 0; x2'' + x2 + x2**3 + x1**2*x2 = 0"
+    for command in ("nnm", "slowflow"):
+        out = run(command, text)
+        assert out.returncode == 2 and out.stderr.count("\n") == 1, out.stderr
+        assert "1:1 internal resonance" in out.stderr and "not built" in out.stderr

@@ -211,10 +211,16 @@ def _resonant_right_side(system: System, order: int) -> _Setup:
                          "are independent and exchange no energy, so there is no slow flow to "
                          "average; lindstedt nnm SYSTEM --mode M gives each mode")
     modes, names = resonant_modes(system)
+    lams = system.modes()
     if not modes:
+        shared = next((k for k in range(1, len(lams)) if lams[k] == lams[k - 1]), None)
+        if shared is not None:
+            raise InputError(f"system {system.text!r}: modes {shared} and {shared + 1} share "
+                             f"ω0² = {lams[shared]} (a 1:1 internal resonance): its slow flow "
+                             "is not built (the mode shapes are not unique); slowflow takes "
+                             "modes whose ω0 are in ratios 1:n, n ≥ 2")
         raise InputError(f"system {system.text!r}: no internal resonance (no ω0 an integer "
                          "multiple of another); lindstedt nnm SYSTEM --mode M gives each mode")
-    lams = system.modes()
     for k in modes:
         if not lams[k].is_Rational:
             raise InputError(f"system {system.text!r}: mode {k + 1}'s ω0² = {lams[k]} is "

@@ -226,7 +226,9 @@ def normal_mode(system: System, mode: int, order: int, amplitude: int = 0,
     lam = lams[mode - 1]
     if sum(1 for other in lams if other == lam) > 1:
         raise InputError(f"--mode {mode}: ω0² = {lam} is shared by two linear modes (a 1:1 "
-                         "internal resonance): the mode shape is not unique")
+                         "internal resonance): the mode shape is not unique, and the slow "
+                         "flow of a 1:1 resonance is not built (slowflow SYSTEM takes modes "
+                         "whose ω0 are in ratios 1:n, n ≥ 2)")
     params = sorted(set().union(*(f.free_symbols for f in system.force))
                     - set(system.coordinates) - set(system.velocities), key=str)
     field = QQ if lam.is_Rational else QQ.algebraic_field(lam)
