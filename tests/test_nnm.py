@@ -348,3 +348,18 @@ def test_one_coordinate_normal_mode_is_the_free_lindstedt_series(text):
         [dict.fromkeys(order, 0) for order in mode.coordinate(0)]
     assert all(set(one.q[j]) <= set(order) | {n for n, c in one.q[j].items() if not c}
                for j, order in enumerate(mode.coordinate(0)))
+
+
+def test_nnm_states_the_reach_of_its_series():
+    """``nnm`` prints where its series holds: one coordinate's mode is Duffing's free series in
+    y = A², whose radius is exactly 1 (the singularity at the separatrix y = −1, the notes'
+    registry): the estimate lies within its spread of 1 and the lower bound below it; the
+    table says it in one line, and a symbolic coefficient leaves it unestimated."""
+    out = run("nnm", "x1'' + x1 + x1**3 = 0", "--order", "24", "--json")
+    r = json.loads(out.stdout)["radius_estimate"]
+    assert abs(r["value"] - 1) <= r["spread"] + 1e-3 and r["lower"] <= 1
+    assert r["reach"] == pytest.approx(r["lower"] ** 0.5, rel=1e-15)
+    table = run("nnm", "x1'' + x1 + x1**3 = 0", "--order", "24").stdout
+    assert "is where emitted modules stop" in table
+    symbolic = run("nnm", "x1'' + x1 + a*x1**3 = 0", "--order", "8", "--json")
+    assert json.loads(symbolic.stdout)["radius_estimate"] is None

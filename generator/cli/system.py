@@ -47,6 +47,11 @@ def _ground_text(ground, c: object) -> str | dict:
     return dict(sorted((_monomial(m), _rational(v)) for m, v in ground.terms(c)))
 
 
+def _finite(x: float) -> float | None:
+    """``x``, or ``None`` (JSON's null) where it is not a finite number."""
+    return x if math.isfinite(x) else None
+
+
 def _decimal(c: object) -> str:
     """A rational's 12 significant digits, from its own integers (no SymPy): in double
     precision where it is a normal double, else (order 300's 1e-330, a denominator past
@@ -77,8 +82,10 @@ def periodic_json(series, valid=None) -> dict:
     coordinate adds ``model``, ``title``, ``q`` (its coefficients), ``radius`` (exact) or
     ``radius_estimate``, ``orbit_limit`` and, for a user's equation, ``equation`` and
     ``units`` (ω in units of ω₀); a system adds ``mode``, ``system``, ``lambda`` (ω₀²),
-    every mode's ω₀², ω₀'s minimal polynomial, the ``parameters`` left symbols and the
-    ``mass``."""
+    every mode's ω₀², ω₀'s minimal polynomial, the ``parameters`` left symbols, the
+    ``mass`` and ``radius_estimate`` (``valid``, the mode's :class:`derive.nnm.ModeRadius`:
+    the ω series' radius in y estimated from its terms, its spread, the lower bound emitted
+    modules stop at and that bound in A, ``reach``; ``None`` where not estimated)."""
     from ..derive.lindstedt import SeriesSolution
 
     if isinstance(series, SeriesSolution):
@@ -130,7 +137,10 @@ def periodic_json(series, valid=None) -> dict:
             "omega0_minimal_polynomial": None if root is None else str(root),
             "lambda_decimal": decimal_text(series.lam),
             "linear_frequencies_squared_decimal": [decimal_text(x) for x in system.modes()],
-            "mass": [[str(c) for c in system.mass.row(i)] for i in range(len(names))]}
+            "mass": [[str(c) for c in system.mass.row(i)] for i in range(len(names))],
+            "radius_estimate": None if valid is None else {
+                "value": _finite(valid.estimate), "spread": _finite(valid.spread),
+                "lower": valid.lower, "reach": valid.reach, "how": valid.how}}
 
     def per_order(form) -> dict:
         return {name: [{str(n): form(c) for n, c in sorted(o.items())} for o in coordinate]
@@ -243,7 +253,22 @@ def _header(data: dict, exact: bool) -> list[str]:
     return [f"mode {data['mode']} of {data['system']}",
             f"omega0 = {w0} (omega0^2 of every mode: {squares}), expansion variable "
             f"{data['variable']}, order {data['order']}",
-            f"convention: {data['convention']}"]
+            f"convention: {data['convention']}", _reach_line(data)]
+
+
+def _reach_line(data: dict) -> str:
+    """The table's line on where a mode's series holds: the radius of its ω series estimated
+    from the terms and the lower bound (in y and in A) that emitted modules stop at."""
+    r = data.get("radius_estimate")
+    if r is None:
+        return ("radius of convergence not estimated (symbolic coefficients, a series that "
+                "ends, or too few terms): the series' reach is unknown")
+    y = data["variable"].partition("=")[0].strip() or data["variable"]
+    estimate = ("" if r["value"] is None else
+                f"the omega series' radius in {y} is estimated at {r['value']:.6g} "
+                f"(spread {r['spread']:.2g}) from its terms; ")
+    return (f"{estimate}its lower bound {r['lower']:.6g} (A < {r['reach']:.6g}; "
+            f"{r['how']}) is where emitted modules stop: NaN beyond, error_estimate inside")
 
 
 def periodic_table(data: dict, exact: bool = False) -> str:
@@ -302,7 +327,7 @@ def backbone_csv(b, path: Path) -> Path:
 
 def run_nnm(args: argparse.Namespace) -> int:
     """Run ``lindstedt nnm``: parse the system, derive the mode, print JSON or the table."""
-    from ..derive.nnm import normal_mode
+    from ..derive.nnm import normal_mode, radius
     from ..derive.system import parse_system
 
     plot, csv = check_outputs(args)
@@ -326,7 +351,7 @@ def run_nnm(args: argparse.Namespace) -> int:
         mode = normal_mode(system, args.mode, args.order, amplitude, progress)
     finally:
         progress.close()
-    data = periodic_json(mode)
+    data = periodic_json(mode, None if symbols else radius(mode))
     if plot is not None:
         from ..analysis.curves import FEP_ORDER, frequency_energy
         from ..charts_modes import nnm_figure
