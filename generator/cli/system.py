@@ -30,7 +30,7 @@ from .common import (
 )
 
 CONVENTION = ("at t = 0 every velocity is zero and {a}(0) = A (a turning point); "
-              "x_i = A sum_j y^j sum_n c[j][n] cos(n*omega*t)")
+              "x_i = A sum_j y^j sum_n c[j][n] cos(n*omega*t), y the expansion variable")
 
 
 def _monomial(powers: tuple[tuple[str, int], ...]) -> str:
