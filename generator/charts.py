@@ -199,13 +199,10 @@ def _balance_panel(ax: plt.Axes, r: Response, i: int, scale: float) -> None:
         if c.shot:
             ax.plot(c.omega / scale, c.shot[i], "o", mfc="none", mec="k", ms=6,
                     label="orbit shot (DOP853)")
-    lo, hi = r.omega_range  # a line outside the range asked would stretch the axis to it
     for w in r.cont.folds:
-        if lo <= w <= hi:
-            ax.axvline(w / scale, color="grey", lw=0.5, ls="-", alpha=0.5)
+        ax.axvline(w / scale, color="grey", lw=0.5, ls="-", alpha=0.5)
     for w in r.linear_frequencies:
-        if lo <= w <= hi:
-            ax.axvline(w / scale, color="grey", lw=0.8, ls=":")
+        ax.axvline(w / scale, color="grey", lw=0.8, ls=":")
     for way, w, before, after in r.jumps:
         ax.annotate("", xy=(w / scale, r.amplitudes[after, i]),
                     xytext=(w / scale, r.amplitudes[before, i]),
@@ -282,11 +279,8 @@ def response_figure(r: Response, path: Path) -> Path:
         _balance_panel(ax, r, i, scale)
         ax.set_ylabel(f"r of {name}" + (", max |q| (sweeps)" if one else ""))
         if i == 0:
-            lo, hi = r.omega_range
-            if any(lo <= w <= hi for w in r.linear_frequencies):
-                ax.plot([], [], ":", color="grey", label="linear ω₀")
-            if any(lo <= w <= hi for w in r.cont.folds):
-                ax.plot([], [], "-", color="grey", lw=0.5, label="fold")
+            ax.plot([], [], ":", color="grey", label="linear ω₀")
+            ax.plot([], [], "-", color="grey", lw=0.5, label="fold")
             handles, labels = ax.get_legend_handles_labels()
             unique = dict(zip(labels, handles, strict=False))
     text = r.system.text if r.system is not None else r.equation.text
