@@ -80,6 +80,12 @@ order; a stage imports only stages above it::
                             the drive from rest, the backbones), Floquet verdicts, folds,
                             jumps; true folds and sweeps, or shooting checks
                             [equation | System, ω range -> Response]
+    analysis.ssm            the spectral submanifold of one mode of a damped system, by the
+                            parametrisation method in normal-form style, in floating point
+                            with sparse matrices: reduced dynamics, backbone, damping ratio,
+                            physical amplitudes; the forced response of the non-autonomous SSM
+                            at leading order, every steady state in closed form
+                            [System, mode, K -> SSM, Reduction]
     analysis.periodic       every distinct periodic orbit at one drive: seeds, balance,
                             shooting, Floquet; the report of `driven`
                             [Drive | equation -> orbits]
@@ -134,7 +140,8 @@ order; a stage imports only stages above it::
                             among them [results -> PNG/SVG/PDF]
     charts_modes            the frequency–energy plot of a system's normal modes: backbones
                             from the series beside shot orbits; a resonant system's energy
-                            exchange [System -> PNG/SVG/PDF]
+                            exchange; an SSM's backbone, damping and forced response
+                            [System | ssm JSON -> PNG/SVG/PDF]
     charts_series           a free oscillator's ω and T against its amplitude variable with the
                             orbit edge and the radius marked; a limit cycle against ε; a slow
                             flow's phase portrait [curves -> PNG/SVG/PDF]
@@ -151,6 +158,8 @@ order; a stage imports only stages above it::
                             [SlowFlow -> JSON, table, CSV]
     cli.driven              driven, subharmonic, parametric, mixing [records -> JSON, tables]
     cli.response            response of any number of coordinates [Response -> JSON, table,
+                            CSV]
+    cli.ssm                 ssm of a SYSTEM or a model folder [Reduction -> JSON, table,
                             CSV]
     cli.choose              choose, clock, scene [Choice -> JSON, tables]
     cli.sweep               sweep [Dataset -> summary]

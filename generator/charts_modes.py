@@ -68,3 +68,36 @@ def exchange_figure(flow: object, exchange: object, path: Path) -> Path:
               frameon=False)  # below the axes, where it hides no curve
     fig.tight_layout()
     return _save(fig, path)
+
+
+def ssm_figure(data: dict, path: Path) -> Path:
+    """The SSM's backbone (frequency against the first output's amplitude) with the forced
+    response's steady states (stable filled, unstable hollow) and the folds, beside the
+    damping ratio along the backbone — from ``ssm``'s JSON (:func:`cli.ssm.ssm_json`)."""
+    check_plot_path(path)
+    name = next(iter(data["outputs"]))
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(10, 4.4))
+    bb = data["backbone"]
+    amp = np.array([p["amplitude"][name] for p in bb])
+    ax.plot([p["omega"] for p in bb], amp, "-", color="C0", lw=2,
+            label=f"backbone, order {data['order']}")
+    frc = data.get("frc", [])
+    for stable, style in ((True, dict(ms=2.5)), (False, dict(ms=3, mfc="none"))):
+        pts = [(s["omega"], s["amplitude"][name]) for s in frc if s["stable"] == stable]
+        if pts:
+            ax.plot(*np.array(pts).T, "o", color="C1" if stable else "C3", lw=0, **style,
+                    label="forced response, " + ("stable" if stable else "unstable"))
+    for f in data.get("frc_folds", []):
+        ax.axvline(f["omega"], color="grey", ls=":", lw=0.8)
+    if data.get("frc_folds"):
+        ax.plot([], [], ":", color="grey", label="folds")
+    ax.set_xlabel("ω")
+    ax.set_ylabel(f"max |{name}| over a period")
+    ax.set_title(f"SSM of mode {data['mode']}")
+    ax.legend(fontsize=8)
+    bx.plot(amp, [p["damping_ratio"] for p in bb], "-", color="C0", lw=2)
+    bx.set_xlabel(f"max |{name}| over a period")
+    bx.set_ylabel("damping ratio ζ")
+    bx.set_title("damping along the backbone")
+    fig.tight_layout()
+    return _save(fig, path)

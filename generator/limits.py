@@ -29,6 +29,12 @@ DRIVEN_MAX_ORDER = 6
 # about 3 minutes, at 7 it would take about 20.
 MU_EXACT_MAX_ORDER = 12
 # NOTE: the exact μ-expansion (undamped, damped) and the symbolic balance take 1..12.
+SSM_MAX_ORDER = 41
+# NOTE: a spectral submanifold in floating point: past order ~40 its terms are rounding (a
+# Duffing oscillator's reach orders of magnitude below 1e-16 by then).
+SSM_MAX_POINTS = 100_000
+# NOTE: drive frequencies of `ssm`'s forced response: each a bordered solve and the roots of
+# one polynomial; 500 take a fraction of a second, 10⁵ a minute of a small system.
 MU_MAX_ORDER = 200
 # NOTE: the numeric μ-expansion at one ω: far above where it stops converging.
 HILL_MAX_INDEX = 100

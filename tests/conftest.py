@@ -23,13 +23,14 @@ from commands import CACHE_VARIABLE, EmittedCache
 from numba.core.caching import CacheImpl
 
 LAYERS = {
-    "exact": ("attractors", "averaging", "branches", "continuation", "driven", "driven_damped",
+    "exact": ("attractors", "averaging", "beam_model", "branches", "continuation", "driven",
+              "driven_damped",
               "driven_equation",
               "equation",
               "hill", "layout", "lindstedt", "newton", "nnm", "parametric", "response",
               "response_equation",
               "response_system",
-              "resonance", "series", "subharmonic", "toolkit"),
+              "resonance", "series", "ssm", "subharmonic", "toolkit"),
     "printers": ("charts", "cli", "costs", "curves", "emit", "files", "fuzz", "interrupt", "latex",
                  "messages", "notebook", "readme", "validity"),
     "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "mass", "nnm_emitted",

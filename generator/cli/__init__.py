@@ -1,7 +1,7 @@
 """The ``lindstedt`` command line.  Bad input: one line on stderr, exit status 2.
 
 One module per command family (:mod:`.series`, :mod:`.system`, :mod:`.driven`,
-:mod:`.response`, :mod:`.choose`, :mod:`.sweep`, :mod:`.demo`), each with its commands'
+:mod:`.response`, :mod:`.ssm`, :mod:`.choose`, :mod:`.sweep`, :mod:`.demo`), each with its commands'
 arguments, JSON contracts and tables;
 :data:`COMMANDS` here lists them for the parser, the cost guard and ``--help``."""
 
@@ -54,6 +54,7 @@ from .series import (
     run_tongues,
 )
 from .slowflow import arguments_slowflow, run_resonant_modes, run_slowflow
+from .ssm import arguments_ssm, run_ssm
 from .sweep import arguments_sweep, run_sweep
 from .system import arguments_nnm, run_nnm
 
@@ -135,6 +136,7 @@ COMMANDS: tuple[Command, ...] = (
              Route("normal mode", _coordinates, run_generate_mode,
                    ROUTE_COSTS["generate normal mode"])),
     _command("nnm", arguments_nnm, run_nnm),
+    _command("ssm", arguments_ssm, run_ssm),
     _command("driven", arguments_driven, run_driven, notes=True),
     _command("response", arguments_response, run_response, notes=True),
     _command("subharmonic", arguments_subharmonic, run_subharmonic, notes=True),

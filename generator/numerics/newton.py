@@ -53,21 +53,37 @@ class Iteration:
     why: str
 
 
+def _dense_solve(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    return np.linalg.solve(J, rhs)
+
+
+def sparse_solve(J, rhs: np.ndarray) -> np.ndarray:
+    """``J⁻¹ rhs`` for a sparse ``J`` (SuperLU); a singular ``J`` raises ``LinAlgError``."""
+    from scipy.sparse.linalg import splu
+
+    try:
+        return splu(J.tocsc()).solve(rhs)
+    except RuntimeError as exc:  # "Factor is exactly singular"
+        raise np.linalg.LinAlgError(str(exc)) from None
+
+
 def iterate(evaluate: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], x: np.ndarray,
-            tol: float = 1e-13, max_iter: int = 50) -> Iteration:
+            tol: float = 1e-13, max_iter: int = 50,
+            solve: Callable[[np.ndarray, np.ndarray], np.ndarray] = _dense_solve) -> Iteration:
     """Newton's method on ``R(x) = 0`` from ``x``, ``evaluate(x)`` giving ``(R(x), ∂R/∂x)``:
     ``x ← x + Δ``, ``J Δ = −R``, until ``max |Δ| ≤ tol·(1 + max |x|)`` (after the step),
     a singular ``J``, a step not finite, or ``max_iter`` steps.  A caller whose evaluation
     meets a domain event (a trajectory that escapes, an integrator that fails) raises from
-    ``evaluate``; it passes through."""
-    x = np.array(x, dtype=float)
+    ``evaluate``; it passes through.  A complex ``x`` stays complex (an eigenpair); ``solve``
+    takes ``(J, −R)`` (:func:`sparse_solve` for a sparse ``J``: nothing n² is formed)."""
+    x = np.array(x, dtype=complex if np.iscomplexobj(x) else float)
     residual, size, steps, why = math.nan, math.nan, 0, "max_iter"
     with np.errstate(over="ignore", invalid="ignore"):
         for _ in range(max_iter):
             R, J = evaluate(x)
             residual = float(np.max(np.abs(R)))
             try:
-                step = np.linalg.solve(J, -R)
+                step = solve(J, -R)
             except np.linalg.LinAlgError:  # singular: exactly at a fold
                 why = "singular"
                 break

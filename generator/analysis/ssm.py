@@ -1,0 +1,670 @@
+"""Spectral submanifolds of ``M x'' + C x' + K x + f(x, x') = F cos ωt``: the two-dimensional
+SSM of one mode by the parametrisation method, normal-form style, in floating point with the
+system's sparse matrices; its reduced dynamics, backbone and damping, each output's physical
+amplitude; the forced response from the non-autonomous SSM at leading order in the forcing.
+
+**The manifold.**  ``x = W(p)``, ``x' = V(p)`` with ``p = (p₁, p₂)``, ``p₂ = p̄₁`` on real
+motions, and the reduced dynamics in normal form ``p₁' = p₁ g(p₁p₂)``, ``g(u) = Σ_j γ_j u^j``,
+``γ₀ = λ`` (the mode's eigenvalue, ``(λ²M + λC + K)φ = 0``).  With ``p₁ = ρ e^{iθ}``:
+``ρ' = ρ a(ρ)``, ``θ' = ω(ρ)``, ``a = Re g(ρ²)``, ``ω = Im g(ρ²)``, and the damping ratio
+``ζ(ρ) = −a/√(a² + ω²)``.  Order ``k`` holds the monomials ``p₁^{k−r} p₂^r`` (``r = 0 … k``),
+one row each: ``W_k`` is a ``(k + 1) × n`` array; ``W₁ = (φ, φ̄)``.
+
+**Order k.**  ``DW·R = V`` and ``M DV·R + C V + K W + f(W, V) = 0`` at the monomial ``m`` of
+row ``r`` (``s = (k − r)λ + r λ̄``): ``V_m = s W_m + φ γ_j δ + Q^W_m`` and
+
+    L(s) W_m + ((s + λ)M + C) φ γ_j δ = −f_m − (sM + C) Q^W_m − M Q^V_m,   L(s) = s²M + sC + K,
+
+``Q`` the terms of ``DW·R`` and ``DV·R`` from lower orders (``Σ_{j≥1} W_q (m₁γ_j + m₂γ̄_j)``),
+``f_m`` from orders below ``k`` only (``f`` has degree ≥ 2), ``δ = 1`` on the near-resonant
+row ``m = (j + 1, j)`` (``s = λ + 2j Re λ``, equal to ``λ`` undamped), where ``γ_j`` is the
+unknown that keeps ``W_m`` bounded: the equation is bordered by the first-order form's
+normalisation ``ψᵀB(W_m, V_m) = 0`` (``ψ = (w, λw)``, ``w`` the left eigenvector,
+``B = [[C, M], [M, 0]]``):
+
+    wᵀ(C + (λ + s)M) W_m + (wᵀMφ) γ_j = −wᵀM Q^W_m.
+
+Each row is one sparse factorization of ``L(s)`` (bordered on the resonant row); rows
+``r > k/2`` are the conjugates of rows ``k − r``.  Nothing of size n² is formed.
+
+**The forced response** at leading order in ``F``: ``x = W(p) + X e^{iΩt} + c.c.``,
+``p₁' = p₁ g(p₁p₂) + S e^{iΩt}``, with ``L(iΩ) X + ((iΩ + λ)M + C) φ S = F/2`` bordered as
+above (``Q = 0``).  Its steady states ``p₁ = ρ e^{i(Ωt + ψ)}`` solve
+``ρ a(ρ) + Re(S e^{−iψ}) = 0``, ``ρ(ω(ρ) − Ω) + Im(S e^{−iψ}) = 0``, so ``u = ρ²`` is a real
+positive root of the polynomial ``u (a(u)² + (ω(u) − Ω)²) − |S|²``: every branch, isolas
+included, at each Ω; stability from the 2 × 2 Jacobian of the polar flow."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sparse
+
+from ..algebra.lazy import LazySeries
+from ..derive.system import DENSE_MODES, Matrices, System
+from ..errors import InputError
+from ..numerics.newton import iterate, sparse_solve
+
+NEAR_RESONANCE = 0.1
+# NOTE: a divisor |s − λ_j| below this fraction of |λ_j| is reported as a near resonance of
+# the monomial with mode j (its coefficients grow as 1/divisor); below SINGULAR the row has
+# no solution and the mode is refused (an internal resonance: a 4-D SSM is needed).
+SINGULAR = 1e-8
+EIGEN_STEPS = 30
+# NOTE: Newton steps refining the mode's eigenpair (from the dense eigenvalue problem or the
+# undamped Lanczos mode: quadratic convergence takes 3 to 6).
+OTHER_MODES = 8
+# NOTE: a large model's divisors are checked against this many modes above the lowest (and
+# every mode below the chosen one): the near resonances of low orders lie among them.
+THETA_SAMPLES = 64
+# NOTE: samples of one period per harmonic order for the physical amplitude max |x_i(θ)|,
+# whose sampled maximum is then refined by Newton on x_i'(θ) = 0 to rounding.
+REFINE_STEPS = 6
+FOLD_STEPS = 50
+# NOTE: bisections that place a fold of the forced response (a change of the number of
+# steady states) between two frequencies of the grid: 2⁻⁵⁰ of the grid's step.
+
+
+@dataclass(frozen=True)
+class LinearMode:
+    """The mode's eigenvalue ``λ`` (``Im λ > 0``), its right eigenvector ``φ`` (``φᴴMφ = 1/4``,
+    its largest component real and positive: the linear motion is ``x = ρ·2Re(φ e^{iθ})``),
+    the left eigenvector ``w`` (``wᵀ(C + 2λM)φ = 1``), and the eigenvalues of the modes
+    the divisors are checked against, with which they are."""
+
+    lam: complex
+    shape: np.ndarray
+    left: np.ndarray
+    others: np.ndarray
+    checked: str
+
+
+def _pencil(w: Matrices, s: complex) -> sparse.csc_array:
+    """``L(s) = s²M + sC + K``, sparse."""
+    L = s * s * w.mass + w.stiffness
+    if w.damping is not None:
+        L = L + s * w.damping
+    return sparse.csc_array(L, dtype=complex)
+
+
+def _damping(w: Matrices) -> sparse.csr_array:
+    return w.damping if w.damping is not None else sparse.csr_array(w.mass.shape)
+
+
+def linear_mode(w: Matrices, mode: int) -> LinearMode:
+    """Mode ``mode`` (1, 2, … by increasing ``Im λ`` among the oscillating modes): dense up
+    to :data:`DENSE_MODES` coordinates (every eigenvalue of the first-order pencil, LAPACK),
+    else the undamped mode by shift-invert Lanczos and its damping to first order; then
+    Newton on ``L(λ)φ = 0`` (sparse, bordered by the normalisation) to rounding."""
+    n = w.size
+    M, C, K = w.mass, _damping(w), w.stiffness
+    if n <= DENSE_MODES:
+        from scipy.linalg import eig
+
+        Md, Cd, Kd = M.toarray(), C.toarray(), K.toarray()
+        A = np.block([[np.zeros((n, n)), np.eye(n)], [-Kd, -Cd]])
+        B = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), Md]])
+        lams, vecs = eig(A, B)
+        scale = max(1.0, float(np.max(np.abs(lams[np.isfinite(lams)]), initial=1.0)))
+        upper = [k for k in np.argsort(lams.imag) if lams[k].imag > 1e-12 * scale]
+        if mode > len(upper):
+            raise InputError(f"--mode {mode}: the system has {len(upper)} oscillating "
+                             f"mode{'s' * (len(upper) != 1)} (complex eigenvalues)")
+        k = upper[mode - 1]
+        lam, phi = complex(lams[k]), vecs[:n, k]
+        others = np.array([lams[j] for j in upper if j != k])
+        checked = f"every mode ({len(upper)}, dense)"
+    else:
+        from scipy.sparse.linalg import eigsh
+
+        count = min(n - 2, mode + OTHER_MODES)
+        squares, shapes = eigsh(K.tocsc(), count, M.tocsc(), sigma=0, which="LM")
+        order = np.argsort(squares)
+        squares, shapes = squares[order], shapes[:, order]
+        if not squares[0] > 0:
+            raise InputError(f"the lowest linear mode has ω0² = {squares[0]:.6g}: no "
+                             "oscillation about the origin")
+        u = shapes[:, mode - 1]
+        w0 = math.sqrt(squares[mode - 1])
+        lam = complex(-0.5 * float(u @ (C @ u)) / float(u @ (M @ u)), w0)
+        phi = u.astype(complex)
+        others = np.array([complex(-0.5 * float(v @ (C @ v)), math.sqrt(q))
+                           for j, (q, v) in enumerate(zip(squares, shapes.T, strict=True))
+                           if j != mode - 1 and q > 0])
+        checked = f"the lowest {count} modes (Lanczos)"
+    lam, phi = _refined(w, lam, phi, mode)
+    phi = phi * np.exp(-1j * np.angle(phi[np.argmax(np.abs(phi))]))
+    phi = phi / (2 * math.sqrt(float(np.real(np.conj(phi) @ (M @ phi)))))
+    left = _left(w, lam, phi)
+    left = left / (left @ ((C + 2 * lam * M) @ phi))
+    return LinearMode(lam, phi, left, others, checked)
+
+
+def _refined(w: Matrices, lam: complex, phi: np.ndarray, mode: int
+             ) -> tuple[complex, np.ndarray]:
+    """Newton on ``(L(λ)φ = 0, rᵀφ = 1)``, ``r = Mφ̄₀``: the eigenpair to rounding."""
+    n = w.size
+    M, C = w.mass, _damping(w)
+    r = np.conj(M @ phi)
+    x0 = np.append(phi / (r @ phi), lam)
+
+    def evaluate(x: np.ndarray) -> tuple[np.ndarray, sparse.csc_array]:
+        v, s = x[:n], x[n]
+        L = _pencil(w, s)
+        dv = (2 * s * M + C) @ v
+        J = sparse.bmat([[L, sparse.csc_array(dv[:, None])],
+                         [sparse.csc_array(r[None, :]), None]], format="csc")
+        return np.append(L @ v, r @ v - 1), J
+
+    run = iterate(evaluate, x0, tol=1e-14, max_iter=EIGEN_STEPS, solve=sparse_solve)
+    v, s = run.x[:n], complex(run.x[n])
+    scale = abs(s) ** 2 * float(abs(M).sum()) + float(abs(w.stiffness).sum())
+    if not np.linalg.norm(_pencil(w, s) @ v) <= 1e-9 * scale * np.linalg.norm(v):
+        raise InputError(f"--mode {mode}: its eigenvalue did not converge in {EIGEN_STEPS} "
+                         f"Newton steps from {lam:.6g} ({run.why})")
+    return s, v
+
+
+def _left(w: Matrices, lam: complex, phi: np.ndarray) -> np.ndarray:
+    """The left eigenvector ``L(λ)ᵀ w = 0``: φ itself where M, C, K are symmetric, else the
+    bordered solve ``[[L(λ)ᵀ, Mφ], [(Mφ)ᵀ, 0]] (w, μ) = (0, 1)`` (μ = 0 at an eigenvalue)."""
+    mats = [w.mass, w.stiffness] + ([w.damping] if w.damping is not None else [])
+    if all(abs(A - A.T).max() == 0 if A.nnz else True for A in mats):
+        return phi
+    n = w.size
+    b = w.mass @ phi
+    J = sparse.bmat([[_pencil(w, lam).T, sparse.csc_array(b[:, None])],
+                     [sparse.csc_array(b[None, :]), None]], format="csc")
+    return sparse_solve(J, np.append(np.zeros(n), 1.0))[:n]
+
+
+class _Column(LazySeries):
+    """One factor of the force's terms as a series in ρ: order k's rows of ``(x, x')`` at the
+    factor's index, one column per term."""
+
+    def __init__(self, states: list[np.ndarray], index: np.ndarray) -> None:
+        super().__init__()
+        self.states, self.index = states, index
+
+    def compute(self, k: int) -> np.ndarray:
+        return self.states[k][:, self.index]
+
+
+class _Product(LazySeries):
+    """``a · b`` of two series in the monomials ``p₁^{k−r}p₂^r`` (order k: ``(k + 1) × T``):
+    the Cauchy sum over orders from each factor's lowest (``low_a``, ``low_b``), each a
+    convolution of the rows."""
+
+    def __init__(self, a: LazySeries, b: LazySeries, low_a: int, low_b: int) -> None:
+        super().__init__()
+        self.a, self.b, self.low_a, self.low_b = a, b, low_a, low_b
+
+    def compute(self, k: int) -> np.ndarray:
+        out = None
+        for i in range(self.low_a, k - self.low_b + 1):
+            A, B = self.a.coeff(i), self.b.coeff(k - i)
+            if out is None:
+                out = np.zeros((k + 1, A.shape[1]), dtype=complex)
+            for row in range(A.shape[0]):
+                out[row:row + B.shape[0]] += A[row] * B
+        return out
+
+
+class _Force:
+    """``f(W, V)`` order by order: the term table grouped by degree, each group a chain of
+    lazy products of its factors' columns, summed into the equations by a sparse matrix."""
+
+    def __init__(self, w: Matrices, states: list[np.ndarray]) -> None:
+        table = w.force
+        n = w.size
+        degrees = (table.factors >= 0).sum(axis=1) if len(table.coefficient) else np.array([])
+        self.groups = []
+        for d in sorted(set(degrees.tolist())):
+            keep = degrees == d
+            factors = table.factors[keep][:, :d]
+            chain: LazySeries = _Column(states, factors[:, 0])
+            for level in range(1, d):
+                chain = _Product(chain, _Column(states, factors[:, level]), level, 1)
+            sums = sparse.csr_array((table.coefficient[keep], (table.equation[keep],
+                                                                np.arange(keep.sum()))),
+                                    shape=(n, int(keep.sum())))
+            self.groups.append((d, chain, sums))
+        self.n = n
+
+    def coeff(self, k: int) -> np.ndarray:
+        """``f`` at order ``k`` (``(k + 1) × n``), from the states below ``k``."""
+        out = np.zeros((k + 1, self.n), dtype=complex)
+        for d, chain, sums in self.groups:
+            if k >= d:
+                out += (sums @ chain.coeff(k).T).T
+        return out
+
+
+def _carried(X: list[np.ndarray], gamma: list[complex], k: int, n: int) -> np.ndarray:
+    """``Q`` at order ``k``: ``Σ_{j≥1} W_q (m₁γ_j + m₂γ̄_j)`` over ``q = k − 2j ≥ 2``, row
+    ``r' + j`` for row ``r'`` of order ``q``."""
+    out = np.zeros((k + 1, n), dtype=complex)
+    for j in range(1, len(gamma)):
+        q = k - 2 * j
+        if q < 2:
+            break
+        r = np.arange(q + 1)
+        out[j:j + q + 1] += ((q - r) * gamma[j] + r * np.conj(gamma[j]))[:, None] * X[q]
+    return out
+
+
+@dataclass(frozen=True)
+class NearResonance:
+    """A monomial ``p₁^{m₁}p₂^{m₂}`` of order ``m₁ + m₂`` whose ``s = m₁λ + m₂λ̄`` lies near
+    another mode's eigenvalue: ``divisor = |s − λ_j|`` (relative: over ``|λ_j|``)."""
+
+    order: int
+    monomial: tuple[int, int]
+    eigenvalue: complex
+    divisor: float
+    relative: float
+
+
+@dataclass(frozen=True)
+class SSM:
+    """The 2-D SSM of one mode to order ``order``: ``W[k]``, ``V[k]`` (``(k + 1) × n`` each,
+    ``k = 0 … K``), the normal form's ``gamma`` (``γ_j``, ``2j + 1 ≤ K``), each order's
+    relative residual of its homological equations, the near resonances and the radius in ρ
+    estimated from the terms."""
+
+    matrices: Matrices = field(repr=False)
+    mode: int
+    order: int
+    linear: LinearMode
+    W: tuple[np.ndarray, ...] = field(repr=False)
+    V: tuple[np.ndarray, ...] = field(repr=False)
+    gamma: tuple[complex, ...]
+    residual: tuple[float, ...]
+    near: tuple[NearResonance, ...]
+    radius: float
+    radius_how: str
+
+    @property
+    def lam(self) -> complex:
+        return self.linear.lam
+
+    def g(self, rho: np.ndarray) -> np.ndarray:
+        """``g(ρ²) = a(ρ) + iω(ρ)``."""
+        u = np.asarray(rho, dtype=float) ** 2
+        return sum(c * u**j for j, c in enumerate(self.gamma))
+
+    def omega(self, rho: np.ndarray) -> np.ndarray:
+        """The backbone's frequency ``ω(ρ)``."""
+        return np.imag(self.g(rho))
+
+    def decay(self, rho: np.ndarray) -> np.ndarray:
+        """``a(ρ)``: ``ρ' = ρ a(ρ)``."""
+        return np.real(self.g(rho))
+
+    def damping_ratio(self, rho: np.ndarray) -> np.ndarray:
+        """``ζ(ρ) = −a/√(a² + ω²)`` (the linear ζ at ρ = 0)."""
+        g = self.g(rho)
+        return -np.real(g) / np.abs(g)
+
+    def error(self, rho: np.ndarray) -> np.ndarray:
+        """The error estimate of ``g``: its last term ``|γ_J| ρ^{2J}`` (0 at order 1), over
+        ``|g|``."""
+        J = len(self.gamma) - 1
+        rho = np.asarray(rho, dtype=float)
+        return abs(self.gamma[J]) * rho ** (2 * J) / np.abs(self.g(rho)) if J else 0 * rho
+
+    def harmonics(self, rho: np.ndarray, outputs: np.ndarray,
+                  phase: np.ndarray | None = None) -> np.ndarray:
+        """The outputs' Fourier coefficients in θ at each ρ (``(P, 2K + 1, outputs)``,
+        harmonic ``h = −K … K`` at index ``h + K``): ``Σ_k ρ^k W_k[r] e^{ih(θ + phase)}``."""
+        rho = np.atleast_1d(np.asarray(rho, dtype=float))
+        K = self.order
+        out = np.zeros((len(rho), 2 * K + 1, len(outputs)), dtype=complex)
+        for k in range(1, K + 1):
+            for r in range(k + 1):
+                out[:, k - 2 * r + K] += rho[:, None] ** k * self.W[k][r, outputs][None, :]
+        if phase is not None:
+            h = np.arange(-K, K + 1)
+            out *= np.exp(1j * h[None, :] * np.atleast_1d(phase)[:, None])[:, :, None]
+        return out
+
+    def amplitude(self, rho: np.ndarray, outputs: np.ndarray) -> np.ndarray:
+        """``max_θ |x_i|`` along the backbone, ``(P, outputs)``."""
+        return peak_amplitude(self.harmonics(rho, outputs))
+
+
+def peak_amplitude(c: np.ndarray) -> np.ndarray:
+    """``max_θ |Σ_h c_h e^{ihθ}|`` of real trigonometric polynomials (``c``: ``(P, H, m)``,
+    harmonics ``−K … K``): sampled (:data:`THETA_SAMPLES` per harmonic order), the largest
+    sample refined by Newton on ``x'(θ) = 0``."""
+    H = c.shape[1]
+    K = (H - 1) // 2
+    h = np.arange(-K, K + 1)
+    N = THETA_SAMPLES * max(K, 1)
+    theta = 2 * np.pi * np.arange(N) / N
+    waves = np.exp(1j * np.outer(h, theta))  # (H, N)
+    x = np.real(np.einsum("phm,hn->pmn", c, waves))
+    t = theta[np.argmax(np.abs(x), axis=2)]  # (P, m)
+    for _ in range(REFINE_STEPS):
+        e = np.exp(1j * h[None, None, :] * t[:, :, None])  # (P, m, H)
+        cc = np.transpose(c, (0, 2, 1))
+        d1 = np.real(np.sum(1j * h * cc * e, axis=2))
+        d2 = np.real(np.sum(-(h**2) * cc * e, axis=2))
+        step = np.where(d2 != 0, d1 / np.where(d2 != 0, d2, 1), 0.0)
+        t = t - np.clip(step, -np.pi / N, np.pi / N)
+    e = np.exp(1j * h[None, None, :] * t[:, :, None])
+    value = np.abs(np.real(np.sum(np.transpose(c, (0, 2, 1)) * e, axis=2)))
+    return np.maximum(value, np.max(np.abs(x), axis=2))
+
+
+def ssm(system: System, mode: int, order: int) -> SSM:
+    """The SSM of ``mode`` to ``order`` (≥ 1) of the system as written in floating point."""
+    w = system.matrices
+    n = w.size
+    lin = linear_mode(w, mode)
+    lam, phi, left = lin.lam, lin.shape, lin.left
+    M, C = w.mass, _damping(w)
+    W: list[np.ndarray] = [np.zeros((1, n), dtype=complex), np.array([phi, np.conj(phi)])]
+    V: list[np.ndarray] = [np.zeros((1, n), dtype=complex),
+                           np.array([lam * phi, np.conj(lam * phi)])]
+    states = [np.hstack([W[0], V[0]]), np.hstack([W[1], V[1]])]
+    force = _Force(w, states)
+    gamma, residual, near = [lam], [0.0], []
+    others = np.concatenate([lin.others, np.conj(lin.others), [np.conj(lam)]])
+    for k in range(2, order + 1):
+        f = force.coeff(k)
+        QW, QV = _carried(W, gamma, k, n), _carried(V, gamma, k, n)
+        Wk = np.zeros((k + 1, n), dtype=complex)
+        Vk = np.zeros((k + 1, n), dtype=complex)
+        worst = 0.0
+        for r in range(k // 2 + 1):
+            s = (k - r) * lam + r * np.conj(lam)
+            rhs = -f[r] - (s * M + C) @ QW[r] - M @ QV[r]
+            L = _pencil(w, s)
+            resonant = k % 2 == 1 and r == (k - 1) // 2
+            if resonant:
+                b = ((s + lam) * M + C) @ phi
+                c = ((C + (lam + s) * M).T @ left)
+                J = sparse.bmat([[L, sparse.csc_array(b[:, None])],
+                                 [sparse.csc_array(c[None, :]), [[left @ (M @ phi)]]]],
+                                format="csc")
+                e = -left @ (M @ QW[r])
+                x = _solve(J, np.append(rhs, e), k, r, mode)
+                Wm, g = x[:n], complex(x[n])
+                gamma.append(g)
+                worst = max(worst, _relative(L @ Wm + b * g - rhs, rhs))
+                Vk[r] = s * Wm + QW[r] + phi * g
+            else:
+                near += _divisors(s, others, k, r)
+                Wm = _solve(L, rhs, k, r, mode)
+                worst = max(worst, _relative(L @ Wm - rhs, rhs))
+                Vk[r] = s * Wm + QW[r]
+            Wk[r] = Wm
+        for r in range(k // 2 + 1, k + 1):
+            Wk[r], Vk[r] = np.conj(Wk[k - r]), np.conj(Vk[k - r])
+        W.append(Wk)
+        V.append(Vk)
+        states.append(np.hstack([Wk, Vk]))
+        residual.append(worst)
+    radius, how = _radius(W, gamma)
+    return SSM(w, mode, order, lin, tuple(W), tuple(V), tuple(gamma), tuple(residual),
+               tuple(near), radius, how)
+
+
+def _solve(J: sparse.csc_array, rhs: np.ndarray, k: int, r: int, mode: int) -> np.ndarray:
+    try:
+        x = sparse_solve(J, rhs)
+    except np.linalg.LinAlgError:
+        x = np.full(len(rhs), np.nan)
+    if not np.all(np.isfinite(x)):
+        raise InputError(f"--mode {mode}: order {k}, monomial p1^{k - r} p2^{r}: the "
+                         "homological equation is singular (an exact internal resonance: "
+                         "this mode's 2-D SSM does not exist)")
+    return x
+
+
+def _relative(residual: np.ndarray, rhs: np.ndarray) -> float:
+    scale = float(np.max(np.abs(rhs)))
+    return float(np.max(np.abs(residual))) / scale if scale > 0 else 0.0
+
+
+def _divisors(s: complex, others: np.ndarray, k: int, r: int) -> list[NearResonance]:
+    """The near resonances of the row's ``s`` with the modes checked; refused where exact."""
+    out = []
+    for lam in others:
+        divisor = abs(s - lam)
+        relative = divisor / abs(lam)
+        if relative < SINGULAR:
+            raise InputError(f"order {k}, monomial p1^{k - r} p2^{r}: s = {s:.6g} equals the "
+                             f"eigenvalue {lam:.6g} of another mode (an internal resonance: "
+                             "the 2-D SSM does not exist; lower --order below it)")
+        if relative < NEAR_RESONANCE:
+            out.append(NearResonance(k, (k - r, r), complex(lam), divisor, relative))
+    return out
+
+
+def _radius(W: list[np.ndarray], gamma: list[complex]) -> tuple[float, str]:
+    """The radius in ρ: the smallest ratio ``(|c_(k−2)|/|c_k|)^{1/2}`` over the last half of
+    the orders, of ``W``'s largest coefficient per order (two orders apart: even and odd
+    orders alternate in size where the force has even and odd terms) and of ``g``'s terms
+    (in ρ², ``(|γ_(j−1)|/|γ_j|)^{1/2}``); inf where every term past the linear one vanishes
+    (a linear system's SSM is its modal plane)."""
+    norms = [float(np.max(np.abs(X))) for X in W]
+    K = len(W) - 1
+    ratios = [math.sqrt(norms[k - 2] / norms[k]) for k in range(max(3, K // 2 + 1), K + 1)
+              if norms[k] > 0 and norms[k - 2] > 0]
+    J = len(gamma) - 1
+    ratios += [math.sqrt(abs(gamma[j - 1]) / abs(gamma[j])) for j in range(max(1, J // 2 + 1),
+                                                                        J + 1)
+               if abs(gamma[j]) > 0 and abs(gamma[j - 1]) > 0]
+    if not ratios:
+        return math.inf, "no term past the linear one: the SSM is the modal plane"
+    return min(ratios), ("the smallest ratio of terms two orders apart over the last half of "
+                         "the orders (of W's largest coefficient, and of g in rho^2)")
+
+
+@dataclass(frozen=True)
+class Forcing:
+    """The forcing at each ``Ω`` of a grid: the reduced model's ``S`` (``p₁' = … +
+    S e^{iΩt}``) and the outputs' non-resonant part ``X`` (``x = W(p) + X e^{iΩt} + c.c.``,
+    ``(Ω, outputs)``)."""
+
+    omega: np.ndarray
+    S: np.ndarray
+    X: np.ndarray
+
+
+def forcing(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> Forcing:
+    """The leading-order non-autonomous terms at each ``Ω``: one bordered solve each — dense
+    and batched up to :data:`DENSE_MODES` coordinates, else sparse."""
+    w = model.matrices
+    if w.drive is None:
+        raise InputError("the system is not driven: no forced response (drive one equation "
+                         "with f*cos(w*t), or give drive.txt)")
+    lin, n = model.linear, w.size
+    lam, phi, left = lin.lam, lin.shape, lin.left
+    M, C, K = w.mass, _damping(w), w.stiffness
+    omegas = np.asarray(omegas, dtype=float)
+    rhs = np.append(w.drive / 2, 0.0)
+    corner = left @ (M @ phi)
+    Mphi, Cphi, MTl, CTl = M @ phi, C @ phi, M.T @ left, C.T @ left
+    if n <= DENSE_MODES:
+        s = 1j * omegas[:, None, None]
+        J = np.zeros((len(omegas), n + 1, n + 1), dtype=complex)
+        J[:, :n, :n] = s * s * M.toarray() + s * C.toarray() + K.toarray()
+        J[:, :n, n] = (s[:, :, 0] + lam) * Mphi + Cphi
+        J[:, n, :n] = CTl + (lam + s[:, :, 0]) * MTl
+        J[:, n, n] = corner
+        x = np.linalg.solve(J, np.broadcast_to(rhs, (len(omegas), n + 1))[..., None])[..., 0]
+    else:
+        x = np.empty((len(omegas), n + 1), dtype=complex)
+        for i, om in enumerate(omegas):
+            s = 1j * om
+            J = sparse.bmat([[_pencil(w, s), sparse.csc_array(((s + lam) * Mphi
+                                                                + Cphi)[:, None])],
+                             [sparse.csc_array((CTl + (lam + s) * MTl)[None, :]),
+                              [[corner]]]], format="csc")
+            x[i] = _solve(J, rhs, 1, 0, model.mode)
+    if not np.all(np.isfinite(x)):
+        raise InputError(f"--mode {model.mode}: the forced terms are singular at a drive "
+                         "frequency of the range (the drive is resonant with another mode)")
+    return Forcing(omegas, x[:, n], x[:, :n][:, outputs])
+
+
+@dataclass(frozen=True)
+class SteadyState:
+    """One steady state of the forced response: ``ρ``, its phase ``ψ`` to the drive, each
+    output's ``max |x_i|`` over a period, stable or not."""
+
+    omega: float
+    rho: float
+    psi: float
+    amplitude: np.ndarray
+    stable: bool
+
+
+@dataclass(frozen=True)
+class ForcedResponse:
+    """Every steady state at each Ω of the grid, the folds between (Ω and ρ where the number
+    of steady states changes) and the states dropped past the radius."""
+
+    states: tuple[SteadyState, ...]
+    folds: tuple[tuple[float, float], ...]
+    beyond: int
+
+
+def _roots(model: SSM, omega: float, S: complex) -> np.ndarray:
+    """The real positive ``u = ρ²`` of ``u (a(u)² + (ω(u) − Ω)²) − |S|²``, ascending."""
+    P = np.polynomial.polynomial
+    a = np.array([g.real for g in model.gamma])
+    b = np.array([g.imag for g in model.gamma])
+    b[0] -= omega
+    poly = P.polymul([0.0, 1.0], P.polyadd(P.polymul(a, a), P.polymul(b, b)))
+    poly = P.polysub(poly, [abs(S) ** 2])
+    roots = P.polyroots(poly)
+    real = roots[np.abs(roots.imag) <= 1e-9 * np.maximum(np.abs(roots), 1e-300)].real
+    return np.sort(real[real > 0])
+
+
+def _stable(model: SSM, rho: float, omega: float) -> bool:
+    """The polar flow's Jacobian at a steady state: trace < 0 and det > 0."""
+    u = rho * rho
+    a = sum(g.real * u**j for j, g in enumerate(model.gamma))
+    da = sum(2 * j * g.real * rho ** (2 * j - 1) for j, g in enumerate(model.gamma) if j)
+    dw = sum(2 * j * g.imag * rho ** (2 * j - 1) for j, g in enumerate(model.gamma) if j)
+    detune = sum(g.imag * u**j for j, g in enumerate(model.gamma)) - omega
+    trace = 2 * a + rho * da
+    det = a * (a + rho * da) + detune * (rho * dw + detune)
+    return bool(trace < 0 and det > 0)
+
+
+def forced_response(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> ForcedResponse:
+    """Every steady state of the reduced model at each ``Ω`` (ascending), inside the radius;
+    the folds placed by bisection on the number of states (:data:`FOLD_STEPS`)."""
+    fo = forcing(model, omegas, outputs)
+    found = [np.sqrt(_roots(model, om, S)) for om, S in zip(fo.omega, fo.S, strict=True)]
+    beyond = sum(int(np.sum(r > model.radius)) for r in found)
+    found = [r[r <= model.radius] for r in found]
+    counts = [len(r) for r in found]
+    at = np.repeat(np.arange(len(omegas)), counts)
+    rho = np.concatenate(found) if found else np.zeros(0)
+    om, S = fo.omega[at], fo.S[at]
+    # S e^{−iψ} = −ρ(a + i(ω − Ω)): the mode's phase to the drive
+    psi = -np.angle(-rho * (model.g(rho) - 1j * om) / S)
+    c = model.harmonics(rho, outputs, psi)
+    K = model.order
+    c[:, K + 1] += fo.X[at]
+    c[:, K - 1] += np.conj(fo.X[at])
+    amp = peak_amplitude(c)
+    states = tuple(SteadyState(float(om[i]), float(rho[i]), float(psi[i]), amp[i],
+                               _stable(model, float(rho[i]), float(om[i])))
+                   for i in range(len(rho)))
+    folds = tuple(_fold(model, float(omegas[i - 1]), float(omegas[i]), counts[i - 1],
+                        fo.S[i - 1], fo.S[i])
+                  for i in range(1, len(omegas)) if counts[i] != counts[i - 1])
+    return ForcedResponse(states, folds, beyond)
+
+
+def _fold(model: SSM, lo: float, hi: float, count: int, S_lo: complex, S_hi: complex
+          ) -> tuple[float, float]:
+    """Ω and ρ where the number of steady states changes between ``lo`` and ``hi`` (``S``
+    interpolated linearly between the two: it varies slowly with Ω)."""
+    def roots(om: float) -> np.ndarray:
+        t = (om - lo) / (hi - lo)
+        return np.sqrt(_roots(model, om, (1 - t) * S_lo + t * S_hi))
+
+    a, b, merged = lo, hi, roots(lo)
+    for _ in range(FOLD_STEPS):
+        mid = 0.5 * (a + b)
+        here = roots(mid)
+        if len(here) == count:
+            a, merged = mid, here
+        else:
+            b = mid
+    if len(merged) < 2:
+        return 0.5 * (a + b), float(merged[0]) if len(merged) else math.nan
+    gaps = np.diff(merged)
+    k = int(np.argmin(gaps))
+    return 0.5 * (a + b), float(0.5 * (merged[k] + merged[k + 1]))
+
+
+BACKBONE_POINTS = 41
+# NOTE: the backbone's samples in ρ, from 0 to its end (the JSON's; the table shows 11).
+REACH = 0.9
+# NOTE: the backbone ends at this fraction of the estimated radius (where no --rho-max says).
+DEFAULT_SPAN = 0.2
+# NOTE: a driven system's forced response without a range: ±20 % about the mode's |λ|.
+NAMED_OUTPUTS = 12
+# NOTE: up to this many coordinates every one is an output by default; a larger model's
+# default output is the coordinate where the mode's shape is largest.
+
+
+@dataclass(frozen=True)
+class Reduction:
+    """What ``ssm`` reports: the system's text (or folder), the SSM, the outputs (indices
+    and names), the backbone (ρ, each output's ``max |x_i|``), and the forced response where
+    the system is driven."""
+
+    text: str
+    model: SSM
+    outputs: np.ndarray
+    names: tuple[str, ...]
+    rho: np.ndarray
+    amplitude: np.ndarray
+    response: ForcedResponse | None
+
+
+def reduce(system: System, mode: int, order: int, outputs: list[int] | None = None,
+           rho_max: float | None = None, span: tuple[float, float] | None = None,
+           points: int = 500) -> Reduction:
+    """The SSM of ``mode`` to ``order``; its backbone up to ``rho_max`` (default
+    :data:`REACH` of the radius, or further to the largest forced state's ρ inside it); the
+    forced response of a driven system at ``points`` frequencies over ``span`` (default
+    :data:`DEFAULT_SPAN` about the mode's ``|λ|``)."""
+    model = ssm(system, mode, order)
+    if outputs is None:
+        outputs = (list(range(system.size)) if system.size <= NAMED_OUTPUTS
+                   else [int(np.argmax(np.abs(model.linear.shape)))])
+    outputs = np.array(outputs, dtype=np.int64)
+    names = tuple(str(system.coordinates[i]) for i in outputs)
+    response = None
+    if system.matrices.drive is not None:
+        lo, hi = span if span is not None else (
+            (1 - DEFAULT_SPAN) * abs(model.lam), (1 + DEFAULT_SPAN) * abs(model.lam))
+        response = forced_response(model, np.linspace(lo, hi, points), outputs)
+    elif span is not None:
+        raise InputError("--omega: the system is not driven (drive one equation with "
+                         "f*cos(w*t), or give drive.txt)")
+    end = rho_max
+    if end is None:
+        end = REACH * model.radius if math.isfinite(model.radius) else 1.0
+        if response is not None and response.states:
+            end = max(end, min(model.radius, max(s.rho for s in response.states)))
+    elif end > model.radius:
+        raise InputError(f"--rho-max {rho_max:g}: beyond the SSM's estimated radius "
+                         f"{model.radius:.6g} in rho ({model.radius_how})")
+    rho = np.linspace(0.0, end, BACKBONE_POINTS)
+    return Reduction(system.text, model, outputs, names, rho, model.amplitude(rho, outputs),
+                     response)

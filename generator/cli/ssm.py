@@ -1,0 +1,263 @@
+"""``ssm``: the spectral submanifold of one mode of a damped (and driven) system, a SYSTEM
+written as text or a model folder: its arguments, its JSON contract, its table and CSV, each
+a pure function of the one record (:class:`analysis.ssm.Reduction`)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+
+from ..errors import InputError
+from ..limits import SSM_MAX_ORDER, SSM_MAX_POINTS, check_int
+
+# NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
+# well under 0.3 s, so each command imports its stages (SymPy, numba, SciPy, matplotlib) itself.
+from .common import (
+    _flag_allow_slow,
+    _flag_csv,
+    _flag_json,
+    _flag_omega,
+    _flag_plot,
+    _params,
+    _positive,
+    _positive_real,
+    check_outputs,
+    write_csv,
+)
+
+DEFAULT_ORDER = 7
+FRC_POINTS = 500
+# NOTE: the forced response's default grid (the reduced model answers 500 drive frequencies
+# in a fraction of a second).
+
+
+def _order(text: str) -> int:
+    k = _positive(text)
+    if k > SSM_MAX_ORDER:
+        raise argparse.ArgumentTypeError(f"{k}: the SSM is computed to order ≤ {SSM_MAX_ORDER} "
+                                         "(floating-point terms past it are rounding)")
+    return k
+
+
+def _pair(z: complex) -> list[float]:
+    return [float(z.real), float(z.imag)]
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def ssm_json(red) -> dict:
+    """The contract of ``lindstedt ssm … --json``, a pure function of a
+    :class:`analysis.ssm.Reduction`: ``kind``, ``mode``, ``lambda`` and ``gamma`` as
+    ``[re, im]`` pairs (``gamma[j]`` the coefficient of ``ρ^{2j}`` in ``a + iω``), the
+    ``backbone`` (``rho``, ``omega``, ``damping_ratio``, each output's ``amplitude``
+    ``max |x|`` over a period, and ``error_estimate``) and, with a drive, ``frc`` (each
+    steady state: ``omega``, ``amplitude``, ``stable``, and ``rho``, ``phase``), its folds;
+    beside them the order, outputs, each order's residual, the near resonances, the radius."""
+    m = red.model
+    names = list(red.names)
+    backbone = [{"rho": float(r), "omega": float(m.omega(r)),
+                 "damping_ratio": float(m.damping_ratio(r)),
+                 "amplitude": {name: float(a) for name, a in zip(names, amp, strict=True)},
+                 "error_estimate": float(m.error(r))}
+                for r, amp in zip(red.rho, red.amplitude, strict=True)]
+    lam = m.lam
+    data = {"kind": "ssm", "mode": m.mode, "lambda": _pair(lam),
+            "gamma": [_pair(g) for g in m.gamma], "backbone": backbone,
+            "order": m.order, "system": red.text, "coordinates": m.matrices.size,
+            "outputs": {name: int(i) for name, i in zip(names, red.outputs, strict=True)},
+            "linear": {"omega0": abs(lam), "damped_frequency": lam.imag,
+                       "damping_ratio": -lam.real / abs(lam)},
+            "reduced_dynamics": "rho' = rho*a(rho), theta' = omega(rho), a + i*omega = "
+                                "sum_j gamma[j]*rho^(2j); x = W(rho*e^(i*theta), "
+                                "rho*e^(-i*theta)), W's linear part rho*2*Re(phi*e^(i*theta)) "
+                                "with phi^H M phi = 1/4",
+            "residual": [float(r) for r in m.residual],
+            "near_resonances": [{"order": q.order, "monomial": list(q.monomial),
+                                 "eigenvalue": _pair(q.eigenvalue), "divisor": q.divisor,
+                                 "relative": q.relative} for q in m.near],
+            "modes_checked": m.linear.checked,
+            "radius_estimate": {"value": _finite(m.radius), "how": m.radius_how}}
+    if red.response is not None:
+        r = red.response
+        data["frc"] = [{"omega": s.omega, "amplitude": {
+            name: float(a) for name, a in zip(names, s.amplitude, strict=True)},
+            "stable": s.stable, "rho": s.rho, "phase": s.psi} for s in r.states]
+        data["frc_folds"] = [{"omega": w, "rho": rho} for w, rho in r.folds]
+        data["frc_beyond_radius"] = r.beyond
+    return data
+
+
+def _number(x: float | None) -> str:
+    return "-" if x is None else f"{x:.6g}"
+
+
+def ssm_table(data: dict) -> list[str]:
+    """The readable table of :func:`ssm_json`'s ``data``."""
+    names = list(data["outputs"])
+    lam, lin = data["lambda"], data["linear"]
+    lines = [f"SSM of mode {data['mode']} of {data['system']} ({data['coordinates']} "
+             f"coordinate{'s' * (data['coordinates'] != 1)}), order {data['order']}, "
+             "floating point",
+             f"lambda = {lam[0]:.9g} {'+-'[lam[1] < 0]} {abs(lam[1]):.9g}i: omega0 = "
+             f"{lin['omega0']:.9g}, damping ratio {lin['damping_ratio']:.6g}",
+             data["reduced_dynamics"],
+             f"{'j':>3}  {'Re gamma_j':>16}  {'Im gamma_j':>16}"]
+    lines += [f"{j:>3}  {g[0]:>16.9g}  {g[1]:>16.9g}" for j, g in enumerate(data["gamma"])]
+    lines.append("relative residual of the homological equations, worst order: "
+                 f"{max(data['residual']):.2g}")
+    near = data["near_resonances"]
+    lines.append("near resonances (divisor |s - lambda_j| under 10 % of |lambda_j|), among "
+                 f"{data['modes_checked']}: " + ("none" if not near else "; ".join(
+                     f"order {q['order']} p1^{q['monomial'][0]} p2^{q['monomial'][1]} with "
+                     f"lambda = {q['eigenvalue'][0]:.6g} + {q['eigenvalue'][1]:.6g}i, divisor "
+                     f"{q['divisor']:.3g}" for q in near)))
+    radius = data["radius_estimate"]
+    lines.append(f"radius in rho estimated at {_number(radius['value'])} ({radius['how']})")
+    lines.append("backbone (amplitude: max |x| over a period):")
+    lines.append(f"{'rho':>10}  {'omega':>12}  {'damping':>10}  " + "  ".join(
+        f"{n:>10}" for n in names) + f"  {'error':>8}")
+    points = data["backbone"]
+    for p in points[::max(1, (len(points) - 1) // 10)]:
+        lines.append(f"{p['rho']:>10.5g}  {p['omega']:>12.9g}  {p['damping_ratio']:>10.5g}  "
+                     + "  ".join(f"{p['amplitude'][n]:>10.5g}" for n in names)
+                     + f"  {p['error_estimate']:>8.1e}")
+    if "frc" in data:
+        frc = data["frc"]
+        lines.append(f"forced response: {len(frc)} steady states over "
+                     f"{len({s['omega'] for s in frc})} drive frequencies"
+                     + (f" ({data['frc_beyond_radius']} beyond the radius dropped)"
+                        if data["frc_beyond_radius"] else ""))
+        for n in names:
+            if frc:
+                top = max(frc, key=lambda s, n=n: s["amplitude"][n])
+                lines.append(f"  peak of {n}: {top['amplitude'][n]:.9g} at omega = "
+                             f"{top['omega']:.9g} ({'stable' if top['stable'] else 'unstable'})")
+        lines += [f"  fold at omega = {f['omega']:.9g}, rho = {f['rho']:.6g}"
+                  for f in data["frc_folds"]]
+    return lines
+
+
+def ssm_csv(data: dict, path) -> None:
+    """``--csv``: the backbone's rows, then the forced response's (``frc`` says which; a
+    column that does not apply holds NaN)."""
+    names = list(data["outputs"])
+    nan = math.nan
+    columns = (("frc", "1 a steady state of the forced response and 0 a backbone point"),
+               ("omega", "frequency"), ("rho", "normal-form amplitude"),
+               ("damping_ratio", "backbone only"),
+               *((n, f"max |{n}| over a period") for n in names),
+               ("stable", "forced response only: 1 stable and 0 not"))
+    rows = [(0, p["omega"], p["rho"], p["damping_ratio"], *(p["amplitude"][n] for n in names),
+             nan) for p in data["backbone"]]
+    rows += [(1, s["omega"], s["rho"], nan, *(s["amplitude"][n] for n in names),
+              int(s["stable"])) for s in data.get("frc", [])]
+    write_csv(path, columns, rows)
+
+
+def _outputs(text: str | None, names: list[str]) -> list[int] | None:
+    """``--output``: indices (0-based) or coordinate names, comma-separated (``None``: the
+    default, :func:`analysis.ssm.reduce`'s)."""
+    if text is None:
+        return None
+    out = []
+    for part in text.split(","):
+        part = part.strip()
+        if part in names:
+            out.append(names.index(part))
+            continue
+        try:
+            k = int(part)
+        except ValueError:
+            raise InputError(f"--output {text}: {part!r} is neither a coordinate name nor an "
+                             "index") from None
+        if not 0 <= k < len(names):
+            raise InputError(f"--output {text}: index {k} outside 0..{len(names) - 1}")
+        out.append(k)
+    if len(set(out)) != len(out):
+        raise InputError(f"--output {text}: a coordinate named twice")
+    return out
+
+
+def run_ssm(args: argparse.Namespace) -> int:
+    """Run ``lindstedt ssm``: read the system (text or folder), reduce, print."""
+    from ..analysis.ssm import reduce
+    from ..derive.system import parse_system, read_model
+
+    plot, csv = check_outputs(args)
+    if (args.system is None) == (args.model is None):
+        raise InputError("ssm: give a SYSTEM or --model DIR (one of them)")
+    if args.model is not None:
+        if args.param:
+            raise InputError("--param: a model folder holds numbers only (no parameters)")
+        system = read_model(args.model)
+    else:
+        system = parse_system(args.system, _params(args.param), driven=True)
+    check_int(args.points, 2, SSM_MAX_POINTS, f"--omega …:{args.points}: the forced response "
+              f"takes 2..{SSM_MAX_POINTS} drive frequencies")
+    span = None
+    if args.omega_min is not None:
+        span = (args.omega_min, args.omega_max)
+        if not 0 < span[0] < span[1]:
+            raise InputError(f"--omega {span[0]:g}:{span[1]:g}: give 0 < A < B")
+    red = reduce(system, args.mode, args.order,
+                 _outputs(args.output, [str(x) for x in system.coordinates]), args.rho_max,
+                 span, args.points)
+    data = ssm_json(red)
+    if plot is not None:
+        from ..charts_modes import ssm_figure
+
+        ssm_figure(data, plot)
+    if csv is not None:
+        ssm_csv(data, csv)
+    print(json.dumps(data) if args.json else "\n".join(ssm_table(data)))
+    return 0
+
+
+def arguments_ssm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``lindstedt ssm``'s arguments."""
+    p = sub.add_parser("ssm", help="the spectral submanifold of a mode of a damped system: "
+                       "backbone, damping, forced response",
+                       description="The two-dimensional spectral submanifold (SSM) of one mode "
+                       "of M x'' + C x' + K x + f(x, x') = F cos(w t), by the parametrisation "
+                       "method in normal-form style to order K, in floating point with sparse "
+                       "matrices: its reduced dynamics rho' = rho a(rho), theta' = omega(rho), "
+                       "the backbone omega(rho), the damping ratio, each output's physical "
+                       "amplitude (max |x_i| over a period); with a drive, the forced response "
+                       "from the reduced model (every steady state, its stability, the folds). "
+                       "The system is a SYSTEM written as text (one equation per coordinate, "
+                       "separated by ';') or a finite-element model's folder (--model).")
+    p.add_argument("system", metavar="SYSTEM", nargs="?",
+                   help="equations such as \"x1'' + 0.02*x1' + 2*x1 - x2 + x1**3 = "
+                   "f*cos(w*t); x2'' + 0.02*x2' + 2*x2 - x1 = 0\" (damping, a drive "
+                   "f*cos(w*t) on any equations; every name but w needs --param)")
+    p.add_argument("--model", metavar="DIR",
+                   help="a model folder instead of SYSTEM: M.mtx, K.mtx, optional C.mtx "
+                   "(Matrix Market), nonlinear.txt ('i j k c' adds c*x_j*x_k to f_i, "
+                   "'i j k l c' adds c*x_j*x_k*x_l; 0-based), optional drive.txt ('i F_i')")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="a value for a parameter of SYSTEM, e.g. f=1/100 (repeatable)")
+    p.add_argument("--mode", type=_positive, default=1, metavar="M",
+                   help="the mode, numbered 1, 2, … by increasing damped frequency (default 1)")
+    p.add_argument("--order", type=_order, default=DEFAULT_ORDER, metavar="K",
+                   help=f"the SSM's order K, 1..{SSM_MAX_ORDER} (default {DEFAULT_ORDER})")
+    p.add_argument("--output", metavar="LIST",
+                   help="the coordinates whose amplitudes are reported, comma-separated: "
+                   "0-based indices or names, e.g. 17,40 (named x17, x40 for a model; "
+                   "default: every coordinate of a SYSTEM of at most 12, else the mode "
+                   "shape's largest)")
+    _flag_omega(p, ("A:B", "A:B:N"), "the drive frequencies of the forced response, from A "
+                "to B (N points, default 500), in the system's time units (default: ±20 %% "
+                "about the mode's linear frequency, where the system is driven)",
+                points=FRC_POINTS)
+    p.add_argument("--rho-max", type=_positive_real, default=None, metavar="R",
+                   help="the backbone's end in rho (default: 0.9 of the estimated radius, or "
+                   "further to the forced response's largest state inside it)")
+    _flag_json(p)
+    _flag_plot(p)
+    _flag_csv(p, "the backbone (omega, rho, damping ratio, amplitudes) and the forced "
+              "response's steady states")
+    _flag_allow_slow(p, deprecated_force=False)
+    return p
