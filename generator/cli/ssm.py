@@ -55,7 +55,8 @@ def ssm_json(red) -> dict:
     ``backbone`` (``rho``, ``omega``, ``damping_ratio``, each output's ``amplitude``
     ``max |x|`` over a period, and ``error_estimate``) and, with a drive, ``frc`` (each
     steady state: ``omega``, ``amplitude``, ``stable``, and ``rho``, ``phase``), its folds;
-    beside them the order, outputs, each order's residual, the near resonances, the radius."""
+    beside them the order, outputs, each order's ``residual`` (the backward error of its
+    homological equations' solves), the near resonances, the radius."""
     m = red.model
     names = list(red.names)
     backbone = [{"rho": float(r), "omega": float(m.omega(r)),
@@ -106,7 +107,7 @@ def ssm_table(data: dict) -> list[str]:
              data["reduced_dynamics"],
              f"{'j':>3}  {'Re gamma_j':>16}  {'Im gamma_j':>16}"]
     lines += [f"{j:>3}  {g[0]:>16.9g}  {g[1]:>16.9g}" for j, g in enumerate(data["gamma"])]
-    lines.append("relative residual of the homological equations, worst order: "
+    lines.append("backward error of the homological equations' sparse solves, worst order: "
                  f"{max(data['residual']):.2g}")
     near = data["near_resonances"]
     lines.append("near resonances (divisor |s - lambda_j| under 10 % of |lambda_j|), among "

@@ -57,14 +57,22 @@ def _dense_solve(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     return np.linalg.solve(J, rhs)
 
 
-def sparse_solve(J, rhs: np.ndarray) -> np.ndarray:
-    """``J⁻¹ rhs`` for a sparse ``J`` (SuperLU); a singular ``J`` raises ``LinAlgError``."""
+def sparse_solve(J, rhs: np.ndarray, refine: int = 0) -> np.ndarray:
+    """``J⁻¹ rhs`` for a sparse ``J`` (SuperLU), with ``refine`` steps of iterative
+    refinement (the residual's correction by the same factors: a stiff structure's L(s),
+    conditioned like 1e12, loses digits to the factorization otherwise); a singular ``J``
+    raises ``LinAlgError``."""
     from scipy.sparse.linalg import splu
 
+    J = J.tocsc()
     try:
-        return splu(J.tocsc()).solve(rhs)
+        lu = splu(J)
     except RuntimeError as exc:  # "Factor is exactly singular"
         raise np.linalg.LinAlgError(str(exc)) from None
+    x = lu.solve(rhs)
+    for _ in range(refine):
+        x = x + lu.solve(rhs - J @ x)
+    return x
 
 
 def iterate(evaluate: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], x: np.ndarray,
