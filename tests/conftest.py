@@ -30,13 +30,13 @@ LAYERS = {
               "hill", "layout", "lindstedt", "newton", "nnm", "parametric", "response",
               "response_equation",
               "response_system",
-              "resonance", "series", "ssm", "subharmonic", "toolkit"),
+              "resonance", "series", "ssm", "ssm_exact", "subharmonic", "toolkit"),
     "printers": ("charts", "cli", "costs", "curves", "emit", "files", "fuzz", "interrupt", "latex",
                  "messages", "notebook", "readme", "validity"),
     "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "mass", "nnm_emitted",
                 "orbits",
                 "orbit_domain_grid",
-                "oscillator", "resum", "sweep", "tongues"),
+                "oscillator", "resum", "sweep", "sweep_ssm", "tongues"),
 }
 LAYER_OF = {f"test_{name}.py": layer for layer, names in LAYERS.items() for name in names}
 
