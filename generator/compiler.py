@@ -28,6 +28,7 @@ from .methods.targets import (
     MU_DAMPED,
     NNM,
     SLOW_FLOW,
+    SSM,
     TONGUE,
     ChoiceRequest,
     CycleRequest,
@@ -36,6 +37,7 @@ from .methods.targets import (
     MathieuRequest,
     NormalModeRequest,
     Progress,
+    ReductionRequest,
     Request,
     SlowFlowRequest,
     Target,
@@ -175,6 +177,17 @@ def generate_nnm(system: object, mode: int, order: int, out: Path, *, amplitude:
     return compile_target(NNM, NormalModeRequest(order, command, system, mode, amplitude, name,
                                                  allow_divergent),
                           out, progress, overwrite_edited=overwrite_edited, flag=flag)
+
+
+def generate_ssm(system: object, mode: int, order: int, out: Path, *, name: str,
+                 command: str, outputs: tuple[int, ...] | None = None,
+                 span: tuple[float, float] | None = None, overwrite_edited: bool = False,
+                 flag: str = "--out") -> list[Path]:
+    """``lindstedt generate SYSTEM --ssm M``: the reduced model's module and its LaTeX."""
+    check_module_name(name)
+    return compile_target(SSM, ReductionRequest(order, command, system, mode, outputs, span,
+                                                name), out,
+                          overwrite_edited=overwrite_edited, flag=flag)
 
 
 TONGUE_MIN_ORDER = 12

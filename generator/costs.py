@@ -242,6 +242,8 @@ def generate_mode_cost(args: argparse.Namespace) -> Cost:
     """``generate SYSTEM --mode M``: the normal mode's series to the radius order, emitted."""
     from .methods.targets import NNM_RADIUS_ORDER
 
+    if getattr(args, "ssm", None) is not None:
+        return ssm_cost(args, emitted=True)
     _generate_bounds(args)
     series = nnm_cost(argparse.Namespace(system=args.model,
                                          order=max(args.order + 2, NNM_RADIUS_ORDER)))
@@ -249,8 +251,47 @@ def generate_mode_cost(args: argparse.Namespace) -> Cost:
                 "generating the normal mode's evaluators")
 
 
+SSM_FIT = (1.5, 2.5e-5, 12.0)
+# NOTE: `lindstedt ssm`: start-up, then ~2.5e-5 s per coordinate and squared order (sparse
+# solves and force products): a chain of 1 000 masses at order 7 took 1.4 s, of 10 000 at
+# order 5 6.3 s, a beam of 2 997 coordinates at order 7 5.0 s; `generate --ssm` adds the
+# module's first numba compile (~12 s).
+
+
+def _model_size(folder: str) -> int:
+    """The coordinates of a model folder, from M.mtx's size line (0 where unreadable: the
+    command refuses it itself)."""
+    from pathlib import Path
+
+    try:
+        with (Path(folder) / "M.mtx").open() as fh:
+            for line in fh:
+                if not line.startswith("%") and line.strip():
+                    return int(line.split()[0])
+    except (OSError, ValueError, UnicodeDecodeError):
+        pass
+    return 0
+
+
+def ssm_cost(args: argparse.Namespace, emitted: bool = False) -> Cost:
+    """``ssm`` (and ``generate --ssm``): :data:`SSM_FIT` in the coordinates and the order."""
+    from .derive.problem import read_problem
+
+    folder = getattr(args, "model_dir", None) if emitted else getattr(args, "model", None)
+    text = getattr(args, "model" if emitted else "system", None)
+    n = _model_size(folder) if folder else (read_problem(text).size if text else 0)
+    fixed, per, compile_ = SSM_FIT
+    return Cost(fixed + per * n * args.order**2 + (compile_ if emitted else 0.0),
+                f"order {args.order}, {n} coordinates", "the spectral submanifold")
+
+
 def generate_cost(args: argparse.Namespace) -> Cost:
     """Bounds first (no switch lifts them), then the model's own fit."""
+    if getattr(args, "ssm", None) is not None or getattr(args, "model_dir", None):
+        return ssm_cost(args, emitted=True)
+    if args.model is None:
+        raise InputError("generate: give an EQUATION or a NAME (or a SYSTEM, or --ssm M with "
+                         "--model DIR)")
     _generate_bounds(args)
     harmonic = args.model in ("balance", "fourier")
     size = args.harmonics if harmonic else args.order
@@ -532,6 +573,7 @@ COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "tongues": tongues_cost,
     "slowflow": slow_flow_cost,
     "nnm": nnm_cost,
+    "ssm": ssm_cost,
 }
 ROUTE_COSTS: Mapping[str, Callable[[argparse.Namespace], Cost]] = {
     "generate normal mode": generate_mode_cost,

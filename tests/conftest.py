@@ -36,7 +36,7 @@ LAYERS = {
     "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "mass", "nnm_emitted",
                 "orbits",
                 "orbit_domain_grid",
-                "oscillator", "resum", "sweep", "sweep_ssm", "tongues"),
+                "oscillator", "resum", "ssm_emitted", "sweep", "sweep_ssm", "tongues"),
 }
 LAYER_OF = {f"test_{name}.py": layer for layer, names in LAYERS.items() for name in names}
 

@@ -33,7 +33,7 @@ def test_every_command_but_the_demo_has_an_estimate_and_the_slow_ones_a_switch()
     names = set(commands())
     assert set(COSTS) == names - {"demo"}
     scalable = {"series", "generate", "driven", "response", "choose", "sweep", "mathieu",
-                "tongues", "nnm"}
+                "tongues", "nnm", "ssm"}
     for name, sub in commands().items():
         has = any("--allow-slow" in a.option_strings for a in sub._actions)
         assert has == (name in scalable), name

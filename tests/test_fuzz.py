@@ -270,6 +270,29 @@ RESPONSE_SYSTEM = command_line((
     Opt("--harmonics", maybe(whole(1, 3)), st.sampled_from(("0", "101", "abc")))), plot="slow")
 # NOTE: a driven system's response over a short range at N ≤ 3 harmonics (2–4 s a valid run).
 
+SSM = command_line((
+    Opt(None, st.sampled_from([
+        "x1'' + 0.02*x1' + 2*x1 - x2 + x1**3 = f*cos(w*t); "
+        "x2'' + 0.02*x2' + 2*x2 - x1 + 0.5*x2**2 = 0",
+        "1.2*x1'' + 0.3*x2'' + 0.01*x1' + 2.5*x1 - 1.1*x2 + 0.4*x1**3 = f*cos(w*t); "
+        "0.3*x1'' + 0.8*x2'' + 0.01*x2' - 1.1*x1 + 1.7*x2 = 0",
+        "x1'' + 0.1*x1' + 1e10*x1 - x2 + x1**3 = f*cos(w*t); x2'' + 0.1*x2' + 2*x2 - x1 = 0",
+        "x1'' + 0.05*x1' + x1 = f*cos(w*t); x2'' + 0.05*x2' + 3*x2 = 0",
+        "x'' + 0.1*x' + x + x**2 + x**3 = f*cos(w*t)"]),
+        st.sampled_from([";", "x1'' + x1 + (x1 + x2)**3 = 0; x2'' + 9*x2 + (x1 + x2)**3 = 0",
+                         "x1'' + __import__('os') = 0; x2'' = 0", "x'' + 3*x' + x = 0",
+                         "x1'' - x1 = 0; x2'' + x2 = 0", "x'' + x' + x = f*x*cos(w*t)"]),
+        number=False),
+    Opt("--param", st.just("f=1/100"), st.sampled_from(["f=abc", "g=1", "f=1e400"]),
+        number=False),
+    Opt("--mode", maybe(whole(1, 2)), INTEGER), Opt("--order", maybe(whole(1, 9)), INTEGER),
+    Opt("--omega", maybe(span(0.5, 1.0, 1.5, points=True)), SPAN_EDGES),
+    Opt("--rho-max", maybe(st.sampled_from(["0.01", "0.1"])), NUMBER),
+    Opt("--output", maybe(st.sampled_from(["0", "x1", "0,1"])),
+        st.sampled_from(["7", "x9", "0,0", ""]), number=False)), plot="fast")
+# NOTE: a damped pair with decimals, a full mass matrix, a stiffness of 1e10, a linear pair,
+# one coordinate; an exact 1:3 resonance, an overdamped mode, injection (1–3 s a valid run).
+
 SLOWFLOW_SYSTEM = command_line((
     Opt(None, st.sampled_from(["x1'' + x1 + x1*x2 = 0; x2'' + 4*x2 + x1**2/2 = 0",
                                "x1'' + x1 + 0.3*x1*x2 = 0; x2'' + 4.0*x2 + 0.15*x1**2 = 0"]),
@@ -379,6 +402,7 @@ BUDGET = {"series": (SERIES, 2), "generate": (GENERATE, 2), "driven": (DRIVEN, 4
           "slowflow": (SLOWFLOW, 2), "tongues": (TONGUES, 2), "nnm": (NNM, 2),
           "response SYSTEM": (RESPONSE_SYSTEM, 2), "slowflow SYSTEM": (SLOWFLOW_SYSTEM, 2),
           "generate SYSTEM": (GENERATE_SYSTEM, 2), "choose SYSTEM": (CHOOSE_BACKBONE, 1),
+          "ssm": (SSM, 2),
           "sweep SYSTEM": (SWEEP_SYSTEM, 1)}
 # NOTE: examples (pairs of runs side by side) per command: 64 runs, the file ~60 s on the
 # 2-core machine with other work loading it (a refusal takes 0.1–3 s, a valid run 2–8 s).
@@ -401,6 +425,7 @@ def _fuzz(key: str):
 
 test_fuzz_series = _fuzz("series")
 test_fuzz_generate = _fuzz("generate")
+test_fuzz_ssm = _fuzz("ssm")
 test_fuzz_driven = _fuzz("driven")
 test_fuzz_response = _fuzz("response")
 test_fuzz_subharmonic = _fuzz("subharmonic")

@@ -732,6 +732,7 @@ class Reduction:
     rho: np.ndarray
     amplitude: np.ndarray
     response: ForcedResponse | None
+    span: tuple[float, float] | None = None
 
 
 def reduce(system: System, mode: int, order: int, outputs: list[int] | None = None,
@@ -749,9 +750,9 @@ def reduce(system: System, mode: int, order: int, outputs: list[int] | None = No
     names = tuple(str(system.coordinates[i]) for i in outputs)
     response = None
     if system.matrices.drive is not None:
-        lo, hi = span if span is not None else (
+        span = (float(span[0]), float(span[1])) if span is not None else (
             (1 - DEFAULT_SPAN) * abs(model.lam), (1 + DEFAULT_SPAN) * abs(model.lam))
-        response = forced_response(model, np.linspace(lo, hi, points), outputs)
+        response = forced_response(model, np.linspace(*span, points), outputs)
     elif span is not None:
         raise InputError("--omega: the system is not driven (drive one equation with "
                          "f*cos(w*t), or give drive.txt)")
@@ -765,4 +766,4 @@ def reduce(system: System, mode: int, order: int, outputs: list[int] | None = No
                          f"{model.radius:.6g} in rho ({model.radius_how})")
     rho = np.linspace(0.0, end, BACKBONE_POINTS)
     return Reduction(system.text, model, outputs, names, rho, model.amplitude(rho, outputs),
-                     response)
+                     response, span)

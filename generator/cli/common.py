@@ -466,11 +466,14 @@ def _flag_out(p: argparse.ArgumentParser, what: str, default: str | None = None,
 # One definition per flag: the same name means the same thing, with one help text and one
 # default, in every command.
 
-def _flag_oscillator(p: argparse.ArgumentParser, emitted: bool = False) -> None:
-    """The oscillator: a name of `lindstedt models` or an equation, with --param and --name."""
+def _flag_oscillator(p: argparse.ArgumentParser, emitted: bool = False,
+                     optional: bool = False) -> None:
+    """The oscillator: a name of `lindstedt models` or an equation, with --param and --name
+    (``optional``: the command says itself what it needs without one)."""
     extra = ("; or driven: μ-expansion A_n(ω), balance: harmonic-balance Newton solver, "
              "fourier: exact Fourier series of Duffing") if emitted else ""
-    p.add_argument("model", metavar="EQUATION|NAME",
+    p.add_argument("model", metavar="EQUATION|NAME", **(dict(nargs="?", default=None)
+                                                          if optional else {}),
                    help="an equation such as \"q'' + q + eps*(alpha*q**2 + q**3) = 0\" (q' and "
                    "q'' are the derivatives, eps the small parameter, other names parameters) "
                    f"or a name: {', '.join(FREE_MODELS)}{extra}")

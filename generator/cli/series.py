@@ -22,6 +22,7 @@ from .common import (
     _flag_csv,
     _flag_harmonics,
     _flag_json,
+    _flag_omega,
     _flag_order,
     _flag_oscillator,
     _flag_out,
@@ -408,6 +409,13 @@ def run_generate(args: argparse.Namespace) -> int:
     """Run ``lindstedt generate MODEL``: write into ``--out`` the numba evaluator modules
     (and LaTeX) of a free oscillator or a limit cycle, or the driven oscillator's
     ``driven``, ``balance`` or ``fourier`` module; print their paths.  Returns the exit status."""
+    if args.ssm is not None or args.model_dir is not None:
+        from .ssm import run_generate_ssm
+
+        return run_generate_ssm(args)
+    if args.model is None:
+        raise InputError("generate: give an EQUATION or a NAME (or a SYSTEM, or --ssm M with "
+                         "--model DIR)")
     order = args.order
     if args.mode is not None or args.amplitude is not None:
         raise InputError("--mode/--amplitude: a system's flags (equations separated by ';')")
@@ -464,6 +472,10 @@ def run_generate(args: argparse.Namespace) -> int:
 def run_generate_mode(args: argparse.Namespace) -> int:
     """``generate SYSTEM --mode M``: the normal mode's module (the flags of free oscillators
     refused beside it)."""
+    if args.ssm is not None or args.model_dir is not None:
+        from .ssm import run_generate_ssm
+
+        return run_generate_ssm(args)
     given = [flag for flag, on in (("--damped", args.damped),
                                    ("--resum-order", args.resum_order is not None)) if on]
     if given:
@@ -610,7 +622,7 @@ def arguments_generate(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
         description="Write a numba evaluator module (and for duffing, pendulum, driven its "
         "LaTeX tables and derivation) into --out; for a SYSTEM (equations separated by ';') "
         "the module of one nonlinear normal mode (--mode).")
-    _flag_oscillator(p, emitted=True)
+    _flag_oscillator(p, emitted=True, optional=True)
     _flag_order(p, f"highest order K (duffing, pendulum; driven up to {DRIVEN_MAX_ORDER})")
     p.add_argument("--out", default="out", metavar="DIR",
                    help="output folder, created if missing (default out/)")
@@ -630,6 +642,19 @@ def arguments_generate(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
                    "(default 1): ω(A), T(A) and each coordinate x_i(t, A)")
     p.add_argument("--amplitude", metavar="NAME",
                    help="a SYSTEM's coordinate at x = A at t = 0 (default: the first)")
+    p.add_argument("--ssm", type=_positive, default=None, metavar="M",
+                   help="the reduced model of the spectral submanifold of mode M of a damped "
+                   "SYSTEM (or --model DIR): omega(rho), decay(rho), damping(rho), "
+                   "error_estimate(rho), amplitude(rho) and, driven, frc(w, f); the reduced "
+                   "dynamics in LaTeX (NAME_reduced.tex); see `lindstedt ssm`")
+    p.add_argument("--model", dest="model_dir", metavar="FOLDER",
+                   help="with --ssm: a model folder (M.mtx, K.mtx, C.mtx, nonlinear.txt, "
+                   "drive.txt) instead of SYSTEM")
+    p.add_argument("--output", metavar="LIST",
+                   help="with --ssm: the coordinates whose amplitudes the module gives "
+                   "(0-based indices or names; default as `lindstedt ssm`)")
+    _flag_omega(p, ("A:B",), "with --ssm and a drive: the range of frc(w, f) (default ±20 %% "
+                "about the mode's linear frequency)")
     _flag_allow_slow(p)
     _flag_overwrite_edited(p)
     return p

@@ -70,7 +70,7 @@ def ssm_json(red) -> dict:
             "order": m.order, "system": red.text, "coordinates": m.matrices.size,
             "outputs": {name: int(i) for name, i in zip(names, red.outputs, strict=True)},
             "linear": {"omega0": abs(lam), "damped_frequency": lam.imag,
-                       "damping_ratio": -lam.real / abs(lam)},
+                       "damping_ratio": -lam.real / abs(lam) + 0.0},
             "reduced_dynamics": "rho' = rho*a(rho), theta' = omega(rho), a + i*omega = "
                                 "sum_j gamma[j]*rho^(2j); x = W(rho*e^(i*theta), "
                                 "rho*e^(-i*theta)), W's linear part rho*2*Re(phi*e^(i*theta)) "
@@ -185,17 +185,9 @@ def _outputs(text: str | None, names: list[str]) -> list[int] | None:
 def run_ssm(args: argparse.Namespace) -> int:
     """Run ``lindstedt ssm``: read the system (text or folder), reduce, print."""
     from ..analysis.ssm import reduce
-    from ..derive.system import parse_system, read_model
 
     plot, csv = check_outputs(args)
-    if (args.system is None) == (args.model is None):
-        raise InputError("ssm: give a SYSTEM or --model DIR (one of them)")
-    if args.model is not None:
-        if args.param:
-            raise InputError("--param: a model folder holds numbers only (no parameters)")
-        system = read_model(args.model)
-    else:
-        system = parse_system(args.system, _params(args.param), driven=True)
+    system = _system(args.system, args.model, args.param)
     check_int(args.points, 2, SSM_MAX_POINTS, f"--omega …:{args.points}: the forced response "
               f"takes 2..{SSM_MAX_POINTS} drive frequencies")
     span = None
@@ -217,6 +209,62 @@ def run_ssm(args: argparse.Namespace) -> int:
     return 0
 
 
+def _system(text: str | None, folder: str | None, params, flag: str = "SYSTEM"):
+    """The system of a text or a model folder (exactly one of them)."""
+    from ..derive.system import parse_system, read_model
+
+    if (text is None) == (folder is None):
+        raise InputError(f"ssm: give a {flag} or --model DIR (one of them)")
+    if folder is not None:
+        if params:
+            raise InputError("--param: a model folder holds numbers only (no parameters)")
+        return read_model(folder)
+    return parse_system(text, _params(params), driven=True)
+
+
+def run_generate_ssm(args: argparse.Namespace) -> int:
+    """``generate SYSTEM --ssm M`` (or ``--model DIR``): the reduced model's numba module and
+    its LaTeX into --out."""
+    import shlex
+
+    from .. import compiler
+    from ..lower.printers import identifier
+    from .common import _out_folder
+
+    if args.ssm is None:
+        raise InputError("--model DIR: generate takes a model folder with --ssm M")
+    given = [flag for flag, on in (
+        ("--mode", args.mode is not None), ("--amplitude", args.amplitude is not None),
+        ("--damped", args.damped), ("--resum-order", args.resum_order is not None),
+        ("--allow-divergent", args.allow_divergent)) if on]
+    if given:
+        raise InputError(f"{', '.join(given)}: not for an SSM's reduced model (--ssm)")
+    if args.order > SSM_MAX_ORDER or args.order < 1:
+        raise InputError(f"--order {args.order}: the SSM is computed to order 1..{SSM_MAX_ORDER}")
+    system = _system(args.model, args.model_dir, args.param, "SYSTEM")
+    outputs = _outputs(args.output, [str(x) for x in system.coordinates])
+    span = None
+    if args.omega_min is not None:
+        span = (args.omega_min, args.omega_max)
+        if not 0 < span[0] < span[1]:
+            raise InputError(f"--omega {span[0]:g}:{span[1]:g}: give 0 < A < B")
+    name = identifier(args.name or f"ssm{args.ssm}")
+    source = (f"--model {shlex.quote(args.model_dir)}" if args.model_dir is not None
+              else f'"{args.model}"')
+    command = " ".join(["lindstedt generate", source, f"--ssm {args.ssm}",
+                        f"--order {args.order}", *(f"--param {p}" for p in args.param or ()),
+                        *([f"--output {args.output}"] if args.output else []),
+                        *([f"--omega {span[0]!r}:{span[1]!r}"] if span else []),
+                        f"--name {name}"])
+    paths = compiler.generate_ssm(system, args.ssm, args.order, _out_folder(args.out),
+                                  name=name, command=command,
+                                  outputs=None if outputs is None else tuple(outputs),
+                                  span=span, overwrite_edited=args.overwrite_edited)
+    for path in paths:
+        print(path)
+    return 0
+
+
 def arguments_ssm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """``lindstedt ssm``'s arguments."""
     p = sub.add_parser("ssm", help="the spectral submanifold of a mode of a damped system: "
@@ -234,7 +282,7 @@ def arguments_ssm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    help="equations such as \"x1'' + 0.02*x1' + 2*x1 - x2 + x1**3 = "
                    "f*cos(w*t); x2'' + 0.02*x2' + 2*x2 - x1 = 0\" (damping, a drive "
                    "f*cos(w*t) on any equations; every name but w needs --param)")
-    p.add_argument("--model", metavar="DIR",
+    p.add_argument("--model", metavar="FOLDER",
                    help="a model folder instead of SYSTEM: M.mtx, K.mtx, optional C.mtx "
                    "(Matrix Market), nonlinear.txt ('i j k c' adds c*x_j*x_k to f_i, "
                    "'i j k l c' adds c*x_j*x_k*x_l; 0-based), optional drive.txt ('i F_i')")

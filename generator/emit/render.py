@@ -48,6 +48,7 @@ from ..lower.records import (
     MuDampedDerivation,
     MuDerivation,
     Provenance,
+    ReducedModule,
     SeriesDerivation,
     SeriesTables,
     SlowFlowDocument,
@@ -601,8 +602,78 @@ def _model_text(name: str) -> str:
     return name.replace("_", " ").capitalize()
 
 
+def _complex(pair: tuple[float, float]) -> str:
+    """A complex constant as Python source that round-trips (``complex(re, im)``)."""
+    return f"complex({pyliteral(float(pair[0]))}, {pyliteral(float(pair[1]))})"
+
+
+def _flat(values: list) -> str:
+    """A flat list of complex constants, eight a line."""
+    items = [_complex(v) for v in values]
+    rows = [", ".join(items[i:i + 4]) for i in range(0, len(items), 4)]
+    return "[\n    " + ",\n    ".join(rows) + ",\n]"
+
+
+SSM_SAMPLES = 64
+# NOTE: samples of a period per harmonic order in the module's max |x_i(θ)| before Newton
+# refines the largest (the same as analysis.ssm's THETA_SAMPLES).
+
+
+def render_ssm_module(r: ReducedModule) -> str:
+    """The reduced model's numba module (template ``ssm.py.j2``)."""
+    driven = r.span is not None
+    return environment(latex=False).get_template("ssm.py.j2").render(
+        banner=banner(r.provenance, "#"), doc=r.doc, mode=r.mode, order=r.order,
+        outputs=repr(tuple(r.outputs)), outputs_count=len(r.outputs),
+        radius=pyliteral(float(r.radius)), gamma=", ".join(_complex(g) for g in r.gamma),
+        shape=_flat([z for order in r.shape for row in order for z in row]),
+        driven=driven, span=tuple(pyliteral(float(x)) for x in r.span or (0.0, 0.0)),
+        nodes=", ".join(pyliteral(float(x)) for x in r.nodes),
+        forcing=_flat([z for row in r.forcing for z in row]) if driven else "[]",
+        nodes_count=len(r.nodes), samples=SSM_SAMPLES)
+
+
+def _decimal_tex(x: float) -> str:
+    """``x`` to 12 significant digits in LaTeX (``1.5 \\times 10^{-7}``)."""
+    mantissa, _, exponent = f"{x:.12g}".partition("e")
+    return mantissa if not exponent else f"{mantissa} \\times 10^{{{int(exponent)}}}"
+
+
+def _even_polynomial(coefficients: list[float]) -> str:
+    """``Σ_j c_j ρ^{2j}`` in LaTeX with decimal coefficients (zero terms left out)."""
+    terms = []
+    for j, c in enumerate(coefficients):
+        if c == 0 and (terms or j < len(coefficients) - 1):
+            continue
+        power = "" if j == 0 else r"\rho^{2}" if j == 1 else rf"\rho^{{{2 * j}}}"
+        sign = "-" if c < 0 else ("+" if terms else "")
+        terms.append(f"{sign} {_decimal_tex(abs(c))}\\,{power}" if power else
+                     f"{sign} {_decimal_tex(abs(c))}")
+    return " ".join(terms).strip() or "0"
+
+
+def render_ssm_tex(r: ReducedModule, p: Provenance) -> dict[str, str]:
+    """``{"<name>_reduced.tex": text}``: the reduced dynamics with its coefficients."""
+    lam = complex(*r.gamma[0])
+    sign = "-" if lam.imag < 0 else "+"
+    tex = environment(latex=True).get_template("ssm.tex.j2").render(
+        banner=banner(p, "%"), mode=r.mode, order=r.order,
+        lam=f"{_decimal_tex(lam.real)} {sign} {_decimal_tex(abs(lam.imag))}\\,i",
+        terms=len(r.gamma) - 1, decay=_even_polynomial([g[0] for g in r.gamma]),
+        frequency=_even_polynomial([g[1] for g in r.gamma]),
+        zeta=_decimal_tex(-lam.real / abs(lam)),
+        radius=None if not math.isfinite(r.radius) else _decimal_tex(r.radius),
+        driven=r.span is not None, degree=2 * len(r.gamma) - 1,
+        lo=_decimal_tex(r.span[0]) if r.span else "", hi=_decimal_tex(r.span[1]) if r.span
+        else "")
+    return {f"{r.name}_reduced.tex": tex}
+
+
 def render(unit: Unit) -> dict[str, str]:
     """``{file name: text}`` of a unit: its module, then each document beside it."""
+    if isinstance(unit.module, ReducedModule):
+        return {f"{unit.module.name}.py": render_ssm_module(unit.module),
+                **render_ssm_tex(unit.module, unit.module.provenance)}
     files = {f"{unit.module.name}.py": render_module(unit.module)}
     renderers = {SeriesTables: render_tables, SeriesDerivation: render_derivation,
                  MuDerivation: render_mu_derivation,

@@ -366,3 +366,30 @@ class SlowFlowDocument:
     driven: bool
     radial: tuple[sp.Expr, ...]
     phase: tuple[sp.Expr, ...]
+
+
+# --- a spectral submanifold's reduced model --------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ReducedModule:
+    """The numbers of an SSM's reduced model for ``ssm.py.j2`` and ``ssm.tex.j2``: the normal
+    form's ``γ_j`` (real and imaginary parts), the radius in ρ, each output's Fourier
+    coefficients of ``ρ^k e^{ihθ}`` (``(K + 1) × (2K + 1) × outputs``), and the forcing on
+    Chebyshev nodes over ``[lo, hi]`` (``S`` and each output's ``X``; empty: not driven)."""
+
+    name: str
+    doc: str
+    provenance: Provenance
+    mode: int
+    order: int
+    outputs: tuple[str, ...]
+    gamma: tuple[tuple[float, float], ...]
+    radius: float
+    shape: tuple[tuple[tuple[tuple[float, float], ...], ...], ...]
+    span: tuple[float, float] | None
+    nodes: tuple[float, ...]
+    forcing: tuple[tuple[tuple[float, float], ...], ...]  # per node: (S, X_1, …, X_m)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "doc", docstring_text(self.doc))

@@ -25,6 +25,7 @@ from ..analysis.mu_exact import (
     mu_expansion_damped,
     mu_expansion_exact,
 )
+from ..analysis.ssm import Reduction, reduce
 from ..derive.averaging import SlowFlow, slow_flow
 from ..derive.cycles import LimitCycle, derive_limit_cycle
 from ..derive.lindstedt import SeriesSolution, derive
@@ -53,6 +54,7 @@ from ..lower.records import (
     Unit,
 )
 from ..lower.series import lower_limit_cycle, lower_mathieu, lower_periodic, lower_tongue
+from ..lower.ssm import lower_reduction
 from ..numerics.shooting import shoot
 from .verify import resum_cycle, resum_mathieu, resum_tongue
 
@@ -132,6 +134,19 @@ class NormalModeRequest(Request):
     amplitude: int
     name: str
     allow_divergent: bool = False
+
+
+@dataclass(frozen=True)
+class ReductionRequest(Request):
+    """The SSM of one mode of a system (text or model folder): its outputs (indices, None:
+    the default), the forced response's range (None: the default, where driven) and the
+    module's name."""
+
+    system: System
+    mode: int
+    outputs: tuple[int, ...] | None
+    span: tuple[float, float] | None
+    name: str
 
 
 @dataclass(frozen=True)
@@ -351,3 +366,14 @@ NNM: Target[NormalModeRequest, NormalModeSeries] = Target(
                                           r.allow_divergent),
                            (lower_tables(series, r.order),
                             lower_series_derivation(series, r.order))))
+
+
+SSM_FRC_POINTS = 41
+# NOTE: the forced response the derivation samples (its states are not emitted: the module
+# solves each w itself); the module's forcing comes from FORCING_NODES solves over the range.
+SSM: Target[ReductionRequest, Reduction] = Target(
+    lambda r: (f"{r.name}.py", f"{r.name}_reduced.tex"),
+    lambda r, progress: reduce(r.system, r.mode, r.order,
+                               None if r.outputs is None else list(r.outputs), None, r.span,
+                               SSM_FRC_POINTS),
+    lambda red, r: Unit(lower_reduction(red, r.name, r.command)))

@@ -16,14 +16,22 @@ what it stores:
   full Hill verdict (about the harmonic-balance orbit, :func:`numerics.orbit_hill_multipliers`)
   with its largest multiplier modulus;
 * ``validity``: the μ-expansion's and low-order harmonic balance's error in ``A₁`` against
-  harmonic balance with 10 harmonics on the largest branch (the driven validity chart).
+  harmonic balance with 10 harmonics on the largest branch (the driven validity chart);
+* ``ssm`` (a system or an equation only, :func:`_ssm_kind`): the spectral submanifold of one
+  mode at each point (:mod:`analysis.ssm`) and its forced response over a grid of drive
+  frequencies: each coordinate's peak amplitude over every steady state, the ω and ρ of the
+  largest state, the number of folds, the linear ``|λ|`` and damping ratio, the first
+  normal-form coefficient ``γ₁``. The SSM depends on M, C, K and f only, so it is computed
+  once per distinct value of the parameters that enter them (:func:`ssm_of`, cached in each
+  process) and only the forced response, linear in the drive, per point.
 
-Every point is computed by the existing solvers of :mod:`driven`, :mod:`response` and
-:mod:`numerics`; nothing here solves anything itself.
+Every point is computed by the existing solvers of :mod:`driven`, :mod:`response`,
+:mod:`analysis.ssm` and :mod:`numerics`; nothing here solves anything itself.
 
 One table (:data:`KINDS`) says which problems each kind takes: the notes' axes, a user's
 equation, a system; with an equation or a system (:func:`kind_of`) a kind is made of its
-own: any of its parameters an axis, every orbit stored with its r and Floquet verdict.
+own: any of its parameters an axis, every orbit stored with its r and Floquet verdict (or,
+for ``ssm``, its reduced model's forced response).
 """
 
 from __future__ import annotations
@@ -543,20 +551,24 @@ class KindOfMap:
     notes: Kind | None
     equation: Callable[..., Kind] | None = None
     system: Callable[..., Kind] | None = None
+    what: str = ""  # a system's map in a few words (the refusal that lists them)
+    template: Kind | None = None  # without a notes' map: what the cost estimate reads
 
     def why_not(self, problem: Problem | None) -> str | None:
         """``None`` where this kind takes ``problem`` (``None``: the notes' flags), else why
         not, in one line."""
         if problem is None:
-            return None if self.notes is not None else f"sweep {self.name}: give an equation"
+            return None if self.notes is not None else (
+                f"sweep {self.name}: give a SYSTEM (or an equation): its parameters are the "
+                "axes, --axis NAME=A:B:N")
         if problem.one_coordinate and self.equation is None:
             takes = ", ".join(k.name for k in KINDS.values() if k.equation is not None)
             return (f"sweep {self.name} EQUATION: the {self.name} map is the notes' "
                     f"(μ-expansion of q + eps q^3); with an equation use {takes}")
         if not problem.one_coordinate and self.system is None:
-            takes = ", ".join(k.name for k in KINDS.values() if k.system is not None)
-            return (f"sweep {self.name} SYSTEM: a system's map is {takes} (every periodic "
-                    "response with its Floquet verdict)")
+            takes = " or ".join(f"{k.name} ({k.what})" for k in KINDS.values()
+                                if k.system is not None)
+            return f"sweep {self.name} SYSTEM: a system's map is {takes}"
         return None
 
 
@@ -598,31 +610,241 @@ def _system_kind(kind: str, text: str, spec: EquationSpec, axes: tuple[str, ...]
                 "r_stable_max", settings, builtin=False, positive=(frequency,))
 
 
+# --- a system's spectral submanifold: any of its parameters an axis ----------------------------
+
+SSM_ORDER = 7
+# NOTE: ``lindstedt ssm``'s default order (cli.ssm.DEFAULT_ORDER).
+SSM_FRC_POINTS = 500
+# NOTE: the forced response's default grid (cli.ssm.FRC_POINTS), ±20 % about each point's
+# |λ| (analysis.ssm.DEFAULT_SPAN): for two coordinates ~0.17 s a point (500 bordered solves
+# batched, the steady states' polynomial roots and amplitudes), the SSM itself ~15 ms at
+# order 7 (measured): the forced response is the point's work, the SSM a large model's.
+SSM_CACHE = 64
+# NOTE: SSMs kept in each process by ssm_of (an SSM of a system written as text is a few
+# KiB): a sweep over drive amplitudes alone needs one, a grid of damping values one each.
+SSM_POINTS_PER_CHUNK = 6
+FOLDS_MAX = 127
+# NOTE: the int8 count's largest value (more folds than that are stored as 127).
+
+
+@dataclass(frozen=True)
+class SsmSpec:
+    """What one point of an ``ssm`` map needs: the system's text, the values fixed for the
+    whole map (exact rationals), the mode, the order, and the forced response's grid
+    ``(A, B, N)`` (``None``: ±20 % about each point's ``|λ|``, :data:`SSM_FRC_POINTS`)."""
+
+    text: str
+    values: tuple[tuple[str, str], ...]
+    mode: int
+    order: int
+    omega: tuple[float, float, int] | None
+
+
+@functools.lru_cache(maxsize=8)
+def _system_parts(text: str) -> tuple[tuple[str, ...], tuple, frozenset[str]]:
+    """The coordinates of the (driven) system ``text``, each equation's autonomous part and
+    its drive's amplitude (:func:`derive.system._read`), and the parameters of the autonomous
+    parts: those of M, C, K and f, on which the SSM depends (the drive's alone do not)."""
+    from ..derive.system import _read
+
+    coordinates, exprs, names, _ = _read(text, True)
+    autonomous = frozenset(str(x) for e, _ in exprs for x in e.free_symbols) & names
+    return tuple(coordinates), tuple(exprs), autonomous
+
+
+def _rationals(values: Sequence[tuple[str, str]]) -> dict:
+    import sympy as sp
+
+    return {sp.Symbol(k): sp.Rational(v) for k, v in values}
+
+
+@functools.lru_cache(maxsize=SSM_CACHE)
+def ssm_of(text: str, autonomous: tuple[tuple[str, str], ...], mode: int, order: int
+           ) -> object:
+    """The SSM (:func:`analysis.ssm.ssm`) of ``mode`` to ``order`` of the autonomous part
+    ``M x'' + C x' + K x + f(x, x') = 0`` of the system ``text`` at the exact values
+    ``autonomous`` (every parameter of M, C, K and f, none of the drive's), or the first line
+    of its refusal (an internal resonance, a mode that does not oscillate, …). Cached in each
+    process (:data:`SSM_CACHE`): a sweep computes one SSM per distinct value of these
+    parameters on each worker, whatever the drive's axes; its ``matrices`` have no drive."""
+    from ..analysis.ssm import ssm
+    from ..derive.system import _lowered
+
+    coordinates, exprs, _ = _system_parts(text)
+    given = _rationals(autonomous)
+    try:
+        system = _lowered(text, list(coordinates), [e.xreplace(given) for e, _ in exprs],
+                          allow_damping=True)
+        return ssm(system, mode, order)
+    except (InputError, np.linalg.LinAlgError, ArithmeticError) as e:
+        return (str(e).splitlines() or [type(e).__name__])[0]
+
+
+def _system_ssm(spec: SsmSpec, **axis: float) -> dict:
+    """One point of an ``ssm`` map: the SSM of the point's M, C, K, f (:func:`ssm_of`,
+    computed once per distinct value of their parameters), its forced response
+    (:func:`analysis.ssm.forced_response`, every steady state at each drive frequency, as
+    :func:`analysis.ssm.reduce` computes it) under this point's drive. Refused SSM: nothing
+    stored (NaN, ``folds`` −1); refused forced response (the drive resonant with another
+    mode, a drive amplitude holding a coordinate): the SSM's fields alone; a drive that
+    vanishes: the rest state, every peak 0. The peaks are over the steady states inside the
+    SSM's estimated radius (``reduce`` drops the others; ``beyond_radius`` says where)."""
+    from dataclasses import replace
+
+    from ..analysis.ssm import DEFAULT_SPAN, forced_response
+
+    values = _point_values(spec, axis)
+    coordinates, exprs, autonomous = _system_parts(spec.text)
+    model = ssm_of(spec.text, tuple(sorted((k, v) for k, v in values.items() if k in autonomous)),
+                   spec.mode, spec.order)
+    if isinstance(model, str):
+        return {}
+    lam = complex(model.lam)
+    gamma1 = complex(model.gamma[1]) if len(model.gamma) > 1 else complex(math.nan, math.nan)
+    out = {"omega0": abs(lam), "damping_ratio0": -lam.real / abs(lam),
+           "gamma1_re": gamma1.real, "gamma1_im": gamma1.imag}
+    given = _rationals(tuple(values.items()))
+    drive = [d.xreplace(given) for _, d in exprs]
+    if not all(d.is_Rational for d in drive):
+        return out  # a coordinate in a drive's amplitude: parametric, no forced response
+    F = np.array(drive, dtype=float)
+    if not F.any():  # no drive at this point: the rest state
+        return {**out, **{f"peak_{x}": 0.0 for x in coordinates}, "rho_peak": 0.0,
+                "folds": 0, "beyond_radius": 0}
+    lo, hi, points = spec.omega or ((1 - DEFAULT_SPAN) * abs(model.lam),
+                                    (1 + DEFAULT_SPAN) * abs(model.lam), SSM_FRC_POINTS)
+    driven = replace(model, matrices=replace(model.matrices, drive=F))
+    try:
+        response = forced_response(driven, np.linspace(lo, hi, points),
+                                   np.arange(len(coordinates)))
+    except (InputError, np.linalg.LinAlgError, ArithmeticError):
+        return out
+    out["folds"] = min(len(response.folds), FOLDS_MAX)
+    out["beyond_radius"] = int(response.beyond > 0)
+    if response.states:
+        peaks = np.max([s.amplitude for s in response.states], axis=0)
+        out.update({f"peak_{x}": float(a) for x, a in zip(coordinates, peaks, strict=True)})
+        top = max(response.states, key=lambda s: s.rho)
+        out["omega_peak"], out["rho_peak"] = top.omega, top.rho
+    return out
+
+
+def _ssm_kind(text: str, values: Mapping[str, str], axes: tuple[str, ...], mode: int,
+              order: int, omega: tuple[float, float, int] | None) -> Kind:
+    """A system's (or an equation's) ``ssm`` map: any of its parameters but the drive
+    frequency an axis (the forced response at each point spans the frequencies ``omega``),
+    the rest exact values; refused in one line: no drive, the drive frequency an axis or a
+    value, a parameter not an axis or a value or both, a value that is no exact rational, a
+    mode, order or grid out of range, an axis named as a field."""
+    from ..derive.equation import parse_expression
+    from ..derive.system import system_parameters
+    from ..limits import SSM_MAX_ORDER, SSM_MAX_POINTS, check_int
+
+    check_int(mode, 1, None, f"--mode {mode!r}: a mode number 1, 2, …")
+    check_int(order, 1, SSM_MAX_ORDER, f"--order {order!r}: the SSM is computed to order "
+              f"1..{SSM_MAX_ORDER}")
+    parameters, frequency = system_parameters(text)
+    if frequency is None:
+        raise InputError(f"system {text!r}: no drive; sweep ssm SYSTEM needs f*cos(w*t) on "
+                         "the right of an equation")
+    for flag, given in (("--axis", axes), ("--param", values)):
+        if frequency in given:
+            raise InputError(f"{flag} {frequency}: {frequency} is the drive frequency; each "
+                             "point's forced response spans it (--omega A:B:N)")
+    _check_names(text, set(parameters), axes, values)
+    exact = {}
+    for k, v in values.items():
+        x = parse_expression(v, f"--param {k}")
+        if not x.is_Rational:
+            raise InputError(f"--param {k}={v}: an exact rational, e.g. 1/3")
+        exact[k] = str(x)
+    if omega is not None:
+        lo, hi, points = omega
+        check_int(points, 2, SSM_MAX_POINTS, f"--omega …:{points}: the forced response takes "
+                  f"2..{SSM_MAX_POINTS} drive frequencies")
+        if not 0 < lo < hi < math.inf:
+            raise InputError(f"--omega {lo:g}:{hi:g}:{points}: give 0 < A < B")
+        omega = (float(lo), float(hi), int(points))
+    coordinates, _, _ = _system_parts(text)
+    fields = (
+        *(Field(f"peak_{x}", f"peak of max |{x}| over the forced response")
+          for x in coordinates),
+        Field("omega_peak", "drive frequency of the forced response's largest steady state "
+              "(largest rho)"),
+        Field("rho_peak", "rho (normal-form amplitude) of the largest steady state"),
+        Field("beyond_radius", "steady states past the SSM's estimated radius were dropped "
+              "(the peaks are those inside it)", "int8", flag=True),
+        Field("folds", "folds of the forced response over the drive frequencies", "int8",
+              unset="not computed, or the SSM or its forced response is refused at this "
+              "point (lindstedt ssm SYSTEM there says why)"),
+        Field("omega0", "|lambda|: the mode's linear natural frequency"),
+        Field("damping_ratio0", "-Re(lambda)/|lambda|: the mode's linear damping ratio"),
+        Field("gamma1_re", "Re gamma_1: rho' = rho (Re lambda + Re gamma_1 rho^2 + ...)"),
+        Field("gamma1_im", "Im gamma_1: the backbone omega(rho) = Im lambda + Im gamma_1 "
+              "rho^2 + ..."))
+    clash = sorted(set(axes) & ({f.name for f in fields} | {"chunk", "done"}))
+    if clash:
+        raise InputError(f"--axis {clash[0]}: the store holds a field of that name; rename "
+                         "the parameter in the system")
+    grid = (f"±20 % about |lambda|, {SSM_FRC_POINTS} frequencies" if omega is None else
+            f"omega {omega[0]:g}..{omega[1]:g}, {omega[2]} frequencies")
+    settings = (("system", text), ("values", dict(sorted(exact.items()))), ("mode", mode),
+                ("order", order), ("omega", None if omega is None else list(omega)))
+    spec = SsmSpec(text, tuple(sorted(exact.items())), mode, order, omega)
+    return Kind("ssm", f"the SSM of mode {mode} of {text} to order {order} and its forced "
+                f"response ({grid})", axes, (), fields, functools.partial(_system_ssm, spec),
+                tuple((a, 1.0) for a in axes), SSM_POINTS_PER_CHUNK, f"peak_{coordinates[0]}",
+                settings, builtin=False)
+
+
+def _ssm_needs_a_problem(**axis: float) -> dict:
+    raise InputError(KINDS["ssm"].why_not(None))
+
+
+SSM_TEMPLATE = Kind("ssm", "the SSM of one mode of a system at each point (the template: "
+                    "give a SYSTEM)", (), (), (), _ssm_needs_a_problem, (),
+                    SSM_POINTS_PER_CHUNK, "omega0", ())
+
+
 _EQUATION_BRANCH = ("branch", tuple(range(1, EQUATION_BRANCHES + 1)))
 
 KINDS: Mapping[str, KindOfMap] = {k.name: k for k in (
-    KindOfMap("response", RESPONSE, _orbits_kind, _system_kind),
+    KindOfMap("response", RESPONSE, _orbits_kind, _system_kind,
+              "every periodic response with its Floquet verdict"),
     KindOfMap("stability", STABILITY, _orbits_kind),
     KindOfMap("subharmonic", SUBHARMONIC, _subharmonic_kind),
     KindOfMap("validity", VALIDITY),
+    KindOfMap("ssm", None, _ssm_kind, _ssm_kind,
+              "one mode's spectral submanifold and its forced response", SSM_TEMPLATE),
 )}
 # NOTE: the one table of kinds: with an equation, response and stability are one map (every
 # orbit shot, its Floquet verdict); validity is the notes' μ-expansion's and takes no equation;
-# a system's map is response.
+# a system's map is response or ssm; ssm takes no notes' axes (its builder, _ssm_kind, takes
+# the mode, the order and the forced response's ω grid besides).
 
 
 def kind_named(name: str) -> Kind:
-    """The notes' :class:`Kind` called ``name``, or :class:`InputError` listing the kinds."""
+    """The notes' :class:`Kind` called ``name``, or :class:`InputError` listing the kinds; a
+    kind without a notes' map (``ssm``) gives its template, no axes, whose cost per point is
+    what the cost estimate reads before the problem is (its point refuses: give a system)."""
+    entry = KINDS.get(name)
+    if entry is not None and entry.notes is None and entry.template is not None:
+        return entry.template
     return kind_of(name)
 
 
 def kind_of(kind: str, text: str | None = None, values: Mapping[str, str] | None = None,
-            axes: Sequence[str] = (), n: int = 3, name: str = "oscillator") -> Kind:
+            axes: Sequence[str] = (), n: int = 3, name: str = "oscillator", *,
+            mode: int = 1, order: int = SSM_ORDER,
+            omega: tuple[float, float, int] | None = None) -> Kind:
     """The :class:`Kind` of ``sweep KIND [PROBLEM]`` from :data:`KINDS`: without ``text`` the
     notes' (over omega, force, eps, Q); with an equation or a system, its parameters the axes
     (its drive frequency included), every other parameter a value in ``values``; refused in
     one line: a kind that does not take the problem (:meth:`KindOfMap.why_not`), an axis that
-    names no parameter, a parameter both an axis and a value, a parameter with neither."""
+    names no parameter, a parameter both an axis and a value, a parameter with neither.
+    ``ssm`` (:func:`_ssm_kind`) takes ``mode``, ``order`` and ``omega``, the forced response's
+    grid ``(A, B, N)`` (``None``: ±20 % about each point's ``|λ|``, 500 frequencies); its
+    drive frequency is no axis."""
     from ..analysis.polynomial import driven_form
     from ..analysis.subharmonic import check_n
     from ..analysis.systems import driven_system
@@ -644,12 +866,14 @@ def kind_of(kind: str, text: str | None = None, values: Mapping[str, str] | None
         check_n(n)
     if not axes:
         raise InputError("sweep EQUATION: give at least one axis, --axis NAME=A:B:N")
+    if kind == "ssm":
+        return _ssm_kind(text, values, tuple(axes), mode, order, omega)
     # NOTE: a system's map holds a field per coordinate (r_x1, …): another Kind's fields
     system = not problem.one_coordinate
     if system:
         parameters, frequency = system_parameters(text)
         if frequency is None:
-            raise InputError(f"system {text!r}: no drive; sweep response SYSTEM needs "
+            raise InputError(f"system {text!r}: no drive; sweep {kind} SYSTEM needs "
                              "f*cos(w*t) on the right of an equation")
         names = {*parameters, frequency}
     else:
@@ -657,18 +881,7 @@ def kind_of(kind: str, text: str | None = None, values: Mapping[str, str] | None
         names = {str(p) for p in osc.equation.parameters}
         if osc.equation.small is not None:
             names.add("eps")
-    both = sorted(set(axes) & set(values))
-    if both:
-        raise InputError(f"--axis {both[0]} and --param {both[0]}: a parameter is an axis or a "
-                         "value, not both")
-    unknown = sorted(set(axes) - names) + sorted(set(values) - names)
-    if unknown:
-        raise InputError(f"{unknown[0]}: not a parameter of {text!r} (its parameters: "
-                         f"{', '.join(sorted(names)) or 'none'})")
-    missing = sorted(names - set(axes) - set(values))
-    if missing:
-        raise InputError(f"{missing[0]}: give it a value (--param {missing[0]}=...) or an axis "
-                         f"(--axis {missing[0]}=A:B:N)")
+    _check_names(text, names, axes, values)
     taken = {f.name for f in (*STABILITY.fields, *SUBHARMONIC.fields)} | {"branch", "chunk",
                                                                           "done"}
     clash = sorted(set(axes) & taken)
@@ -703,6 +916,24 @@ def kind_of(kind: str, text: str | None = None, values: Mapping[str, str] | None
         return entry.system(kind, text, spec, tuple(axes), common, settings, frequency,
                             coordinates)
     return entry.equation(kind, text, spec, tuple(axes), common, settings, frequency)
+
+
+def _check_names(text: str, names: set[str], axes: Sequence[str], values: Mapping[str, str]
+                 ) -> None:
+    """Every parameter in ``names`` an axis or a value, not both, and nothing else: else one
+    line."""
+    both = sorted(set(axes) & set(values))
+    if both:
+        raise InputError(f"--axis {both[0]} and --param {both[0]}: a parameter is an axis or a "
+                         "value, not both")
+    unknown = sorted(set(axes) - names) + sorted(set(values) - names)
+    if unknown:
+        raise InputError(f"{unknown[0]}: not a parameter of {text!r} (its parameters: "
+                         f"{', '.join(sorted(names)) or 'none'})")
+    missing = sorted(names - set(axes) - set(values))
+    if missing:
+        raise InputError(f"{missing[0]}: give it a value (--param {missing[0]}=...) or an axis "
+                         f"(--axis {missing[0]}=A:B:N)")
 
 
 def _frequency_name(osc: object, text: str, name: str) -> str:
