@@ -1,0 +1,808 @@
+"""An independent full-order reference for the SSM tests: periodic orbits of the damped, driven
+
+    M x'' + C x' + K x + f(x, x') = F cos(ω t)
+
+by single shooting, judged by residuals.
+
+Nothing here imports the package ``generator``: NumPy and SciPy only.  Time is rescaled to
+``τ = ω t`` so that every orbit has period ``2π``; the state is ``y = (x, v)`` with ``v = dx/dt``.
+One period of the state and of its variational equations (the monodromy ``Φ = ∂y(2π)/∂y(0)``
+and ``z = ∂y(2π)/∂ω``) is integrated by ``solve_ivp(method="DOP853", rtol=1e-12, atol=1e-13)``.
+
+* ``forced_orbit``: Newton on ``y(2π) - y(0) = 0`` at fixed ω; the orbit is accepted only when
+  the residual ``|y(2π) - y(0)| / |y(0)|`` is at most a stated threshold (1e-11 by default;
+  never on a solver flag), else ``ShootingError``.
+* ``forced_curve``: natural-parameter continuation over a grid of ω; reports folds instead of
+  jumping across them.
+* ``trace_branch`` and ``peak``: pseudo-arclength continuation in ``(y(0), ω)`` (through
+  folds), and the peak of an amplitude where its derivative along the arclength vanishes.
+* ``free_decay``: the unforced motion from given initial conditions.
+* ``linear_amplitude``: the closed-form linear amplitudes, for checks.
+
+Every loop is bounded by a number of steps, never by time; nothing is random.  One period of a
+2-DOF system costs ~15-30 ms, an orbit ~0.1 s, a peak through a fold ~100 periods (2-3 s).
+
+The force is ``None`` (linear), a table of monomials (``terms_force``, exact Jacobians), a
+``Force`` or ``(f, dfdx, dfdv)`` triple, or a bare callable ``f(x, v)`` (``callable_force``,
+central finite differences).  Amplitudes are ``max_t |x_i(t)|`` over one period: the largest of
+400 samples of the dense output, refined by Newton on ``v_i(τ) = 0``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from itertools import pairwise
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+TWO_PI = 2.0 * math.pi
+RTOL, ATOL = 1e-12, 1e-13
+TINY = np.finfo(float).tiny
+TRACE_TOL = 1e-6  # residual of the intermediate points of ``peak``'s traces
+STEP_MAX = 8.0  # the largest pseudo-arclength step is STEP_MAX / points (scaled units)
+
+
+class ShootingError(RuntimeError):
+    """Newton's method did not bring the shooting residual below its threshold."""
+
+
+class ContinuationError(RuntimeError):
+    """A continuation could not proceed within its bounded number of steps."""
+
+
+# --------------------------------------------------------------------------- forces
+
+
+class Force:
+    """A nonlinear force ``f(x, v)`` with its Jacobians; unpacks as ``(f, dfdx, dfdv)``.
+
+    ``through(A)`` is the fast path the integrator uses: a function of ``y = (x, v)``
+    returning ``(A @ f, A @ [dfdx | dfdv])``."""
+
+    def __init__(self, f: Callable, dfdx: Callable, dfdv: Callable,
+                 through: Callable | None = None):
+        self.f, self.dfdx, self.dfdv = f, dfdx, dfdv
+        self._through = through
+
+    def __iter__(self):
+        return iter((self.f, self.dfdx, self.dfdv))
+
+    def through(self, A: np.ndarray) -> Callable:
+        if self._through is not None:
+            return self._through(A)
+        n = A.shape[1]
+
+        def at(y):
+            x, v = y[:n], y[n:]
+            jac = np.hstack((np.asarray(self.dfdx(x, v), float),
+                             np.asarray(self.dfdv(x, v), float)))
+            return A @ np.asarray(self.f(x, v), float), A @ jac
+
+        return at
+
+
+def terms_force(n: int, terms: Sequence) -> Force:
+    """The force of a table of monomials, with exact Jacobians.
+
+    Each entry ``(i, [j, k, ...], c)`` adds ``c * z[j] * z[k] * ...`` to ``f_i``, where
+    ``z = concatenate(x, v)``: an index below ``n`` is ``x_j``, one at or above ``n`` is
+    ``v_{j-n}``.  Repeated indices give powers (``(0, [0, 0, 0], 1.0)`` is ``x_0³``)."""
+    table = [(int(i), [int(j) for j in js], float(c)) for i, js, c in terms]
+    for i, js, _ in table:
+        if not 0 <= i < n or any(not 0 <= j < 2 * n for j in js):
+            raise ValueError(f"term ({i}, {js}) out of range for n = {n}")
+    N, m = 2 * n, len(table)
+    degree = max([1] + [len(js) for _, js, _ in table])
+    index = np.full((m, degree), N)  # z[N] = 1 pads monomials of lower degree
+    for r, (_, js, _) in enumerate(table):
+        index[r, :len(js)] = js
+    row = np.array([i for i, _, _ in table], dtype=int)
+    coef = np.array([c for _, _, c in table])
+    # slot (p, r), p-major: the other factors of monomial r, and the z index it differentiates
+    others = np.array([np.delete(index[r], p) for p in range(degree) for r in range(m)],
+                      dtype=int).reshape(m * degree, degree - 1)
+    wrt = index.T.ravel()
+    select = np.zeros((m * degree, N + 1))
+    select[np.arange(m * degree), wrt] = 1.0
+    select = select[:, :N]  # the padding 1 is no variable
+    rows = np.zeros((n, m))
+    rows[row, np.arange(m)] = coef
+    product = np.multiply.reduce
+
+    def through(A):
+        z = np.ones(N + 1)
+        value, slope = A @ rows, np.tile(A @ rows, degree)
+
+        def at(y):
+            z[:N] = y
+            return (value @ product(z[index], axis=1),
+                    (slope * product(z[others], axis=1)) @ select)
+
+        return at
+
+    plain = through(np.eye(n))
+
+    def split(x, v):
+        return plain(np.concatenate((np.asarray(x, float), np.asarray(v, float))))
+
+    return Force(lambda x, v: split(x, v)[0], lambda x, v: split(x, v)[1][:, :n],
+                 lambda x, v: split(x, v)[1][:, n:], through)
+
+
+def callable_force(f: Callable, n: int, step: float = 1e-6) -> Force:
+    """A bare ``f(x, v) -> ndarray`` with Jacobians by central differences of relative step
+    ``step`` (errors ~1e-10: Newton and the multipliers are fine, amplitudes are exact); each
+    right-hand side then calls ``f`` 1 + 4n times, ~10x slower than ``terms_force``."""
+
+    def jacobian(x, v, which):
+        x, v = np.asarray(x, float), np.asarray(v, float)
+        out = np.empty((n, n))
+        for j in range(n):
+            z = [x.copy(), v.copy()]
+            h = step * max(1.0, abs(z[which][j]))
+            z[which][j] += h
+            up = np.asarray(f(*z), float)
+            z[which][j] -= 2 * h
+            out[:, j] = (up - np.asarray(f(*z), float)) / (2 * h)
+        return out
+
+    return Force(f, lambda x, v: jacobian(x, v, 0), lambda x, v: jacobian(x, v, 1))
+
+
+def _as_force(force, n: int) -> Force | None:
+    if force is None or isinstance(force, Force):
+        return force
+    if callable(force):
+        return callable_force(force, n)
+    force = list(force)
+    if len(force) == 3 and all(callable(g) for g in force):
+        return Force(*force)
+    return terms_force(n, force)
+
+
+# --------------------------------------------------------------------------- the system
+
+
+class _System:
+    """``y' = g(y, τ) / ω`` in ``τ = ω t``, with the variational equations of ``(y0, ω)``.
+
+    The integrated state is ``Q = [y | Φ | z]``, an ``N × (N+2)`` matrix flattened by rows."""
+
+    def __init__(self, M, C, K, force, F):
+        M = np.atleast_2d(np.asarray(M, float))
+        n = M.shape[0]
+        C = np.atleast_2d(np.asarray(C, float))
+        K = np.atleast_2d(np.asarray(K, float))
+        F = np.atleast_1d(np.asarray(F, float))
+        if C.shape != (n, n) or K.shape != (n, n) or F.shape != (n,):
+            raise ValueError("M, C, K must be n×n and F of length n")
+        minv = np.linalg.inv(M)
+        self.n, self.N = n, 2 * n
+        self.M, self.C, self.K, self.F = M, C, K, F
+        self.mkc, self.mf = minv @ np.hstack((K, C)), minv @ F
+        force = _as_force(force, n)
+        self.nonlinear = None if force is None else force.through(minv)
+
+    def accel(self, y, tau):
+        """``dv/dt`` at ``y = (x, v)`` and forcing phase ``τ``."""
+        acc = self.mf * math.cos(tau) - self.mkc @ y
+        if self.nonlinear is not None:
+            acc -= self.nonlinear(y)[0]
+        return acc
+
+    def rhs(self, omega: float) -> Callable:
+        """``dQ/dτ``: the state and its sensitivities ``[Φ | z]`` to ``(y0, ω)``."""
+        n, N = self.n, self.N
+        mkc, mf, nonlinear = self.mkc, self.mf, self.nonlinear
+        inv = 1.0 / omega
+
+        def fun(tau, Y):
+            Q = Y.reshape(N, N + 2)
+            y = Q[:, 0]
+            out = np.empty((N, N + 2))
+            out[:n] = Q[n:]
+            if nonlinear is None:
+                out[n:, 0] = mf * math.cos(tau) - mkc @ y
+                out[n:, 1:] = -mkc @ Q[:, 1:]
+            else:
+                g, jac = nonlinear(y)
+                out[n:, 0] = mf * math.cos(tau) - mkc @ y - g
+                out[n:, 1:] = -(mkc + jac) @ Q[:, 1:]
+            out *= inv
+            out[:, -1] -= out[:, 0] * inv  # ∂/∂ω of g/ω is -g/ω²
+            return out.ravel()
+
+        return fun
+
+    def linear_phasor(self, omega: float) -> np.ndarray:
+        """``X`` with ``(K - ω²M + iωC) X = F``: the linear response ``Re(X e^{iωt})``."""
+        return np.linalg.solve(self.K - omega**2 * self.M + 1j * omega * self.C, self.F)
+
+    def linear_guess(self, omega: float) -> np.ndarray:
+        X = self.linear_phasor(omega)
+        return np.concatenate((X.real, -omega * X.imag))
+
+
+@dataclass
+class _Shot:
+    y0: np.ndarray
+    omega: float
+    yT: np.ndarray
+    Phi: np.ndarray
+    z: np.ndarray
+    sol: object | None
+
+    @property
+    def residual(self) -> float:
+        return float(np.linalg.norm(self.yT - self.y0) / max(np.linalg.norm(self.y0), TINY))
+
+
+def _shoot(system: _System, y0: np.ndarray, omega: float, dense: bool = False) -> _Shot:
+    """One period of the state and of ``[Φ | z]`` from ``y0``."""
+    N = system.N
+    start = np.hstack((np.asarray(y0, float)[:, None], np.eye(N), np.zeros((N, 1))))
+    sol = solve_ivp(system.rhs(omega), (0.0, TWO_PI), start.ravel(), method="DOP853",
+                    rtol=RTOL, atol=ATOL, dense_output=dense)
+    if sol.status != 0 or not np.all(np.isfinite(sol.y[:, -1])):
+        raise ShootingError(f"integration failed at omega = {omega}: {sol.message}")
+    Q = sol.y[:, -1].reshape(N, N + 2)
+    return _Shot(np.array(y0, float), float(omega), Q[:, 0].copy(), Q[:, 1:-1].copy(),
+                 Q[:, -1].copy(), sol.sol if dense else None)
+
+
+def _at(shot: _Shot, tau) -> np.ndarray:
+    """``Q(τ) = [y | Φ | z]`` from the dense output: ``(N, N+2)`` or ``(N, N+2, len(τ))``."""
+    N = len(shot.y0)
+    Y = shot.sol(tau)
+    return Y.reshape((N, N + 2, *Y.shape[1:]))
+
+
+def _peak_times(system: _System, shot: _Shot, samples: int = 400) -> tuple:
+    """``max_τ |x_i(τ)|`` and its ``τ`` for every coordinate: the largest sample of the dense
+    output, then Newton on ``v_i(τ) = 0`` (``dv_i/dτ = a_i / ω``), steps within one sample."""
+    n, omega = system.n, shot.omega
+    grid = np.linspace(0.0, TWO_PI, samples, endpoint=False)
+    xs = _at(shot, grid)[:n, 0]
+    spacing = TWO_PI / samples
+    amplitude, times = np.zeros(n), np.zeros(n)
+    for i in range(n):
+        tau = grid[int(np.argmax(np.abs(xs[i])))]
+        for _ in range(8):
+            y = _at(shot, tau % TWO_PI)[:, 0]
+            acc = system.accel(y, tau)[i]
+            if acc == 0.0:
+                break
+            step = float(np.clip(-omega * y[n + i] / acc, -spacing, spacing))
+            tau += step
+            if abs(step) < 1e-15:
+                break
+        tau %= TWO_PI
+        times[i] = tau
+        amplitude[i] = max(abs(_at(shot, tau)[i, 0]), np.max(np.abs(xs[i])))
+    return amplitude, times
+
+
+# --------------------------------------------------------------------------- one orbit
+
+
+@dataclass(frozen=True)
+class Orbit:
+    """A periodic orbit of period ``2π/ω``.
+
+    ``y0 = (x(0), v(0))``; ``residual = |y(T) - y0| / |y0|``; ``multipliers`` are the Floquet
+    multipliers (eigenvalues of the monodromy); ``stable`` means all ``|μ| < 1``;
+    ``amplitude[i] = max_t |x_i(t)|``; ``steps`` is the number of integrations Newton used;
+    ``tolerance`` the threshold the residual was judged against."""
+
+    omega: float
+    y0: np.ndarray
+    residual: float
+    multipliers: np.ndarray
+    stable: bool
+    amplitude: np.ndarray
+    steps: int
+    tolerance: float = field(repr=False, default=1e-11)
+
+
+def _orbit(system: _System, shot: _Shot, steps: int, tol: float) -> Orbit:
+    mu = np.linalg.eigvals(shot.Phi)
+    amplitude, _ = _peak_times(system, shot)
+    return Orbit(shot.omega, shot.y0, shot.residual, mu, bool(np.all(np.abs(mu) < 1.0)),
+                 amplitude, steps, tol)
+
+
+def _newton(system: _System, omega: float, y0: np.ndarray, tol: float,
+            max_steps: int = 30, max_halvings: int = 6) -> tuple[_Shot, int]:
+    """Newton on ``y(2π) - y0`` at fixed ω, halving steps that do not lower the residual; at
+    most ``max_steps`` integrations, and it gives up after ``max_halvings`` halvings in a row
+    (a stall: no orbit near, typically past a fold).  Returns a dense shot whose residual is
+    at most ``tol``, else ``ShootingError``."""
+    N = system.N
+    y, base, delta, base_res, res = np.array(y0, float), None, None, math.inf, math.inf
+    halvings = 0
+    for step in range(1, max_steps + 1):
+        try:
+            shot = _shoot(system, y, omega, dense=base_res < 1e-4)  # dense: likely the last
+            res = shot.residual
+        except ShootingError:
+            if delta is None:
+                raise
+            shot, res = None, math.inf
+        if delta is not None and not res < base_res:
+            if halvings == max_halvings:
+                break
+            halvings += 1
+            delta = delta / 2  # backtrack towards the last accepted iterate
+            y = base + delta
+            continue
+        if res <= tol:
+            if shot.sol is None:
+                shot = _shoot(system, y, omega, dense=True)
+                step += 1
+            return shot, step
+        base, base_res, halvings = y, res, 0
+        delta = -np.linalg.solve(shot.Phi - np.eye(N), shot.yT - y)
+        y = base + delta
+    raise ShootingError(f"omega = {omega:.12g}: residual {base_res:.3e} above {tol:.1e} after "
+                        f"{step} Newton steps ({halvings} halvings in a row)")
+
+
+def forced_orbit(M, C, K, force, F, omega: float, guess=None, tol: float = 1e-11) -> Orbit:
+    """The periodic orbit of period ``2π/ω`` of ``M x'' + C x' + K x + f(x, x') = F cos ωt``
+    near ``guess`` (``y0 = (x(0), x'(0))``; ``None``: the linear response), by single shooting.
+
+    Newton on ``y(T) - y(0) = 0`` with the monodromy from the variational equations, at most
+    30 integrations; the orbit is returned only if ``|y(T) - y0| / |y0| <= tol``, else
+    ``ShootingError`` says which residual was reached."""
+    system = _System(M, C, K, force, F)
+    y0 = system.linear_guess(omega) if guess is None else np.asarray(guess, float)
+    shot, steps = _newton(system, float(omega), y0, tol)
+    return _orbit(system, shot, steps, tol)
+
+
+def linear_amplitude(M, C, K, F, omega: float) -> np.ndarray:
+    """``|X_i|`` with ``(K - ω²M + iωC) X = F``: the closed-form linear amplitudes."""
+    return np.abs(_System(M, C, K, None, F).linear_phasor(omega))
+
+
+# --------------------------------------------------------------------------- natural parameter
+
+
+@dataclass(frozen=True)
+class Curve:
+    """A response curve over a grid of ω (``amplitude[k, i] = max_t |x_i|`` at ``omegas[k]``).
+
+    ``folds`` lists the indices past a fold: the branch followed by pseudo-arclength from the
+    previous orbit turned back before reaching that ω.  With ``stop_at_fold`` the entries from
+    the first fold on are NaN (``stable`` False); ``residual`` is each orbit's shooting
+    residual."""
+
+    omegas: np.ndarray
+    amplitude: np.ndarray
+    stable: np.ndarray
+    residual: np.ndarray
+    y0: np.ndarray
+    folds: list
+
+
+def _same(a: np.ndarray, b: np.ndarray, rel: float = 1e-6) -> bool:
+    return bool(np.linalg.norm(a - b) <= rel * max(np.linalg.norm(a), np.linalg.norm(b), TINY))
+
+
+def forced_curve(M, C, K, force, F, omegas, guess=None, tol: float = 1e-11,
+                 stop_at_fold: bool = True) -> Curve:
+    """Natural-parameter continuation over an increasing grid ``omegas``.
+
+    The first orbit starts from ``guess`` (default: the linear response ``(K - ω²M + iωC) X =
+    F``; ``ShootingError`` if Newton fails there), every later one from the linear
+    extrapolation of the previous one along its tangent ``dy0/dω = -(Φ - I)⁻¹ z`` (from the
+    variational equations, exact to first order).  This follows ONE branch, the one
+    connected to the start; it cannot pass a fold, and it reports one rather than silently
+    jumping: where Newton fails, or where the orbit it finds is far from the extrapolation
+    (more than twice the predicted step and 2 % of |y0|), the branch is followed from the
+    previous orbit to the new ω by pseudo-arclength.  If it gets there without turning back,
+    that orbit is the next point (a steep stretch, no fold); if it turns back, the index goes
+    to ``folds``.  ``stop_at_fold``: NaN from there on; otherwise go on from the orbit Newton
+    found (or from the linear response, if it found none).  A jump smaller than both bounds
+    (near a cusp) is not examined."""
+    system = _System(M, C, K, force, F)
+    omegas = np.asarray(omegas, float)
+    if np.any(np.diff(omegas) <= 0):
+        raise ValueError("omegas must increase")
+    n, N, m = system.n, system.N, len(omegas)
+    amplitude, y0s = np.full((m, n), np.nan), np.full((m, N), np.nan)
+    stable, residual = np.zeros(m, bool), np.full(m, np.nan)
+    folds: list[int] = []
+    last: _Shot | None = None  # the previous orbit, None at the start and after a restart
+    for k, omega in enumerate(omegas):
+        if last is None:
+            pred = system.linear_guess(omega) if guess is None or k else np.asarray(guess, float)
+        else:
+            pred = last.y0 - (omega - last.omega) * np.linalg.solve(last.Phi - np.eye(N), last.z)
+        try:
+            shot, steps = _newton(system, omega, pred, tol)
+        except ShootingError:
+            if k == 0:
+                raise
+            shot, steps = None, 0
+        if last is not None:
+            suspicious = shot is None or np.linalg.norm(shot.y0 - pred) > max(
+                2 * np.linalg.norm(pred - last.y0), 0.02 * np.linalg.norm(last.y0))
+            if suspicious:
+                bridged = _bridge(system, last, omega, tol)
+                if bridged is None:
+                    folds.append(k)
+                    if stop_at_fold:
+                        break
+                shot = bridged or shot
+        last = shot
+        if shot is not None:
+            orbit = _orbit(system, shot, steps, tol)
+            amplitude[k], y0s[k] = orbit.amplitude, orbit.y0
+            stable[k], residual[k] = orbit.stable, orbit.residual
+    return Curve(omegas, amplitude, stable, residual, y0s, folds)
+
+
+# --------------------------------------------------------------------------- pseudo-arclength
+
+
+@dataclass
+class _Point:
+    """A converged point of a branch, in scaled coordinates ``w = (y0, ω) / scale``."""
+
+    w: np.ndarray
+    shot: _Shot
+    tangent: np.ndarray
+    amplitude: np.ndarray
+    slope: float  # d amplitude[coordinate] / ds along ``tangent``
+    stable: bool
+
+
+def _scale(system: _System, lo: float, hi: float, points: int) -> np.ndarray:
+    """Scales of ``(x, v, ω)``: the largest linear |X| and ω|X| over [lo, hi], and hi - lo."""
+    grid = np.linspace(lo, hi, max(points, 2) * 4)
+    X = np.array([np.linalg.norm(system.linear_phasor(w)) for w in grid])
+    sx, sv = max(X.max(), TINY), max((grid * X).max(), TINY)
+    n = system.n
+    return np.concatenate((np.full(n, sx), np.full(n, sv), [hi - lo]))
+
+
+def _jacobian(shot: _Shot, scale: np.ndarray) -> np.ndarray:
+    """``∂R/∂w`` of the scaled residual ``R = (y(2π) - y0) / scale``."""
+    N = len(shot.y0)
+    J = np.hstack((shot.Phi - np.eye(N), shot.z[:, None])) * scale
+    return J / scale[:N, None]
+
+
+def _tangent(J: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
+    """The unit null vector of ``J``, oriented along ``previous`` (or the last singular one)."""
+    if previous is None:
+        return np.linalg.svd(J)[2][-1]
+    t = np.linalg.solve(np.vstack((J, previous)), np.eye(len(previous))[-1])
+    return t / np.linalg.norm(t)
+
+
+def _point(system: _System, scale: np.ndarray, w: np.ndarray, shot: _Shot,
+           previous: np.ndarray | None, coordinate: int) -> _Point:
+    t = _tangent(_jacobian(shot, scale), previous)
+    amplitude, times = _peak_times(system, shot)
+    Q = _at(shot, times[coordinate])
+    sens = Q[coordinate, 1:] * scale  # ∂x_c(τ*)/∂w
+    slope = float(np.sign(Q[coordinate, 0]) * sens @ t)
+    stable = bool(np.all(np.abs(np.linalg.eigvals(shot.Phi)) < 1.0))
+    return _Point(w, shot, t, amplitude, slope, stable)
+
+
+def _correct(system: _System, scale: np.ndarray, w: np.ndarray, normal: np.ndarray,
+             level: float, tol: float, max_iter: int = 8):
+    """Newton on ``R(w) = 0``, ``normal · w = level`` (the bordered system); ``None`` if it
+    diverges or needs more than ``max_iter`` integrations, else ``(w, dense shot)``."""
+    N = system.N
+    previous = math.inf
+    for it in range(max_iter):
+        y0, omega = w[:N] * scale[:N], w[N] * scale[N]
+        if omega <= 0:
+            return None
+        try:
+            shot = _shoot(system, y0, omega, dense=it > 0)  # likely the last one
+        except ShootingError:
+            return None
+        res = shot.residual
+        if res <= tol:
+            if shot.sol is None:
+                shot = _shoot(system, y0, omega, dense=True)
+            return w, shot
+        if res > 2 * previous:
+            return None
+        previous = res
+        A = np.vstack((_jacobian(shot, scale), normal))
+        b = np.concatenate(((shot.yT - y0) / scale[:N], [normal @ w - level]))
+        w = w - np.linalg.solve(A, b)
+    return None
+
+
+def _omega(point: _Point, scale: np.ndarray) -> float:
+    return float(point.w[-1] * scale[-1])
+
+
+def _first(system, scale, shot: _Shot, coordinate, direction) -> _Point:
+    """The branch point of a converged dense ``shot``, its tangent towards ``direction`` in ω."""
+    w = np.concatenate((shot.y0, [shot.omega])) / scale
+    point = _point(system, scale, w, shot, None, coordinate)
+    if point.tangent[-1] * direction < 0:
+        point.tangent, point.slope = -point.tangent, -point.slope
+    return point
+
+
+def _start(system, scale, omega, coordinate, direction, tol) -> _Point:
+    """The orbit at ``omega`` by Newton from the linear response, as a branch point."""
+    shot, _ = _newton(system, omega, system.linear_guess(omega), tol)
+    return _first(system, scale, shot, coordinate, direction)
+
+
+def _trace(system, scale, start: _Point, lo, hi, coordinate, points, tol,
+           max_steps=None) -> list[_Point]:
+    """Pseudo-arclength from ``start`` along its tangent until ω leaves [lo, hi] (the last
+    point returned is the first outside).  In scaled ``w``, the predictor is the tangent plus
+    the curvature through the previous point, the corrector Newton on the bordered system
+    (residual and the hyperplane normal to the tangent).  The step starts at 1/points, halves
+    on failure or a turn of more than ~37°, grows by 1.5 (up to STEP_MAX/points) after a turn
+    of less than ~18°.  At most ``max_steps`` (default ``20 * points``) steps, else
+    ``ContinuationError``."""
+    ds_max, ds_min = STEP_MAX / points, 1e-7
+    ds, branch = 1.0 / points, [start]
+    max_steps = 20 * points if max_steps is None else max_steps
+    for _ in range(max_steps):
+        p = branch[-1]
+        bend = np.zeros_like(p.w)
+        if len(branch) > 1:  # w(-h) = w_k - h t + h² c through the previous point
+            back = branch[-2].w - p.w
+            h = -p.tangent @ back
+            bend = (back + h * p.tangent) / h**2
+        while True:
+            pred = p.w + ds * p.tangent + ds**2 * bend
+            out = _correct(system, scale, pred, p.tangent, p.tangent @ pred, tol)
+            if out is not None:
+                new = _point(system, scale, out[0], out[1], p.tangent, coordinate)
+                if new.tangent @ p.tangent > 0.8:
+                    break
+            ds /= 2
+            if ds < ds_min:
+                raise ContinuationError(f"step below {ds_min:g} at omega = "
+                                        f"{_omega(p, scale):.12g}")
+        branch.append(new)
+        ds = min(1.5 * ds, ds_max) if new.tangent @ p.tangent > 0.95 else ds
+        if not lo < _omega(new, scale) < hi:
+            return branch
+    raise ContinuationError(f"no exit from [{lo}, {hi}] after {max_steps} steps")
+
+
+def _at_omega(system, scale, inside: _Point, outside: _Point, omega, coordinate, tol) -> _Point:
+    """The branch point at exactly ω between two consecutive points."""
+    a, b = _omega(inside, scale), _omega(outside, scale)
+    guess = inside.w + (outside.w - inside.w) * (omega - a) / (b - a)
+    normal = np.eye(len(guess))[-1]
+    out = _correct(system, scale, guess, normal, omega / scale[-1], tol, max_iter=30)
+    if out is None:
+        raise ContinuationError(f"could not land on omega = {omega}")
+    return _point(system, scale, out[0], out[1], inside.tangent, coordinate)
+
+
+def _bridge(system: _System, back: _Shot, omega: float, tol: float) -> _Shot | None:
+    """The orbit at ``omega`` on the branch through ``back`` (a dense shot at a lower ω),
+    followed by pseudo-arclength; ``None`` if the branch turns back first (a fold) or cannot be
+    followed there."""
+    lo, hi = back.omega, omega
+    scale = _scale(system, lo, hi, 4)
+    try:
+        branch = _trace(system, scale, _first(system, scale, back, 0, +1), lo, hi, 0, 8,
+                        max(tol, TRACE_TOL))
+        if _omega(branch[-1], scale) < hi:
+            return None
+        return _at_omega(system, scale, branch[-2], branch[-1], hi, 0, tol).shot
+    except ContinuationError:
+        return None
+
+
+def _tighten(system, scale, p: _Point, coordinate, tol) -> _Point:
+    """``p`` corrected to residual ``tol`` on its own tangent hyperplane."""
+    if p.shot.residual <= tol:
+        return p
+    out = _correct(system, scale, p.w, p.tangent, p.tangent @ p.w, tol, max_iter=30)
+    if out is None:
+        raise ContinuationError(f"could not tighten the point at omega = {_omega(p, scale)}")
+    return _point(system, scale, out[0], out[1], p.tangent, coordinate)
+
+
+def _bracket(system, scale, branch, k, coordinate, tol):
+    """Branch points ``k, k+1`` at residual ``tol`` with ``dA/ds`` going from + to - (moving
+    along the branch if the traced slopes, at a looser residual, put the sign change one
+    interval off); ``None`` if the tightened slopes show no maximum there after all."""
+    tight: dict[int, _Point] = {}
+
+    def at(j):
+        if j not in tight:
+            tight[j] = _tighten(system, scale, branch[j], coordinate, tol)
+        return tight[j]
+
+    while True:
+        a, b = at(k), at(k + 1)
+        if a.slope > 0 >= b.slope:
+            return a, b
+        if a.slope <= 0 and k > 0:
+            k -= 1
+        elif b.slope > 0 and k + 2 < len(branch):
+            k += 1
+        else:
+            return None
+
+
+def _refine(system, scale, a: _Point, b: _Point, coordinate, tol, xtol=1e-10) -> _Point:
+    """The point between ``a`` and ``b`` where ``slope`` (dA/ds) vanishes: Illinois regula falsi
+    on ``σ = t_a · (w - w_a)``, each value from the bordered corrector at level σ; stops when
+    the step in σ (scaled, so ω moves by at most ``(hi-lo)·xtol``) is below ``xtol``."""
+    t = a.tangent
+    known = [(0.0, a), (float(t @ (b.w - a.w)), b)]
+
+    def evaluate(sigma):
+        s0, p0 = min(known, key=lambda sp: abs(sp[0] - sigma))
+        guess = p0.w + (sigma - s0) / (t @ p0.tangent) * p0.tangent
+        out = _correct(system, scale, guess, t, t @ a.w + sigma, tol, max_iter=30)
+        if out is None:
+            raise ContinuationError("corrector failed while refining a peak")
+        point = _point(system, scale, out[0], out[1], t, coordinate)
+        known.append((sigma, point))
+        return point
+
+    (sa, pa), (sb, pb) = known
+    ga, gb = pa.slope, pb.slope
+    last, side, best = None, 0, None
+    for _ in range(60):
+        sigma = sb - gb * (sb - sa) / (gb - ga)
+        best = evaluate(sigma)
+        g = best.slope
+        if (last is not None and abs(sigma - last) < xtol) or g == 0.0 or sb - sa < xtol:
+            return best
+        last = sigma
+        if g > 0:
+            sa, ga = sigma, g
+            if side == +1:
+                gb /= 2
+            side = +1
+        else:
+            sb, gb = sigma, g
+            if side == -1:
+                ga /= 2
+            side = -1
+    raise ContinuationError("peak refinement did not converge in 60 steps")
+
+
+@dataclass(frozen=True)
+class Branch:
+    """A branch by pseudo-arclength: ω, amplitudes ``max_t |x_i|``, stability and
+    ``slope = d amplitude[coordinate] / ds`` at every point (the last one outside [lo, hi]).
+    ``folds`` are the indices after which ω turned back (a saddle-node between k and k+1)."""
+
+    omegas: np.ndarray
+    amplitude: np.ndarray
+    stable: np.ndarray
+    slope: np.ndarray
+    y0: np.ndarray
+    folds: list
+
+
+def _as_branch(points: list[_Point], scale: np.ndarray) -> Branch:
+    omegas = np.array([_omega(p, scale) for p in points])
+    dw = np.array([p.tangent[-1] for p in points])
+    folds = [k for k in range(len(points) - 1) if dw[k] * dw[k + 1] < 0]
+    return Branch(omegas, np.array([p.amplitude for p in points]),
+                  np.array([p.stable for p in points]), np.array([p.slope for p in points]),
+                  np.array([p.shot.y0 for p in points]), folds)
+
+
+def trace_branch(M, C, K, force, F, lo: float, hi: float, coordinate: int = 0,
+                 points: int = 40, start: str = "lo", tol: float = 1e-9) -> Branch:
+    """The branch through the orbit at ω = ``lo`` (``start="lo"``, leaving towards higher ω)
+    or ``hi`` (towards lower ω), seeded by the linear response, followed by pseudo-arclength
+    through folds until ω leaves [lo, hi] (the last point is the first one outside): at most
+    ``20 * points`` steps.  Points are accepted at residual ``tol``; ``slope`` is
+    ``d amplitude[coordinate] / ds``."""
+    if start not in ("lo", "hi"):
+        raise ValueError('start is "lo" or "hi"')
+    system = _System(M, C, K, force, F)
+    scale = _scale(system, lo, hi, points)
+    omega, direction = (lo, +1) if start == "lo" else (hi, -1)
+    first = _start(system, scale, omega, coordinate, direction, tol)
+    return _as_branch(_trace(system, scale, first, lo, hi, coordinate, points, tol), scale)
+
+
+def _candidates(system, scale, branch, lo, hi, coordinate, tol) -> list[_Point]:
+    """The branch's start, its landing on the boundary it left by, and its interior maxima."""
+    out = [branch[0]]
+    last, inside = branch[-1], branch[-2]
+    edge = hi if _omega(last, scale) >= hi else lo
+    out.append(_at_omega(system, scale, inside, last, edge, coordinate, tol))
+    for k, (a, b) in enumerate(pairwise(branch)):
+        if a.slope > 0 >= b.slope:
+            pair = _bracket(system, scale, branch, k, coordinate, tol)
+            top = pair and _refine(system, scale, *pair, coordinate, tol)
+            if top and lo <= _omega(top, scale) <= hi:
+                out.append(top)
+    return out
+
+
+def _starts(system, scale, lo, hi, coordinate, tol) -> tuple:
+    """The orbits at ``lo`` and ``hi`` from the linear response (``None`` where Newton fails)."""
+    out = []
+    for omega, direction in ((lo, +1), (hi, -1)):
+        try:
+            out.append(_start(system, scale, omega, coordinate, direction, tol))
+        except ShootingError:
+            out.append(None)
+    if out == [None, None]:
+        raise ShootingError(f"no orbit from the linear response at either {lo} or {hi}")
+    return tuple(out)
+
+
+def peak(M, C, K, force, F, lo: float, hi: float, coordinate: int, points: int = 40,
+         tol: float = 1e-11) -> tuple[float, float]:
+    """``(ω, A)`` of the largest ``A = max_t |x_coordinate(t)|`` over ω in [lo, hi].
+
+    The branch through the orbit at ``lo`` (Newton from the linear response) is traced by
+    pseudo-arclength towards higher ω, through folds, so a hardening or softening peak's upper
+    branch is followed to its top, until ω leaves [lo, hi]; so is the branch through the orbit
+    at ``hi`` towards lower ω, unless the first trace landed on that very orbit.  Candidates
+    are the branches' ends on [lo, hi] and every point where ``dA/ds`` (from the variational
+    equations at the time of the maximum) changes sign from + to -, refined by Illinois regula
+    falsi on ``dA/ds`` until the step moves ω by less than ``1e-10·(hi-lo)``; the largest
+    candidate wins.  Trace points are accepted at residual 1e-6 (TRACE_TOL), every candidate
+    at ``tol``.  ``points`` sets the resolution: steps of 1/points to 8/points of the scaled
+    ``(y0/|X|max, ω/(hi-lo))``, at most ``20 * points`` of them per trace.
+
+    Where ``max_t |x_c|`` switches between two humps of ``x_c(t)`` along the branch, ``A`` has
+    a kink and ``dA/ds`` jumps; if the jump is from + to -, regula falsi converges to the kink,
+    which is then the maximum."""
+    system = _System(M, C, K, force, F)
+    if not np.any(system.F) or not 0 < lo < hi:
+        raise ValueError("peak needs F != 0 and 0 < lo < hi")
+    scale = _scale(system, lo, hi, points)
+    trace_tol = max(tol, TRACE_TOL)
+    first, end = _starts(system, scale, lo, hi, coordinate, tol)
+    found: list[_Point] = []
+    if first is not None:
+        forward = _trace(system, scale, first, lo, hi, coordinate, points, trace_tol)
+        found += _candidates(system, scale, forward, lo, hi, coordinate, tol)
+        landed = found[1]
+        if end is None or (math.isclose(_omega(landed, scale), hi, rel_tol=1e-12)
+                           and _same(landed.shot.y0, end.shot.y0)):
+            end = None  # the orbit at hi is on the branch just traced
+    if end is not None:
+        backward = _trace(system, scale, end, lo, hi, coordinate, points, trace_tol)
+        found += _candidates(system, scale, backward, lo, hi, coordinate, tol)
+    best = max(found, key=lambda p: p.amplitude[coordinate])
+    return _omega(best, scale), float(best.amplitude[coordinate])
+
+
+# --------------------------------------------------------------------------- free decay
+
+
+def free_decay(M, C, K, force, x0, v0, times) -> tuple[np.ndarray, np.ndarray]:
+    """The unforced motion from ``x(0) = x0``, ``x'(0) = v0``, sampled at ``times`` (increasing,
+    t ≥ 0, dense output): ``(x, v)``, each of shape ``(len(times), n)``.  DOP853, rtol 1e-12,
+    atol 1e-14."""
+    system = _System(M, C, K, force, np.zeros(np.atleast_2d(M).shape[0]))
+    n = system.n
+    times = np.asarray(times, float)
+
+    def fun(t, y):
+        return np.concatenate((y[n:], system.accel(y, 0.0)))
+
+    start = np.concatenate((np.asarray(x0, float), np.asarray(v0, float)))
+    sol = solve_ivp(fun, (0.0, float(times.max())), start, method="DOP853", rtol=1e-12,
+                    atol=1e-14, t_eval=times)
+    if sol.status != 0:
+        raise RuntimeError(f"free decay integration failed: {sol.message}")
+    return sol.y[:n].T.copy(), sol.y[n:].T.copy()
