@@ -40,6 +40,9 @@ order; a stage imports only stages above it::
     derive.resonance        a system's modes in internal resonance, named, their shapes; of
                             their slow flow the coupled modes and how weak the nonlinearity
                             is [System -> modes]
+    derive.ssm_exact        a spectral submanifold's normal form exactly in Q(λ, λ̄) (rational
+                            data, n ≤ 3), the floating-point ground's check
+                            [System, mode, K -> ExactSSM]
     derive.averaging        the slow flow of q'' + q = ε f (+ ε F cos ωt) and of a system's
                             modes in internal resonance: near-identity averaging over one
                             angle in van der Pol's variables, to any order (a system: the
@@ -83,9 +86,11 @@ order; a stage imports only stages above it::
     analysis.ssm            the spectral submanifold of one mode of a damped system, by the
                             parametrisation method in normal-form style, in floating point
                             with sparse matrices: reduced dynamics, backbone, damping ratio,
-                            physical amplitudes; the forced response of the non-autonomous SSM
-                            at leading order, every steady state in closed form
-                            [System, mode, K -> SSM, Reduction]
+                            physical amplitudes [System, mode, K -> SSM]
+    analysis.ssm_forced     its forced response: the non-autonomous SSM at first order in the
+                            drive and every order in p, every steady state (a resultant's
+                            roots), stability, folds, peaks; what ssm reports
+                            [SSM, ω range -> ForcedResponse, Reduction]
     analysis.periodic       every distinct periodic orbit at one drive: seeds, balance,
                             shooting, Floquet; the report of `driven`
                             [Drive | equation -> orbits]
@@ -113,6 +118,9 @@ order; a stage imports only stages above it::
                             Mathieu, tongues [solution -> Module]
     lower.driven            the μ-expansion's branches (Cardano), damped, the harmonic-balance
                             system [orders -> Module]
+    lower.ssm               an SSM's reduced model as numbers: γ_j, the radius, the outputs'
+                            harmonics, the forced terms on Chebyshev nodes
+                            [Reduction -> ReducedModule]
     lower.documents         the derivations' LaTeX records, the AGM period, a chosen formula,
                             the slow flow [solution -> Unit]
     emit.render             strict Jinja2 environments, provenance, one-unit writes
@@ -151,6 +159,8 @@ order; a stage imports only stages above it::
     cli.system              nnm; the JSON and table of a family of periodic orbits of any
                             number of coordinates [NormalModeSeries, SeriesSolution -> JSON,
                             tables]
+    cli.ssm                 ssm of a SYSTEM or a model folder, and generate --ssm
+                            [Reduction -> JSON, table, CSV, module]
     cli.series              series, mathieu, tongues, models, generate
                             [records -> JSON, tables]
     cli.slowflow            slowflow of one oscillator or of a system's resonant modes: one
@@ -158,8 +168,6 @@ order; a stage imports only stages above it::
                             [SlowFlow -> JSON, table, CSV]
     cli.driven              driven, subharmonic, parametric, mixing [records -> JSON, tables]
     cli.response            response of any number of coordinates [Response -> JSON, table,
-                            CSV]
-    cli.ssm                 ssm of a SYSTEM or a model folder [Reduction -> JSON, table,
                             CSV]
     cli.choose              choose, clock, scene [Choice -> JSON, tables]
     cli.sweep               sweep [Dataset -> summary]

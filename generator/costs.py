@@ -251,11 +251,11 @@ def generate_mode_cost(args: argparse.Namespace) -> Cost:
                 "generating the normal mode's evaluators")
 
 
-SSM_FIT = (1.5, 2.5e-5, 12.0)
-# NOTE: `lindstedt ssm`: start-up, then ~2.5e-5 s per coordinate and squared order (sparse
-# solves and force products): a chain of 1 000 masses at order 7 took 1.4 s, of 10 000 at
-# order 5 6.3 s, a beam of 2 997 coordinates at order 7 5.0 s; `generate --ssm` adds the
-# module's first numba compile (~12 s).
+SSM_FIT = (1.5, 4.6e-5, 12.0)
+# NOTE: `lindstedt ssm`: start-up, then ~4.6e-5 s per coordinate and squared order (sparse
+# solves and force products): chains of 1 000 masses at order 7 took 1.4 s, of 10 000 at
+# order 5 6.3 s, of 10⁵ at order 5 116 s (the fit); a beam of 2 997 coordinates at order 7
+# 5.0 s; `generate --ssm` adds the module's first numba compile (~12 s).
 
 
 def _model_size(folder: str) -> int:

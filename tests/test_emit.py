@@ -121,6 +121,13 @@ def test_templates_get_exactly_the_variables_they_use(tmp_path, monkeypatch):
     mode = normal_mode(parse_system("x1'' + 2*x1 - x2 + x1**3 = 0; x2'' + 2*x2 - x1 = 0"), 1, 4)
     render_tables(lower_tables(mode, 3), module.provenance)
     render_derivation(lower_series_derivation(mode, 3), module.provenance)
+    from lindstedt.compiler import generate_ssm
+
+    for text in ("x1'' + x1'/50 + 2*x1 - x2 + x1**3 = f*cos(w*t); x2'' + 2*x2 - x1 = 0",
+                 "x1'' + x1'/50 + 2*x1 - x2 + x1**3 = 0; x2'' + 2*x2 - x1 = 0"):
+        system = parse_system(text, {"f": "1/100"} if "f" in text else {}, driven=True)
+        generate_ssm(system, 1, 3, tmp_path / "ssm", name="reduced", command="cmd",
+                     overwrite_edited=True)  # ssm.py.j2 and ssm.tex.j2, driven and not
     folder = template_folder()
     used, includes = {}, {}
     for path in folder.glob("*.j2"):

@@ -6,11 +6,13 @@ outside its range, byte-identical regeneration, a model folder, and bad input.""
 from __future__ import annotations
 
 import importlib.util
+import sys
 
 import numpy as np
 import pytest
 from commands import run
-from lindstedt.analysis.ssm import forced_response, ssm
+from lindstedt.analysis.ssm import ssm
+from lindstedt.analysis.ssm_forced import forced_response
 from lindstedt.derive.system import parse_system
 from test_ssm import PAIR
 
@@ -24,6 +26,7 @@ def emitted(tmp_path_factory):
     assert done.stdout.split() == [str(out / "ssm1.py"), str(out / "ssm1_reduced.tex")]
     spec = importlib.util.spec_from_file_location("ssm1", out / "ssm1.py")
     module = importlib.util.module_from_spec(spec)
+    sys.modules["ssm1"] = module  # as `import ssm1` does: numba's cache finds its callees
     spec.loader.exec_module(module)
     return out, module
 

@@ -516,7 +516,8 @@ def test_one_table_says_which_problems_each_kind_takes():
     takes = {name: tuple(k.why_not(p) is None for p in (None, one, pair))
              for name, k in KINDS.items()}
     assert takes == {"response": (True, True, True), "stability": (True, True, False),
-                     "subharmonic": (True, True, False), "validity": (True, False, False)}
+                     "subharmonic": (True, True, False), "validity": (True, False, False),
+                     "ssm": (False, True, True)}
     assert "with an equation use response, stability, subharmonic" in \
         KINDS["validity"].why_not(one)
     assert "a system's map is response" in KINDS["stability"].why_not(pair)

@@ -8,7 +8,7 @@ import json
 
 import numpy as np
 import pytest
-from lindstedt.analysis.ssm import reduce
+from lindstedt.analysis.ssm_forced import reduce
 from lindstedt.cli import main
 from lindstedt.derive.system import parse_system
 from lindstedt.sweep import kinds

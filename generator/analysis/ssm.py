@@ -89,12 +89,20 @@ class LinearMode:
     checked: str
 
 
-def _pencil(w: Matrices, s: complex) -> sparse.csc_array:
-    """``L(s) = s²M + sC + K``, sparse."""
+def _pencil(w: Matrices, s: complex) -> sparse.csc_array | np.ndarray:
+    """``L(s) = s²M + sC + K``: sparse, or dense up to :data:`DENSE_SOLVES` coordinates."""
+    if w.size <= DENSE_SOLVES:
+        L = s * s * w.mass.toarray() + w.stiffness.toarray()
+        return L + s * w.damping.toarray() if w.damping is not None else L.astype(complex)
     L = s * s * w.mass + w.stiffness
     if w.damping is not None:
         L = L + s * w.damping
     return sparse.csc_array(L, dtype=complex)
+
+
+DENSE_SOLVES = 64
+# NOTE: up to this many coordinates L(s) is dense and solved by LAPACK: SuperLU's set-up costs
+# more than the solve itself for a small system (the forced terms solve ~30 rows per Ω).
 
 
 def _damping(w: Matrices) -> sparse.csr_array:
@@ -198,7 +206,7 @@ def _left(w: Matrices, lam: complex, phi: np.ndarray) -> np.ndarray:
             return left
     except np.linalg.LinAlgError:
         pass
-    J = sparse.bmat([[_pencil(w, lam).T, sparse.csc_array(b[:, None])],
+    J = sparse.bmat([[sparse.csc_array(_pencil(w, lam).T), sparse.csc_array(b[:, None])],
                      [sparse.csc_array(b[None, :]), None]], format="csc")
     return sparse_solve(J, np.append(np.zeros(n), 1.0))[:n]
 
@@ -453,7 +461,7 @@ def _bordered(L: sparse.csc_array, b: np.ndarray, c: np.ndarray, d: complex, rhs
     factorization of ``L`` (two solves), or, where ``L`` is (nearly) singular, the bordered
     matrix factorized whole (its dense row and column fill in)."""
     if singular:
-        J = sparse.bmat([[L, sparse.csc_array(b[:, None])],
+        J = sparse.bmat([[sparse.csc_array(L), sparse.csc_array(b[:, None])],
                          [sparse.csc_array(c[None, :]), [[d]]]], format="csc")
         x = _solve(J, np.append(rhs, e), where)
         return x[:-1], complex(x[-1])
@@ -502,268 +510,3 @@ def _radius(W: list[np.ndarray], gamma: list[complex]) -> tuple[float, str]:
         return math.inf, "no term past the linear one: the SSM is the modal plane"
     return min(ratios), ("the smallest ratio of terms two orders apart over the last half of "
                          "the orders (of W's largest coefficient, and of g in rho^2)")
-
-
-@dataclass(frozen=True)
-class Forcing:
-    """The forcing at each ``Ω`` of a grid: the reduced model's ``S`` (``p₁' = … +
-    S e^{iΩt}``) and the outputs' non-resonant part ``X`` (``x = W(p) + X e^{iΩt} + c.c.``,
-    ``(Ω, outputs)``)."""
-
-    omega: np.ndarray
-    S: np.ndarray
-    X: np.ndarray
-
-
-def forcing(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> Forcing:
-    """The leading-order non-autonomous terms at each ``Ω``: one bordered solve each — dense
-    and batched up to :data:`DENSE_MODES` coordinates; for a larger model, sparse at the
-    nodes of a Chebyshev interpolant over the range (``S`` and ``X`` are smooth in ``Ω``),
-    checked at the midpoints between them and refined (:data:`CHEBYSHEV_NODES`), else at
-    every ``Ω``."""
-    w = model.matrices
-    if w.drive is None:
-        raise InputError("the system is not driven: no forced response (drive one equation "
-                         "with f*cos(w*t), or give drive.txt)")
-    omegas = np.asarray(omegas, dtype=float)
-    if w.size <= DENSE_MODES:
-        x = _forced_dense(model, omegas)
-        return Forcing(omegas, x[:, -1], x[:, :-1][:, outputs])
-    lo, hi = float(omegas.min()), float(omegas.max())
-    picked = np.append(outputs, w.size)  # the outputs' X and S
-    for nodes in CHEBYSHEV_NODES:
-        if nodes >= len(omegas) or hi == lo:
-            break
-        at = 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(np.pi * np.arange(nodes + 1) / nodes)
-        mid = 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(np.pi * (np.arange(nodes) + 0.5)
-                                                         / nodes)
-        values = _forced_sparse(model, at)[:, picked]
-        check = _forced_sparse(model, mid)[:, picked]
-        if np.max(np.abs(_barycentric(at, values, mid) - check)) <= INTERPOLATED * np.max(
-                np.abs(check)):
-            x = _barycentric(at, values, omegas)
-            return Forcing(omegas, x[:, -1], x[:, :-1])
-    x = _forced_sparse(model, omegas)[:, picked]
-    return Forcing(omegas, x[:, -1], x[:, :-1])
-
-
-CHEBYSHEV_NODES = (16, 32, 64)
-INTERPOLATED = 1e-10
-# NOTE: a large model's S(Ω) and X(Ω) are interpolated on Chebyshev nodes (a rational
-# function with no pole near the real range: another mode's pole inside it needs more); each
-# degree is accepted where the interpolant meets the exact solves at every midpoint to this
-# fraction, else the next is tried, and past the last every Ω is solved.
-
-
-def _barycentric(nodes: np.ndarray, values: np.ndarray, at: np.ndarray) -> np.ndarray:
-    """Barycentric interpolation on Chebyshev points of the second kind (rows: nodes)."""
-    weights = (-1.0) ** np.arange(len(nodes))
-    weights[[0, -1]] *= 0.5
-    diff = at[:, None] - nodes[None, :]
-    exact = diff == 0
-    diff[exact] = 1.0
-    kernel = weights / diff
-    out = (kernel @ values) / kernel.sum(axis=1)[:, None]
-    hit = exact.any(axis=1)
-    out[hit] = values[np.argmax(exact[hit], axis=1)]
-    return out
-
-
-def _forced_parts(model: SSM):
-    w, lin = model.matrices, model.linear
-    M, C = w.mass, _damping(w)
-    return (lin.lam, M @ lin.shape, C @ lin.shape, M.T @ lin.left, C.T @ lin.left,
-            lin.left @ (M @ lin.shape), np.append(w.drive / 2, 0.0))
-
-
-def _forced_dense(model: SSM, omegas: np.ndarray) -> np.ndarray:
-    """``(X, S)`` at each Ω, the bordered systems dense and batched."""
-    w, n = model.matrices, model.matrices.size
-    lam, Mphi, Cphi, MTl, CTl, corner, rhs = _forced_parts(model)
-    s = 1j * omegas[:, None]
-    J = np.zeros((len(omegas), n + 1, n + 1), dtype=complex)
-    J[:, :n, :n] = (s[:, :, None] ** 2 * w.mass.toarray() + s[:, :, None]
-                    * _damping(w).toarray() + w.stiffness.toarray())
-    J[:, :n, n] = (s + lam) * Mphi + Cphi
-    J[:, n, :n] = CTl + (lam + s) * MTl
-    J[:, n, n] = corner
-    try:
-        x = np.linalg.solve(J, np.broadcast_to(rhs, (len(omegas), n + 1))[..., None])[..., 0]
-    except np.linalg.LinAlgError:
-        x = np.full((len(omegas), n + 1), np.nan)
-    if not np.all(np.isfinite(x)):
-        raise InputError(f"--mode {model.mode}: the forced terms are singular at a drive "
-                         "frequency of the range (the drive is resonant with another mode)")
-    return x
-
-
-def _forced_sparse(model: SSM, omegas: np.ndarray) -> np.ndarray:
-    """``(X, S)`` at each Ω, one sparse bordered solve each (:func:`_bordered`)."""
-    w = model.matrices
-    lam, Mphi, Cphi, MTl, CTl, corner, rhs = _forced_parts(model)
-    out = np.empty((len(omegas), w.size + 1), dtype=complex)
-    for i, om in enumerate(omegas):
-        s = 1j * om
-        X, S = _bordered(_pencil(w, s), (s + lam) * Mphi + Cphi, CTl + (lam + s) * MTl,
-                         corner, rhs[:-1], 0.0, abs(s - lam) <= BORDERED * abs(lam),
-                         (1, 0, model.mode))
-        out[i] = np.append(X, S)
-    return out
-
-
-@dataclass(frozen=True)
-class SteadyState:
-    """One steady state of the forced response: ``ρ``, its phase ``ψ`` to the drive, each
-    output's ``max |x_i|`` over a period, stable or not."""
-
-    omega: float
-    rho: float
-    psi: float
-    amplitude: np.ndarray
-    stable: bool
-
-
-@dataclass(frozen=True)
-class ForcedResponse:
-    """Every steady state at each Ω of the grid, the folds between (Ω and ρ where the number
-    of steady states changes) and the states dropped past the radius."""
-
-    states: tuple[SteadyState, ...]
-    folds: tuple[tuple[float, float], ...]
-    beyond: int
-
-
-def _roots(model: SSM, omega: float, S: complex) -> np.ndarray:
-    """The real positive ``u = ρ²`` of ``u (a(u)² + (ω(u) − Ω)²) − |S|²``, ascending."""
-    P = np.polynomial.polynomial
-    a = np.array([g.real for g in model.gamma])
-    b = np.array([g.imag for g in model.gamma])
-    b[0] -= omega
-    poly = P.polymul([0.0, 1.0], P.polyadd(P.polymul(a, a), P.polymul(b, b)))
-    poly = P.polysub(poly, [abs(S) ** 2])
-    roots = P.polyroots(poly)
-    real = roots[np.abs(roots.imag) <= 1e-9 * np.maximum(np.abs(roots), 1e-300)].real
-    return np.sort(real[real > 0])
-
-
-def _stable(model: SSM, rho: float, omega: float) -> bool:
-    """The polar flow's Jacobian at a steady state: trace < 0 and det > 0."""
-    u = rho * rho
-    a = sum(g.real * u**j for j, g in enumerate(model.gamma))
-    da = sum(2 * j * g.real * rho ** (2 * j - 1) for j, g in enumerate(model.gamma) if j)
-    dw = sum(2 * j * g.imag * rho ** (2 * j - 1) for j, g in enumerate(model.gamma) if j)
-    detune = sum(g.imag * u**j for j, g in enumerate(model.gamma)) - omega
-    trace = 2 * a + rho * da
-    det = a * (a + rho * da) + detune * (rho * dw + detune)
-    return bool(trace < 0 and det > 0)
-
-
-def forced_response(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> ForcedResponse:
-    """Every steady state of the reduced model at each ``Ω`` (ascending), inside the radius;
-    the folds placed by bisection on the number of states (:data:`FOLD_STEPS`)."""
-    fo = forcing(model, omegas, outputs)
-    found = [np.sqrt(_roots(model, om, S)) for om, S in zip(fo.omega, fo.S, strict=True)]
-    beyond = sum(int(np.sum(r > model.radius)) for r in found)
-    found = [r[r <= model.radius] for r in found]
-    counts = [len(r) for r in found]
-    at = np.repeat(np.arange(len(omegas)), counts)
-    rho = np.concatenate(found) if found else np.zeros(0)
-    om, S = fo.omega[at], fo.S[at]
-    # S e^{−iψ} = −ρ(a + i(ω − Ω)): the mode's phase to the drive
-    psi = -np.angle(-rho * (model.g(rho) - 1j * om) / S)
-    c = model.harmonics(rho, outputs, psi)
-    K = model.order
-    c[:, K + 1] += fo.X[at]
-    c[:, K - 1] += np.conj(fo.X[at])
-    amp = peak_amplitude(c)
-    states = tuple(SteadyState(float(om[i]), float(rho[i]), float(psi[i]), amp[i],
-                               _stable(model, float(rho[i]), float(om[i])))
-                   for i in range(len(rho)))
-    folds = tuple(_fold(model, float(omegas[i - 1]), float(omegas[i]), counts[i - 1],
-                        fo.S[i - 1], fo.S[i])
-                  for i in range(1, len(omegas)) if counts[i] != counts[i - 1])
-    return ForcedResponse(states, folds, beyond)
-
-
-def _fold(model: SSM, lo: float, hi: float, count: int, S_lo: complex, S_hi: complex
-          ) -> tuple[float, float]:
-    """Ω and ρ where the number of steady states changes between ``lo`` and ``hi`` (``S``
-    interpolated linearly between the two: it varies slowly with Ω)."""
-    def roots(om: float) -> np.ndarray:
-        t = (om - lo) / (hi - lo)
-        return np.sqrt(_roots(model, om, (1 - t) * S_lo + t * S_hi))
-
-    a, b, merged = lo, hi, roots(lo)
-    for _ in range(FOLD_STEPS):
-        mid = 0.5 * (a + b)
-        here = roots(mid)
-        if len(here) == count:
-            a, merged = mid, here
-        else:
-            b = mid
-    if len(merged) < 2:
-        return 0.5 * (a + b), float(merged[0]) if len(merged) else math.nan
-    gaps = np.diff(merged)
-    k = int(np.argmin(gaps))
-    return 0.5 * (a + b), float(0.5 * (merged[k] + merged[k + 1]))
-
-
-BACKBONE_POINTS = 41
-# NOTE: the backbone's samples in ρ, from 0 to its end (the JSON's; the table shows 11).
-REACH = 0.9
-# NOTE: the backbone ends at this fraction of the estimated radius (where no --rho-max says).
-DEFAULT_SPAN = 0.2
-# NOTE: a driven system's forced response without a range: ±20 % about the mode's |λ|.
-NAMED_OUTPUTS = 12
-# NOTE: up to this many coordinates every one is an output by default; a larger model's
-# default output is the coordinate where the mode's shape is largest.
-
-
-@dataclass(frozen=True)
-class Reduction:
-    """What ``ssm`` reports: the system's text (or folder), the SSM, the outputs (indices
-    and names), the backbone (ρ, each output's ``max |x_i|``), and the forced response where
-    the system is driven."""
-
-    text: str
-    model: SSM
-    outputs: np.ndarray
-    names: tuple[str, ...]
-    rho: np.ndarray
-    amplitude: np.ndarray
-    response: ForcedResponse | None
-    span: tuple[float, float] | None = None
-
-
-def reduce(system: System, mode: int, order: int, outputs: list[int] | None = None,
-           rho_max: float | None = None, span: tuple[float, float] | None = None,
-           points: int = 500) -> Reduction:
-    """The SSM of ``mode`` to ``order``; its backbone up to ``rho_max`` (default
-    :data:`REACH` of the radius, or further to the largest forced state's ρ inside it); the
-    forced response of a driven system at ``points`` frequencies over ``span`` (default
-    :data:`DEFAULT_SPAN` about the mode's ``|λ|``)."""
-    model = ssm(system, mode, order)
-    if outputs is None:
-        outputs = (list(range(system.size)) if system.size <= NAMED_OUTPUTS
-                   else [int(np.argmax(np.abs(model.linear.shape)))])
-    outputs = np.array(outputs, dtype=np.int64)
-    names = tuple(str(system.coordinates[i]) for i in outputs)
-    response = None
-    if system.matrices.drive is not None:
-        span = (float(span[0]), float(span[1])) if span is not None else (
-            (1 - DEFAULT_SPAN) * abs(model.lam), (1 + DEFAULT_SPAN) * abs(model.lam))
-        response = forced_response(model, np.linspace(*span, points), outputs)
-    elif span is not None:
-        raise InputError("--omega: the system is not driven (drive one equation with "
-                         "f*cos(w*t), or give drive.txt)")
-    end = rho_max
-    if end is None:
-        end = REACH * model.radius if math.isfinite(model.radius) else 1.0
-        if response is not None and response.states:
-            end = max(end, min(model.radius, max(s.rho for s in response.states)))
-    elif end > model.radius:
-        raise InputError(f"--rho-max {rho_max:g}: beyond the SSM's estimated radius "
-                         f"{model.radius:.6g} in rho ({model.radius_how})")
-    rho = np.linspace(0.0, end, BACKBONE_POINTS)
-    return Reduction(system.text, model, outputs, names, rho, model.amplitude(rho, outputs),
-                     response, span)

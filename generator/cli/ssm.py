@@ -88,6 +88,12 @@ def ssm_json(red) -> dict:
             "stable": s.stable, "rho": s.rho, "phase": s.psi} for s in r.states]
         data["frc_folds"] = [{"omega": w, "rho": rho} for w, rho in r.folds]
         data["frc_beyond_radius"] = r.beyond
+        data["frc_peaks"] = {name: None if p is None else {
+            "omega": float(p.omega), "rho": float(p.rho), "amplitude": p.amplitude}
+            for name, p in zip(names, r.peaks, strict=True)}
+        data["frc_method"] = ("the non-autonomous SSM at first order in the drive and to "
+                              f"order {max(m.order - 1, 0)} in p; peaks refined along the "
+                              "curve in rho")
     return data
 
 
@@ -107,6 +113,12 @@ def ssm_table(data: dict) -> list[str]:
              data["reduced_dynamics"],
              f"{'j':>3}  {'Re gamma_j':>16}  {'Im gamma_j':>16}"]
     lines += [f"{j:>3}  {g[0]:>16.9g}  {g[1]:>16.9g}" for j, g in enumerate(data["gamma"])]
+    if "gamma_exact" in data:
+        ex = data["gamma_exact"]
+        lines.append(f"exact ground: lambda a root of {ex['field']['lambda_polynomial']} "
+                     f"(the field of degree {ex['field']['degree']}); {ex['normalisation']}, "
+                     f"gamma[j] = gamma_exact[j]*({ex['factor']['exact']})**j; floating point "
+                     f"agrees to {ex['agreement']:.1e} (--json holds every exact form)")
     lines.append("backward error of the homological equations' sparse solves, worst order: "
                  f"{max(data['residual']):.2g}")
     near = data["near_resonances"]
@@ -132,10 +144,10 @@ def ssm_table(data: dict) -> list[str]:
                      + (f" ({data['frc_beyond_radius']} beyond the radius dropped)"
                         if data["frc_beyond_radius"] else ""))
         for n in names:
-            if frc:
-                top = max(frc, key=lambda s, n=n: s["amplitude"][n])
-                lines.append(f"  peak of {n}: {top['amplitude'][n]:.9g} at omega = "
-                             f"{top['omega']:.9g} ({'stable' if top['stable'] else 'unstable'})")
+            p = data["frc_peaks"][n]
+            if p is not None:
+                lines.append(f"  peak of {n}: {p['amplitude']:.9g} at omega = "
+                             f"{p['omega']:.9g} (rho = {p['rho']:.6g})")
         lines += [f"  fold at omega = {f['omega']:.9g}, rho = {f['rho']:.6g}"
                   for f in data["frc_folds"]]
     return lines
@@ -184,7 +196,7 @@ def _outputs(text: str | None, names: list[str]) -> list[int] | None:
 
 def run_ssm(args: argparse.Namespace) -> int:
     """Run ``lindstedt ssm``: read the system (text or folder), reduce, print."""
-    from ..analysis.ssm import reduce
+    from ..analysis.ssm_forced import reduce
 
     plot, csv = check_outputs(args)
     system = _system(args.system, args.model, args.param)
@@ -195,10 +207,20 @@ def run_ssm(args: argparse.Namespace) -> int:
         span = (args.omega_min, args.omega_max)
         if not 0 < span[0] < span[1]:
             raise InputError(f"--omega {span[0]:g}:{span[1]:g}: give 0 < A < B")
+    exact = None
+    if args.exact:  # first: a refusal costs nothing
+        from ..derive.ssm_exact import exact_gamma
+
+        exact = exact_gamma(system, args.mode, args.order)
     red = reduce(system, args.mode, args.order,
                  _outputs(args.output, [str(x) for x in system.coordinates]), args.rho_max,
                  span, args.points)
     data = ssm_json(red)
+    if exact is not None:
+        data["gamma_exact"] = exact.json()
+        worst = max(abs(complex(*g) - z) / max(abs(z), 1e-300)
+                    for g, z in zip(data["gamma"], exact.gamma, strict=True))
+        data["gamma_exact"]["agreement"] = worst
     if plot is not None:
         from ..charts_modes import ssm_figure
 
@@ -304,6 +326,10 @@ def arguments_ssm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--rho-max", type=_positive_real, default=None, metavar="R",
                    help="the backbone's end in rho (default: 0.9 of the estimated radius, or "
                    "further to the forced response's largest state inside it)")
+    p.add_argument("--exact", action="store_true",
+                   help="also the normal form's gamma_j exactly, in the number field of the "
+                   "eigenvalues (rational data, at most 3 coordinates; the exact forms under "
+                   "gamma_exact in --json, with the floating point's agreement)")
     _flag_json(p)
     _flag_plot(p)
     _flag_csv(p, "the backbone (omega, rho, damping ratio, amplitudes) and the forced "

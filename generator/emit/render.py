@@ -630,7 +630,16 @@ def render_ssm_module(r: ReducedModule) -> str:
         driven=driven, span=tuple(pyliteral(float(x)) for x in r.span or (0.0, 0.0)),
         nodes=", ".join(pyliteral(float(x)) for x in r.nodes),
         forcing=_flat([z for row in r.forcing for z in row]) if driven else "[]",
-        nodes_count=len(r.nodes), samples=SSM_SAMPLES)
+        nodes_count=len(r.nodes), width=len(r.forcing[0]) if driven else 0,
+        a_terms=r.sizes[0], b_terms=r.sizes[1], forced_order=r.sizes[2],
+        states=_most_states(len(r.gamma) - 1, *r.sizes[:2]), samples=SSM_SAMPLES)
+
+
+def _most_states(J: int, a_terms: int, b_terms: int) -> int:
+    """The degree in u of the steady states' resultant: at most this many states at one Ω."""
+    first = max(2 + 2 * (b_terms - 1) if b_terms else 0, 2 * (a_terms - 1))
+    inner = max(1 + (b_terms - 1) + J if b_terms else 0, a_terms - 1 + J)
+    return max(2 * first, 1 + 2 * inner, 1)
 
 
 def _decimal_tex(x: float) -> str:
@@ -663,7 +672,8 @@ def render_ssm_tex(r: ReducedModule, p: Provenance) -> dict[str, str]:
         frequency=_even_polynomial([g[1] for g in r.gamma]),
         zeta=_decimal_tex(-lam.real / abs(lam)),
         radius=None if not math.isfinite(r.radius) else _decimal_tex(r.radius),
-        driven=r.span is not None, degree=2 * len(r.gamma) - 1,
+        driven=r.span is not None, degree=_most_states(len(r.gamma) - 1, *r.sizes[:2]),
+        forced_order=r.sizes[2],
         lo=_decimal_tex(r.span[0]) if r.span else "", hi=_decimal_tex(r.span[1]) if r.span
         else "")
     return {f"{r.name}_reduced.tex": tex}

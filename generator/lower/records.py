@@ -375,8 +375,10 @@ class SlowFlowDocument:
 class ReducedModule:
     """The numbers of an SSM's reduced model for ``ssm.py.j2`` and ``ssm.tex.j2``: the normal
     form's ``γ_j`` (real and imaginary parts), the radius in ρ, each output's Fourier
-    coefficients of ``ρ^k e^{ihθ}`` (``(K + 1) × (2K + 1) × outputs``), and the forcing on
-    Chebyshev nodes over ``[lo, hi]`` (``S`` and each output's ``X``; empty: not driven)."""
+    coefficients of ``ρ^k e^{ihθ}`` (``(K + 1) × (2K + 1) × outputs``), and the forced terms
+    on Chebyshev nodes over ``[lo, hi]`` (per node ``A_j``, ``B_j``, then the outputs' ``W¹``
+    order by order; ``sizes``: how many ``A_j``, ``B_j`` and the order of ``W¹``; empty: not
+    driven)."""
 
     name: str
     doc: str
@@ -389,7 +391,8 @@ class ReducedModule:
     shape: tuple[tuple[tuple[tuple[float, float], ...], ...], ...]
     span: tuple[float, float] | None
     nodes: tuple[float, ...]
-    forcing: tuple[tuple[tuple[float, float], ...], ...]  # per node: (S, X_1, …, X_m)
+    forcing: tuple[tuple[tuple[float, float], ...], ...]  # per node: A, B, W¹ flattened
+    sizes: tuple[int, int, int]
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "doc", docstring_text(self.doc))

@@ -25,7 +25,7 @@ from ..analysis.mu_exact import (
     mu_expansion_damped,
     mu_expansion_exact,
 )
-from ..analysis.ssm import Reduction, reduce
+from ..analysis.ssm_forced import Reduction, reduce
 from ..derive.averaging import SlowFlow, slow_flow
 from ..derive.cycles import LimitCycle, derive_limit_cycle
 from ..derive.lindstedt import SeriesSolution, derive

@@ -58,12 +58,14 @@ def _dense_solve(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
 
 
 def sparse_solve(J, rhs: np.ndarray, refine: int = 0) -> np.ndarray:
-    """``J⁻¹ rhs`` for a sparse ``J`` (SuperLU), with ``refine`` steps of iterative
-    refinement (the residual's correction by the same factors: a stiff structure's L(s),
-    conditioned like 1e12, loses digits to the factorization otherwise); a singular ``J``
-    raises ``LinAlgError``."""
+    """``J⁻¹ rhs`` for a sparse ``J`` (SuperLU; a dense one by LAPACK), with ``refine`` steps
+    of iterative refinement (the residual's correction by the same factors: a stiff
+    structure's L(s), conditioned like 1e12, loses digits to the factorization otherwise); a
+    singular ``J`` raises ``LinAlgError``."""
     from scipy.sparse.linalg import splu
 
+    if isinstance(J, np.ndarray):
+        return np.linalg.solve(J, rhs)
     J = J.tocsc()
     try:
         lu = splu(J)

@@ -691,7 +691,7 @@ def _system_ssm(spec: SsmSpec, **axis: float) -> dict:
     SSM's estimated radius (``reduce`` drops the others; ``beyond_radius`` says where)."""
     from dataclasses import replace
 
-    from ..analysis.ssm import DEFAULT_SPAN, forced_response
+    from ..analysis.ssm_forced import DEFAULT_SPAN, forced_response
 
     values = _point_values(spec, axis)
     coordinates, exprs, autonomous = _system_parts(spec.text)
