@@ -1,7 +1,7 @@
 """Spectral submanifolds of ``M x'' + C x' + K x + f(x, x') = F cos ωt``: the two-dimensional
 SSM of one mode by the parametrisation method, normal-form style, in floating point with the
 system's sparse matrices; its reduced dynamics, backbone and damping, each output's physical
-amplitude; the forced response from the non-autonomous SSM at leading order in the forcing.
+amplitude (its forced response: :mod:`analysis.ssm_forced`).
 
 **The manifold.**  ``x = W(p)``, ``x' = V(p)`` with ``p = (p₁, p₂)``, ``p₂ = p̄₁`` on real
 motions, and the reduced dynamics in normal form ``p₁' = p₁ g(p₁p₂)``, ``g(u) = Σ_j γ_j u^j``,
@@ -25,14 +25,7 @@ normalisation ``ψᵀB(W_m, V_m) = 0`` (``ψ = (w, λw)``, ``w`` the left eigenv
     wᵀ(C + (λ + s)M) W_m + (wᵀMφ) γ_j = −wᵀM Q^W_m.
 
 Each row is one sparse factorization of ``L(s)`` (bordered on the resonant row); rows
-``r > k/2`` are the conjugates of rows ``k − r``.  Nothing of size n² is formed.
-
-**The forced response** at leading order in ``F``: ``x = W(p) + X e^{iΩt} + c.c.``,
-``p₁' = p₁ g(p₁p₂) + S e^{iΩt}``, with ``L(iΩ) X + ((iΩ + λ)M + C) φ S = F/2`` bordered as
-above (``Q = 0``).  Its steady states ``p₁ = ρ e^{i(Ωt + ψ)}`` solve
-``ρ a(ρ) + Re(S e^{−iψ}) = 0``, ``ρ(ω(ρ) − Ω) + Im(S e^{−iψ}) = 0``, so ``u = ρ²`` is a real
-positive root of the polynomial ``u (a(u)² + (ω(u) − Ω)²) − |S|²``: every branch, isolas
-included, at each Ω; stability from the 2 × 2 Jacobian of the polar flow."""
+``r > k/2`` are the conjugates of rows ``k − r``.  Nothing of size n² is formed."""
 
 from __future__ import annotations
 
@@ -70,9 +63,6 @@ THETA_SAMPLES = 64
 # NOTE: samples of one period per harmonic order for the physical amplitude max |x_i(θ)|,
 # whose sampled maximum is then refined by Newton on x_i'(θ) = 0 to rounding.
 REFINE_STEPS = 6
-FOLD_STEPS = 50
-# NOTE: bisections that place a fold of the forced response (a change of the number of
-# steady states) between two frequencies of the grid: 2⁻⁵⁰ of the grid's step.
 
 
 @dataclass(frozen=True)
@@ -238,39 +228,59 @@ class _Product(LazySeries):
             A, B = self.a.coeff(i), self.b.coeff(k - i)
             if out is None:
                 out = np.zeros((k + 1, A.shape[1]), dtype=complex)
-            for row in range(A.shape[0]):
-                out[row:row + B.shape[0]] += A[row] * B
+            if A.shape[0] <= B.shape[0]:  # a loop over the shorter factor's rows
+                for row in range(A.shape[0]):
+                    out[row:row + B.shape[0]] += A[row] * B
+            else:
+                for row in range(B.shape[0]):
+                    out[row:row + A.shape[0]] += B[row] * A
         return out
 
 
 class _Force:
-    """``f(W, V)`` order by order: the term table grouped by degree, each group a chain of
-    lazy products of its factors' columns, summed into the equations by a sparse matrix."""
+    """``f(W, V)`` order by order — or, given ``varied`` (the states of a first-order change
+    ``Z¹``), its linear part ``Df(Z)·Z¹``: the term table grouped by degree, each group a chain
+    of lazy products of its factors' columns (for ``Df·Z¹`` one chain per factor, that factor's
+    column taken from ``Z¹``), summed into the equations by a sparse matrix."""
 
-    def __init__(self, w: Matrices, states: list[np.ndarray]) -> None:
+    def __init__(self, w: Matrices, states: list[np.ndarray],
+                 varied: list[np.ndarray] | None = None) -> None:
         table = w.force
-        n = w.size
         degrees = (table.factors >= 0).sum(axis=1) if len(table.coefficient) else np.array([])
         self.groups = []
         for d in sorted(set(degrees.tolist())):
             keep = degrees == d
             factors = table.factors[keep][:, :d]
-            chain: LazySeries = _Column(states, factors[:, 0])
-            for level in range(1, d):
-                chain = _Product(chain, _Column(states, factors[:, level]), level, 1)
             sums = sparse.csr_array((table.coefficient[keep], (table.equation[keep],
                                                                 np.arange(keep.sum()))),
-                                    shape=(n, int(keep.sum())))
-            self.groups.append((d, chain, sums))
-        self.n = n
+                                    shape=(w.size, int(keep.sum())))
+            picks = [[states] * d] if varied is None else [
+                [varied if level == v else states for level in range(d)] for v in range(d)]
+            chains = [_chain(factors, sources, varied) for sources in picks]
+            self.groups.append((d if varied is None else d - 1, chains, sums))
+        self.n = w.size
 
     def coeff(self, k: int) -> np.ndarray:
-        """``f`` at order ``k`` (``(k + 1) × n``), from the states below ``k``."""
+        """Order ``k`` (``(k + 1) × n``), from the states below ``k``."""
         out = np.zeros((k + 1, self.n), dtype=complex)
-        for d, chain, sums in self.groups:
-            if k >= d:
-                out += (sums @ chain.coeff(k).T).T
+        for lowest, chains, sums in self.groups:
+            if k >= lowest:
+                for chain in chains:
+                    out += (sums @ chain.coeff(k).T).T
         return out
+
+
+def _chain(factors: np.ndarray, sources: list[list[np.ndarray]],
+           varied: list[np.ndarray] | None) -> LazySeries:
+    """The product of the factors' columns, column ``l`` from ``sources[l]`` (a series from
+    order 1, or ``varied``, from order 0)."""
+    low = 0 if sources[0] is varied else 1
+    chain: LazySeries = _Column(sources[0], factors[:, 0])
+    for level in range(1, len(sources)):
+        this = 0 if sources[level] is varied else 1
+        chain = _Product(chain, _Column(sources[level], factors[:, level]), low, this)
+        low += this
+    return chain
 
 
 def _carried(X: list[np.ndarray], gamma: list[complex], k: int, n: int) -> np.ndarray:
@@ -423,6 +433,9 @@ def ssm(system: System, mode: int, order: int) -> SSM:
                 gamma.append(g)
                 worst = max(worst, _backward(L, Wm, rhs - b * g))
                 Vk[r] = s * Wm + QW[r] + phi * g
+            elif not np.any(rhs):  # nothing drives this monomial (an odd force's even orders)
+                Wm = np.zeros(n, dtype=complex)
+                Vk[r] = QW[r]
             else:
                 near += _divisors(s, others, k, r)
                 Wm = _solve(L, rhs, (k, r, mode))

@@ -34,9 +34,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sparse
 
-from ..algebra.lazy import LazySeries
 from ..derive.system import System
 from ..errors import InputError
 from .ssm import (
@@ -45,31 +43,32 @@ from .ssm import (
     SSM,
     _bordered,
     _carried,
-    _Column,
     _damping,
+    _Force,
     _pencil,
-    _Product,
     _solve,
     peak_amplitude,
     ssm,
 )
 
-CHEBYSHEV_NODES = (16, 32, 64)
-INTERPOLATED = 1e-10
-# NOTE: A(Ω), B(Ω) and the outputs' W¹(Ω) are rational in Ω with no pole near the real range
-# (another mode's pole inside it needs more nodes): each degree is accepted where the
-# interpolant meets the exact values at every midpoint to this fraction of their largest, else
-# the next is tried, and past the last every Ω is computed.
+CHEBYSHEV_NODES = 8
+CHEBYSHEV_MOST = 128
+INTERPOLATED = 1e-8
+# NOTE: A(Ω), B(Ω) and the outputs' W¹(Ω) are rational in Ω, their poles off the real axis by
+# the damping (a combination 2ω₁ + Ω = ω₃ inside the range is one: a chain of 1 000 masses
+# needs 128 nodes): a degree is accepted where the interpolant meets the exact values at every
+# midpoint to this fraction of their largest, else doubled, and past the last every Ω is
+# computed.
 ON_CIRCLE = 1e-6
 # NOTE: a common root z of the steady-state equation and its conjugate is a steady state where
 # | |z| − 1 | is below this (the others come in pairs z, 1/z̄ off the circle).
 FOLD_STEPS = 50
-PEAK_STEPS = 40
+PEAK_STEPS = 32
 FIXED_POINT = 8
 PEAK_BRACKET = 0.05
-PEAK_PROBES = 200
+PEAK_PROBES = 100
 # NOTE: a fold is placed by 50 bisections between two frequencies of the grid; a peak by
-# golden section (0.618⁴⁰ of the bracket) along the curve in ρ within 5 % below its top, Ω on
+# golden section (0.618³² of the bracket) along the curve in ρ within 5 % below its top, Ω on
 # the curve by 8 fixed-point steps (A and B vary slowly with Ω).
 
 
@@ -107,7 +106,7 @@ def forced_terms(model: SSM, omega: float, outputs: np.ndarray) -> Forced:
     W1: list[np.ndarray] = []
     V1: list[np.ndarray] = []
     states1: list[np.ndarray] = []
-    linear = _Linearised(w, [np.hstack([a, b]) for a, b in zip(W0, V0, strict=True)], states1)
+    linear = _Force(w, [np.hstack([a, b]) for a, b in zip(W0, V0, strict=True)], states1)
     A, B = [], []
     for k in range(K1 + 1):
         Df = linear.coeff(k)
@@ -164,43 +163,6 @@ def _lifted(Z0: tuple[np.ndarray, ...], A: list[complex], B: list[complex], k: i
     return out
 
 
-class _Linearised:
-    """``Df(Z⁰)·Z¹`` order by order: for each term of degree d, the sum over its factors of
-    that factor's ``Z¹`` column times the others' ``Z⁰`` columns (lazy products, each
-    coefficient once), summed into the equations."""
-
-    def __init__(self, w, states0: list[np.ndarray], states1: list[np.ndarray]) -> None:
-        table = w.force
-        degrees = (table.factors >= 0).sum(axis=1) if len(table.coefficient) else np.array([])
-        self.groups = []
-        for d in sorted(set(degrees.tolist())):
-            keep = degrees == d
-            factors = table.factors[keep][:, :d]
-            sums = sparse.csr_array((table.coefficient[keep], (table.equation[keep],
-                                                                np.arange(keep.sum()))),
-                                    shape=(w.size, int(keep.sum())))
-            chains = []
-            for varied in range(d):
-                low = 0 if varied == 0 else 1
-                chain: LazySeries = _Column(states1 if varied == 0 else states0, factors[:, 0])
-                for level in range(1, d):
-                    column = _Column(states1 if level == varied else states0, factors[:, level])
-                    this = 0 if level == varied else 1
-                    chain = _Product(chain, column, low, this)
-                    low += this
-                chains.append(chain)
-            self.groups.append((d, chains, sums))
-        self.n = w.size
-
-    def coeff(self, k: int) -> np.ndarray:
-        out = np.zeros((k + 1, self.n), dtype=complex)
-        for d, chains, sums in self.groups:
-            if k >= d - 1:
-                for chain in chains:
-                    out += (sums @ chain.coeff(k).T).T
-        return out
-
-
 def _flatten(f: Forced) -> np.ndarray:
     return np.concatenate([f.A, f.B, *(X.ravel() for X in f.X)])
 
@@ -235,8 +197,10 @@ def chebyshev(lo: float, hi: float, nodes: int) -> np.ndarray:
 
 
 def forcing_table(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> list[Forced]:
-    """:func:`forced_terms` at every ``Ω`` of ``omegas``, interpolated on Chebyshev nodes
-    (:data:`CHEBYSHEV_NODES`, checked at the midpoints), else computed at each."""
+    """:func:`forced_terms` at every ``Ω`` of ``omegas``, interpolated on Chebyshev nodes:
+    ``N`` nodes (:data:`CHEBYSHEV_NODES` first) checked at the ``N`` midpoints, which are the
+    new nodes of ``2N`` (no value is computed twice), doubled up to
+    :data:`CHEBYSHEV_MOST`; else computed at each ``Ω``."""
     omegas = np.asarray(omegas, dtype=float)
     lo, hi = float(omegas.min()), float(omegas.max())
     m = len(outputs)
@@ -244,18 +208,22 @@ def forcing_table(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> list[F
     def exact(at: np.ndarray) -> np.ndarray:
         return np.array([_flatten(forced_terms(model, float(om), outputs)) for om in at])
 
-    for nodes in CHEBYSHEV_NODES:
-        if nodes + 1 >= len(omegas) or hi == lo:
-            break
+    nodes = CHEBYSHEV_NODES
+    if hi > lo and 2 * nodes + 1 < len(omegas):
         at = chebyshev(lo, hi, nodes)
-        mid = 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(np.pi * (np.arange(nodes) + 0.5)
-                                                         / nodes)
-        values, check = exact(at), exact(mid)
-        if np.max(np.abs(_barycentric(at, values, mid) - check)) <= INTERPOLATED * np.max(
-                np.abs(check)):
-            table = _barycentric(at, values, omegas)
-            return [_unflatten(model, float(om), v, m) for om, v in zip(omegas, table,
-                                                                        strict=True)]
+        values = exact(at)
+        while nodes <= CHEBYSHEV_MOST and 2 * nodes + 1 < len(omegas):
+            mid = 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(
+                np.pi * (np.arange(nodes) + 0.5) / nodes)
+            check = exact(mid)
+            if np.max(np.abs(_barycentric(at, values, mid) - check)) <= INTERPOLATED * np.max(
+                    np.abs(check)):
+                table = _barycentric(at, values, omegas)
+                return [_unflatten(model, float(om), v, m)
+                        for om, v in zip(omegas, table, strict=True)]
+            merged = np.empty((2 * nodes + 1, values.shape[1]), dtype=complex)
+            merged[0::2], merged[1::2] = values, check
+            at, values, nodes = chebyshev(lo, hi, 2 * nodes), merged, 2 * nodes
     return [forced_terms(model, float(om), outputs) for om in omegas]
 
 
