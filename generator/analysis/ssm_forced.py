@@ -339,10 +339,9 @@ def forced_response(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> Forc
     found, counts, beyond = [], [], 0
     for f in table:
         here = _steady_rhos(model, f)
+        counts.append(len(here))  # every root: a state crossing the radius is no fold
         beyond += sum(1 for r, _ in here if r > model.radius)
-        here = [(r, p) for r, p in here if r <= model.radius]
-        counts.append(len(here))
-        found += [(f, r, p) for r, p in here]
+        found += [(f, r, p) for r, p in here if r <= model.radius]
     states: tuple[SteadyState, ...] = ()
     if found:
         rho = np.array([r for _, r, _ in found])
@@ -350,8 +349,10 @@ def forced_response(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> Forc
         amp = _amplitudes(model, [f for f, _, _ in found], outputs, rho, psi)
         states = tuple(SteadyState(f.omega, r, p, amp[i], _stable(model, f, r, p))
                        for i, (f, r, p) in enumerate(found))
-    folds = tuple(_fold(model, table[i - 1], table[i], counts[i - 1])
-                  for i in range(1, len(omegas)) if counts[i] != counts[i - 1])
+    folds = tuple(fold for fold in (_fold(model, table[i - 1], table[i], counts[i - 1])
+                                    for i in range(1, len(omegas))
+                                    if counts[i] != counts[i - 1])
+                  if math.isfinite(fold[1]) and fold[1] <= model.radius)
     peaks = tuple(peak(model, outputs, i, table) for i in range(len(outputs)))
     return ForcedResponse(states, folds, beyond, peaks)
 
@@ -364,11 +365,12 @@ def _between(a: Forced, b: Forced, omega: float) -> Forced:
 
 
 def _fold(model: SSM, a: Forced, b: Forced, count: int) -> tuple[float, float]:
-    """Ω and ρ where the number of steady states changes between two frequencies."""
+    """Ω and ρ where the number of steady states changes between two frequencies (where
+    two merge: ρ NaN where none is left to say)."""
     lo, hi, merged = a.omega, b.omega, [r for r, _ in _steady_rhos(model, a)]
     for _ in range(FOLD_STEPS):
         mid = 0.5 * (lo + hi)
-        here = [r for r, _ in _steady_rhos(model, _between(a, b, mid)) if r <= model.radius]
+        here = [r for r, _ in _steady_rhos(model, _between(a, b, mid))]
         if len(here) == count:
             lo, merged = mid, here
         else:

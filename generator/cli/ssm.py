@@ -145,9 +145,10 @@ def ssm_table(data: dict) -> list[str]:
                         if data["frc_beyond_radius"] else ""))
         for n in names:
             p = data["frc_peaks"][n]
-            if p is not None:
-                lines.append(f"  peak of {n}: {p['amplitude']:.9g} at omega = "
-                             f"{p['omega']:.9g} (rho = {p['rho']:.6g})")
+            lines.append(f"  peak of {n}: not inside the radius and the range (widen --omega, "
+                         "or raise --order)" if p is None else
+                         f"  peak of {n}: {p['amplitude']:.9g} at omega = {p['omega']:.9g} "
+                         f"(rho = {p['rho']:.6g})")
         lines += [f"  fold at omega = {f['omega']:.9g}, rho = {f['rho']:.6g}"
                   for f in data["frc_folds"]]
     return lines
