@@ -353,7 +353,8 @@ def forced_response(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> Forc
                                     for i in range(1, len(omegas))
                                     if counts[i] != counts[i - 1])
                   if math.isfinite(fold[1]) and fold[1] <= model.radius)
-    peaks = tuple(peak(model, outputs, i, table) for i in range(len(outputs)))
+    grid = Grid.of(table)
+    peaks = tuple(peak(model, outputs, i, grid) for i in range(len(outputs)))
     return ForcedResponse(states, folds, beyond, peaks)
 
 
@@ -381,7 +382,7 @@ def _fold(model: SSM, a: Forced, b: Forced, count: int) -> tuple[float, float]:
     return 0.5 * (lo + hi), float(0.5 * (merged[k] + merged[k + 1]))
 
 
-def _on_curve(model: SSM, rho: float, sign: float, table: list[Forced], outputs: np.ndarray,
+def _on_curve(model: SSM, rho: float, sign: float, grid: Grid, outputs: np.ndarray,
               output: int, amplitude: bool = True) -> tuple[float, float] | None:
     """``(Ω, max |x_output|)`` on the forced response at ρ, on its branch ``sign``: the real
     part of ``ρ(iΩ − g) = A e^{−iψ} + ρ²B e^{iψ}`` fixes ψ (two roots, ``sign`` picks one), its
@@ -389,7 +390,7 @@ def _on_curve(model: SSM, rho: float, sign: float, table: list[Forced], outputs:
     P = np.polynomial.polynomial
     u = rho * rho
     g = complex(P.polyval(u, np.array(model.gamma)))
-    omegas, As, Bs = _coefficients(table)
+    omegas, As, Bs = grid.omegas, grid.A, grid.B
     om = min(max(g.imag, omegas[0]), omegas[-1])
     for _ in range(FIXED_POINT):
         i = int(np.clip(np.searchsorted(omegas, om), 1, len(omegas) - 1))
@@ -406,41 +407,42 @@ def _on_curve(model: SSM, rho: float, sign: float, table: list[Forced], outputs:
             return None
     if not amplitude:
         return om, math.nan
-    amp = _amplitudes(model, [_interpolated(table, om)], outputs, np.array([rho]),
+    amp = _amplitudes(model, [grid.at(om)], outputs, np.array([rho]),
                       np.array([psi]))[0, output]
     return om, float(amp)
 
 
-_TABLES: dict[int, tuple] = {}
+@dataclass(frozen=True)
+class Grid:
+    """The forced terms over the grid of Ω, with their Ω, A and B as arrays (the peak's
+    search interpolates them many times)."""
+
+    table: tuple[Forced, ...]
+    omegas: np.ndarray
+    A: np.ndarray
+    B: np.ndarray
+
+    @classmethod
+    def of(cls, table: list[Forced]) -> Grid:
+        return cls(tuple(table), np.array([f.omega for f in table]),
+                   np.array([f.A for f in table]), np.array([f.B for f in table]))
+
+    def at(self, omega: float) -> Forced:
+        """The forced terms at ``omega`` inside the grid, linearly between its neighbours
+        (the grid is fine: 500 points by default)."""
+        i = int(np.clip(np.searchsorted(self.omegas, omega), 1, len(self.table) - 1))
+        return _between(self.table[i - 1], self.table[i], omega)
 
 
-def _coefficients(table: list[Forced]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The grid's Ω, A and B as arrays (made once per table)."""
-    key = id(table)
-    if key not in _TABLES or _TABLES[key][0] is not table:
-        _TABLES.clear()
-        _TABLES[key] = (table, np.array([f.omega for f in table]),
-                        np.array([f.A for f in table]), np.array([f.B for f in table]))
-    return _TABLES[key][1:]
-
-
-def _interpolated(table: list[Forced], omega: float) -> Forced:
-    """The forced terms at ``omega`` inside the grid, linearly between its neighbours (the
-    grid is fine: 500 points by default)."""
-    omegas = _coefficients(table)[0]
-    i = int(np.clip(np.searchsorted(omegas, omega), 1, len(table) - 1))
-    return _between(table[i - 1], table[i], omega)
-
-
-def peak(model: SSM, outputs: np.ndarray, output: int, table: list[Forced]) -> Peak | None:
+def peak(model: SSM, outputs: np.ndarray, output: int, grid: Grid) -> Peak | None:
     """Output ``output``'s largest amplitude on the forced response over the grid of
-    ``table``: the curve's top ρ* (the largest ρ with a steady state, by bisection), then
+    ``grid``: the curve's top ρ* (the largest ρ with a steady state, by bisection), then
     golden section along both branches within :data:`PEAK_BRACKET` below it; ``None`` where
     the top lies past the radius or the grid."""
     hi = model.radius if math.isfinite(model.radius) else 1e6
     lo = 0.0
     def exists(r: float) -> bool:
-        return _on_curve(model, r, 1.0, table, outputs, output, False) is not None
+        return _on_curve(model, r, 1.0, grid, outputs, output, False) is not None
 
     probe = np.geomspace(hi * 1e-9, hi, PEAK_PROBES)
     held = [exists(r) for r in probe]
@@ -464,7 +466,7 @@ def peak(model: SSM, outputs: np.ndarray, output: int, table: list[Forced]) -> P
     ratio = (math.sqrt(5) - 1) / 2
     for sign in (1.0, -1.0):
         def value(r: float, sign: float = sign) -> float:
-            got = _on_curve(model, r, sign, table, outputs, output)
+            got = _on_curve(model, r, sign, grid, outputs, output)
             return -math.inf if got is None else got[1]
 
         a, b = top * (1 - PEAK_BRACKET), top
@@ -480,7 +482,7 @@ def peak(model: SSM, outputs: np.ndarray, output: int, table: list[Forced]) -> P
                 x2 = a + ratio * (b - a)
                 f2 = value(x2)
         for x in (x1, x2, top):
-            got = _on_curve(model, x, sign, table, outputs, output)
+            got = _on_curve(model, x, sign, grid, outputs, output)
             if got is not None and (best is None or got[1] > best.amplitude):
                 best = Peak(got[0], x, got[1])
     return best
