@@ -30,7 +30,7 @@ LAYERS = {
               "hill", "layout", "lindstedt", "newton", "nnm", "parametric", "response",
               "response_equation",
               "response_system",
-              "resonance", "series", "ssm", "ssm_exact", "subharmonic", "toolkit"),
+              "resonance", "series", "ssm", "ssm_exact", "ssm_resonant", "subharmonic", "toolkit"),
     "printers": ("charts", "cli", "costs", "curves", "emit", "files", "fuzz", "interrupt", "latex",
                  "messages", "notebook", "readme", "validity"),
     "emitted": ("choose", "emitted_safety", "install", "limit_cycle", "mass", "nnm_emitted",
