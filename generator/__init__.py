@@ -91,6 +91,11 @@ order; a stage imports only stages above it::
                             drive and every order in p, every steady state (a resultant's
                             roots), stability, folds, peaks; what ssm reports
                             [SSM, ω range -> ForcedResponse, Reduction]
+    analysis.ssm_resonant   the 4-D SSM of two modes in near 1:1, 1:2 or 1:3 internal
+                            resonance: multi-index homological equations bordered per resonant
+                            direction, the reduced dynamics in normal form and polar form
+                            (ρ₁, ρ₂, ψ = θ₂ − rθ₁), the slow flow's variables
+                            [System, (M1, M2), K -> ResonantSSM]
     analysis.periodic       every distinct periodic orbit at one drive: seeds, balance,
                             shooting, Floquet; the report of `driven`
                             [Drive | equation -> orbits]

@@ -30,6 +30,7 @@ Each row is one sparse factorization of ``L(s)`` (bordered on the resonant row);
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -244,7 +245,13 @@ class _Force:
     column taken from ``Z¹``), summed into the equations by a sparse matrix."""
 
     def __init__(self, w: Matrices, states: list[np.ndarray],
-                 varied: list[np.ndarray] | None = None) -> None:
+                 varied: list[np.ndarray] | None = None,
+                 product: Callable[..., LazySeries] = _Product,
+                 rows: Callable[[int], int] | None = None) -> None:
+        # NOTE: ``product`` and ``rows`` (order -> its number of monomials) name the monomials'
+        # layout: p₁^{k−r}p₂^r rows by default, multi-indices for several master modes
+        # (:mod:`analysis.ssm_resonant`)
+        self.rows = rows if rows is not None else (lambda k: k + 1)
         table = w.force
         degrees = (table.factors >= 0).sum(axis=1) if len(table.coefficient) else np.array([])
         self.groups = []
@@ -256,13 +263,14 @@ class _Force:
                                     shape=(w.size, int(keep.sum())))
             picks = [[states] * d] if varied is None else [
                 [varied if level == v else states for level in range(d)] for v in range(d)]
-            chains = [_chain(factors, sources, varied) for sources in picks]
+            chains = [_chain(factors, sources, varied, product) for sources in picks]
             self.groups.append((d if varied is None else d - 1, chains, sums))
         self.n = w.size
 
     def coeff(self, k: int) -> np.ndarray:
-        """Order ``k`` (``(k + 1) × n``), from the states below ``k``."""
-        out = np.zeros((k + 1, self.n), dtype=complex)
+        """Order ``k`` (``(k + 1) × n``, or one row per monomial), from the states below
+        ``k``."""
+        out = np.zeros((self.rows(k), self.n), dtype=complex)
         for lowest, chains, sums in self.groups:
             if k >= lowest:
                 for chain in chains:
@@ -271,14 +279,15 @@ class _Force:
 
 
 def _chain(factors: np.ndarray, sources: list[list[np.ndarray]],
-           varied: list[np.ndarray] | None) -> LazySeries:
+           varied: list[np.ndarray] | None,
+           product: Callable[..., LazySeries] = _Product) -> LazySeries:
     """The product of the factors' columns, column ``l`` from ``sources[l]`` (a series from
-    order 1, or ``varied``, from order 0)."""
+    order 1, or ``varied``, from order 0), each step a ``product``."""
     low = 0 if sources[0] is varied else 1
     chain: LazySeries = _Column(sources[0], factors[:, 0])
     for level in range(1, len(sources)):
         this = 0 if sources[level] is varied else 1
-        chain = _Product(chain, _Column(sources[level], factors[:, level]), low, this)
+        chain = product(chain, _Column(sources[level], factors[:, level]), low, this)
         low += this
     return chain
 
@@ -299,10 +308,11 @@ def _carried(X: list[np.ndarray], gamma: list[complex], k: int, n: int) -> np.nd
 @dataclass(frozen=True)
 class NearResonance:
     """A monomial ``p₁^{m₁}p₂^{m₂}`` of order ``m₁ + m₂`` whose ``s = m₁λ + m₂λ̄`` lies near
-    another mode's eigenvalue: ``divisor = |s − λ_j|`` (relative: over ``|λ_j|``)."""
+    another mode's eigenvalue: ``divisor = |s − λ_j|`` (relative: over ``|λ_j|``); a 4-D
+    SSM's monomial has four exponents."""
 
     order: int
-    monomial: tuple[int, int]
+    monomial: tuple[int, ...]
     eigenvalue: complex
     divisor: float
     relative: float
@@ -453,34 +463,45 @@ def ssm(system: System, mode: int, order: int) -> SSM:
                tuple(near), radius, how)
 
 
-def _solve(J: sparse.csc_array, rhs: np.ndarray, where: tuple[int, int, int]) -> np.ndarray:
-    """``J⁻¹ rhs`` (columns); refused where singular (``where``: order, row, mode)."""
+def _solve(J: sparse.csc_array, rhs: np.ndarray, where: tuple) -> np.ndarray:
+    """``J⁻¹ rhs`` (columns); refused where singular (``where``: order, row or a 4-D SSM's
+    exponents, mode or modes)."""
     try:
         x = sparse_solve(J, rhs, REFINE)
     except np.linalg.LinAlgError:
         x = np.full(rhs.shape, np.nan)
     if not np.all(np.isfinite(x)):
         k, r, mode = where
-        raise InputError(f"--mode {mode}: order {k}, monomial p1^{k - r} p2^{r}: the "
-                         "homological equation is singular (an exact internal resonance: "
-                         "this mode's 2-D SSM does not exist)")
+        name = _monomial_name(r) if isinstance(r, tuple) else f"p1^{k - r} p2^{r}"
+        what = "this mode's 2-D SSM" if isinstance(mode, int) else "the modes' SSM"
+        raise InputError(f"--mode {mode}: order {k}, monomial {name}: the homological "
+                         f"equation is singular (an exact internal resonance: {what} does "
+                         "not exist)")
     return x
 
 
-def _bordered(L: sparse.csc_array, b: np.ndarray, c: np.ndarray, d: complex, rhs: np.ndarray,
-              e: complex, singular: bool, where: tuple[int, int, int]
-              ) -> tuple[np.ndarray, complex]:
+def _bordered(L: sparse.csc_array, b: np.ndarray, c: np.ndarray, d, rhs: np.ndarray,
+              e, singular: bool, where: tuple[int, int, int]) -> tuple[np.ndarray, complex]:
     """``(x, σ)`` of ``L x + b σ = rhs``, ``cᵀx + d σ = e``: by block elimination with one
     factorization of ``L`` (two solves), or, where ``L`` is (nearly) singular, the bordered
-    matrix factorized whole (its dense row and column fill in)."""
+    matrix factorized whole (its dense row and column fill in).  Several borders: ``b`` an
+    ``n × m`` array, ``c`` ``m × n``, ``d`` ``m × m``, ``e`` and ``σ`` of length m (a 4-D SSM's
+    monomial resonant with two master directions)."""
+    one = b.ndim == 1
+    B, Cb = (b[:, None], c[None, :]) if one else (b, c)
+    D, E = np.atleast_2d(d), np.atleast_1d(e)
     if singular:
-        J = sparse.bmat([[sparse.csc_array(L), sparse.csc_array(b[:, None])],
-                         [sparse.csc_array(c[None, :]), [[d]]]], format="csc")
-        x = _solve(J, np.append(rhs, e), where)
-        return x[:-1], complex(x[-1])
-    y = _solve(L, np.column_stack([rhs, b]), where)
-    sigma = (c @ y[:, 0] - e) / (c @ y[:, 1] - d)
-    return y[:, 0] - y[:, 1] * sigma, complex(sigma)
+        J = sparse.bmat([[sparse.csc_array(L), sparse.csc_array(B)],
+                         [sparse.csc_array(Cb), sparse.csc_array(D)]], format="csc")
+        x = _solve(J, np.append(rhs, E), where)
+        m = B.shape[1]
+        return (x[:-1], complex(x[-1])) if one else (x[:-m], x[-m:])
+    y = _solve(L, np.column_stack([rhs, B]), where)
+    if one:
+        sigma = (c @ y[:, 0] - e) / (c @ y[:, 1] - d)
+        return y[:, 0] - y[:, 1] * sigma, complex(sigma)
+    sigma = np.linalg.solve(Cb @ y[:, 1:] - D, Cb @ y[:, 0] - E)
+    return y[:, 0] - y[:, 1:] @ sigma, sigma
 
 
 def _backward(L: sparse.csc_array, x: np.ndarray, rhs: np.ndarray) -> float:
@@ -490,19 +511,29 @@ def _backward(L: sparse.csc_array, x: np.ndarray, rhs: np.ndarray) -> float:
     return float(np.max(np.abs(L @ x - rhs))) / scale if scale > 0 else 0.0
 
 
-def _divisors(s: complex, others: np.ndarray, k: int, r: int) -> list[NearResonance]:
-    """The near resonances of the row's ``s`` with the modes checked; refused where exact."""
+def _divisors(s: complex, others: np.ndarray, k: int, r: int,
+              monomial: tuple[int, ...] | None = None,
+              refusal: str = "the 2-D SSM does not exist; lower --order below it"
+              ) -> list[NearResonance]:
+    """The near resonances of the row's ``s`` with the modes checked; refused where exact
+    (``monomial``: the row's exponents, by default ``(k − r, r)``)."""
+    monomial = (k - r, r) if monomial is None else monomial
     out = []
     for lam in others:
         divisor = abs(s - lam)
         relative = divisor / abs(lam)
         if relative < SINGULAR:
-            raise InputError(f"order {k}, monomial p1^{k - r} p2^{r}: s = {s:.6g} equals the "
-                             f"eigenvalue {lam:.6g} of another mode (an internal resonance: "
-                             "the 2-D SSM does not exist; lower --order below it)")
+            raise InputError(f"order {k}, monomial {_monomial_name(monomial)}: s = {s:.6g} "
+                             f"equals the eigenvalue {lam:.6g} of another mode (an internal "
+                             f"resonance: {refusal})")
         if relative < NEAR_RESONANCE:
-            out.append(NearResonance(k, (k - r, r), complex(lam), divisor, relative))
+            out.append(NearResonance(k, monomial, complex(lam), divisor, relative))
     return out
+
+
+def _monomial_name(monomial: tuple[int, ...]) -> str:
+    """``p1^a p2^b …`` (every exponent written, as the 2-D rows always were)."""
+    return " ".join(f"p{i + 1}^{e}" for i, e in enumerate(monomial))
 
 
 def _radius(W: list[np.ndarray], gamma: list[complex]) -> tuple[float, str]:
