@@ -1,0 +1,117 @@
+"""The 4-D spectral submanifold of two modes in internal resonance (analysis.ssm_resonant,
+`lindstedt ssm SYSTEM --mode M1,M2`) against independent references: the exact first-order
+averaged flow of `slowflow SYSTEM` (in its amplitude and phase variables), the 2-D SSM of a
+mode whose plane is invariant, and the full system integrated from a point of the manifold."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import sympy as sp
+from lindstedt.analysis.ssm import ssm
+from lindstedt.analysis.ssm_resonant import resonant_ssm, slow_flow_scale
+from lindstedt.cli import main
+from lindstedt.derive.averaging import slow_flow
+from lindstedt.derive.system import parse_system
+from scipy.integrate import solve_ivp
+
+QUADRATIC_1_2 = ("x1'' + 5*x1/2 + 3*x2/2 + x1**2 + x1*x2/3 = 0; "
+                 "x2'' + 3*x1/2 + 5*x2/2 + 2*x2**2 - x1**2/2 = 0")
+# NOTE: ω0² = 1 (shape (1, −1)) and 4 (shape (1, 1)): the SSM's φ_k and the slow flow's shapes
+# differ by a factor −1/√2 and 1/√2 (one of them negative: the phase shifts by π).
+CUBIC_1_3 = "x1'' + 5*x1 + 4*x2 + x1**3 = 0; x2'' + 4*x1 + 5*x2 + x1*x2**2/2 + x2**3 = 0"
+# NOTE: ω0² = 1 and 9, shapes (1, −1) and (1, 1).
+DAMPED_1_2 = ("x1'' + 0.02*x1' + x1 + x1**2 + x1*x2 + x1**3 = 0; "
+              "x2'' + 0.03*x2' + 4.2*x2 + x1**2 + 0.5*x2**2 + x2**3 = 0")
+# NOTE: ω₂/ω₁ = 2.049: near 1:2; p₁ = 0 is invariant (no monomial of p₂ alone is resonant
+# with p₁), and there the SSM is mode 2's 2-D SSM.
+DAMPED_1_1 = ("x1'' + 0.01*x1' + x1 + 0.02*(x1 - x2) + x1**3 = 0; "
+              "x2'' + 0.01*x2' + 1.1*x2 + 0.02*(x2 - x1) + x2**3 + x1**2*x2 = 0")
+# NOTE: ω₂/ω₁ = 1.05: near 1:1, every kept monomial resonant with p₁ and p₂ at once (two
+# borders).
+UNDAMPED_1_1 = "x1'' + x1 + x1**3 + x1*x2**2 = 0; x2'' + 1.05*x2 + x2**3 + x1**2*x2 = 0"
+# NOTE: undamped near 1:1 whose plane p₂ = 0 is invariant (x₂ = 0 solves the second
+# equation): there the SSM is mode 1's 2-D SSM.
+
+
+@pytest.mark.parametrize("text", [QUADRATIC_1_2, CUBIC_1_3])
+def test_first_order_equals_the_averaged_flow(text):
+    """`slowflow SYSTEM`'s exact first-order flow (a_k, φ_k of x = Σ a_k s_k cos(ω_k t + φ_k))
+    equals the normal form's terms of the force's degree d in the same variables:
+    a_k = |c_k| ρ_k, θ_k = ω_k t + φ_k (+ π where c_k < 0), da_k/dt = |c_k| ρ_k',
+    dφ_k/dt = θ_k' − ω_k (to rounding: both are the resonant averages of the same terms)."""
+    flow = slow_flow(parse_system(text), 1)
+    model = resonant_ssm(parse_system(text, driven=True), (1, 2), 3)
+    assert flow.resonances[0].startswith(f"1:{model.ratio} ")
+    c = slow_flow_scale(model, flow.shapes)
+    assert min(c) < 0 < max(c)  # a shape of each sign: the phase shift is exercised
+    rates = sp.lambdify((*flow.a, *flow.phi), [*flow.amplitude, *flow.phase])
+    rng = np.random.default_rng(34)
+    for a1, a2, f1, f2 in rng.uniform([0.05, 0.05, -3, -3], [0.4, 0.4, 3, 3], (4, 4)):
+        expected = np.array(rates(a1, a2, f1, f2), dtype=float)
+        theta = [f + np.pi * (ck < 0) for f, ck in zip((f1, f2), c, strict=True)]
+        r1, r2, w1, w2 = model.polar(a1 / abs(c[0]), a2 / abs(c[1]),
+                                     theta[1] - model.ratio * theta[0], top=flow.degree)
+        got = [abs(c[0]) * r1, abs(c[1]) * r2, w1 - model.lam[0].imag, w2 - model.lam[1].imag]
+        assert np.max(np.abs(got - expected)) < 1e-14 * max(1.0, np.max(np.abs(expected)))
+
+
+@pytest.mark.parametrize("text, mode, both", [(DAMPED_1_2, 2, False), (UNDAMPED_1_1, 1, True)])
+def test_an_invariant_mode_plane_is_that_modes_2d_ssm(text, mode, both):
+    """Where the other mode's plane is invariant, the 4-D SSM restricted to it is the mode's
+    2-D SSM (analysis.ssm): the same γ_j and the same W rows.  Near 1:2, p₁² drives p₂: mode
+    1's plane is not invariant (its 2-D SSM has a small divisor there)."""
+    system = parse_system(text, driven=True)
+    model = resonant_ssm(system, (1, 2), 7)
+    two = ssm(system, mode, 7)
+    gamma = model.backbone(mode)
+    assert gamma is not None and (model.backbone(3 - mode) is not None) == both
+    assert np.allclose(gamma, two.gamma, rtol=1e-11, atol=1e-14)
+    first = 0 if mode == 1 else 2
+    for k in range(2, 8):
+        for r in range(k + 1):
+            e = [0, 0, 0, 0]
+            e[first], e[first + 1] = k - r, r
+            row = model.basis.index[k][tuple(e)]
+            assert np.allclose(model.W[k][row], two.W[k][r], rtol=1e-11, atol=1e-14)
+
+
+def _drift(text: str, order: int, p: tuple[complex, complex], T: float = 20.0) -> float:
+    """max |x| of W(p(T)) (the reduced dynamics integrated) against the full system
+    integrated from W(p(0)), V(p(0))."""
+    system = parse_system(text, driven=True)
+    w = system.matrices
+    model = resonant_ssm(system, (1, 2), order)
+    mass = w.mass.toarray()
+
+    def full(t, z):
+        x, v = z[:w.size], z[w.size:]
+        force = w.stiffness @ x + w.force(x, v) + (w.damping @ v if w.damping is not None
+                                                   else 0)
+        return np.concatenate([v, -np.linalg.solve(mass, force)])
+
+    def reduced(t, y):
+        d1, d2 = model.field(y[0] + 1j * y[1], y[2] + 1j * y[3])
+        return [d1.real, d1.imag, d2.real, d2.imag]
+
+    tol = {"rtol": 1e-12, "atol": 1e-14, "method": "DOP853"}
+    x0, v0 = model.state(*p)
+    truth = solve_ivp(full, (0, T), np.concatenate([x0, v0]), **tol).y[:w.size, -1]
+    y = solve_ivp(reduced, (0, T), [p[0].real, p[0].imag, p[1].real, p[1].imag], **tol).y[:, -1]
+    return float(np.max(np.abs(model.state(y[0] + 1j * y[1], y[2] + 1j * y[3])[0] - truth)))
+
+
+@pytest.mark.parametrize("text", [DAMPED_1_2, DAMPED_1_1])
+def test_the_full_system_stays_on_the_manifold(text):
+    """Started on the manifold, the full system's motion is W of the reduced motion over
+    three periods of the slower mode, with an error falling with the order as ρ^{K+1}."""
+    p = (0.08 + 0j, 0.05 * np.exp(0.7j))
+    low, high = _drift(text, 3, p), _drift(text, 7, p)
+    assert high < 5e-10 and low / high > 1e4
+
+
+def _json(argv, capsys) -> dict:
+    assert main(argv) == 0
+    return json.loads(capsys.readouterr().out)
