@@ -115,3 +115,36 @@ def test_the_full_system_stays_on_the_manifold(text):
 def _json(argv, capsys) -> dict:
     assert main(argv) == 0
     return json.loads(capsys.readouterr().out)
+
+
+def test_command_reports_the_invariant_mode_as_its_2d_ssm(capsys):
+    """`ssm SYSTEM --mode 1,2 --json`: the contract's keys, and mode 2's family (its plane
+    invariant near 1:2) equal to `ssm SYSTEM --mode 2 --json`'s γ and backbone amplitudes."""
+    pair = _json(["ssm", DAMPED_1_2, "--mode", "1,2", "--order", "5", "--json"], capsys)
+    assert pair["kind"] == "ssm" and pair["modes"] == [1, 2] and pair["ratio"] == "1:2"
+    assert np.array(pair["lambda"]).shape == (2, 2) and max(pair["residual"]) < 1e-14
+    assert {t["equation"] for t in pair["terms"]} == {"p1", "p2"}
+    assert any(t["monomial"] == [0, 1, 1, 0] and t["equation"] == "p1" for t in pair["terms"])
+    (family,) = pair["families"]
+    single = _json(["ssm", DAMPED_1_2, "--mode", "2", "--order", "5", "--rho-max",
+                    str(family["backbone"][-1]["rho"]), "--json"], capsys)
+    assert family["mode"] == 2
+    assert np.allclose(family["gamma"], single["gamma"], rtol=1e-11, atol=1e-15)
+    for a, b in zip(family["backbone"], single["backbone"], strict=True):
+        assert abs(a["rho"] - b["rho"]) < 1e-14
+        assert np.allclose([a["amplitude"][x] for x in ("x1", "x2")],
+                           [b["amplitude"][x] for x in ("x1", "x2")], rtol=1e-10, atol=1e-14)
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--mode", "1,2"], "not near 1:1, 1:2 or 1:3"),
+    (["--mode", "1,2,3"], "more are not built"),
+    (["--mode", "1,3"], "2 oscillating modes"),
+    (["--mode", "2,2"], "the same mode twice"),
+    (["--mode", "1,2", "--omega", "1:2"], "not built for a mode pair"),
+])
+def test_pair_refusals_are_one_line(argv, message, capsys):
+    status = main(["ssm", "x1'' + x1 + x1**3 = 0; x2'' + 2.5*x2 + x1**3 = 0", *argv])
+    assert status == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and "\n" not in err

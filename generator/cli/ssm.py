@@ -40,6 +40,11 @@ def _order(text: str) -> int:
     return k
 
 
+def _modes(text: str) -> tuple[int, ...]:
+    """``--mode``: one mode ``M``, or a pair ``M1,M2`` in internal resonance."""
+    return tuple(_positive(part.strip()) for part in text.split(","))
+
+
 def _pair(z: complex) -> list[float]:
     return [float(z.real), float(z.imag)]
 
@@ -199,6 +204,9 @@ def run_ssm(args: argparse.Namespace) -> int:
     """Run ``lindstedt ssm``: read the system (text or folder), reduce, print."""
     from ..analysis.ssm_forced import reduce
 
+    if len(args.mode) > 1:
+        return run_resonant(args)
+    (mode,) = args.mode
     plot, csv = check_outputs(args)
     system = _system(args.system, args.model, args.param)
     check_int(args.points, 2, SSM_MAX_POINTS, f"--omega …:{args.points}: the forced response "
@@ -212,8 +220,8 @@ def run_ssm(args: argparse.Namespace) -> int:
     if args.exact:  # first: a refusal costs nothing
         from ..derive.ssm_exact import exact_gamma
 
-        exact = exact_gamma(system, args.mode, args.order)
-    red = reduce(system, args.mode, args.order,
+        exact = exact_gamma(system, mode, args.order)
+    red = reduce(system, mode, args.order,
                  _outputs(args.output, [str(x) for x in system.coordinates]), args.rho_max,
                  span, args.points)
     data = ssm_json(red)
@@ -229,6 +237,111 @@ def run_ssm(args: argparse.Namespace) -> int:
     if csv is not None:
         ssm_csv(data, csv)
     print(json.dumps(data) if args.json else "\n".join(ssm_table(data)))
+    return 0
+
+
+def resonant_json(red) -> dict:
+    """``lindstedt ssm SYSTEM --mode M1,M2 --json``, a pure function of an
+    :class:`analysis.ssm_resonant.ResonantReduction`: ``kind``, ``modes``, ``lambda`` (two
+    ``[re, im]`` pairs), the ratio and detuning, the reduced dynamics' kept ``terms`` (each
+    with its monomial in ``(p1, conj p1, p2, conj p2)``, its coefficient and its polar form),
+    the single-mode ``families`` where their planes are invariant, each order's
+    ``residual``, the near resonances of the monomials not kept, the radius."""
+    m = red.model
+    names = list(red.names)
+    r = m.ratio
+    terms = [{"equation": f"p{t.mode}", "monomial": list(t.monomial),
+              "coefficient": _pair(t.coefficient),
+              "polar": {"rho1": t.rho1, "rho2": t.rho2, "psi": t.psi}} for t in red.terms]
+    families = [{"mode": f.mode, "gamma": [_pair(g) for g in f.gamma], "backbone": [
+        {"rho": float(rho), "omega": float(w), "damping_ratio": float(z),
+         "amplitude": {name: float(a) for name, a in zip(names, amp, strict=True)}}
+        for rho, w, z, amp in zip(f.rho, f.omega, f.damping_ratio, f.amplitude, strict=True)]}
+        for f in red.families]
+    return {"kind": "ssm", "modes": list(m.modes), "lambda": [_pair(lam) for lam in m.lam],
+            "ratio": f"1:{r}", "detuning": m.detuning, "order": m.order, "system": red.text,
+            "coordinates": m.matrices.size,
+            "outputs": {name: int(i) for name, i in zip(names, red.outputs, strict=True)},
+            "shapes": [[_pair(z) for z in lin.shape[red.outputs]] for lin in m.linear],
+            "reduced_dynamics": "d(p_k)/dt = lambda_k*p_k + the sum of the terms of equation "
+                                "p_k, each coefficient*p1^a*conj(p1)^b*p2^c*conj(p2)^d "
+                                "(monomial [a, b, c, d]); x = W(p), W's linear part "
+                                "2*Re(phi1*p1 + phi2*p2) with phi_k^H M phi_k = 1/4",
+            "polar": f"p_k = rho_k*e^(i*theta_k), psi = theta2 - {r}*theta1: d(rho_k)/dt + "
+                     "i*rho_k*d(theta_k)/dt = lambda_k*rho_k + the sum of the terms of "
+                     "equation p_k, each coefficient*rho1^rho1*rho2^rho2*e^(i*psi*psi)",
+            "terms": terms, "families": families,
+            "residual": [float(x) for x in m.residual],
+            "near_resonances": [{"order": q.order, "monomial": list(q.monomial),
+                                 "eigenvalue": _pair(q.eigenvalue), "divisor": q.divisor,
+                                 "relative": q.relative} for q in m.near],
+            "modes_checked": m.linear[0].checked,
+            "radius_estimate": {"value": _finite(m.radius), "how": m.radius_how}}
+
+
+def resonant_table(data: dict) -> list[str]:
+    """The readable table of :func:`resonant_json`'s ``data``."""
+    m1, m2 = data["modes"]
+    lines = [f"SSM of modes {m1},{m2} of {data['system']} ({data['coordinates']} "
+             f"coordinate{'s' * (data['coordinates'] != 1)}), order {data['order']}, "
+             f"floating point: near {data['ratio']} resonance (omega{m2}/omega{m1} - "
+             f"{data['ratio'][2:]} = {data['detuning']:.6g})"]
+    lines += [f"lambda{k + 1} = {lam[0]:.9g} {'+-'[lam[1] < 0]} {abs(lam[1]):.9g}i"
+              for k, lam in enumerate(data["lambda"])]
+    lines += [data["reduced_dynamics"], data["polar"]]
+    lines.append(f"{'equation':>8}  {'monomial':>12}  {'Re':>16}  {'Im':>16}  "
+                 f"{'rho1^':>5}  {'rho2^':>5}  {'psi':>4}")
+    for t in data["terms"]:
+        lines.append(f"{t['equation']:>8}  {' '.join(str(e) for e in t['monomial']):>12}  "
+                     f"{t['coefficient'][0]:>16.9g}  {t['coefficient'][1]:>16.9g}  "
+                     f"{t['polar']['rho1']:>5}  {t['polar']['rho2']:>5}  "
+                     f"{t['polar']['psi']:>4}")
+    lines.append("backward error of the homological equations' sparse solves, worst order: "
+                 f"{max(data['residual']):.2g}")
+    near = data["near_resonances"]
+    lines.append("near resonances of the monomials not kept (divisor under 10 % of "
+                 f"|lambda_j|), among {data['modes_checked']}: " + ("none" if not near else
+                 "; ".join(f"order {q['order']} monomial {q['monomial']} with lambda = "
+                           f"{q['eigenvalue'][0]:.6g} + {q['eigenvalue'][1]:.6g}i, divisor "
+                           f"{q['divisor']:.3g}" for q in near)))
+    radius = data["radius_estimate"]
+    lines.append(f"radius in max |p_k| estimated at {_number(radius['value'])} "
+                 f"({radius['how']})")
+    names = list(data["outputs"])
+    for f in data["families"]:
+        lines.append(f"mode {f['mode']} alone (its plane is invariant), backbone "
+                     "(amplitude: max |x| over a period):")
+        lines.append(f"{'rho':>10}  {'omega':>12}  {'damping':>10}  " + "  ".join(
+            f"{n:>10}" for n in names))
+        points = f["backbone"]
+        for p in points[::max(1, (len(points) - 1) // 10)]:
+            lines.append(f"{p['rho']:>10.5g}  {p['omega']:>12.9g}  {p['damping_ratio']:>10.5g}"
+                         "  " + "  ".join(f"{p['amplitude'][n]:>10.5g}" for n in names))
+    if not data["families"]:
+        lines.append("no mode alone: the resonance couples both planes")
+    return lines
+
+
+def run_resonant(args: argparse.Namespace) -> int:
+    """``lindstedt ssm SYSTEM --mode M1,M2``: the 4-D SSM of two modes in internal
+    resonance, its reduced dynamics; the options of one mode's SSM alone are refused."""
+    from ..analysis.ssm_resonant import reduce_pair
+
+    given = [flag for flag, on in (("--omega", args.omega_min is not None),
+                                   ("--exact", args.exact), ("--plot", args.plot is not None),
+                                   ("--csv", args.csv is not None)) if on]
+    if given:
+        raise InputError(f"{', '.join(given)}: not built for a mode pair (--mode "
+                         f"{','.join(str(m) for m in args.mode)}); give one mode")
+    if len(args.mode) > 2:
+        raise InputError(f"--mode {','.join(str(m) for m in args.mode)}: give one mode, or "
+                         "two in internal resonance (M1,M2); more are not built")
+    system = _system(args.system, args.model, args.param)
+    red = reduce_pair(system, args.mode, args.order,
+                      _outputs(args.output, [str(x) for x in system.coordinates]),
+                      args.rho_max)
+    data = resonant_json(red)
+    print(json.dumps(data) if args.json else "\n".join(resonant_table(data)))
     return 0
 
 
@@ -311,8 +424,10 @@ def arguments_ssm(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    "'i j k l c' adds c*x_j*x_k*x_l; 0-based), optional drive.txt ('i F_i')")
     p.add_argument("--param", action="append", metavar="NAME=VALUE",
                    help="a value for a parameter of SYSTEM, e.g. f=1/100 (repeatable)")
-    p.add_argument("--mode", type=_positive, default=1, metavar="M",
-                   help="the mode, numbered 1, 2, … by increasing damped frequency (default 1)")
+    p.add_argument("--mode", type=_modes, default=(1,), metavar="M",
+                   help="the mode, numbered 1, 2, … by increasing damped frequency (default "
+                   "1); or two modes M1,M2 in near 1:1, 1:2 or 1:3 internal resonance: their "
+                   "4-D SSM and its reduced dynamics in normal form")
     p.add_argument("--order", type=_order, default=DEFAULT_ORDER, metavar="K",
                    help=f"the SSM's order K, 1..{SSM_MAX_ORDER} (default {DEFAULT_ORDER})")
     p.add_argument("--output", metavar="LIST",
