@@ -96,6 +96,9 @@ order; a stage imports only stages above it::
                             direction, the reduced dynamics in normal form and polar form
                             (ρ₁, ρ₂, ψ = θ₂ − rθ₁), the slow flow's variables
                             [System, (M1, M2), K -> ResonantSSM]
+    analysis.ssm_resonant_forced  its forced response (the drive at leading order, the
+                            steady states continued in ω, stability, amplitudes) and what
+                            ssm --mode M1,M2 reports [ResonantSSM, ω range -> ResonantReduction]
     analysis.periodic       every distinct periodic orbit at one drive: seeds, balance,
                             shooting, Floquet; the report of `driven`
                             [Drive | equation -> orbits]

@@ -60,9 +60,7 @@ from .ssm import (
     _radius,
     _solve,
     linear_mode,
-    peak_amplitude,
 )
-from .ssm_forced import BACKBONE_POINTS, NAMED_OUTPUTS, REACH
 
 RATIOS = (1, 2, 3)
 DETUNING = 0.1
@@ -350,81 +348,6 @@ def resonant_ssm(system: System, modes: tuple[int, ...], order: int) -> Resonant
                "of W's largest coefficient per order")
     return ResonantSSM(w, (m1, m2), order, r, (lin1, lin2), basis, tuple(W), tuple(V),
                        tuple(R), tuple(residual), tuple(near), radius, how)
-
-
-@dataclass(frozen=True)
-class Family:
-    """A family of motions of the SSM the command reports: one mode alone on its invariant
-    plane (``mode``, ``gamma``: its normal form ``p_k' = p_k Σ_j γ_j (p_k p̄_k)^j``), at
-    ``rho`` (that mode's ``ρ_k``), with ``omega``, ``damping_ratio`` and each output's
-    ``amplitude`` (max |x_i| over a period)."""
-
-    mode: int
-    gamma: tuple[complex, ...]
-    rho: np.ndarray = field(repr=False)
-    omega: np.ndarray = field(repr=False)
-    damping_ratio: np.ndarray = field(repr=False)
-    amplitude: np.ndarray = field(repr=False)
-
-
-@dataclass(frozen=True)
-class ResonantReduction:
-    """What ``ssm SYSTEM --mode M1,M2`` reports: the 4-D SSM, the outputs, the kept terms of
-    the reduced dynamics and the single-mode families where their planes are invariant."""
-
-    text: str
-    model: ResonantSSM
-    outputs: np.ndarray
-    names: tuple[str, ...]
-    terms: tuple[Term, ...]
-    families: tuple[Family, ...]
-
-
-def reduce_pair(system: System, modes: tuple[int, ...], order: int,
-                outputs: list[int] | None = None, rho_max: float | None = None
-                ) -> ResonantReduction:
-    """The 4-D SSM of ``modes`` to ``order``, its terms and families up to ``rho_max``
-    (default :data:`analysis.ssm_forced.REACH` of the radius)."""
-    model = resonant_ssm(system, modes, order)
-    if outputs is None:
-        outputs = (list(range(system.size)) if system.size <= NAMED_OUTPUTS else sorted(
-            {int(np.argmax(np.abs(lin.shape))) for lin in model.linear}))
-    outputs = np.array(outputs, dtype=np.int64)
-    names = tuple(str(system.coordinates[i]) for i in outputs)
-    end = rho_max
-    if end is None:
-        end = REACH * model.radius if math.isfinite(model.radius) else 1.0
-    elif end > model.radius:
-        raise InputError(f"--rho-max {rho_max:g}: beyond the SSM's estimated radius "
-                         f"{model.radius:.6g} in max |p_k| ({model.radius_how})")
-    rho = np.linspace(0.0, end, BACKBONE_POINTS)
-    families = []
-    for mode in (1, 2):
-        gamma = model.backbone(mode)
-        if gamma is None:
-            continue
-        g = sum(c * rho ** (2 * j) for j, c in enumerate(gamma))
-        families.append(Family(model.modes[mode - 1], gamma, rho, g.imag,
-                               -g.real / np.abs(g) + 0.0,
-                               peak_amplitude(_plane_harmonics(model, mode, rho, outputs))))
-    return ResonantReduction(system.text, model, outputs, names, tuple(model.terms()),
-                             tuple(families))
-
-
-def _plane_harmonics(model: ResonantSSM, mode: int, rho: np.ndarray, outputs: np.ndarray
-                     ) -> np.ndarray:
-    """The outputs' Fourier coefficients in ``θ_k`` on mode ``mode``'s plane at each ρ_k
-    (``(P, 2K + 1, outputs)``, harmonic ``h`` at index ``h + K``)."""
-    K = model.order
-    first = 0 if mode == 1 else 2
-    out = np.zeros((len(rho), 2 * K + 1, len(outputs)), dtype=complex)
-    for k in range(1, K + 1):
-        for r in range(k + 1):
-            e = [0, 0, 0, 0]
-            e[first], e[first + 1] = k - r, r
-            row = model.basis.index[k][tuple(e)]
-            out[:, k - 2 * r + K] += rho[:, None] ** k * model.W[k][row, outputs][None, :]
-    return out
 
 
 def _backward_bordered(L, B: np.ndarray, x: np.ndarray, sigma: np.ndarray,

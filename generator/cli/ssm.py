@@ -276,7 +276,32 @@ def resonant_json(red) -> dict:
                                  "eigenvalue": _pair(q.eigenvalue), "divisor": q.divisor,
                                  "relative": q.relative} for q in m.near],
             "modes_checked": m.linear[0].checked,
-            "radius_estimate": {"value": _finite(m.radius), "how": m.radius_how}}
+            "radius_estimate": {"value": _finite(m.radius), "how": m.radius_how},
+            **_pair_frc(red, names)}
+
+
+def _pair_frc(red, names: list[str]) -> dict:
+    """The forced response's keys of :func:`resonant_json` (none where not driven)."""
+    r = red.response
+    if r is None:
+        return {}
+    peaks = {}
+    for k, name in enumerate(names):
+        best = max(r.states, key=lambda s: s.amplitude[k], default=None)
+        peaks[name] = None if best is None else {"omega": best.omega,
+                                                 "amplitude": float(best.amplitude[k])}
+    return {"frc": [{"omega": s.omega, "amplitude": {
+        name: float(a) for name, a in zip(names, s.amplitude, strict=True)},
+        "stable": s.stable, "rho": list(s.rho), "u": [_pair(u) for u in s.u]}
+        for s in r.states],
+        "frc_folds": list(r.folds), "frc_pieces": list(r.pieces),
+        "frc_driven_mode": red.model.modes[0 if r.kappa == 1 else 1],
+        "frc_forcing": [_pair(a) for a in r.forcing], "frc_peaks": peaks,
+        "frc_method": "the drive at leading order (order 0 in p) on the directions resonant "
+                      "with it; p_k = u_k*e^(i*nu_k*w*t/kappa), the reduced system's steady "
+                      "states continued in w from the linear response at both ends "
+                      "(pseudo-arclength), stable where its Jacobian's eigenvalues have "
+                      "negative real parts; branches reaching neither end are not sought"}
 
 
 def resonant_table(data: dict) -> list[str]:
@@ -319,16 +344,27 @@ def resonant_table(data: dict) -> list[str]:
                          "  " + "  ".join(f"{p['amplitude'][n]:>10.5g}" for n in names))
     if not data["families"]:
         lines.append("no mode alone: the resonance couples both planes")
+    if "frc" in data:
+        frc = data["frc"]
+        lines.append(f"forced response near mode {data['frc_driven_mode']}: {len(frc)} steady "
+                     f"states ({sum(not s['stable'] for s in frc)} unstable) along "
+                     f"{len(data['frc_pieces'])} traced curve"
+                     f"{'s' * (len(data['frc_pieces']) != 1)}")
+        for n in names:
+            p = data["frc_peaks"][n]
+            if p is not None:
+                lines.append(f"  peak of {n}: {p['amplitude']:.9g} at omega = "
+                             f"{p['omega']:.9g}")
+        lines += [f"  fold at omega = {w:.9g}" for w in data["frc_folds"]]
     return lines
 
 
 def run_resonant(args: argparse.Namespace) -> int:
     """``lindstedt ssm SYSTEM --mode M1,M2``: the 4-D SSM of two modes in internal
     resonance, its reduced dynamics; the options of one mode's SSM alone are refused."""
-    from ..analysis.ssm_resonant import reduce_pair
+    from ..analysis.ssm_resonant_forced import reduce_pair
 
-    given = [flag for flag, on in (("--omega", args.omega_min is not None),
-                                   ("--exact", args.exact), ("--plot", args.plot is not None),
+    given = [flag for flag, on in (("--exact", args.exact), ("--plot", args.plot is not None),
                                    ("--csv", args.csv is not None)) if on]
     if given:
         raise InputError(f"{', '.join(given)}: not built for a mode pair (--mode "
@@ -336,10 +372,15 @@ def run_resonant(args: argparse.Namespace) -> int:
     if len(args.mode) > 2:
         raise InputError(f"--mode {','.join(str(m) for m in args.mode)}: give one mode, or "
                          "two in internal resonance (M1,M2); more are not built")
+    span = None
+    if args.omega_min is not None:
+        span = (args.omega_min, args.omega_max)
+        if not 0 < span[0] < span[1]:
+            raise InputError(f"--omega {span[0]:g}:{span[1]:g}: give 0 < A < B")
     system = _system(args.system, args.model, args.param)
     red = reduce_pair(system, args.mode, args.order,
                       _outputs(args.output, [str(x) for x in system.coordinates]),
-                      args.rho_max)
+                      args.rho_max, span)
     data = resonant_json(red)
     print(json.dumps(data) if args.json else "\n".join(resonant_table(data)))
     return 0

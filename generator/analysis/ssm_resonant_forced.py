@@ -1,0 +1,378 @@
+"""The forced response of two modes in internal resonance from their 4-D SSM
+(:mod:`analysis.ssm_resonant`): the drive ``F cos Ωt`` at leading order (order 0 in p), the
+steady states of the reduced polynomial system traced in Ω by the package's one
+pseudo-arclength continuation (:func:`analysis.continuation._continue`), each with its
+stability and each output's physical amplitude.
+
+**The drive.**  Near ``Ω ≈ κ ω₁`` (``κ = 1``, or ``κ = r`` near the upper mode) the drive's
+``e^{iΩt}`` is resonant with the directions ``j`` of ``ν_j = κ``: the order-0 homological
+equation ``L(iΩ) X + Σ_j ((iΩ + Λ_j)M + C) Φ_j a_j = F/2``, bordered as every resonant row by
+``w_jᵀ(C + (Λ_j + iΩ)M) X + Σ_l (w_jᵀ M Φ_l) a_l = 0``, gives the forcing ``a_j`` of the
+reduced dynamics and the manifold's forced part ``x ∋ X e^{iΩt} + c.c.``:
+``p_k' = R_k(p) + a_k e^{iΩt}`` (``a_k = 0`` where ``ν_k ≠ κ``).
+
+**Steady states.**  In the frame ``p_k = u_k e^{iν_kφ}``, ``φ = Ωt/κ``, every kept monomial
+``p^m`` of ``p_k'`` turns into ``u^m e^{iν_kφ}`` (``m·ν = ν_k``), so
+
+    u_k' = (λ_k − iν_kΩ/κ) u_k + Σ_m R_{k,m} u^m + a_k(Ω) = 0
+
+is autonomous: four real equations in ``(Re u₁, Im u₁, Re u₂, Im u₂)``, continued in Ω from the
+linear response at both ends of the range through its folds.  A state is stable where every
+eigenvalue of the 4 × 4 Jacobian has a negative real part.  Its motion ``x(φ)`` has the
+harmonics ``h = m·ν`` of ``W_m u^m`` and ``±κ`` of ``X``; the amplitude is ``max |x_i|`` over a
+period ``2πκ/Ω`` (:func:`analysis.ssm.peak_amplitude`).  Branches that do not reach an end of
+the range (isolas, branches born at a branch point off the traced curve) are not sought."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sparse
+from numpy.polynomial import chebyshev
+
+from ..derive.system import System
+from ..errors import InputError
+from .continuation import _continue
+from .ssm import DENSE_SOLVES, _bordered, _damping, peak_amplitude
+from .ssm_forced import BACKBONE_POINTS, DEFAULT_SPAN, NAMED_OUTPUTS, REACH
+from .ssm_resonant import ResonantSSM, Term, resonant_ssm
+
+STEPS = 50
+# NOTE: the continuation's step is the range over this many (in (u, Ω), u of order ρ): a
+# resonance of Q ~ 50 over a ±20 % range is crossed in ~10 steps, halved where it turns.
+POINT_SECONDS = 2e-4
+# NOTE: the continuation's cost per point for its point bound (a 4 × 4 system: ~0.1 ms).
+MAX_POINTS = 20000
+DIFFERENCE = 1e-7
+# NOTE: the relative step in Ω of the drive's a_k(Ω) central difference (its derivative).
+CHEBYSHEV_NODES = 16
+CHEBYSHEV_MOST = 256
+INTERPOLATED = 1e-12
+# NOTE: a(Ω) is smooth over a range that holds no eigenvalue it is not bordered against: 16
+# nodes reach 1e-12 (relative) over ±20 % of a 2-DOF pair's mode; 256 is a bound, not a need.
+
+
+@dataclass(frozen=True)
+class PairState:
+    """One steady state: ``omega`` (Ω), ``u`` (``p_k = u_k e^{iν_kφ}``), ``rho`` (``|u_k|``),
+    each output's ``amplitude`` (max |x_i| over a period), ``stable``, and the full state
+    ``(x, x')`` at ``t = 0`` (``W(u) + 2 Re X``, ``V(u) + 2 Re(iΩX)``)."""
+
+    omega: float
+    u: tuple[complex, complex]
+    rho: tuple[float, float]
+    amplitude: np.ndarray = field(repr=False)
+    stable: bool
+    start: np.ndarray = field(repr=False)  # (x(0), x'(0)) of the motion, t = 0
+
+
+@dataclass(frozen=True)
+class PairResponse:
+    """The traced steady states in order along the curve (``pieces``: each piece's first
+    index), the folds in Ω, the drive's resonant mode (``kappa``: Ω ≈ κω₁) and forcing
+    ``a_k`` at the range's middle."""
+
+    kappa: int
+    states: tuple[PairState, ...]
+    pieces: tuple[int, ...]
+    folds: tuple[float, ...]
+    forcing: tuple[complex, complex]
+
+
+class _Drive:
+    """The order-0 forced terms at Ω, each solved once: ``(a, X)``, ``a`` the forcing of
+    ``(p₁', p₂')``, ``X`` the manifold's forced part."""
+
+    def __init__(self, model: ResonantSSM, kappa: int) -> None:
+        w = model.matrices
+        if w.drive is None:
+            raise InputError("the system is not driven: no forced response (drive one equation "
+                             "with f*cos(w*t), or give drive.txt)")
+        self.w, self.model = w, model
+        l1, l2 = model.lam
+        self.lams = np.array([l1, np.conj(l1), l2, np.conj(l2)])
+        s1, s2 = (lin.shape for lin in model.linear)
+        self.phis = np.array([s1, np.conj(s1), s2, np.conj(s2)])
+        v1, v2 = (lin.left for lin in model.linear)
+        self.lefts = np.array([v1, np.conj(v1), v2, np.conj(v2)])
+        nu = np.array([1, -1, model.ratio, -model.ratio])
+        self.kept = kept = np.flatnonzero(nu == kappa)
+        M, C, K = w.mass, _damping(w), w.stiffness
+        if w.size <= DENSE_SOLVES:  # products with small sparse matrices cost more
+            M, C, K = M.toarray(), C.toarray(), K.toarray()
+        self.M, self.C, self.K = M, C, K
+        # NOTE: the borders are affine in s: b_j = s·Mφ_j + (Λ_j M + C)φ_j and
+        # c_i = s·Mᵀw_i + (Cᵀ + Λ_i Mᵀ)w_i, made once
+        MPhi = np.array([M @ self.phis[j] for j in kept]).T
+        self.b = (MPhi, np.array([(self.lams[j] * M + C) @ self.phis[j] for j in kept]).T)
+        self.c = (np.array([M.T @ self.lefts[i] for i in kept]),
+                  np.array([(C.T + self.lams[i] * M.T) @ self.lefts[i] for i in kept]))
+        self.d = self.lefts[kept] @ MPhi
+        self.force = w.drive.astype(complex) / 2
+        self.cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+        self.chebyshev: tuple | None = None
+
+    def interpolate(self, lo: float, hi: float) -> None:
+        """``a(Ω)`` over ``[lo, hi]`` as a Chebyshev series (nodes doubled from
+        :data:`CHEBYSHEV_NODES` until the midpoints agree to :data:`INTERPOLATED`): the
+        continuation asks ``a`` and ``da/dΩ`` thousands of times."""
+        mid, half = (hi + lo) / 2, (hi - lo) / 2
+        N = CHEBYSHEV_NODES
+        while True:
+            nodes = np.cos(np.pi * (np.arange(N) + 0.5) / N)
+            values = np.array([self.at(mid + half * x)[0] for x in nodes])
+            coef = chebyshev.chebfit(nodes, values, N - 1)
+            probes = np.cos(np.pi * np.arange(1, N) / N)
+            exact = np.array([self.at(mid + half * x)[0] for x in probes])
+            error = np.max(np.abs(chebyshev.chebval(probes, coef).T - exact))
+            if error <= INTERPOLATED * max(np.max(np.abs(values)), 1e-300) or N >= CHEBYSHEV_MOST:
+                break
+            N *= 2
+        self.chebyshev = (mid, half, coef, chebyshev.chebder(coef) / half)
+
+    def forcing(self, omega: float) -> np.ndarray:
+        """``a(Ω)`` (interpolated where :meth:`interpolate` was called)."""
+        if self.chebyshev is None:
+            return self.at(omega)[0]
+        mid, half, coef, _ = self.chebyshev
+        return chebyshev.chebval((omega - mid) / half, coef)
+
+    def slope(self, omega: float) -> np.ndarray:
+        """``da/dΩ``: the Chebyshev series' derivative, or a central difference."""
+        if self.chebyshev is None:
+            h = DIFFERENCE * max(1.0, abs(omega))
+            return (self.at(omega + h)[0] - self.at(omega - h)[0]) / (2 * h)
+        mid, half, _, der = self.chebyshev
+        return chebyshev.chebval((omega - mid) / half, der)
+
+    def at(self, omega: float) -> tuple[np.ndarray, np.ndarray]:
+        if omega not in self.cache:
+            s = 1j * omega
+            L = s * s * self.M + s * self.C + self.K
+            if sparse.issparse(L):
+                L = sparse.csc_array(L)
+            X, sigma = _bordered(L, s * self.b[0] + self.b[1], s * self.c[0] + self.c[1],
+                                 self.d, self.force, np.zeros(len(self.kept)), False,
+                                 (0, (0, 0, 0, 0), "drive"))
+            a = np.zeros(2, dtype=complex)
+            for j, value in zip(self.kept, np.atleast_1d(sigma), strict=True):
+                a[j // 2] = value
+            self.cache[omega] = (a, X)
+        return self.cache[omega]
+
+
+class _Balance:
+    """``u' = 0`` in ``x = (Re u₁, Im u₁, Re u₂, Im u₂)`` and Ω: ``residual``, ``jacobian``
+    and ``d_omega``, as :func:`analysis.continuation._continue` asks of a balance."""
+
+    def __init__(self, model: ResonantSSM, drive: _Drive, kappa: int) -> None:
+        self.lams = np.array(model.lam)
+        self.nu = np.array([1, model.ratio]) / kappa
+        terms = model.terms()
+        self.E = [np.array([t.monomial for t in terms if t.mode == k], dtype=int).reshape(-1, 4)
+                  for k in (1, 2)]
+        self.c = [np.array([t.coefficient for t in terms if t.mode == k], dtype=complex)
+                  for k in (1, 2)]
+        self.drive = drive
+
+    @staticmethod
+    def _u(x: np.ndarray) -> np.ndarray:
+        u1, u2 = x[0] + 1j * x[1], x[2] + 1j * x[3]
+        return np.array([u1, np.conj(u1), u2, np.conj(u2)])
+
+    def complex_residual(self, x: np.ndarray, omega: float) -> np.ndarray:
+        U = self._u(x)
+        a = self.drive.forcing(omega)
+        out = (self.lams - 1j * self.nu * omega) * U[[0, 2]] + a
+        for k in range(2):
+            if len(self.c[k]):
+                out[k] += self.c[k] @ np.prod(U[None, :] ** self.E[k], axis=1)
+        return out
+
+    def residual(self, x: np.ndarray, omega: float) -> np.ndarray:
+        G = self.complex_residual(x, omega)
+        return np.array([G[0].real, G[0].imag, G[1].real, G[1].imag])
+
+    def jacobian(self, x: np.ndarray, omega: float) -> np.ndarray:
+        U = self._u(x)
+        dU = np.zeros((2, 4), dtype=complex)  # ∂G_k/∂(u₁, ū₁, u₂, ū₂)
+        for k in range(2):
+            dU[k, 2 * k] = self.lams[k] - 1j * self.nu[k] * omega
+            E = self.E[k]
+            if len(E):  # ∂(u^m)/∂U_j = m_j u^(m − e_j), every j at once
+                lowered = np.maximum(E[:, None, :] - np.eye(4, dtype=int)[None], 0)
+                dU[k] += np.einsum("t,tj,tj->j", self.c[k], E, np.prod(U ** lowered, axis=2))
+        re = dU[:, 0::2] + dU[:, 1::2]  # ∂/∂Re u_j
+        im = 1j * (dU[:, 0::2] - dU[:, 1::2])  # ∂/∂Im u_j
+        J = np.empty((4, 4))
+        J[0::2, 0::2], J[1::2, 0::2] = re.real, re.imag
+        J[0::2, 1::2], J[1::2, 1::2] = im.real, im.imag
+        return J
+
+    def d_omega(self, x: np.ndarray, omega: float) -> np.ndarray:
+        da = self.drive.slope(omega)
+        U = self._u(x)
+        G = -1j * self.nu * U[[0, 2]] + da
+        return np.array([G[0].real, G[0].imag, G[1].real, G[1].imag])
+
+
+def pair_response(model: ResonantSSM, span: tuple[float, float], outputs: np.ndarray
+                  ) -> PairResponse:
+    """The forced response of ``model``'s system over Ω in ``span``: every steady state on
+    the curves from the linear response at both ends, its stability and amplitudes."""
+    lo, hi = span
+    l1, l2 = model.lam
+    middle = (lo + hi) / 2
+    kappa = 1 if abs(middle - l1.imag) <= abs(middle - l2.imag) else model.ratio
+    drive = _Drive(model, kappa)
+    drive.interpolate(lo, hi)
+    balance = _Balance(model, drive, kappa)
+
+    def linear(omega: float) -> np.ndarray:
+        a = drive.forcing(omega)
+        u = -a / (balance.lams - 1j * balance.nu * omega)
+        return np.array([u[0].real, u[0].imag, u[1].real, u[1].imag])
+
+    def ends():
+        return [(lo, linear(lo), 1.0), (hi, linear(hi), -1.0)], True
+
+    step = (hi - lo) / STEPS
+    curve = _continue(balance, ends, lo, hi, step, STEPS, STEPS * POINT_SECONDS,
+                      POINT_SECONDS, MAX_POINTS, f"modes {model.modes[0]},{model.modes[1]}")
+    keep = (curve.omega >= lo) & (curve.omega <= hi)
+    starts = set(curve.pieces)
+    pieces, chosen = [], []
+    for i in range(len(curve.omega)):
+        if i in starts:
+            pieces.append(len(chosen))
+        if keep[i]:
+            chosen.append(i)
+    omegas, xs = curve.omega[chosen], curve.x[chosen]
+    us = xs[:, 0::2] + 1j * xs[:, 1::2]
+    amplitude = peak_amplitude(_harmonics(model, drive, kappa, omegas, us, outputs))
+    states = tuple(
+        PairState(float(omega), (complex(u[0]), complex(u[1])), (abs(u[0]), abs(u[1])), amp,
+                  bool(np.all(np.linalg.eigvals(balance.jacobian(x, omega)).real < 0)),
+                  _start(model, drive, float(omega), u))
+        for omega, x, u, amp in zip(omegas, xs, us, amplitude, strict=True))
+    return PairResponse(kappa, states, tuple(p for p in pieces if p < len(states)),
+                        tuple(f for f in curve.folds if lo <= f <= hi),
+                        tuple(drive.at(middle)[0]))
+
+
+def _harmonics(model: ResonantSSM, drive: _Drive, kappa: int, omegas: np.ndarray,
+               us: np.ndarray, outputs: np.ndarray) -> np.ndarray:
+    """The outputs' Fourier coefficients in ``φ = Ωt/κ`` of steady states (``us``:
+    ``(P, 2)``; ``(P, 2H + 1, outputs)``, harmonic ``h`` at index ``h + H``, ``H = rK``)."""
+    r, K = model.ratio, model.order
+    H = max(r * K, kappa)
+    nu = np.array([1, -1, r, -r])
+    U = np.stack([us[:, 0], np.conj(us[:, 0]), us[:, 1], np.conj(us[:, 1])], axis=1)
+    out = np.zeros((len(us), 2 * H + 1, len(outputs)), dtype=complex)
+    for k in range(1, K + 1):
+        E = model.basis.exponents[k]
+        powers = np.prod(U[:, None, :] ** E[None], axis=2)  # (P, N_k)
+        spread = np.zeros((2 * H + 1, len(E)))
+        spread[E @ nu + H, np.arange(len(E))] = 1.0
+        out += np.einsum("hm,pm,mo->pho", spread, powers, model.W[k][:, outputs])
+    X = np.array([drive.at(float(omega))[1][outputs] for omega in omegas])
+    out[:, H + kappa] += X
+    out[:, H - kappa] += np.conj(X)
+    return out
+
+
+def _start(model: ResonantSSM, drive: _Drive, omega: float, u: np.ndarray) -> np.ndarray:
+    """``(x(0), x'(0))`` of a steady state."""
+    x, v = model.state(complex(u[0]), complex(u[1]))
+    X = drive.at(omega)[1]
+    return np.concatenate([x + 2 * X.real, v + 2 * (1j * omega * X).real])
+
+
+@dataclass(frozen=True)
+class Family:
+    """A family of motions of the SSM the command reports: one mode alone on its invariant
+    plane (``mode``, ``gamma``: its normal form ``p_k' = p_k Σ_j γ_j (p_k p̄_k)^j``), at
+    ``rho`` (that mode's ``ρ_k``), with ``omega``, ``damping_ratio`` and each output's
+    ``amplitude`` (max |x_i| over a period)."""
+
+    mode: int
+    gamma: tuple[complex, ...]
+    rho: np.ndarray = field(repr=False)
+    omega: np.ndarray = field(repr=False)
+    damping_ratio: np.ndarray = field(repr=False)
+    amplitude: np.ndarray = field(repr=False)
+
+
+@dataclass(frozen=True)
+class ResonantReduction:
+    """What ``ssm SYSTEM --mode M1,M2`` reports: the 4-D SSM, the outputs, the kept terms of
+    the reduced dynamics and the single-mode families where their planes are invariant."""
+
+    text: str
+    model: ResonantSSM
+    outputs: np.ndarray
+    names: tuple[str, ...]
+    terms: tuple[Term, ...]
+    families: tuple[Family, ...]
+    response: PairResponse | None
+    span: tuple[float, float] | None
+
+
+def reduce_pair(system: System, modes: tuple[int, ...], order: int,
+                outputs: list[int] | None = None, rho_max: float | None = None,
+                span: tuple[float, float] | None = None) -> ResonantReduction:
+    """The 4-D SSM of ``modes`` to ``order``, its terms and families up to ``rho_max``
+    (default :data:`analysis.ssm_forced.REACH` of the radius) and, driven, its forced
+    response over ``span`` (default :data:`analysis.ssm_forced.DEFAULT_SPAN` about the lower
+    mode's ``|λ|``)."""
+    model = resonant_ssm(system, modes, order)
+    if outputs is None:
+        outputs = (list(range(system.size)) if system.size <= NAMED_OUTPUTS else sorted(
+            {int(np.argmax(np.abs(lin.shape))) for lin in model.linear}))
+    outputs = np.array(outputs, dtype=np.int64)
+    names = tuple(str(system.coordinates[i]) for i in outputs)
+    end = rho_max
+    if end is None:
+        end = REACH * model.radius if math.isfinite(model.radius) else 1.0
+    elif end > model.radius:
+        raise InputError(f"--rho-max {rho_max:g}: beyond the SSM's estimated radius "
+                         f"{model.radius:.6g} in max |p_k| ({model.radius_how})")
+    rho = np.linspace(0.0, end, BACKBONE_POINTS)
+    families = []
+    for mode in (1, 2):
+        gamma = model.backbone(mode)
+        if gamma is None:
+            continue
+        g = sum(c * rho ** (2 * j) for j, c in enumerate(gamma))
+        families.append(Family(model.modes[mode - 1], gamma, rho, g.imag,
+                               -g.real / np.abs(g) + 0.0,
+                               peak_amplitude(_plane_harmonics(model, mode, rho, outputs))))
+    response = None
+    if system.matrices.drive is not None:
+        lam = abs(model.lam[0])
+        span = (float(span[0]), float(span[1])) if span is not None else (
+            (1 - DEFAULT_SPAN) * lam, (1 + DEFAULT_SPAN) * lam)
+        response = pair_response(model, span, outputs)
+    elif span is not None:
+        raise InputError("--omega: the system is not driven (drive one equation with "
+                         "f*cos(w*t), or give drive.txt)")
+    return ResonantReduction(system.text, model, outputs, names, tuple(model.terms()),
+                             tuple(families), response, span)
+
+
+def _plane_harmonics(model: ResonantSSM, mode: int, rho: np.ndarray, outputs: np.ndarray
+                     ) -> np.ndarray:
+    """The outputs' Fourier coefficients in ``θ_k`` on mode ``mode``'s plane at each ρ_k
+    (``(P, 2K + 1, outputs)``, harmonic ``h`` at index ``h + K``)."""
+    K = model.order
+    first = 0 if mode == 1 else 2
+    out = np.zeros((len(rho), 2 * K + 1, len(outputs)), dtype=complex)
+    for k in range(1, K + 1):
+        for r in range(k + 1):
+            e = [0, 0, 0, 0]
+            e[first], e[first + 1] = k - r, r
+            row = model.basis.index[k][tuple(e)]
+            out[:, k - 2 * r + K] += rho[:, None] ** k * model.W[k][row, outputs][None, :]
+    return out
