@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 from itertools import pairwise
 
 import numpy as np
+from numba import njit
 from scipy.integrate import solve_ivp
 
 TWO_PI = 2.0 * math.pi
@@ -806,3 +807,205 @@ def free_decay(M, C, K, force, x0, v0, times) -> tuple[np.ndarray, np.ndarray]:
     if sol.status != 0:
         raise RuntimeError(f"free decay integration failed: {sol.message}")
     return sol.y[:n].T.copy(), sol.y[n:].T.copy()
+
+
+# --------------------------------------------------------------------------- conservative backbone
+
+
+@dataclass(frozen=True)
+class FreeOrbit:
+    """A periodic orbit of the conservative ``M x'' + K x + f(x) = 0``, of period ``2π/ω``,
+    starting at rest: ``y0 = (x(0), 0)``.
+
+    ``residual = |y(T) - y0| / |y0|``: one whole period integrated afresh from the converged
+    ``y0`` with half the step Newton used (the judge: it holds the integration error as well
+    as Newton's); ``half`` is the half-period condition Newton solved, ``|v(T/2)| / (ω|x(0)|)``;
+    ``amplitude[i] = max_t |x_i(t)|`` over the period's steps; ``steps`` the RK4 steps a
+    period (Newton's; the judge takes twice as many); ``newton`` the half-period
+    integrations Newton used."""
+
+    omega: float
+    y0: np.ndarray
+    residual: float
+    half: float
+    amplitude: np.ndarray
+    steps: int
+    newton: int
+    tolerance: float = field(repr=False, default=1e-9)
+
+
+def _monomials(n: int, terms: Sequence) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A table of monomials in ``x`` alone (``(i, [j, k, ...], c)``, degree ≤ 3) as arrays:
+    equation, factors padded with −1 to three, coefficient."""
+    table = [(int(i), [int(j) for j in js], float(c)) for i, js, c in terms]
+    if any(not 0 <= i < n or not 1 <= len(js) <= 3 or any(not 0 <= j < n for j in js)
+           for i, js, _ in table):
+        raise ValueError("a conservative backbone takes monomials of x of degree ≤ 3")
+    return (np.array([i for i, _, _ in table], dtype=np.int64),
+            np.array([[*js, -1, -1][:3] for _, js, _ in table], dtype=np.int64).reshape(-1, 3),
+            np.array([c for _, _, c in table], dtype=float))
+
+
+@njit(cache=True)
+def _field(y, P, mk, minv, eq, fac, coef, variational):
+    """``(y', P')``: the state's field and the variational one."""
+    n = mk.shape[0]
+    f = np.zeros(n)
+    J = np.zeros((n, n))
+    for t in range(coef.size):
+        i, a, b, c = eq[t], fac[t, 0], fac[t, 1], fac[t, 2]
+        xa, xb = y[a], y[b]
+        if c < 0:
+            f[i] += coef[t] * xa * xb
+            if variational:
+                J[i, a] += coef[t] * xb
+                J[i, b] += coef[t] * xa
+        else:
+            xc = y[c]
+            f[i] += coef[t] * xa * xb * xc
+            if variational:
+                J[i, a] += coef[t] * xb * xc
+                J[i, b] += coef[t] * xa * xc
+                J[i, c] += coef[t] * xa * xb
+    dy = np.empty(2 * n)
+    dy[:n] = y[n:]
+    dy[n:] = -(mk @ y[:n]) - minv @ f
+    if not variational:
+        return dy, P
+    dP = np.empty_like(P)
+    dP[:n] = P[n:]
+    dP[n:] = -(mk + minv @ J) @ P[:n]
+    return dy, dP
+
+
+@njit(cache=True)
+def _flow(y, P, h, steps, mk, minv, eq, fac, coef, variational, path):
+    """``steps`` classical RK4 steps of :func:`_field`."""
+    for s in range(steps):
+        a1, b1 = _field(y, P, mk, minv, eq, fac, coef, variational)
+        a2, b2 = _field(y + h / 2 * a1, P + h / 2 * b1, mk, minv, eq, fac, coef, variational)
+        a3, b3 = _field(y + h / 2 * a2, P + h / 2 * b2, mk, minv, eq, fac, coef, variational)
+        a4, b4 = _field(y + h * a3, P + h * b3, mk, minv, eq, fac, coef, variational)
+        y = y + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+        if variational:
+            P = P + h / 6 * (b1 + 2 * b2 + 2 * b3 + b4)
+        if path.shape[0] > 1:
+            path[s + 1] = y
+    return y, P
+
+
+class _Conservative:
+    """``x'' = −M⁻¹(K x + f(x))`` and its variational equation for perturbations of ``x(0)``
+    alone (``v(0) = 0`` held), by classical RK4 with a fixed step (a stiff model takes tens
+    of thousands of steps a period), the loop compiled by numba."""
+
+    def __init__(self, M, K, terms):
+        M = np.atleast_2d(np.asarray(M, float))
+        self.n = n = M.shape[0]
+        self.minv = np.linalg.inv(M)
+        self.mk = self.minv @ np.atleast_2d(np.asarray(K, float))
+        self.table = _monomials(n, terms)
+        self.fastest = float(np.sqrt(np.max(np.abs(np.linalg.eigvals(self.mk)))))
+
+    def accel(self, y: np.ndarray) -> np.ndarray:
+        n = self.n
+        return _field(np.asarray(y, float), np.zeros((2 * n, n)), self.mk, self.minv,
+                           *self.table, False)[0][n:]
+
+    def flow(self, x0: np.ndarray, duration: float, steps: int, variational: bool,
+             keep: bool = False):
+        """RK4 over ``duration`` in ``steps`` steps from ``(x0, 0)``: the end state, the
+        sensitivities ``∂y/∂x(0)`` (``2n × n``; None without ``variational``), and with
+        ``keep`` every step's state (``(steps + 1, 2n)``)."""
+        n = self.n
+        y = np.concatenate((np.asarray(x0, float), np.zeros(n)))
+        P = np.vstack((np.eye(n), np.zeros((n, n))))
+        path = np.empty((steps + 1 if keep else 1, 2 * n))
+        path[0] = y
+        y, P = _flow(y, P, duration / steps, steps, self.mk, self.minv, *self.table,
+                          variational, path)
+        return y, (P if variational else None), (path if keep else None)
+
+
+STEP_STABILITY = 0.5
+# NOTE: the fixed step keeps ω_max·h ≤ 0.5 (RK4 is stable to 2.83 on the imaginary axis):
+# the stiffest mode (a beam's axial ones, thousands of times the lowest frequency) then sets
+# the step, not the accuracy, and the slow motion is integrated far below 1e-12.
+
+
+def free_orbit(M, K, terms, coordinate: int, amplitude: float, x0, omega: float,
+               tol: float = 1e-9, steps: int | None = None, max_steps: int = 12,
+               system: _Conservative | None = None) -> FreeOrbit:
+    """The periodic orbit of the conservative system through ``x_coordinate(0) = amplitude``
+    at rest, near the guess ``(x0, ω)``, by half-period shooting.
+
+    The system is reversible (``t → −t``): an orbit with ``v(0) = 0`` and ``v(T/2) = 0`` is
+    ``T``-periodic.  The unknowns are ``x(0)`` but its ``coordinate`` (held at ``amplitude``:
+    the amplitude condition) and ``ω`` (the period is unknown; ``v(0) = 0`` is the phase
+    condition); the equations ``v(T/2) = 0``, ``n`` of them, solved by Newton with the
+    variational equations (``∂v(T/2)/∂ω = −(π/ω²) a(T/2)``).  Classical RK4 with a fixed step,
+    ``steps`` a period (default: a power of two with ``ω_max h ≤`` :data:`STEP_STABILITY`), so
+    that a stiff model costs steps, not failures.  The converged orbit is integrated over a
+    whole period with half the step and returned only when ``|y(T) − y0| / |y0| ≤ tol``, else
+    :class:`ShootingError` — never on a flag."""
+    system = system or _Conservative(M, K, terms)
+    n = system.n
+    if steps is None:
+        steps = 2 ** math.ceil(math.log2(system.fastest * TWO_PI / omega / STEP_STABILITY))
+    free = np.delete(np.arange(n), coordinate)
+    x = np.array(x0, float)
+    x[coordinate] = amplitude
+    omega = float(omega)
+    half, used = math.inf, 0
+    while used < max_steps:
+        used += 1
+        y, P, _ = system.flow(x, math.pi / omega, steps // 2, True)
+        r = y[n:]  # v(T/2)
+        half = float(np.linalg.norm(r) / (omega * np.linalg.norm(x)))
+        if half <= 1e-3 * tol:
+            break
+        J = np.column_stack((P[n:][:, free], -math.pi / omega**2 * system.accel(y)))
+        delta = np.linalg.solve(J, -r)
+        x[free] += delta[:-1]
+        omega += float(delta[-1])
+    y0 = np.concatenate((x, np.zeros(n)))
+    end, _, path = system.flow(x, TWO_PI / omega, 2 * steps, False, keep=True)
+    residual = float(np.linalg.norm(end - y0) / np.linalg.norm(y0))
+    if not residual <= tol:
+        raise ShootingError(f"amplitude {amplitude:.6g}: periodicity residual {residual:.3e} "
+                            f"above {tol:.1e} (half-period condition {half:.1e}, {used} "
+                            "Newton steps)")
+    peak = np.max(np.abs(path[:, :n]), axis=0)
+    return FreeOrbit(omega, y0, residual, half, peak, steps, used, tol)
+
+
+def backbone(M, K, terms, coordinate: int, amplitudes, tol: float = 1e-9,
+             steps: int | None = None) -> list[FreeOrbit]:
+    """The conservative backbone of the lowest mode at increasing ``amplitudes`` of
+    ``x_coordinate``: continuation from the linear mode (``K φ = ω₀² M φ``, scaled to the
+    first amplitude), each next guess extrapolated linearly in the amplitude from the last
+    two orbits (scaled from the last one at the second)."""
+    from scipy.linalg import eigh
+
+    M = np.atleast_2d(np.asarray(M, float))
+    K = np.atleast_2d(np.asarray(K, float))
+    system = _Conservative(M, K, terms)
+    lam, phi = eigh(K, M)
+    mode = phi[:, 0] / phi[coordinate, 0]
+    n = len(mode)
+    orbits: list[FreeOrbit] = []
+    done: list[float] = []
+    for A in amplitudes:
+        if not orbits:
+            x0, omega = A * mode, math.sqrt(lam[0])
+        elif len(orbits) == 1:
+            x0, omega = orbits[0].y0[:n] * A / done[0], orbits[0].omega
+        else:
+            a, b = orbits[-2], orbits[-1]
+            t = (A - done[-1]) / (done[-1] - done[-2])
+            x0 = b.y0[:n] + t * (b.y0[:n] - a.y0[:n])
+            omega = b.omega + t * (b.omega - a.omega)
+        orbits.append(free_orbit(M, K, terms, coordinate, A, x0, omega, tol, steps,
+                                 system=system))
+        done.append(float(A))
+    return orbits
