@@ -12,9 +12,10 @@ import pytest
 import sympy as sp
 from lindstedt.analysis.ssm import ssm
 from lindstedt.analysis.ssm_resonant import resonant_ssm, slow_flow_scale
-from lindstedt.analysis.ssm_resonant_forced import reduce_pair
+from lindstedt.analysis.ssm_resonant_forced import coupled_modes, reduce_pair
 from lindstedt.cli import main
 from lindstedt.derive.averaging import slow_flow
+from lindstedt.derive.resonance import coupled_modes as averaged_modes
 from lindstedt.derive.system import parse_system
 from scipy.integrate import solve_ivp
 
@@ -42,7 +43,8 @@ def test_first_order_equals_the_averaged_flow(text):
     """`slowflow SYSTEM`'s exact first-order flow (a_k, φ_k of x = Σ a_k s_k cos(ω_k t + φ_k))
     equals the normal form's terms of the force's degree d in the same variables:
     a_k = |c_k| ρ_k, θ_k = ω_k t + φ_k (+ π where c_k < 0), da_k/dt = |c_k| ρ_k',
-    dφ_k/dt = θ_k' − ω_k (to rounding: both are the resonant averages of the same terms)."""
+    dφ_k/dt = θ_k' − ω_k (to rounding: both are the resonant averages of the same terms);
+    and so are its coupled modes."""
     flow = slow_flow(parse_system(text), 1)
     model = resonant_ssm(parse_system(text, driven=True), (1, 2), 3)
     assert flow.resonances[0].startswith(f"1:{model.ratio} ")
@@ -57,6 +59,16 @@ def test_first_order_equals_the_averaged_flow(text):
                                      theta[1] - model.ratio * theta[0], top=flow.degree)
         got = [abs(c[0]) * r1, abs(c[1]) * r2, w1 - model.lam[0].imag, w2 - model.lam[1].imag]
         assert np.max(np.abs(got - expected)) < 1e-14 * max(1.0, np.max(np.abs(expected)))
+    # the coupled modes (derive.resonance.coupled_modes: exact a₂/a₁ at γ = rφ₁ − φ₂ = 0 or
+    # π): the same ratio |c₂|ρ₂/(|c₁|ρ₁), at ψ = −γ + π([c₂ < 0] − r[c₁ < 0]) (mod 2π)
+    shift = (c[1] < 0) - model.ratio * (c[0] < 0)
+    expected = {(round(float(-g / sp.pi)) + shift) % 2: float(r)
+                for g, r in averaged_modes(flow)}
+    found = coupled_modes(model, np.array([0.01]), np.array([0, 1]), top=flow.degree)
+    assert sorted(round(f.psi / np.pi) for f in found) == sorted(expected)
+    for f in found:
+        (ratio,) = f.rho[:, 1] / f.rho[:, 0] * abs(c[1] / c[0])
+        assert abs(ratio - expected[round(f.psi / np.pi)]) < 1e-10 * ratio
 
 
 @pytest.mark.parametrize("text, mode, both", [(DAMPED_1_2, 2, False), (UNDAMPED_1_1, 1, True)])
@@ -193,3 +205,26 @@ def test_forced_response_against_full_order_shooting(f, rtol):
             assert error[0] < rtol[0] and error[1] < rtol[1], (s.omega, error)
         elif s.stable:  # off the peak, x₂ is small and its error relatively large
             assert error[0] < 1e-2, (s.omega, error)
+
+
+def test_coupled_modes_are_periodic_orbits_of_the_full_system():
+    """A coupled mode at s = 0.05 started on the manifold returns to its start after one
+    period 2π/ω of the full system, to an error falling with the order."""
+    system = parse_system(QUADRATIC_1_2, driven=True)
+    w = system.matrices
+
+    def full(t, z):
+        return np.concatenate([z[2:], -(w.stiffness @ z[:2] + w.force(z[:2], z[2:]))])
+
+    gaps = []
+    for order in (3, 7):
+        model = resonant_ssm(system, (1, 2), order)
+        families = coupled_modes(model, np.array([0.05]), np.array([0, 1]))
+        assert [f.psi for f in families] == [0.0, np.pi]
+        for f in families:
+            x, v = model.state(f.rho[0, 0], f.rho[0, 1] * np.exp(1j * f.psi))
+            y0 = np.concatenate([x, v])
+            end = solve_ivp(full, (0, 2 * np.pi / f.omega[0]), y0, method="DOP853",
+                            rtol=1e-12, atol=1e-14).y[:, -1]
+            gaps.append(np.max(np.abs(end - y0)) / np.max(np.abs(y0)))
+    assert max(gaps[2:]) < 2e-9 and min(gaps[:2]) / max(gaps[2:]) > 1e4

@@ -34,6 +34,7 @@ from numpy.polynomial import chebyshev
 
 from ..derive.system import System
 from ..errors import InputError
+from ..numerics.newton import secant
 from .continuation import _continue
 from .ssm import DENSE_SOLVES, _bordered, _damping, peak_amplitude
 from .ssm_forced import BACKBONE_POINTS, DEFAULT_SPAN, NAMED_OUTPUTS, REACH
@@ -308,7 +309,8 @@ class Family:
 @dataclass(frozen=True)
 class ResonantReduction:
     """What ``ssm SYSTEM --mode M1,M2`` reports: the 4-D SSM, the outputs, the kept terms of
-    the reduced dynamics and the single-mode families where their planes are invariant."""
+    the reduced dynamics, the single-mode families where their planes are invariant, the
+    forced response (driven) and the coupled modes (undamped)."""
 
     text: str
     model: ResonantSSM
@@ -318,6 +320,7 @@ class ResonantReduction:
     families: tuple[Family, ...]
     response: PairResponse | None
     span: tuple[float, float] | None
+    coupled: tuple[CoupledMode, ...] = ()
 
 
 def reduce_pair(system: System, modes: tuple[int, ...], order: int,
@@ -358,8 +361,10 @@ def reduce_pair(system: System, modes: tuple[int, ...], order: int,
     elif span is not None:
         raise InputError("--omega: the system is not driven (drive one equation with "
                          "f*cos(w*t), or give drive.txt)")
+    amplitudes = np.linspace(end / (BACKBONE_POINTS - 1), end, BACKBONE_POINTS - 1)
     return ResonantReduction(system.text, model, outputs, names, tuple(model.terms()),
-                             tuple(families), response, span)
+                             tuple(families), response, span,
+                             coupled_modes(model, amplitudes, outputs))
 
 
 def _plane_harmonics(model: ResonantSSM, mode: int, rho: np.ndarray, outputs: np.ndarray
@@ -375,4 +380,92 @@ def _plane_harmonics(model: ResonantSSM, mode: int, rho: np.ndarray, outputs: np
             e[first], e[first + 1] = k - r, r
             row = model.basis.index[k][tuple(e)]
             out[:, k - 2 * r + K] += rho[:, None] ** k * model.W[k][row, outputs][None, :]
+    return out
+
+
+@dataclass(frozen=True)
+class CoupledMode:
+    """Phase-locked periodic motions of an undamped pair at one phase difference ``psi``
+    (0 or π): ``ρ₁, ρ₂`` constant, ``ψ' = θ₂' − rθ₁' = 0``; at each point ``rho`` (``(P,
+    2)``), ``omega`` (``θ₁'``: the motion has period ``2π/ω``, mode 2 turning r times as
+    fast) and each output's ``amplitude``."""
+
+    psi: float
+    rho: np.ndarray = field(repr=False)
+    omega: np.ndarray = field(repr=False)
+    amplitude: np.ndarray = field(repr=False)
+
+
+CONSERVATIVE = 1e-10
+# NOTE: the kept coefficients' real parts below this fraction of |λ| (and no linear damping):
+# the pair is conservative, ρ_k' vanishes at ψ = 0 and π, and the coupled modes are families
+# of periodic orbits; a damped pair's amplitudes decay and it has none.
+ANGLES = 64
+# NOTE: samples of the ray's angle β (ρ₁ = s cos β, ρ₂ = s sin β) in (0, π/2) where ψ' changes
+# sign: each bracket refined by false position to rounding.
+
+
+def coupled_modes(model: ResonantSSM, amplitudes: np.ndarray, outputs: np.ndarray,
+                  top: int | None = None) -> tuple[CoupledMode, ...]:
+    """The coupled modes of an undamped pair at each ``s = √(ρ₁² + ρ₂²)`` of ``amplitudes``
+    (the reduced dynamics to order ``top``, default all): every root ``β`` of ``ψ'`` in
+    ``(0, π/2)`` at ``ψ = 0`` and ``ψ = π``; none for a damped pair."""
+    damping = model.matrices.damping
+    scale = max(abs(lam) for lam in model.lam)
+    if (damping is not None and damping.count_nonzero()) or any(
+            abs(t.coefficient.real) > CONSERVATIVE * scale for t in model.terms(top)):
+        return ()
+    terms = model.terms(top)
+    beta = np.pi / 2 * (np.arange(ANGLES) + 0.5) / ANGLES
+    out = []
+    for psi in (0.0, np.pi):
+        points = []
+        for s in amplitudes:
+            def locked(b, s: float = s, psi: float = psi):
+                return _locked_rates(model, terms, s * np.cos(b), s * np.sin(b), psi)[0]
+
+            values = locked(beta)
+            for a, b, fa, fb in zip(beta[:-1], beta[1:], values[:-1], values[1:], strict=True):
+                if fa == 0 or (fa > 0) != (fb > 0):
+                    run = secant(lambda x: float(locked(x)), a, b, fa, fb, tol=1e-15,
+                                 bracketed=True)
+                    root = float(run.x)
+                    rho = (s * math.cos(root), s * math.sin(root))
+                    points.append((rho, float(_locked_rates(model, terms, *rho, psi)[1])))
+        if points:
+            rho = np.array([p[0] for p in points])
+            omega = np.array([p[1] for p in points])
+            out.append(CoupledMode(psi, rho, omega, peak_amplitude(
+                _locked_harmonics(model, rho, psi, outputs))))
+    return tuple(out)
+
+
+def _locked_rates(model: ResonantSSM, terms: list[Term], rho1, rho2, psi: float):
+    """``(ψ', θ₁')`` at ``ρ₁, ρ₂`` (arrays) and ``ψ``, from the polar form of the kept terms:
+    ``θ_k' = Im λ_k + Σ Im(c e^{iqψ}) ρ₁^{a}ρ₂^{b} / ρ_k``."""
+    rho1, rho2 = np.asarray(rho1, dtype=float), np.asarray(rho2, dtype=float)
+    theta = [np.full(rho1.shape, lam.imag) for lam in model.lam]
+    for t in terms:
+        value = (t.coefficient * np.exp(1j * t.psi * psi)).imag * rho1**t.rho1 * rho2**t.rho2
+        theta[t.mode - 1] = theta[t.mode - 1] + value / (rho1 if t.mode == 1 else rho2)
+    return theta[1] - model.ratio * theta[0], theta[0]
+
+
+def _locked_harmonics(model: ResonantSSM, rho: np.ndarray, psi: float, outputs: np.ndarray
+                      ) -> np.ndarray:
+    """The outputs' Fourier coefficients in ``θ = θ₁`` of coupled motions (``p₁ = ρ₁e^{iθ}``,
+    ``p₂ = ρ₂e^{i(rθ + ψ)}``; ``(P, 2H + 1, outputs)``, ``H = rK``)."""
+    r, K = model.ratio, model.order
+    H = r * K
+    phase = np.exp(1j * psi)
+    us = np.stack([rho[:, 0] + 0j, rho[:, 1] * phase], axis=1)
+    nu = np.array([1, -1, r, -r])
+    U = np.stack([us[:, 0], np.conj(us[:, 0]), us[:, 1], np.conj(us[:, 1])], axis=1)
+    out = np.zeros((len(us), 2 * H + 1, len(outputs)), dtype=complex)
+    for k in range(1, K + 1):
+        E = model.basis.exponents[k]
+        powers = np.prod(U[:, None, :] ** E[None], axis=2)
+        spread = np.zeros((2 * H + 1, len(E)))
+        spread[E @ nu + H, np.arange(len(E))] = 1.0
+        out += np.einsum("hm,pm,mo->pho", spread, powers, model.W[k][:, outputs])
     return out

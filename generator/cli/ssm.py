@@ -245,8 +245,11 @@ def resonant_json(red) -> dict:
     :class:`analysis.ssm_resonant.ResonantReduction`: ``kind``, ``modes``, ``lambda`` (two
     ``[re, im]`` pairs), the ratio and detuning, the reduced dynamics' kept ``terms`` (each
     with its monomial in ``(p1, conj p1, p2, conj p2)``, its coefficient and its polar form),
-    the single-mode ``families`` where their planes are invariant, each order's
-    ``residual``, the near resonances of the monomials not kept, the radius."""
+    the single-mode ``families`` where their planes are invariant, an undamped pair's
+    ``coupled_modes`` (at ψ = 0 and π: ``rho``, ``omega``, amplitudes), each order's
+    ``residual``, the near resonances of the monomials not kept, the radius; driven, the
+    forced response ``frc`` (each steady state's ``omega``, ``amplitude``, ``stable``,
+    ``rho``, ``u``), its folds and peaks."""
     m = red.model
     names = list(red.names)
     r = m.ratio
@@ -271,6 +274,11 @@ def resonant_json(red) -> dict:
                      "i*rho_k*d(theta_k)/dt = lambda_k*rho_k + the sum of the terms of "
                      "equation p_k, each coefficient*rho1^rho1*rho2^rho2*e^(i*psi*psi)",
             "terms": terms, "families": families,
+            "coupled_modes": [{"psi": c.psi, "points": [
+                {"rho": [float(a), float(b)], "omega": float(w),
+                 "amplitude": {name: float(x) for name, x in zip(names, amp, strict=True)}}
+                for (a, b), w, amp in zip(c.rho, c.omega, c.amplitude, strict=True)]}
+                for c in red.coupled],
             "residual": [float(x) for x in m.residual],
             "near_resonances": [{"order": q.order, "monomial": list(q.monomial),
                                  "eigenvalue": _pair(q.eigenvalue), "divisor": q.divisor,
@@ -344,6 +352,15 @@ def resonant_table(data: dict) -> list[str]:
                          "  " + "  ".join(f"{p['amplitude'][n]:>10.5g}" for n in names))
     if not data["families"]:
         lines.append("no mode alone: the resonance couples both planes")
+    for c in data["coupled_modes"]:
+        lines.append(f"coupled modes at psi = {c['psi']:.6g} (phase-locked periodic motions, "
+                     f"period 2*pi/omega; mode {m2} turns {data['ratio'][2:]} times as fast):")
+        lines.append(f"{'rho1':>10}  {'rho2':>10}  {'omega':>12}  " + "  ".join(
+            f"{n:>10}" for n in names))
+        points = c["points"]
+        for p in points[::max(1, (len(points) - 1) // 10)]:
+            lines.append(f"{p['rho'][0]:>10.5g}  {p['rho'][1]:>10.5g}  {p['omega']:>12.9g}  "
+                         + "  ".join(f"{p['amplitude'][n]:>10.5g}" for n in names))
     if "frc" in data:
         frc = data["frc"]
         lines.append(f"forced response near mode {data['frc_driven_mode']}: {len(frc)} steady "
