@@ -48,6 +48,7 @@ from ..derive.system import Matrices, System
 from ..errors import InputError
 from .ssm import (
     BORDERED,
+    DENSE_SOLVES,
     SINGULAR,
     LinearMode,
     NearResonance,
@@ -85,8 +86,12 @@ class Monomials:
                           for k in range(order + 1)]
         self.index = [{tuple(int(x) for x in e): i for i, e in enumerate(E)}
                       for E in self.exponents]
-        self.conjugate = [np.array([index[(b, a, d, c)] for a, b, c, d in E.tolist()], dtype=int)
-                          for E, index in zip(self.exponents, self.index, strict=True)]
+        # NOTE: a monomial's code Σ e_i B^{3−i} (B = K + 1) falls as its row rises (the rows
+        # are lexicographically descending): rows are found by bisection on the codes
+        self.weights = (order + 1) ** np.arange(3, -1, -1)
+        self._codes = [-(E @ self.weights) for E in self.exponents]
+        self.conjugate = [self.locate(k, E[:, [1, 0, 3, 2]])
+                          for k, E in enumerate(self.exponents)]
         self._tables: dict[tuple[int, int], tuple] = {}
         self._shifts: dict[tuple, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
@@ -94,13 +99,16 @@ class Monomials:
         """The number of monomials of order ``k``, ``(k + 1)(k + 2)(k + 3)/6``."""
         return len(self.exponents[k])
 
+    def locate(self, k: int, E: np.ndarray) -> np.ndarray:
+        """The rows of order ``k`` of the exponents ``E`` (each of order k)."""
+        return np.searchsorted(self._codes[k], -(E @ self.weights))
+
     def table(self, i: int, j: int) -> tuple[np.ndarray, np.ndarray, sparse.csr_array]:
         """``(ia, ib, S)``: ``(A·B)_k = S (A[ia] * B[ib])`` for coefficients of orders i, j."""
         if (i, j) not in self._tables:
             ia, ib = np.divmod(np.arange(self.rows(i) * self.rows(j)), self.rows(j))
             sums = self.exponents[i][ia] + self.exponents[j][ib]
-            index = self.index[i + j]
-            ic = np.array([index[tuple(e)] for e in sums.tolist()], dtype=int)
+            ic = self.locate(i + j, sums)
             S = sparse.csr_array((np.ones(len(ic)), (ic, np.arange(len(ic)))),
                                  shape=(self.rows(i + j), len(ic)))
             self._tables[(i, j)] = (ia, ib, S)
@@ -114,8 +122,7 @@ class Monomials:
             E = self.exponents[q]
             src = np.flatnonzero(E[:, i] >= 1)
             target = E[src] + np.array(n) - np.eye(4, dtype=int)[i]
-            index = self.index[q + sum(n) - 1]
-            dst = np.array([index[tuple(e)] for e in target.tolist()], dtype=int)
+            dst = self.locate(q + sum(n) - 1, target)
             self._shifts[key] = (src, E[src, i].astype(float), dst)
         return self._shifts[key]
 
@@ -292,8 +299,15 @@ def resonant_ssm(system: System, modes: tuple[int, ...], order: int) -> Resonant
     force = _Force(w, states, product=partial(_MonomialProduct, basis), rows=basis.rows)
     others = [lam for lam in lin1.others if abs(lam - lin2.lam) > SINGULAR * abs(lin2.lam)]
     others = np.array(others + [np.conj(lam) for lam in others], dtype=complex)
+    if n <= DENSE_SOLVES:  # products with small sparse matrices cost more than dense ones
+        M, C = M.toarray(), C.toarray()
     MPhi = np.array([M @ phi for phi in phis])  # (4, n)
     coupling = lefts @ MPhi.T  # w_iᵀ M Φ_j
+    # NOTE: the borders are affine in s, b_j = s·MΦ_j + (Λ_j M + C)Φ_j and
+    # c_i = s·Mᵀw_i + (Cᵀ + Λ_i Mᵀ)w_i: their parts made once
+    border = (MPhi, np.array([(lams[j] * M + C) @ phis[j] for j in range(4)]))
+    row_border = (np.array([M.T @ v for v in lefts]),
+                  np.array([(C.T + lams[i] * M.T) @ lefts[i] for i in range(4)]))
     residual, near = [0.0], []
     where = f"the 4-D SSM of modes {m1},{m2} does not exist; lower --order below it"
     for k in range(2, order + 1):
@@ -314,8 +328,8 @@ def resonant_ssm(system: System, modes: tuple[int, ...], order: int) -> Resonant
             L = _pencil(w, s)
             label = (k, tuple(int(x) for x in e), f"{m1},{m2}")
             if len(kept):
-                B = np.array([((s + lams[j]) * M + C) @ phis[j] for j in kept]).T
-                Cb = np.array([(C + (lams[i] + s) * M).T @ lefts[i] for i in kept])
+                B = (s * border[0][kept] + border[1][kept]).T
+                Cb = s * row_border[0][kept] + row_border[1][kept]
                 E = -lefts[kept] @ (M @ QW[row])
                 singular = bool(np.any(np.abs(s - lams[kept]) <= BORDERED * np.abs(lams[kept])))
                 Wm, sigma = _bordered(L, B, Cb, coupling[np.ix_(kept, kept)], rhs, E, singular,
