@@ -36,7 +36,6 @@ from dataclasses import dataclass, field
 from itertools import pairwise
 
 import numpy as np
-from numba import njit
 from scipy.integrate import solve_ivp
 
 TWO_PI = 2.0 * math.pi
@@ -817,9 +816,10 @@ class FreeOrbit:
     """A periodic orbit of the conservative ``M x'' + K x + f(x) = 0``, of period ``2π/ω``,
     starting at rest: ``y0 = (x(0), 0)``.
 
-    ``residual = |y(T) - y0| / |y0|``: one whole period integrated afresh from the converged
-    ``y0`` with half the step Newton used (the judge: it holds the integration error as well
-    as Newton's); ``half`` is the half-period condition Newton solved, ``|v(T/2)| / (ω|x(0)|)``;
+    ``residual = |(x(T) − x(0), v(T)/ω)| / |x(0)|`` (dimensionless: velocities over ω): one
+    whole period integrated afresh from the converged ``y0``, by a finer integration than
+    Newton's (the judge: it holds the integration error as well as Newton's); ``half`` is the
+    half-period condition Newton solved, ``|v(T/2)| / (ω|x(0)|)``;
     ``amplitude[i] = max_t |x_i(t)|`` over the period's steps; ``steps`` the RK4 steps a
     period (Newton's; the judge takes twice as many); ``newton`` the half-period
     integrations Newton used."""
@@ -846,9 +846,8 @@ def _monomials(n: int, terms: Sequence) -> tuple[np.ndarray, np.ndarray, np.ndar
             np.array([c for _, _, c in table], dtype=float))
 
 
-@njit(cache=True)
 def _field(y, P, mk, minv, eq, fac, coef, variational):
-    """``(y', P')``: the state's field and the variational one."""
+    """``(y', P')``: the state's field and the variational one (compiled by numba)."""
     n = mk.shape[0]
     f = np.zeros(n)
     J = np.zeros((n, n))
@@ -878,14 +877,15 @@ def _field(y, P, mk, minv, eq, fac, coef, variational):
     return dy, dP
 
 
-@njit(cache=True)
 def _flow(y, P, h, steps, mk, minv, eq, fac, coef, variational, path):
-    """``steps`` classical RK4 steps of :func:`_field`."""
+    """``steps`` classical RK4 steps of ``_jit_field`` (compiled by numba: :func:`_compiled`)."""
     for s in range(steps):
-        a1, b1 = _field(y, P, mk, minv, eq, fac, coef, variational)
-        a2, b2 = _field(y + h / 2 * a1, P + h / 2 * b1, mk, minv, eq, fac, coef, variational)
-        a3, b3 = _field(y + h / 2 * a2, P + h / 2 * b2, mk, minv, eq, fac, coef, variational)
-        a4, b4 = _field(y + h * a3, P + h * b3, mk, minv, eq, fac, coef, variational)
+        a1, b1 = _jit_field(y, P, mk, minv, eq, fac, coef, variational)
+        a2, b2 = _jit_field(y + h / 2 * a1, P + h / 2 * b1, mk, minv, eq, fac, coef,
+                            variational)
+        a3, b3 = _jit_field(y + h / 2 * a2, P + h / 2 * b2, mk, minv, eq, fac, coef,
+                            variational)
+        a4, b4 = _jit_field(y + h * a3, P + h * b3, mk, minv, eq, fac, coef, variational)
         y = y + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
         if variational:
             P = P + h / 6 * (b1 + 2 * b2 + 2 * b3 + b4)
@@ -894,35 +894,151 @@ def _flow(y, P, h, steps, mk, minv, eq, fac, coef, variational, path):
     return y, P
 
 
+_jit_field = None  # the compiled field, set before _flow is compiled
+_COMPILED: tuple = ()
+COMPILE_ABOVE = 12
+# NOTE: above this many coordinates the RK4 loop is compiled by numba (10-20 s the first
+# time, cached on disk; then ~10x faster); up to it, NumPy on dense tensors of the force
+# (n⁴ numbers) in a Python loop, no compilation.
+
+
+def _compiled() -> tuple:
+    """``(field, flow)`` compiled by numba (cached on disk)."""
+    global _jit_field, _COMPILED
+    if not _COMPILED:
+        from numba import njit
+
+        _jit_field = njit(cache=True)(_field)
+        _COMPILED = (_jit_field, njit(cache=True)(_flow))
+    return _COMPILED
+
+
+def _tensor_field(mk, minv, eq, fac, coef):
+    """:func:`_field` by NumPy on dense tensors: ``M⁻¹f = F₂(x⊗x) + F₃(x⊗x⊗x)`` and its
+    Jacobian ``G₂ x + G₃ (x⊗x)``, reshaped ``n × n``."""
+    n = mk.shape[0]
+    T2, T3 = np.zeros((n, n, n)), np.zeros((n, n, n, n))
+    for i, (a, b, c), value in zip(eq, fac, coef, strict=True):
+        if c < 0:
+            T2[i, a, b] += value
+        else:
+            T3[i, a, b, c] += value
+    T2 = np.einsum("ij,jab->iab", minv, T2)
+    T3 = np.einsum("ij,jabc->iabc", minv, T3)
+    F2, F3 = T2.reshape(n, n * n), T3.reshape(n, n**3)
+    G2 = (T2 + T2.transpose(0, 2, 1)).reshape(n * n, n)
+    G3 = (T3 + T3.transpose(0, 2, 1, 3) + T3.transpose(0, 3, 1, 2)).reshape(n * n, n * n)
+
+    def field(y, P, *_):
+        x = y[:n]
+        xx = np.outer(x, x).ravel()
+        dy = np.concatenate((y[n:], -(mk @ x) - F2 @ xx - F3 @ np.outer(xx, x).ravel()))
+        if P is None:
+            return dy, None
+        J = (G2 @ x + G3 @ xx).reshape(n, n)
+        return dy, np.concatenate((P[n:], -((mk + J) @ P[:n])))
+
+    def flow(y, P, h, steps, mk, minv, eq, fac, coef, variational, path):
+        P = P if variational else None
+        for s in range(steps):
+            a1, b1 = field(y, P)
+            if variational:
+                a2, b2 = field(y + h / 2 * a1, P + h / 2 * b1)
+                a3, b3 = field(y + h / 2 * a2, P + h / 2 * b2)
+                a4, b4 = field(y + h * a3, P + h * b3)
+                P = P + h / 6 * (b1 + 2 * b2 + 2 * b3 + b4)
+            else:
+                a2 = field(y + h / 2 * a1, None)[0]
+                a3 = field(y + h / 2 * a2, None)[0]
+                a4 = field(y + h * a3, None)[0]
+            y = y + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+            if path.shape[0] > 1:
+                path[s + 1] = y
+        return y, P
+
+    return field, flow
+
+
 class _Conservative:
     """``x'' = −M⁻¹(K x + f(x))`` and its variational equation for perturbations of ``x(0)``
     alone (``v(0) = 0`` held), by classical RK4 with a fixed step (a stiff model takes tens
-    of thousands of steps a period), the loop compiled by numba."""
+    of thousands of steps a period), the loop compiled by numba above
+    :data:`COMPILE_ABOVE` coordinates (or as ``compiled`` says)."""
 
-    def __init__(self, M, K, terms):
+    def __init__(self, M, K, terms, compiled: bool | None = None, method: str = "RK4"):
         M = np.atleast_2d(np.asarray(M, float))
         self.n = n = M.shape[0]
         self.minv = np.linalg.inv(M)
         self.mk = self.minv @ np.atleast_2d(np.asarray(K, float))
         self.table = _monomials(n, terms)
         self.fastest = float(np.sqrt(np.max(np.abs(np.linalg.eigvals(self.mk)))))
+        if method not in ("RK4", "DOP853"):
+            raise ValueError(f"method {method!r}: RK4 or DOP853")
+        self.method = method
+        if method == "RK4" and (n > COMPILE_ABOVE if compiled is None else compiled):
+            self._field, self._flow = _compiled()
+        else:
+            self._field, self._flow = _tensor_field(self.mk, self.minv, *self.table)
 
     def accel(self, y: np.ndarray) -> np.ndarray:
         n = self.n
-        return _field(np.asarray(y, float), np.zeros((2 * n, n)), self.mk, self.minv,
+        return self._field(np.asarray(y, float), np.zeros((2 * n, n)), self.mk, self.minv,
                            *self.table, False)[0][n:]
 
+    def static(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``M⁻¹(K x + f(x))`` and its Jacobian ``M⁻¹(K + ∂f/∂x)``."""
+        n = self.n
+        P = np.vstack((np.eye(n), np.zeros((n, n))))
+        y = np.concatenate((np.asarray(x, float), np.zeros(n)))
+        dy, dP = self._field(y, P, self.mk, self.minv, *self.table, True)
+        return -dy[n:], -dP[n:]
+
+    def quasi_static(self, x: np.ndarray, fast: np.ndarray, left: np.ndarray) -> np.ndarray:
+        """``x`` with its components on the ``fast`` modes (columns, ``left`` their rows of
+        ``Φᵀ M``) put where those modes are in static equilibrium, ``Φ_fᵀ(K x + f(x)) = 0``
+        (Newton, a few steps): at a turning point of an orbit the fast modes follow the slow
+        ones nearly statically, so this is the guess Newton's shooting starts nearest from."""
+        x = np.array(x, float)
+        for _ in range(8):
+            g, J = self.static(x)
+            r = left @ g
+            if np.linalg.norm(r) <= 1e-14 * np.linalg.norm(left @ (self.mk @ x)):
+                break
+            x -= fast @ np.linalg.solve(left @ J @ fast, r)
+        return x
+
     def flow(self, x0: np.ndarray, duration: float, steps: int, variational: bool,
-             keep: bool = False):
-        """RK4 over ``duration`` in ``steps`` steps from ``(x0, 0)``: the end state, the
-        sensitivities ``∂y/∂x(0)`` (``2n × n``; None without ``variational``), and with
-        ``keep`` every step's state (``(steps + 1, 2n)``)."""
+             keep: bool = False, fine: bool = False):
+        """The flow over ``duration`` from ``(x0, 0)``: the end state, the sensitivities
+        ``∂y/∂x(0)`` (``2n × n``; None without ``variational``), and with ``keep`` the state
+        at ``steps + 1`` equally spaced times (``(steps + 1, 2n)``).  RK4: ``steps`` steps
+        (``2·steps`` when ``fine``); DOP853: rtol 1e-12, atol 1e-13 (both 10 times smaller
+        when ``fine``)."""
         n = self.n
         y = np.concatenate((np.asarray(x0, float), np.zeros(n)))
         P = np.vstack((np.eye(n), np.zeros((n, n))))
+        if self.method == "DOP853":
+            size = 2 * n * (n + 1) if variational else 2 * n
+
+            def fun(t, Y):
+                a, b = self._field(Y[:2 * n], Y[2 * n:].reshape(2 * n, n) if variational
+                                   else None)
+                return np.concatenate((a, b.ravel())) if variational else a
+
+            start = np.concatenate((y, P.ravel())) if variational else y
+            scale = 0.1 if fine else 1.0
+            sol = solve_ivp(fun, (0.0, duration), start[:size], method="DOP853",
+                            rtol=RTOL * scale, atol=ATOL * scale, dense_output=keep)
+            if sol.status != 0 or not np.all(np.isfinite(sol.y[:, -1])):
+                raise ShootingError(f"integration failed: {sol.message}")
+            end = sol.y[:, -1]
+            path = sol.sol(np.linspace(0.0, duration, steps + 1))[:2 * n].T if keep else None
+            return end[:2 * n], (end[2 * n:].reshape(2 * n, n) if variational else None), path
+        if fine:
+            steps *= 2
         path = np.empty((steps + 1 if keep else 1, 2 * n))
         path[0] = y
-        y, P = _flow(y, P, duration / steps, steps, self.mk, self.minv, *self.table,
+        y, P = self._flow(y, P, duration / steps, steps, self.mk, self.minv, *self.table,
                           variational, path)
         return y, (P if variational else None), (path if keep else None)
 
@@ -931,11 +1047,14 @@ STEP_STABILITY = 0.5
 # NOTE: the fixed step keeps ω_max·h ≤ 0.5 (RK4 is stable to 2.83 on the imaginary axis):
 # the stiffest mode (a beam's axial ones, thousands of times the lowest frequency) then sets
 # the step, not the accuracy, and the slow motion is integrated far below 1e-12.
+MIN_STEPS = 4096
+# NOTE: and at least this many steps a period (ω h ≤ 3e-3 on the orbit's own frequency; RK4's
+# error after a period is then ~1e-11): a mildly stiff model is set by accuracy.
 
 
 def free_orbit(M, K, terms, coordinate: int, amplitude: float, x0, omega: float,
                tol: float = 1e-9, steps: int | None = None, max_steps: int = 12,
-               system: _Conservative | None = None) -> FreeOrbit:
+               method: str = "RK4", system: _Conservative | None = None) -> FreeOrbit:
     """The periodic orbit of the conservative system through ``x_coordinate(0) = amplitude``
     at rest, near the guess ``(x0, ω)``, by half-period shooting.
 
@@ -943,15 +1062,24 @@ def free_orbit(M, K, terms, coordinate: int, amplitude: float, x0, omega: float,
     ``T``-periodic.  The unknowns are ``x(0)`` but its ``coordinate`` (held at ``amplitude``:
     the amplitude condition) and ``ω`` (the period is unknown; ``v(0) = 0`` is the phase
     condition); the equations ``v(T/2) = 0``, ``n`` of them, solved by Newton with the
-    variational equations (``∂v(T/2)/∂ω = −(π/ω²) a(T/2)``).  Classical RK4 with a fixed step,
-    ``steps`` a period (default: a power of two with ``ω_max h ≤`` :data:`STEP_STABILITY`), so
-    that a stiff model costs steps, not failures.  The converged orbit is integrated over a
-    whole period with half the step and returned only when ``|y(T) − y0| / |y0| ≤ tol``, else
-    :class:`ShootingError` — never on a flag."""
-    system = system or _Conservative(M, K, terms)
+    variational equations (``∂v(T/2)/∂ω = −(π/ω²) a(T/2)``).
+
+    ``method="RK4"``: classical RK4 with a fixed step, ``steps`` a period (default: a power
+    of two with ``ω_max h ≤`` :data:`STEP_STABILITY`, at least :data:`MIN_STEPS`), so that a
+    stiff model (a slender beam's axial modes) costs steps, not failures; the judge
+    integrates a whole period with half the step.  ``method="DOP853"``: SciPy's adaptive
+    DOP853 (rtol 1e-12), for a mildly stiff model, where it takes far fewer steps; the judge
+    integrates a whole period at tolerances ten times smaller (``steps``: samples of the
+    amplitude, default 400).  The orbit is returned only when the judge's
+    ``|(x(T) − x(0), v(T)/ω)| / |x(0)| ≤ tol``, else :class:`ShootingError` — never on a
+    flag."""
+    system = system or _Conservative(M, K, terms, method=method)
     n = system.n
-    if steps is None:
-        steps = 2 ** math.ceil(math.log2(system.fastest * TWO_PI / omega / STEP_STABILITY))
+    if steps is None and system.method == "DOP853":
+        steps = 400
+    elif steps is None:
+        steps = max(MIN_STEPS, 2 ** math.ceil(math.log2(system.fastest * TWO_PI / omega
+                                                        / STEP_STABILITY)))
     free = np.delete(np.arange(n), coordinate)
     x = np.array(x0, float)
     x[coordinate] = amplitude
@@ -969,8 +1097,10 @@ def free_orbit(M, K, terms, coordinate: int, amplitude: float, x0, omega: float,
         x[free] += delta[:-1]
         omega += float(delta[-1])
     y0 = np.concatenate((x, np.zeros(n)))
-    end, _, path = system.flow(x, TWO_PI / omega, 2 * steps, False, keep=True)
-    residual = float(np.linalg.norm(end - y0) / np.linalg.norm(y0))
+    end, _, path = system.flow(x, TWO_PI / omega, steps, False, keep=True, fine=True)
+    gap = end - y0
+    gap[n:] /= omega  # velocities in units of displacement: the residual is dimensionless
+    residual = float(np.linalg.norm(gap) / np.linalg.norm(x))
     if not residual <= tol:
         raise ShootingError(f"amplitude {amplitude:.6g}: periodicity residual {residual:.3e} "
                             f"above {tol:.1e} (half-period condition {half:.1e}, {used} "
@@ -979,20 +1109,29 @@ def free_orbit(M, K, terms, coordinate: int, amplitude: float, x0, omega: float,
     return FreeOrbit(omega, y0, residual, half, peak, steps, used, tol)
 
 
+FAST = 3.0
+# NOTE: modes above this multiple of the lowest frequency start each orbit's Newton in static
+# equilibrium (:meth:`_Conservative.quasi_static`): a beam's axial modes, stretched by the
+# bending one, would else ring at their own frequency and cost Newton two or three steps.
+
+
 def backbone(M, K, terms, coordinate: int, amplitudes, tol: float = 1e-9,
-             steps: int | None = None) -> list[FreeOrbit]:
+             steps: int | None = None, method: str = "RK4") -> list[FreeOrbit]:
     """The conservative backbone of the lowest mode at increasing ``amplitudes`` of
     ``x_coordinate``: continuation from the linear mode (``K φ = ω₀² M φ``, scaled to the
     first amplitude), each next guess extrapolated linearly in the amplitude from the last
-    two orbits (scaled from the last one at the second)."""
+    two orbits (scaled from the last one at the second); in each guess the modes above
+    :data:`FAST` times the lowest frequency are put in static equilibrium."""
     from scipy.linalg import eigh
 
     M = np.atleast_2d(np.asarray(M, float))
     K = np.atleast_2d(np.asarray(K, float))
-    system = _Conservative(M, K, terms)
+    system = _Conservative(M, K, terms, method=method)
     lam, phi = eigh(K, M)
     mode = phi[:, 0] / phi[coordinate, 0]
     n = len(mode)
+    fast = phi[:, lam > FAST**2 * lam[0]]  # φᵀMφ = I: the rows of φᵀM are the left ones
+    left = fast.T @ M
     orbits: list[FreeOrbit] = []
     done: list[float] = []
     for A in amplitudes:
@@ -1005,6 +1144,7 @@ def backbone(M, K, terms, coordinate: int, amplitudes, tol: float = 1e-9,
             t = (A - done[-1]) / (done[-1] - done[-2])
             x0 = b.y0[:n] + t * (b.y0[:n] - a.y0[:n])
             omega = b.omega + t * (b.omega - a.omega)
+        x0 = system.quasi_static(x0, fast, left) if fast.size else x0
         orbits.append(free_orbit(M, K, terms, coordinate, A, x0, omega, tol, steps,
                                  system=system))
         done.append(float(A))

@@ -258,3 +258,54 @@ def test_folder_form(bm, tmp_path: Path, capsys):
 
     assert bm.main([str(tmp_path / "c"), "--elements", "9"]) == 2
     assert not (tmp_path / "c").exists()
+
+
+def test_ssm_backbone_against_shooting(bm, tmp_path: Path):
+    """The SSM backbone of the undamped beam (``--zeta 0``: ``C = 0``; ``lindstedt ssm
+    --model``'s route, ``read_model`` then ``analysis.ssm``) against the conservative beam's
+    periodic orbits, every coordinate kept: ``tests/ssm_reference.py``'s ``backbone``
+    (half-period shooting with the period unknown, DOP853, each orbit judged by a whole
+    period's residual ``|(x(T) − x(0), v(T)/ω)| / |x(0)|`` ≤ 1e-10).  Four elements and a
+    50 mm thick section: the axial modes lie 35 times above the lowest, not 870 times as in
+    the 2 mm strip, so an adaptive integrator shoots it in about a second — and the backbone
+    in ``w/t`` is the strip's (the relative errors below agree with the strip's at the same
+    ``w/t`` to 1e-7).  At ``w(L/2) = 0.15 t`` and ``0.3 t`` (the frequency up 0.9 % and
+    3.4 %) the SSM's ω at the same mid-span amplitude is within 8e-8 and 2.1e-5 at K = 7,
+    2.4e-9 and 2.5e-6 at K = 9 (``benchmarks/beam_backbone.py``'s table has the 8-element
+    strip, K = 3 … 9): checked within four times those, and falling with K."""
+    from lindstedt.analysis.ssm import ssm
+    from lindstedt.derive.system import read_model
+    from scipy.optimize import brentq
+    from ssm_reference import backbone
+
+    beam = bm.Beam(elements=4, thickness=0.05)
+    model = bm.assemble(beam, zeta=0.0)
+    bm.write_folder(model, tmp_path)
+    system = read_model(tmp_path)
+    assert system.matrices.damping is None or not system.matrices.damping.count_nonzero()
+    out = beam.midspan
+    amplitudes = [0.15 * beam.thickness, 0.3 * beam.thickness]
+    equation, factors, coefficient = model.terms
+    terms = [(i, [k for k in f if k >= 0], c) for i, f, c in
+             zip(equation.tolist(), factors.tolist(), coefficient.tolist(), strict=True)]
+    orbits = backbone(model.mass.toarray(), model.stiffness.toarray(), terms, out, amplitudes,
+                      tol=1e-10, method="DOP853")
+    w0 = model.bending[0]
+    assert orbits[0].omega / w0 - 1 > 0.008 and orbits[1].omega / w0 - 1 > 0.03
+    errors = {}
+
+    def gap(rho: float, red, A: float) -> float:  # the SSM's amplitude at rho, less A
+        return float(red.amplitude(np.array([rho]), np.array([out]))[0, 0]) - A
+
+    for K in (7, 9):
+        red = ssm(system, 1, K)
+        for A, orbit in zip(amplitudes, orbits, strict=True):
+            assert orbit.residual <= 1e-10
+            assert math.isclose(orbit.amplitude[out], A, rel_tol=1e-9)  # the peak is at t = 0
+            assert gap(0.5 * red.radius, red, A) > 0  # A lies well inside the radius
+            rho = brentq(gap, 0.0, 0.5 * red.radius, args=(red, A), xtol=1e-16, rtol=1e-14)
+            errors[K, A] = abs(red.omega(np.array([rho]))[0] / orbit.omega - 1)
+    small, large = amplitudes
+    assert errors[7, small] < 3.2e-7 and errors[7, large] < 8.4e-5, errors
+    assert errors[9, small] < 1e-8 and errors[9, large] < 1e-5, errors
+    assert errors[9, small] < errors[7, small] / 5 and errors[9, large] < errors[7, large] / 5
