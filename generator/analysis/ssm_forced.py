@@ -35,6 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..algebra.lazy import LazySeries
 from ..derive.system import System
 from ..errors import InputError
 from .ssm import (
@@ -58,7 +59,8 @@ INTERPOLATED = 1e-8
 # the damping (a combination 2ω₁ + Ω = ω₃ inside the range is one: a chain of 1 000 masses
 # needs 128 nodes): a degree is accepted where the interpolant meets the exact values at every
 # midpoint to this fraction of their largest, else doubled, and past the last every Ω is
-# computed.
+# computed (the emitted module, which cannot compute them, fits each half instead:
+# lower.ssm).
 ON_CIRCLE = 1e-6
 # NOTE: a common root z of the steady-state equation and its conjugate is a steady state where
 # | |z| − 1 | is below this (the others come in pairs z, 1/z̄ off the circle).
@@ -91,75 +93,196 @@ def forced_order(model: SSM) -> int:
 
 def forced_terms(model: SSM, omega: float, outputs: np.ndarray) -> Forced:
     """The first-order non-autonomous SSM at ``Ω`` to :func:`forced_order` (sparse solves)."""
+    return _unflatten(model, omega, forced_values(model, np.array([omega]), outputs)[0],
+                      len(outputs))
+
+
+BATCH_VALUES = 1 << 22
+# NOTE: the forced terms of several Ω are computed together (one recursion, every product
+# and dense solve batched over Ω) while their states hold at most this many complex numbers
+# (64 MB); a large model's Ω go a few at a time.
+
+
+def forced_values(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> np.ndarray:
+    """:func:`forced_terms` at each Ω of ``omegas``, flattened as :func:`_flatten` (a row per
+    Ω): one recursion over orders for a batch of Ω (:data:`BATCH_VALUES`)."""
     w = model.matrices
     if w.drive is None:
         raise InputError("the system is not driven: no forced response (drive one equation "
                          "with f*cos(w*t), or give drive.txt)")
-    n, K1 = w.size, forced_order(model)
+    omegas = np.asarray(omegas, dtype=float)
+    K1 = forced_order(model)
+    per = 4 * w.size * (K1 + 1) * (K1 + 2) // 2
+    size = max(1, BATCH_VALUES // per)
+    parts = [_forced_batch(model, omegas[at:at + size], outputs)
+             for at in range(0, len(omegas), size)]
+    return np.concatenate(parts) if parts else np.zeros((0, 0), dtype=complex)
+
+
+class _BatchedProduct(LazySeries):
+    """:class:`analysis.ssm._Product` over a batch of Ω: a factor's order ``i`` holds
+    ``(i + 1)·batch`` rows (monomial-major, one per Ω: the first-order states ``Z¹``) or
+    ``i + 1`` (the autonomous ``Z``, the same at every Ω); the product is batched where either
+    factor is."""
+
+    def __init__(self, a: LazySeries, b: LazySeries, low_a: int, low_b: int) -> None:
+        super().__init__()
+        self.a, self.b, self.low_a, self.low_b = a, b, low_a, low_b
+
+    def compute(self, k: int) -> np.ndarray | None:
+        out = None
+        for i in range(self.low_a, k - self.low_b + 1):
+            A, B = self.a.coeff(i), self.b.coeff(k - i)
+            A = A.reshape(i + 1, -1, A.shape[-1])  # (rows, batch or 1, terms)
+            B = B.reshape(k - i + 1, -1, B.shape[-1])
+            if out is None:
+                out = np.zeros((k + 1, max(A.shape[1], B.shape[1]), A.shape[2]),
+                               dtype=complex)
+            if A.shape[0] <= B.shape[0]:  # a loop over the shorter factor's rows
+                for row in range(A.shape[0]):
+                    out[row:row + B.shape[0]] += A[row] * B
+            else:
+                for row in range(B.shape[0]):
+                    out[row:row + A.shape[0]] += B[row] * A
+        return None if out is None else out.reshape(-1, out.shape[2])
+
+
+def _forced_batch(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> np.ndarray:
+    """The recursion of :func:`forced_values` for one batch of Ω: ``W¹_k``, ``V¹_k`` as
+    ``(k + 1, batch, n)``; a small system's solves stacked (LAPACK, the resonant rows'
+    bordered matrix whole), a large one's sparse, Ω by Ω."""
+    w = model.matrices
+    n, K1, nb = w.size, forced_order(model), len(omegas)
     lin = model.linear
     lam, phi, left = lin.lam, lin.shape, lin.left
     lamc, phic, leftc = np.conj(lam), np.conj(phi), np.conj(left)
     M, C = w.mass, _damping(w)
-    if n <= DENSE_SOLVES:  # products with small sparse matrices cost more than dense ones
-        M, C = M.toarray(), C.toarray()
+    dense = n <= DENSE_SOLVES  # products with small sparse matrices cost more than dense ones
+    mats = (M.toarray(), C.toarray(), w.stiffness.toarray()) if dense else None
+    if dense:
+        M, C, Kd = mats
     W0, V0, gamma = model.W, model.V, list(model.gamma)
     W1: list[np.ndarray] = []
     V1: list[np.ndarray] = []
     states1: list[np.ndarray] = []
-    linear = _Force(w, [np.hstack([a, b]) for a, b in zip(W0, V0, strict=True)], states1)
-    A, B = [], []
+    linear = _Force(w, [np.hstack([a, b]) for a, b in zip(W0, V0, strict=True)], states1,
+                    _BatchedProduct, lambda k: (k + 1) * nb)
+    A: list[np.ndarray] = []
+    B: list[np.ndarray] = []
     for k in range(K1 + 1):
-        Df = linear.coeff(k)
-        QW, QV = _carried(W1, gamma, k, n), _carried(V1, gamma, k, n)
-        PW, PV = _lifted(W0, A, B, k, n), _lifted(V0, A, B, k, n)
-        Wk = np.zeros((k + 1, n), dtype=complex)
-        Vk = np.zeros((k + 1, n), dtype=complex)
+        Df = linear.coeff(k).reshape(k + 1, nb, n)
+        QW = _carried([X.reshape(len(X), -1) for X in W1], gamma, k, nb * n).reshape(
+            k + 1, nb, n)
+        QV = _carried([X.reshape(len(X), -1) for X in V1], gamma, k, nb * n).reshape(
+            k + 1, nb, n)
+        QW += _lifted(W0, A, B, k, n, nb)
+        QV += _lifted(V0, A, B, k, n, nb)
+        Wk = np.zeros((k + 1, nb, n), dtype=complex)
+        Vk = np.zeros((k + 1, nb, n), dtype=complex)
         for r in range(k + 1):
-            s = (k - r) * lam + r * lamc + 1j * omega
-            carried_w, carried_v = QW[r] + PW[r], QV[r] + PV[r]
-            rhs = -Df[r] - (s * M + C) @ carried_w - M @ carried_v
+            s = (k - r) * lam + r * lamc + 1j * omegas
+            cw, cv = QW[r], QV[r]
+            rhs = -Df[r] - s[:, None] * (M @ cw.T).T - (C @ cw.T).T - (M @ cv.T).T
             if k == 0:
                 rhs = rhs + w.drive / 2
-            L = _pencil(w, s)
             if k - r == r:  # m = (j, j): resonant with λ, A_j
-                Wm, a = _bordered(L, ((s + lam) * M + C) @ phi, (C + (lam + s) * M).T @ left,
-                                  left @ (M @ phi), rhs, -left @ (M @ carried_w),
-                                  abs(s - lam) <= BORDERED * abs(lam), (k, r, model.mode))
+                Wm, a = _resonant_row(w, dense, mats, s, lam, phi,
+                                      left, rhs, cw, (k, r, model.mode))
                 A.append(a)
-                Vk[r] = s * Wm + carried_w + phi * a
+                Vk[r] = s[:, None] * Wm + cw + a[:, None] * phi
             elif r - (k - r) == 2:  # m = (j, j + 2): resonant with λ̄, the conjugate of B_j
-                Wm, b = _bordered(L, ((s + lamc) * M + C) @ phic,
-                                  (C + (lamc + s) * M).T @ leftc, leftc @ (M @ phic), rhs,
-                                  -leftc @ (M @ carried_w), abs(s - lamc) <= BORDERED * abs(lam),
-                                  (k, r, model.mode))
+                Wm, b = _resonant_row(w, dense, mats, s, lamc, phic,
+                                      leftc, rhs, cw, (k, r, model.mode))
                 B.append(np.conj(b))
-                Vk[r] = s * Wm + carried_w + phic * b
+                Vk[r] = s[:, None] * Wm + cw + b[:, None] * phic
             else:
-                Wm = _solve(L, rhs, (k, r, model.mode))
-                Vk[r] = s * Wm + carried_w
+                if dense:
+                    Wm = _stacked(M, C, Kd, s, rhs, (k, r, model.mode))
+                else:
+                    Wm = np.array([_solve(_pencil(w, z), x, (k, r, model.mode))
+                                   for z, x in zip(s, rhs, strict=True)])
+                Vk[r] = s[:, None] * Wm + cw
             Wk[r] = Wm
         W1.append(Wk)
         V1.append(Vk)
-        states1.append(np.hstack([Wk, Vk]))
-    return Forced(omega, np.array(A, dtype=complex), np.array(B, dtype=complex),
-                  tuple(X[:, outputs] for X in W1))
+        states1.append(np.concatenate([Wk, Vk], axis=2).reshape((k + 1) * nb, 2 * n))
+    parts = [np.array(A, dtype=complex).reshape(-1, nb).T,
+             np.array(B, dtype=complex).reshape(-1, nb).T]
+    parts += [np.transpose(X[:, :, outputs], (1, 0, 2)).reshape(nb, -1) for X in W1]
+    return np.concatenate(parts, axis=1)
 
 
-def _lifted(Z0: tuple[np.ndarray, ...], A: list[complex], B: list[complex], k: int,
-            n: int) -> np.ndarray:
-    """``P`` at order ``k``: the autonomous ``∂Z/∂p₁·A_j|p|^{2j}`` and ``∂Z/∂p₂·B̄_j p₂²…``
-    terms of order ``k`` from ``Z``'s orders ≥ 2 (the order-1 ones are the unknowns)."""
-    out = np.zeros((k + 1, n), dtype=complex)
+def _stacked(M: np.ndarray, C: np.ndarray, K: np.ndarray, s: np.ndarray, rhs: np.ndarray,
+             where: tuple) -> np.ndarray:
+    """``L(s_b)⁻¹ rhs_b`` for each Ω of a batch (dense, stacked LAPACK); refused where
+    singular, as :func:`analysis.ssm._solve`."""
+    z = s[:, None, None]
+    try:
+        x = np.linalg.solve(z * z * M + z * C + K, rhs[:, :, None])[:, :, 0]
+    except np.linalg.LinAlgError:
+        x = np.full(rhs.shape, np.nan)
+    if not np.all(np.isfinite(x)):
+        _refused(where)
+    return x
+
+
+def _refused(where: tuple) -> None:
+    """Raise :func:`analysis.ssm._solve`'s refusal of a singular row (``where``: order, row,
+    mode)."""
+    _solve(np.zeros((1, 1)), np.array([np.nan]), where)
+
+
+def _resonant_row(w, dense: bool, mats: tuple | None, s: np.ndarray, lam: complex,
+                  phi: np.ndarray, left: np.ndarray, rhs: np.ndarray, carried: np.ndarray,
+                  where: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """A row resonant with ``λ`` (or ``λ̄``: the conjugate data) for each Ω of a batch:
+    ``L(s)W + ((s + λ)M + C)φσ = rhs``, ``wᵀ(C + (λ + s)M)W + (wᵀMφ)σ = −wᵀM·carried``
+    (the first-order form's normalisation); ``(W, σ)``."""
+    if dense:
+        M, C, K = mats
+        n, nb = len(phi), len(s)
+        z = s[:, None, None]
+        J = np.zeros((nb, n + 1, n + 1), dtype=complex)
+        J[:, :n, :n] = z * z * M + z * C + K
+        J[:, :n, n] = (s[:, None] + lam) * (M @ phi) + C @ phi
+        J[:, n, :n] = left @ C + (lam + s)[:, None] * (left @ M)
+        J[:, n, n] = left @ (M @ phi)
+        e = -(carried @ M.T) @ left
+        try:
+            x = np.linalg.solve(J, np.concatenate([rhs, e[:, None]], axis=1)[:, :, None])
+        except np.linalg.LinAlgError:
+            x = np.full((nb, n + 1, 1), np.nan)
+        if not np.all(np.isfinite(x)):
+            _refused(where)
+        return x[:, :n, 0], x[:, n, 0]
+    M, C = w.mass, _damping(w)
+    Ws, sigmas = [], []
+    for z, x, cw in zip(s, rhs, carried, strict=True):
+        Wm, sigma = _bordered(_pencil(w, z), ((z + lam) * M + C) @ phi,
+                              (C + (lam + z) * M).T @ left, left @ (M @ phi), x,
+                              -left @ (M @ cw), abs(z - lam) <= BORDERED * abs(lam), where)
+        Ws.append(Wm)
+        sigmas.append(sigma)
+    return np.array(Ws), np.array(sigmas, dtype=complex)
+
+
+def _lifted(Z0: tuple[np.ndarray, ...], A: list[np.ndarray], B: list[np.ndarray], k: int,
+            n: int, nb: int) -> np.ndarray:
+    """``P`` at order ``k`` (``(k + 1, batch, n)``): the autonomous ``∂Z/∂p₁·A_j|p|^{2j}`` and
+    ``∂Z/∂p₂·B̄_j p₂²…`` terms of order ``k`` from ``Z``'s orders ≥ 2 (the order-1 ones are the
+    unknowns), ``A_j``, ``B_j`` one per Ω."""
+    out = np.zeros((k + 1, nb, n), dtype=complex)
     for j, a in enumerate(A):  # q + (j − 1, j): row r_q + j, factor q₁
         q = k - 2 * j + 1
         if q >= 2 and q < len(Z0):
             rows = np.arange(q)  # q₁ = q − r ≥ 1
-            out[j:j + q] += ((q - rows) * a)[:, None] * Z0[q][:q]
+            out[j:j + q] += ((q - rows)[:, None] * a[None, :])[:, :, None] * Z0[q][:q, None]
     for j, b in enumerate(B):  # q + (j, j + 1): row r_q + j + 1, factor q₂, coefficient b̄
         q = k - 2 * j - 1
         if q >= 2 and q < len(Z0):
             rows = np.arange(q + 1)
-            out[j + 1:j + q + 2] += (rows * np.conj(b))[:, None] * Z0[q]
+            out[j + 1:j + q + 2] += (rows[:, None] * np.conj(b)[None, :])[:, :, None] \
+                * Z0[q][:, None]
     return out
 
 
@@ -196,35 +319,77 @@ def chebyshev(lo: float, hi: float, nodes: int) -> np.ndarray:
     return 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(np.pi * np.arange(nodes + 1) / nodes)
 
 
+@dataclass(frozen=True)
+class ForcingFit:
+    """The forced terms (:func:`forced_values`' rows) on ``N + 1`` Chebyshev nodes over
+    ``[lo, hi]``, and how well they interpolate: ``error``, the barycentric interpolant's
+    largest discrepancy at the ``N`` midpoints from the exact values there, over the largest
+    of those; ``verified`` where it is within :data:`INTERPOLATED`."""
+
+    lo: float
+    hi: float
+    nodes: np.ndarray
+    values: np.ndarray
+    error: float
+    verified: bool
+
+    def __call__(self, at: np.ndarray) -> np.ndarray:
+        """The interpolated rows at ``at`` (inside ``[lo, hi]``)."""
+        return _barycentric(self.nodes, self.values, np.asarray(at, dtype=float))
+
+
+def forcing_fit(model: SSM, lo: float, hi: float, outputs: np.ndarray,
+                most: int | None = None) -> ForcingFit:
+    """The forced terms on Chebyshev nodes over ``[lo, hi]``: ``N`` nodes
+    (:data:`CHEBYSHEV_NODES` first) checked at the ``N`` midpoints, which are the new nodes of
+    ``2N`` (no value is computed twice), doubled while the check fails, up to ``most``
+    (:data:`CHEBYSHEV_MOST`); the last degree checked, verified or not."""
+    most = CHEBYSHEV_MOST if most is None else most
+    nodes = CHEBYSHEV_NODES
+    at = chebyshev(lo, hi, nodes)
+    values = forced_values(model, at, outputs)
+    while True:
+        mid = 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(np.pi * (np.arange(nodes) + 0.5) / nodes)
+        check = forced_values(model, mid, outputs)
+        scale = float(np.max(np.abs(check)))
+        miss = float(np.max(np.abs(_barycentric(at, values, mid) - check)))
+        error = miss / scale if scale > 0 else 0.0
+        if error <= INTERPOLATED or 2 * nodes > most:
+            return ForcingFit(lo, hi, at, values, error, error <= INTERPOLATED)
+        merged = np.empty((2 * nodes + 1, values.shape[1]), dtype=complex)
+        merged[0::2], merged[1::2] = values, check
+        at, values, nodes = chebyshev(lo, hi, 2 * nodes), merged, 2 * nodes
+
+
+def forcing_pieces(model: SSM, lo: float, hi: float, outputs: np.ndarray,
+                   splits: int = 0) -> list[ForcingFit]:
+    """:func:`forcing_fit` over ``[lo, hi]``; where it is not verified, over each half, ``splits``
+    times at most (each unverified piece is reported as such: its values are not to be
+    used)."""
+    fit = forcing_fit(model, lo, hi, outputs)
+    if fit.verified or splits <= 0:
+        return [fit]
+    middle = 0.5 * (lo + hi)
+    return (forcing_pieces(model, lo, middle, outputs, splits - 1)
+            + forcing_pieces(model, middle, hi, outputs, splits - 1))
+
+
 def forcing_table(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> list[Forced]:
-    """:func:`forced_terms` at every ``Ω`` of ``omegas``, interpolated on Chebyshev nodes:
-    ``N`` nodes (:data:`CHEBYSHEV_NODES` first) checked at the ``N`` midpoints, which are the
-    new nodes of ``2N`` (no value is computed twice), doubled up to
-    :data:`CHEBYSHEV_MOST`; else computed at each ``Ω``."""
+    """The forced terms at every ``Ω`` of ``omegas``: interpolated by :func:`forcing_fit` over
+    their range where it verifies with fewer values than the grid holds (``2N + 1`` for ``N``
+    nodes), else computed at each ``Ω``."""
     omegas = np.asarray(omegas, dtype=float)
     lo, hi = float(omegas.min()), float(omegas.max())
-    m = len(outputs)
-
-    def exact(at: np.ndarray) -> np.ndarray:
-        return np.array([_flatten(forced_terms(model, float(om), outputs)) for om in at])
-
-    nodes = CHEBYSHEV_NODES
-    if hi > lo and 2 * nodes + 1 < len(omegas):
-        at = chebyshev(lo, hi, nodes)
-        values = exact(at)
-        while nodes <= CHEBYSHEV_MOST and 2 * nodes + 1 < len(omegas):
-            mid = 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(
-                np.pi * (np.arange(nodes) + 0.5) / nodes)
-            check = exact(mid)
-            if np.max(np.abs(_barycentric(at, values, mid) - check)) <= INTERPOLATED * np.max(
-                    np.abs(check)):
-                table = _barycentric(at, values, omegas)
-                return [_unflatten(model, float(om), v, m)
-                        for om, v in zip(omegas, table, strict=True)]
-            merged = np.empty((2 * nodes + 1, values.shape[1]), dtype=complex)
-            merged[0::2], merged[1::2] = values, check
-            at, values, nodes = chebyshev(lo, hi, 2 * nodes), merged, 2 * nodes
-    return [forced_terms(model, float(om), outputs) for om in omegas]
+    most = CHEBYSHEV_NODES
+    while 2 * most <= CHEBYSHEV_MOST and 4 * most + 1 < len(omegas):
+        most *= 2
+    fit = None
+    if hi > lo and len(omegas) > 2 * CHEBYSHEV_NODES + 1:
+        fit = forcing_fit(model, lo, hi, outputs, most)
+    rows = fit(omegas) if fit is not None and fit.verified else forced_values(model, omegas,
+                                                                             outputs)
+    return [_unflatten(model, float(om), v, len(outputs))
+            for om, v in zip(omegas, rows, strict=True)]
 
 
 def _poly(c: np.ndarray) -> np.ndarray:

@@ -376,9 +376,11 @@ class ReducedModule:
     """The numbers of an SSM's reduced model for ``ssm.py.j2`` and ``ssm.tex.j2``: the normal
     form's ``γ_j`` (real and imaginary parts), the radius in ρ, each output's Fourier
     coefficients of ``ρ^k e^{ihθ}`` (``(K + 1) × (2K + 1) × outputs``), and the forced terms
-    on Chebyshev nodes over ``[lo, hi]`` (per node ``A_j``, ``B_j``, then the outputs' ``W¹``
+    on Chebyshev nodes over the pieces of ``[lo, hi]`` (each piece ``(lo, hi, first node,
+    nodes, error, verified)``: its interpolation error at the midpoints, relative; an
+    unverified piece holds no nodes); per node ``A_j``, ``B_j``, then the outputs' ``W¹``
     order by order; ``sizes``: how many ``A_j``, ``B_j`` and the order of ``W¹``; empty: not
-    driven)."""
+    driven; ``tolerance``: the error a piece must reach)."""
 
     name: str
     doc: str
@@ -390,9 +392,18 @@ class ReducedModule:
     radius: float
     shape: tuple[tuple[tuple[tuple[float, float], ...], ...], ...]
     span: tuple[float, float] | None
+    pieces: tuple[tuple[float, float, int, int, float, bool], ...]
     nodes: tuple[float, ...]
     forcing: tuple[tuple[tuple[float, float], ...], ...]  # per node: A, B, W¹ flattened
     sizes: tuple[int, int, int]
+    tolerance: float  # the interpolation error a piece must reach to be verified
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "doc", docstring_text(self.doc))
+
+    @property
+    def interpolation_error(self) -> float:
+        """The forced terms' largest interpolation error over the verified pieces (NaN: none
+        is, or not driven)."""
+        return max((p[4] for p in self.pieces if p[5]), default=float("nan"))
+
