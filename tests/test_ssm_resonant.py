@@ -6,6 +6,7 @@ mode whose plane is invariant, and the full system integrated from a point of th
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -228,3 +229,39 @@ def test_coupled_modes_are_periodic_orbits_of_the_full_system():
                             rtol=1e-12, atol=1e-14).y[:, -1]
             gaps.append(np.max(np.abs(end - y0)) / np.max(np.abs(y0)))
     assert max(gaps[2:]) < 2e-9 and min(gaps[:2]) / max(gaps[2:]) > 1e4
+
+
+def test_drive_near_the_upper_mode_saturates_through_the_coupled_branch():
+    """Driven near ω₂ ≈ 2ω₁ (the saturation of a 1:2 pair): the single-mode response (u₁ = 0)
+    loses stability between two branch points, where the coupled branch (ρ₁ > 0, the lower
+    mode at half the drive frequency) is born. Against the full system integrated: a small
+    perturbation of the single-mode state grows at the reduced Jacobian's rate (2 %), and a
+    stable coupled state returns after two drive periods (a subharmonic orbit) to 5e-3."""
+    system = parse_system(DAMPED_1_2.replace("x2**3 = 0", "x2**3 = f*cos(w*t)"), {"f": "0.02"},
+                          driven=True)
+    w = system.matrices
+    response = reduce_pair(system, (1, 2), 5, span=(1.9, 2.2)).response
+    assert response.kappa == 2
+    single = min((s for s in response.states if s.rho[0] == 0),
+                 key=lambda s: abs(s.omega - 2.02))
+    coupled = min((s for s in response.states if s.rho[0] > 0.1 and s.stable),
+                  key=lambda s: abs(s.omega - 2.06))
+    assert not single.stable and abs(coupled.omega - 2.06) < 2e-3
+
+    def full(omega):
+        def rate(t, z):
+            x, v = z[:2], z[2:]
+            return np.concatenate([v, w.drive * np.cos(omega * t) - (
+                w.stiffness @ x + w.damping @ v + w.force(x, v))])
+        return rate
+
+    T = 4 * np.pi / single.omega
+    run = solve_ivp(full(single.omega), (0, 30 * T), single.start + np.array([1e-4, 0, 0, 0]),
+                    method="DOP853", rtol=1e-9, atol=1e-12, dense_output=True)
+    peaks = [np.max(np.abs(run.sol(np.linspace((n - 1) * T, n * T, 400))[0])) for n in (20, 30)]
+    growth = math.log(peaks[1] / peaks[0]) / (10 * T)
+    assert abs(growth - single.rate) < 0.02 * single.rate, (growth, single.rate)
+    T = 4 * np.pi / coupled.omega
+    end = solve_ivp(full(coupled.omega), (0, T), coupled.start, method="DOP853", rtol=1e-11,
+                    atol=1e-13).y[:, -1]
+    assert np.max(np.abs(end - coupled.start)) < 5e-3 * np.max(np.abs(coupled.start))

@@ -17,11 +17,15 @@ reduced dynamics and the manifold's forced part ``x ∋ X e^{iΩt} + c.c.``:
     u_k' = (λ_k − iν_kΩ/κ) u_k + Σ_m R_{k,m} u^m + a_k(Ω) = 0
 
 is autonomous: four real equations in ``(Re u₁, Im u₁, Re u₂, Im u₂)``, continued in Ω from the
-linear response at both ends of the range through its folds.  A state is stable where every
+linear response at both ends of the range through its folds, and from every branch point on
+that curve (``det ∂R/∂x`` changes sign with no fold: the branch it crosses, e.g. the coupled
+branch born where a drive near the upper mode saturates).  A state is stable where every
 eigenvalue of the 4 × 4 Jacobian has a negative real part.  Its motion ``x(φ)`` has the
 harmonics ``h = m·ν`` of ``W_m u^m`` and ``±κ`` of ``X``; the amplitude is ``max |x_i|`` over a
-period ``2πκ/Ω`` (:func:`analysis.ssm.peak_amplitude`).  Branches that do not reach an end of
-the range (isolas, branches born at a branch point off the traced curve) are not sought."""
+period ``2πκ/Ω`` (:func:`analysis.ssm.peak_amplitude`).  A subharmonic state (κ > 1) recurs
+κ times (``u₁`` turned by ``2π/κ``: the same motion a drive period later); one is kept.
+Isolas (branches that reach neither an end of the range nor a branch point of the traced
+curve) are not sought."""
 
 from __future__ import annotations
 
@@ -35,7 +39,7 @@ from numpy.polynomial import chebyshev
 from ..derive.system import System
 from ..errors import InputError
 from ..numerics.newton import secant
-from .continuation import _continue
+from .continuation import Continuation, _continue, _corrector, _extended_jacobian
 from .ssm import DENSE_SOLVES, _bordered, _damping, peak_amplitude
 from .ssm_forced import BACKBONE_POINTS, DEFAULT_SPAN, NAMED_OUTPUTS, REACH
 from .ssm_resonant import ResonantSSM, Term, resonant_ssm
@@ -48,6 +52,9 @@ POINT_SECONDS = 2e-4
 MAX_POINTS = 20000
 DIFFERENCE = 1e-7
 # NOTE: the relative step in Ω of the drive's a_k(Ω) central difference (its derivative).
+SAME = 1e-9
+# NOTE: folds of the κ copies of a subharmonic branch agree to rounding; one is reported; and
+# |u₁| below this fraction of the largest unknown is the plane u₁ = 0 (kept whatever its angle).
 CHEBYSHEV_NODES = 16
 CHEBYSHEV_MOST = 256
 INTERPOLATED = 1e-12
@@ -58,8 +65,10 @@ INTERPOLATED = 1e-12
 @dataclass(frozen=True)
 class PairState:
     """One steady state: ``omega`` (Ω), ``u`` (``p_k = u_k e^{iν_kφ}``), ``rho`` (``|u_k|``),
-    each output's ``amplitude`` (max |x_i| over a period), ``stable``, and the full state
-    ``(x, x')`` at ``t = 0`` (``W(u) + 2 Re X``, ``V(u) + 2 Re(iΩX)``)."""
+    each output's ``amplitude`` (max |x_i| over a period), ``stable``, the full state
+    ``(x, x')`` at ``t = 0`` (``W(u) + 2 Re X``, ``V(u) + 2 Re(iΩX)``) and ``rate``, the
+    largest real part of the reduced Jacobian's eigenvalues (a perturbation grows or decays
+    as ``e^{rate·t}``; stable where negative)."""
 
     omega: float
     u: tuple[complex, complex]
@@ -67,6 +76,7 @@ class PairState:
     amplitude: np.ndarray = field(repr=False)
     stable: bool
     start: np.ndarray = field(repr=False)  # (x(0), x'(0)) of the motion, t = 0
+    rate: float = 0.0  # the largest real part of the Jacobian's eigenvalues
 
 
 @dataclass(frozen=True)
@@ -131,22 +141,27 @@ class _Drive:
             if error <= INTERPOLATED * max(np.max(np.abs(values)), 1e-300) or N >= CHEBYSHEV_MOST:
                 break
             N *= 2
-        self.chebyshev = (mid, half, coef, chebyshev.chebder(coef) / half)
+        self.chebyshev = (mid, half, [complex(c) for c in coef[:, 0]],
+                          [complex(c) for c in coef[:, 1]],
+                          [complex(c) for c in chebyshev.chebder(coef[:, 0]) / half],
+                          [complex(c) for c in chebyshev.chebder(coef[:, 1]) / half])
 
     def forcing(self, omega: float) -> np.ndarray:
         """``a(Ω)`` (interpolated where :meth:`interpolate` was called)."""
         if self.chebyshev is None:
             return self.at(omega)[0]
-        mid, half, coef, _ = self.chebyshev
-        return chebyshev.chebval((omega - mid) / half, coef)
+        mid, half, a1, a2, _, _ = self.chebyshev
+        x = (omega - mid) / half
+        return np.array([_clenshaw(a1, x), _clenshaw(a2, x)])
 
     def slope(self, omega: float) -> np.ndarray:
         """``da/dΩ``: the Chebyshev series' derivative, or a central difference."""
         if self.chebyshev is None:
             h = DIFFERENCE * max(1.0, abs(omega))
             return (self.at(omega + h)[0] - self.at(omega - h)[0]) / (2 * h)
-        mid, half, _, der = self.chebyshev
-        return chebyshev.chebval((omega - mid) / half, der)
+        mid, half, _, _, d1, d2 = self.chebyshev
+        x = (omega - mid) / half
+        return np.array([_clenshaw(d1, x), _clenshaw(d2, x)])
 
     def at(self, omega: float) -> tuple[np.ndarray, np.ndarray]:
         if omega not in self.cache:
@@ -164,6 +179,15 @@ class _Drive:
         return self.cache[omega]
 
 
+def _clenshaw(c: list[complex], x: float) -> complex:
+    """``Σ c_j T_j(x)`` by Clenshaw's recurrence, in Python scalars (NumPy's ``chebval``
+    costs ~80 µs a call on two coefficients; the continuation makes thousands)."""
+    b1 = b2 = 0j
+    for cj in reversed(c[1:]):
+        b1, b2 = 2 * x * b1 - b2 + cj, b1
+    return x * b1 - b2 + c[0]
+
+
 class _Balance:
     """``u' = 0`` in ``x = (Re u₁, Im u₁, Re u₂, Im u₂)`` and Ω: ``residual``, ``jacobian``
     and ``d_omega``, as :func:`analysis.continuation._continue` asks of a balance."""
@@ -177,6 +201,9 @@ class _Balance:
         self.c = [np.array([t.coefficient for t in terms if t.mode == k], dtype=complex)
                   for k in (1, 2)]
         self.drive = drive
+        self.lowered = [np.maximum(E[:, None, :] - np.eye(4, dtype=int)[None], 0)
+                        for E in self.E]
+        self.weighted = [c[:, None] * E for c, E in zip(self.c, self.E, strict=True)]
 
     @staticmethod
     def _u(x: np.ndarray) -> np.ndarray:
@@ -201,10 +228,8 @@ class _Balance:
         dU = np.zeros((2, 4), dtype=complex)  # ∂G_k/∂(u₁, ū₁, u₂, ū₂)
         for k in range(2):
             dU[k, 2 * k] = self.lams[k] - 1j * self.nu[k] * omega
-            E = self.E[k]
-            if len(E):  # ∂(u^m)/∂U_j = m_j u^(m − e_j), every j at once
-                lowered = np.maximum(E[:, None, :] - np.eye(4, dtype=int)[None], 0)
-                dU[k] += np.einsum("t,tj,tj->j", self.c[k], E, np.prod(U ** lowered, axis=2))
+            if len(self.E[k]):  # ∂(u^m)/∂U_j = m_j u^(m − e_j), every j at once
+                dU[k] += np.sum(self.weighted[k] * np.prod(U ** self.lowered[k], axis=2), axis=0)
         re = dU[:, 0::2] + dU[:, 1::2]  # ∂/∂Re u_j
         im = 1j * (dU[:, 0::2] - dU[:, 1::2])  # ∂/∂Im u_j
         J = np.empty((4, 4))
@@ -240,27 +265,82 @@ def pair_response(model: ResonantSSM, span: tuple[float, float], outputs: np.nda
         return [(lo, linear(lo), 1.0), (hi, linear(hi), -1.0)], True
 
     step = (hi - lo) / STEPS
-    curve = _continue(balance, ends, lo, hi, step, STEPS, STEPS * POINT_SECONDS,
-                      POINT_SECONDS, MAX_POINTS, f"modes {model.modes[0]},{model.modes[1]}")
-    keep = (curve.omega >= lo) & (curve.omega <= hi)
-    starts = set(curve.pieces)
-    pieces, chosen = [], []
-    for i in range(len(curve.omega)):
-        if i in starts:
-            pieces.append(len(chosen))
-        if keep[i]:
-            chosen.append(i)
-    omegas, xs = curve.omega[chosen], curve.x[chosen]
+    where = f"modes {model.modes[0]},{model.modes[1]}"
+
+    def trace(starts) -> Continuation:
+        return _continue(balance, starts, lo, hi, step, STEPS, STEPS * POINT_SECONDS,
+                         POINT_SECONDS, MAX_POINTS, where)
+
+    curves = [trace(ends)]
+    for y in _branch_seeds(balance, curves[0], step):
+        if all(np.min(np.linalg.norm(np.column_stack([c.x, c.omega]) - y, axis=1)) > step
+               for c in curves):
+            curves.append(trace(lambda y=y: ([(y[-1], y[:-1], 1.0), (y[-1], y[:-1], -1.0)],
+                                             True)))
+    pieces, chosen_omega, chosen_x = [], [], []
+    for curve in curves:
+        keep = (curve.omega >= lo) & (curve.omega <= hi)
+        if kappa > 1:  # NOTE: one of the κ copies of a subharmonic state, |arg u₁| ≤ π/κ
+            # (a drive period later its motion is the same with u₁ turned by 2π/κ)
+            angle = np.angle(curve.x[:, 0] + 1j * curve.x[:, 1])
+            small = np.hypot(curve.x[:, 0], curve.x[:, 1]) <= SAME * np.max(np.abs(curve.x))
+            keep &= small | ((-np.pi / kappa < angle) & (angle <= np.pi / kappa))
+        starts = set(curve.pieces)
+        for i in range(len(curve.omega)):
+            if keep[i] and (i in starts or not keep[i - 1]):
+                pieces.append(len(chosen_omega))
+            if keep[i]:
+                chosen_omega.append(curve.omega[i])
+                chosen_x.append(curve.x[i])
+    omegas, xs = np.array(chosen_omega), np.array(chosen_x)
     us = xs[:, 0::2] + 1j * xs[:, 1::2]
     amplitude = peak_amplitude(_harmonics(model, drive, kappa, omegas, us, outputs))
+    rates = [float(np.max(np.linalg.eigvals(balance.jacobian(x, omega)).real))
+             for omega, x in zip(omegas, xs, strict=True)]
     states = tuple(
         PairState(float(omega), (complex(u[0]), complex(u[1])), (abs(u[0]), abs(u[1])), amp,
-                  bool(np.all(np.linalg.eigvals(balance.jacobian(x, omega)).real < 0)),
-                  _start(model, drive, float(omega), u))
-        for omega, x, u, amp in zip(omegas, xs, us, amplitude, strict=True))
-    return PairResponse(kappa, states, tuple(p for p in pieces if p < len(states)),
-                        tuple(f for f in curve.folds if lo <= f <= hi),
-                        tuple(drive.at(middle)[0]))
+                  rate < 0, _start(model, drive, float(omega), u), rate)
+        for omega, u, amp, rate in zip(omegas, us, amplitude, rates, strict=True))
+    folds = sorted(f for c in curves for f in c.folds if lo <= f <= hi)
+    folds = [f for i, f in enumerate(folds) if i == 0 or f - folds[i - 1] > SAME * abs(f)]
+    return PairResponse(kappa, states, tuple(sorted({p for p in pieces if p < len(states)})),
+                        tuple(folds), tuple(drive.at(middle)[0]))
+
+
+def _branch_seeds(balance: _Balance, curve: Continuation, step: float) -> list[np.ndarray]:
+    """A point on each branch crossing the traced curve (``y = (x, Ω)``): where ``det ∂R/∂x``
+    changes sign between neighbours with no fold between them (a branch point: the
+    extended Jacobian's null space is two-dimensional there), located on the chord and
+    corrected onto the curve, then a step along the null direction orthogonal to the curve,
+    each way, corrected (:func:`analysis.continuation._corrector`) — kept where it lands off
+    the curve."""
+    ys = np.column_stack([curve.x, curve.omega])
+    dets = [np.linalg.det(balance.jacobian(y[:-1], y[-1])) for y in ys]
+    breaks = set(curve.pieces)
+    seeds = []
+    for i in range(len(ys) - 1):
+        if i + 1 in breaks or (dets[i] > 0) == (dets[i + 1] > 0):
+            continue
+        a, b = ys[i], ys[i + 1]
+        if any(min(a[-1], b[-1]) <= f <= max(a[-1], b[-1]) for f in curve.folds):
+            continue
+        chord = (b - a) / np.linalg.norm(b - a)
+        try:
+            bp = _corrector(balance, a + dets[i] / (dets[i] - dets[i + 1]) * (b - a), chord)
+            _, _, vt = np.linalg.svd(_extended_jacobian(balance, bp))
+            null = vt[-2:]
+            other = null.T @ np.linalg.lstsq(null.T, chord, rcond=None)[0]
+            direction = chord - other if np.linalg.norm(chord - other) > 0.5 else null[0]
+            direction = null.T @ (null @ direction)
+            direction /= np.linalg.norm(direction)
+            for sign in (1.0, -1.0):
+                y = _corrector(balance, bp + sign * 2 * step * direction, direction)
+                if np.all(np.isfinite(y)) and np.linalg.norm(y - bp) > step and np.max(
+                        np.abs(balance.residual(y[:-1], y[-1]))) < 1e-9:
+                    seeds.append(y)
+        except np.linalg.LinAlgError:
+            continue
+    return seeds
 
 
 def _harmonics(model: ResonantSSM, drive: _Drive, kappa: int, omegas: np.ndarray,

@@ -300,7 +300,7 @@ def _pair_frc(red, names: list[str]) -> dict:
                                                  "amplitude": float(best.amplitude[k])}
     return {"frc": [{"omega": s.omega, "amplitude": {
         name: float(a) for name, a in zip(names, s.amplitude, strict=True)},
-        "stable": s.stable, "rho": list(s.rho), "u": [_pair(u) for u in s.u]}
+        "stable": s.stable, "rate": s.rate, "rho": list(s.rho), "u": [_pair(u) for u in s.u]}
         for s in r.states],
         "frc_folds": list(r.folds), "frc_pieces": list(r.pieces),
         "frc_driven_mode": red.model.modes[0 if r.kappa == 1 else 1],
@@ -308,8 +308,9 @@ def _pair_frc(red, names: list[str]) -> dict:
         "frc_method": "the drive at leading order (order 0 in p) on the directions resonant "
                       "with it; p_k = u_k*e^(i*nu_k*w*t/kappa), the reduced system's steady "
                       "states continued in w from the linear response at both ends "
-                      "(pseudo-arclength), stable where its Jacobian's eigenvalues have "
-                      "negative real parts; branches reaching neither end are not sought"}
+                      "and from the branch points along them (pseudo-arclength), stable where "
+                      "its Jacobian's eigenvalues have negative real parts (rate: the largest); "
+                      "a subharmonic state once (|arg u1| <= pi/kappa); isolas not sought"}
 
 
 def resonant_table(data: dict) -> list[str]:
