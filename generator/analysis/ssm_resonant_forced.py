@@ -40,7 +40,7 @@ from ..derive.system import System
 from ..errors import InputError
 from ..numerics.newton import secant
 from .continuation import Continuation, _continue, _corrector, _extended_jacobian
-from .ssm import DENSE_SOLVES, _bordered, _damping, peak_amplitude
+from .ssm import BORDERED, DENSE_SOLVES, _bordered, _damping, peak_amplitude
 from .ssm_forced import BACKBONE_POINTS, DEFAULT_SPAN, NAMED_OUTPUTS, REACH
 from .ssm_resonant import ResonantSSM, Term, resonant_ssm
 
@@ -169,8 +169,10 @@ class _Drive:
             L = s * s * self.M + s * self.C + self.K
             if sparse.issparse(L):
                 L = sparse.csc_array(L)
+            lams = self.lams[self.kept]
             X, sigma = _bordered(L, s * self.b[0] + self.b[1], s * self.c[0] + self.c[1],
-                                 self.d, self.force, np.zeros(len(self.kept)), False,
+                                 self.d, self.force, np.zeros(len(self.kept)),
+                                 bool(np.any(np.abs(s - lams) <= BORDERED * np.abs(lams))),
                                  (0, (0, 0, 0, 0), "drive"))
             a = np.zeros(2, dtype=complex)
             for j, value in zip(self.kept, np.atleast_1d(sigma), strict=True):
