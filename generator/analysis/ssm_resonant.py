@@ -67,6 +67,8 @@ RATIOS = (1, 2, 3)
 DETUNING = 0.1
 # NOTE: the largest relative detuning |ω₂/ω₁ − r|/r taken as a near 1:r resonance; past it
 # the kept monomials' divisors are no longer small and each mode has its own 2-D SSM.
+SAME_MODE = 1e-3
+# NOTE: the other modes' list entry within this (relative) of λ₂ is λ₂ itself.
 CONJUGATE = (1, 0, 3, 2)
 # NOTE: the direction conjugate to each of (p₁, p̄₁, p₂, p̄₂).
 INVARIANT = 1e-12
@@ -297,7 +299,11 @@ def resonant_ssm(system: System, modes: tuple[int, ...], order: int) -> Resonant
     R: list[np.ndarray] = [np.zeros((1, 4), dtype=complex), np.diag(lams)]
     states = [np.hstack([W[0], V[0]]), np.hstack([W[1], V[1]])]
     force = _Force(w, states, product=partial(_MonomialProduct, basis), rows=basis.rows)
-    others = [lam for lam in lin1.others if abs(lam - lin2.lam) > SINGULAR * abs(lin2.lam)]
+    # NOTE: the other master is no other mode; a large model's list holds it with its
+    # first-order damping (Lanczos), off the refined λ₂ by O(ζ²): the nearest entry goes
+    nearest = int(np.argmin(np.abs(lin1.others - lin2.lam))) if len(lin1.others) else -1
+    others = [lam for j, lam in enumerate(lin1.others)
+              if j != nearest or abs(lam - lin2.lam) > SAME_MODE * abs(lin2.lam)]
     others = np.array(others + [np.conj(lam) for lam in others], dtype=complex)
     if n <= DENSE_SOLVES:  # products with small sparse matrices cost more than dense ones
         M, C = M.toarray(), C.toarray()
