@@ -4,7 +4,8 @@
 
 by single shooting, judged by residuals.
 
-Nothing here imports the package ``generator``: NumPy and SciPy only.  Time is rescaled to
+Nothing here imports the package ``generator``: NumPy and SciPy only.  (The conservative
+backbone's RK4 loop of a large model is compiled by numba as well.)  Time is rescaled to
 ``τ = ω t`` so that every orbit has period ``2π``; the state is ``y = (x, v)`` with ``v = dx/dt``.
 One period of the state and of its variational equations (the monodromy ``Φ = ∂y(2π)/∂y(0)``
 and ``z = ∂y(2π)/∂ω``) is integrated by ``solve_ivp(method="DOP853", rtol=1e-12, atol=1e-13)``.
@@ -17,6 +18,10 @@ and ``z = ∂y(2π)/∂ω``) is integrated by ``solve_ivp(method="DOP853", rtol=
 * ``trace_branch`` and ``peak``: pseudo-arclength continuation in ``(y(0), ω)`` (through
   folds), and the peak of an amplitude where its derivative along the arclength vanishes.
 * ``free_decay``: the unforced motion from given initial conditions.
+* ``backbone`` and ``free_orbit``: the periodic orbits of the conservative ``M x'' + K x + f(x)
+  = 0`` along one mode (the backbone), by half-period shooting from rest with the period
+  unknown, continued in amplitude from the linear mode; RK4 with a fixed step under a stiff
+  model's stability limit, or DOP853; each orbit judged by a whole period's residual.
 * ``linear_amplitude``: the closed-form linear amplitudes, for checks.
 
 Every loop is bounded by a number of steps, never by time; nothing is random.  One period of a

@@ -268,8 +268,8 @@ def test_ssm_backbone_against_shooting(bm, tmp_path: Path):
     period's residual ``|(x(T) − x(0), v(T)/ω)| / |x(0)|`` ≤ 1e-10).  Four elements and a
     50 mm thick section: the axial modes lie 35 times above the lowest, not 870 times as in
     the 2 mm strip, so an adaptive integrator shoots it in about a second — and the backbone
-    in ``w/t`` is the strip's (the relative errors below agree with the strip's at the same
-    ``w/t`` to 1e-7).  At ``w(L/2) = 0.15 t`` and ``0.3 t`` (the frequency up 0.9 % and
+    in ``w/t`` is the strip's (the errors below are the 4-element 2 mm strip's at the same
+    ``w/t`` to four digits).  At ``w(L/2) = 0.15 t`` and ``0.3 t`` (the frequency up 0.9 % and
     3.4 %) the SSM's ω at the same mid-span amplitude is within 8e-8 and 2.1e-5 at K = 7,
     2.4e-9 and 2.5e-6 at K = 9 (``benchmarks/beam_backbone.py``'s table has the 8-element
     strip, K = 3 … 9): checked within four times those, and falling with K."""
