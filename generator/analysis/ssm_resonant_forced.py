@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sparse
@@ -39,10 +40,12 @@ from numpy.polynomial import chebyshev
 from ..derive.system import System
 from ..errors import InputError
 from ..numerics.newton import secant
-from .continuation import Continuation, _continue, _corrector, _extended_jacobian
 from .ssm import BORDERED, DENSE_SOLVES, _bordered, _damping, peak_amplitude
 from .ssm_forced import BACKBONE_POINTS, DEFAULT_SPAN, NAMED_OUTPUTS, REACH
 from .ssm_resonant import ResonantSSM, Term, resonant_ssm
+
+if TYPE_CHECKING:
+    from .continuation import Continuation
 
 STEPS = 50
 # NOTE: the continuation's step is the range over this many (in (u, Ω), u of order ρ): a
@@ -266,6 +269,9 @@ def pair_response(model: ResonantSSM, span: tuple[float, float], outputs: np.nda
     def ends():
         return [(lo, linear(lo), 1.0), (hi, linear(hi), -1.0)], True
 
+    from .continuation import _continue  # NOTE: here: its imports cost 0.5 s, and an
+    # undriven pair needs none of it
+
     step = (hi - lo) / STEPS
     where = f"modes {model.modes[0]},{model.modes[1]}"
 
@@ -316,6 +322,8 @@ def _branch_seeds(balance: _Balance, curve: Continuation, step: float) -> list[n
     corrected onto the curve, then a step along the null direction orthogonal to the curve,
     each way, corrected (:func:`analysis.continuation._corrector`) — kept where it lands off
     the curve."""
+    from .continuation import _corrector, _extended_jacobian
+
     ys = np.column_stack([curve.x, curve.omega])
     dets = [np.linalg.det(balance.jacobian(y[:-1], y[-1])) for y in ys]
     breaks = set(curve.pieces)
