@@ -139,6 +139,10 @@ def test_command_reports_the_invariant_mode_as_its_2d_ssm(capsys):
     assert np.array(pair["lambda"]).shape == (2, 2) and max(pair["residual"]) < 1e-14
     assert {t["equation"] for t in pair["terms"]} == {"p1", "p2"}
     assert any(t["monomial"] == [0, 1, 1, 0] and t["equation"] == "p1" for t in pair["terms"])
+    assert "slowflow_variables" not in pair  # damped: slowflow does not apply
+    exact = _json(["ssm", QUADRATIC_1_2, "--mode", "1,2", "--order", "3", "--json"], capsys)
+    # slowflow's shapes (−1, 1) and (1, 1) against φ₁ = (1, −1)/(2√2), φ₂ = (1, 1)/(2√2)
+    assert np.allclose(exact["slowflow_variables"]["scale"], [-2**-0.5, 2**-0.5], rtol=1e-14)
     (family,) = pair["families"]
     single = _json(["ssm", DAMPED_1_2, "--mode", "2", "--order", "5", "--rho-max",
                     str(family["backbone"][-1]["rho"]), "--json"], capsys)

@@ -411,6 +411,7 @@ class ResonantReduction:
     response: PairResponse | None
     span: tuple[float, float] | None
     coupled: tuple[CoupledMode, ...] = ()
+    slow_flow: tuple[float, float] | None = None  # c_k of slowflow's variables, where it applies
 
 
 def reduce_pair(system: System, modes: tuple[int, ...], order: int,
@@ -454,7 +455,29 @@ def reduce_pair(system: System, modes: tuple[int, ...], order: int,
     amplitudes = np.linspace(end / (BACKBONE_POINTS - 1), end, BACKBONE_POINTS - 1)
     return ResonantReduction(system.text, model, outputs, names, tuple(model.terms()),
                              tuple(families), response, span,
-                             coupled_modes(model, amplitudes, outputs))
+                             coupled_modes(model, amplitudes, outputs),
+                             _slow_flow_variables(system, model))
+
+
+def _slow_flow_variables(system: System, model: ResonantSSM) -> tuple[float, float] | None:
+    """``c_k`` of ``slowflow SYSTEM``'s amplitudes (``a_k = |c_k| ρ_k``,
+    :func:`analysis.ssm_resonant.slow_flow_scale`) where its flow applies: a system written
+    as text, undamped, no velocity in the force, the two ω₀² rational in the exact ratio
+    ``r²`` (its shapes: :func:`derive.resonance._shapes`); ``None`` elsewhere."""
+    from ..derive.resonance import _shapes
+    from .ssm_resonant import slow_flow_scale
+
+    if not system.exact or system.damping is not None or any(
+            f.has(*system.velocities) for f in system.force):
+        return None
+    try:
+        lams = system.modes()
+    except InputError:  # too many coordinates for exact modes
+        return None
+    pair = [lams[m - 1] for m in model.modes]
+    if not all(lam.is_Rational for lam in pair) or pair[1] != model.ratio**2 * pair[0]:
+        return None
+    return slow_flow_scale(model, [_shapes(system, lam)[0] for lam in pair])
 
 
 def _plane_harmonics(model: ResonantSSM, mode: int, rho: np.ndarray, outputs: np.ndarray

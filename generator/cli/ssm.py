@@ -285,6 +285,11 @@ def resonant_json(red) -> dict:
                                  "relative": q.relative} for q in m.near],
             "modes_checked": m.linear[0].checked,
             "radius_estimate": {"value": _finite(m.radius), "how": m.radius_how},
+            **({} if red.slow_flow is None else {"slowflow_variables": {
+                "scale": list(red.slow_flow),
+                "map": "slowflow SYSTEM's x = sum_k a_k*s_k*cos(omega_k*t + phi_k): a_k = "
+                       "|scale_k|*rho_k, phi_k = theta_k - omega_k*t (- pi where scale_k < 0); "
+                       "at first order the two flows are equal"}}),
             **_pair_frc(red, names)}
 
 
@@ -341,6 +346,12 @@ def resonant_table(data: dict) -> list[str]:
     radius = data["radius_estimate"]
     lines.append(f"radius in max |p_k| estimated at {_number(radius['value'])} "
                  f"({radius['how']})")
+    if "slowflow_variables" in data:
+        c1, c2 = data["slowflow_variables"]["scale"]
+        lines.append(f"slowflow SYSTEM's variables: a1 = {abs(c1):.9g}*rho1, a2 = "
+                     f"{abs(c2):.9g}*rho2, " + ", ".join(
+                         f"phi{k} = theta{k} - omega{k}*t" + (" - pi" if c < 0 else "")
+                         for k, c in ((1, c1), (2, c2))))
     names = list(data["outputs"])
     for f in data["families"]:
         lines.append(f"mode {f['mode']} alone (its plane is invariant), backbone "
