@@ -131,7 +131,7 @@ def _json(argv, capsys) -> dict:
     return json.loads(capsys.readouterr().out)
 
 
-def test_command_reports_the_invariant_mode_as_its_2d_ssm(capsys):
+def test_command_reports_the_invariant_mode_as_its_2d_ssm(capsys, tmp_path):
     """`ssm SYSTEM --mode 1,2 --json`: the contract's keys, and mode 2's family (its plane
     invariant near 1:2) equal to `ssm SYSTEM --mode 2 --json`'s γ and backbone amplitudes."""
     pair = _json(["ssm", DAMPED_1_2, "--mode", "1,2", "--order", "5", "--json"], capsys)
@@ -140,9 +140,14 @@ def test_command_reports_the_invariant_mode_as_its_2d_ssm(capsys):
     assert {t["equation"] for t in pair["terms"]} == {"p1", "p2"}
     assert any(t["monomial"] == [0, 1, 1, 0] and t["equation"] == "p1" for t in pair["terms"])
     assert "slowflow_variables" not in pair  # damped: slowflow does not apply
-    exact = _json(["ssm", QUADRATIC_1_2, "--mode", "1,2", "--order", "3", "--json"], capsys)
+    csv = tmp_path / "pair.csv"
+    exact = _json(["ssm", QUADRATIC_1_2, "--mode", "1,2", "--order", "3", "--json", "--csv",
+                   str(csv)], capsys)
     # slowflow's shapes (−1, 1) and (1, 1) against φ₁ = (1, −1)/(2√2), φ₂ = (1, 1)/(2√2)
     assert np.allclose(exact["slowflow_variables"]["scale"], [-2**-0.5, 2**-0.5], rtol=1e-14)
+    rows = np.genfromtxt(csv, delimiter=",", skip_header=1)
+    coupled = [p["omega"] for c in exact["coupled_modes"] for p in c["points"]]
+    assert np.array_equal(rows[rows[:, 0] == 1, 1], coupled) and len(coupled) >= 2
     (family,) = pair["families"]
     single = _json(["ssm", DAMPED_1_2, "--mode", "2", "--order", "5", "--rho-max",
                     str(family["backbone"][-1]["rho"]), "--json"], capsys)

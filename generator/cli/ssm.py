@@ -388,19 +388,45 @@ def resonant_table(data: dict) -> list[str]:
     return lines
 
 
+def resonant_csv(data: dict, path) -> None:
+    """``--csv`` of a pair: the single-mode backbones' rows, the coupled modes', then the
+    forced response's (``kind`` says which; a column that does not apply holds NaN)."""
+    names = list(data["outputs"])
+    nan = math.nan
+    columns = (("kind", "0 a mode alone on its backbone and 1 a coupled mode and 2 a forced "
+                "steady state"), ("omega", "frequency (a coupled mode: theta1')"),
+               ("rho1", "normal-form amplitude of mode 1"),
+               ("rho2", "normal-form amplitude of mode 2"),
+               ("psi", "coupled modes only: the locked phase difference"),
+               *((n, f"max |{n}| over a period") for n in names),
+               ("stable", "forced response only: 1 stable and 0 not"))
+    rows = []
+    for f in data["families"]:
+        first = f["mode"] == data["modes"][0]
+        rows += [(0, p["omega"], p["rho"] if first else 0.0, 0.0 if first else p["rho"], nan,
+                  *(p["amplitude"][n] for n in names), nan) for p in f["backbone"]]
+    for c in data["coupled_modes"]:
+        rows += [(1, p["omega"], *p["rho"], c["psi"], *(p["amplitude"][n] for n in names), nan)
+                 for p in c["points"]]
+    rows += [(2, q["omega"], *q["rho"], nan, *(q["amplitude"][n] for n in names),
+              int(q["stable"])) for q in data.get("frc", [])]
+    write_csv(path, columns, rows)
+
+
 def run_resonant(args: argparse.Namespace) -> int:
     """``lindstedt ssm SYSTEM --mode M1,M2``: the 4-D SSM of two modes in internal
     resonance, its reduced dynamics; the options of one mode's SSM alone are refused."""
     from ..analysis.ssm_resonant_forced import reduce_pair
 
-    given = [flag for flag, on in (("--exact", args.exact), ("--plot", args.plot is not None),
-                                   ("--csv", args.csv is not None)) if on]
+    given = [flag for flag, on in (("--exact", args.exact), ("--plot", args.plot is not None))
+             if on]
     if given:
         raise InputError(f"{', '.join(given)}: not built for a mode pair (--mode "
                          f"{','.join(str(m) for m in args.mode)}); give one mode")
     if len(args.mode) > 2:
         raise InputError(f"--mode {','.join(str(m) for m in args.mode)}: give one mode, or "
                          "two in internal resonance (M1,M2); more are not built")
+    _, csv = check_outputs(args)
     span = None
     if args.omega_min is not None:
         span = (args.omega_min, args.omega_max)
@@ -411,6 +437,8 @@ def run_resonant(args: argparse.Namespace) -> int:
                       _outputs(args.output, [str(x) for x in system.coordinates]),
                       args.rho_max, span)
     data = resonant_json(red)
+    if csv is not None:
+        resonant_csv(data, csv)
     print(json.dumps(data) if args.json else "\n".join(resonant_table(data)))
     return 0
 
