@@ -824,7 +824,8 @@ class FreeOrbit:
     ``residual = |(x(T) − x(0), v(T)/ω)| / |x(0)|`` (dimensionless: velocities over ω): one
     whole period integrated afresh from the converged ``y0``, by a finer integration than
     Newton's (the judge: it holds the integration error as well as Newton's); ``half`` is the
-    half-period condition Newton solved, ``|v(T/2)| / (ω|x(0)|)``;
+    half-period condition ``|v(T/2)| / (ω|x(0)|)`` at Newton's last integration (before its
+    last update where the judge stopped it: :data:`EARLY`);
     ``amplitude[i] = max_t |x_i(t)|`` over the period's steps; ``steps`` the RK4 steps a
     period (Newton's; the judge takes twice as many); ``newton`` the half-period
     integrations Newton used."""
@@ -966,9 +967,10 @@ def _tensor_field(mk, minv, eq, fac, coef):
 
 class _Conservative:
     """``x'' = −M⁻¹(K x + f(x))`` and its variational equation for perturbations of ``x(0)``
-    alone (``v(0) = 0`` held), by classical RK4 with a fixed step (a stiff model takes tens
+    alone (``v(0) = 0`` held): by classical RK4 with a fixed step (a stiff model takes tens
     of thousands of steps a period), the loop compiled by numba above
-    :data:`COMPILE_ABOVE` coordinates (or as ``compiled`` says)."""
+    :data:`COMPILE_ABOVE` coordinates (or as ``compiled`` says); or by SciPy's DOP853 on the
+    force's dense tensors (``method="DOP853"``: small models, n⁴ numbers)."""
 
     def __init__(self, M, K, terms, compiled: bool | None = None, method: str = "RK4"):
         M = np.atleast_2d(np.asarray(M, float))
@@ -1053,8 +1055,8 @@ STEP_STABILITY = 0.5
 # the stiffest mode (a beam's axial ones, thousands of times the lowest frequency) then sets
 # the step, not the accuracy, and the slow motion is integrated far below 1e-12.
 MIN_STEPS = 4096
-# NOTE: and at least this many steps a period (ω h ≤ 3e-3 on the orbit's own frequency; RK4's
-# error after a period is then ~1e-11): a mildly stiff model is set by accuracy.
+# NOTE: and at least this many steps a period (ω h ≤ 1.6e-3 on the orbit's own frequency): a
+# mildly stiff model's step is set by accuracy (its fast modes' phase error), not stability.
 
 
 def free_orbit(M, K, terms, coordinate: int, amplitude: float, x0, omega: float,
@@ -1089,23 +1091,30 @@ def free_orbit(M, K, terms, coordinate: int, amplitude: float, x0, omega: float,
     x = np.array(x0, float)
     x[coordinate] = amplitude
     omega = float(omega)
-    half, used = math.inf, 0
+    def judge() -> tuple[float, np.ndarray]:
+        end, _, path = system.flow(x, TWO_PI / omega, steps, False, keep=True, fine=True)
+        gap = end - np.concatenate((x, np.zeros(n)))
+        gap[n:] /= omega  # velocities in units of displacement: the residual is dimensionless
+        return float(np.linalg.norm(gap) / np.linalg.norm(x)), path
+
+    half, used, residual, path = math.inf, 0, math.inf, None
     while used < max_steps:
         used += 1
         y, P, _ = system.flow(x, math.pi / omega, steps // 2, True)
         r = y[n:]  # v(T/2)
         half = float(np.linalg.norm(r) / (omega * np.linalg.norm(x)))
         if half <= 1e-3 * tol:
+            residual, path = judge()
             break
         J = np.column_stack((P[n:][:, free], -math.pi / omega**2 * system.accel(y)))
         delta = np.linalg.solve(J, -r)
         x[free] += delta[:-1]
         omega += float(delta[-1])
+        if half <= EARLY:  # Newton's next step would be ~half²: the judge may accept it now
+            residual, path = judge()
+            if residual <= 1e-2 * tol:
+                break
     y0 = np.concatenate((x, np.zeros(n)))
-    end, _, path = system.flow(x, TWO_PI / omega, steps, False, keep=True, fine=True)
-    gap = end - y0
-    gap[n:] /= omega  # velocities in units of displacement: the residual is dimensionless
-    residual = float(np.linalg.norm(gap) / np.linalg.norm(x))
     if not residual <= tol:
         raise ShootingError(f"amplitude {amplitude:.6g}: periodicity residual {residual:.3e} "
                             f"above {tol:.1e} (half-period condition {half:.1e}, {used} "
@@ -1114,6 +1123,10 @@ def free_orbit(M, K, terms, coordinate: int, amplitude: float, x0, omega: float,
     return FreeOrbit(omega, y0, residual, half, peak, steps, used, tol)
 
 
+EARLY = 1e-5
+# NOTE: once the half-period condition is this small, each Newton update is followed by the
+# judge's whole period, and Newton stops when it closes to 1e-2 tol: the quadratic step has
+# landed, and the half period that would only confirm it is saved.
 FAST = 3.0
 # NOTE: modes above this multiple of the lowest frequency start each orbit's Newton in static
 # equilibrium (:meth:`_Conservative.quasi_static`): a beam's axial modes, stretched by the
