@@ -393,57 +393,112 @@ def forcing_table(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> list[F
 
 
 def _poly(c: np.ndarray) -> np.ndarray:
-    return np.asarray(c, dtype=complex) if len(c) else np.zeros(1, dtype=complex)
+    """Coefficient rows, at least one column (a missing polynomial is 0)."""
+    c = np.asarray(c, dtype=complex)
+    return c if c.shape[-1] else np.zeros((*c.shape[:-1], 1), dtype=complex)
+
+
+def _horner(c: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``Σ_j c[..., j] x^j`` by Horner (as ``numpy.polynomial.polynomial.polyval``), row by row:
+    ``c`` ``(N, d)``, ``x`` ``(N,)`` or ``(N, R)``."""
+    x = np.asarray(x)
+    col = (slice(None),) + (None,) * (x.ndim - 1)
+    acc = c[:, -1][col] + 0 * x
+    for j in range(c.shape[1] - 2, -1, -1):
+        acc = acc * x + c[:, j][col]
+    return acc
+
+
+def _derivative(c: np.ndarray) -> np.ndarray:
+    """The rows' derivative polynomials (a constant's: 0)."""
+    if c.shape[1] < 2:
+        return np.zeros_like(c)
+    return c[:, 1:] * np.arange(1, c.shape[1])
+
+
+def _times(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-by-row polynomial products (``(N, p)`` and ``(N, q)``, or one row broadcast)."""
+    out = np.zeros((max(len(a), len(b)), a.shape[1] + b.shape[1] - 1),
+                   dtype=np.result_type(a, b))
+    for j in range(a.shape[1]):
+        out[:, j:j + b.shape[1]] += a[:, j:j + 1] * b
+    return out
+
+
+def _plus(a: np.ndarray, b: np.ndarray, shift: int = 0) -> np.ndarray:
+    """``a + u^shift·b``, row by row."""
+    out = np.zeros((max(len(a), len(b)), max(a.shape[1], b.shape[1] + shift)),
+                   dtype=np.result_type(a, b))
+    out[:, :a.shape[1]] += a
+    out[:, shift:shift + b.shape[1]] += b
+    return out
+
+
+def _roots(res: np.ndarray) -> np.ndarray:
+    """Each row's polynomial's roots (``numpy.polynomial.polynomial.polyroots``: the reversed
+    companion matrix's eigenvalues, trailing zero coefficients dropped), NaN-padded."""
+    N, D = res.shape
+    nonzero = res != 0
+    top = np.where(nonzero.any(axis=1), D - 1 - np.argmax(nonzero[:, ::-1], axis=1), 0)
+    out = np.full((N, max(D - 1, 1)), np.nan, dtype=complex)
+    for n in np.unique(top):
+        rows = np.flatnonzero(top == n)
+        if n == 1:
+            out[rows, 0] = -res[rows, 0] / res[rows, 1]
+        elif n >= 2:
+            mat = np.zeros((len(rows), n, n))
+            mat.reshape(len(rows), -1)[:, n::n + 1] = 1
+            mat[:, :, -1] -= res[rows, :n] / res[rows, n:n + 1]
+            out[rows, :n] = np.linalg.eigvals(mat[:, ::-1, ::-1])
+    return out
+
+
+def _steady_states(model: SSM, omegas: np.ndarray, A: np.ndarray, B: np.ndarray
+                   ) -> list[list[tuple[float, float]]]:
+    """Every steady state ``(ρ, ψ)`` at each Ω (``A``, ``B``: the forced terms' coefficient
+    rows there): the resultant's real positive roots ``u = ρ²`` whose common root
+    ``z = e^{iψ}`` lies on the unit circle, ascending in ρ."""
+    g = np.array(model.gamma, dtype=complex)[None, :]
+    A, B = _poly(A), _poly(B)
+    iw = (1j * np.asarray(omegas, dtype=float))[:, None]
+    inner = _plus(_times(np.conj(A), _plus(iw, -g)), _times(B, _plus(iw, np.conj(g))), 1)
+    first = _plus(-_times(A, np.conj(A)), _times(B, np.conj(B)), 2)
+    res = np.real(_plus(_times(first, first), -_times(inner, np.conj(inner)), 1))
+    u = _roots(res)
+    with np.errstate(invalid="ignore"):
+        real = (np.abs(u.imag) <= 1e-9 * np.maximum(np.abs(u), 1e-300)) & (u.real > 0)
+    x = np.where(real, u.real, 0.0)
+    rho = np.sqrt(x)
+    gs = np.broadcast_to(g, (len(iw), g.shape[1]))
+    Au, Bu, gu = _horner(A, x), _horner(B, x), _horner(gs, x)
+    a1, b1, c1 = rho * rho * Bu, -rho * (iw - gu), Au
+    a2, b2, c2 = np.conj(Au), rho * (iw + np.conj(gu)), rho * rho * np.conj(Bu)
+    den = a2 * b1 - a1 * b2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        z = (a1 * c2 - a2 * c1) / np.where(den == 0, 1, den)
+        keep = real & (den != 0) & (np.abs(np.abs(z) - 1) <= ON_CIRCLE)
+    psi = np.angle(z)
+    return [sorted((float(rho[i, j]), float(psi[i, j])) for j in np.flatnonzero(keep[i]))
+            for i in range(len(iw))]
 
 
 def _steady_rhos(model: SSM, f: Forced) -> list[tuple[float, float]]:
-    """Every steady state ``(ρ, ψ)`` at ``f.omega``: the resultant's real positive roots
-    ``u = ρ²`` whose common root ``z = e^{iψ}`` lies on the unit circle, ascending in ρ."""
-    P = np.polynomial.polynomial
-    g = np.array(model.gamma, dtype=complex)
-    A, B = _poly(f.A), _poly(f.B)
-    iw = 1j * f.omega
-    inner = P.polyadd(P.polymul([0, 1], P.polymul(B, P.polyadd([iw], np.conj(g)))),
-                      P.polymul(np.conj(A), P.polysub([iw], g)))
-    first = P.polysub(P.polymul([0, 0, 1], P.polymul(B, np.conj(B))), P.polymul(A, np.conj(A)))
-    res = P.polysub(P.polymul(first, first), P.polymul([0, 1], P.polymul(inner, np.conj(inner))))
-    res = np.real(res)
-    top = len(res) - 1
-    while top > 0 and res[top] == 0:
-        top -= 1
-    if top == 0:
-        return []
-    out = []
-    for u in P.polyroots(res[:top + 1]):
-        if abs(u.imag) > 1e-9 * max(abs(u), 1e-300) or not u.real > 0:
-            continue
-        rho = math.sqrt(u.real)
-        Au, Bu, gu = P.polyval(u.real, A), P.polyval(u.real, B), P.polyval(u.real, g)
-        a1, b1, c1 = rho * rho * Bu, -rho * (iw - gu), Au
-        a2, b2, c2 = np.conj(Au), rho * (iw + np.conj(gu)), rho * rho * np.conj(Bu)
-        den = a2 * b1 - a1 * b2
-        if den == 0:
-            continue
-        z = (a1 * c2 - a2 * c1) / den
-        if abs(abs(z) - 1) <= ON_CIRCLE:
-            out.append((rho, float(np.angle(z))))
-    return sorted(out)
+    """:func:`_steady_states` at one Ω."""
+    return _steady_states(model, np.array([f.omega]), f.A[None, :], f.B[None, :])[0]
 
 
-def _stable(model: SSM, f: Forced, rho: float, psi: float) -> bool:
-    """The steady state's stability: trace and determinant of the real Jacobian of
-    ``q' = q(g(|q|²) − iΩ) + A(|q|²) + B(|q|²)q²``."""
-    P = np.polynomial.polynomial
+def _stable(model: SSM, omegas: np.ndarray, A: np.ndarray, B: np.ndarray, rho: np.ndarray,
+            psi: np.ndarray) -> np.ndarray:
+    """Each steady state's stability (its Ω, forced terms' rows, ρ and ψ): trace and
+    determinant of the real Jacobian of ``q' = q(g(|q|²) − iΩ) + A(|q|²) + B(|q|²)q²``."""
     u, q = rho * rho, rho * np.exp(1j * psi)
-    g = np.array(model.gamma, dtype=complex)
-    A, B = _poly(f.A), _poly(f.B)
-    gu, dg = P.polyval(u, g), P.polyval(u, P.polyder(g)) if len(g) > 1 else 0j
-    dA = P.polyval(u, P.polyder(A)) if len(A) > 1 else 0j
-    Bu = P.polyval(u, B)
-    dB = P.polyval(u, P.polyder(B)) if len(B) > 1 else 0j
-    Fq = gu - 1j * f.omega + u * dg + np.conj(q) * dA + np.conj(q) * q * q * dB + 2 * q * Bu
+    g = np.broadcast_to(np.array(model.gamma, dtype=complex), (len(u), len(model.gamma)))
+    A, B = _poly(A), _poly(B)
+    gu, dg = _horner(g, u), _horner(_derivative(g), u)
+    dA, Bu, dB = _horner(_derivative(A), u), _horner(B, u), _horner(_derivative(B), u)
+    Fq = gu - 1j * omegas + u * dg + np.conj(q) * dA + np.conj(q) * q * q * dB + 2 * q * Bu
     Fqc = q * q * dg + q * dA + q**3 * dB
-    return bool(2 * Fq.real < 0 and abs(Fq) ** 2 - abs(Fqc) ** 2 > 0)
+    return (2 * Fq.real < 0) & (np.abs(Fq) ** 2 - np.abs(Fqc) ** 2 > 0)
 
 
 def _amplitudes(model: SSM, forced: list[Forced], outputs: np.ndarray, rho: np.ndarray,
@@ -498,29 +553,30 @@ class ForcedResponse:
 def forced_response(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> ForcedResponse:
     """Every steady state of the reduced model at each ``Ω`` (ascending) inside the radius,
     the folds (:data:`FOLD_STEPS` bisections on the number of states) and each output's peak
-    (:func:`peak`)."""
+    (:func:`peaks`)."""
     omegas = np.asarray(omegas, dtype=float)
     table = forcing_table(model, omegas, outputs)
+    grid = Grid.of(table)
     found, counts, beyond = [], [], 0
-    for f in table:
-        here = _steady_rhos(model, f)
+    for i, here in enumerate(_steady_states(model, omegas, grid.A, grid.B)):
         counts.append(len(here))  # every root: a state crossing the radius is no fold
         beyond += sum(1 for r, _ in here if r > model.radius)
-        found += [(f, r, p) for r, p in here if r <= model.radius]
+        found += [(i, r, p) for r, p in here if r <= model.radius]
     states: tuple[SteadyState, ...] = ()
     if found:
+        at = np.array([i for i, _, _ in found])
         rho = np.array([r for _, r, _ in found])
         psi = np.array([p for _, _, p in found])
-        amp = _amplitudes(model, [f for f, _, _ in found], outputs, rho, psi)
-        states = tuple(SteadyState(f.omega, r, p, amp[i], _stable(model, f, r, p))
-                       for i, (f, r, p) in enumerate(found))
+        amp = _amplitudes(model, [table[i] for i in at], outputs, rho, psi)
+        stable = _stable(model, omegas[at], grid.A[at], grid.B[at], rho, psi)
+        states = tuple(SteadyState(table[i].omega, r, p, amp[k], bool(stable[k]))
+                       for k, (i, r, p) in enumerate(found))
     folds = tuple(fold for fold in (_fold(model, table[i - 1], table[i], counts[i - 1])
                                     for i in range(1, len(omegas))
                                     if counts[i] != counts[i - 1])
                   if math.isfinite(fold[1]) and fold[1] <= model.radius)
-    grid = Grid.of(table)
-    peaks = tuple(peak(model, outputs, i, grid) for i in range(len(outputs)))
-    return ForcedResponse(states, folds, beyond, peaks)
+    peaks_ = peaks(model, outputs, grid)
+    return ForcedResponse(states, folds, beyond, peaks_)
 
 
 def _between(a: Forced, b: Forced, omega: float) -> Forced:
@@ -547,34 +603,37 @@ def _fold(model: SSM, a: Forced, b: Forced, count: int) -> tuple[float, float]:
     return 0.5 * (lo + hi), float(0.5 * (merged[k] + merged[k + 1]))
 
 
-def _on_curve(model: SSM, rho: float, sign: float, grid: Grid, outputs: np.ndarray,
-              output: int, amplitude: bool = True) -> tuple[float, float] | None:
-    """``(Ω, max |x_output|)`` on the forced response at ρ, on its branch ``sign``: the real
+def _on_curve(model: SSM, rho: np.ndarray, sign: np.ndarray, grid: Grid
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(Ω, ψ, found)`` on the forced response at each ρ, on its branch ``sign``: the real
     part of ``ρ(iΩ − g) = A e^{−iψ} + ρ²B e^{iψ}`` fixes ψ (two roots, ``sign`` picks one), its
-    imaginary part Ω; A and B at Ω by fixed point.  None where ρ is past the curve's top."""
-    P = np.polynomial.polynomial
+    imaginary part Ω; A and B at Ω by fixed point (linearly between the grid's frequencies).
+    Not found where ρ is past the curve's top or Ω leaves the grid."""
+    rho = np.asarray(rho, dtype=float)
+    sign = np.broadcast_to(np.asarray(sign, dtype=float), rho.shape)
     u = rho * rho
-    g = complex(P.polyval(u, np.array(model.gamma)))
-    omegas, As, Bs = grid.omegas, grid.A, grid.B
-    om = min(max(g.imag, omegas[0]), omegas[-1])
-    for _ in range(FIXED_POINT):
-        i = int(np.clip(np.searchsorted(omegas, om), 1, len(omegas) - 1))
-        t = (om - omegas[i - 1]) / (omegas[i] - omegas[i - 1])
-        A = P.polyval(u, _poly((1 - t) * As[i - 1] + t * As[i]))
-        B = P.polyval(u, _poly((1 - t) * Bs[i - 1] + t * Bs[i]))
-        alpha, beta = A.real + u * B.real, A.imag - u * B.imag
-        size = math.hypot(alpha, beta)
-        if size == 0 or abs(rho * g.real) > size:
-            return None
-        psi = math.atan2(beta, alpha) + sign * math.acos(-rho * g.real / size)
-        om = g.imag + (A * np.exp(-1j * psi) + u * B * np.exp(1j * psi)).imag / rho
-        if not omegas[0] <= om <= omegas[-1]:
-            return None
-    if not amplitude:
-        return om, math.nan
-    amp = _amplitudes(model, [grid.at(om)], outputs, np.array([rho]),
-                      np.array([psi]))[0, output]
-    return om, float(amp)
+    g = _horner(np.broadcast_to(np.array(model.gamma, dtype=complex),
+                                (len(u), len(model.gamma))), u)
+    omegas = grid.omegas
+    As, Bs = _poly(grid.A), _poly(grid.B)
+    om = np.clip(g.imag, omegas[0], omegas[-1])
+    found = np.ones(len(u), dtype=bool)
+    psi = np.zeros(len(u))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for _ in range(FIXED_POINT):
+            i = np.clip(np.searchsorted(omegas, om), 1, len(omegas) - 1)
+            t = ((om - omegas[i - 1]) / (omegas[i] - omegas[i - 1]))[:, None]
+            A = _horner((1 - t) * As[i - 1] + t * As[i], u)
+            B = _horner((1 - t) * Bs[i - 1] + t * Bs[i], u)
+            alpha, beta = A.real + u * B.real, A.imag - u * B.imag
+            size = np.hypot(alpha, beta)
+            found &= (size != 0) & ~(np.abs(rho * g.real) > size)
+            psi = np.arctan2(beta, alpha) + sign * np.arccos(
+                np.clip(-rho * g.real / np.where(found, size, 1.0), -1, 1))
+            step = g.imag + (A * np.exp(-1j * psi) + u * B * np.exp(1j * psi)).imag / rho
+            found &= (omegas[0] <= step) & (step <= omegas[-1])
+            om = np.where(found, step, om)
+    return om, psi, found
 
 
 @dataclass(frozen=True)
@@ -599,58 +658,76 @@ class Grid:
         return _between(self.table[i - 1], self.table[i], omega)
 
 
-def peak(model: SSM, outputs: np.ndarray, output: int, grid: Grid) -> Peak | None:
-    """Output ``output``'s largest amplitude on the forced response over the grid of
-    ``grid``: the curve's top ρ* (the largest ρ with a steady state, by bisection), then
-    golden section along both branches within :data:`PEAK_BRACKET` below it; ``None`` where
-    the top lies past the radius or the grid."""
-    hi = model.radius if math.isfinite(model.radius) else 1e6
-    lo = 0.0
-    def exists(r: float) -> bool:
-        return _on_curve(model, r, 1.0, grid, outputs, output, False) is not None
+def _amplitudes_on_curve(model: SSM, grid: Grid, outputs: np.ndarray, rho: np.ndarray,
+                         sign: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(Ω, max |x_i|)`` on the curve at each ρ of its branch ``sign`` (``(P,)`` and
+    ``(P, outputs)``; −∞ where not found)."""
+    om, psi, found = _on_curve(model, rho, sign, grid)
+    amp = np.full((len(rho), len(outputs)), -math.inf)
+    if found.any():
+        amp[found] = _amplitudes(model, [grid.at(float(o)) for o in om[found]], outputs,
+                                 rho[found], psi[found])
+    return om, amp
 
+
+def peaks(model: SSM, outputs: np.ndarray, grid: Grid) -> tuple[Peak | None, ...]:
+    """Each output's largest amplitude on the forced response over the grid of ``grid``: the
+    curve's top ρ* (the largest ρ with a steady state, by bisection; one for every output),
+    then golden section along both branches within :data:`PEAK_BRACKET` below it, every
+    output's and branch's search a step at a time together; ``None`` where the top lies past
+    the radius or the grid."""
+    m = len(outputs)
+    hi = model.radius if math.isfinite(model.radius) else 1e6
+    if len(grid.omegas) < 2:
+        return (None,) * m
     probe = np.geomspace(hi * 1e-9, hi, PEAK_PROBES)
-    held = [exists(r) for r in probe]
+    held = _on_curve(model, probe, 1.0, grid)[2].tolist()
     if not any(held):
-        return None
+        return (None,) * m
     first = held.index(True)
     if all(held[first:]):
-        return None  # the curve reaches the radius: its top is not inside
+        return (None,) * m  # the curve reaches the radius: its top is not inside
     # the top of the curve that grows from the small responses (a far branch of the truncated
     # series, past where it holds, is not the resonance's)
     end = first + held[first:].index(False)
     lo, hi = probe[end - 1], probe[end]
     for _ in range(FOLD_STEPS + 10):
         mid = 0.5 * (lo + hi)
-        if not exists(mid):
-            hi = mid
-        else:
+        if _on_curve(model, np.array([mid]), 1.0, grid)[2][0]:
             lo = mid
+        else:
+            hi = mid
     top = lo
-    best = None
     ratio = (math.sqrt(5) - 1) / 2
-    for sign in (1.0, -1.0):
-        def value(r: float, sign: float = sign) -> float:
-            got = _on_curve(model, r, sign, grid, outputs, output)
-            return -math.inf if got is None else got[1]
+    # one search per (output, branch): output i's on rows i (branch +1) and m + i (−1)
+    column = np.tile(np.arange(m), 2)
+    sign = np.repeat([1.0, -1.0], m)
+    rows = np.arange(2 * m)
 
-        a, b = top * (1 - PEAK_BRACKET), top
-        x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
-        f1, f2 = value(x1), value(x2)
-        for _ in range(PEAK_STEPS):
-            if f1 > f2:
-                b, x2, f2 = x2, x1, f1
-                x1 = b - ratio * (b - a)
-                f1 = value(x1)
-            else:
-                a, x1, f1 = x1, x2, f2
-                x2 = a + ratio * (b - a)
-                f2 = value(x2)
-        for x in (x1, x2, top):
-            got = _on_curve(model, x, sign, grid, outputs, output)
-            if got is not None and (best is None or got[1] > best.amplitude):
-                best = Peak(got[0], x, got[1])
-    return best
+    def value(r: np.ndarray) -> np.ndarray:
+        return _amplitudes_on_curve(model, grid, outputs, r, sign)[1][rows, column]
+
+    a, b = np.full(2 * m, top * (1 - PEAK_BRACKET)), np.full(2 * m, top)
+    x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
+    f1, f2 = value(x1), value(x2)
+    for _ in range(PEAK_STEPS):
+        left = f1 > f2  # the maximum lies in [a, x2]
+        b = np.where(left, x2, b)
+        a = np.where(left, a, x1)
+        x1, x2 = np.where(left, b - ratio * (b - a), x2), np.where(left, x1, a + ratio * (b - a))
+        f1, f2 = np.where(left, -math.inf, f2), np.where(left, f1, -math.inf)
+        new = np.where(left, x1, x2)
+        fresh = value(new)
+        f1, f2 = np.where(left, fresh, f1), np.where(left, f2, fresh)
+    best: list[Peak | None] = [None] * m
+    ends = [(x, *_amplitudes_on_curve(model, grid, outputs, x, sign))
+            for x in (x1, x2, np.full(2 * m, top))]
+    for k in rows:  # each output's branch +1 first, then −1, each at x1, x2 and the top
+        i = column[k]
+        for x, om, amp in ends:
+            if amp[k, i] > -math.inf and (best[i] is None or amp[k, i] > best[i].amplitude):
+                best[i] = Peak(float(om[k]), float(x[k]), float(amp[k, i]))
+    return tuple(best)
 
 
 BACKBONE_POINTS = 41
