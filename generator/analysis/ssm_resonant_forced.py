@@ -84,15 +84,17 @@ class PairState:
 
 @dataclass(frozen=True)
 class PairResponse:
-    """The traced steady states in order along the curve (``pieces``: each piece's first
-    index), the folds in Ω, the drive's resonant mode (``kappa``: Ω ≈ κω₁) and forcing
-    ``a_k`` at the range's middle."""
+    """The traced steady states inside the radius in order along the curve (``pieces``: each
+    piece's first index; ``beyond``: how many past the radius were dropped), the folds in Ω
+    (inside the radius), the drive's resonant mode (``kappa``: Ω ≈ κω₁) and forcing ``a_k`` at
+    the range's middle."""
 
     kappa: int
     states: tuple[PairState, ...]
     pieces: tuple[int, ...]
     folds: tuple[float, ...]
     forcing: tuple[complex, complex]
+    beyond: int = 0  # traced states past the radius (max |u_k| > radius), dropped
 
 
 class _Drive:
@@ -285,9 +287,13 @@ def pair_response(model: ResonantSSM, span: tuple[float, float], outputs: np.nda
                for c in curves):
             curves.append(trace(lambda y=y: ([(y[-1], y[:-1], 1.0), (y[-1], y[:-1], -1.0)],
                                              True)))
-    pieces, chosen_omega, chosen_x = [], [], []
+    pieces, chosen_omega, chosen_x, beyond = [], [], [], 0
     for curve in curves:
         keep = (curve.omega >= lo) & (curve.omega <= hi)
+        outside = np.maximum(np.hypot(curve.x[:, 0], curve.x[:, 1]),
+                             np.hypot(curve.x[:, 2], curve.x[:, 3])) > model.radius
+        beyond += int(np.sum(keep & outside))
+        keep &= ~outside
         if kappa > 1:  # NOTE: one of the κ copies of a subharmonic state, |arg u₁| ≤ π/κ
             # (a drive period later its motion is the same with u₁ turned by 2π/κ)
             angle = np.angle(curve.x[:, 0] + 1j * curve.x[:, 1])
@@ -309,10 +315,22 @@ def pair_response(model: ResonantSSM, span: tuple[float, float], outputs: np.nda
         PairState(float(omega), (complex(u[0]), complex(u[1])), (abs(u[0]), abs(u[1])), amp,
                   rate < 0, _start(model, drive, float(omega), u), rate)
         for omega, u, amp, rate in zip(omegas, us, amplitude, rates, strict=True))
-    folds = sorted(f for c in curves for f in c.folds if lo <= f <= hi)
+    folds = sorted(f for c in curves for f in c.folds if lo <= f <= hi
+                   and _inside(balance, c, f, model.radius))
     folds = [f for i, f in enumerate(folds) if i == 0 or f - folds[i - 1] > SAME * abs(f)]
     return PairResponse(kappa, states, tuple(sorted({p for p in pieces if p < len(states)})),
-                        tuple(folds), tuple(drive.at(middle)[0]))
+                        tuple(folds), tuple(drive.at(middle)[0]), beyond)
+
+
+def _inside(balance: _Balance, curve: Continuation, fold: float, radius: float) -> bool:
+    """Whether the traced point nearest the fold ``fold`` (in Ω, where ``dΩ`` turns) lies
+    inside the radius."""
+    turns = np.flatnonzero(np.diff(np.sign(np.diff(curve.omega))) != 0) + 1
+    if not len(turns):
+        return True
+    i = turns[np.argmin(np.abs(curve.omega[turns] - fold))]
+    x = curve.x[i]
+    return max(math.hypot(x[0], x[1]), math.hypot(x[2], x[3])) <= radius
 
 
 def _branch_seeds(balance: _Balance, curve: Continuation, step: float) -> list[np.ndarray]:

@@ -308,6 +308,7 @@ def _pair_frc(red, names: list[str]) -> dict:
         "stable": s.stable, "rate": s.rate, "rho": list(s.rho), "u": [_pair(u) for u in s.u]}
         for s in r.states],
         "frc_folds": list(r.folds), "frc_pieces": list(r.pieces),
+        "frc_beyond_radius": r.beyond,
         "frc_driven_mode": red.model.modes[0 if r.kappa == 1 else 1],
         "frc_forcing": [_pair(a) for a in r.forcing], "frc_peaks": peaks,
         "frc_method": "the drive at leading order (order 0 in p) on the directions resonant "
@@ -378,7 +379,9 @@ def resonant_table(data: dict) -> list[str]:
         lines.append(f"forced response near mode {data['frc_driven_mode']}: {len(frc)} steady "
                      f"states ({sum(not s['stable'] for s in frc)} unstable) along "
                      f"{len(data['frc_pieces'])} traced curve"
-                     f"{'s' * (len(data['frc_pieces']) != 1)}")
+                     f"{'s' * (len(data['frc_pieces']) != 1)}"
+                     + (f" ({data['frc_beyond_radius']} beyond the radius dropped)"
+                        if data["frc_beyond_radius"] else ""))
         for n in names:
             p = data["frc_peaks"][n]
             if p is not None:
