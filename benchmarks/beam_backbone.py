@@ -178,6 +178,8 @@ def main(argv: list[str] | None = None) -> int:
           + f"; shooting {len(orbits)} orbits {shooting_time:.1f} s "
           f"({shooting_time / len(orbits):.1f} s an orbit)"
           + (f"; DOP853 check {check_time:.1f} s" if args.check else ""))
+    print("time: each orbit " + ", ".join(f"{A * 1e3:.1f} mm {o.seconds:.1f} s"
+                                          for A, o in zip(AMPLITUDES, orbits, strict=True)))
     return 0
 
 

@@ -36,6 +36,7 @@ central finite differences).  Amplitudes are ``max_t |x_i(t)|`` over one period:
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from itertools import pairwise
@@ -828,7 +829,8 @@ class FreeOrbit:
     last update where the judge stopped it: :data:`EARLY`);
     ``amplitude[i] = max_t |x_i(t)|`` over the period's steps; ``steps`` the RK4 steps a
     period (Newton's; the judge takes twice as many); ``newton`` the half-period
-    integrations Newton used."""
+    integrations Newton used; ``seconds`` the wall time it took (the one field that varies
+    from run to run)."""
 
     omega: float
     y0: np.ndarray
@@ -838,6 +840,7 @@ class FreeOrbit:
     steps: int
     newton: int
     tolerance: float = field(repr=False, default=1e-9)
+    seconds: float = field(repr=False, compare=False, default=0.0)  # wall time, guess to judge
 
 
 def _monomials(n: int, terms: Sequence) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -1080,6 +1083,7 @@ def free_orbit(M, K, terms, coordinate: int, amplitude: float, x0, omega: float,
     amplitude, default 400).  The orbit is returned only when the judge's
     ``|(x(T) − x(0), v(T)/ω)| / |x(0)| ≤ tol``, else :class:`ShootingError` — never on a
     flag."""
+    start = time.perf_counter()
     system = system or _Conservative(M, K, terms, method=method)
     n = system.n
     if steps is None and system.method == "DOP853":
@@ -1120,7 +1124,8 @@ def free_orbit(M, K, terms, coordinate: int, amplitude: float, x0, omega: float,
                             f"above {tol:.1e} (half-period condition {half:.1e}, {used} "
                             "Newton steps)")
     peak = np.max(np.abs(path[:, :n]), axis=0)
-    return FreeOrbit(omega, y0, residual, half, peak, steps, used, tol)
+    return FreeOrbit(omega, y0, residual, half, peak, steps, used, tol,
+                     time.perf_counter() - start)
 
 
 EARLY = 1e-5

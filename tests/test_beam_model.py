@@ -267,7 +267,7 @@ def test_ssm_backbone_against_shooting(bm, tmp_path: Path):
     (half-period shooting with the period unknown, DOP853, each orbit judged by a whole
     period's residual ``|(x(T) − x(0), v(T)/ω)| / |x(0)|`` ≤ 1e-10).  Four elements and a
     50 mm thick section: the axial modes lie 35 times above the lowest, not 870 times as in
-    the 2 mm strip, so an adaptive integrator shoots it in about a second — and the backbone
+    the 2 mm strip, so an adaptive integrator shoots it in seconds — and the backbone
     in ``w/t`` is the strip's (the errors below are the 4-element 2 mm strip's at the same
     ``w/t`` to four digits).  At ``w(L/2) = 0.15 t`` and ``0.3 t`` (the frequency up 0.9 % and
     3.4 %) the SSM's ω at the same mid-span amplitude is within 8e-8 and 2.1e-5 at K = 7,
