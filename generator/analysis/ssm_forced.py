@@ -69,9 +69,11 @@ PEAK_STEPS = 32
 FIXED_POINT = 8
 PEAK_BRACKET = 0.05
 PEAK_PROBES = 100
+TOP_HALVINGS = 4
 # NOTE: a fold is placed by 50 bisections between two frequencies of the grid; a peak by
 # golden section (0.618³² of the bracket) along the curve in ρ within 5 % below its top, Ω on
-# the curve by 8 fixed-point steps (A and B vary slowly with Ω).
+# the curve by 8 fixed-point steps (A and B vary slowly with Ω); the top itself by 60
+# halvings of its bracket, 4 at a time (15 points tried together).
 
 
 @dataclass(frozen=True)
@@ -91,12 +93,6 @@ def forced_order(model: SSM) -> int:
     return max(model.order - 1, 0)
 
 
-def forced_terms(model: SSM, omega: float, outputs: np.ndarray) -> Forced:
-    """The first-order non-autonomous SSM at ``Ω`` to :func:`forced_order` (sparse solves)."""
-    return _unflatten(model, omega, forced_values(model, np.array([omega]), outputs)[0],
-                      len(outputs))
-
-
 BATCH_VALUES = 1 << 22
 # NOTE: the forced terms of several Ω are computed together (one recursion, every product
 # and dense solve batched over Ω) while their states hold at most this many complex numbers
@@ -104,8 +100,10 @@ BATCH_VALUES = 1 << 22
 
 
 def forced_values(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> np.ndarray:
-    """:func:`forced_terms` at each Ω of ``omegas``, flattened as :func:`_flatten` (a row per
-    Ω): one recursion over orders for a batch of Ω (:data:`BATCH_VALUES`)."""
+    """The first-order non-autonomous SSM at each Ω of ``omegas`` to :func:`forced_order`, a
+    row per Ω: ``A_j``, ``B_j``, then the outputs' ``W¹`` order by order (row-major, as
+    :class:`Forced` holds them); one recursion over the orders for a batch of Ω
+    (:data:`BATCH_VALUES`)."""
     w = model.matrices
     if w.drive is None:
         raise InputError("the system is not driven: no forced response (drive one equation "
@@ -286,10 +284,6 @@ def _lifted(Z0: tuple[np.ndarray, ...], A: list[np.ndarray], B: list[np.ndarray]
     return out
 
 
-def _flatten(f: Forced) -> np.ndarray:
-    return np.concatenate([f.A, f.B, *(X.ravel() for X in f.X)])
-
-
 def _unflatten(model: SSM, omega: float, v: np.ndarray, m: int) -> Forced:
     K1 = forced_order(model)
     nA, nB = K1 // 2 + 1, max((K1 - 2) // 2 + 1, 0)
@@ -375,9 +369,16 @@ def forcing_pieces(model: SSM, lo: float, hi: float, outputs: np.ndarray,
 
 
 def forcing_table(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> list[Forced]:
-    """The forced terms at every ``Ω`` of ``omegas``: interpolated by :func:`forcing_fit` over
-    their range where it verifies with fewer values than the grid holds (``2N + 1`` for ``N``
-    nodes), else computed at each ``Ω``."""
+    """The forced terms at every ``Ω`` of ``omegas`` (:func:`forcing_rows`), one
+    :class:`Forced` each."""
+    return [_unflatten(model, float(om), v, len(outputs))
+            for om, v in zip(omegas, forcing_rows(model, omegas, outputs), strict=True)]
+
+
+def forcing_rows(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> np.ndarray:
+    """The forced terms at every ``Ω`` of ``omegas`` as :func:`forced_values`' rows:
+    interpolated by :func:`forcing_fit` over their range where it verifies with fewer values
+    than the grid holds (``2N + 1`` for ``N`` nodes), else computed at each ``Ω``."""
     omegas = np.asarray(omegas, dtype=float)
     lo, hi = float(omegas.min()), float(omegas.max())
     most = CHEBYSHEV_NODES
@@ -386,10 +387,8 @@ def forcing_table(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> list[F
     fit = None
     if hi > lo and len(omegas) > 2 * CHEBYSHEV_NODES + 1:
         fit = forcing_fit(model, lo, hi, outputs, most)
-    rows = fit(omegas) if fit is not None and fit.verified else forced_values(model, omegas,
-                                                                             outputs)
-    return [_unflatten(model, float(om), v, len(outputs))
-            for om, v in zip(omegas, rows, strict=True)]
+    return fit(omegas) if fit is not None and fit.verified else forced_values(model, omegas,
+                                                                              outputs)
 
 
 def _poly(c: np.ndarray) -> np.ndarray:
@@ -501,20 +500,20 @@ def _stable(model: SSM, omegas: np.ndarray, A: np.ndarray, B: np.ndarray, rho: n
     return (2 * Fq.real < 0) & (np.abs(Fq) ** 2 - np.abs(Fqc) ** 2 > 0)
 
 
-def _amplitudes(model: SSM, forced: list[Forced], outputs: np.ndarray, rho: np.ndarray,
+def _amplitudes(model: SSM, X: tuple[np.ndarray, ...], outputs: np.ndarray, rho: np.ndarray,
                 psi: np.ndarray) -> np.ndarray:
     """Each output's max |x_i| over a period of the steady states (ρ, ψ), each with its own
-    forced terms (``(states, outputs)``): the autonomous SSM at ρ with phase ψ and ``W¹``."""
+    forced terms (``X[k]``: the outputs' ``W¹`` of order ``k``, ``(states, k + 1, outputs)``):
+    the autonomous SSM at ρ with phase ψ and ``W¹`` (``(states, outputs)``)."""
     rho, psi = np.atleast_1d(rho), np.atleast_1d(psi)
     c = model.harmonics(rho, outputs, psi)
-    K = model.order
-    for k in range(len(forced[0].X)):
-        X = np.stack([f.X[k] for f in forced])  # (states, k + 1, outputs)
-        for r in range(k + 1):
-            h = k - 2 * r + 1
-            term = (rho**k * np.exp(1j * (k - 2 * r) * psi))[:, None] * X[:, r]
-            c[:, K + h] += term
-            c[:, K - h] += np.conj(term)
+    K, K1 = model.order, len(X) - 1
+    turns = np.exp(1j * np.outer(psi, np.arange(-K1, K1 + 1)))  # e^{inψ}, n = −K1 … K1
+    for k, Xk in enumerate(X):
+        n = k - 2 * np.arange(k + 1)  # row r: p₁^{k−r}p₂^r e^{iΩt}, harmonic n + 1
+        term = (rho[:, None] ** k * turns[:, n + K1])[:, :, None] * Xk
+        c[:, K + n + 1] += term  # distinct harmonics within an order
+        c[:, K - n - 1] += np.conj(term)
     return peak_amplitude(c)
 
 
@@ -555,8 +554,7 @@ def forced_response(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> Forc
     the folds (:data:`FOLD_STEPS` bisections on the number of states) and each output's peak
     (:func:`peaks`)."""
     omegas = np.asarray(omegas, dtype=float)
-    table = forcing_table(model, omegas, outputs)
-    grid = Grid.of(table)
+    grid = Grid.of(model, omegas, forcing_rows(model, omegas, outputs), len(outputs))
     found, counts, beyond = [], [], 0
     for i, here in enumerate(_steady_states(model, omegas, grid.A, grid.B)):
         counts.append(len(here))  # every root: a state crossing the radius is no fold
@@ -567,11 +565,12 @@ def forced_response(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> Forc
         at = np.array([i for i, _, _ in found])
         rho = np.array([r for _, r, _ in found])
         psi = np.array([p for _, _, p in found])
-        amp = _amplitudes(model, [table[i] for i in at], outputs, rho, psi)
+        amp = _amplitudes(model, tuple(X[at] for X in grid.X), outputs, rho, psi)
         stable = _stable(model, omegas[at], grid.A[at], grid.B[at], rho, psi)
-        states = tuple(SteadyState(table[i].omega, r, p, amp[k], bool(stable[k]))
+        states = tuple(SteadyState(float(omegas[i]), r, p, amp[k], bool(stable[k]))
                        for k, (i, r, p) in enumerate(found))
-    folds = tuple(fold for fold in (_fold(model, table[i - 1], table[i], counts[i - 1])
+    folds = tuple(fold for fold in (_fold(model, grid.forced(i - 1), grid.forced(i),
+                                          counts[i - 1])
                                     for i in range(1, len(omegas))
                                     if counts[i] != counts[i - 1])
                   if math.isfinite(fold[1]) and fold[1] <= model.radius)
@@ -638,24 +637,37 @@ def _on_curve(model: SSM, rho: np.ndarray, sign: np.ndarray, grid: Grid
 
 @dataclass(frozen=True)
 class Grid:
-    """The forced terms over the grid of Ω, with their Ω, A and B as arrays (the peak's
-    search interpolates them many times)."""
+    """The forced terms over the grid of Ω as arrays: ``A`` and ``B`` (a row per Ω) and the
+    outputs' ``W¹`` of each order ``k`` (``(Ω, k + 1, outputs)``)."""
 
-    table: tuple[Forced, ...]
     omegas: np.ndarray
     A: np.ndarray
     B: np.ndarray
+    X: tuple[np.ndarray, ...]
 
     @classmethod
-    def of(cls, table: list[Forced]) -> Grid:
-        return cls(tuple(table), np.array([f.omega for f in table]),
-                   np.array([f.A for f in table]), np.array([f.B for f in table]))
+    def of(cls, model: SSM, omegas: np.ndarray, rows: np.ndarray, m: int) -> Grid:
+        """The grid of :func:`forced_values`' ``rows`` at ``omegas`` (``m`` outputs)."""
+        K1 = forced_order(model)
+        nA, nB = K1 // 2 + 1, max((K1 - 2) // 2 + 1, 0)
+        X, at = [], nA + nB
+        for k in range(K1 + 1):
+            X.append(rows[:, at:at + (k + 1) * m].reshape(len(rows), k + 1, m))
+            at += (k + 1) * m
+        return cls(np.asarray(omegas, dtype=float), rows[:, :nA], rows[:, nA:nA + nB],
+                   tuple(X))
 
-    def at(self, omega: float) -> Forced:
-        """The forced terms at ``omega`` inside the grid, linearly between its neighbours
-        (the grid is fine: 500 points by default)."""
-        i = int(np.clip(np.searchsorted(self.omegas, omega), 1, len(self.table) - 1))
-        return _between(self.table[i - 1], self.table[i], omega)
+    def forced(self, i: int) -> Forced:
+        """The forced terms at the grid's ``i``-th Ω."""
+        return Forced(float(self.omegas[i]), self.A[i], self.B[i], tuple(X[i] for X in self.X))
+
+    def at(self, omega: np.ndarray) -> tuple[np.ndarray, ...]:
+        """The outputs' ``W¹`` by order at each ``omega`` inside the grid, linearly between
+        its neighbours (the grid is fine: 500 points by default)."""
+        i = np.clip(np.searchsorted(self.omegas, omega), 1, len(self.omegas) - 1)
+        t = (omega - self.omegas[i - 1]) / (self.omegas[i] - self.omegas[i - 1])
+        return tuple((1 - t)[:, None, None] * X[i - 1] + t[:, None, None] * X[i]
+                     for X in self.X)
 
 
 def _amplitudes_on_curve(model: SSM, grid: Grid, outputs: np.ndarray, rho: np.ndarray,
@@ -665,8 +677,7 @@ def _amplitudes_on_curve(model: SSM, grid: Grid, outputs: np.ndarray, rho: np.nd
     om, psi, found = _on_curve(model, rho, sign, grid)
     amp = np.full((len(rho), len(outputs)), -math.inf)
     if found.any():
-        amp[found] = _amplitudes(model, [grid.at(float(o)) for o in om[found]], outputs,
-                                 rho[found], psi[found])
+        amp[found] = _amplitudes(model, grid.at(om[found]), outputs, rho[found], psi[found])
     return om, amp
 
 
@@ -691,12 +702,12 @@ def peaks(model: SSM, outputs: np.ndarray, grid: Grid) -> tuple[Peak | None, ...
     # series, past where it holds, is not the resonance's)
     end = first + held[first:].index(False)
     lo, hi = probe[end - 1], probe[end]
-    for _ in range(FOLD_STEPS + 10):
-        mid = 0.5 * (lo + hi)
-        if _on_curve(model, np.array([mid]), 1.0, grid)[2][0]:
-            lo = mid
-        else:
-            hi = mid
+    split = 2**TOP_HALVINGS
+    for _ in range((FOLD_STEPS + 10) // TOP_HALVINGS):  # 60 halvings, a few at a time
+        inner = lo + (hi - lo) * np.arange(1, split) / split
+        held = _on_curve(model, inner, 1.0, grid)[2]
+        k = int(np.argmin(held)) if not held.all() else split - 1
+        lo, hi = (inner[k - 1] if k else lo), (inner[k] if k < split - 1 else hi)
     top = lo
     ratio = (math.sqrt(5) - 1) / 2
     # one search per (output, branch): output i's on rows i (branch +1) and m + i (−1)
