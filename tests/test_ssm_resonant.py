@@ -257,3 +257,26 @@ def test_drive_near_the_upper_mode_saturates_through_the_coupled_branch():
     end = solve_ivp(full(coupled.omega), (0, T), coupled.start, method="DOP853", rtol=1e-11,
                     atol=1e-13).y[:, -1]
     assert np.max(np.abs(end - coupled.start)) < 5e-3 * np.max(np.abs(coupled.start))
+
+
+def test_coupled_modes_are_periodic_orbits_of_the_full_system():
+    """A coupled mode at s = 0.05 started on the manifold returns to its start after one
+    period 2π/ω of the full system, to an error falling with the order."""
+    system = parse_system(QUADRATIC_1_2, driven=True)
+    w = system.matrices
+
+    def full(t, z):
+        return np.concatenate([z[2:], -(w.stiffness @ z[:2] + w.force(z[:2], z[2:]))])
+
+    gaps = []
+    for order in (3, 7):
+        model = resonant_ssm(system, (1, 2), order)
+        families = coupled_modes(model, np.array([0.05]), np.array([0, 1]))
+        assert [f.psi for f in families] == [0.0, np.pi]
+        for f in families:
+            x, v = model.state(f.rho[0, 0], f.rho[0, 1] * np.exp(1j * f.psi))
+            y0 = np.concatenate([x, v])
+            end = solve_ivp(full, (0, 2 * np.pi / f.omega[0]), y0, method="DOP853",
+                            rtol=1e-12, atol=1e-14).y[:, -1]
+            gaps.append(np.max(np.abs(end - y0)) / np.max(np.abs(y0)))
+    assert max(gaps[2:]) < 2e-9 and min(gaps[:2]) / max(gaps[2:]) > 1e4
