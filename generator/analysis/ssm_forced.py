@@ -65,15 +65,18 @@ ON_CIRCLE = 1e-6
 # NOTE: a common root z of the steady-state equation and its conjugate is a steady state where
 # | |z| − 1 | is below this (the others come in pairs z, 1/z̄ off the circle).
 FOLD_STEPS = 50
-PEAK_STEPS = 32
 FIXED_POINT = 8
 PEAK_BRACKET = 0.05
 PEAK_PROBES = 100
+PEAK_GRID = 17
+PEAK_ZOOMS = 9
 TOP_HALVINGS = 4
-# NOTE: a fold is placed by 50 bisections between two frequencies of the grid; a peak by
-# golden section (0.618³² of the bracket) along the curve in ρ within 5 % below its top, Ω on
-# the curve by 8 fixed-point steps (A and B vary slowly with Ω); the top itself by 60
-# halvings of its bracket, 4 at a time (15 points tried together).
+# NOTE: a fold is placed by 50 bisections between two frequencies of the grid; a peak along
+# the curve in ρ within 5 % below its top by 9 zooms of 17 points each (each keeps the two
+# cells about the best: 8⁻⁹ = 7e-9 of the bracket, golden section's 0.618³⁹, every output's
+# and branch's points tried together), Ω on the curve by 8 fixed-point steps (A and B vary
+# slowly with Ω); the top itself by 60 halvings of its bracket, 4 at a time (15 points tried
+# together).
 
 
 @dataclass(frozen=True)
@@ -683,9 +686,9 @@ def _amplitudes_on_curve(model: SSM, grid: Grid, outputs: np.ndarray, rho: np.nd
 
 def peaks(model: SSM, outputs: np.ndarray, grid: Grid) -> tuple[Peak | None, ...]:
     """Each output's largest amplitude on the forced response over the grid of ``grid``: the
-    curve's top ρ* (the largest ρ with a steady state, by bisection; one for every output),
-    then golden section along both branches within :data:`PEAK_BRACKET` below it, every
-    output's and branch's search a step at a time together; ``None`` where the top lies past
+    curve's top ρ* (the largest ρ with a steady state, by 60 halvings; one for every output),
+    then zooms on both branches within :data:`PEAK_BRACKET` below it (:data:`PEAK_GRID`
+    points a zoom, every output's and branch's at once); ``None`` where the top lies past
     the radius or the grid."""
     m = len(outputs)
     hi = model.radius if math.isfinite(model.radius) else 1e6
@@ -709,35 +712,29 @@ def peaks(model: SSM, outputs: np.ndarray, grid: Grid) -> tuple[Peak | None, ...
         k = int(np.argmin(held)) if not held.all() else split - 1
         lo, hi = (inner[k - 1] if k else lo), (inner[k] if k < split - 1 else hi)
     top = lo
-    ratio = (math.sqrt(5) - 1) / 2
     # one search per (output, branch): output i's on rows i (branch +1) and m + i (−1)
     column = np.tile(np.arange(m), 2)
     sign = np.repeat([1.0, -1.0], m)
     rows = np.arange(2 * m)
-
-    def value(r: np.ndarray) -> np.ndarray:
-        return _amplitudes_on_curve(model, grid, outputs, r, sign)[1][rows, column]
-
+    cells = np.linspace(0.0, 1.0, PEAK_GRID)
     a, b = np.full(2 * m, top * (1 - PEAK_BRACKET)), np.full(2 * m, top)
-    x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
-    f1, f2 = value(x1), value(x2)
-    for _ in range(PEAK_STEPS):
-        left = f1 > f2  # the maximum lies in [a, x2]
-        b = np.where(left, x2, b)
-        a = np.where(left, a, x1)
-        x1, x2 = np.where(left, b - ratio * (b - a), x2), np.where(left, x1, a + ratio * (b - a))
-        f1, f2 = np.where(left, -math.inf, f2), np.where(left, f1, -math.inf)
-        new = np.where(left, x1, x2)
-        fresh = value(new)
-        f1, f2 = np.where(left, fresh, f1), np.where(left, f2, fresh)
+    ends = []
+    for _ in range(PEAK_ZOOMS):
+        x = a[:, None] + (b - a)[:, None] * cells  # (searches, PEAK_GRID)
+        om, amp = _amplitudes_on_curve(model, grid, outputs, x.ravel(),
+                                       np.repeat(sign, PEAK_GRID))
+        value = amp.reshape(2 * m, PEAK_GRID, m)[rows, :, column]
+        j = np.argmax(value, axis=1)
+        ends.append((x[rows, j], om.reshape(2 * m, PEAK_GRID)[rows, j], value[rows, j]))
+        a, b = x[rows, np.maximum(j - 1, 0)], x[rows, np.minimum(j + 1, PEAK_GRID - 1)]
+    om, amp = _amplitudes_on_curve(model, grid, outputs, np.full(2 * m, top), sign)
+    ends.append((np.full(2 * m, top), om, amp[rows, column]))
     best: list[Peak | None] = [None] * m
-    ends = [(x, *_amplitudes_on_curve(model, grid, outputs, x, sign))
-            for x in (x1, x2, np.full(2 * m, top))]
-    for k in rows:  # each output's branch +1 first, then −1, each at x1, x2 and the top
+    for k in rows:  # each output's branch +1 first, then −1
         i = column[k]
-        for x, om, amp in ends:
-            if amp[k, i] > -math.inf and (best[i] is None or amp[k, i] > best[i].amplitude):
-                best[i] = Peak(float(om[k]), float(x[k]), float(amp[k, i]))
+        for x, om, value in ends:
+            if value[k] > -math.inf and (best[i] is None or value[k] > best[i].amplitude):
+                best[i] = Peak(float(om[k]), float(x[k]), float(value[k]))
     return tuple(best)
 
 
