@@ -62,10 +62,10 @@ def sparse_solve(J, rhs: np.ndarray, refine: int = 0) -> np.ndarray:
     of iterative refinement (the residual's correction by the same factors: a stiff
     structure's L(s), conditioned like 1e12, loses digits to the factorization otherwise); a
     singular ``J`` raises ``LinAlgError``."""
-    from scipy.sparse.linalg import splu
-
     if isinstance(J, np.ndarray):
         return np.linalg.solve(J, rhs)
+    from scipy.sparse.linalg import splu  # here: a dense J needs no SciPy (start-up)
+
     J = J.tocsc()
     try:
         lu = splu(J)
