@@ -504,10 +504,11 @@ def _stable(model: SSM, omegas: np.ndarray, A: np.ndarray, B: np.ndarray, rho: n
 
 
 def _amplitudes(model: SSM, X: tuple[np.ndarray, ...], outputs: np.ndarray, rho: np.ndarray,
-                psi: np.ndarray) -> np.ndarray:
+                psi: np.ndarray, column: np.ndarray | None = None) -> np.ndarray:
     """Each output's max |x_i| over a period of the steady states (ρ, ψ), each with its own
     forced terms (``X[k]``: the outputs' ``W¹`` of order ``k``, ``(states, k + 1, outputs)``):
-    the autonomous SSM at ρ with phase ψ and ``W¹`` (``(states, outputs)``)."""
+    the autonomous SSM at ρ with phase ψ and ``W¹`` (``(states, outputs)``; given ``column``,
+    only that output's at each state, ``(states, 1)``)."""
     rho, psi = np.atleast_1d(rho), np.atleast_1d(psi)
     c = model.harmonics(rho, outputs, psi)
     K, K1 = model.order, len(X) - 1
@@ -517,6 +518,8 @@ def _amplitudes(model: SSM, X: tuple[np.ndarray, ...], outputs: np.ndarray, rho:
         term = (rho[:, None] ** k * turns[:, n + K1])[:, :, None] * Xk
         c[:, K + n + 1] += term  # distinct harmonics within an order
         c[:, K - n - 1] += np.conj(term)
+    if column is not None:
+        c = c[np.arange(len(rho)), :, column][:, :, None]
     return peak_amplitude(c)
 
 
@@ -674,13 +677,14 @@ class Grid:
 
 
 def _amplitudes_on_curve(model: SSM, grid: Grid, outputs: np.ndarray, rho: np.ndarray,
-                         sign: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(Ω, max |x_i|)`` on the curve at each ρ of its branch ``sign`` (``(P,)`` and
-    ``(P, outputs)``; −∞ where not found)."""
+                         sign: np.ndarray, column: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(Ω, max |x_column|)`` on the curve at each ρ of its branch ``sign``, each point its
+    output ``column`` (−∞ where not found)."""
     om, psi, found = _on_curve(model, rho, sign, grid)
-    amp = np.full((len(rho), len(outputs)), -math.inf)
+    amp = np.full(len(rho), -math.inf)
     if found.any():
-        amp[found] = _amplitudes(model, grid.at(om[found]), outputs, rho[found], psi[found])
+        amp[found] = _amplitudes(model, grid.at(om[found]), outputs, rho[found], psi[found],
+                                 column[found])[:, 0]
     return om, amp
 
 
@@ -721,14 +725,15 @@ def peaks(model: SSM, outputs: np.ndarray, grid: Grid) -> tuple[Peak | None, ...
     ends = []
     for _ in range(PEAK_ZOOMS):
         x = a[:, None] + (b - a)[:, None] * cells  # (searches, PEAK_GRID)
-        om, amp = _amplitudes_on_curve(model, grid, outputs, x.ravel(),
-                                       np.repeat(sign, PEAK_GRID))
-        value = amp.reshape(2 * m, PEAK_GRID, m)[rows, :, column]
+        om, value = _amplitudes_on_curve(model, grid, outputs, x.ravel(),
+                                         np.repeat(sign, PEAK_GRID),
+                                         np.repeat(column, PEAK_GRID))
+        value = value.reshape(2 * m, PEAK_GRID)
         j = np.argmax(value, axis=1)
         ends.append((x[rows, j], om.reshape(2 * m, PEAK_GRID)[rows, j], value[rows, j]))
         a, b = x[rows, np.maximum(j - 1, 0)], x[rows, np.minimum(j + 1, PEAK_GRID - 1)]
-    om, amp = _amplitudes_on_curve(model, grid, outputs, np.full(2 * m, top), sign)
-    ends.append((np.full(2 * m, top), om, amp[rows, column]))
+    ends.append((np.full(2 * m, top),
+                 *_amplitudes_on_curve(model, grid, outputs, np.full(2 * m, top), sign, column)))
     best: list[Peak | None] = [None] * m
     for k in rows:  # each output's branch +1 first, then −1
         i = column[k]
