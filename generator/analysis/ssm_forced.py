@@ -98,8 +98,9 @@ def forced_order(model: SSM) -> int:
 
 BATCH_VALUES = 1 << 22
 # NOTE: the forced terms of several Ω are computed together (one recursion, every product
-# and dense solve batched over Ω) while their states hold at most this many complex numbers
-# (64 MB); a large model's Ω go a few at a time.
+# and dense solve batched over Ω) while what the recursion keeps of them — the states and
+# every cached product of the force's chains, order by order — holds at most this many
+# complex numbers (64 MB): a large model's Ω go one at a time, as its memory was.
 
 
 def forced_values(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> np.ndarray:
@@ -112,12 +113,23 @@ def forced_values(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> np.nda
         raise InputError("the system is not driven: no forced response (drive one equation "
                          "with f*cos(w*t), or give drive.txt)")
     omegas = np.asarray(omegas, dtype=float)
-    K1 = forced_order(model)
-    per = 4 * w.size * (K1 + 1) * (K1 + 2) // 2
-    size = max(1, BATCH_VALUES // per)
+    size = max(1, BATCH_VALUES // _kept(model))
     parts = [_forced_batch(model, omegas[at:at + size], outputs)
              for at in range(0, len(omegas), size)]
     return np.concatenate(parts) if parts else np.zeros((0, 0), dtype=complex)
+
+
+def _kept(model: SSM) -> int:
+    """The complex numbers the recursion of :func:`_forced_batch` keeps per Ω: ``W¹``,
+    ``V¹`` and their states (``4n`` a monomial) and each chain's products (a term of degree
+    ``d`` has ``d`` chains of ``d − 1`` products, a column each), over every order's
+    monomials; a dense solve's matrix."""
+    w = model.matrices
+    K1 = forced_order(model)
+    degrees = (w.force.factors >= 0).sum(axis=1)
+    columns = int(np.sum(degrees * (degrees - 1)))
+    dense = w.size * w.size if w.size <= DENSE_SOLVES else 0
+    return (K1 + 1) * (K1 + 2) // 2 * (4 * w.size + columns) + dense
 
 
 class _BatchedProduct(LazySeries):
