@@ -18,7 +18,6 @@ mine`` precedes the Python that imports from ``mine``), each section as its own 
 
 from __future__ import annotations
 
-import os
 import re
 import shlex
 import subprocess
@@ -27,10 +26,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from commands import cached_env, run
 
 ROOT = Path(__file__).resolve().parent.parent
 README = ROOT / "README.md"
-LINDSTEDT = Path(sys.executable).parent / "lindstedt"
 CUT = "…"
 TIMEOUT = 120
 # NOTE: generous, so a loaded machine does not fail an example; each takes seconds.
@@ -134,13 +133,14 @@ def _expected(shown: str) -> str:
 
 
 def _run(step: Step, cwd: Path) -> subprocess.CompletedProcess:
-    if step.kind == "python":
-        argv = [sys.executable, "-c", step.text]
-    else:
-        argv = [str(LINDSTEDT), *shlex.split(step.text)[1:]]
-    env = {**os.environ, "MPLBACKEND": "Agg"}
-    return subprocess.run(argv, cwd=cwd, capture_output=True, text=True, timeout=TIMEOUT,
-                          env=env, check=False)
+    """A command in this process (tests/commands.py: the same parse, checks, output and exit
+    status as the ``lindstedt`` script, without its second of imports); a Python block in a
+    fresh interpreter, as a reader runs it, sharing the suite's numba cache."""
+    if step.kind == "command":
+        return run(*shlex.split(step.text)[1:], cwd=cwd)
+    env = {**cached_env(), "MPLBACKEND": "Agg"}
+    return subprocess.run([sys.executable, "-c", step.text], cwd=cwd, capture_output=True,
+                          text=True, timeout=TIMEOUT, env=env, check=False)
 
 
 def test_readme_has_examples():
