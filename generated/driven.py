@@ -2,7 +2,7 @@
 # model: driven, order: 3
 # command: lindstedt generate driven --order 3
 # inputs sha256: cef33ff01dffb2211c3af2d37365f7b8bff5e57c04ba6b53bf77b6cbbf023e34
-# body sha256: 0785a633feb4ec97635b827485f47d974d2199aff1acaa009c4adfb8580cd3ec
+# body sha256: 1634ed02912dd643cc4503c91f12b99328b8cdf640ec02ec3469478a8d370ffe
 """Driven Duffing q'' + q + eps*q**3 = f cos(omega t): μ-expansion to order 3.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -103,6 +103,12 @@ def _arg(v, out, where, name):
             return np.ascontiguousarray(v, dtype=_FLOAT64)
     raise ValueError(f"{where}: {name} must be a real number or a 1-D array of out's length "
                      f"{out.size}, got shape {v.shape}")
+
+
+def _spread(v, out):
+    """A number spread over ``out``'s length, an array as it is: each loop is then compiled
+    once, for arrays alone, whichever of its arguments are numbers."""
+    return np.full(out.size, v) if type(v) is float else v
 
 
 def _masked(out, *args):
@@ -279,7 +285,7 @@ def A_1_into(out, omega, eps, force, branch):
         # whose arguments are all scalars.
         out.fill(A_1(omega, eps, force, branch))
     else:
-        _A_1_into(out, omega, eps, force, branch)
+        _A_1_into(out, _spread(omega, out), _spread(eps, out), _spread(force, out), _spread(branch, out))
     if masked is not None:
         out[masked] = math.nan
     return out
@@ -386,7 +392,7 @@ def A_3_into(out, omega, eps, force, branch):
         # whose arguments are all scalars.
         out.fill(A_3(omega, eps, force, branch))
     else:
-        _A_3_into(out, omega, eps, force, branch)
+        _A_3_into(out, _spread(omega, out), _spread(eps, out), _spread(force, out), _spread(branch, out))
     if masked is not None:
         out[masked] = math.nan
     return out
@@ -471,7 +477,7 @@ def A_5_into(out, omega, eps, force, branch):
         # whose arguments are all scalars.
         out.fill(A_5(omega, eps, force, branch))
     else:
-        _A_5_into(out, omega, eps, force, branch)
+        _A_5_into(out, _spread(omega, out), _spread(eps, out), _spread(force, out), _spread(branch, out))
     if masked is not None:
         out[masked] = math.nan
     return out
@@ -546,7 +552,7 @@ def A_7_into(out, omega, eps, force, branch):
         # whose arguments are all scalars.
         out.fill(A_7(omega, eps, force, branch))
     else:
-        _A_7_into(out, omega, eps, force, branch)
+        _A_7_into(out, _spread(omega, out), _spread(eps, out), _spread(force, out), _spread(branch, out))
     if masked is not None:
         out[masked] = math.nan
     return out
@@ -619,7 +625,7 @@ def first_order_into(out, omega, eps, force, branch):
         # whose arguments are all scalars.
         out.fill(first_order(omega, eps, force, branch))
     else:
-        _first_order_into(out, omega, eps, force, branch)
+        _first_order_into(out, _spread(omega, out), _spread(eps, out), _spread(force, out), _spread(branch, out))
     if masked is not None:
         out[masked] = math.nan
     return out

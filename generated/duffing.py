@@ -2,7 +2,7 @@
 # model: duffing, order: 12
 # command: lindstedt generate duffing --order 12
 # inputs sha256: 66ca4a0e4d6afa8046c93839a6f1efa563f457106a4ae4f18222a37b87ca56f2
-# body sha256: 7f739f60f69ac47ac0d23474ae3e9e4e71b484c7cee58d5d8601c601bc2bac13
+# body sha256: e2c574628ce67669db3d45ae9b29812e1beda20adb304da983ca6367dae10c1a
 """q'' + q + eps*q**3 = 0: L–P evaluators to order 12 in y = eps*A**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -193,6 +193,12 @@ def _arg(v, out, where, name):
                      f"{out.size}, got shape {v.shape}")
 
 
+def _spread(v, out):
+    """A number spread over ``out``'s length, an array as it is: each loop is then compiled
+    once, for arrays alone, whichever of its arguments are numbers."""
+    return np.full(out.size, v) if type(v) is float else v
+
+
 def _masked(out, *args):
     """Where any argument that is a masked array is masked (a bool array of ``out``'s shape),
     or None: a masked element has no value, so ``out`` is NaN there, as NumPy's ``filled``
@@ -308,7 +314,7 @@ def omega_into(out, A, eps):
         # whose arguments are all scalars.
         out.fill(omega(A, eps))
     else:
-        _omega_into(out, A, eps)
+        _omega_into(out, _spread(A, out), _spread(eps, out))
     if masked is not None:
         out[masked] = math.nan
     return out
@@ -368,7 +374,7 @@ def period_into(out, A, eps):
         # whose arguments are all scalars.
         out.fill(period(A, eps))
     else:
-        _period_into(out, A, eps)
+        _period_into(out, _spread(A, out), _spread(eps, out))
     if masked is not None:
         out[masked] = math.nan
     return out
@@ -470,7 +476,7 @@ def q_into(out, t, A, eps):
         # whose arguments are all scalars.
         out.fill(q(t, A, eps))
     else:
-        _q_into(out, t, A, eps)
+        _q_into(out, _spread(t, out), _spread(A, out), _spread(eps, out))
     if masked is not None:
         out[masked] = math.nan
     return out
@@ -598,7 +604,7 @@ def qdot_into(out, t, A, eps):
         # whose arguments are all scalars.
         out.fill(qdot(t, A, eps))
     else:
-        _qdot_into(out, t, A, eps)
+        _qdot_into(out, _spread(t, out), _spread(A, out), _spread(eps, out))
     if masked is not None:
         out[masked] = math.nan
     return out
@@ -660,7 +666,7 @@ def error_estimate_into(out, A, eps):
         # whose arguments are all scalars.
         out.fill(error_estimate(A, eps))
     else:
-        _error_estimate_into(out, A, eps)
+        _error_estimate_into(out, _spread(A, out), _spread(eps, out))
     if masked is not None:
         out[masked] = math.nan
     return out

@@ -2,7 +2,7 @@
 # model: pendulum, order: 12
 # command: lindstedt generate pendulum --order 12
 # inputs sha256: 89790c3fd0e75fcdff47f37c71d07dae7a9aef7a774488dd064ce33f5d86074d
-# body sha256: e7286097522082c39004ccff2d2a6e6a86eb59cf1322f26d0489d933cdd4e8f9
+# body sha256: 753cd5068b0d7f4123ff6c3c76728ba76357d1c5d62d8d574dfc454db676db97
 """theta'' + sin(theta) = 0: L–P evaluators to order 12 in y = theta0**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -193,6 +193,12 @@ def _arg(v, out, where, name):
                      f"{out.size}, got shape {v.shape}")
 
 
+def _spread(v, out):
+    """A number spread over ``out``'s length, an array as it is: each loop is then compiled
+    once, for arrays alone, whichever of its arguments are numbers."""
+    return np.full(out.size, v) if type(v) is float else v
+
+
 def _masked(out, *args):
     """Where any argument that is a masked array is masked (a bool array of ``out``'s shape),
     or None: a masked element has no value, so ``out`` is NaN there, as NumPy's ``filled``
@@ -297,7 +303,7 @@ def omega_into(out, theta0):
         # whose arguments are all scalars.
         out.fill(omega(theta0))
     else:
-        _omega_into(out, theta0)
+        _omega_into(out, _spread(theta0, out))
     if masked is not None:
         out[masked] = math.nan
     return out
@@ -346,7 +352,7 @@ def period_into(out, theta0):
         # whose arguments are all scalars.
         out.fill(period(theta0))
     else:
-        _period_into(out, theta0)
+        _period_into(out, _spread(theta0, out))
     if masked is not None:
         out[masked] = math.nan
     return out
@@ -437,7 +443,7 @@ def theta_into(out, t, theta0):
         # whose arguments are all scalars.
         out.fill(theta(t, theta0))
     else:
-        _theta_into(out, t, theta0)
+        _theta_into(out, _spread(t, out), _spread(theta0, out))
     if masked is not None:
         out[masked] = math.nan
     return out
@@ -554,7 +560,7 @@ def thetadot_into(out, t, theta0):
         # whose arguments are all scalars.
         out.fill(thetadot(t, theta0))
     else:
-        _thetadot_into(out, t, theta0)
+        _thetadot_into(out, _spread(t, out), _spread(theta0, out))
     if masked is not None:
         out[masked] = math.nan
     return out
@@ -605,7 +611,7 @@ def error_estimate_into(out, theta0):
         # whose arguments are all scalars.
         out.fill(error_estimate(theta0))
     else:
-        _error_estimate_into(out, theta0)
+        _error_estimate_into(out, _spread(theta0, out))
     if masked is not None:
         out[masked] = math.nan
     return out
