@@ -41,14 +41,15 @@ demo: $(STAMP) tex
 	$(BIN)/lindstedt demo --out out
 
 # The suite's three layers (tests/conftest.py): the exact identities first and alone, then the
-# printers and the emitted modules; each on every core.
+# printers and the emitted modules; each on every core, an idle worker taking the other's queued
+# tests (--dist worksteal: the long ones otherwise end on one worker while the other waits).
 test: $(STAMP) tex
 	$(BIN)/ruff check generator tests benchmarks
-	$(BIN)/python -m pytest -n auto -m exact
-	$(BIN)/python -m pytest -n auto -m "printers or emitted"
+	$(BIN)/python -m pytest -n auto --dist worksteal -m exact
+	$(BIN)/python -m pytest -n auto --dist worksteal -m "printers or emitted"
 
 test-fast: $(STAMP)
-	$(BIN)/python -m pytest -n auto -m exact
+	$(BIN)/python -m pytest -n auto --dist worksteal -m exact
 
 lint: $(STAMP)
 	$(BIN)/ruff check generator tests benchmarks

@@ -36,8 +36,9 @@ def run_layer(marker: str, report: Path, extra: list[str]) -> tuple[float, float
     """One layer as ``make test`` runs it: its wall time, its CPU time and pytest's exit
     code."""
     start, cpu = time.perf_counter(), _children_cpu()
-    done = subprocess.run([sys.executable, "-m", "pytest", "-n", "auto", "-m", marker, "-q",
-                           f"--junitxml={report}", *extra], cwd=ROOT, check=False)
+    done = subprocess.run([sys.executable, "-m", "pytest", "-n", "auto", "--dist", "worksteal",
+                           "-m", marker, "-q", f"--junitxml={report}", *extra], cwd=ROOT,
+                          check=False)
     return time.perf_counter() - start, _children_cpu() - cpu, done.returncode
 
 
