@@ -7,6 +7,8 @@ line would print as a traceback propagates and fails the test outright.
 
 ``run_fresh`` starts ``python -m lindstedt`` in a new process: for what only a process shows
 (the modules a command imports, signals, what an emitted module does on its first import).
+``run_forked`` runs it in a process forked from a server that has already imported what a
+command imports: a process of its own (a crash, a hang, its memory) without the imports.
 
 ``EmittedCache`` keeps numba's compiled code of an emitted module by the module's text, not by
 its folder: the same text written to two temporary folders (by two tests, by ``choose`` while
@@ -50,6 +52,74 @@ def run(*args: str, cwd=None) -> subprocess.CompletedProcess:
             status = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
     return subprocess.CompletedProcess([sys.executable, "-m", "lindstedt", *args], status,
                                        out.getvalue(), err.getvalue())
+
+
+PRELOAD = ("lindstedt.cli", "sympy", "scipy.optimize", "scipy.integrate", "scipy.sparse.linalg",
+           "numba", "matplotlib.pyplot")
+# NOTE: what a command's process imports before it computes (a second or more of CPU each
+# time): the fork server imports it once, and each forked run starts with it in memory.
+_SERVER: dict = {}
+
+
+def _forked(args: list[str], cwd: str, out: str, err: str) -> None:
+    """The child of :func:`run_forked`: ``lindstedt *args`` in ``cwd``, as the script runs
+    it, its stdout and stderr into the files ``out`` and ``err``."""
+    for fd, path in ((1, out), (2, err)):
+        f = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
+        os.dup2(f, fd)
+        os.close(f)
+    sys.stdout = open(1, "w", encoding="utf-8", closefd=False)  # noqa: SIM115
+    sys.stderr = open(2, "w", encoding="utf-8", buffering=1, closefd=False)  # noqa: SIM115
+    os.chdir(cwd)
+    sys.argv = ["lindstedt", *args]
+    from lindstedt.cli import run as script
+
+    script()
+
+
+def run_forked(*args: str, cwd=None, timeout: float = 600.0, env: dict[str, str] | None = None,
+               check: bool = False) -> subprocess.CompletedProcess:
+    """``lindstedt *args`` in a process of its own, forked from a server that has imported
+    what commands import (:data:`PRELOAD`): a fresh process for the command — its own memory,
+    folder, exit status, a crash or a hang its own — without a fresh process's imports.  The
+    server starts at the first call with this process's environment and ``env`` (the same
+    ``env`` at every call: it is the server's).  ``subprocess.TimeoutExpired`` past
+    ``timeout`` seconds (the run killed); ``subprocess.CalledProcessError`` for a non-zero
+    status with ``check``."""
+    import multiprocessing
+    import tempfile
+
+    if "context" not in _SERVER:
+        context = multiprocessing.get_context("forkserver")
+        context.set_forkserver_preload(list(PRELOAD))
+        saved = dict(os.environ)
+        os.environ.update({**cached_env(), **(env or {})})
+        try:
+            from multiprocessing import forkserver
+
+            forkserver.ensure_running()
+        finally:
+            os.environ.clear()
+            os.environ.update(saved)
+        _SERVER["context"] = context
+    with tempfile.TemporaryDirectory(prefix="lindstedt-forked-") as tmp:
+        out, err = os.path.join(tmp, "stdout"), os.path.join(tmp, "stderr")
+        child = _SERVER["context"].Process(target=_forked, args=([str(a) for a in args],
+                                                                 str(cwd or os.getcwd()), out,
+                                                                 err))
+        child.start()
+        child.join(timeout)
+        if child.exitcode is None:
+            child.kill()
+            child.join()
+            raise subprocess.TimeoutExpired(["lindstedt", *args], timeout)
+        stdout, stderr = (Path(f).read_text(encoding="utf-8", errors="replace")
+                          if os.path.exists(f) else "" for f in (out, err))
+    status = child.exitcode if child.exitcode >= 0 else 128 - child.exitcode
+    argv = [sys.executable, "-m", "lindstedt", *map(str, args)]
+    if check and status:
+        raise subprocess.CalledProcessError(status, argv, stdout, stderr)
+    return subprocess.CompletedProcess(argv, status, stdout, stderr)
 
 
 def run_fresh(*args: str, cwd=None) -> subprocess.CompletedProcess:

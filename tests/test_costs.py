@@ -9,16 +9,14 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from commands import run_forked
 
 
 def run(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
-                          text=True, check=False, cwd=cwd)
+    return run_forked(*args, check=False, cwd=cwd)
 
 
 def commands() -> dict[str, argparse.ArgumentParser]:

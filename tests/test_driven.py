@@ -11,6 +11,7 @@ import sys
 import numpy as np
 import pytest
 import sympy as sp
+from commands import run_forked
 from lindstedt.analysis.driven import (
     Drive,
     amplitudes,
@@ -144,10 +145,8 @@ def test_bad_drive(kwargs):
 
 
 def test_driven_contract():
-    out = subprocess.run(
-        [sys.executable, "-m", "lindstedt", "driven", "--eps", "0.1", "--force", "0.3",
-         "--omega", "1.3", "--Q", "20", "--order", "3", "--harmonics", "5", "--json"],
-        capture_output=True, text=True, check=False)
+    out = run_forked("driven", "--eps", "0.1", "--force", "0.3", "--omega", "1.3", "--Q", "20",
+                     "--order", "3", "--harmonics", "5", "--json", check=False)
     assert out.returncode == 0, out.stderr
     data = json.loads(out.stdout)
     assert {"parameters", "branches"} <= data.keys()
@@ -160,9 +159,8 @@ def test_driven_contract():
         num = br["numerical"]
         assert set(num) >= {"A", "floquet_moduli", "stable"}
         assert abs(num["A"]["1"] - br["harmonic_balance"]["A"]["1"]) < 1e-9
-    bad = subprocess.run([sys.executable, "-m", "lindstedt", "driven", "--eps", "0.1",
-                          "--force", "1", "--omega", "1", "--Q", "0"],
-                         capture_output=True, text=True, check=False)
+    bad = run_forked("driven", "--eps", "0.1", "--force", "1", "--omega", "1", "--Q", "0",
+                     check=False)
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
 
 

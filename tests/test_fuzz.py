@@ -1,5 +1,6 @@
 """Fuzz the command line: every subcommand, its arguments drawn from edge values (0, negative,
-huge, tiny, nan, inf, strings) and valid ones, each run as a subprocess in an empty folder.
+huge, tiny, nan, inf, strings) and valid ones, each run in a process of its own in an empty
+folder.
 
 Every run must end with exit status 0 or 2 within ``TIMEOUT``, never print a traceback, and a
 refusal (exit 2) must be one line on stderr, nothing on stdout, nothing written — not even its
@@ -27,12 +28,14 @@ from datetime import timedelta
 from pathlib import Path
 
 import pytest
+from commands import run_forked
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 TIMEOUT = 40.0
 # NOTE: the slowest valid run the strategies allow (a response with a figure) takes ~15 s here.
-ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+THREADS = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+ENV = {**os.environ, **THREADS}
 # NOTE: one BLAS thread: on a loaded 2-core machine OpenBLAS threads on small dense solves make
 # the same run 3–7× slower, which would turn time bounds into noise.
 LOG = os.environ.get("LINDSTEDT_FUZZ_LOG")
@@ -42,7 +45,12 @@ PAIR = 2
 
 
 def run(argv: list[str], cwd: Path, timeout: float = TIMEOUT) -> subprocess.CompletedProcess:
+    """``lindstedt *argv`` in a process of its own (forked from a server that has imported
+    what commands import: tests/commands.py; a sweep, whose cluster's workers are
+    processes of its own, in a fresh interpreter)."""
     try:
+        if argv[0] != "sweep":
+            return run_forked(*argv, cwd=cwd, timeout=timeout, env=THREADS)
         return subprocess.run([sys.executable, "-m", "lindstedt", *argv], cwd=cwd, env=ENV,
                               capture_output=True, text=True, timeout=timeout, check=False)
     except subprocess.TimeoutExpired:

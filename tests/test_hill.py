@@ -4,12 +4,11 @@ and at any order against the eigenvalues of the truncated Hill matrix (mpmath, 4
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from fractions import Fraction as F
 
 import mpmath as mp
 import pytest
+from commands import run_forked
 from lindstedt.cli import main
 from lindstedt.derive.hill import mathieu_series
 from lindstedt.errors import InputError
@@ -91,8 +90,7 @@ def test_the_contract_and_bad_input(capsys):
         mathieu_series("b", 0, 4)
     for args in (["mathieu", "b", "--m", "0"], ["mathieu", "c"], ["mathieu", "a", "--m", "x"],
                  ["mathieu", "a", "--order", "-1"]):
-        done = subprocess.run([sys.executable, "-m", "lindstedt", *args], capture_output=True,
-                              text=True, check=False)
+        done = run_forked(*args, check=False)
         assert done.returncode == 2 and done.stdout == "", args
         assert done.stderr.count("\n") == 1 and done.stderr.startswith("lindstedt: error:")
 

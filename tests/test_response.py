@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from commands import run_forked
 from lindstedt.analysis.driven import Drive, amplitude_residual, amplitude_slope
 from lindstedt.analysis.response import OneHarmonic, first_harmonic, one_harmonic_curve
 from lindstedt.analysis.systems import continue_balance
@@ -197,9 +196,8 @@ def test_sweep_jumps_near_the_folds():
 
 
 def test_response_contract_and_bad_input():
-    out = subprocess.run([sys.executable, "-m", "lindstedt", "response", "--eps", "0.1",
-                          "--force", "0.3", "--Q", "20", "--harmonics", "4", "--json"],
-                         capture_output=True, text=True, check=False)
+    out = run_forked("response", "--eps", "0.1", "--force", "0.3", "--Q", "20", "--harmonics", "4",
+                     "--json", check=False)
     assert out.returncode == 0, out.stderr
     data = json.loads(out.stdout)
     assert data["one_harmonic"]["folds"] == sorted(data["one_harmonic"]["folds"])
@@ -207,9 +205,7 @@ def test_response_contract_and_bad_input():
     assert len(data["numerical"]["folds"]) == 2
     assert {"sweep_up_jump", "sweep_down_jump"} <= data["numerical"].keys()
     for bad in (["--Q", "inf"], ["--Q", "0"], ["--Q", "nan"]):
-        run = subprocess.run([sys.executable, "-m", "lindstedt", "response", "--eps", "0.1",
-                              "--force", "0.3", *bad], capture_output=True, text=True,
-                             check=False)
+        run = run_forked("response", "--eps", "0.1", "--force", "0.3", *bad, check=False)
         assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1
 
 
@@ -320,9 +316,8 @@ def test_hill_verdict_fails_for_the_negative_root_at_small_eps(monkeypatch):
 
 
 def test_subharmonic_does_not_exist_and_says_why():
-    out = subprocess.run([sys.executable, "-m", "lindstedt", "subharmonic", "--eps", "0.1",
-                          "--force", "0.5", "--omega", "0.9", "--json"],
-                         capture_output=True, text=True, check=False)
+    out = run_forked("subharmonic", "--eps", "0.1", "--force", "0.5", "--omega", "0.9", "--json",
+                     check=False)
     data = json.loads(out.stdout)
     assert data["exists"] is False and data["solutions"] == [] and "21 F^2" in data["reason"]
 
@@ -341,9 +336,8 @@ def test_cubic_mixing_makes_three_fold_combinations_not_sums():
 
 
 def test_mixing_amplitudes_against_simulated_spectrum():
-    out = subprocess.run([sys.executable, "-m", "lindstedt", "mixing", "--eps", "0.1", "--Q",
-                          "10", "--drive", "0.3@1.3", "--drive", "0.3@1.7", "--json"],
-                         capture_output=True, text=True, check=False)
+    out = run_forked("mixing", "--eps", "0.1", "--Q", "10", "--drive", "0.3@1.3", "--drive",
+                     "0.3@1.7", "--json", check=False)
     assert out.returncode == 0, out.stderr
     tones = json.loads(out.stdout)["tones"]
     assert {"frequency", "combination", "predicted", "simulated"} <= tones[0].keys()

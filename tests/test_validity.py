@@ -8,6 +8,7 @@ import subprocess
 import sys
 
 import numpy as np
+from commands import run_forked
 from scipy.integrate import solve_ivp
 
 
@@ -31,8 +32,7 @@ def reference_tones(eps, Q, drives, frequencies, window=2000.0):
 
 
 def mixing(*args):
-    out = subprocess.run([sys.executable, "-m", "lindstedt", "mixing", *args],
-                         capture_output=True, text=True, check=True)
+    out = run_forked("mixing", *args, check=True)
     return out.stdout
 
 
@@ -76,9 +76,8 @@ def test_sweep_jumps_are_where_the_amplitude_crosses_past_the_fold():
     down the small branch stays stable until it, so the jump lies below it, where the simulated
     amplitude crosses between the branches (≈ 1.1603), not at the start of the detecting window
     (1.16971 before: above the fold). Sweeping up, the jump lies above the upper fold."""
-    data = json.loads(subprocess.run(
-        [sys.executable, "-m", "lindstedt", "response", "--eps", "0.1", "--force", "0.3", "--Q",
-         "30", "--json"], capture_output=True, text=True, check=True).stdout)
+    data = json.loads(run_forked("response", "--eps", "0.1", "--force", "0.3", "--Q", "30",
+                                 "--json", check=True).stdout)
     num = data["numerical"]
     lower, upper = num["folds"]
     assert abs(lower - 1.16379) < 1e-5
@@ -95,9 +94,8 @@ def test_a_softening_spring_over_its_barrier_escapes_and_is_reported_so():
     0.8016" with amplitudes of 1e214). Reported as an escape, never as a jump."""
     from lindstedt.numerics.integrate import sweep
 
-    data = json.loads(subprocess.run(
-        [sys.executable, "-m", "lindstedt", "response", "--eps", "-0.1", "--force", "0.3",
-         "--Q", "20", "--json"], capture_output=True, text=True, check=True).stdout)
+    data = json.loads(run_forked("response", "--eps", "-0.1", "--force", "0.3", "--Q", "20",
+                                 "--json", check=True).stdout)
     num = data["numerical"]
     assert num["sweep_up_jump"] is None and 0.7 < num["sweep_up_escape"] < 0.9
     run = sweep(-0.1, 0.3, 0.05, 0.5, 1.5)
@@ -105,9 +103,7 @@ def test_a_softening_spring_over_its_barrier_escapes_and_is_reported_so():
     assert np.all(np.isfinite(before)) and np.nanmax(before) <= 1 / np.sqrt(0.1)
     assert np.all(np.isnan(run.amplitude[run.omega > run.escape + 1e-3]))
     assert sweep(0.1, 0.3, 0.05, 0.5, 1.9).escape is None  # a hardening spring never escapes
-    text = subprocess.run([sys.executable, "-m", "lindstedt", "response", "--eps", "-0.1",
-                           "--force", "0.3", "--Q", "20"], capture_output=True, text=True,
-                          check=True).stdout
+    text = run_forked("response", "--eps", "-0.1", "--force", "0.3", "--Q", "20", check=True).stdout
     assert "escapes the well" in text and "jumps" not in text
 
 
@@ -138,9 +134,8 @@ def test_the_unstable_subharmonic_near_its_existence_boundary_is_found():
             for e in np.eye(2)]
     trace = cols[0][0] + cols[1][1]
     assert trace > 2  # unstable (a real pair λ, 1/λ)
-    data = json.loads(subprocess.run(
-        [sys.executable, "-m", "lindstedt", "subharmonic", "--eps", "0.1", "--force", "7.8",
-         "--omega", "1.05", "--json"], capture_output=True, text=True, check=True).stdout)
+    data = json.loads(run_forked("subharmonic", "--eps", "0.1", "--force", "7.8", "--omega", "1.05",
+                                 "--json", check=True).stdout)
     minus = next(s for s in data["solutions"] if s["root"] == "-")
     plus = next(s for s in data["solutions"] if s["root"] == "+")
     assert minus["numerical"] is not None, "the unstable orbit is missed"
