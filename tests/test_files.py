@@ -257,12 +257,23 @@ def test_any_command_text_stays_data(command):
                                                              command=command)))
 
 
+UNCOMPILED = """
+import numba, numba.extending
+def _later(*args, **kwargs):
+    return args[0] if len(args) == 1 and callable(args[0]) and not kwargs else lambda f: f
+numba.njit = numba.vectorize = numba.extending.overload = _later
+"""
+# NOTE: numba's decorators leave each function as written: every statement of the module runs
+# on import as it would, but nothing is compiled (the command reaches only comments and
+# docstrings, which compiling never reads; seven compilations of the module took ~30 s).
+
+
 @pytest.mark.parametrize("command", HOSTILE)
 def test_hostile_command_runs_nothing_on_import(tmp_path, command):
     emit.write_files(tmp_path, {"duffing.py": _check_text(command)})
-    probe = subprocess.run([sys.executable, "-c", "import duffing; print(duffing.ORDER)"],
-                           cwd=tmp_path, capture_output=True, text=True, timeout=300,
-                           check=False)
+    code = f"{UNCOMPILED}import duffing; print(duffing.ORDER)"
+    probe = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                           text=True, timeout=300, check=False)
     assert probe.returncode == 0, probe.stderr
     assert probe.stdout.strip() == str(SOLUTION.order - 2)  # generate derives K + 2 orders
     assert not (tmp_path / "PWNED").exists()
