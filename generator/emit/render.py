@@ -628,21 +628,21 @@ def render_ssm_module(r: ReducedModule) -> str:
         radius=pyliteral(float(r.radius)), gamma=", ".join(_complex(g) for g in r.gamma),
         shape=_flat([z for order in r.shape for row in order for z in row]),
         driven=driven, span=tuple(pyliteral(float(x)) for x in r.span or (0.0, 0.0)),
-        nodes=_rows([[pyliteral(float(x)) for x in r.nodes[i:i + 4]]
+        nodes=_list_lines([[pyliteral(float(x)) for x in r.nodes[i:i + 4]]
                      for i in range(0, len(r.nodes), 4)]),
         forcing=_flat([z for row in r.forcing for z in row]) if r.forcing else "[]",
         nodes_count=len(r.nodes), width=_forcing_width(r),
         interpolation_error=pyliteral(float(r.interpolation_error)),
         interpolated=pyliteral(float(r.tolerance)),
         unverified=repr(tuple((float(p[0]), float(p[1])) for p in r.pieces if not p[5])),
-        pieces=_rows([[pyliteral(float(x)) for x in (p[0], p[1], p[2], p[3], float(p[5]))]
+        pieces=_list_lines([[pyliteral(float(x)) for x in (p[0], p[1], p[2], p[3], float(p[5]))]
                       for p in r.pieces]),
         pieces_count=len(r.pieces),
         a_terms=r.sizes[0], b_terms=r.sizes[1], forced_order=r.sizes[2],
         states=_most_states(len(r.gamma) - 1, *r.sizes[:2]), samples=SSM_SAMPLES)
 
 
-def _rows(rows: list[list[str]]) -> str:
+def _list_lines(rows: list[list[str]]) -> str:
     """A flat list literal of printed numbers, one given row a line."""
     if not rows:
         return "[]"
