@@ -304,3 +304,16 @@ def test_forced_peak_against_full_order_shooting(text, f, lo, hi, order):
     assert abs(omega / abs(model.lam) - 1) >= 0.02
     assert errors[1] < 1e-3 < errors[0]
     assert abs(top.omega - omega) < 1e-3
+
+
+def test_a_curve_still_rising_at_the_range_end_has_no_peak():
+    """x'' + 0.02x' + x + x³ = 0.01 cos ωt peaks near ω = 1.08 (the hardening backbone at
+    the peak's amplitude, 0.47): over [0.9, 1.05] the curve leaves the range still rising and
+    no peak is reported (it was the range's end); over [0.9, 1.2] the peak lies on the
+    backbone, ω(ρ) at the peak's ρ."""
+    duffing = parse_system("x'' + 0.02*x' + x + x**3 = f*cos(w*t)", {"f": "1/100"}, driven=True)
+    assert reduce(duffing, mode=1, order=9, span=(0.9, 1.05)).response.peaks[0] is None
+    red = reduce(duffing, mode=1, order=9, span=(0.9, 1.2))
+    top = red.response.peaks[0]
+    assert 1.05 < top.omega < 1.2
+    assert abs(top.omega - float(red.model.omega(top.rho))) < 1e-3 * top.omega

@@ -108,12 +108,12 @@ def linear_mode(w: Matrices, mode: int) -> LinearMode:
     n = w.size
     M, C, K = w.mass, _damping(w), w.stiffness
     if n <= DENSE_MODES:
-        from scipy.linalg import eig
-
         Md, Cd, Kd = M.toarray(), C.toarray(), K.toarray()
-        A = np.block([[np.zeros((n, n)), np.eye(n)], [-Kd, -Cd]])
-        B = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), Md]])
-        lams, vecs = eig(A, B)
+        # the pencil (A, diag(I, M)) as one matrix, M being positive definite: NumPy's LAPACK,
+        # no SciPy import on a small system's path (Newton below refines the pair to rounding)
+        A = np.block([[np.zeros((n, n)), np.eye(n)],
+                      [-np.linalg.solve(Md, Kd), -np.linalg.solve(Md, Cd)]])
+        lams, vecs = np.linalg.eig(A)
         scale = max(1.0, float(np.max(np.abs(lams[np.isfinite(lams)]), initial=1.0)))
         upper = [k for k in np.argsort(lams.imag) if lams[k].imag > 1e-12 * scale]
         if mode > len(upper):
@@ -396,7 +396,8 @@ def peak_amplitude(c: np.ndarray) -> np.ndarray:
     N = THETA_SAMPLES * max(K, 1)
     theta = 2 * np.pi * np.arange(N) / N
     waves = np.exp(1j * np.outer(h, theta))  # (H, N)
-    x = np.real(np.einsum("phm,hn->pmn", c, waves))
+    cc = np.transpose(c, (0, 2, 1))  # (P, m, H)
+    x = cc.real @ waves.real - cc.imag @ waves.imag  # Re Σ_h c_h e^{ihθ}: two real products
     t = theta[np.argmax(np.abs(x), axis=2)]  # (P, m)
     for _ in range(REFINE_STEPS):
         e = np.exp(1j * h[None, None, :] * t[:, :, None])  # (P, m, H)

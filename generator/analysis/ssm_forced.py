@@ -700,6 +700,11 @@ def _amplitudes_on_curve(model: SSM, grid: Grid, outputs: np.ndarray, rho: np.nd
     return om, amp
 
 
+RANGE_END = 1e-6
+# NOTE: a curve whose largest ρ lies this close to an end of the range (relative to its
+# width) leaves the range there still rising: the range holds no top.
+
+
 def peaks(model: SSM, outputs: np.ndarray, grid: Grid) -> tuple[Peak | None, ...]:
     """Each output's largest amplitude on the forced response over the grid of ``grid``: the
     curve's top ρ* (the largest ρ with a steady state, by 60 halvings; one for every output),
@@ -728,6 +733,10 @@ def peaks(model: SSM, outputs: np.ndarray, grid: Grid) -> tuple[Peak | None, ...
         k = int(np.argmin(held)) if not held.all() else split - 1
         lo, hi = (inner[k - 1] if k else lo), (inner[k] if k < split - 1 else hi)
     top = lo
+    at_top, _, held = _on_curve(model, np.array([top, top]), np.array([1.0, -1.0]), grid)
+    margin = np.minimum(at_top - grid.omegas[0], grid.omegas[-1] - at_top)
+    if np.any(held & (margin <= RANGE_END * (grid.omegas[-1] - grid.omegas[0]))):
+        return (None,) * m  # the curve leaves the range still rising: its top is not inside
     # one search per (output, branch): output i's on rows i (branch +1) and m + i (−1)
     column = np.tile(np.arange(m), 2)
     sign = np.repeat([1.0, -1.0], m)
