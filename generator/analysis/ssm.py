@@ -215,27 +215,32 @@ class _Column(LazySeries):
 
 
 class _Product(LazySeries):
-    """``a · b`` of two series in the monomials ``p₁^{k−r}p₂^r`` (order k: ``(k + 1) × T``):
-    the Cauchy sum over orders from each factor's lowest (``low_a``, ``low_b``), each a
-    convolution of the rows."""
+    """``a · b`` of two series in the monomials ``p₁^{k−r}p₂^r`` (order k: ``(k + 1) × T``,
+    or ``(k + 1)·batch × T``, monomial-major, for a factor that differs over a batch of drive
+    frequencies, as :mod:`analysis.ssm_forced`'s first-order states do): the Cauchy sum over
+    orders from each factor's lowest (``low_a``, ``low_b``), each a convolution of the rows,
+    batched where either factor is."""
 
     def __init__(self, a: LazySeries, b: LazySeries, low_a: int, low_b: int) -> None:
         super().__init__()
         self.a, self.b, self.low_a, self.low_b = a, b, low_a, low_b
 
-    def compute(self, k: int) -> np.ndarray:
+    def compute(self, k: int) -> np.ndarray | None:
         out = None
         for i in range(self.low_a, k - self.low_b + 1):
             A, B = self.a.coeff(i), self.b.coeff(k - i)
+            A = A.reshape(i + 1, -1, A.shape[-1])  # (rows, batch or 1, terms)
+            B = B.reshape(k - i + 1, -1, B.shape[-1])
             if out is None:
-                out = np.zeros((k + 1, A.shape[1]), dtype=complex)
+                out = np.zeros((k + 1, max(A.shape[1], B.shape[1]), A.shape[2]),
+                               dtype=complex)
             if A.shape[0] <= B.shape[0]:  # a loop over the shorter factor's rows
                 for row in range(A.shape[0]):
                     out[row:row + B.shape[0]] += A[row] * B
             else:
                 for row in range(B.shape[0]):
                     out[row:row + A.shape[0]] += B[row] * A
-        return out
+        return None if out is None else out.reshape(-1, out.shape[2])
 
 
 class _Force:

@@ -35,7 +35,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..algebra.lazy import LazySeries
 from ..derive.system import System
 from ..errors import InputError
 from .ssm import (
@@ -47,6 +46,7 @@ from .ssm import (
     _damping,
     _Force,
     _pencil,
+    _Product,
     _solve,
     peak_amplitude,
     ssm,
@@ -132,34 +132,6 @@ def _kept(model: SSM) -> int:
     return (K1 + 1) * (K1 + 2) // 2 * (4 * w.size + columns) + dense
 
 
-class _BatchedProduct(LazySeries):
-    """:class:`analysis.ssm._Product` over a batch of Ω: a factor's order ``i`` holds
-    ``(i + 1)·batch`` rows (monomial-major, one per Ω: the first-order states ``Z¹``) or
-    ``i + 1`` (the autonomous ``Z``, the same at every Ω); the product is batched where either
-    factor is."""
-
-    def __init__(self, a: LazySeries, b: LazySeries, low_a: int, low_b: int) -> None:
-        super().__init__()
-        self.a, self.b, self.low_a, self.low_b = a, b, low_a, low_b
-
-    def compute(self, k: int) -> np.ndarray | None:
-        out = None
-        for i in range(self.low_a, k - self.low_b + 1):
-            A, B = self.a.coeff(i), self.b.coeff(k - i)
-            A = A.reshape(i + 1, -1, A.shape[-1])  # (rows, batch or 1, terms)
-            B = B.reshape(k - i + 1, -1, B.shape[-1])
-            if out is None:
-                out = np.zeros((k + 1, max(A.shape[1], B.shape[1]), A.shape[2]),
-                               dtype=complex)
-            if A.shape[0] <= B.shape[0]:  # a loop over the shorter factor's rows
-                for row in range(A.shape[0]):
-                    out[row:row + B.shape[0]] += A[row] * B
-            else:
-                for row in range(B.shape[0]):
-                    out[row:row + A.shape[0]] += B[row] * A
-        return None if out is None else out.reshape(-1, out.shape[2])
-
-
 def _forced_batch(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> np.ndarray:
     """The recursion of :func:`forced_values` for one batch of Ω: ``W¹_k``, ``V¹_k`` as
     ``(k + 1, batch, n)``; a small system's solves stacked (LAPACK, the resonant rows'
@@ -179,7 +151,7 @@ def _forced_batch(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> np.nda
     V1: list[np.ndarray] = []
     states1: list[np.ndarray] = []
     linear = _Force(w, [np.hstack([a, b]) for a, b in zip(W0, V0, strict=True)], states1,
-                    _BatchedProduct, lambda k: (k + 1) * nb)
+                    _Product, lambda k: (k + 1) * nb)
     A: list[np.ndarray] = []
     B: list[np.ndarray] = []
     for k in range(K1 + 1):
