@@ -370,7 +370,8 @@ NNM: Target[NormalModeRequest, NormalModeSeries] = Target(
 
 SSM_FRC_POINTS = 41
 # NOTE: the forced response the derivation samples (its states are not emitted: the module
-# solves each w itself); the module's forcing comes from FORCING_NODES solves over the range.
+# solves each w itself); the module's forcing is fitted over the range by lower.ssm (forcing_fit,
+# in pieces where one fit misses its tolerance).
 SSM: Target[ReductionRequest, Reduction] = Target(
     lambda r: (f"{r.name}.py", f"{r.name}_reduced.tex"),
     lambda r, progress: reduce(r.system, r.mode, r.order,
