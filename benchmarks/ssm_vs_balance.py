@@ -175,6 +175,8 @@ def near_peak(model, branches: list[dict], peak: float, fold: float
                     for w, a in zip(b["omega"], b["amplitudes"]["x1"], strict=True)
                     if a >= (1 - NEAR_PEAK) * peak})
     near = [(w, a) for w, a in every if w <= fold]
+    if not near:
+        return np.nan, np.nan, 0, len(every)
     omegas = np.array(sorted({w for w, _ in near}))
     same = first_harmonics(model, omegas)
     dense = np.array(first_harmonics(model, np.linspace(omegas[0] * 0.997, omegas[-1] * 1.003,
@@ -257,8 +259,6 @@ def one_size(n: int) -> dict:
     row["frc"] = median_time(lambda: forced_response(model, omegas, outputs))
     response = forced_response(model, omegas, outputs)
     row["frc_top"] = max(s.amplitude[0] for s in response.states)
-    row["ssm_fold"] = max((w for w, _ in response.folds), default=np.inf)
-    row["balance_fold"] = max(data["folds"], default=np.inf)
     row["near"] = len(model.near)
     row["generate"], row["compile"], row["emitted"], row["emitted_top"] = emitted(
         text, span, omegas)
@@ -276,6 +276,11 @@ def one_size(n: int) -> dict:
     row["ssm_peak"], row["ssm_peak_omega"] = ssm_peak(model, lo, hi)
     row["check_peak"], _ = ssm_peak(ssm(system, 1, CHECK_ORDER), lo, hi)
     row["refined"], row["refined_omega"] = refined(branches)
+    # the upper folds: the first above each peak (the jump down of a hardening curve)
+    row["ssm_fold"] = min((w for w, _ in response.folds if w >= row["ssm_peak_omega"]),
+                          default=np.inf)
+    row["balance_fold"] = min((w for w in data["folds"] if w >= row["refined_omega"]),
+                              default=np.inf)
     row["vertical"], row["distance"], row["near_points"], row["past_fold"] = near_peak(
         model, branches, row["balance_peak"], row["ssm_fold"])
     return row
@@ -346,10 +351,17 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="n = 2 only")
     parser.add_argument("--large", action="store_true",
                         help=f"also n = {LARGE} (response SYSTEM alone runs about 5 minutes)")
+    parser.add_argument("--sizes", type=lambda t: tuple(int(x) for x in t.split(",")),
+                        help="these chain sizes instead, e.g. 12 or 2,5")
     args = parser.parse_args()
     rows = []
-    for n in (2,) if args.quick else SIZES + ((LARGE,) if args.large else ()):
-        rows.append(one_size(n))
+    sizes = (2,) if args.quick else SIZES + ((LARGE,) if args.large else ())
+    for n in args.sizes or sizes:
+        try:
+            rows.append(one_size(n))
+        except Exception as error:  # one size's failure is reported, the others kept
+            print(f"n = {n} failed: {error!r}", flush=True)
+            continue
         print(f"n = {n} done", file=sys.stderr, flush=True)
     report(rows)
 
