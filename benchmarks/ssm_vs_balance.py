@@ -3,7 +3,8 @@ full-order harmonic balance (``response SYSTEM``) on chains of n masses, all in 
 
     .venv/bin/python benchmarks/ssm_vs_balance.py            # n = 2, 3, 4, 5, 6, 8 (~6 minutes)
     .venv/bin/python benchmarks/ssm_vs_balance.py --quick    # n = 2 only
-    .venv/bin/python benchmarks/ssm_vs_balance.py --large    # and n = 12 (~6 minutes more)
+    .venv/bin/python benchmarks/ssm_vs_balance.py --large    # and n = 12 (~5 minutes more)
+    .venv/bin/python benchmarks/ssm_vs_balance.py --sizes 12  # these sizes only
 
 The issue's target: a 500-point forced response curve from the reduced model in ≤ 0.5 s in
 process, and ≥ 100× faster than ``response SYSTEM`` on the largest system that one handles, at
