@@ -317,3 +317,21 @@ def test_a_curve_still_rising_at_the_range_end_has_no_peak():
     top = red.response.peaks[0]
     assert 1.05 < top.omega < 1.2
     assert abs(top.omega - float(red.model.omega(top.rho))) < 1e-3 * top.omega
+
+
+def test_a_narrow_range_about_the_peak_finds_the_same_peak():
+    """A graded pair with a cubic spring (peak +2.6 % above ω₁): the peak from ±0.3 % about
+    it equals the one from ±10 % (it was None at K = 9: one geometric probe between the
+    states found fell where the curve's fixed point fails), and an empty range has none."""
+    pair = parse_system("x1'' + 2789/100000*x1' + 11/4*x1 - 7/4*x2 + 4*x1**3 = f*cos(w*t); "
+                        "x2'' + 2789/100000*x2' + 23/4*x2 - 7/4*x1 = 0", {"f": "1/100"},
+                        driven=True)
+    model = ssm(pair, 1, 9)
+    outputs = np.array([0])
+    wide = forced_response(model, np.linspace(1.3, 1.6, 500), outputs).peaks[0]
+    narrow = forced_response(model, np.linspace(wide.omega * 0.997, wide.omega * 1.003, 500),
+                             outputs).peaks[0]
+    assert narrow is not None
+    assert abs(narrow.amplitude - wide.amplitude) < 1e-8 * wide.amplitude
+    assert abs(narrow.omega - wide.omega) < 1e-7 * wide.omega
+    assert forced_response(model, np.empty(0), outputs).peaks == (None,)

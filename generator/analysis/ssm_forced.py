@@ -544,6 +544,8 @@ def forced_response(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> Forc
     the folds (:data:`FOLD_STEPS` bisections on the number of states) and each output's peak
     (:func:`peaks`)."""
     omegas = np.asarray(omegas, dtype=float)
+    if not omegas.size:
+        return ForcedResponse((), (), 0, (None,) * len(outputs))
     grid = Grid.of(model, omegas, forcing_rows(model, omegas, outputs), len(outputs))
     found, counts, beyond = [], [], 0
     for i, here in enumerate(_steady_states(model, omegas, grid.A, grid.B)):
@@ -564,7 +566,7 @@ def forced_response(model: SSM, omegas: np.ndarray, outputs: np.ndarray) -> Forc
                                     for i in range(1, len(omegas))
                                     if counts[i] != counts[i - 1])
                   if math.isfinite(fold[1]) and fold[1] <= model.radius)
-    peaks_ = peaks(model, outputs, grid)
+    peaks_ = peaks(model, outputs, grid, np.array([state.rho for state in states]))
     return ForcedResponse(states, folds, beyond, peaks_)
 
 
@@ -677,9 +679,17 @@ RANGE_END = 1e-6
 # width) leaves the range there still rising: the range holds no top.
 
 
-def peaks(model: SSM, outputs: np.ndarray, grid: Grid) -> tuple[Peak | None, ...]:
+def _held(model: SSM, rho: np.ndarray, grid: Grid) -> np.ndarray:
+    """Whether the curve has a state at each ``ρ`` on either branch inside the grid's range
+    (on a narrow range about the peak, one branch of a lower ρ lies outside it)."""
+    return _on_curve(model, rho, 1.0, grid)[2] | _on_curve(model, rho, -1.0, grid)[2]
+
+
+def peaks(model: SSM, outputs: np.ndarray, grid: Grid,
+          seeds: np.ndarray | None = None) -> tuple[Peak | None, ...]:
     """Each output's largest amplitude on the forced response over the grid of ``grid``: the
-    curve's top ρ* (the largest ρ with a steady state, by 60 halvings; one for every output),
+    curve's top ρ* (the largest ρ with a steady state, probed geometrically and at the ρ of
+    the states already found, ``seeds``, then 60 halvings; one for every output),
     then zooms on both branches within :data:`PEAK_BRACKET` below it (:data:`PEAK_GRID`
     points a zoom, every output's and branch's at once); ``None`` where the top lies past
     the radius or the grid."""
@@ -687,8 +697,14 @@ def peaks(model: SSM, outputs: np.ndarray, grid: Grid) -> tuple[Peak | None, ...
     hi = model.radius if math.isfinite(model.radius) else 1e6
     if len(grid.omegas) < 2:
         return (None,) * m
-    probe = np.geomspace(hi * 1e-9, hi, PEAK_PROBES)
-    held = _on_curve(model, probe, 1.0, grid)[2].tolist()
+    seeds = np.empty(0) if seeds is None else np.asarray(seeds, dtype=float)
+    probe = np.union1d(np.geomspace(hi * 1e-9, hi, PEAK_PROBES), seeds[seeds < hi])
+    held = _held(model, probe, grid)
+    if seeds.size:  # the states found are on the curve, and so is a probe between two of them
+        seed = np.isin(probe, seeds)
+        held |= seed
+        held[1:-1] |= held[:-2] & held[2:] & (seed[:-2] | seed[2:])
+    held = held.tolist()
     if not any(held):
         return (None,) * m
     first = held.index(True)
@@ -701,7 +717,7 @@ def peaks(model: SSM, outputs: np.ndarray, grid: Grid) -> tuple[Peak | None, ...
     split = 2**TOP_HALVINGS
     for _ in range((FOLD_STEPS + 10) // TOP_HALVINGS):  # 60 halvings, a few at a time
         inner = lo + (hi - lo) * np.arange(1, split) / split
-        held = _on_curve(model, inner, 1.0, grid)[2]
+        held = _held(model, inner, grid)
         k = int(np.argmin(held)) if not held.all() else split - 1
         lo, hi = (inner[k - 1] if k else lo), (inner[k] if k < split - 1 else hi)
     top = lo
