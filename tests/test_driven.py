@@ -5,8 +5,6 @@ from __future__ import annotations
 import itertools
 import json
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -216,9 +214,7 @@ def test_damped_output_shows_r_and_both_phases_parts():
     level (the branch's first-order r, each μ order, the balance, the true orbit) and the text
     table shows r, A1 and B1; checked against an independent shooting of the true orbit."""
     args = ["driven", "--eps", "0.1", "--force", "0.3", "--omega", "1.3", "--Q", "20"]
-    run = [sys.executable, "-m", "lindstedt", *args]
-    data = json.loads(subprocess.run([*run, "--json"], capture_output=True, text=True,
-                                     check=True).stdout)
+    data = json.loads(run_forked(*args, "--json", check=True).stdout)
     top = data["branches"][0]
     orbit = shoot(0.1, 0.3, 1.3, 0.05, np.array([2.3, 1.3 * 2.2]))
     r_true = math.hypot(orbit.A[1], orbit.B[1])
@@ -228,7 +224,7 @@ def test_damped_output_shows_r_and_both_phases_parts():
     assert abs(top["mu_expansion"][-1]["r"] - r_true) < 1e-4
     assert top["r"] == top["A1"] > 0  # damped: the first-order amplitude r, its phase delta0
     assert abs(top["r"] - r_true) < 0.05
-    text = subprocess.run(run, capture_output=True, text=True, check=True).stdout
+    text = run_forked(*args, check=True).stdout
     header = next(line for line in text.splitlines() if line.split()[:2] == ["r", "A1"])
     assert header.split() == ["r", "A1", "B1", "A3", "A5"]
     shooting = next(line for line in text.splitlines() if "shooting" in line).split()[-5:]

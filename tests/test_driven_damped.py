@@ -5,12 +5,11 @@ balance approached like μ^(K+1), and the emitted A_n, B_n against shooting."""
 from __future__ import annotations
 
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 import sympy as sp
+from commands import run_forked
 from lindstedt.analysis.driven import (
     Drive,
     amplitudes,
@@ -262,13 +261,10 @@ def test_emitted_literals_fit_numba_at_order_four():
 
 def test_cli_damped(tmp_path):
     """`generate driven --damped` writes the damped pair; --damped elsewhere is one line, exit 2."""
-    run = [sys.executable, "-m", "lindstedt", "generate"]
-    ok = subprocess.run([*run, "driven", "--order", "1", "--damped", "--out", str(tmp_path)],
-                        capture_output=True, text=True)
+    ok = run_forked("generate", "driven", "--order", "1", "--damped", "--out", tmp_path)
     assert ok.returncode == 0, ok.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["driven_damped.py",
                                                           "driven_damped_derivation.tex"]
-    bad = subprocess.run([*run, "duffing", "--order", "2", "--damped", "--out", str(tmp_path)],
-                         capture_output=True, text=True)
+    bad = run_forked("generate", "duffing", "--order", "2", "--damped", "--out", tmp_path)
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
     assert "--damped" in bad.stderr and "Traceback" not in bad.stderr

@@ -4,8 +4,6 @@ verdict, and the simulated tones' uncertainty, against an independent DOP853 ref
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 from commands import run_forked
@@ -261,9 +259,7 @@ def test_driven_says_the_branch_escapes_the_well():
 
     eps, f, Q, w = -0.1, 0.3, 20.0, 0.2
     args = ["driven", "--eps", str(eps), "--force", str(f), "--Q", str(Q), "--omega", str(w)]
-    run = [sys.executable, "-m", "lindstedt", *args]
-    data = json.loads(subprocess.run([*run, "--json"], capture_output=True, text=True,
-                                     check=True).stdout)
+    data = json.loads(run_forked(*args, "--json", check=True).stdout)
     *outer, small = data["branches"]
     assert outer  # the resonant branch (each root over the barrier: its own balance)
     for big in outer:
@@ -281,5 +277,5 @@ def test_driven_says_the_branch_escapes_the_well():
     assert ref[3] is small["numerical"]["stable"] is True
     # a root that stands for no branch (its balance converged onto another's) says why
     assert all(root["escapes"] for root in data["one_harmonic_roots"] if root["branch"] is None)
-    text = subprocess.run(run, capture_output=True, text=True, check=True).stdout
+    text = run_forked(*args, check=True).stdout
     assert "(escapes the well)" in text and "no orbit found" not in text
