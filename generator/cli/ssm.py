@@ -272,7 +272,8 @@ def resonant_json(red) -> dict:
                                 "2*Re(phi1*p1 + phi2*p2) with phi_k^H M phi_k = 1/4",
             "polar": f"p_k = rho_k*e^(i*theta_k), psi = theta2 - {r}*theta1: d(rho_k)/dt + "
                      "i*rho_k*d(theta_k)/dt = lambda_k*rho_k + the sum of the terms of "
-                     "equation p_k, each coefficient*rho1^rho1*rho2^rho2*e^(i*psi*psi)",
+                     "equation p_k, each coefficient*rho1^m*rho2^n*e^(i*s*psi), (m, n, s) "
+                     "its polar powers (rho1, rho2, psi)",
             "terms": terms, "families": families,
             "coupled_modes": [{"psi": c.psi, "points": [
                 {"rho": [float(a), float(b)], "omega": float(w),
