@@ -634,9 +634,10 @@ def render_ssm_module(r: ReducedModule) -> str:
         nodes_count=len(r.nodes), width=_forcing_width(r),
         interpolation_error=pyliteral(float(r.interpolation_error)),
         interpolated=pyliteral(float(r.tolerance)),
-        unverified=repr(tuple((float(p[0]), float(p[1])) for p in r.pieces if not p[5])),
-        pieces=_list_lines([[pyliteral(float(x)) for x in (p[0], p[1], p[2], p[3], float(p[5]))]
-                      for p in r.pieces]),
+        unverified=repr(tuple((p.lo, p.hi) for p in r.pieces if not p.verified)),
+        pieces=_list_lines([[pyliteral(float(x))
+                             for x in (p.lo, p.hi, p.first, p.count, p.verified)]
+                            for p in r.pieces]),
         pieces_count=len(r.pieces),
         a_terms=r.sizes[0], b_terms=r.sizes[1], forced_order=r.sizes[2],
         states=_most_states(len(r.gamma) - 1, *r.sizes[:2]), samples=SSM_SAMPLES)

@@ -7,6 +7,7 @@ import hashlib
 import json
 import unicodedata
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import sympy as sp
 
@@ -371,14 +372,26 @@ class SlowFlowDocument:
 # --- a spectral submanifold's reduced model --------------------------------------------------
 
 
+class ForcingPiece(NamedTuple):
+    """One piece of the drive's range in a reduced module: its ends, its first node's index in
+    the module's table and its node count (0: unverified), the interpolation error reached at
+    its midpoints (relative to the largest term), and whether that met the tolerance."""
+
+    lo: float
+    hi: float
+    first: int
+    count: int
+    error: float
+    verified: bool
+
+
 @dataclass(frozen=True)
 class ReducedModule:
     """The numbers of an SSM's reduced model for ``ssm.py.j2`` and ``ssm.tex.j2``: the normal
     form's ``γ_j`` (real and imaginary parts), the radius in ρ, each output's Fourier
     coefficients of ``ρ^k e^{ihθ}`` (``(K + 1) × (2K + 1) × outputs``), and the forced terms
-    on Chebyshev nodes over the pieces of ``[lo, hi]`` (each piece ``(lo, hi, first node,
-    nodes, error, verified)``: its interpolation error at the midpoints, relative; an
-    unverified piece holds no nodes); per node ``A_j``, ``B_j``, then the outputs' ``W¹``
+    on Chebyshev nodes over the pieces of ``[lo, hi]`` (:class:`ForcingPiece`; an unverified
+    piece holds no nodes); per node ``A_j``, ``B_j``, then the outputs' ``W¹``
     order by order; ``sizes``: how many ``A_j``, ``B_j`` and the order of ``W¹``; empty: not
     driven; ``tolerance``: the error a piece must reach)."""
 
@@ -392,7 +405,7 @@ class ReducedModule:
     radius: float
     shape: tuple[tuple[tuple[tuple[float, float], ...], ...], ...]
     span: tuple[float, float] | None
-    pieces: tuple[tuple[float, float, int, int, float, bool], ...]
+    pieces: tuple[ForcingPiece, ...]
     nodes: tuple[float, ...]
     forcing: tuple[tuple[tuple[float, float], ...], ...]  # per node: A, B, W¹ flattened
     sizes: tuple[int, int, int]
@@ -405,5 +418,5 @@ class ReducedModule:
     def interpolation_error(self) -> float:
         """The forced terms' largest interpolation error over the verified pieces (NaN: none
         is, or not driven)."""
-        return max((p[4] for p in self.pieces if p[5]), default=float("nan"))
+        return max((p.error for p in self.pieces if p.verified), default=float("nan"))
 

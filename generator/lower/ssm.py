@@ -16,7 +16,7 @@ from ..analysis.ssm_forced import (
     forced_order,
     forcing_pieces,
 )
-from .records import ReducedModule, provenance
+from .records import ForcingPiece, ReducedModule, provenance
 
 FORCING_SPLITS = 3
 # NOTE: the forced terms are fitted as the in-process forced response fits them
@@ -48,8 +48,8 @@ def lower_reduction(red: Reduction, name: str, command: str) -> ReducedModule:
         out = []
         for fit in forcing_pieces(m, span[0], span[1], red.outputs, FORCING_SPLITS):
             count = len(fit.nodes) if fit.verified else 0
-            out.append((float(fit.lo), float(fit.hi), len(nodes), count, float(fit.error),
-                        bool(fit.verified)))
+            out.append(ForcingPiece(float(fit.lo), float(fit.hi), len(nodes), count,
+                                    float(fit.error), bool(fit.verified)))
             if fit.verified:
                 nodes += [float(x) for x in fit.nodes]
                 table += [tuple(_pair(z) for z in row) for row in fit.values]
@@ -68,23 +68,23 @@ def lower_reduction(red: Reduction, name: str, command: str) -> ReducedModule:
         tuple(table), sizes, INTERPOLATED)
 
 
-def _forcing_note(pieces: tuple, span: tuple[float, float]) -> str:
+def _forcing_note(pieces: tuple[ForcingPiece, ...], span: tuple[float, float]) -> str:
     """What the module's docstring says of its forced terms: nodes, the error reached, where
     frc is NaN because the tolerance was not."""
-    good = [p for p in pieces if p[5]]
-    bad = [p for p in pieces if not p[5]]
+    good = [p for p in pieces if p.verified]
+    bad = [p for p in pieces if not p.verified]
     lines = []
     if good:
         lines.append(
             f"The forced terms (A_j, B_j, the outputs' W1) are interpolated on Chebyshev nodes "
             f"over w in [{span[0]!r}, {span[1]!r}]"
             + ("" if len(pieces) == 1 else f" in {len(pieces)} pieces")
-            + f" ({', '.join(str(p[3]) for p in good)} nodes), each piece checked against the "
+            + f" ({', '.join(str(p.count) for p in good)} nodes), each piece checked against the "
             f"exact terms at its midpoints: the largest interpolation error is "
-            f"{max(p[4] for p in good):.2e} (relative to the largest term; "
+            f"{max(p.error for p in good):.2e} (relative to the largest term; "
             f"INTERPOLATION_ERROR), within the tolerance {INTERPOLATED:g}.")
-    for lo, hi, _, _, error, _ in bad:
-        lines.append(f"On [{lo!r}, {hi!r}] the tolerance {INTERPOLATED:g} was not reached with "
-                     f"{CHEBYSHEV_MOST} nodes (error {error:.2e}): frc is NaN there "
+    for p in bad:
+        lines.append(f"On [{p.lo!r}, {p.hi!r}] the tolerance {INTERPOLATED:g} was not reached "
+                     f"with {CHEBYSHEV_MOST} nodes (error {p.error:.2e}): frc is NaN there "
                      "(UNVERIFIED).")
     return "\n".join(textwrap.fill(line, 90) for line in lines)
