@@ -40,16 +40,15 @@ tex:
 demo: $(STAMP) tex
 	$(BIN)/lindstedt demo --out out
 
-# The suite's three layers (tests/conftest.py): the exact identities first and alone, then the
-# printers and the emitted modules; each on every core, an idle worker taking the other's queued
-# tests (--dist worksteal: the long ones otherwise end on one worker while the other waits).
+# The whole suite in one run on every core (pytest-xdist): whole test files handed to the first
+# idle worker, the longest first (tests/conftest.py, tests/durations.json).
+SUITE = -n auto --dist loadfile --no-loadscope-reorder
 test: $(STAMP) tex
 	$(BIN)/ruff check generator tests benchmarks
-	$(BIN)/python -m pytest -n auto --dist worksteal -m exact
-	$(BIN)/python -m pytest -n auto --dist worksteal -m "printers or emitted"
+	$(BIN)/python -m pytest $(SUITE)
 
 test-fast: $(STAMP)
-	$(BIN)/python -m pytest -n auto --dist worksteal -m exact
+	$(BIN)/python -m pytest $(SUITE) -m exact
 
 lint: $(STAMP)
 	$(BIN)/ruff check generator tests benchmarks

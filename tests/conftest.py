@@ -1,4 +1,4 @@
-"""The suite's three layers, as markers, so the fast one runs first and alone:
+"""The suite's three layers, as markers:
 
 * ``exact``: exact identities and in-process numerics against independent references (series
   against elliptic integrals, DLMF, product-to-sum, quadrature, shooting); nothing is emitted.
@@ -6,8 +6,15 @@
 * ``emitted``: generated numba modules compiled and checked against references, the wheel in a
   fresh venv, ``make demo``, Dask clusters.
 
-``make test`` runs ``-m exact`` first, then the other two, each on every core (pytest-xdist);
-``pytest -m exact`` alone takes a minute.  A module's layer is where its slowest test belongs.
+``make test`` runs every layer in one pytest run on every core (pytest-xdist); ``make
+test-fast`` (``pytest -m exact``) the exact layer alone, in a minute.  A module's layer is where
+its slowest test belongs.
+
+The run hands out whole files (``--dist loadfile``: a module's fixtures are set up once), the
+longest first (tests/durations.json: each file's seconds, measured by
+``benchmarks/suite_times.py --write-durations``; a file it does not list counts as ``SHORT``),
+each to the first idle worker, so that no worker ends with a long file while the others wait.
+The order only schedules: it decides no outcome.
 
 An emitted module compiles once per run of the suite, whichever test, worker or folder loads
 it: numba's cache of emitted modules is kept by their text in one folder that every worker
@@ -15,6 +22,7 @@ shares (tests/commands.py, ``EmittedCache``)."""
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
@@ -46,12 +54,18 @@ def pytest_configure(config: pytest.Config) -> None:
         config.addinivalue_line("markers", f"{layer}: a layer of the suite (tests/conftest.py)")
 
 
+DURATIONS = Path(__file__).with_name("durations.json")
+SHORT = 1.0  # seconds: a test file durations.json does not list
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     for item in items:
         name = Path(str(item.fspath)).name
         if name not in LAYER_OF:
             raise pytest.UsageError(f"{name}: give it a layer in tests/conftest.py")
         item.add_marker(getattr(pytest.mark, LAYER_OF[name]))
+    seconds = json.loads(DURATIONS.read_text(encoding="utf-8"))
+    items.sort(key=lambda item: -seconds.get(Path(str(item.fspath)).name, SHORT))  # stable
 
 
 @pytest.fixture(scope="session")

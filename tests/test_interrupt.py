@@ -16,7 +16,8 @@ import pytest
 import xarray as xr
 
 LINDSTEDT = [sys.executable, "-m", "lindstedt"]
-GRID = ["stability", "--omega", "0.5:2:60", "--force", "0.3", "--eps", "0.1", "--Q", "20"]
+GRID = ["stability", "--omega", "0.5:2:30", "--force", "0.3", "--eps", "0.1", "--Q", "20",
+        "--chunk", "10"]
 
 
 def _start(args: list[str]) -> subprocess.Popen:
@@ -53,7 +54,7 @@ def _workers_left(pid: int) -> list[str]:
 @pytest.mark.parametrize("how", ["ctrl-c", "sigterm"])
 def test_an_interrupted_sweep_says_what_it_saved_and_resumes(how, tmp_path):
     store = tmp_path / "map.zarr"
-    p = _start(["sweep", *GRID, "--out", str(store), "--workers", "1"])  # ~1 s a block
+    p = _start(["sweep", *GRID, "--out", str(store), "--workers", "1"])  # ~1 s a block of 10
     deadline = time.monotonic() + 120
     while _blocks_done(store) < 1:
         assert p.poll() is None, p.communicate()

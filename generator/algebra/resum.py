@@ -336,23 +336,25 @@ def pade(coefficients: Sequence[Fraction], L: int, M: int, variable: str = "x") 
     if len(c) < L + M + 1:
         raise InputError(f"Padé [{L}/{M}]: needs {L + M + 1} coefficients, got {len(c)}")
 
-    def at(i: int) -> Fraction:
-        return c[i] if i >= 0 else Fraction(0)
+    f = [_fmpq(x) for x in c[: L + M + 1]]  # FLINT's rationals: Fraction's gcds dominate
 
-    q = [Fraction(1)]
+    def at(i: int) -> flint.fmpq:
+        return f[i] if i >= 0 else flint.fmpq(0)
+
+    q = [flint.fmpq(1)]
     if M:
-        A = flint.fmpq_mat(M, M, [_fmpq(at(L + k - j)) for k in range(1, M + 1)
+        A = flint.fmpq_mat(M, M, [at(L + k - j) for k in range(1, M + 1)
                                   for j in range(1, M + 1)])
-        b = flint.fmpq_mat(M, 1, [_fmpq(-at(L + k)) for k in range(1, M + 1)])
+        b = flint.fmpq_mat(M, 1, [-at(L + k) for k in range(1, M + 1)])
         try:
             x = A.solve(b)
         except ZeroDivisionError as exc:
             raise InputError(f"Padé [{L}/{M}] in {variable}: singular (a block of the Padé "
                              "table); choose other degrees") from exc
-        q += [_fraction(x[j, 0]) for j in range(M)]
-    p = [sum((q[j] * at(i - j) for j in range(min(i, M) + 1)), Fraction(0))
-         for i in range(L + 1)]
-    return Pade(tuple(p), tuple(q), variable)
+        q += [x[j, 0] for j in range(M)]
+    product = (flint.fmpq_poly(q) * flint.fmpq_poly(f[: L + 1])).coeffs()
+    p = [product[i] if i < len(product) else flint.fmpq(0) for i in range(L + 1)]
+    return Pade(tuple(map(_fraction, p)), tuple(map(_fraction, q)), variable)
 
 
 def real_poles(approximant: Pade, lo: float, hi: float) -> list[float]:
