@@ -2,19 +2,19 @@
 # model: balance, order: 4
 # command: lindstedt generate balance --harmonics 4
 # inputs sha256: b5d2168261d8c00fcb65880bc8741f3c5a26a9f4dd1fe0fb56b56d98742758bc
-# body sha256: 26d52aa1d27e02143bf258444cddc84165038a951d2d4c2fbd927bef3263e467
+# body sha256: ddc4240641cf92a0985bd783fa1f6bd133e000cf1a96a7e66b2176b596dc4bb3
 """Driven Duffing q'' + damping*q' + q + eps*q**3 = force*cos(omega t): harmonic balance with 4 odd harmonics.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
-or arrays.  Outside its domain it returns NaN (see each docstring).  The compiled kernels take ``x``, a 1-D
-array of ``len(UNKNOWNS)`` real numbers (converted to float64), and real numbers; anything else
-raises TypeError or ValueError."""
+or arrays.  Outside its domain it returns NaN (see each docstring).  The kernels take ``x``, a 1-D array of
+``len(UNKNOWNS)`` real numbers (converted to float64), and real numbers; anything else raises
+TypeError or ValueError.  Each checks and converts its arguments in Python, then calls its
+compiled twin ``_<name>``, compiled once for float64."""
 
 import math
 
 import numpy as np
-from numba import njit, types
-from numba.extending import overload
+from numba import njit
 
 HARMONICS = 4
 UNKNOWNS = (
@@ -29,84 +29,27 @@ UNKNOWNS = (
 )
 
 
-def _is_vector(v):
-    """Whether ``v`` is a 1-D array of real numbers, known when compiling (compiled only)."""
-    raise NotImplementedError
+def _vector(x, where, name, size):
+    """``x`` as a C-contiguous float64 array (``x`` itself if it is one) for a compiled
+    kernel, which is then compiled once whatever the caller's dtype; TypeError or ValueError
+    naming ``where`` and ``name`` unless ``x`` is a 1-D array of ``size`` real numbers."""
+    if (not isinstance(x, np.ndarray) or isinstance(x, np.ma.MaskedArray) or x.ndim != 1
+            or x.dtype.kind not in "biuf"):
+        raise TypeError(f"{where}: {name} must be a 1-D array of {size} real numbers (UNKNOWNS)")
+    if x.size != size:
+        raise ValueError(f"{where}: {name} must have {size} elements, one per UNKNOWNS")
+    return np.ascontiguousarray(x, dtype=np.float64)
 
 
-@overload(_is_vector, inline="always")
-def _is_vector_overload(v):
-    ok = (isinstance(v, types.Array) and v.ndim == 1
-          and isinstance(v.dtype, (types.Integer, types.Float, types.Boolean)))
-    return (lambda v: True) if ok else (lambda v: False)
-
-
-def _vector(v):
-    """``v`` as a C-contiguous float64 array (``v`` itself if it is one); an empty stand-in
-    for anything else, which the caller has refused already (compiled only)."""
-    raise NotImplementedError
-
-
-@overload(_vector)
-def _vector_overload(v):
-    if not (isinstance(v, types.Array) and v.ndim == 1
-            and isinstance(v.dtype, (types.Integer, types.Float, types.Boolean))):
-        return lambda v: np.zeros(0)
-    if v.dtype == types.float64 and v.layout == "C":
-        return lambda v: v
-
-    def convert(v):
-        w = np.empty(v.size)
-        for i in range(v.size):
-            w[i] = v[i]
-        return w
-    return convert
-
-
-def _is_real(v):
-    """Whether ``v`` is a real number, known when compiling (compiled only)."""
-    raise NotImplementedError
-
-
-@overload(_is_real, inline="always")
-def _is_real_overload(v):
-    ok = isinstance(v, (types.Integer, types.Float, types.Boolean))
-    return (lambda v: True) if ok else (lambda v: False)
-
-
-def _real(v):
-    """``v`` as a float64; 0.0 for anything else, which the caller has refused (compiled only)."""
-    raise NotImplementedError
-
-
-@overload(_real, inline="always")
-def _real_overload(v):
-    if isinstance(v, (types.Integer, types.Float, types.Boolean)):
-        return lambda v: np.float64(v)  # float() keeps a float32 a float32
-    return lambda v: 0.0
-
-
-def _is_integer(v):
-    """Whether ``v`` is an integer, known when compiling (compiled only)."""
-    raise NotImplementedError
-
-
-@overload(_is_integer, inline="always")
-def _is_integer_overload(v):
-    ok = isinstance(v, types.Integer)
-    return (lambda v: True) if ok else (lambda v: False)
-
-
-def _integer(v):
-    """``v`` as an int64; 0 for anything else, which the caller has refused (compiled only)."""
-    raise NotImplementedError
-
-
-@overload(_integer, inline="always")
-def _integer_overload(v):
-    if isinstance(v, types.Integer):
-        return lambda v: np.int64(v)
-    return lambda v: np.int64(0)
+def _real(v, where, name):
+    """``v`` as a float for a compiled kernel; TypeError or ValueError naming ``where`` and
+    ``name`` unless it is a real number (bool, int, float or a NumPy scalar of those)."""
+    if not isinstance(v, (bool, int, float, np.bool_, np.integer, np.floating)):
+        raise TypeError(f"{where}: {name} must be a real number")
+    try:
+        return float(v)
+    except OverflowError:
+        raise ValueError(f"{where}: {name} = {v} is beyond the range of float64") from None
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -232,26 +175,12 @@ def _residual(x, omega, eps, force, damping):
     return out
 
 
-@njit(cache=True)
 def residual(x, omega, eps, force, damping):
     """Galerkin residual: cos and sin components for k = 1, 3, …
 
     ``x``: a 1-D array of the 8 UNKNOWNS; the rest real numbers.  TypeError or
     ValueError for anything else."""
-    if not _is_vector(x):
-        raise TypeError("residual: x must be a 1-D array of 8 real numbers (UNKNOWNS)")
-    v = _vector(x)
-    if v.size != 8:
-        raise ValueError("residual: x must have 8 elements, one per UNKNOWNS")
-    if not _is_real(omega):
-        raise TypeError("residual: omega must be a real number")
-    if not _is_real(eps):
-        raise TypeError("residual: eps must be a real number")
-    if not _is_real(force):
-        raise TypeError("residual: force must be a real number")
-    if not _is_real(damping):
-        raise TypeError("residual: damping must be a real number")
-    return _residual(v, _real(omega), _real(eps), _real(force), _real(damping))
+    return _residual(_vector(x, "residual", "x", 8), _real(omega, "residual", "omega"), _real(eps, "residual", "eps"), _real(force, "residual", "force"), _real(damping, "residual", "damping"))
 
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
@@ -485,26 +414,12 @@ def _jacobian(x, omega, eps, force, damping):
     return out
 
 
-@njit(cache=True)
 def jacobian(x, omega, eps, force, damping):
     """d residual / d (a_1, a_3, …, b_1, b_3, …)
 
     ``x``: a 1-D array of the 8 UNKNOWNS; the rest real numbers.  TypeError or
     ValueError for anything else."""
-    if not _is_vector(x):
-        raise TypeError("jacobian: x must be a 1-D array of 8 real numbers (UNKNOWNS)")
-    v = _vector(x)
-    if v.size != 8:
-        raise ValueError("jacobian: x must have 8 elements, one per UNKNOWNS")
-    if not _is_real(omega):
-        raise TypeError("jacobian: omega must be a real number")
-    if not _is_real(eps):
-        raise TypeError("jacobian: eps must be a real number")
-    if not _is_real(force):
-        raise TypeError("jacobian: force must be a real number")
-    if not _is_real(damping):
-        raise TypeError("jacobian: damping must be a real number")
-    return _jacobian(v, _real(omega), _real(eps), _real(force), _real(damping))
+    return _jacobian(_vector(x, "jacobian", "x", 8), _real(omega, "jacobian", "omega"), _real(eps, "jacobian", "eps"), _real(force, "jacobian", "force"), _real(damping, "jacobian", "damping"))
 
 
 @njit(cache=True)
@@ -519,27 +434,17 @@ def _newton(x0, omega, eps, force, damping, tol, max_iter):
     return x, False
 
 
-@njit(cache=True)
 def newton(x0, omega, eps, force, damping, tol=1e-13, max_iter=50):
     """Newton's method on residual() with jacobian(); returns (x, converged).
 
     ``x0``: a 1-D array of the 8 UNKNOWNS; the rest real numbers, ``max_iter`` an
     integer.  TypeError or ValueError for anything else."""
-    if not _is_vector(x0):
-        raise TypeError("newton: x0 must be a 1-D array of 8 real numbers (UNKNOWNS)")
-    v = _vector(x0)
-    if v.size != 8:
-        raise ValueError("newton: x0 must have 8 elements, one per UNKNOWNS")
-    if not _is_real(omega):
-        raise TypeError("newton: omega must be a real number")
-    if not _is_real(eps):
-        raise TypeError("newton: eps must be a real number")
-    if not _is_real(force):
-        raise TypeError("newton: force must be a real number")
-    if not _is_real(damping):
-        raise TypeError("newton: damping must be a real number")
-    if not _is_real(tol):
-        raise TypeError("newton: tol must be a real number")
-    if not _is_integer(max_iter):
+    v = _vector(x0, "newton", "x0", 8)
+    omega = _real(omega, "newton", "omega")
+    eps = _real(eps, "newton", "eps")
+    force = _real(force, "newton", "force")
+    damping = _real(damping, "newton", "damping")
+    tol = _real(tol, "newton", "tol")
+    if not isinstance(max_iter, (int, np.integer)) or isinstance(max_iter, bool):
         raise TypeError("newton: max_iter must be an integer")
-    return _newton(v, _real(omega), _real(eps), _real(force), _real(damping), _real(tol), _integer(max_iter))
+    return _newton(v, omega, eps, force, damping, tol, max(0, min(int(max_iter), 2**62)))
