@@ -1,8 +1,10 @@
-"""Where the suite's time goes: ``make test``'s pytest run (every core, pytest-xdist, whole
-files handed out longest first), its wall time and its CPU time (user + system of pytest and
-every process it waited for: workers, commands, compilers); each layer's test count and summed
-test time, the test files whose tests take longest together, and the ten slowest tests (their
-own wall time from pytest's JUnit report, setup included).  On a machine shared with other
+"""Where the suite's time goes, as make test runs it.
+
+``make test``'s pytest run (every core, pytest-xdist, whole files handed out longest first):
+its wall time and its CPU time (user + system of pytest and every process it waited for:
+workers, commands, compilers); each layer's test count and summed test time, the test files
+whose tests take longest together, and the ten slowest tests (their own wall time from pytest's
+JUnit report, setup included).  On a machine shared with other
 work, compare CPU times: wall times follow the load.
 
     python benchmarks/suite_times.py [--top 10] [--write-durations] [PYTEST_ARGS...]
