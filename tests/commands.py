@@ -12,19 +12,22 @@ command imports: a process of its own (a crash, a hang, its memory) without the 
 
 ``EmittedCache`` keeps numba's compiled code of an emitted module by the module's text, not by
 its folder: the same text written to two temporary folders (by two tests, by ``choose`` while
-it verifies, by a child process) compiles once.  tests/conftest.py puts it first for the
-suite's processes; ``cached_env`` hands it to a child process."""
+it verifies, by a child process) compiles once, even when two processes want it at the same
+moment (``_one_compiler``: the second waits for the first's result).  tests/conftest.py puts
+it first for the suite's processes; ``cached_env`` hands it to a child process."""
 
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import io
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
-from numba.core.caching import _CacheLocator, _SourceFileBackedLocatorMixin
+from numba.core.caching import Cache, _CacheLocator, _SourceFileBackedLocatorMixin
 
 CACHE_VARIABLE = "LINDSTEDT_TEST_NUMBA_CACHE"
 # NOTE: the folder of the suite's shared numba cache, for a child process (tests/conftest.py
@@ -152,6 +155,61 @@ class EmittedCache(_SourceFileBackedLocatorMixin, _CacheLocator):
             if source.read(len(MARKER)) != MARKER:
                 return None
         return super().from_function(py_func, py_file)
+
+
+WAIT = (1200, 0.1)
+# NOTE: a process finding another compiling the same emitted function waits for it up to 1200
+# times 0.1 s (a function compiles in seconds), then compiles it itself.
+_HELD: dict[int, int] = {}  # id of a numba Cache → the lock it holds while its process compiles
+_LOAD, _SAVE = Cache.load_overload, Cache.save_overload
+
+
+def _load_overload(self, sig, target_context):
+    """numba's cache lookup; on a miss for an emitted function, the function's lock in the
+    shared cache is taken (waiting while another process compiles it, then looking again)
+    and kept until :func:`_save_overload`: of several processes, one compiles."""
+    found = _LOAD(self, sig, target_context)
+    if found is not None or not isinstance(self._impl.locator, EmittedCache) \
+            or id(self) in _HELD:
+        return found
+    os.makedirs(self._cache_path, exist_ok=True)
+    lock = os.open(os.path.join(self._cache_path, f"{self._cache_file._index_name}.lock"),
+                   os.O_RDWR | os.O_CREAT, 0o644)
+    for _ in range(WAIT[0]):
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            break
+        except BlockingIOError:
+            time.sleep(WAIT[1])
+    else:
+        os.close(lock)
+        return None
+    found = _LOAD(self, sig, target_context)
+    if found is not None:
+        os.close(lock)
+        return found
+    _HELD[id(self)] = lock
+    return None
+
+
+def _save_overload(self, sig, data):
+    """numba's cache store, then the lock :func:`_load_overload` took released."""
+    try:
+        _SAVE(self, sig, data)
+    finally:
+        lock = _HELD.pop(id(self), None)
+        if lock is not None:
+            os.close(lock)
+
+
+def _one_compiler() -> None:
+    """Every numba cache of this process serialises the compiles of emitted functions across
+    the suite's processes (installed when this module is imported: by tests/conftest.py, and
+    by numba in a child given :func:`cached_env`)."""
+    Cache.load_overload, Cache.save_overload = _load_overload, _save_overload
+
+
+_one_compiler()
 
 
 def cached_env() -> dict[str, str]:
