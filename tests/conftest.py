@@ -7,8 +7,8 @@
   fresh venv, ``make demo``, Dask clusters.
 
 ``make test`` runs every layer in one pytest run on every core (pytest-xdist); ``make
-test-fast`` (``pytest -m exact``) the exact layer alone, in a minute.  A module's layer is where
-its slowest test belongs.
+test-fast`` (``pytest -m exact``) the exact layer alone, in about three minutes on two cores.  A
+module's layer is where its slowest test belongs.
 
 The run hands out whole files (``--dist loadfile``: a module's fixtures are set up once), the
 longest first (tests/durations.json: each file's seconds, measured by
