@@ -24,6 +24,7 @@ import io
 import os
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -62,6 +63,7 @@ PRELOAD = ("lindstedt.cli", "sympy", "scipy.optimize", "scipy.integrate", "scipy
 # NOTE: what a command's process imports before it computes (a second or more of CPU each
 # time): the fork server imports it once, and each forked run starts with it in memory.
 _SERVER: dict = {}
+_STARTING = threading.Lock()
 
 
 def _forked(args: list[str], cwd: str, out: str, err: str) -> None:
@@ -80,6 +82,27 @@ def _forked(args: list[str], cwd: str, out: str, err: str) -> None:
     script()
 
 
+def _start_server(env: dict[str, str] | None) -> None:
+    """The fork server of :func:`run_forked`, started once per process with this process's
+    environment and ``env`` (the environment restored after)."""
+    import multiprocessing
+
+    if "context" in _SERVER:
+        return
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(list(PRELOAD))
+    saved = dict(os.environ)
+    os.environ.update({**cached_env(), **(env or {})})
+    try:
+        from multiprocessing import forkserver
+
+        forkserver.ensure_running()
+    finally:
+        os.environ.clear()
+        os.environ.update(saved)
+    _SERVER["context"] = context
+
+
 def run_forked(*args: str, cwd=None, timeout: float = 600.0, env: dict[str, str] | None = None,
                check: bool = False) -> subprocess.CompletedProcess:
     """``lindstedt *args`` in a process of its own, forked from a server that has imported
@@ -89,22 +112,10 @@ def run_forked(*args: str, cwd=None, timeout: float = 600.0, env: dict[str, str]
     ``env`` at every call: it is the server's).  ``subprocess.TimeoutExpired`` past
     ``timeout`` seconds (the run killed); ``subprocess.CalledProcessError`` for a non-zero
     status with ``check``."""
-    import multiprocessing
     import tempfile
 
-    if "context" not in _SERVER:
-        context = multiprocessing.get_context("forkserver")
-        context.set_forkserver_preload(list(PRELOAD))
-        saved = dict(os.environ)
-        os.environ.update({**cached_env(), **(env or {})})
-        try:
-            from multiprocessing import forkserver
-
-            forkserver.ensure_running()
-        finally:
-            os.environ.clear()
-            os.environ.update(saved)
-        _SERVER["context"] = context
+    with _STARTING:  # two threads starting it at once: the second's "saved" was the first's
+        _start_server(env)  # environment for the server, and it kept it (tests/test_fuzz.py)
     with tempfile.TemporaryDirectory(prefix="lindstedt-forked-") as tmp:
         out, err = os.path.join(tmp, "stdout"), os.path.join(tmp, "stderr")
         child = _SERVER["context"].Process(target=_forked, args=([str(a) for a in args],

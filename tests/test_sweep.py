@@ -341,7 +341,9 @@ def test_cli_sweep_killed_then_resumed_equals_serial(tmp_path):
             "Q": [20.0]}
     args = [sys.executable, "-m", "lindstedt", "sweep", "stability", "--omega", "1.0:1.6:12",
             "--force", "0.3", "--eps", "0.1", "--Q", "20", "--chunk", "4", "--out", "s",
-            "--json"]
+            "--workers", "1", "--json"]
+    # NOTE: one worker: its cluster is killed and a second started all the same, for half
+    # the processes (test_local_cluster_equals_serial_and_shooting runs two)
     proc = subprocess.Popen(args, cwd=tmp_path, start_new_session=True,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 240
