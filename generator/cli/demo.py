@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
@@ -85,10 +86,12 @@ def run_demo(args: argparse.Namespace) -> int:
         print(f"  {draw(figures / name)}")
     if shutil.which("pdflatex"):
         for tex in sorted(out.glob("*.tex")):
-            for _ in range(2):  # longtable settles its column widths on the second pass
+            for _ in range(LATEX_PASSES):  # again while LaTeX asks (a longtable's widths)
                 subprocess.run(["pdflatex", "-interaction=batchmode", "-halt-on-error",
                                 "-output-directory", str(out), str(tex)],
                                check=True, stdout=subprocess.DEVNULL)
+                if not RERUN.search((out / f"{tex.stem}.log").read_text(errors="replace")):
+                    break
             print(f"  typeset {tex.with_suffix('.pdf')}")
     else:
         print("\npdflatex not found: `make demo` installs it; LaTeX sources are in", out)
@@ -98,6 +101,10 @@ def run_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+LATEX_PASSES = 3
+RERUN = re.compile(r"Rerun (LaTeX|to get)")
+# NOTE: pdflatex runs again only while its log asks (longtable: "Table widths have changed.
+# Rerun LaTeX."), as latexmk does: a document without a table is typeset once.
 DEMO_FIGURES = ("response.png", "mixing.png")
 # NOTE: two of the README's figures (~10 s together); `make figures` draws every one.
 LONGER_RUNS = (
