@@ -2,7 +2,7 @@
 # model: duffing, order: 12
 # command: lindstedt generate duffing --order 12
 # inputs sha256: 66ca4a0e4d6afa8046c93839a6f1efa563f457106a4ae4f18222a37b87ca56f2
-# body sha256: e2c574628ce67669db3d45ae9b29812e1beda20adb304da983ca6367dae10c1a
+# body sha256: 21fd1bd3ba7ab982e4926a7854b9c7f57905b57c42c594b47b8fa95f48a9582f
 """q'' + q + eps*q**3 = 0: L–P evaluators to order 12 in y = eps*A**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -260,9 +260,10 @@ def _sin(x):
     return v if abs(x) < TRIG_LIMIT else math.nan
 
 
-@vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
-def omega(A, eps):
-    """Frequency ω to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
+def _enter_0(A, eps):
+    """The common start of omega, period, error_estimate: whether the arguments are
+    inside their domain, and the quantities their bodies read (compiled once for all)."""
     inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
     A = ((A) if (inside == 1) else (0.1))
     eps = ((eps) if (inside == 1) else (0.1))
@@ -272,7 +273,32 @@ def omega(A, eps):
     x = eps
     x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
     x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
-    if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
+    return ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)), x
+
+
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
+def _enter_1(t, A, eps):
+    """The common start of q, qdot: whether the arguments are
+    inside their domain, and the quantities their bodies read (compiled once for all)."""
+    inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(t) and not math.isinf(t)) else (0))
+    A = ((A) if (inside == 1) else (0.1))
+    eps = ((eps) if (inside == 1) else (0.1))
+    t = ((t) if (inside == 1) else (0))
+    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) and (abs(t) <= 1.0e+300) else (0))
+    A = ((A) if (inside == 1) else (0.1))
+    eps = ((eps) if (inside == 1) else (0.1))
+    t = ((t) if (inside == 1) else (0))
+    x = eps
+    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
+    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
+    return ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)), A, t, x
+
+
+@vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
+def omega(A, eps):
+    """Frequency ω to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
+    _inside, x = _enter_0(A, eps)
+    if not _inside:
         return math.nan
     return 1 + x*(0.375 + x*(-0.08203125 + 0.03955078125*x)) + x**4*(-0.024982452392578125 + x*(0.017994403839111328 + x*(-0.01395021378993988 + 0.011320983991026878*x))) + x**8*(-0.00947632974202861 + x*(0.008112444011658226 + x*(-0.00706504934849761 + x*(0.006237279708448895 - 0.005568128115294488*x))))
 
@@ -323,16 +349,8 @@ def omega_into(out, A, eps):
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def period(A, eps):
     """Period T = 2π Σ τ_j y^j to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
-    inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
-    A = ((A) if (inside == 1) else (0.1))
-    eps = ((eps) if (inside == 1) else (0.1))
-    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) else (0))
-    A = ((A) if (inside == 1) else (0.1))
-    eps = ((eps) if (inside == 1) else (0.1))
-    x = eps
-    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
-    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
-    if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
+    _inside, x = _enter_0(A, eps)
+    if not _inside:
         return math.nan
     return 2*math.pi*(1 + x*(-0.375 + x*(0.22265625 - 0.15380859375*x)) + x**4*(0.11575698852539062 + x*(-0.09219503402709961 + x*(0.07641269266605377 - 0.0651973094791174*x))) + x**8*(0.05685099380571046 + x*(-0.05040817548206178 + x*(0.045286478809785535 + x*(-0.04111688992562357 + 0.037655499172602594*x)))))
 
@@ -383,18 +401,8 @@ def period_into(out, A, eps):
 @vectorize(["float64(float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def q(t, A, eps):
     """q(t) with s = ωt, harmonics by the Chebyshev recurrence (NaN where no periodic orbit exists or beyond the radius of convergence)."""
-    inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(t) and not math.isinf(t)) else (0))
-    A = ((A) if (inside == 1) else (0.1))
-    eps = ((eps) if (inside == 1) else (0.1))
-    t = ((t) if (inside == 1) else (0))
-    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) and (abs(t) <= 1.0e+300) else (0))
-    A = ((A) if (inside == 1) else (0.1))
-    eps = ((eps) if (inside == 1) else (0.1))
-    t = ((t) if (inside == 1) else (0))
-    x = eps
-    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
-    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
-    if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
+    _inside, A, t, x = _enter_1(t, A, eps)
+    if not _inside:
         return math.nan
     w = 1 + x*(0.375 + x*(-0.08203125 + 0.03955078125*x)) + x**4*(-0.024982452392578125 + x*(0.017994403839111328 + x*(-0.01395021378993988 + 0.011320983991026878*x))) + x**8*(-0.00947632974202861 + x*(0.008112444011658226 + x*(-0.00706504934849761 + x*(0.006237279708448895 - 0.005568128115294488*x))))
     s = t*w
@@ -485,18 +493,8 @@ def q_into(out, t, A, eps):
 @vectorize(["float64(float64, float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def qdot(t, A, eps):
     """dq/dt (NaN where no periodic orbit exists or beyond the radius of convergence)."""
-    inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(t) and not math.isinf(t)) else (0))
-    A = ((A) if (inside == 1) else (0.1))
-    eps = ((eps) if (inside == 1) else (0.1))
-    t = ((t) if (inside == 1) else (0))
-    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) and (abs(t) <= 1.0e+300) else (0))
-    A = ((A) if (inside == 1) else (0.1))
-    eps = ((eps) if (inside == 1) else (0.1))
-    t = ((t) if (inside == 1) else (0))
-    x = eps
-    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
-    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
-    if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
+    _inside, A, t, x = _enter_1(t, A, eps)
+    if not _inside:
         return math.nan
     w = 1 + x*(0.375 + x*(-0.08203125 + 0.03955078125*x)) + x**4*(-0.024982452392578125 + x*(0.017994403839111328 + x*(-0.01395021378993988 + 0.011320983991026878*x))) + x**8*(-0.00947632974202861 + x*(0.008112444011658226 + x*(-0.00706504934849761 + x*(0.006237279708448895 - 0.005568128115294488*x))))
     s = t*w
@@ -613,16 +611,8 @@ def qdot_into(out, t, A, eps):
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def error_estimate(A, eps):
     """Relative truncation error of period(), a bound on the omitted tail: |τ_{K+1}| |y|^(K+1) + c |y|^(K+2) / (1 - r|y|), its terms growing at most by r = max(1/R, |τ_{K+2}/τ_{K+1}|) an order, R the smaller of the radius less its spread and the distance to the orbits' edge, c = max(|τ_{K+2}|, r|τ_{K+1}|); over the truncated sum (inf from r|y| = 1 on: no bound there)."""
-    inside = ((1) if (not math.isnan(A) and not math.isinf(A)) and (not math.isnan(eps) and not math.isinf(eps)) else (0))
-    A = ((A) if (inside == 1) else (0.1))
-    eps = ((eps) if (inside == 1) else (0.1))
-    inside = ((1) if (inside == 1) and (abs(A) <= 1.0e+300) else (0))
-    A = ((A) if (inside == 1) else (0.1))
-    eps = ((eps) if (inside == 1) else (0.1))
-    x = eps
-    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
-    x = ((A*min(100000000.0, max(-100000000.0, x))) if (abs(A) > 1) else (A*x))
-    if not ((inside == 1) and (x > -1.0) and (x > -1) and (abs(x) < 1)):
+    _inside, x = _enter_0(A, eps)
+    if not _inside:
         return math.nan
     T = 1 + x*(-0.375 + x*(0.22265625 - 0.15380859375*x)) + x**4*(0.11575698852539062 + x*(-0.09219503402709961 + x*(0.07641269266605377 - 0.0651973094791174*x))) + x**8*(0.05685099380571046 + x*(-0.05040817548206178 + x*(0.045286478809785535 + x*(-0.04111688992562357 + 0.037655499172602594*x))))
     return (((0.03473509559274875)*abs(x)**13 + 0.034735095592748752*abs(x)**14/(1 - 1.0*abs(x))) if (1.0*abs(x) < 1) else (math.inf))/abs(T)

@@ -2,7 +2,7 @@
 # model: pendulum, order: 12
 # command: lindstedt generate pendulum --order 12
 # inputs sha256: 89790c3fd0e75fcdff47f37c71d07dae7a9aef7a774488dd064ce33f5d86074d
-# body sha256: 753cd5068b0d7f4123ff6c3c76728ba76357d1c5d62d8d574dfc454db676db97
+# body sha256: 6284daf3498c77a2f7739140b3363e6b14f7729deddbed49e76f93ebbe3176b2
 """theta'' + sin(theta) = 0: L–P evaluators to order 12 in y = theta0**2.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -260,15 +260,37 @@ def _sin(x):
     return v if abs(x) < TRIG_LIMIT else math.nan
 
 
-@vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
-def omega(theta0):
-    """Frequency ω to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
+def _enter_0(theta0):
+    """The common start of omega, period, error_estimate: whether the arguments are
+    inside their domain, and the quantities their bodies read (compiled once for all)."""
     inside = ((1) if (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
     theta0 = ((theta0) if (inside == 1) else (0.1))
     inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
     theta0 = ((theta0) if (inside == 1) else (0.1))
     x = theta0**2
-    if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+    return ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)), x
+
+
+@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
+def _enter_1(t, theta0):
+    """The common start of theta, thetadot: whether the arguments are
+    inside their domain, and the quantities their bodies read (compiled once for all)."""
+    inside = ((1) if (not math.isnan(t) and not math.isinf(t)) and (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
+    theta0 = ((theta0) if (inside == 1) else (0.1))
+    t = ((t) if (inside == 1) else (0))
+    inside = ((1) if (inside == 1) and (abs(t) <= 1.0e+300) and (abs(theta0) <= 1.0e+150) else (0))
+    theta0 = ((theta0) if (inside == 1) else (0.1))
+    t = ((t) if (inside == 1) else (0))
+    x = theta0**2
+    return ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)), theta0, t, x
+
+
+@vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
+def omega(theta0):
+    """Frequency ω to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
+    _inside, x = _enter_0(theta0)
+    if not _inside:
         return math.nan
     return 1 + x*(-0.0625 + x*(0.0003255208333333333 - 3.1195746527777775e-05*x)) + x**4*(-1.9065917484343998e-06 + x*(-1.4752202143324326e-07 + x*(-1.1845659117174713e-08 - 9.840751922602837e-10*x))) + x**8*(-8.387246616960268e-11 + x*(-7.292721445171067e-12 + x*(-6.443099177531727e-13 + x*(-5.76708223627214e-14 - 5.218096898167283e-15*x))))
 
@@ -312,12 +334,8 @@ def omega_into(out, theta0):
 @vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def period(theta0):
     """Period T = 2π Σ τ_j y^j to order 12 (NaN where no periodic orbit exists or beyond the radius of convergence)."""
-    inside = ((1) if (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
-    theta0 = ((theta0) if (inside == 1) else (0.1))
-    inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
-    theta0 = ((theta0) if (inside == 1) else (0.1))
-    x = theta0**2
-    if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+    _inside, x = _enter_0(theta0)
+    if not _inside:
         return math.nan
     return 2*math.pi*(1 + x*(0.0625 + x*(0.0035807291666666665 + 0.00023464626736111112*x)) + x**4*(1.735611567421565e-05 + x*(1.3867625063268805e-06 + x*(1.162356190273135e-07 + 1.0054783016898737e-08*x))) + x**8*(8.893476960263209e-10 + x*(7.997964280393218e-11 + x*(7.286018609303663e-12 + x*(6.706433207421971e-13 + 6.225550505750492e-14*x)))))
 
@@ -361,14 +379,8 @@ def period_into(out, theta0):
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def theta(t, theta0):
     """theta(t) with s = ωt, harmonics by the Chebyshev recurrence (NaN where no periodic orbit exists or beyond the radius of convergence)."""
-    inside = ((1) if (not math.isnan(t) and not math.isinf(t)) and (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
-    theta0 = ((theta0) if (inside == 1) else (0.1))
-    t = ((t) if (inside == 1) else (0))
-    inside = ((1) if (inside == 1) and (abs(t) <= 1.0e+300) and (abs(theta0) <= 1.0e+150) else (0))
-    theta0 = ((theta0) if (inside == 1) else (0.1))
-    t = ((t) if (inside == 1) else (0))
-    x = theta0**2
-    if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+    _inside, theta0, t, x = _enter_1(t, theta0)
+    if not _inside:
         return math.nan
     w = 1 + x*(-0.0625 + x*(0.0003255208333333333 - 3.1195746527777775e-05*x)) + x**4*(-1.9065917484343998e-06 + x*(-1.4752202143324326e-07 + x*(-1.1845659117174713e-08 - 9.840751922602837e-10*x))) + x**8*(-8.387246616960268e-11 + x*(-7.292721445171067e-12 + x*(-6.443099177531727e-13 + x*(-5.76708223627214e-14 - 5.218096898167283e-15*x))))
     s = t*w
@@ -452,14 +464,8 @@ def theta_into(out, t, theta0):
 @vectorize(["float64(float64, float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def thetadot(t, theta0):
     """dtheta/dt (NaN where no periodic orbit exists or beyond the radius of convergence)."""
-    inside = ((1) if (not math.isnan(t) and not math.isinf(t)) and (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
-    theta0 = ((theta0) if (inside == 1) else (0.1))
-    t = ((t) if (inside == 1) else (0))
-    inside = ((1) if (inside == 1) and (abs(t) <= 1.0e+300) and (abs(theta0) <= 1.0e+150) else (0))
-    theta0 = ((theta0) if (inside == 1) else (0.1))
-    t = ((t) if (inside == 1) else (0))
-    x = theta0**2
-    if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+    _inside, theta0, t, x = _enter_1(t, theta0)
+    if not _inside:
         return math.nan
     w = 1 + x*(-0.0625 + x*(0.0003255208333333333 - 3.1195746527777775e-05*x)) + x**4*(-1.9065917484343998e-06 + x*(-1.4752202143324326e-07 + x*(-1.1845659117174713e-08 - 9.840751922602837e-10*x))) + x**8*(-8.387246616960268e-11 + x*(-7.292721445171067e-12 + x*(-6.443099177531727e-13 + x*(-5.76708223627214e-14 - 5.218096898167283e-15*x))))
     s = t*w
@@ -569,12 +575,8 @@ def thetadot_into(out, t, theta0):
 @vectorize(["float64(float64)"], cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"})
 def error_estimate(theta0):
     """Relative truncation error of period(), a bound on the omitted tail: |τ_{K+1}| |y|^(K+1) + c |y|^(K+2) / (1 - r|y|), its terms growing at most by r = max(1/R, |τ_{K+2}/τ_{K+1}|) an order, R the smaller of the radius less its spread and the distance to the orbits' edge, c = max(|τ_{K+2}|, r|τ_{K+1}|); over the truncated sum (inf from r|y| = 1 on: no bound there)."""
-    inside = ((1) if (not math.isnan(theta0) and not math.isinf(theta0)) else (0))
-    theta0 = ((theta0) if (inside == 1) else (0.1))
-    inside = ((1) if (inside == 1) and (abs(theta0) <= 1.0e+150) else (0))
-    theta0 = ((theta0) if (inside == 1) else (0.1))
-    x = theta0**2
-    if not ((inside == 1) and (x < 9.869604401089358) and (x < math.pi**2) and (abs(x) < math.pi**2)):
+    _inside, x = _enter_0(theta0)
+    if not _inside:
         return math.nan
     T = 1 + x*(0.0625 + x*(0.0035807291666666665 + 0.00023464626736111112*x)) + x**4*(1.735611567421565e-05 + x*(1.3867625063268805e-06 + x*(1.162356190273135e-07 + 1.0054783016898737e-08*x))) + x**8*(8.893476960263209e-10 + x*(7.997964280393218e-11 + x*(7.286018609303663e-12 + x*(6.706433207421971e-13 + 6.225550505750492e-14*x))))
     return (((5.8202915552354634e-15)*abs(x)**13 + 5.8971882951996013e-16*abs(x)**14/(1 - 0.10132118364233778*abs(x))) if (0.10132118364233778*abs(x) < 1) else (math.inf))/abs(T)

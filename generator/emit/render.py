@@ -126,8 +126,59 @@ def pyliteral(value: object) -> str:
     return repr(value)
 
 
-def _evaluator_context(ev: Evaluator) -> dict:
+ENTRY_SHARED_BY = 2
+# NOTE: evaluators of one module with the same prelude and guard (the driven modules' cubic
+# root, phase and truncation test, repeated in every A_n, B_n) start from one compiled entry
+# function: numba types and lowers it once, not once per evaluator and again per ``_into`` loop
+# (every evaluator and loop of the damped module at order 2: 37 → 17 s of CPU to compile; the
+# undamped one at order 3: 26 → 12 s).  The loops share it only where the prelude calls libm
+# (acos, atan2, …), which keeps a loop scalar anyway; a vectorisable prelude stays inline.
+
+
+def _entry_outputs(ev: Evaluator) -> list[str]:
+    """The prelude's names the body and output read, in the prelude's order (once each)."""
+    used = set().union(*(e.free_symbols for e in (ev.output, *(r for _, r in ev.body))))
+    names = dict.fromkeys(str(lhs) for lhs, _ in ev.prelude if lhs in used)
+    return list(names)
+
+
+def _entries(evaluators: tuple[Evaluator, ...]) -> dict[tuple, dict]:
+    """One entry function for each prelude and guard that ``ENTRY_SHARED_BY`` or more
+    evaluators share: its name, source (scalar and SIMD) and the names it returns."""
+    groups: dict[tuple, list[Evaluator]] = {}
+    for ev in evaluators:
+        if ev.prelude:
+            groups.setdefault((ev.args, ev.prelude, ev.guard), []).append(ev)
+    entries = {}
+    for key, users in groups.items():
+        if len(users) < ENTRY_SHARED_BY:
+            continue
+        args, prelude, guard = key
+        outputs = list(dict.fromkeys(n for ev in users for n in _entry_outputs(ev)))
+        into_prelude = [(str(lhs), pycode(rhs, simd=True)) for lhs, rhs in prelude]
+        into_guard = pycode(guard, simd=True)
+        entries[key] = {
+            "name": f"_enter_{len(entries)}",
+            "args": ", ".join(str(a) for a in args),
+            "users": [ev.name for ev in users],
+            "prelude": [(str(lhs), pycode(rhs)) for lhs, rhs in prelude],
+            "guard": pycode(guard),
+            "into_prelude": into_prelude,
+            "into_guard": into_guard,
+            "outputs": outputs,
+            "into": any(LIBM.search(rhs) for _, rhs in (*into_prelude, ("", into_guard))),
+        }
+    return entries
+
+
+LIBM = re.compile(r"\bmath\.(acos|asin|atan|atan2|cbrt|cos|sin|tan|exp|expm1|log|log1p|pow|"
+                  r"cosh|sinh|tanh|erf|gamma|lgamma)\(")
+# NOTE: a call LLVM has no vector form of here: the loop that makes it is scalar.
+
+
+def _evaluator_context(ev: Evaluator, entry: dict | None = None) -> dict:
     return {
+        "entry": entry,
         "name": ev.name,
         "doc": ev.doc,
         "args": ", ".join(str(a) for a in ev.args),
@@ -176,7 +227,10 @@ def render_module(module: Module) -> str:
         doc=module.doc,
         fastmath=FASTMATH,
         constants=[(name, pyliteral(value)) for name, value in module.constants],
-        evaluators=(evaluators := [_evaluator_context(ev) for ev in module.evaluators]),
+        entries=list((entries := _entries(module.evaluators)).values()),
+        evaluators=(evaluators := [
+            _evaluator_context(ev, entries.get((ev.args, ev.prelude, ev.guard)))
+            for ev in module.evaluators]),
         trig=any(ev["trig"] for ev in evaluators),
         kernels=[_kernel_context(k) for k in module.kernels],
         newton=module.newton,
