@@ -7,12 +7,16 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: demo test test-fast tex lint lock bench figures generated clean
 
-# constraints.txt pins every package of the test and demo environment (make lock refreshes it);
-# --no-compile: Python compiles what is imported as it imports it, not all of SciPy up front.
+# constraints.txt pins every package of the test and demo environment (make lock refreshes it).
+# The venv's bytecode is compiled once, on every core (compileall -j 0; pip's own --compile is
+# one core): a machine with PYTHONDONTWRITEBYTECODE set never writes it as it imports, so every
+# new process (a CLI run, a Dask worker) would compile SymPy, SciPy and NumPy from source again,
+# about 3 s of CPU each.
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet -c constraints.txt --upgrade pip
 	$(BIN)/pip install --quiet --no-compile -c constraints.txt -e '.[test]'
+	$(BIN)/python -m compileall -q -j 0 $$($(BIN)/python -c "import sysconfig; print(sysconfig.get_path('purelib'))") generator > /dev/null
 	touch $(STAMP)
 
 # Re-pins constraints.txt from pyproject.toml's ranges in a scratch venv: run it on purpose,
