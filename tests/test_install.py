@@ -8,7 +8,6 @@ One venv serves every test here, on whichever pytest-xdist worker runs it (build
 from __future__ import annotations
 
 import fcntl
-import os
 import shutil
 import subprocess
 import sys
@@ -27,10 +26,6 @@ SOURCES = ("pyproject.toml", "README.md", "generator", "templates")
 
 def _run(cmd: list, cwd: Path, timeout: float = 900, env: dict | None = None
          ) -> subprocess.CompletedProcess:
-    # NOTE: bytecode written as the venv's processes import (PYTHONDONTWRITEBYTECODE dropped):
-    # the venv is this run's own, and each later process then reads SymPy and SciPy compiled.
-    env = {k: v for k, v in (os.environ if env is None else env).items()
-           if k != "PYTHONDONTWRITEBYTECODE"}
     out = subprocess.run([str(c) for c in cmd], cwd=cwd, capture_output=True, text=True,
                          timeout=timeout, check=False, env=env)
     assert out.returncode == 0, f"{cmd}\n{out.stdout[-2000:]}\n{out.stderr[-4000:]}"

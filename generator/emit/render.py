@@ -135,39 +135,29 @@ ENTRY_SHARED_BY = 2
 # (acos, atan2, …), which keeps a loop scalar anyway; a vectorisable prelude stays inline.
 
 
-def _entry_outputs(ev: Evaluator) -> list[str]:
-    """The prelude's names the body and output read, in the prelude's order (once each)."""
-    used = set().union(*(e.free_symbols for e in (ev.output, *(r for _, r in ev.body))))
-    names = dict.fromkeys(str(lhs) for lhs, _ in ev.prelude if lhs in used)
-    return list(names)
-
-
 def _entries(evaluators: tuple[Evaluator, ...]) -> dict[tuple, dict]:
     """One entry function for each prelude and guard that ``ENTRY_SHARED_BY`` or more
-    evaluators share: its name, source (scalar and SIMD) and the names it returns."""
+    evaluators share: its name, source (scalar and SIMD) and the prelude's names it returns
+    (those the users' bodies read)."""
     groups: dict[tuple, list[Evaluator]] = {}
     for ev in evaluators:
         if ev.prelude:
             groups.setdefault((ev.args, ev.prelude, ev.guard), []).append(ev)
     entries = {}
-    for key, users in groups.items():
-        if len(users) < ENTRY_SHARED_BY:
-            continue
-        args, prelude, guard = key
-        outputs = list(dict.fromkeys(n for ev in users for n in _entry_outputs(ev)))
-        into_prelude = [(str(lhs), pycode(rhs, simd=True)) for lhs, rhs in prelude]
-        into_guard = pycode(guard, simd=True)
-        entries[key] = {
-            "name": f"_enter_{len(entries)}",
-            "args": ", ".join(str(a) for a in args),
-            "users": [ev.name for ev in users],
-            "prelude": [(str(lhs), pycode(rhs)) for lhs, rhs in prelude],
-            "guard": pycode(guard),
-            "into_prelude": into_prelude,
-            "into_guard": into_guard,
-            "outputs": outputs,
-            "into": any(LIBM.search(rhs) for _, rhs in (*into_prelude, ("", into_guard))),
-        }
+    for (args, prelude, guard), users in groups.items():
+        if len(users) >= ENTRY_SHARED_BY:
+            read = set().union(*(e.free_symbols for ev in users
+                                 for e in (ev.output, *(r for _, r in ev.body))))
+            into = [(str(lhs), pycode(rhs, simd=True)) for lhs, rhs in prelude]
+            entries[args, prelude, guard] = {
+                "name": f"_enter_{len(entries)}", "args": ", ".join(map(str, args)),
+                "users": [ev.name for ev in users],
+                "prelude": [(str(lhs), pycode(rhs)) for lhs, rhs in prelude],
+                "guard": pycode(guard), "into_prelude": into,
+                "into_guard": pycode(guard, simd=True),
+                "outputs": list(dict.fromkeys(str(lhs) for lhs, _ in prelude if lhs in read)),
+                "into": any(LIBM.search(r) for _, r in (*into, ("", pycode(guard, simd=True)))),
+            }
     return entries
 
 
