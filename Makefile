@@ -7,19 +7,20 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: demo test test-fast tex lint lock bench figures generated clean
 
-# constraints.txt pins every package of the test and demo environment (make lock refreshes it);
-# --no-compile: Python compiles what is imported as it imports it, not all of SciPy up front.
+# constraints.txt pins every package of the test and demo environment (make lock refreshes it).
+# The venv's bytecode is compiled once, on every core (compileall -j 0; pip's own --compile is
+# one core), packages' own test folders left out: where PYTHONDONTWRITEBYTECODE is set nothing
+# writes it as it imports, and every new process (a CLI run, a Dask worker, a child) compiled
+# SymPy, SciPy and NumPy from source again, about 3 s of CPU each (lindstedt.sweep.kinds
+# imported in 4.4 s rather than 1.4).
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet -c constraints.txt --upgrade pip
 	$(BIN)/pip install --quiet --no-compile -c constraints.txt -e '.[test]'
+	$(BIN)/python -m compileall -q -j 0 -x 'site-packages/.+/tests?/' \
+	  "$$($(BIN)/python -c "import sysconfig; print(sysconfig.get_path('purelib'))")" generator \
+	  > /dev/null
 	touch $(STAMP)
-
-# Bytecode is written as it is compiled, under the venv (PYTHONPYCACHEPREFIX: nothing beside the
-# sources), even where PYTHONDONTWRITEBYTECODE is set: otherwise every new process of the suite
-# (a CLI run, a Dask worker, a child) compiles SymPy, SciPy and NumPy from source again, about
-# 3 s of CPU each (lindstedt.sweep.kinds imports in 4.4 s rather than 1.4).
-RUN = env -u PYTHONDONTWRITEBYTECODE PYTHONPYCACHEPREFIX=$(abspath $(VENV))/pycache
 
 # Re-pins constraints.txt from pyproject.toml's ranges in a scratch venv: run it on purpose,
 # then run make test and commit both.
@@ -44,17 +45,17 @@ tex:
 
 # Writes only under out/ (ignored by git): the checkout stays clean.
 demo: $(STAMP) tex
-	$(RUN) $(BIN)/lindstedt demo --out out
+	$(BIN)/lindstedt demo --out out
 
 # The whole suite in one run on every core (pytest-xdist): whole test files handed to the first
 # idle worker, the longest first (tests/conftest.py, tests/durations.json).
 SUITE = -n auto --dist loadfile --no-loadscope-reorder
 test: $(STAMP) tex
 	$(BIN)/ruff check generator tests benchmarks
-	$(RUN) $(BIN)/python -m pytest $(SUITE)
+	$(BIN)/python -m pytest $(SUITE)
 
 test-fast: $(STAMP)
-	$(RUN) $(BIN)/python -m pytest $(SUITE) -m exact
+	$(BIN)/python -m pytest $(SUITE) -m exact
 
 lint: $(STAMP)
 	$(BIN)/ruff check generator tests benchmarks

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from commands import cached_env, run
+from commands import cached_env, run, van_der_pol_resummed
 
 ROOT = Path(__file__).resolve().parent.parent
 GENERATED = ROOT / "generated"
@@ -433,46 +433,37 @@ def domain_findings(mod, names: tuple[str, ...], skip: frozenset = frozenset()) 
 
 NEWER = {  # each module's name, and the command (less --out) that emits it
     "driven_damped": ["generate", "driven", "--damped", "--order", "2"],
-    "van_der_pol": ["generate", "van_der_pol", "--order", "12", "--resum-order", "60"],
     "mathieu_a1": ["mathieu", "a", "--m", "1", "--order", "8"],
     "vdp_slow_flow": ["slowflow", "van_der_pol", "--name", "vdp"],
     "tongue_1": ["tongues", "cos(t) + 1/2*cos(2*t)", "--n", "1", "--order", "12"],
 }
-RESUM_CHECKS = {"van_der_pol": (1.0, 2.0)}
-# NOTE: van der Pol's resummed evaluators shot at two check points rather than fourteen: the
-# module then differs only in its list of them (the same limits, 3.75, 3.025 and 1.875, and
-# the same code), and it is written in 16 s rather than 29.  With these checks it is, byte for
-# byte, the module tests/test_resum.py verifies against shooting: compiled once for both.
-
-
 class _Emitted(dict):
     """Each module of :data:`NEWER` emitted and loaded when a test first asks for it: a worker
     compiles only the modules its tests use."""
 
-    def __init__(self, out: Path) -> None:
+    def __init__(self, out: Path, run_folder: Path) -> None:
         super().__init__()
-        self.out = out
+        self.out, self.run_folder = out, run_folder
 
     def __missing__(self, name: str):
         from lindstedt.emit.render import load_generated
-        from lindstedt.methods import verify
 
-        with pytest.MonkeyPatch.context() as patch:
-            if name in RESUM_CHECKS:
-                patch.setattr(verify, "RESUM_CHECKS", RESUM_CHECKS[name])
-            made = run(*NEWER[name], "--out", self.out)
+        if name == "van_der_pol":  # the module tests/test_resum.py verifies against shooting
+            self[name] = load_generated(van_der_pol_resummed(self.run_folder) / f"{name}.py")
+            return self[name]
+        made = run(*NEWER[name], "--out", self.out)
         assert made.returncode == 0, made.stderr
         self[name] = load_generated(self.out / f"{name}.py")
         return self[name]
 
 
 @pytest.fixture(scope="module")
-def newer_modules(tmp_path_factory):
+def newer_modules(tmp_path_factory, run_folder):
     """The modules emitted on request: the damped μ-expansion (order 2), van der Pol's cycle
     with its resummed evaluators (order 12, ω resummed from order 60), Mathieu's a₁, van der
     Pol's slow flow and the transition curves of a two-harmonic p (order 12), each made when
     first used."""
-    return _Emitted(tmp_path_factory.mktemp("newer"))
+    return _Emitted(tmp_path_factory.mktemp("newer"), run_folder)
 
 
 def test_damped_module_is_nan_without_a_warning_outside_its_domain(newer_modules):

@@ -7,7 +7,6 @@ One venv serves every test here, on whichever pytest-xdist worker runs it (build
 
 from __future__ import annotations
 
-import fcntl
 import shutil
 import subprocess
 import sys
@@ -16,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from commands import cached_env
+from commands import cached_env, made_once
 from scipy.special import ellipk
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,14 +35,7 @@ def _run(cmd: list, cwd: Path, timeout: float = 900, env: dict | None = None
 def venv(run_folder) -> Path:
     """A fresh venv holding the wheel of this checkout and its dependencies, built once in the
     run's folder: a pytest-xdist worker that needs it while another builds it waits for it."""
-    work = run_folder / "install"
-    work.mkdir(exist_ok=True)
-    with open(work / "lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
-        if not (work / "built").exists():
-            _build(work)
-            (work / "built").touch()
-    return work / "venv"
+    return made_once(run_folder / "install", _build) / "venv"
 
 
 def _build(work: Path) -> None:

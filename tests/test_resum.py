@@ -10,6 +10,7 @@ from fractions import Fraction as F
 import mpmath
 import numpy as np
 import pytest
+from commands import van_der_pol_resummed
 from lindstedt.algebra.resum import (
     compose,
     pade,
@@ -141,29 +142,26 @@ def test_the_shooting_reference_against_the_literature():
 
 
 @pytest.fixture(scope="module")
-def emitted(tmp_path_factory):
+def emitted(run_folder):
     """The module `lindstedt generate van_der_pol --order 12 --resum-order 60` writes (partial
     sums to order 12, ω resummed from its series to order 60: the relaxation form is then
-    verified to |ε| ≈ 3.75), with fewer shooting checks."""
-    from lindstedt.compiler import generate_limit_cycle
+    verified to |ε| ≈ 3.75), with fewer shooting checks, and its folder (made once a run:
+    tests/test_emitted_safety.py loads it too)."""
     from lindstedt.emit.render import load_generated
 
-    out = tmp_path_factory.mktemp("vdp")
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(methods, "RESUM_CHECKS", (1.0, 2.0))
-        paths = generate_limit_cycle(series_model("van_der_pol", 14), 12, out, resum_order=60)
-    return load_generated(out / "van_der_pol.py"), paths
+    folder = van_der_pol_resummed(run_folder)
+    return load_generated(folder / "van_der_pol.py"), folder
 
 
 def test_emitted_resummed_frequency_against_shooting(emitted):
     """omega_resummed, period_resummed and amplitude_resummed within 1e-12 of DOP853 shooting
     for ε ≤ 1 (the series alone stops at 0.9·√3.42 = 1.66) and within 1e-6 up to the verified
     limit; NaN beyond it; the error estimate is below the tolerance there."""
-    mod, paths = emitted
+    mod, folder = emitted
     assert 3.5 < mod.RESUMMED_LIMIT < 4.5
     # the partial sums stop at 12, the resummed form uses all 31 terms in ε² of order 60
     assert mod.ORDER == 12 and len(mod.OMEGA_EXACT) == 13 and mod.RESUMMED_DEGREES == (17, 16)
-    assert "--order 12 --resum-order 60" in paths[0].read_text()
+    assert "--order 12 --resum-order 60" in (folder / "van_der_pol.py").read_text()
     vdp = series_model("van_der_pol", 4)
     for eps, tol in ((0.1, 1e-12), (1.0, 1e-12), (2.5, 1e-6), (mod.RESUMMED_LIMIT, 1e-6)):
         ref = cycle_reference(vdp, eps)
@@ -253,17 +251,19 @@ def test_resum_order_is_refused_where_it_means_nothing(tmp_path, capsys):
 
 
 def test_generated_limit_cycle_module_is_byte_identical(emitted, tmp_path):
-    """A second, independent generation writes the same bytes."""
+    """A second, independent generation (through the API, in this process) writes the same
+    bytes as the command line's."""
     from lindstedt.compiler import generate_limit_cycle
 
-    _, paths = emitted
+    _, folder = emitted
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(methods, "RESUM_CHECKS", (1.0, 2.0))
         again = generate_limit_cycle(series_model("van_der_pol", 14), 12, tmp_path,
                                      resum_order=60)
-    assert [p.name for p in again] == [p.name for p in paths]
-    for a, b in zip(paths, again, strict=True):
-        assert a.read_bytes() == b.read_bytes()
+    assert sorted(p.name for p in again) == sorted(p.name for p in folder.iterdir()
+                                                   if p.is_file())
+    for p in again:
+        assert p.read_bytes() == (folder / p.name).read_bytes(), p.name
 
 
 def test_mathieu_reference_against_dlmf_and_mpmath():
