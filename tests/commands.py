@@ -26,6 +26,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 from numba.core.caching import Cache, _CacheLocator, _SourceFileBackedLocatorMixin
@@ -136,7 +137,7 @@ def run_forked(*args: str, cwd=None, timeout: float = 600.0, env: dict[str, str]
     return subprocess.CompletedProcess(argv, status, stdout, stderr)
 
 
-def made_once(folder: Path, make) -> Path:
+def made_once(folder: Path, make: Callable[[Path], object]) -> Path:
     """``folder`` holding what ``make(folder)`` writes, made once in a run of the suite: by
     the first test, on whichever pytest-xdist worker, that asks for it (``folder`` in the run's
     shared folder); a worker that asks while another makes it waits for it."""

@@ -149,14 +149,14 @@ def _entries(evaluators: tuple[Evaluator, ...]) -> dict[tuple, dict]:
             read = set().union(*(e.free_symbols for ev in users
                                  for e in (ev.output, *(r for _, r in ev.body))))
             into = [(str(lhs), pycode(rhs, simd=True)) for lhs, rhs in prelude]
+            into_guard = pycode(guard, simd=True)
             entries[args, prelude, guard] = {
                 "name": f"_enter_{len(entries)}", "args": ", ".join(map(str, args)),
                 "users": [ev.name for ev in users],
                 "prelude": [(str(lhs), pycode(rhs)) for lhs, rhs in prelude],
-                "guard": pycode(guard), "into_prelude": into,
-                "into_guard": pycode(guard, simd=True),
+                "guard": pycode(guard), "into_prelude": into, "into_guard": into_guard,
                 "outputs": list(dict.fromkeys(str(lhs) for lhs, _ in prelude if lhs in read)),
-                "into": any(LIBM.search(r) for _, r in (*into, ("", pycode(guard, simd=True)))),
+                "into": any(LIBM.search(r) for r in (into_guard, *(r for _, r in into))),
             }
     return entries
 
