@@ -176,6 +176,28 @@ def test_lanczos_route_equals_the_dense_one(monkeypatch, tmp_path):
         assert abs(a - b) < 1e-9 * abs(b)
 
 
+@pytest.mark.parametrize("turn", [-1.0, 1j, np.exp(2.5j)])
+def test_the_mode_shape_does_not_follow_lapacks_orientation(monkeypatch, turn):
+    """A symmetric pair's lower mode is (1, −1)/(2√2): its two components are equal in size and
+    differ by rounding that LAPACK's kernels do not share across machines.  Its eigenvectors
+    turned by −1, i or any phase, and the largest component made larger or smaller by one
+    rounding, give the same shape: the first of the largest components real and positive."""
+    system = parse_system("x1'' + 5*x1/2 + 3*x2/2 + x1**2 = 0; x2'' + 3*x1/2 + 5*x2/2 = 0")
+    eig = np.linalg.eig
+    for nudge in (1 - 2**-52, 1 + 2**-52):
+        def turned(A, nudge=nudge):
+            lams, vecs = eig(A)
+            vecs = vecs * turn
+            vecs[1] *= nudge  # x2's component a rounding larger or smaller than x1's
+            return lams, vecs
+
+        monkeypatch.setattr(np.linalg, "eig", turned)
+        shape = ssm_module.linear_mode(system.matrices, 1).shape
+        assert np.max(np.abs(shape - np.array([1, -1]) / (2 * math.sqrt(2)))) < 1e-15
+    assert ssm_module.leading(np.array([1 - 2**-52, -1.0, 0.5])) == 0
+    assert ssm_module.leading(np.array([0.5, -1.0, 1 - 2**-52])) == 1
+
+
 def _model_folder(folder, M, K, C, lines, drive):
     """A model folder as a finite-element code writes it."""
     mmwrite(folder / "M.mtx", sparse.coo_matrix(M))

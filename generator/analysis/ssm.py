@@ -142,11 +142,22 @@ def linear_mode(w: Matrices, mode: int) -> LinearMode:
                            if j != mode - 1 and q > 0])
         checked = f"the lowest {count} modes (Lanczos)"
     lam, phi = _refined(w, lam, phi, mode)
-    phi = phi * np.exp(-1j * np.angle(phi[np.argmax(np.abs(phi))]))
+    phi = phi * np.exp(-1j * np.angle(phi[leading(phi)]))
     phi = phi / (2 * math.sqrt(float(np.real(np.conj(phi) @ (M @ phi)))))
     left = _left(w, lam, phi)
     left = left / (left @ ((C + 2 * lam * M) @ phi))
     return LinearMode(lam, phi, left, others, checked)
+
+
+def leading(v: np.ndarray) -> int:
+    """The index of ``v``'s largest component: the first of those within :data:`TIE` of the
+    largest (components equal in exact arithmetic, as in ``(1, −1)/√2``, differ by rounding that
+    LAPACK's kernels do not share across machines; the choice must not depend on it)."""
+    size = np.abs(v)
+    return int(np.flatnonzero(size >= (1 - TIE) * size.max())[0])
+
+
+TIE = 1e-9
 
 
 def _refined(w: Matrices, lam: complex, phi: np.ndarray, mode: int

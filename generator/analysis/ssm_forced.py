@@ -48,6 +48,7 @@ from .ssm import (
     _pencil,
     _Product,
     _solve,
+    leading,
     peak_amplitude,
     ssm,
 )
@@ -789,7 +790,7 @@ def reduce(system: System, mode: int, order: int, outputs: list[int] | None = No
     model = ssm(system, mode, order)
     if outputs is None:
         outputs = (list(range(system.size)) if system.size <= NAMED_OUTPUTS
-                   else [int(np.argmax(np.abs(model.linear.shape)))])
+                   else [leading(model.linear.shape)])
     outputs = np.array(outputs, dtype=np.int64)
     names = tuple(str(system.coordinates[i]) for i in outputs)
     response = None

@@ -40,7 +40,7 @@ from numpy.polynomial import chebyshev
 from ..derive.system import System
 from ..errors import InputError
 from ..numerics.newton import secant
-from .ssm import BORDERED, DENSE_SOLVES, _bordered, _damping, peak_amplitude
+from .ssm import BORDERED, DENSE_SOLVES, _bordered, _damping, leading, peak_amplitude
 from .ssm_forced import BACKBONE_POINTS, DEFAULT_SPAN, NAMED_OUTPUTS, REACH
 from .ssm_resonant import ResonantSSM, Term, resonant_ssm
 
@@ -442,7 +442,7 @@ def reduce_pair(system: System, modes: tuple[int, ...], order: int,
     model = resonant_ssm(system, modes, order)
     if outputs is None:
         outputs = (list(range(system.size)) if system.size <= NAMED_OUTPUTS else sorted(
-            {int(np.argmax(np.abs(lin.shape))) for lin in model.linear}))
+            {leading(lin.shape) for lin in model.linear}))
     outputs = np.array(outputs, dtype=np.int64)
     names = tuple(str(system.coordinates[i]) for i in outputs)
     end = rho_max
