@@ -7,6 +7,13 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: demo test test-fast tex lint lock bench figures generated clean
 
+# The venv and TeX install side by side (each waits on downloads and the disk more than on a
+# core: half a minute saved on a fresh machine), where no password prompt for sudo can be lost
+# to a job without the terminal.
+ifeq ($(shell id -u),0)
+MAKEFLAGS += -j2
+endif
+
 # constraints.txt pins every package of the test and demo environment (make lock refreshes it).
 # The venv's bytecode is compiled once, on every core (compileall -j 0; pip's own --compile is
 # one core), packages' own test folders left out: where PYTHONDONTWRITEBYTECODE is set nothing

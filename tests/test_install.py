@@ -7,6 +7,7 @@ One venv serves every test here, on whichever pytest-xdist worker runs it (build
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import sys
@@ -25,6 +26,11 @@ SOURCES = ("pyproject.toml", "README.md", "generator", "templates")
 
 def _run(cmd: list, cwd: Path, timeout: float = 900, env: dict | None = None
          ) -> subprocess.CompletedProcess:
+    """``cmd`` in ``cwd``, writing bytecode as it imports (as a user's Python does): the wheel
+    is installed ``--no-compile``, and where ``PYTHONDONTWRITEBYTECODE`` is set every process
+    would compile SymPy, SciPy and NumPy from source again."""
+    env = {k: v for k, v in (os.environ if env is None else env).items()
+           if k != "PYTHONDONTWRITEBYTECODE"}
     out = subprocess.run([str(c) for c in cmd], cwd=cwd, capture_output=True, text=True,
                          timeout=timeout, check=False, env=env)
     assert out.returncode == 0, f"{cmd}\n{out.stdout[-2000:]}\n{out.stderr[-4000:]}"
