@@ -73,10 +73,12 @@ def reciprocal(series: list[Fraction]) -> list[Fraction]:
 
 
 def periodic_orbit(eps: float, force: float, omega: float, q0: float,
-                   rtol: float = 1e-12, samples: int = 64) -> tuple:
-    """The periodic orbit of the undamped ``q'' + q + εq³ = f cos ωt`` through ``q(0) ≈ q0``,
-    ``q'(0) ≈ 0``: Newton's method on the period map ``y(0) ↦ y(2π/ω)`` (SciPy's DOP853 at
-    ``rtol``, the Jacobian from the variational equations), then the Fourier coefficients of
+                   rtol: float = 1e-12, samples: int = 64, damping: float = 0.0,
+                   p0: float = 0.0) -> tuple:
+    """The periodic orbit of ``q'' + c q' + q + εq³ = f cos ωt`` (``c``: ``damping``, none by
+    default) through ``q(0) ≈ q0``, ``q'(0) ≈ p0``: Newton's method on the period map
+    ``y(0) ↦ y(2π/ω)`` (SciPy's DOP853 at ``rtol``, the Jacobian from the variational
+    equations), then the Fourier coefficients of
     ``q = Σ A_n cos nωt + B_n sin nωt`` from ``samples`` points of one period (arrays indexed
     by n).  SciPy and NumPy only."""
     import numpy as np
@@ -86,14 +88,14 @@ def periodic_orbit(eps: float, force: float, omega: float, q0: float,
 
     def rhs(t, y):
         k = -1 - 3 * eps * y[0] ** 2
-        return [y[1], -y[0] - eps * y[0] ** 3 + force * np.cos(omega * t),
-                y[4], y[5], k * y[2], k * y[3]]
+        return [y[1], -y[0] - eps * y[0] ** 3 - damping * y[1] + force * np.cos(omega * t),
+                y[4], y[5], k * y[2] - damping * y[4], k * y[3] - damping * y[5]]
 
     def flow(y0, t_eval=None):
         return solve_ivp(rhs, (0, period), [*y0, 1.0, 0.0, 0.0, 1.0], method="DOP853",
                          rtol=rtol, atol=rtol * 1e-3, t_eval=t_eval)
 
-    y0 = np.array([q0, 0.0])
+    y0 = np.array([q0, p0])
     for _ in range(30):
         end = flow(y0).y[:, -1]
         step = np.linalg.solve(end[2:].reshape(2, 2) - np.eye(2), y0 - end[:2])
