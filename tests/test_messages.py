@@ -4,6 +4,7 @@ range printed with its ends alike."""
 from __future__ import annotations
 
 import pytest
+from commands import run
 from lindstedt.cli import build_parser, main
 from lindstedt.cli.common import interval
 
@@ -52,3 +53,19 @@ def test_response_prints_a_narrow_range_with_distinct_ends(capsys):
                  "1:1.0000001"]) == 0
     head = capsys.readouterr().out.splitlines()[0]
     assert head.endswith("w in [1, 1.0000001] (omega0 = 1)"), head
+
+
+
+HUGE = "1" + "0" * 400
+
+
+@pytest.mark.parametrize("argv", [["choose", "period", "--tol", "1e-6", "--range", f"0:{HUGE}"],
+                                  ["response", "duffing", "--omega", HUGE],
+                                  ["generate", "duffing", "--order", HUGE]])
+def test_a_huge_number_is_named_by_its_ends_and_length(argv):
+    """A 401-digit value (refused by argparse, or by the command itself): one line that names
+    it by its ends and its length rather than echoing it whole; exit status 2."""
+    done = run(*argv)
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr.count("\n") == 1 and "1000000000…0000 (401 digits)" in done.stderr
+    assert HUGE not in done.stderr and len(done.stderr) < 250, done.stderr

@@ -232,7 +232,9 @@ def test_emitted_resummed_q_against_the_shot_orbit(emitted):
 
 def test_resum_order_is_refused_where_it_means_nothing(tmp_path, capsys):
     """--resum-order below the order + 2 the error estimate needs, on a module without a
-    limit cycle, on an oscillator without one, negative: one line, exit 2, nothing written."""
+    limit cycle, on an oscillator without one, negative, on a cycle whose ω(ε) is not resummed
+    (rather than a module without the resummed evaluators asked for): one line, exit 2,
+    nothing written."""
     from lindstedt.cli import main
 
     for args, words in (
@@ -240,7 +242,10 @@ def test_resum_order_is_refused_where_it_means_nothing(tmp_path, capsys):
             (["duffing", "--resum-order", "60"], "duffing has no limit cycle"),
             (["driven", "--resum-order", "60"], "no limit cycle to resum"),
             (["q'' + q + eps*q**3 = 0", "--resum-order", "60"], "has no limit cycle"),
-            (["van_der_pol", "--resum-order", "-1"], "--resum-order")):
+            (["van_der_pol", "--resum-order", "-1"], "--resum-order"),
+            # a cycle whose ω(ε) has a real singularity (Domb–Sykes): asked for, not resummed
+            (["q'' + q = eps*(1 - q**2)*q' + eps*q**2", "--order", "6", "--resum-order", "30"],
+             "ω(ε) is not resummed: ω's nearest singularity is estimated by Domb–Sykes")):
         try:
             code = main(["generate", *args, "--out", str(tmp_path / "x")])
         except SystemExit as exc:  # argparse's own refusals

@@ -17,7 +17,7 @@ from typing import NoReturn
 from .. import __version__
 from ..costs import COSTS, ROUTE_COSTS
 from ..derive.problem import NOTES_PRESET, Problem, read_problem
-from ..errors import InputError, Interrupted
+from ..errors import InputError, Interrupted, clipped
 from ..limits import COST_LIMIT_SECONDS
 from .choose import (
     arguments_choose,
@@ -209,7 +209,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         sys.stdout.flush()  # a reader that went away (`| head`) is noticed here, not at exit
         return status
     except InputError as exc:
-        print(f"lindstedt: error: {exc}", file=sys.stderr)
+        print(f"lindstedt: error: {clipped(str(exc))}", file=sys.stderr)
         return 2
     except (KeyboardInterrupt, Interrupted) as exc:
         # Ctrl-C or SIGTERM: one line and exit 130 (128 + SIGINT), at once.  Files are written

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from fractions import Fraction
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import InputError, clipped
 from ..limits import COST_LIMIT_SECONDS, MAX_HARMONICS
 
 # NOTE: nothing heavy is imported here: `lindstedt --help` and argument errors must answer in
@@ -336,7 +336,7 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> None:  # type: ignore[override]
         # one prefix for every error, a subcommand's argparse ones included
-        message = self._did_you_mean(message)
+        message = clipped(self._did_you_mean(message))
         self.exit(2, f"lindstedt: error: {self.prog.removeprefix('lindstedt ')}: {message}\n"
                   if self.prog != "lindstedt" else f"lindstedt: error: {message}\n")
 

@@ -214,7 +214,12 @@ def _cycle_derive(r: CycleRequest, progress: Progress | None
                          f"Q({first.amplitude}); the evaluators and their resummation need "
                          "rational coefficients and are not emitted for it")
     lc = derive_limit_cycle(r.model, cycle_series_order(r.order, r.resum_order))
-    return lc, resum_cycle(lc)
+    resummed = resum_cycle(lc)
+    if isinstance(resummed, str) and r.resum_order is not None:
+        raise InputError(f"--resum-order {r.resum_order}: {r.model.name}'s ω(ε) is not "
+                         f"resummed: {resummed}; without --resum-order, generate emits the "
+                         "partial sums and their error estimate")
+    return lc, None if isinstance(resummed, str) else resummed
 
 
 def _cycle_lower(derived: tuple[LimitCycle, ResummedCycle | None], r: CycleRequest) -> Unit:

@@ -51,26 +51,32 @@ RELAXATION_TERMS = {
 # equation, so the two share ω(ε)); keyed by the terms q^a q̇^b c of f(q, q̇).
 
 
-def resum_cycle(lc: object, tolerance: float = RESUM_TOLERANCE) -> ResummedCycle | None:
+def resum_cycle(lc: object, tolerance: float = RESUM_TOLERANCE) -> ResummedCycle | str:
     """The resummed ω(ε) of a limit cycle (:func:`resum.resum_relaxation` for the oscillators
     of :data:`RELAXATION_TERMS`, else :func:`resum.resum_frequency`) and its amplitude
     q(0) (Padé in ε², :func:`resum.resum_series`), each with the |ε| up to which it is
     verified: the neighbour spread below ``tolerance/margin`` on a dense grid of ``(0, 10]``, then
     DOP853 shooting (:func:`numerics.cycle_reference`) at the check points up to there and at
-    its end, the domain cut at the last one passed when one fails.  None for a series with
-    odd powers of ε or without a singularity estimate (the amplitude alone: None in it)."""
+    its end, the domain cut at the last one passed when one fails.  Why not, where there is
+    none: a series with odd powers of ε, no singularity estimate, a resummation that fails or
+    that no check point verifies."""
     import numpy as np
 
     est = nearest_singularity(lc.omega)
-    if est is None or not est.variable.endswith("**2") or est.method != "Mercer–Roberts":
-        return None
+    if est is None:
+        return "ω's series gives no estimate of its nearest singularity"
+    if not est.variable.endswith("**2"):
+        return "ω's series has odd powers of ε (the resummation is in ε²)"
+    if est.method != "Mercer–Roberts":
+        return (f"ω's nearest singularity is estimated by {est.method}, not by Mercer and "
+                "Roberts' ratios (a pair of complex singularities the Padé form is built on)")
     relaxation = RELAXATION_TERMS.get(frozenset(
         (a, b, Fraction(c)) for a, b, c in getattr(lc.model, "terms", ())))
     try:
         form = (resum_relaxation(lc.omega, est.radius, est.angle, relaxation())
                 if relaxation else resum_frequency(lc.omega, est.radius, est.angle))
-    except InputError:
-        return None
+    except InputError as exc:
+        return str(exc)
     refs: dict[float, object] = {}
 
     def reference(e: float) -> object:
@@ -81,7 +87,8 @@ def resum_cycle(lc: object, tolerance: float = RESUM_TOLERANCE) -> ResummedCycle
     omega = _verified(form, lambda e: 2 * np.pi / reference(e).period, tolerance,
                       RELAXATION_SPREAD_MARGIN if form.log is not None else RESUM_SPREAD_MARGIN)
     if omega is None:
-        return None
+        return (f"the resummed ω meets {tolerance:g} at no check point (its neighbour spread, "
+                "or its error against shooting, is larger from the smallest ε on)")
     try:
         amplitude = resum_series(lc.amplitude, RESUM_RANGE)
     except InputError:
