@@ -82,6 +82,40 @@ def test_printer_exact_strings():
     assert r"\begin{array}" in latex_rational(sp.Rational(10**50 + 1, 3))
 
 
+def _constants(module: Path, *names: str) -> list:
+    """The literal values of ``names`` assigned in an emitted module, read without importing
+    it (no numba compile)."""
+    import ast
+
+    found = {t.id: node.value for node in ast.parse(module.read_text()).body
+             if isinstance(node, ast.Assign) for t in node.targets if isinstance(t, ast.Name)}
+    return [ast.literal_eval(found[n]) for n in names]
+
+
+def test_exact_constants_read_back_as_the_series(tmp_path):
+    """OMEGA_EXACT and PERIOD_EXACT of a user module whose ω₀ = √1.3 multiplies each
+    polynomial coefficient read back (``sympify``) as the series: Σ ω_k εᵏ and Σ τ_k εᵏ (T/2π) at
+    A = 0.5, ε = 0.01 against 2π/T and T from the energy integral by mpmath's quadrature (the
+    order-4 truncation ~1e-11).  Their text once lost the brackets round a coefficient."""
+    made = commands.run("generate", "q'' + 1.3*q + eps*(0.7*q**2 - 2.1*q**3) = 0", "--order",
+                        "4", "--out", tmp_path)
+    assert made.returncode == 0, made.stderr
+    omega, period = _constants(tmp_path / "oscillator.py", "OMEGA_EXACT", "PERIOD_EXACT")
+    A, eps = mpmath.mpf("0.5"), mpmath.mpf("0.01")
+    at = {sp.Symbol("A"): sp.Rational(1, 2)}
+    w = sum(sp.sympify(c).subs(at) * sp.Rational(1, 100) ** k for k, c in enumerate(omega))
+    T = sum(sp.sympify(c).subs(at) * sp.Rational(1, 100) ** k for k, c in enumerate(period))
+    mpmath.mp.dps = 30
+    try:
+        V = lambda q: 1.3 * q**2 / 2 + eps * (0.7 * q**3 / 3 - 2.1 * q**4 / 4)  # noqa: E731
+        low = mpmath.findroot(lambda q: V(q) - V(A), -A)
+        ref = 2 * mpmath.quad(lambda q: 1 / mpmath.sqrt(2 * (V(A) - V(q))), [low, 0, A])
+    finally:
+        mpmath.mp.dps = 15
+    assert abs(float(2 * mpmath.pi * T) / float(ref) - 1) < 1e-10
+    assert abs(float(w) * float(ref) / float(2 * mpmath.pi) - 1) < 1e-10
+
+
 @pytest.mark.parametrize("bad", ["import os", "a-b", "class", "__import__", "", "x;y"])
 def test_identifiers_are_validated(bad):
     with pytest.raises(InputError):

@@ -15,6 +15,7 @@ import sympy as sp
 from sympy.printing.latex import LatexPrinter as SympyLatexPrinter
 from sympy.printing.precedence import PRECEDENCE
 from sympy.printing.pycode import PythonCodePrinter
+from sympy.printing.str import StrPrinter
 
 from ..derive.equation import Equation
 from ..errors import InputError
@@ -37,6 +38,28 @@ class Coefficient(sp.Symbol):
         obj = super().__new__(cls, polynomial_text(terms))
         obj.terms = terms
         return obj
+
+
+class _ExactText(StrPrinter):
+    """SymPy's ``str`` that reads back as the value: a :class:`Coefficient` of two terms or
+    more is bracketed inside any expression (``sqrt(130)*(-9261*A**4/43264 - …)/10``), one of
+    a single term wherever SymPy would bracket an operand (a denominator, a power's base)."""
+
+    def _print_Coefficient(self, expr: Coefficient) -> str:
+        return f"({expr.name})" if len(expr.terms) > 1 else expr.name
+
+    def parenthesize(self, item: sp.Basic, level: int, strict: bool = False) -> str:
+        if isinstance(item, Coefficient):
+            text = self._print(item)
+            return text if text.isidentifier() or len(item.terms) > 1 else f"({text})"
+        return super().parenthesize(item, level, strict)
+
+
+def exact_text(expr: sp.Basic) -> str:
+    """The text of an exact expression for a module's ``*_EXACT`` constants: SymPy's spelling,
+    each :class:`Coefficient` bracketed where it is not the whole (``sympify`` reads it back
+    as the value)."""
+    return expr.name if isinstance(expr, Coefficient) else _ExactText().doprint(expr)
 
 
 def _monomial(powers: tuple[tuple[str, int], ...], power: str = "**") -> str:

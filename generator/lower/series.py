@@ -32,7 +32,7 @@ from .forms import (
     scaled_variable,
     tail_bound,
 )
-from .printers import exact, identifier
+from .printers import exact, exact_text, identifier
 from .records import (
     Assign,
     Evaluator,
@@ -333,8 +333,8 @@ def lower_periodic(series: SeriesSolution | NormalModeSeries, command: str,
         *domain_constants,
         ("ALLOW_DIVERGENT", allow_divergent),
         *numeric,
-        ("OMEGA_EXACT", tuple(str(c) for c in p.omega)),
-        ("PERIOD_EXACT", tuple(str(c) for c in p.tau[: order + 1])),
+        ("OMEGA_EXACT", tuple(exact_text(c) for c in p.omega)),
+        ("PERIOD_EXACT", tuple(exact_text(c) for c in p.tau[: order + 1])),
         *(() if barrier is None else (("ORBIT_BARRIER_EXACT", barrier.exact),)),
         *(() if barrier is None or not barrier.weight else
           (("ORBIT_WEIGHT_EXACT", barrier.weight_exact),)),
@@ -694,9 +694,9 @@ def lower_limit_cycle(lc: LimitCycle, command: str, order: int,
         ("VARIABLE", "eps"),
         ("CONVENTION", "q'(0) = 0; q(0) = amplitude(eps)"),
         ("RADIUS", float(radius) if radius is not None else float("nan")),
-        ("OMEGA_EXACT", tuple(str(c) for c in omega)),
-        ("PERIOD_EXACT", tuple(str(c) for c in tau)),
-        ("AMPLITUDE_EXACT", tuple(str(c) for c in amp)),
+        ("OMEGA_EXACT", tuple(exact_text(c) for c in omega)),
+        ("PERIOD_EXACT", tuple(exact_text(c) for c in tau)),
+        ("AMPLITUDE_EXACT", tuple(exact_text(c) for c in amp)),
     )
     if resummed is not None:
         evaluators = (*evaluators, *lower_resummed_cycle(resummed))
