@@ -518,9 +518,13 @@ def _check_analytic(osc: Oscillator, g: sp.Expr) -> None:
             raise osc.refuse(LP, f"{sp.sstr(f)} is not analytic at {q} = 0")
 
 
+def _signed(text: str) -> str:
+    """`` + text``, or `` - rest`` where ``text`` (a sum as SymPy prints it) starts with a minus."""
+    return f" - {text[1:].lstrip()}" if text.startswith("-") else f" + {text}"
+
+
 def _title(osc: Oscillator) -> str:
-    q = osc.coordinate
-    return f"{q}'' + {sp.sstr(osc.force)} = 0"
+    return f"{osc.coordinate}''{_signed(sp.sstr(osc.force))} = 0"
 
 
 def _latex(osc: Oscillator) -> str:
@@ -528,7 +532,7 @@ def _latex(osc: Oscillator) -> str:
     name = sp.latex(q)
     shown = osc.force.xreplace({v: sp.Symbol(rf"\dot{{{name}}}")})
     names = {osc.equation.small: r"\varepsilon"} if osc.equation.small is not None else {}
-    return rf"\ddot{{{name}}} + {sp.latex(shown, symbol_names=names)} = 0"
+    return rf"\ddot{{{name}}}{_signed(sp.latex(shown, symbol_names=names))} = 0"
 
 
 @dataclass(frozen=True)
