@@ -26,6 +26,7 @@ from .limits import (
     MAX_DRIVE_POINTS,
     PERIOD_SERIES_ORDER,
     SLOW_FLOW_MAX_ORDER,
+    SLOW_LIMIT_SECONDS,
 )
 
 
@@ -39,10 +40,14 @@ class Cost:
 
     def refusal(self) -> str:
         """The one-line refusal: the input, the estimated time of the work, and
-        ``--allow-slow`` to run it anyway."""
+        ``--allow-slow`` to run it anyway (past :data:`limits.SLOW_LIMIT_SECONDS`, that
+        nothing runs it)."""
         about = (f"about {self.seconds:,.0f} s" if self.seconds < 1e7
                  else f"about {self.seconds:.1e} s" if math.isfinite(self.seconds)
                  else "more than 1e300 s")
+        if self.seconds > SLOW_LIMIT_SECONDS:
+            return (f"{self.subject}: {about} of {self.what} on this machine, past the week "
+                    "that --allow-slow admits")
         return (f"{self.subject}: {about} of {self.what} on this machine; pass --allow-slow "
                 "to run it")
 

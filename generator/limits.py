@@ -91,6 +91,9 @@ WEAK_NONLINEARITY = 0.1
 
 COST_LIMIT_SECONDS = 60.0
 # NOTE: above this estimate the CLI asks for --allow-slow instead of running for minutes or hours.
+SLOW_LIMIT_SECONDS = 7 * 24 * 3600.0
+# NOTE: above this estimate (a week) a command is refused even with --allow-slow: an order of
+# 29 digits was estimated at 6e90 s, and the switch would have let it run without end.
 MAX_WORKERS = 64
 # NOTE: a bound against typos (workers=1000 on a laptop), far above this machine's 2 cores.
 SWEEP_MAX_VALUES = 100_000

@@ -62,6 +62,21 @@ def test_a_long_command_is_refused_at_once_and_writes_nothing(tmp_path, args, ne
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("args", [["series", "duffing", "--order", "1" + "0" * 28],
+                                  ["nnm", "x1'' + 2*x1 - x2 + x1**3 = 0; x2'' + 2*x2 - x1 = 0",
+                                   "--order", "10000"]])
+def test_an_estimate_past_a_week_is_refused_even_with_allow_slow(tmp_path, args):
+    """--allow-slow runs a long command, not an endless one: past a week's estimate (a
+    29-digit order: 1e90 s) the refusal stands with the switch and no longer offers it."""
+    for switch in ((), ("--allow-slow",)):
+        out = run(*args, *switch, cwd=tmp_path)
+        lines = out.stderr.strip().splitlines()
+        assert out.returncode == 2 and len(lines) == 1, (switch, out.stderr)
+        assert "past the week that --allow-slow admits" in lines[0], lines
+        assert "pass --allow-slow" not in lines[0]
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_the_estimates_grow_with_the_work_and_bounds_come_first():
     """Orders the printer cannot print are refused whatever --allow-slow says; the driven
     estimate follows its fit (16 s measured at order 100, 57 s at 150)."""

@@ -18,7 +18,7 @@ from .. import __version__
 from ..costs import COSTS, ROUTE_COSTS
 from ..derive.problem import NOTES_PRESET, Problem, read_problem
 from ..errors import InputError, Interrupted, clipped
-from ..limits import COST_LIMIT_SECONDS
+from ..limits import COST_LIMIT_SECONDS, SLOW_LIMIT_SECONDS
 from .choose import (
     arguments_choose,
     arguments_clock,
@@ -170,11 +170,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 def check_cost(route: Route, args: argparse.Namespace) -> None:
     """The method's estimate (lindstedt.costs) before it runs: bounds that no switch lifts,
-    then a refusal above COST_LIMIT_SECONDS without --allow-slow."""
+    then a refusal above COST_LIMIT_SECONDS without --allow-slow, and above
+    SLOW_LIMIT_SECONDS with it."""
     if route.cost is None:
         return
     cost = route.cost(args)
-    if cost.seconds > COST_LIMIT_SECONDS and not getattr(args, "allow_slow", False):
+    if cost.seconds > SLOW_LIMIT_SECONDS or (
+            cost.seconds > COST_LIMIT_SECONDS and not getattr(args, "allow_slow", False)):
         raise InputError(cost.refusal())
 
 

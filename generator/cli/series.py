@@ -619,9 +619,10 @@ def arguments_generate(sub: argparse._SubParsersAction) -> argparse.ArgumentPars
     """``lindstedt generate``'s arguments."""
     p = sub.add_parser(
         "generate", help="write a numba evaluator module and LaTeX tables and derivation",
-        description="Write a numba evaluator module (and for duffing, pendulum, driven its "
-        "LaTeX tables and derivation) into --out; for a SYSTEM (equations separated by ';') "
-        "the module of one nonlinear normal mode (--mode).")
+        description="Write a numba evaluator module and its LaTeX (the tables and the "
+        "derivation; balance and fourier have a module alone) into --out; for a SYSTEM "
+        "(equations separated by ';') the module of one nonlinear normal mode (--mode) or of "
+        "its spectral submanifold (--ssm).")
     _flag_oscillator(p, emitted=True, optional=True)
     _flag_order(p, f"highest order K (duffing, pendulum; driven up to {DRIVEN_MAX_ORDER})")
     p.add_argument("--out", default="out", metavar="DIR",
