@@ -92,28 +92,32 @@ def _constants(module: Path, *names: str) -> list:
     return [ast.literal_eval(found[n]) for n in names]
 
 
-def test_exact_constants_read_back_as_the_series(tmp_path):
-    """OMEGA_EXACT and PERIOD_EXACT of a user module whose ω₀ = √1.3 multiplies each
-    polynomial coefficient read back (``sympify``) as the series: Σ ω_k εᵏ and Σ τ_k εᵏ (T/2π) at
-    A = 0.5, ε = 0.01 against 2π/T and T from the energy integral by mpmath's quadrature (the
-    order-4 truncation ~1e-11).  Their text once lost the brackets round a coefficient."""
-    made = commands.run("generate", "q'' + 1.3*q + eps*(0.7*q**2 - 2.1*q**3) = 0", "--order",
-                        "4", "--out", tmp_path)
+@pytest.mark.parametrize(("k", "a2", "a3"), [("1.3", "0.7", "-2.1"), ("4", "1", "1")])
+def test_exact_constants_read_back_as_the_series(tmp_path, k, a2, a3):
+    """OMEGA_EXACT and PERIOD_EXACT of ``q'' + k q + ε(a₂q² + a₃q³) = 0`` read back
+    (``sympify``) as the series, whether ω₀ = √k multiplies each polynomial coefficient
+    (√1.3) or is taken into it (2): Σ ω_k εᵏ and Σ τ_k εᵏ (T/2π) at A = 0.5, ε = 0.01 against
+    2π/T and T from the energy integral by mpmath's quadrature (the order-4 truncation
+    ~1e-11).  Their text once lost the brackets round a coefficient."""
+    made = commands.run("generate", f"q'' + {k}*q + eps*({a2}*q**2 + {a3}*q**3) = 0",
+                        "--order", "4", "--out", tmp_path)
     assert made.returncode == 0, made.stderr
     omega, period = _constants(tmp_path / "oscillator.py", "OMEGA_EXACT", "PERIOD_EXACT")
-    A, eps = mpmath.mpf("0.5"), mpmath.mpf("0.01")
     at = {sp.Symbol("A"): sp.Rational(1, 2)}
-    w = sum(sp.sympify(c).subs(at) * sp.Rational(1, 100) ** k for k, c in enumerate(omega))
-    T = sum(sp.sympify(c).subs(at) * sp.Rational(1, 100) ** k for k, c in enumerate(period))
+    w = sum(sp.sympify(c).subs(at) * sp.Rational(1, 100) ** j for j, c in enumerate(omega))
+    T = sum(sp.sympify(c).subs(at) * sp.Rational(1, 100) ** j for j, c in enumerate(period))
     mpmath.mp.dps = 30
     try:
-        V = lambda q: 1.3 * q**2 / 2 + eps * (0.7 * q**3 / 3 - 2.1 * q**4 / 4)  # noqa: E731
+        A, eps = mpmath.mpf("0.5"), mpmath.mpf("0.01")
+        K, B, C = (mpmath.mpf(v) for v in (k, a2, a3))
+        V = lambda q: K * q**2 / 2 + eps * (B * q**3 / 3 + C * q**4 / 4)  # noqa: E731
         low = mpmath.findroot(lambda q: V(q) - V(A), -A)
         ref = 2 * mpmath.quad(lambda q: 1 / mpmath.sqrt(2 * (V(A) - V(q))), [low, 0, A])
     finally:
         mpmath.mp.dps = 15
     assert abs(float(2 * mpmath.pi * T) / float(ref) - 1) < 1e-10
     assert abs(float(w) * float(ref) / float(2 * mpmath.pi) - 1) < 1e-10
+    assert all("*-" not in c for c in (*omega, *period))
 
 
 @pytest.mark.parametrize("bad", ["import os", "a-b", "class", "__import__", "", "x;y"])

@@ -98,6 +98,15 @@ def exact(ground: object, c: object) -> sp.Expr:
                              for powers, v in sorted(items, key=order)))
 
 
+def scaled(factor: sp.Expr, c: sp.Expr) -> sp.Expr:
+    """``factor · c``; a rational ``factor`` taken into a :class:`Coefficient`'s terms
+    (``2·(3A²/32)`` is ``3A²/16``), where SymPy would keep the product."""
+    if not (isinstance(c, Coefficient) and factor.is_Rational):
+        return factor * c
+    return Coefficient(tuple(
+        (powers, ((r := sp.Rational(p, q) * factor).p, r.q)) for powers, (p, q) in c.terms))
+
+
 ESTRIN_FROM = 8
 # NOTE: polynomials of this many coefficients or more are split by Estrin's scheme (Knuth,
 # TAOCP 2, §4.6.4): Horner's chain of n dependent multiply-adds runs at the FPU's latency in

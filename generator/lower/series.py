@@ -32,7 +32,7 @@ from .forms import (
     scaled_variable,
     tail_bound,
 )
-from .printers import exact, exact_text, identifier
+from .printers import exact, exact_text, identifier, scaled
 from .records import (
     Assign,
     Evaluator,
@@ -136,8 +136,8 @@ def periodic_series(series: SeriesSolution | NormalModeSeries, order: int | None
         return PeriodicSeries(
             m.name, m.title, order, m.variable, series.convention, m.y.xreplace(to_args),
             m.amplitude.xreplace(to_args), tuple(args.values()),
-            tuple(m.frequency * exact(g, c) for c in series.omega[: order + 1]),
-            tuple(exact(g, c) / m.frequency for c in series.period[: order + 3]),
+            tuple(scaled(m.frequency, exact(g, c)) for c in series.omega[: order + 1]),
+            tuple(scaled(1 / m.frequency, exact(g, c)) for c in series.period[: order + 3]),
             ((identifier(str(m.coordinate)),
               tuple({n: exact(g, c) for n, c in qj.items()} for qj in series.q[: order + 1])),),
             m.odd, reach,
