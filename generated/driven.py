@@ -2,7 +2,7 @@
 # model: driven, order: 3
 # command: lindstedt generate driven --order 3
 # inputs sha256: cef33ff01dffb2211c3af2d37365f7b8bff5e57c04ba6b53bf77b6cbbf023e34
-# body sha256: 35295a70026768aaa9b954f107885cb76cea9fa907146ce1bb75a46a9d463816
+# body sha256: ef3ef9d684f1104def2055cd5713bb2c154e9d83a932b8ec711058a61cbcd32d
 """Driven Duffing q'' + q + eps*q**3 = f cos(omega t): μ-expansion to order 3.
 
 Every evaluator is a numba ufunc: it broadcasts like a NumPy function and accepts scalars
@@ -174,7 +174,7 @@ def _sin(x):
 
 @njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
 def _enter_0(omega, eps, force, branch):
-    """The common start of A_1, A_3, A_5, A_7: whether the arguments are
+    """The common start of A_1, A_3, A_5, A_7 and their loops: whether the arguments are
     inside their domain, and the quantities their bodies read (compiled once for all)."""
     inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
     omega = ((omega) if (inside == 1) else (2))
@@ -187,25 +187,6 @@ def _enter_0(omega, eps, force, branch):
     force = ((force) if (inside == 1) else (0.1))
     branch = ((branch) if (inside == 1) else (0))
     A1 = (((((0.6666666666666666)*math.sqrt(-(4 - 4*omega**2)/eps)*math.cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))))) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (abs(math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3)*(0.0 if force/eps == 0 else math.copysign(1, force/eps)) + (0.6666666666666666)*force/eps)**(0.3333333333333333)*(0.0 if math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3)*(0.0 if force/eps == 0 else math.copysign(1, force/eps)) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3)*(0.0 if force/eps == 0 else math.copysign(1, force/eps)) + (0.6666666666666666)*force/eps)) - 0.1111111111111111*(4 - 4*omega**2)/(eps*abs(math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3)*(0.0 if force/eps == 0 else math.copysign(1, force/eps)) + (0.6666666666666666)*force/eps)**(0.3333333333333333)*(0.0 if math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3)*(0.0 if force/eps == 0 else math.copysign(1, force/eps)) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3)*(0.0 if force/eps == 0 else math.copysign(1, force/eps)) + (0.6666666666666666)*force/eps)))))) if (branch == 0) else (((3*force/((4 - 4*omega**2)*math.sin((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.16666666666666666)*math.pi)*math.cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2))))))) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 1) else (((-0.6666666666666666*math.sqrt(-(4 - 4*omega**2)/eps)*math.sin((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.16666666666666666)*math.pi)) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 2) else (math.nan))
-    D = -2.25*A1**2*eps/omega**2 + 1 - 1/omega**2
-    return ((inside == 1) and ((0.0003662109375)*abs(A1**5*eps**2*(66825*A1**12*eps**6 - 219240*A1**10*eps**5*omega**2 + 219240*A1**10*eps**5 + 285840*A1**8*eps**4*omega**4 - 571680*A1**8*eps**4*omega**2 + 285840*A1**8*eps**4 - 191808*A1**6*eps**3*omega**6 + 575424*A1**6*eps**3*omega**4 - 575424*A1**6*eps**3*omega**2 + 191808*A1**6*eps**3 + 70208*A1**4*eps**2*omega**8 - 280832*A1**4*eps**2*omega**6 + 421248*A1**4*eps**2*omega**4 - 280832*A1**4*eps**2*omega**2 + 70208*A1**4*eps**2 - 13312*A1**2*eps*omega**10 + 66560*A1**2*eps*omega**8 - 133120*A1**2*eps*omega**6 + 133120*A1**2*eps*omega**4 - 66560*A1**2*eps*omega**2 + 13312*A1**2*eps + 1024*omega**12 - 6144*omega**10 + 15360*omega**8 - 20480*omega**6 + 15360*omega**4 - 6144*omega**2 + 1024)/(omega**6*(9*A1**2*eps - 4*omega**2 + 4)**5)) <= (0.01171875)*abs(A1**5*eps**2*(3*A1**2*eps - 2*omega**2 + 2)*(45*A1**4*eps**2 - 40*A1**2*eps*omega**2 + 40*A1**2*eps + 8*omega**4 - 16*omega**2 + 8)/(omega**4*(9*A1**2*eps - 4*omega**2 + 4)**3))) and (D != 0)), omega, eps, A1
-
-
-@njit(cache=True, fastmath={"arcp", "contract", "nsz", "reassoc"}, error_model="numpy")
-def _enter_0_simd(omega, eps, force, branch):
-    """The common start of A_1, A_3, A_5, A_7 in their loops: whether the arguments are
-    inside their domain, and the quantities their bodies read (compiled once for all)."""
-    inside = ((1) if (not math.isnan(branch) and not math.isinf(branch)) and (not math.isnan(eps) and not math.isinf(eps)) and (not math.isnan(force) and not math.isinf(force)) and (not math.isnan(omega) and not math.isinf(omega)) else (0))
-    omega = ((omega) if (inside == 1) else (2))
-    eps = ((eps) if (inside == 1) else (0.1))
-    force = ((force) if (inside == 1) else (0.1))
-    branch = ((branch) if (inside == 1) else (0))
-    inside = ((1) if (inside == 1) and (abs(omega) >= 1.0e-6) and (abs(eps) <= 1000000.0) and (abs(force) <= 1000000.0) and (abs(omega) <= 1000000.0) and ((branch == 0) or (branch == 1) or (branch == 2)) and (eps != 0) else (0))
-    omega = ((omega) if (inside == 1) else (2))
-    eps = ((eps) if (inside == 1) else (0.1))
-    force = ((force) if (inside == 1) else (0.1))
-    branch = ((branch) if (inside == 1) else (0))
-    A1 = (((((0.6666666666666666)*math.sqrt(-(4 - 4*omega**2)/eps)*_cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))))) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (abs(math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3)*(0.0 if force/eps == 0 else math.copysign(1, force/eps)) + (0.6666666666666666)*force/eps)**(0.3333333333333333)*(0.0 if math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3)*(0.0 if force/eps == 0 else math.copysign(1, force/eps)) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3)*(0.0 if force/eps == 0 else math.copysign(1, force/eps)) + (0.6666666666666666)*force/eps)) - 0.1111111111111111*(4 - 4*omega**2)/(eps*abs(math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3)*(0.0 if force/eps == 0 else math.copysign(1, force/eps)) + (0.6666666666666666)*force/eps)**(0.3333333333333333)*(0.0 if math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3)*(0.0 if force/eps == 0 else math.copysign(1, force/eps)) + (0.6666666666666666)*force/eps == 0 else math.copysign(1, math.sqrt((0.4444444444444444)*force**2/eps**2 + (0.0013717421124828531)*(4 - 4*omega**2)**3/eps**3)*(0.0 if force/eps == 0 else math.copysign(1, force/eps)) + (0.6666666666666666)*force/eps)))))) if (branch == 0) else (((3*force/((4 - 4*omega**2)*_sin((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.16666666666666666)*math.pi)*_cos((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2))))))) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 1) else (((-0.6666666666666666*math.sqrt(-(4 - 4*omega**2)/eps)*_sin((0.3333333333333333)*math.acos(min(1, max(-1, -18*force*math.sqrt(-eps/(4 - 4*omega**2))/(4 - 4*omega**2)))) + (0.16666666666666666)*math.pi)) if (48*force**2/eps**2 + (0.14814814814814814)*(4 - 4*omega**2)**3/eps**3 < 0) else (math.nan))) if (branch == 2) else (math.nan))
     D = -2.25*A1**2*eps/omega**2 + 1 - 1/omega**2
     return ((inside == 1) and ((0.0003662109375)*abs(A1**5*eps**2*(66825*A1**12*eps**6 - 219240*A1**10*eps**5*omega**2 + 219240*A1**10*eps**5 + 285840*A1**8*eps**4*omega**4 - 571680*A1**8*eps**4*omega**2 + 285840*A1**8*eps**4 - 191808*A1**6*eps**3*omega**6 + 575424*A1**6*eps**3*omega**4 - 575424*A1**6*eps**3*omega**2 + 191808*A1**6*eps**3 + 70208*A1**4*eps**2*omega**8 - 280832*A1**4*eps**2*omega**6 + 421248*A1**4*eps**2*omega**4 - 280832*A1**4*eps**2*omega**2 + 70208*A1**4*eps**2 - 13312*A1**2*eps*omega**10 + 66560*A1**2*eps*omega**8 - 133120*A1**2*eps*omega**6 + 133120*A1**2*eps*omega**4 - 66560*A1**2*eps*omega**2 + 13312*A1**2*eps + 1024*omega**12 - 6144*omega**10 + 15360*omega**8 - 20480*omega**6 + 15360*omega**4 - 6144*omega**2 + 1024)/(omega**6*(9*A1**2*eps - 4*omega**2 + 4)**5)) <= (0.01171875)*abs(A1**5*eps**2*(3*A1**2*eps - 2*omega**2 + 2)*(45*A1**4*eps**2 - 40*A1**2*eps*omega**2 + 40*A1**2*eps + 8*omega**4 - 16*omega**2 + 8)/(omega**4*(9*A1**2*eps - 4*omega**2 + 4)**3))) and (D != 0)), omega, eps, A1
 
@@ -253,7 +234,7 @@ def _A_1_into(out, omega_in, eps_in, force_in, branch_in):
         eps = _at(eps_in, i)
         force = _at(force_in, i)
         branch = _at(branch_in, i)
-        _inside, omega, eps, A1 = _enter_0_simd(omega, eps, force, branch)
+        _inside, omega, eps, A1 = _enter_0(omega, eps, force, branch)
         if not _inside:
             out[i] = math.nan
             continue
@@ -344,7 +325,7 @@ def _A_3_into(out, omega_in, eps_in, force_in, branch_in):
         eps = _at(eps_in, i)
         force = _at(force_in, i)
         branch = _at(branch_in, i)
-        _inside, omega, eps, A1 = _enter_0_simd(omega, eps, force, branch)
+        _inside, omega, eps, A1 = _enter_0(omega, eps, force, branch)
         if not _inside:
             out[i] = math.nan
             continue
@@ -418,7 +399,7 @@ def _A_5_into(out, omega_in, eps_in, force_in, branch_in):
         eps = _at(eps_in, i)
         force = _at(force_in, i)
         branch = _at(branch_in, i)
-        _inside, omega, eps, A1 = _enter_0_simd(omega, eps, force, branch)
+        _inside, omega, eps, A1 = _enter_0(omega, eps, force, branch)
         if not _inside:
             out[i] = math.nan
             continue
@@ -476,7 +457,7 @@ def _A_7_into(out, omega_in, eps_in, force_in, branch_in):
         eps = _at(eps_in, i)
         force = _at(force_in, i)
         branch = _at(branch_in, i)
-        _inside, omega, eps, A1 = _enter_0_simd(omega, eps, force, branch)
+        _inside, omega, eps, A1 = _enter_0(omega, eps, force, branch)
         if not _inside:
             out[i] = math.nan
             continue

@@ -131,14 +131,15 @@ ENTRY_SHARED_BY = 2
 # root, phase and truncation test, repeated in every A_n, B_n) start from one compiled entry
 # function: numba types and lowers it once, not once per evaluator and again per ``_into`` loop
 # (every evaluator and loop of the damped module at order 2: 37 → 17 s of CPU to compile; the
-# undamped one at order 3: 26 → 12 s).  The loops share it only where the prelude calls libm
-# (acos, atan2, …), which keeps a loop scalar anyway; a vectorisable prelude stays inline.
+# undamped one at order 3: 26 → 12 s).  The loops call it too where their (SIMD) prelude calls
+# libm (acos, atan2, …), which keeps a loop scalar anyway: the same values as the ufuncs'; a
+# vectorisable prelude stays inline.
 
 
 def _entries(evaluators: tuple[Evaluator, ...]) -> dict[tuple, dict]:
     """One entry function for each prelude and guard that ``ENTRY_SHARED_BY`` or more
-    evaluators share: its name, source (scalar and SIMD) and the prelude's names it returns
-    (those the users' bodies read)."""
+    evaluators share: its name, source and the prelude's names it returns (those the users'
+    bodies read), and whether their loops call it (``into``)."""
     groups: dict[tuple, list[Evaluator]] = {}
     for ev in evaluators:
         if ev.prelude:
@@ -148,15 +149,14 @@ def _entries(evaluators: tuple[Evaluator, ...]) -> dict[tuple, dict]:
         if len(users) >= ENTRY_SHARED_BY:
             read = set().union(*(e.free_symbols for ev in users
                                  for e in (ev.output, *(r for _, r in ev.body))))
-            into = [(str(lhs), pycode(rhs, simd=True)) for lhs, rhs in prelude]
-            into_guard = pycode(guard, simd=True)
+            into = (pycode(guard, simd=True), *(pycode(rhs, simd=True) for _, rhs in prelude))
             entries[args, prelude, guard] = {
                 "name": f"_enter_{len(entries)}", "args": ", ".join(map(str, args)),
                 "users": [ev.name for ev in users],
                 "prelude": [(str(lhs), pycode(rhs)) for lhs, rhs in prelude],
-                "guard": pycode(guard), "into_prelude": into, "into_guard": into_guard,
+                "guard": pycode(guard),
                 "outputs": list(dict.fromkeys(str(lhs) for lhs, _ in prelude if lhs in read)),
-                "into": any(LIBM.search(r) for r in (into_guard, *(r for _, r in into))),
+                "into": any(LIBM.search(r) for r in into),
             }
     return entries
 
